@@ -1,0 +1,39 @@
+// What every subcommand shares: global options, size arguments with K/M/G suffixes, and how a
+// subcommand reports its outcome (a Status that main turns into an exit code).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "lodforge/core/status.h"
+
+namespace lodforge::cli {
+
+struct Global {
+  unsigned threads = 0;           // 0: all cores
+  int verbosity = 0;              // -1 quiet, 0 normal, 1 verbose
+  std::uint64_t memoryLimit = 0;  // bytes, 0: unlimited
+};
+
+// A subcommand's body; main runs the one the user chose.
+using Run = std::function<Status()>;
+
+// An option taking a count with decimal suffixes (10K = 10,000; 100M; 1G).
+CLI::Option* addCountOption(CLI::App& app, const std::string& name, std::uint64_t& target,
+                            const std::string& description);
+// An option taking a byte size with binary suffixes (512M = 512 MiB, 2G).
+CLI::Option* addByteSizeOption(CLI::App& app, const std::string& name, std::uint64_t& target,
+                               const std::string& description);
+
+// Normal output (suppressed by -q) and verbose output (shown with -v).
+void say(const Global& global, const std::string& text);
+void detail(const Global& global, const std::string& text);
+
+void addInfo(CLI::App& app, const Global& global, Run& run);
+void addConvert(CLI::App& app, const Global& global, Run& run);
+void addGenerate(CLI::App& app, const Global& global, Run& run);
+
+}  // namespace lodforge::cli

@@ -1,0 +1,89 @@
+// `lodforge convert IN -o OUT`: between the formats lodforge reads (.ply .obj .stl .gltf .glb)
+// and writes (.ply .glb .obj .stl), optionally welding vertices on the way.
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "lodforge/core/mesh.h"
+#include "lodforge/core/units.h"
+#include "lodforge/io/model_io.h"
+#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/stl_writer.h"
+
+namespace lodforge::cli {
+
+namespace {
+
+// Refuses before loading when the header already tells the model will not fit the limit.
+Status checkMemory(const std::string& path, std::uint64_t limit) {
+  if (limit == 0 || formatFromPath(path) != FileFormat::kPly) return {};
+  Result<PlyReader> reader = PlyReader::open(path);
+  if (!reader) return reader.status();
+  const PlyHeader& h = reader->header();
+  const std::uint64_t need =
+      modelMemoryBytes(h.vertexCount, h.faceCount, 1, h.hasNormals, h.hasColors);
+  if (need <= limit) return {};
+  return Error{ErrorKind::kLimit, fmt::format("{}: loading needs about {} but --memory-limit is {}",
+                                              path, formatBytes(need), formatBytes(limit))};
+}
+
+}  // namespace
+
+void addConvert(CLI::App& app, const Global& global, Run& run) {
+  struct Options {
+    std::string input, output;
+    bool weld = false;
+    float weldEpsilon = 0;
+    bool stlAscii = false;
+    bool salvage = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("convert", "Convert a model between formats (by extension)");
+  sub->add_option("INPUT", options->input, "A .ply .obj .stl .gltf or .glb file")->required();
+  sub->add_option("-o,--output", options->output, "A .ply .glb .obj or .stl file")->required();
+  sub->add_flag("--weld", options->weld,
+                "Merge vertices with equal positions (keeping normal and colour splits)");
+  sub->add_option("--weld-epsilon", options->weldEpsilon,
+                  "With --weld: merge positions closer than this")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--stl-ascii", options->stlAscii, "Write ascii STL instead of binary");
+  sub->add_flag("--salvage", options->salvage,
+                "Keep what a truncated PLY holds up to the cut (with a warning)");
+  sub->callback([&global, &run, options] {
+    run = [&global, options]() -> Status {
+      const auto start = std::chrono::steady_clock::now();
+      if (!canWrite(formatFromPath(options->output)))
+        return Error{
+            ErrorKind::kUsage,
+            fmt::format("{}: cannot write this format (lodforge writes .ply .glb .obj .stl)",
+                        options->output)};
+      LODFORGE_TRY(checkMemory(options->input, global.memoryLimit));
+      std::vector<std::string> warnings;
+      Result<Model> model =
+          readModel(options->input, {.salvageTruncated = options->salvage, .warnings = &warnings});
+      for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
+      if (!model) return model.status();
+      if (options->weld) {
+        WeldOptions weld;
+        weld.epsilon = options->weldEpsilon;
+        weld.keepNormalSplits = model->hasNormals();
+        weld.keepColorSplits = model->hasColors();
+        weldModel(*model, weld);
+      }
+      const Status written = formatFromPath(options->output) == FileFormat::kStl
+                                 ? writeStl(*model, options->output, {options->stlAscii})
+                                 : writeModel(*model, options->output);
+      LODFORGE_TRY(written);
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      say(global, fmt::format("wrote {}: {} objects, {} vertices, {} triangles in {:.2f} s",
+                              options->output, formatCount(model->objectCount()),
+                              formatCount(model->vertexCount()),
+                              formatCount(model->triangleCount()), seconds));
+      return {};
+    };
+  });
+}
+
+}  // namespace lodforge::cli

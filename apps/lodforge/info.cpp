@@ -1,0 +1,155 @@
+// `lodforge info FILE`: format, counts, bounds and what loading the file would cost. PLY files
+// are streamed (constant memory, any size); other formats are loaded.
+#include <chrono>
+#include <unordered_set>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/core/units.h"
+#include "lodforge/io/model_io.h"
+#include "lodforge/io/ply_reader.h"
+
+namespace lodforge::cli {
+
+namespace {
+
+struct Summary {
+  std::string format;
+  std::string encoding;  // e.g. PLY's binary_little_endian
+  std::uint64_t fileBytes = 0;
+  std::uint64_t vertices = 0, triangles = 0, objects = 0;
+  bool normals = false, colors = false;
+  Aabbd bounds;  // world coordinates
+  std::uint64_t memoryBytes = 0;
+};
+
+Result<Summary> summarizePly(const std::string& path, bool salvage) {
+  PlyReadOptions options;
+  options.salvageTruncated = salvage;
+  Result<PlyReader> reader = PlyReader::open(path, options);
+  if (!reader) return reader.status();
+  const PlyHeader& header = reader->header();
+  Summary s;
+  s.format = "PLY";
+  s.encoding = std::string(plyFormatName(header.format));
+  s.normals = header.hasNormals;
+  s.colors = header.hasColors;
+  std::unordered_set<std::uint32_t> ids;
+  PlyBatch batch;
+  Progress progress("reading", header.vertexCount + header.faceCount);
+  while (true) {
+    LODFORGE_TRY(checkCancelled());
+    Result<bool> more = reader->next(batch);
+    if (!more) return more.status();
+    if (!*more) break;
+    for (const Vec3d& p : batch.positions) s.bounds.add(p);
+    s.vertices += batch.positions.size();
+    s.triangles += batch.triangles.size() / 3;
+    ids.insert(batch.triangleObjects.begin(), batch.triangleObjects.end());
+    progress.advance(batch.count);
+  }
+  if (reader->truncation()) {
+    fmt::print(stderr, "lodforge: warning: {}; counted what came before\n", *reader->truncation());
+  }
+  s.objects = header.hasObjectIds ? ids.size() : 1;
+  s.memoryBytes = modelMemoryBytes(s.vertices, s.triangles, s.objects, s.normals, s.colors);
+  return s;
+}
+
+Result<Summary> summarizeLoaded(const std::string& path, FileFormat format) {
+  Result<Model> model = readModel(path);
+  if (!model) return model.status();
+  Summary s;
+  s.format = std::string(formatName(format));
+  s.vertices = model->vertexCount();
+  s.triangles = model->triangleCount();
+  s.objects = model->objectCount();
+  s.normals = model->hasNormals();
+  s.colors = model->hasColors();
+  const Aabb local = model->bounds();
+  if (!local.empty()) {
+    s.bounds.add(model->origin + toDouble(local.min));
+    s.bounds.add(model->origin + toDouble(local.max));
+  }
+  s.memoryBytes = model->memoryBytes();
+  return s;
+}
+
+nlohmann::json toJson(const std::string& path, const Summary& s) {
+  nlohmann::json j = {
+      {"file", path},           {"format", s.format},       {"fileBytes", s.fileBytes},
+      {"vertices", s.vertices}, {"triangles", s.triangles}, {"objects", s.objects},
+      {"normals", s.normals},   {"colors", s.colors},       {"memoryBytes", s.memoryBytes}};
+  if (!s.encoding.empty()) j["encoding"] = s.encoding;
+  if (!s.bounds.empty()) {
+    j["bounds"] = {{"min", {s.bounds.min.x, s.bounds.min.y, s.bounds.min.z}},
+                   {"max", {s.bounds.max.x, s.bounds.max.y, s.bounds.max.z}}};
+  }
+  return j;
+}
+
+void print(const std::string& path, const Summary& s) {
+  fmt::print("file       {}\n", path);
+  fmt::print("format     {}{} ({})\n", s.format, s.encoding.empty() ? "" : " " + s.encoding,
+             formatBytes(s.fileBytes));
+  std::string attributes;
+  if (s.normals) attributes += "normals";
+  if (s.colors) attributes += attributes.empty() ? "colors" : ", colors";
+  fmt::print("vertices   {}{}\n", formatCount(s.vertices),
+             attributes.empty() ? "" : " (" + attributes + ")");
+  fmt::print("triangles  {}\n", formatCount(s.triangles));
+  fmt::print("objects    {}\n", formatCount(s.objects));
+  if (!s.bounds.empty()) {
+    const Vec3d size = s.bounds.size();
+    fmt::print("bounds     min ({:.6g}, {:.6g}, {:.6g})  max ({:.6g}, {:.6g}, {:.6g})\n",
+               s.bounds.min.x, s.bounds.min.y, s.bounds.min.z, s.bounds.max.x, s.bounds.max.y,
+               s.bounds.max.z);
+    fmt::print("size       {:.6g} x {:.6g} x {:.6g}\n", size.x, size.y, size.z);
+  } else {
+    fmt::print("bounds     empty\n");
+  }
+  fmt::print("memory     {} to load\n", formatBytes(s.memoryBytes));
+}
+
+}  // namespace
+
+void addInfo(CLI::App& app, const Global& global, Run& run) {
+  struct Options {
+    std::string path;
+    bool json = false;
+    bool salvage = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("info", "Print a file's format, counts, bounds and load cost");
+  sub->add_option("FILE", options->path, "A .ply .obj .stl .gltf or .glb file")->required();
+  sub->add_flag("--json", options->json, "Print JSON instead of text");
+  sub->add_flag("--salvage", options->salvage,
+                "Read a truncated PLY up to the cut (with a warning)");
+  sub->callback([&global, &run, options] {
+    run = [&global, options]() -> Status {
+      const FileFormat format = formatFromPath(options->path);
+      if (format == FileFormat::kUnknown)
+        return Error{ErrorKind::kUsage,
+                     fmt::format("{}: unknown format (lodforge reads .ply .obj .stl .gltf .glb)",
+                                 options->path)};
+      Result<std::uint64_t> bytes = fileSize(options->path);
+      if (!bytes) return bytes.status();
+      Result<Summary> summary = format == FileFormat::kPly
+                                    ? summarizePly(options->path, options->salvage)
+                                    : summarizeLoaded(options->path, format);
+      if (!summary) return summary.status();
+      summary->fileBytes = *bytes;
+      if (options->json)
+        fmt::print("{}\n", toJson(options->path, *summary).dump(2));
+      else if (global.verbosity >= 0)
+        print(options->path, *summary);
+      return {};
+    };
+  });
+}
+
+}  // namespace lodforge::cli

@@ -1,0 +1,47 @@
+// The `lodforge` command: one subcommand per file in this folder.
+// Exit codes: 0 ok, 1 failure (I/O, limits, cancelled), 2 bad input or usage.
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/core/threads.h"
+
+int main(int argc, char** argv) {
+  using namespace lodforge;
+  CLI::App app{"lodforge: level-of-detail data for massive 3D models", "lodforge"};
+  app.set_version_flag("--version", "lodforge " LODFORGE_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough();
+
+  cli::Global global;
+  app.add_option("--threads", global.threads, "Threads to use (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag_callback(
+      "-v,--verbose", [&] { global.verbosity = 1; }, "More detail on stderr");
+  app.add_flag_callback(
+      "-q,--quiet", [&] { global.verbosity = -1; }, "Only errors (no progress, no summary)");
+  cli::addByteSizeOption(app, "--memory-limit", global.memoryLimit,
+                         "Memory the command may use (e.g. 2G)");
+
+  cli::Run run;
+  cli::addInfo(app, global, run);
+  cli::addConvert(app, global, run);
+  cli::addGenerate(app, global, run);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version end here too, with exit code 0.
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  if (global.verbosity < 0) setProgressMode(ProgressMode::kOff);
+  installInterruptHandler();
+  const ThreadLimit threads(global.threads);
+
+  const Status status = run ? run() : Status(Error{ErrorKind::kUsage, "no subcommand"});
+  if (!status.ok()) fmt::print(stderr, "lodforge: {}\n", status.message());
+  return exitCodeFor(status);
+}

@@ -1,0 +1,119 @@
+// Kernel throughput: the mesh utilities and readers/writers on real and generated data.
+// Run: build/release/bench/bench_kernels (or `make bench`).
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+
+#include "lodforge/core/mesh.h"
+#include "lodforge/core/random.h"
+#include "lodforge/generate/scan.h"
+#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/obj_reader.h"
+#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/ply_writer.h"
+
+namespace lodforge {
+namespace {
+
+// A scanned surface of `triangles` triangles as a triangle soup (3 vertices per triangle).
+struct Soup {
+  std::vector<Vec3f> positions;
+  std::vector<std::uint32_t> indices;  // the welded mesh's indices
+  std::vector<Vec3f> welded;
+};
+
+const Soup& scanSoup() {
+  static const Soup soup = [] {
+    const std::string path =
+        (std::filesystem::temp_directory_path() / "lodforge-bench-scan.ply").string();
+    if (!generateScan({.triangles = 1'000'000}, path).ok()) std::abort();
+    Result<Model> model = readPly(path);
+    std::filesystem::remove(path);
+    Soup s;
+    s.welded = model->positions;
+    s.indices = model->indices;
+    for (std::uint32_t i : model->indices) s.positions.push_back(model->positions[i]);
+    return s;
+  }();
+  return soup;
+}
+
+void BM_WeldExact(benchmark::State& state) {
+  const Soup& soup = scanSoup();
+  std::vector<std::uint32_t> remap(soup.positions.size());
+  for (auto _ : state) benchmark::DoNotOptimize(weldVertices(soup.positions, {}, {}, {}, remap));
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(soup.positions.size()));
+}
+BENCHMARK(BM_WeldExact)->Unit(benchmark::kMillisecond);
+
+void BM_WeldEpsilon(benchmark::State& state) {
+  const Soup& soup = scanSoup();
+  std::vector<std::uint32_t> remap(soup.positions.size());
+  WeldOptions options;
+  options.epsilon = 1e-3f;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(weldVertices(soup.positions, {}, {}, options, remap));
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(soup.positions.size()));
+}
+BENCHMARK(BM_WeldEpsilon)->Unit(benchmark::kMillisecond);
+
+void BM_VertexNormals(benchmark::State& state) {
+  const Soup& soup = scanSoup();
+  std::vector<Vec3f> normals(soup.welded.size());
+  for (auto _ : state) computeVertexNormals(soup.welded, soup.indices, normals);
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(soup.indices.size() / 3));
+}
+BENCHMARK(BM_VertexNormals)->Unit(benchmark::kMillisecond);
+
+void BM_ConnectedComponents(benchmark::State& state) {
+  const Soup& soup = scanSoup();
+  std::vector<std::uint32_t> labels(soup.indices.size() / 3);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        connectedComponents(std::uint32_t(soup.welded.size()), soup.indices, labels));
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(labels.size()));
+}
+BENCHMARK(BM_ConnectedComponents)->Unit(benchmark::kMillisecond);
+
+void BM_ReadPly(benchmark::State& state) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "lodforge-bench-read.ply").string();
+  if (!generateScan({.triangles = 1'000'000}, path).ok()) std::abort();
+  const auto bytes = std::filesystem::file_size(path);
+  for (auto _ : state) benchmark::DoNotOptimize(readPly(path));
+  state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(bytes));
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_ReadPly)->Unit(benchmark::kMillisecond);
+
+void BM_ReadObjBunny(benchmark::State& state) {
+  const std::string path = std::string(LODFORGE_DATA_DIR) + "/meshes/stanford-bunny.obj";
+  const auto bytes = std::filesystem::file_size(path);
+  for (auto _ : state) benchmark::DoNotOptimize(readObj(path));
+  state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(bytes));
+}
+BENCHMARK(BM_ReadObjBunny)->Unit(benchmark::kMillisecond);
+
+void BM_WriteGlb(benchmark::State& state) {
+  const Soup& soup = scanSoup();
+  Model model;
+  ModelBuilder builder(model);
+  builder.beginObject("scan");
+  model.positions = soup.welded;
+  model.indices = soup.indices;
+  builder.endObject();
+  const std::string path = (std::filesystem::temp_directory_path() / "lodforge-bench.glb").string();
+  for (auto _ : state) {
+    if (!writeGlb(model, path).ok()) std::abort();
+  }
+  state.SetBytesProcessed(std::int64_t(state.iterations()) *
+                          std::int64_t(std::filesystem::file_size(path)));
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_WriteGlb)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace lodforge
+
+BENCHMARK_MAIN();

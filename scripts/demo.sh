@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# `make demo`: generates a CAD assembly and a scanned surface, reads them and the real models in
+# ../shared/data, prints `lodforge info` for each and writes GLBs under out/demo/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+lodforge=build/release/lodforge
+out=out/demo
+data=${LODFORGE_DATA:-../shared/data}
+[[ -d $data ]] || data=/work/shared/data
+mkdir -p "$out"
+
+section() { printf '\n== %s\n' "$*"; }
+
+section "generating a 10,000-part CAD assembly and a 1M-triangle scan"
+"$lodforge" generate cad --objects 10K --seed 1 -o "$out/cad-assembly.glb"
+"$lodforge" generate scan --triangles 1M --seed 1 -o "$out/scan.ply"
+"$lodforge" convert "$out/scan.ply" -o "$out/scan.glb"
+"$lodforge" generate points --points 1M --seed 1 -o "$out/points.ply"
+
+for model in "$out/cad-assembly.glb" "$out/scan.ply" "$out/points.ply"; do
+  section "lodforge info $model"
+  "$lodforge" info "$model"
+done
+
+if [[ -d $data/meshes ]]; then
+  for model in "$data"/meshes/*; do
+    name=$(basename "${model%.*}")
+    section "lodforge info $model"
+    "$lodforge" info "$model"
+    "$lodforge" convert "$model" -o "$out/$name.glb"
+  done
+else
+  echo "(no real models: $data/meshes not found)"
+fi
+
+section "results"
+ls -l "$out"
+echo
+echo "The GLBs in $(pwd)/$out open in any glTF 2.0 viewer (Blender, the three.js editor, ...)."

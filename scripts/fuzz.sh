@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Runs every reader's fuzzer for N seconds (default 20), two at a time, on its seed corpus plus
+# the malformed-input corpus. New inputs go to build/fuzz/work (never into the repository);
+# a crash, leak, timeout or out-of-memory leaves its input in build/fuzz/artifacts and fails.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-20}
+readers=(ply obj stl gltf)
+mkdir -p build/fuzz/artifacts
+run() {
+  local reader=$1 work=build/fuzz/work/$1
+  mkdir -p "$work"
+  if build/fuzz/fuzz/fuzz_"$reader" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=10 \
+       -print_final_stats=1 -artifact_prefix=build/fuzz/artifacts/"$reader"- \
+       "$work" fuzz/corpus/"$reader" tests/data/malformed > build/fuzz/"$reader".log 2>&1; then
+    echo "fuzz_$reader: $(grep -m1 number_of_executed_units build/fuzz/"$reader".log | awk '{print $2}') inputs, no findings"
+  else
+    echo "fuzz_$reader FAILED; the log follows" >&2
+    tail -60 build/fuzz/"$reader".log >&2
+    return 1
+  fi
+}
+status=0
+for ((i = 0; i < ${#readers[@]}; i += 2)); do
+  pids=()
+  for reader in "${readers[@]:i:2}"; do
+    run "$reader" & pids+=($!)
+  done
+  for pid in "${pids[@]}"; do wait "$pid" || status=1; done
+done
+exit $status

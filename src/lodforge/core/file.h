@@ -1,0 +1,125 @@
+// Files: a buffered sequential reader that knows its byte offset (for error messages), an output
+// file that appears under its name only when complete, and read-only memory mapping.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+// Sequential reader over a file or a memory block. Streaming parsers pull from it a little at a
+// time, so a file larger than RAM is read with a fixed buffer.
+class ByteSource {
+ public:
+  static Result<ByteSource> openFile(const std::string& path);
+  static ByteSource fromMemory(std::span<const std::byte> bytes, std::string name);
+
+  ByteSource(ByteSource&& other) noexcept;
+  ByteSource& operator=(ByteSource&& other) noexcept;
+  ByteSource(const ByteSource&) = delete;
+  ByteSource& operator=(const ByteSource&) = delete;
+  ~ByteSource();
+
+  const std::string& name() const { return name_; }
+  std::uint64_t size() const { return size_; }
+  std::uint64_t offset() const { return bufferOffset_ + position_; }
+  std::uint64_t remaining() const { return size_ - offset(); }
+
+  // Makes at least `n` bytes available at data() unless the input ends first; returns how many
+  // are available. Throws ErrorException on a read error.
+  std::size_t ensure(std::size_t n);
+  const std::byte* data() const { return begin_ + position_; }
+  void advance(std::size_t n) { position_ += n; }
+  // Copies exactly n bytes; false (and nothing consumed) if the input ends first.
+  bool read(void* out, std::size_t n);
+  // Skips n bytes; false if the input ends first.
+  bool skip(std::uint64_t n);
+  // Reads up to '\n' (dropping "\r\n" or "\n"); false at end of input. Lines longer than
+  // `maxLength` throw a bad-input error rather than growing without bound.
+  bool readLine(std::string& line, std::size_t maxLength = 1 << 20);
+
+ private:
+  ByteSource() = default;
+  void refill(std::size_t wanted);
+
+  std::string name_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+  std::vector<std::byte> buffer_;
+  const std::byte* begin_ = nullptr;  // start of buffered bytes (buffer_ or the memory block)
+  std::size_t available_ = 0;         // bytes valid at begin_
+  std::size_t position_ = 0;          // next byte, relative to begin_
+  std::uint64_t bufferOffset_ = 0;    // file offset of begin_
+};
+
+// A file written under "<path>.tmp-<pid>" and renamed to <path> by commit(). Destroyed without
+// commit (error, cancel) it removes the temporary, so no half-written output is ever left.
+class OutputFile {
+ public:
+  static Result<OutputFile> create(const std::string& path);
+  OutputFile(OutputFile&& other) noexcept;
+  OutputFile& operator=(OutputFile&& other) noexcept;
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+  ~OutputFile();
+
+  Status write(const void* data, std::size_t size);
+  template <class T>
+  Status writeSpan(std::span<const T> values) {
+    return write(values.data(), values.size_bytes());
+  }
+  // Writes at an absolute offset, unbuffered (pwrite), for formats whose sections are filled
+  // side by side; do not mix with write() on overlapping ranges.
+  Status writeAt(std::uint64_t offset, const void* data, std::size_t size);
+  // Appends the first `bytes` of another file (a spilled section written earlier).
+  Status appendFileContents(const std::string& path, std::uint64_t bytes);
+  Status commit();
+  std::uint64_t bytesWritten() const { return written_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  OutputFile() = default;
+  Status flush();
+  void discard();
+
+  std::string path_;
+  std::string tempPath_;
+  int fd_ = -1;
+  std::vector<std::byte> buffer_;
+  std::size_t buffered_ = 0;
+  std::uint64_t written_ = 0;
+};
+
+// Read-only mapping of a whole file; the runtime reads packages in place through it.
+class MappedFile {
+ public:
+  static Result<MappedFile> open(const std::string& path);
+  MappedFile(MappedFile&& other) noexcept;
+  MappedFile& operator=(MappedFile&& other) noexcept;
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  ~MappedFile();
+
+  std::span<const std::byte> bytes() const { return {data_, size_}; }
+  const std::string& path() const { return path_; }
+
+ private:
+  MappedFile() = default;
+  std::string path_;
+  const std::byte* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+Result<std::string> readFileToString(const std::string& path, std::uint64_t maxBytes);
+Result<std::uint64_t> fileSize(const std::string& path);
+// Lower-cased extension without the dot ("glb", "ply"); empty when there is none.
+std::string fileExtension(const std::string& path);
+// A unique temporary name beside `path`, used for the rename-on-complete pattern.
+std::string temporaryPathFor(const std::string& path);
+
+}  // namespace lodforge

@@ -1,0 +1,48 @@
+#include "lodforge/core/memory.h"
+
+#include <cstdio>
+#include <cstring>
+
+#include "lodforge/core/units.h"
+
+namespace lodforge {
+
+namespace {
+std::uint64_t statusField(const char* field) {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  if (!f) return 0;
+  char line[256];
+  std::uint64_t kib = 0;
+  const std::size_t length = std::strlen(field);
+  while (std::fgets(line, sizeof line, f)) {
+    if (std::strncmp(line, field, length) == 0) {
+      kib = std::strtoull(line + length, nullptr, 10);
+      break;
+    }
+  }
+  std::fclose(f);
+  return kib * 1024;
+}
+}  // namespace
+
+std::uint64_t currentRssBytes() {
+  return statusField("VmRSS:");
+}
+std::uint64_t peakRssBytes() {
+  return statusField("VmHWM:");
+}
+
+Status MemoryBudget::reserve(std::uint64_t bytes, const char* what) {
+  std::uint64_t current = used_.load();
+  do {
+    if (limit_ != 0 && current + bytes > limit_) {
+      return Error{
+          ErrorKind::kLimit,
+          fmt::format("{} needs {} but only {} of the {} memory limit is free", what,
+                      formatBytes(bytes), formatBytes(limit_ - current), formatBytes(limit_))};
+    }
+  } while (!used_.compare_exchange_weak(current, current + bytes));
+  return {};
+}
+
+}  // namespace lodforge

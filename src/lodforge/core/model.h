@@ -1,0 +1,101 @@
+// The model in memory: a few flat arrays plus an object table. The same shape holds one scanned
+// mesh or a CAD assembly of a million parts; there are no per-object vectors.
+//
+// Conventions:
+// - positions are float, relative to a double-precision `origin` (world = origin + position), so
+//   geo-scale coordinates keep millimetres.
+// - triangle indices are local to their object: triangle t of object o refers to vertices
+//   objects[o].vertexOffset + indices[3t + k].
+// - normals and colors are either empty or one per vertex.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lodforge/core/math.h"
+
+namespace lodforge {
+
+struct ObjectRecord {
+  std::uint64_t vertexOffset = 0;
+  std::uint64_t triangleOffset = 0;
+  std::uint32_t vertexCount = 0;
+  std::uint32_t triangleCount = 0;
+  std::uint64_t nameOffset = 0;  // into Model::names
+  std::uint32_t nameLength = 0;
+  Aabb bounds;  // of the object's vertices, relative to the model origin
+};
+
+struct Model {
+  Vec3d origin;
+  std::vector<Vec3f> positions;
+  std::vector<Vec3f> normals;          // empty or one per vertex
+  std::vector<Rgba8> colors;           // empty or one per vertex
+  std::vector<std::uint32_t> indices;  // 3 per triangle, local to the object
+  std::vector<ObjectRecord> objects;
+  std::string names;  // all object names, back to back
+
+  std::uint64_t vertexCount() const { return positions.size(); }
+  std::uint64_t triangleCount() const { return indices.size() / 3; }
+  std::uint64_t objectCount() const { return objects.size(); }
+  bool hasNormals() const { return !normals.empty(); }
+  bool hasColors() const { return !colors.empty(); }
+
+  std::string_view objectName(std::size_t object) const {
+    const ObjectRecord& o = objects[object];
+    return std::string_view(names).substr(o.nameOffset, o.nameLength);
+  }
+  std::span<const Vec3f> objectPositions(std::size_t object) const {
+    const ObjectRecord& o = objects[object];
+    return std::span(positions).subspan(o.vertexOffset, o.vertexCount);
+  }
+  std::span<const std::uint32_t> objectIndices(std::size_t object) const {
+    const ObjectRecord& o = objects[object];
+    return std::span(indices).subspan(3 * o.triangleOffset, 3 * std::size_t{o.triangleCount});
+  }
+  Aabb bounds() const;
+  // Bytes the arrays take, i.e. what loading the model costs.
+  std::uint64_t memoryBytes() const;
+};
+
+// Bytes a model of these counts takes in memory (for `info` and memory limits before loading).
+std::uint64_t modelMemoryBytes(std::uint64_t vertexCount, std::uint64_t triangleCount,
+                               std::uint64_t objectCount, bool normals, bool colors,
+                               std::uint64_t nameBytes = 0);
+
+// Appends objects one at a time and keeps offsets, names and bounds consistent. Between
+// beginObject and endObject the caller appends to the model's arrays directly (in bulk);
+// endObject turns what was appended into the object's record. Empty objects are kept so object
+// ids stay stable.
+class ModelBuilder {
+ public:
+  explicit ModelBuilder(Model& model) : model_(model) {}
+
+  void beginObject(std::string_view name);
+  // Appends a vertex to the current object; returns its local index.
+  std::uint32_t addVertex(Vec3f position);
+  void addTriangle(std::uint32_t a, std::uint32_t b, std::uint32_t c);
+  // Closes the current object: counts from the arrays' growth, bounds from its positions.
+  void endObject();
+
+ private:
+  Model& model_;
+  bool open_ = false;
+};
+
+// Picks a double origin for world coordinates: zero for models near the origin, otherwise the
+// box centre rounded to whole units so float offsets keep sub-millimetre precision.
+Vec3d chooseOrigin(const Aabbd& worldBounds);
+
+// Welds each object's vertices (see weldVertices) and drops the triangles that welding made
+// degenerate (repeated corners). Objects stay separate: nothing welds across objects.
+struct WeldOptions;
+void weldModel(Model& model, const WeldOptions& options);
+
+// Checks the invariants above (sizes, offsets, index ranges); for tests and debug builds.
+bool isConsistent(const Model& model, std::string* why = nullptr);
+
+}  // namespace lodforge

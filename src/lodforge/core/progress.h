@@ -1,0 +1,55 @@
+// Progress for long work and cooperative cancellation. Work that can take over a second reports
+// through a Progress (a bar on a terminal, plain lines otherwise, nothing for the first second)
+// and checks cancellation between batches, so Ctrl-C stops it cleanly with temporaries removed.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <string>
+
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+// Ctrl-C (SIGINT) and SIGTERM request cancellation; a second Ctrl-C exits at once.
+void installInterruptHandler();
+void requestCancel();
+void clearCancel();
+bool cancelRequested();
+// An ErrorKind::kCancelled status when cancellation was requested, ok otherwise.
+Status checkCancelled();
+
+enum class ProgressMode : std::uint8_t { kAuto, kBar, kLines, kOff };
+// Process-wide choice (the CLI sets kOff for -q); kAuto picks a bar when stderr is a terminal.
+void setProgressMode(ProgressMode mode);
+
+class Progress {
+ public:
+  enum class Unit : std::uint8_t { kCount, kBytes };
+  Progress(std::string label, std::uint64_t total, Unit unit = Unit::kCount);
+  ~Progress();
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
+  // Thread-safe; redraws at most a few times a second.
+  void advance(std::uint64_t amount);
+  void finish();
+
+ private:
+  void draw(bool final);
+
+  std::string label_;
+  std::uint64_t total_;
+  Unit unit_;
+  ProgressMode mode_;
+  std::atomic<std::uint64_t> done_{0};
+  std::chrono::steady_clock::time_point start_;
+  std::atomic<std::int64_t> nextDrawMs_{0};
+  std::mutex drawMutex_;
+  bool drawn_ = false;
+  bool finished_ = false;
+};
+
+}  // namespace lodforge

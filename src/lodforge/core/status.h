@@ -1,0 +1,117 @@
+// The one error type of lodforge. Caller bugs are asserts; bad input, I/O failures and
+// cancellation travel as a Status (or a Result<T>) whose message names the file and position.
+#pragma once
+
+#include <cassert>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include <fmt/format.h>
+
+namespace lodforge {
+
+enum class ErrorKind : std::uint8_t {
+  kBadInput,   // the input is malformed or unsupported: exit code 2
+  kUsage,      // the command line is wrong: exit code 2
+  kIo,         // the system failed us (open, write, disk full): exit code 1
+  kCancelled,  // the user interrupted: exit code 1
+  kLimit,      // a memory or size limit would be exceeded: exit code 1
+  kInternal,   // a bug we caught: exit code 1
+};
+
+struct Error {
+  ErrorKind kind = ErrorKind::kInternal;
+  std::string message;
+};
+
+// Thrown inside readers to unwind to their entry point, where it becomes a Status.
+// Never crosses a public API boundary.
+struct ErrorException {
+  Error error;
+};
+
+class [[nodiscard]] Status {
+ public:
+  Status() = default;
+  Status(Error error) : error_(std::move(error)) {}  // NOLINT: implicit on purpose
+
+  bool ok() const { return !error_.has_value(); }
+  explicit operator bool() const { return ok(); }
+  const Error& error() const {
+    assert(error_);
+    return *error_;
+  }
+  ErrorKind kind() const { return error().kind; }
+  const std::string& message() const { return error().message; }
+
+ private:
+  std::optional<Error> error_;
+};
+
+template <class T>
+class [[nodiscard]] Result {
+ public:
+  Result(T value) : value_(std::move(value)) {}                             // NOLINT
+  Result(Error error) : error_(std::move(error)) {}                         // NOLINT
+  Result(Status status) : error_(status.error()) { assert(!status.ok()); }  // NOLINT
+
+  bool ok() const { return value_.has_value(); }
+  explicit operator bool() const { return ok(); }
+  T& value() & {
+    assert(value_);
+    return *value_;
+  }
+  const T& value() const& {
+    assert(value_);
+    return *value_;
+  }
+  T&& value() && {
+    assert(value_);
+    return std::move(*value_);
+  }
+  T* operator->() { return &value(); }
+  const T* operator->() const { return &value(); }
+  T& operator*() & { return value(); }
+  const T& operator*() const& { return value(); }
+  const Error& error() const {
+    assert(error_);
+    return *error_;
+  }
+  Status status() const { return ok() ? Status() : Status(*error_); }
+
+ private:
+  std::optional<T> value_;
+  std::optional<Error> error_;
+};
+
+// Bad input at a byte offset: "FILE: byte N: WHAT".
+inline Error badInputAtByte(std::string_view file, std::uint64_t offset, std::string_view what) {
+  return {ErrorKind::kBadInput, fmt::format("{}: byte {}: {}", file, offset, what)};
+}
+// Bad input at a line: "FILE:LINE: WHAT".
+inline Error badInputAtLine(std::string_view file, std::uint64_t line, std::string_view what) {
+  return {ErrorKind::kBadInput, fmt::format("{}:{}: {}", file, line, what)};
+}
+// Bad input where no finer position exists (a JSON path, an object): "FILE: WHAT".
+inline Error badInput(std::string_view file, std::string_view what) {
+  return {ErrorKind::kBadInput, fmt::format("{}: {}", file, what)};
+}
+inline Error ioError(std::string_view file, std::string_view what) {
+  return {ErrorKind::kIo, fmt::format("{}: {}", file, what)};
+}
+Error ioErrorFromErrno(std::string_view file, std::string_view action);
+
+// Exit code for the command line: 0 ok, 2 bad input or usage, 1 anything else.
+int exitCodeFor(const Status& status);
+
+}  // namespace lodforge
+
+// Propagate a failed Status/Result from the current function.
+#define LODFORGE_TRY(expr)                                      \
+  do {                                                          \
+    if (auto lodforge_status_ = (expr); !lodforge_status_.ok()) \
+      return lodforge::Status(lodforge_status_.error());        \
+  } while (false)

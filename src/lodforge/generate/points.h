@@ -1,0 +1,23 @@
+// `lodforge generate points`: a scanned-surface point cloud of exactly N points (positions,
+// normals, colours) sampled over the Terrain, written as a binary PLY in batches so memory stays
+// flat. Deterministic for a seed whatever the thread count.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "lodforge/core/status.h"
+#include "lodforge/generate/stats.h"
+
+namespace lodforge {
+
+struct PointsOptions {
+  std::uint64_t points = 1'000'000;
+  std::uint64_t seed = 1;
+  double width = 1000.0;  // metres; depth is 2/3 of it
+  double noise = 0.005;   // metres of scanner noise along the normal
+};
+
+Result<GenerateStats> generatePoints(const PointsOptions& options, const std::string& path);
+
+}  // namespace lodforge

@@ -1,0 +1,271 @@
+#include "lodforge/io/glb_writer.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "lodforge/core/file.h"
+
+namespace lodforge {
+
+namespace {
+constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
+constexpr int kUnsignedByte = 5121, kUnsignedShort = 5123, kUnsignedInt = 5125, kFloat = 5126;
+constexpr std::uint32_t kGlbMagic = 0x46546C67, kChunkJson = 0x4E4F534A, kChunkBin = 0x004E4942;
+constexpr const char* kGenerator = "lodforge " LODFORGE_VERSION;
+}  // namespace
+
+struct GlbWriter::State {
+  std::string path;
+  GlbWriteOptions options;
+  nlohmann::json accessors = nlohmann::json::array();
+  nlohmann::json bufferViews = nlohmann::json::array();
+  nlohmann::json meshes = nlohmann::json::array();
+  nlohmann::json materials = nlohmann::json::array();
+  nlohmann::json nodes = nlohmann::json::array();
+  std::vector<std::uint32_t> rootChildren;
+  std::optional<Vec3d> rootTranslation;
+  std::optional<std::uint32_t> defaultMaterial;
+  // Binary chunk: in memory until it exceeds options.spillBytes, then appended to `spill`.
+  std::vector<std::byte> binary;
+  std::optional<OutputFile> spill;
+  std::string spillPath;
+  std::uint64_t binaryBytes = 0;  // total, memory + spilled
+  std::vector<std::byte> scratch;
+
+  Status appendBinary(const void* data, std::size_t size) {
+    const auto* bytes = static_cast<const std::byte*>(data);
+    binary.insert(binary.end(), bytes, bytes + size);
+    binaryBytes += size;
+    // Keep every view 4-byte aligned (glTF requires it for 4-byte components).
+    while (binaryBytes % 4 != 0) {
+      binary.push_back(std::byte{0});
+      ++binaryBytes;
+    }
+    if (binary.size() > options.spillBytes) {
+      if (!spill) {
+        spillPath = temporaryPathFor(path) + ".bin";
+        Result<OutputFile> file = OutputFile::create(spillPath);
+        if (!file) return file.status();
+        spill.emplace(std::move(file.value()));
+      }
+      LODFORGE_TRY(spill->write(binary.data(), binary.size()));
+      binary.clear();
+    }
+    return {};
+  }
+
+  // Writes one view + accessor; returns the accessor index.
+  Result<std::uint32_t> addAccessor(const void* data, std::size_t bytes, std::size_t count,
+                                    int componentType, const char* type, int target,
+                                    bool normalized, const nlohmann::json* min,
+                                    const nlohmann::json* max) {
+    const std::uint64_t offset = binaryBytes;
+    LODFORGE_TRY(appendBinary(data, bytes));
+    bufferViews.push_back(
+        {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}});
+    nlohmann::json accessor = {{"bufferView", bufferViews.size() - 1},
+                               {"componentType", componentType},
+                               {"count", count},
+                               {"type", type}};
+    if (normalized) accessor["normalized"] = true;
+    if (min) accessor["min"] = *min;
+    if (max) accessor["max"] = *max;
+    accessors.push_back(std::move(accessor));
+    return static_cast<std::uint32_t>(accessors.size() - 1);
+  }
+};
+
+GlbWriter::GlbWriter(std::unique_ptr<State> state) : state_(std::move(state)) {}
+GlbWriter::GlbWriter(GlbWriter&&) noexcept = default;
+GlbWriter& GlbWriter::operator=(GlbWriter&&) noexcept = default;
+GlbWriter::~GlbWriter() = default;
+
+Result<GlbWriter> GlbWriter::create(const std::string& path, const GlbWriteOptions& options) {
+  auto state = std::make_unique<State>();
+  state->path = path;
+  state->options = options;
+  return GlbWriter(std::move(state));
+}
+
+std::uint32_t GlbWriter::addMaterial(const std::array<float, 4>& baseColor, std::string_view name) {
+  // Dielectric and fairly rough: the default glTF material (metallic 1) renders black without
+  // an environment map, which is what most viewers have for CAD data.
+  nlohmann::json material = {
+      {"pbrMetallicRoughness",
+       {{"baseColorFactor", {baseColor[0], baseColor[1], baseColor[2], baseColor[3]}},
+        {"metallicFactor", 0.0},
+        {"roughnessFactor", 0.7}}}};
+  if (state_->options.doubleSided) material["doubleSided"] = true;
+  if (baseColor[3] < 1.0f) material["alphaMode"] = "BLEND";
+  if (!name.empty()) material["name"] = std::string(name);
+  state_->materials.push_back(std::move(material));
+  return static_cast<std::uint32_t>(state_->materials.size() - 1);
+}
+
+Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_view name,
+                                         std::optional<std::uint32_t> material) {
+  State& s = *state_;
+  assert(!mesh.positions.empty() && !mesh.indices.empty() && mesh.indices.size() % 3 == 0);
+  assert(mesh.normals.empty() || mesh.normals.size() == mesh.positions.size());
+  assert(mesh.colors.empty() || mesh.colors.size() == mesh.positions.size());
+  const std::size_t vertexCount = mesh.positions.size();
+
+  const Aabb bounds = [&] {
+    Aabb box;
+    for (const Vec3f& p : mesh.positions) box.add(p);
+    return box;
+  }();
+  const nlohmann::json min = {bounds.min.x, bounds.min.y, bounds.min.z};
+  const nlohmann::json max = {bounds.max.x, bounds.max.y, bounds.max.z};
+  nlohmann::json attributes;
+  Result<std::uint32_t> position =
+      s.addAccessor(mesh.positions.data(), mesh.positions.size_bytes(), vertexCount, kFloat, "VEC3",
+                    kArrayBuffer, false, &min, &max);
+  if (!position) return position.status();
+  attributes["POSITION"] = *position;
+  if (!mesh.normals.empty()) {
+    // The validator requires unit normals; fix up zero or unnormalised ones here.
+    std::vector<Vec3f> unit(mesh.normals.begin(), mesh.normals.end());
+    for (Vec3f& n : unit) n = normalizeOr(n, Vec3f{0, 0, 1});
+    Result<std::uint32_t> normal =
+        s.addAccessor(unit.data(), unit.size() * sizeof(Vec3f), vertexCount, kFloat, "VEC3",
+                      kArrayBuffer, false, nullptr, nullptr);
+    if (!normal) return normal.status();
+    attributes["NORMAL"] = *normal;
+  }
+  if (!mesh.colors.empty()) {
+    Result<std::uint32_t> color =
+        s.addAccessor(mesh.colors.data(), mesh.colors.size_bytes(), vertexCount, kUnsignedByte,
+                      "VEC4", kArrayBuffer, true, nullptr, nullptr);
+    if (!color) return color.status();
+    attributes["COLOR_0"] = *color;
+  }
+  // 16-bit indices when they fit; 65535 itself is the primitive-restart value glTF forbids.
+  Result<std::uint32_t> indices = [&]() -> Result<std::uint32_t> {
+    if (vertexCount < 65535) {
+      s.scratch.resize(mesh.indices.size() * 2);
+      for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
+        const auto v = static_cast<std::uint16_t>(mesh.indices[i]);
+        std::memcpy(s.scratch.data() + 2 * i, &v, 2);
+      }
+      return s.addAccessor(s.scratch.data(), s.scratch.size(), mesh.indices.size(), kUnsignedShort,
+                           "SCALAR", kElementArrayBuffer, false, nullptr, nullptr);
+    }
+    return s.addAccessor(mesh.indices.data(), mesh.indices.size_bytes(), mesh.indices.size(),
+                         kUnsignedInt, "SCALAR", kElementArrayBuffer, false, nullptr, nullptr);
+  }();
+  if (!indices) return indices.status();
+
+  if (!material) {
+    if (!s.defaultMaterial) s.defaultMaterial = addMaterial({1, 1, 1, 1}, "default");
+    material = s.defaultMaterial;
+  }
+  nlohmann::json primitive = {
+      {"attributes", attributes}, {"indices", *indices}, {"mode", 4}, {"material", *material}};
+  nlohmann::json entry = {{"primitives", nlohmann::json::array({primitive})}};
+  if (!name.empty()) entry["name"] = std::string(name);
+  s.meshes.push_back(std::move(entry));
+  return static_cast<std::uint32_t>(s.meshes.size() - 1);
+}
+
+void GlbWriter::addNode(std::string_view name, std::optional<std::uint32_t> mesh,
+                        const Mat4d* transform) {
+  nlohmann::json node = nlohmann::json::object();
+  if (!name.empty()) node["name"] = std::string(name);
+  if (mesh) node["mesh"] = *mesh;
+  if (transform && transform->m != Mat4d{}.m) node["matrix"] = transform->m;
+  state_->nodes.push_back(std::move(node));
+  state_->rootChildren.push_back(static_cast<std::uint32_t>(state_->nodes.size() - 1));
+}
+
+void GlbWriter::setRootTranslation(Vec3d translation) {
+  state_->rootTranslation = translation;
+}
+
+std::uint64_t GlbWriter::binaryBytes() const {
+  return state_->binaryBytes;
+}
+
+Status GlbWriter::finish() {
+  State& s = *state_;
+  // The root node holds every object node, and the origin offset if there is one.
+  nlohmann::json root = {{"name", "root"}};
+  if (!s.rootChildren.empty()) root["children"] = s.rootChildren;
+  if (s.rootTranslation && *s.rootTranslation != Vec3d{})
+    root["translation"] = {s.rootTranslation->x, s.rootTranslation->y, s.rootTranslation->z};
+  s.nodes.push_back(std::move(root));
+
+  nlohmann::json document = {{"asset", {{"version", "2.0"}, {"generator", kGenerator}}},
+                             {"scene", 0},
+                             {"scenes", {{{"nodes", {s.nodes.size() - 1}}}}},
+                             {"nodes", std::move(s.nodes)}};
+  if (!s.meshes.empty()) {
+    document["meshes"] = std::move(s.meshes);
+    document["accessors"] = std::move(s.accessors);
+    document["bufferViews"] = std::move(s.bufferViews);
+    document["buffers"] = {{{"byteLength", s.binaryBytes}}};
+  }
+  if (!s.materials.empty()) document["materials"] = std::move(s.materials);
+  std::string json = document.dump();
+  while (json.size() % 4 != 0) json += ' ';
+
+  const bool hasBinary = s.binaryBytes > 0;
+  const std::uint64_t total = 12 + 8 + json.size() + (hasBinary ? 8 + s.binaryBytes : 0);
+  if (total > 0xFFFFFFFFull) {
+    return Error{
+        ErrorKind::kLimit,
+        fmt::format("{}: GLB would be {} bytes; the format's limit is 4 GiB", s.path, total)};
+  }
+  Result<OutputFile> out = OutputFile::create(s.path);
+  if (!out) return out.status();
+  const std::uint32_t header[3] = {kGlbMagic, 2, static_cast<std::uint32_t>(total)};
+  const std::uint32_t jsonChunk[2] = {static_cast<std::uint32_t>(json.size()), kChunkJson};
+  LODFORGE_TRY(out->write(header, sizeof header));
+  LODFORGE_TRY(out->write(jsonChunk, sizeof jsonChunk));
+  LODFORGE_TRY(out->write(json.data(), json.size()));
+  if (hasBinary) {
+    const std::uint32_t binChunk[2] = {static_cast<std::uint32_t>(s.binaryBytes), kChunkBin};
+    LODFORGE_TRY(out->write(binChunk, sizeof binChunk));
+    if (s.spill) {
+      // The spilled part is committed to a side file, copied in, then removed.
+      const std::uint64_t spilled = s.spill->bytesWritten();
+      LODFORGE_TRY(s.spill->commit());
+      s.spill.reset();
+      Status copied = out->appendFileContents(s.spillPath, spilled);
+      ::remove(s.spillPath.c_str());
+      LODFORGE_TRY(copied);
+    }
+    LODFORGE_TRY(out->write(s.binary.data(), s.binary.size()));
+  }
+  return out->commit();
+}
+
+Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptions& options) {
+  Result<GlbWriter> writer = GlbWriter::create(path, options);
+  if (!writer) return writer.status();
+  for (std::size_t o = 0; o < model.objectCount(); ++o) {
+    const ObjectRecord& record = model.objects[o];
+    std::optional<std::uint32_t> mesh;
+    if (record.triangleCount > 0) {
+      GlbMeshData data;
+      data.positions = model.objectPositions(o);
+      if (model.hasNormals())
+        data.normals = std::span(model.normals).subspan(record.vertexOffset, record.vertexCount);
+      if (model.hasColors())
+        data.colors = std::span(model.colors).subspan(record.vertexOffset, record.vertexCount);
+      data.indices = model.objectIndices(o);
+      Result<std::uint32_t> added = writer->addMesh(data, model.objectName(o));
+      if (!added) return added.status();
+      mesh = *added;
+    }
+    writer->addNode(model.objectName(o), mesh);
+  }
+  writer->setRootTranslation(model.origin);
+  return writer->finish();
+}
+
+}  // namespace lodforge

@@ -1,0 +1,66 @@
+// GLB (binary glTF 2.0) writer. GlbWriter streams: meshes go to the binary chunk as they are
+// added (spilling to a temporary file past a threshold), nodes and materials are collected as
+// JSON, and finish() assembles header + JSON + BIN under a temporary name and renames it. Output
+// passes the Khronos glTF validator: accessor min/max on positions, unit normals, 4-byte
+// aligned views, no primitive-restart index values.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "lodforge/core/model.h"
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+struct GlbMeshData {
+  std::span<const Vec3f> positions;
+  std::span<const Vec3f> normals;          // empty or one per vertex (normalised on write)
+  std::span<const Rgba8> colors;           // empty or one per vertex
+  std::span<const std::uint32_t> indices;  // 3 per triangle, < positions.size()
+};
+
+struct GlbWriteOptions {
+  // CAD parts are often open sheets: draw both sides unless told otherwise.
+  bool doubleSided = true;
+  // Binary data beyond this stays on disk until finish() instead of in memory.
+  std::size_t spillBytes = std::size_t{64} << 20;
+};
+
+class GlbWriter {
+ public:
+  static Result<GlbWriter> create(const std::string& path, const GlbWriteOptions& options = {});
+  GlbWriter(GlbWriter&&) noexcept;
+  GlbWriter& operator=(GlbWriter&&) noexcept;
+  ~GlbWriter();
+
+  // A material with this base colour (linear RGBA); index for addMesh.
+  std::uint32_t addMaterial(const std::array<float, 4>& baseColor, std::string_view name = {});
+  // Writes the mesh's data; returns its mesh index for addNode. Empty meshes are refused (assert).
+  Result<std::uint32_t> addMesh(const GlbMeshData& mesh, std::string_view name = {},
+                                std::optional<std::uint32_t> material = std::nullopt);
+  // A node drawing `mesh` (or nothing) with an optional transform, a child of the root node.
+  void addNode(std::string_view name, std::optional<std::uint32_t> mesh,
+               const Mat4d* transform = nullptr);
+  // Translation of the root node: places float geometry at a double-precision origin.
+  void setRootTranslation(Vec3d translation);
+  // Size of the binary chunk so far (GLB caps a file at 4 GiB).
+  std::uint64_t binaryBytes() const;
+  Status finish();
+
+ private:
+  struct State;
+  explicit GlbWriter(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+// Writes a whole Model: one node + mesh per object (objects without triangles become empty
+// nodes), the origin as the root translation.
+Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptions& options = {});
+
+}  // namespace lodforge

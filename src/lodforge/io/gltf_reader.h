@@ -1,0 +1,25 @@
+// glTF 2.0 reader (.gltf and .glb, through tinygltf). Each node's mesh instance becomes one
+// object — a CAD part — with its world transform applied and its primitives merged; instanced
+// meshes (several nodes, or EXT_mesh_gpu_instancing) are expanded. Each primitive's base colour
+// (times COLOR_0) becomes vertex colour. KHR_draco_mesh_compression is decoded with libdraco.
+#pragma once
+
+#include <span>
+#include <string>
+
+#include "lodforge/core/model.h"
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+struct GltfReadOptions {
+  // Load buffers named by relative URIs beside the file. Off for untrusted in-memory input.
+  bool allowExternalFiles = true;
+};
+
+Result<Model> readGltf(const std::string& path, const GltfReadOptions& options = {});
+// Detects GLB by its magic, otherwise parses glTF JSON.
+Result<Model> readGltfFromMemory(std::span<const std::byte> bytes, const std::string& name,
+                                 const GltfReadOptions& options = {});
+
+}  // namespace lodforge

@@ -1,0 +1,93 @@
+#include "lodforge/io/model_io.h"
+
+#include <fmt/format.h>
+
+#include "lodforge/core/file.h"
+#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/gltf_reader.h"
+#include "lodforge/io/obj_reader.h"
+#include "lodforge/io/obj_writer.h"
+#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/ply_writer.h"
+#include "lodforge/io/stl_reader.h"
+#include "lodforge/io/stl_writer.h"
+
+namespace lodforge {
+
+FileFormat formatFromPath(const std::string& path) {
+  const std::string ext = fileExtension(path);
+  if (ext == "ply") return FileFormat::kPly;
+  if (ext == "obj") return FileFormat::kObj;
+  if (ext == "stl") return FileFormat::kStl;
+  if (ext == "gltf") return FileFormat::kGltf;
+  if (ext == "glb") return FileFormat::kGlb;
+  return FileFormat::kUnknown;
+}
+
+std::string_view formatName(FileFormat format) {
+  switch (format) {
+    case FileFormat::kPly:
+      return "PLY";
+    case FileFormat::kObj:
+      return "OBJ";
+    case FileFormat::kStl:
+      return "STL";
+    case FileFormat::kGltf:
+      return "glTF";
+    case FileFormat::kGlb:
+      return "GLB";
+    case FileFormat::kUnknown:
+      break;
+  }
+  return "unknown";
+}
+
+bool canRead(FileFormat format) {
+  return format != FileFormat::kUnknown;
+}
+bool canWrite(FileFormat format) {
+  return format == FileFormat::kPly || format == FileFormat::kGlb || format == FileFormat::kObj ||
+         format == FileFormat::kStl;
+}
+
+Result<Model> readModel(const std::string& path, const ReadOptions& options) {
+  switch (formatFromPath(path)) {
+    case FileFormat::kPly: {
+      PlyReadOptions ply;
+      ply.salvageTruncated = options.salvageTruncated;
+      ply.warnings = options.warnings;
+      return readPly(path, ply);
+    }
+    case FileFormat::kObj:
+      return readObj(path);
+    case FileFormat::kStl:
+      return readStl(path);
+    case FileFormat::kGltf:
+    case FileFormat::kGlb:
+      return readGltf(path);
+    case FileFormat::kUnknown:
+      break;
+  }
+  return Error{ErrorKind::kUsage,
+               fmt::format("{}: unknown format (lodforge reads .ply .obj .stl .gltf .glb)", path)};
+}
+
+Status writeModel(const Model& model, const std::string& path) {
+  switch (formatFromPath(path)) {
+    case FileFormat::kPly:
+      return writePly(model, path);
+    case FileFormat::kGlb:
+      return writeGlb(model, path);
+    case FileFormat::kObj:
+      return writeObj(model, path);
+    case FileFormat::kStl:
+      return writeStl(model, path);
+    default:
+      break;
+  }
+  return Error{
+      ErrorKind::kUsage,
+      fmt::format("{}: cannot write this format (lodforge writes .ply .glb .obj .stl)", path)};
+}
+
+}  // namespace lodforge

@@ -1,0 +1,18 @@
+// Wavefront OBJ reader (tinyobjloader, double precision). Every `o` or `g` starts an object;
+// polygons are fan-triangulated; colours come from vertex colours (`v x y z r g b`) or the
+// material's diffuse colour (Kd) when the .mtl is found beside the file.
+#pragma once
+
+#include <span>
+#include <string>
+
+#include "lodforge/core/model.h"
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+Result<Model> readObj(const std::string& path);
+// From memory, for fuzzing and tests: material libraries are not loaded.
+Result<Model> readObjFromMemory(std::span<const std::byte> bytes, const std::string& name);
+
+}  // namespace lodforge

@@ -1,0 +1,218 @@
+// The `lodforge` command as users run it: real binary, real files, exit codes and messages.
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+extern char** environ;
+
+namespace lodforge {
+namespace {
+
+struct Outcome {
+  int code = -1;
+  std::string out, err;
+};
+
+// Runs `lodforge ARGS` through the shell, capturing stdout and stderr.
+Outcome lodforge(const std::string& args, const test::TempDir& dir) {
+  const std::string out = dir.file(".stdout"), err = dir.file(".stderr");
+  const std::string command = std::string(LODFORGE_BINARY) + " " + args + " >" + out + " 2>" + err;
+  const int status = std::system(command.c_str());
+  Outcome o;
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  o.out = test::readFile(out);
+  o.err = test::readFile(err);
+  std::remove(out.c_str());
+  std::remove(err.c_str());
+  return o;
+}
+
+nlohmann::json info(const std::string& path, const test::TempDir& dir) {
+  const Outcome o = lodforge("info --json " + path, dir);
+  EXPECT_EQ(o.code, 0) << o.err;
+  return nlohmann::json::parse(o.out);
+}
+
+TEST(Cli, VersionHelpAndUsageErrors) {
+  test::TempDir dir;
+  Outcome o = lodforge("--version", dir);
+  EXPECT_EQ(o.code, 0);
+  EXPECT_EQ(o.out, "lodforge " LODFORGE_VERSION "\n");
+  o = lodforge("--help", dir);
+  EXPECT_EQ(o.code, 0);
+  EXPECT_NE(o.out.find("generate"), std::string::npos);
+  o = lodforge("generate cad --help", dir);
+  EXPECT_EQ(o.code, 0);
+  EXPECT_NE(o.out.find("--objects"), std::string::npos);
+  EXPECT_EQ(lodforge("", dir).code, 2);
+  EXPECT_EQ(lodforge("frobnicate", dir).code, 2);
+  o = lodforge("generate cad --objects 10X", dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("expected a count such as"), std::string::npos) << o.err;
+  o = lodforge("--memory-limit lots info x.ply", dir);
+  EXPECT_EQ(o.code, 2);
+  o = lodforge("info " + dir.file("model.fbx"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("unknown format"), std::string::npos);
+  o = lodforge("info " + dir.file("missing.ply"), dir);
+  EXPECT_EQ(o.code, 1);  // the system failed, not the input
+  EXPECT_NE(o.err.find("missing.ply: cannot stat: No such file"), std::string::npos) << o.err;
+}
+
+TEST(Cli, InfoReportsEveryRealModel) {
+  test::TempDir dir;
+  struct Case {
+    const char* file;
+    std::uint64_t vertices, triangles, objects;
+  };
+  for (const Case& c : {Case{"meshes/stanford-bunny.obj", 34'834, 69'451, 1},
+                        Case{"meshes/horse.ply", 48'485, 96'966, 1},
+                        Case{"meshes/2CylinderEngine.glb", 84'657, 121'496, 67},
+                        Case{"meshes/as1_motor.glb", 21'980, 27'506, 35},
+                        Case{"meshes/Motor-c.glb", 22'374, 30'682, 17}}) {
+    const nlohmann::json j = info(test::dataPath(c.file), dir);
+    EXPECT_EQ(j["vertices"], c.vertices) << c.file;
+    EXPECT_EQ(j["triangles"], c.triangles) << c.file;
+    EXPECT_EQ(j["objects"], c.objects) << c.file;
+    EXPECT_GT(j["memoryBytes"].get<std::uint64_t>(), c.triangles * 12) << c.file;
+    EXPECT_LT(j["bounds"]["min"][0].get<double>(), j["bounds"]["max"][0].get<double>());
+  }
+  const Outcome text = lodforge("info " + test::dataPath("meshes/horse.ply"), dir);
+  EXPECT_EQ(text.code, 0);
+  EXPECT_NE(text.out.find("triangles  96,966"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("PLY binary_little_endian"), std::string::npos);
+}
+
+TEST(Cli, ConvertBetweenEveryFormat) {
+  test::TempDir dir;
+  const std::string bunny = test::dataPath("meshes/stanford-bunny.obj");
+  for (const char* ext : {"ply", "glb", "obj", "stl"}) {
+    const std::string out = dir.file(std::string("bunny.") + ext);
+    const Outcome o = lodforge("convert " + bunny + " -o " + out, dir);
+    ASSERT_EQ(o.code, 0) << o.err;
+    EXPECT_NE(o.out.find("69,451 triangles"), std::string::npos) << o.out;
+    EXPECT_EQ(info(out, dir)["triangles"], 69'451u) << ext;
+  }
+  // Welding a soup restores shared vertices.
+  Outcome o = lodforge(
+      "convert " + dir.file("bunny.stl") + " -o " + dir.file("welded.ply") + " --weld", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(info(dir.file("welded.ply"), dir)["vertices"], 34'834u);
+  o = lodforge("convert " + bunny + " -o " + dir.file("bunny.gltf"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("cannot write this format"), std::string::npos);
+}
+
+TEST(Cli, GenerateWritesWhatInfoReads) {
+  test::TempDir dir;
+  Outcome o = lodforge("generate cad --objects 400 --seed 3 -o " + dir.file("cad.glb"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("400 objects"), std::string::npos) << o.out;
+  EXPECT_EQ(info(dir.file("cad.glb"), dir)["objects"], 400u);
+  o = lodforge("generate cad --objects 400 --seed 3 -o " + dir.file("cad.ply"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(info(dir.file("cad.ply"), dir)["objects"], 400u);
+  o = lodforge("generate scan --triangles 10K -o " + dir.file("scan.ply"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(info(dir.file("scan.ply"), dir)["triangles"], 10'000u);
+  o = lodforge("-q generate points --points 2.5K -o " + dir.file("points.ply"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(o.out, "");  // quiet
+  EXPECT_EQ(info(dir.file("points.ply"), dir)["vertices"], 2'500u);
+  o = lodforge("generate scan --triangles 100 -o " + dir.file("scan.obj"), dir);
+  EXPECT_EQ(o.code, 2);
+}
+
+// Every file of the malformed corpus: exit code 2, a message naming the file and the position,
+// and nothing written by a conversion that fails.
+TEST(Cli, MalformedCorpusGetsExitCode2AndAPositionedMessage) {
+  test::TempDir dir;
+  std::ifstream expected(test::testDataPath("malformed/expected.tsv"));
+  ASSERT_TRUE(expected) << "missing tests/data/malformed/expected.tsv";
+  std::string line;
+  int cases = 0;
+  while (std::getline(expected, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    const std::string file = line.substr(0, line.find('\t'));
+    const std::string fragment = line.substr(line.find('\t') + 1);
+    const std::string path = test::testDataPath("malformed/" + file);
+    for (const std::string& command :
+         {"info " + path, "convert " + path + " -o " + dir.file("out.glb")}) {
+      const Outcome o = lodforge(command, dir);
+      EXPECT_EQ(o.code, 2) << command << "\n" << o.err;
+      EXPECT_EQ(o.err.rfind("lodforge: " + path, 0), 0u) << o.err;
+      EXPECT_NE(o.err.find(fragment), std::string::npos) << file << ": " << o.err;
+      EXPECT_EQ(o.err.find('\n'), o.err.size() - 1) << "one line: " << o.err;
+    }
+    EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{}) << file;
+    ++cases;
+  }
+  EXPECT_GE(cases, 25);
+}
+
+TEST(Cli, DamagedRealFileIsRefused) {
+  test::TempDir dir;
+  const Outcome o = lodforge("info " + test::dataPath("points/pond.0.ply"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("the file is truncated"), std::string::npos) << o.err;
+}
+
+TEST(Cli, MemoryLimitRefusesBeforeLoading) {
+  test::TempDir dir;
+  const Outcome o = lodforge("--memory-limit 1M convert " + test::dataPath("meshes/horse.ply") +
+                                 " -o " + dir.file("h.glb"),
+                             dir);
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.err.find("--memory-limit is 1.00 MiB"), std::string::npos) << o.err;
+  EXPECT_TRUE(test::listFolder(dir.path()).empty());
+}
+
+TEST(Cli, CtrlCCancelsAndLeavesNothingBehind) {
+  test::TempDir dir;
+  const std::string output = dir.file("big.ply");
+  const std::string binary = LODFORGE_BINARY;
+  std::vector<std::string> args = {binary, "generate", "scan", "--triangles", "50M", "-o", output};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  const std::string err = dir.file(".stderr");
+  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), &actions, nullptr, argv.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&actions);
+  // Wait until the temporary output exists, i.e. the generator is writing.
+  bool writing = false;
+  for (int i = 0; i < 600 && !writing; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    for (const std::string& name : test::listFolder(dir.path()))
+      writing = writing || name.starts_with("big.ply.tmp");
+  }
+  ASSERT_TRUE(writing);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_NE(test::readFile(err).find("lodforge: cancelled"), std::string::npos)
+      << test::readFile(err);
+  std::remove(err.c_str());
+  EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{});
+}
+
+}  // namespace
+}  // namespace lodforge

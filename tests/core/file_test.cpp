@@ -1,0 +1,145 @@
+#include "lodforge/core/file.h"
+
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+TEST(ByteSource, ReadsLinesAcrossBufferBoundariesFromFileAndMemory) {
+  test::TempDir dir;
+  // Lines long enough that several straddle the 1 MiB read buffer, with CRLF and a last line
+  // without newline.
+  std::string text;
+  for (int i = 0; i < 3000; ++i)
+    text += std::string(1000 + i % 7, char('a' + i % 26)) + (i % 2 ? "\r\n" : "\n");
+  text += "last";
+  test::writeFile(dir.file("lines.txt"), text);
+  Result<ByteSource> file = ByteSource::openFile(dir.file("lines.txt"));
+  ASSERT_TRUE(file.ok());
+  ByteSource memory = ByteSource::fromMemory(test::bytesOf(text), "memory");
+  for (ByteSource* source : {&file.value(), &memory}) {
+    std::string line;
+    for (int i = 0; i < 3000; ++i) {
+      ASSERT_TRUE(source->readLine(line));
+      ASSERT_EQ(line, std::string(1000 + i % 7, char('a' + i % 26))) << i;
+    }
+    ASSERT_TRUE(source->readLine(line));
+    EXPECT_EQ(line, "last");
+    EXPECT_FALSE(source->readLine(line));
+    EXPECT_EQ(source->offset(), text.size());
+  }
+}
+
+TEST(ByteSource, ReadSkipAndOffsets) {
+  test::TempDir dir;
+  std::string data(3 << 20, '\0');
+  for (std::size_t i = 0; i < data.size(); ++i) data[i] = char(i % 251);
+  test::writeFile(dir.file("data.bin"), data);
+  Result<ByteSource> source = ByteSource::openFile(dir.file("data.bin"));
+  ASSERT_TRUE(source.ok());
+  EXPECT_EQ(source->size(), data.size());
+  char chunk[10];
+  ASSERT_TRUE(source->read(chunk, 10));
+  EXPECT_EQ(std::string(chunk, 10), data.substr(0, 10));
+  ASSERT_TRUE(source->skip(2'000'000));  // past the buffer: seeks
+  EXPECT_EQ(source->offset(), 2'000'010u);
+  ASSERT_TRUE(source->read(chunk, 10));
+  EXPECT_EQ(std::string(chunk, 10), data.substr(2'000'010, 10));
+  EXPECT_FALSE(source->skip(data.size()));
+  EXPECT_EQ(source->ensure(5u << 20),
+            data.size() - 2'000'020);  // grows the buffer, stops at the end
+  ASSERT_TRUE(source->skip(source->remaining() - 5));
+  EXPECT_FALSE(source->read(chunk, 10));  // only 5 left: nothing consumed
+  EXPECT_EQ(source->remaining(), 5u);
+}
+
+TEST(ByteSource, RefusesOverlongLinesAndMissingFiles) {
+  const std::string text(5000, 'x');
+  ByteSource memory = ByteSource::fromMemory(test::bytesOf(text), "long.txt");
+  std::string line;
+  try {
+    memory.readLine(line, 100);
+    FAIL() << "expected an error";
+  } catch (const ErrorException& e) {
+    EXPECT_EQ(e.error.kind, ErrorKind::kBadInput);
+    EXPECT_NE(e.error.message.find("long.txt"), std::string::npos);
+  }
+  Result<ByteSource> missing = ByteSource::openFile("/nonexistent/file.ply");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.error().kind, ErrorKind::kIo);
+  EXPECT_NE(missing.error().message.find("/nonexistent/file.ply"), std::string::npos);
+}
+
+TEST(OutputFile, AppearsOnlyOnCommit) {
+  test::TempDir dir;
+  const std::string path = dir.file("out.bin");
+  {
+    Result<OutputFile> out = OutputFile::create(path);
+    ASSERT_TRUE(out.ok());
+    ASSERT_TRUE(out->write("hello ", 6).ok());
+    EXPECT_FALSE(std::filesystem::exists(path));
+    ASSERT_TRUE(out->commit().ok());
+  }
+  EXPECT_EQ(test::readFile(path), "hello ");
+  {
+    Result<OutputFile> out = OutputFile::create(dir.file("abandoned.bin"));
+    ASSERT_TRUE(out.ok());
+    ASSERT_TRUE(out->write("partial", 7).ok());
+  }  // destroyed without commit: the temporary disappears
+  EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"out.bin"});
+}
+
+TEST(OutputFile, PositionalWritesAndAppendedFiles) {
+  test::TempDir dir;
+  test::writeFile(dir.file("tail.bin"), "0123456789");
+  Result<OutputFile> out = OutputFile::create(dir.file("out.bin"));
+  ASSERT_TRUE(out.ok());
+  ASSERT_TRUE(out->writeAt(4, "WXYZ", 4).ok());
+  ASSERT_TRUE(out->writeAt(0, "abcd", 4).ok());
+  ASSERT_TRUE(out->writeAt(8, "", 0).ok());
+  ASSERT_TRUE(out->commit().ok());
+  EXPECT_EQ(test::readFile(dir.file("out.bin")), "abcdWXYZ");
+
+  Result<OutputFile> joined = OutputFile::create(dir.file("joined.bin"));
+  ASSERT_TRUE(joined.ok());
+  ASSERT_TRUE(joined->write("head:", 5).ok());
+  ASSERT_TRUE(joined->appendFileContents(dir.file("tail.bin"), 6).ok());
+  ASSERT_TRUE(joined->write(":end", 4).ok());
+  EXPECT_EQ(joined->bytesWritten(), 15u);
+  ASSERT_TRUE(joined->commit().ok());
+  EXPECT_EQ(test::readFile(dir.file("joined.bin")), "head:012345:end");
+}
+
+TEST(OutputFile, FailsCleanlyWhereItCannotWrite) {
+  Result<OutputFile> out = OutputFile::create("/nonexistent-dir/out.glb");
+  ASSERT_FALSE(out.ok());
+  EXPECT_EQ(out.error().kind, ErrorKind::kIo);
+  EXPECT_NE(out.error().message.find("/nonexistent-dir/out.glb"), std::string::npos);
+}
+
+TEST(MappedFile, SeesTheFileContents) {
+  test::TempDir dir;
+  test::writeFile(dir.file("m.bin"), "mapped bytes");
+  Result<MappedFile> mapped = MappedFile::open(dir.file("m.bin"));
+  ASSERT_TRUE(mapped.ok());
+  const auto bytes = mapped->bytes();
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size()), "mapped bytes");
+  test::writeFile(dir.file("empty.bin"), "");
+  Result<MappedFile> empty = MappedFile::open(dir.file("empty.bin"));
+  ASSERT_TRUE(empty.ok());
+  EXPECT_TRUE(empty->bytes().empty());
+}
+
+TEST(Paths, ExtensionsAreLowerCase) {
+  EXPECT_EQ(fileExtension("a/b/Model.GLB"), "glb");
+  EXPECT_EQ(fileExtension("scan.ply"), "ply");
+  EXPECT_EQ(fileExtension("noext"), "");
+  EXPECT_NE(temporaryPathFor("x.ply"), temporaryPathFor("x.ply"));
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -1,0 +1,98 @@
+#include "lodforge/core/math.h"
+
+#include <gtest/gtest.h>
+
+#include "lodforge/core/random.h"
+
+namespace lodforge {
+namespace {
+
+void expectNear(Vec3d a, Vec3d b, double tolerance = 1e-9) {
+  EXPECT_NEAR(a.x, b.x, tolerance);
+  EXPECT_NEAR(a.y, b.y, tolerance);
+  EXPECT_NEAR(a.z, b.z, tolerance);
+}
+
+TEST(Mat4d, RotationOfUnitQuaternionIsOrthonormal) {
+  Random random(11);
+  for (int i = 0; i < 100; ++i) {
+    Vec3d axis = normalizeOr(
+        Vec3d{random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1)}, Vec3d{0, 0, 1});
+    const double angle = random.uniform(-3, 3);
+    const Mat4d r = Mat4d::rotation(axis.x * std::sin(angle / 2), axis.y * std::sin(angle / 2),
+                                    axis.z * std::sin(angle / 2), std::cos(angle / 2));
+    EXPECT_NEAR(r.determinant3(), 1.0, 1e-12);
+    expectNear(r.transformVector(axis), axis);  // the axis stays put
+    const Vec3d v{random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1)};
+    EXPECT_NEAR(length(r.transformVector(v)), length(v), 1e-12);
+  }
+  // 90 degrees about z takes x to y.
+  const double h = std::sqrt(0.5);
+  expectNear(Mat4d::rotation(0, 0, h, h).transformVector({1, 0, 0}), {0, 1, 0});
+}
+
+TEST(Mat4d, ComposesTranslateRotateScale) {
+  const Mat4d m = Mat4d::translation({1, 2, 3}) * Mat4d::scale({2, 2, 2});
+  expectNear(m.transformPoint({1, 1, 1}), {3, 4, 5});
+  expectNear(m.transformVector({1, 1, 1}), {2, 2, 2});
+}
+
+TEST(Mat4d, NormalMatrixKeepsNormalsPerpendicularUnderShearAndMirror) {
+  Random random(5);
+  for (int i = 0; i < 50; ++i) {
+    Mat4d m;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m.at(r, c) = random.uniform(-2, 2);
+    }
+    if (std::abs(m.determinant3()) < 0.1) continue;
+    // A surface with tangents t1, t2 and normal t1 x t2.
+    const Vec3d t1{random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1)};
+    const Vec3d t2{random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1)};
+    const Vec3d n = cross(t1, t2);
+    const Vec3d transformed = m.normalMatrix().transformVector(n);
+    EXPECT_NEAR(dot(transformed, m.transformVector(t1)), 0.0, 1e-9);
+    EXPECT_NEAR(dot(transformed, m.transformVector(t2)), 0.0, 1e-9);
+    // Same side as the transformed surface's own normal (inverse-transpose, also for mirrors).
+    EXPECT_GT(
+        dot(transformed, cross(m.transformVector(t1), m.transformVector(t2))) * m.determinant3(),
+        0.0);
+  }
+}
+
+TEST(Box3, EmptyAbsorbsPoints) {
+  Aabb box;
+  EXPECT_TRUE(box.empty());
+  EXPECT_EQ(box.size(), Vec3f{});
+  box.add(Vec3f{1, 2, 3});
+  EXPECT_FALSE(box.empty());
+  box.add(Vec3f{-1, 5, 3});
+  EXPECT_EQ(box.min, (Vec3f{-1, 2, 3}));
+  EXPECT_EQ(box.max, (Vec3f{1, 5, 3}));
+  EXPECT_EQ(box.longestSide(), 3.0f);
+  Aabb other;
+  box.add(other);  // adding an empty box changes nothing
+  EXPECT_EQ(box.min, (Vec3f{-1, 2, 3}));
+}
+
+TEST(Random, IsDeterministicAndIndependentPerItem) {
+  Random a(42), b(42);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(a.next(), b.next());
+  EXPECT_NE(Random::forItem(42, 1).next(), Random::forItem(42, 2).next());
+  Random r(1);
+  double sum = 0;
+  for (int i = 0; i < 10000; ++i) {
+    const double u = r.uniform();
+    ASSERT_GE(u, 0.0);
+    ASSERT_LT(u, 1.0);
+    sum += u;
+  }
+  EXPECT_NEAR(sum / 10000, 0.5, 0.02);
+  for (int i = 0; i < 1000; ++i) {
+    const double v = r.logUniform(0.01, 10);
+    ASSERT_GE(v, 0.01 * 0.999999);
+    ASSERT_LE(v, 10.0);
+  }
+}
+
+}  // namespace
+}  // namespace lodforge

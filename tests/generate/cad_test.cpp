@@ -1,0 +1,107 @@
+#include "lodforge/generate/cad.h"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "lodforge/core/mesh.h"
+#include "lodforge/io/gltf_reader.h"
+#include "lodforge/io/ply_reader.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+TEST(Cad, GlbAndPlyHoldTheSameAssembly) {
+  test::TempDir dir;
+  Result<GenerateStats> glb = generateCad({.objects = 800, .seed = 4}, dir.file("a.glb"));
+  Result<GenerateStats> ply = generateCad({.objects = 800, .seed = 4}, dir.file("a.ply"));
+  ASSERT_TRUE(glb.ok()) << glb.error().message;
+  ASSERT_TRUE(ply.ok()) << ply.error().message;
+  EXPECT_EQ(glb->triangles, ply->triangles);
+  EXPECT_EQ(glb->vertices, ply->vertices);
+  Result<Model> fromGlb = readGltf(dir.file("a.glb"));
+  Result<Model> fromPly = readPly(dir.file("a.ply"));
+  ASSERT_TRUE(fromGlb.ok()) << fromGlb.error().message;
+  ASSERT_TRUE(fromPly.ok()) << fromPly.error().message;
+  ASSERT_EQ(fromGlb->objectCount(), 800u);
+  ASSERT_EQ(fromPly->objectCount(), 800u);  // every object id 0..799 present
+  EXPECT_EQ(fromGlb->triangleCount(), glb->triangles);
+  for (std::size_t o = 0; o < 800; ++o) {
+    ASSERT_EQ(fromGlb->objects[o].triangleCount, fromPly->objects[o].triangleCount) << o;
+    const Aabb a = fromGlb->objects[o].bounds, b = fromPly->objects[o].bounds;
+    ASSERT_NEAR(a.min.x, b.min.x, 1e-3f) << o;
+    ASSERT_NEAR(a.max.z, b.max.z, 1e-3f) << o;
+  }
+}
+
+TEST(Cad, PartsVaryWidelyInKindSizeAndTessellation) {
+  test::TempDir dir;
+  ASSERT_TRUE(generateCad({.objects = 3000, .seed = 1}, dir.file("a.glb")).ok());
+  Result<Model> model = readGltf(dir.file("a.glb"));
+  ASSERT_TRUE(model.ok());
+  std::map<std::string, int> kinds;
+  std::uint32_t fewest = ~0u, most = 0;
+  float smallest = 1e9f, largest = 0;
+  std::uint64_t openParts = 0;
+  for (std::size_t o = 0; o < model->objectCount(); ++o) {
+    const std::string name(model->objectName(o));
+    kinds[name.substr(0, name.find('_'))]++;
+    fewest = std::min(fewest, model->objects[o].triangleCount);
+    most = std::max(most, model->objects[o].triangleCount);
+    smallest = std::min(smallest, model->objects[o].bounds.longestSide());
+    largest = std::max(largest, model->objects[o].bounds.longestSide());
+    if (name.starts_with("plate") && countBoundaryEdges(model->objectIndices(o)) > 0) ++openParts;
+  }
+  EXPECT_EQ(kinds.size(), 7u);
+  for (const auto& [kind, count] : kinds) EXPECT_GT(count, 100) << kind;
+  EXPECT_GT(most, 100 * fewest);                        // tessellation over two orders of magnitude
+  EXPECT_GT(largest, 500 * smallest);                   // sizes from millimetres to metres
+  EXPECT_EQ(openParts, std::uint64_t(kinds["plate"]));  // plates with holes are open sheets
+  // The assembly spans a fuselage and wings.
+  const Aabb box = model->bounds();
+  EXPECT_GT(box.size().x, 60.0f);
+  EXPECT_GT(box.size().y, 50.0f);
+}
+
+TEST(Cad, StandardBoltsAreInstancedInGlb) {
+  test::TempDir dir;
+  ASSERT_TRUE(generateCad({.objects = 2000, .seed = 2}, dir.file("a.glb")).ok());
+  const std::string bytes = test::readFile(dir.file("a.glb"));
+  std::uint32_t jsonLength = 0;
+  std::memcpy(&jsonLength, bytes.data() + 12, 4);
+  const auto document = nlohmann::json::parse(bytes.substr(20, jsonLength));
+  const std::size_t nodes = document["nodes"].size() - 1;  // minus the root
+  EXPECT_EQ(nodes, 2000u);
+  EXPECT_LT(document["meshes"].size(), nodes - 400);  // ~30% bolts share 24 catalogue meshes
+  std::set<int> used;
+  for (const auto& node : document["nodes"]) {
+    if (node.contains("mesh")) used.insert(node["mesh"].get<int>());
+  }
+  EXPECT_EQ(used.size(), document["meshes"].size());
+}
+
+TEST(Cad, DeterministicAndSeedDependent) {
+  test::TempDir dir;
+  ASSERT_TRUE(generateCad({.objects = 300, .seed = 7}, dir.file("a.ply")).ok());
+  ASSERT_TRUE(generateCad({.objects = 300, .seed = 7}, dir.file("b.ply")).ok());
+  ASSERT_TRUE(generateCad({.objects = 300, .seed = 8}, dir.file("c.ply")).ok());
+  EXPECT_EQ(test::readFile(dir.file("a.ply")), test::readFile(dir.file("b.ply")));
+  EXPECT_NE(test::readFile(dir.file("a.ply")), test::readFile(dir.file("c.ply")));
+}
+
+TEST(Cad, DetailScalesTessellation) {
+  test::TempDir dir;
+  Result<GenerateStats> coarse =
+      generateCad({.objects = 500, .seed = 3, .detail = 0.5}, dir.file("c.ply"));
+  Result<GenerateStats> fine =
+      generateCad({.objects = 500, .seed = 3, .detail = 2.0}, dir.file("f.ply"));
+  ASSERT_TRUE(coarse.ok() && fine.ok());
+  EXPECT_GT(fine->triangles, 2 * coarse->triangles);
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -1,0 +1,178 @@
+#include <cstring>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "lodforge/core/mesh.h"
+#include "lodforge/core/random.h"
+#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/gltf_reader.h"
+#include "lodforge/io/ply_reader.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+struct Glb {
+  nlohmann::json document;
+  std::uint32_t totalLength = 0, jsonLength = 0, binLength = 0;
+};
+
+Glb parseGlb(const std::string& bytes) {
+  Glb glb;
+  std::uint32_t header[5];
+  std::memcpy(header, bytes.data(), 20);
+  EXPECT_EQ(header[0], 0x46546C67u);
+  EXPECT_EQ(header[1], 2u);
+  glb.totalLength = header[2];
+  glb.jsonLength = header[3];
+  glb.document = nlohmann::json::parse(bytes.substr(20, glb.jsonLength));
+  if (bytes.size() > 20 + glb.jsonLength)
+    std::memcpy(&glb.binLength, bytes.data() + 20 + glb.jsonLength, 4);
+  return glb;
+}
+
+Model randomModel(std::uint64_t seed, int objects, int verticesPerObject) {
+  Random random(seed);
+  Model model;
+  ModelBuilder builder(model);
+  for (int o = 0; o < objects; ++o) {
+    builder.beginObject(fmt::format("part-{}", o));
+    for (int v = 0; v < verticesPerObject; ++v) {
+      builder.addVertex({float(random.uniform(-3, 3)), float(random.uniform(-3, 3)),
+                         float(random.uniform(-3, 3))});
+      model.normals.push_back(normalizeOr(
+          Vec3f{float(random.uniform(-1, 1)), float(random.uniform(-1, 1)), 1}, Vec3f{}));
+      model.colors.push_back(
+          {std::uint8_t(random.below(256)), 100, std::uint8_t(random.below(256)), 255});
+    }
+    for (int t = 0; t < verticesPerObject; ++t) {
+      const auto a = std::uint32_t(random.below(std::uint64_t(verticesPerObject)));
+      builder.addTriangle(a, (a + 1) % std::uint32_t(verticesPerObject),
+                          (a + 2) % std::uint32_t(verticesPerObject));
+    }
+  }
+  builder.endObject();
+  return model;
+}
+
+TEST(GlbWrite, ModelRoundTripsThroughOurReader) {
+  Model model = randomModel(1, 4, 30);
+  model.origin = {637000, 5106000, 100};  // geo-scale: the root node carries the translation
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(model, dir.file("m.glb")).ok());
+  Result<Model> back = readGltf(dir.file("m.glb"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->objectCount(), 4u);
+  EXPECT_EQ(back->indices, model.indices);
+  EXPECT_EQ(back->colors, model.colors);
+  for (std::size_t o = 0; o < 4; ++o) EXPECT_EQ(back->objectName(o), model.objectName(o));
+  for (std::size_t v = 0; v < model.vertexCount(); ++v) {
+    const Vec3d a = model.origin + toDouble(model.positions[v]),
+                b = back->origin + toDouble(back->positions[v]);
+    ASSERT_NEAR(a.x, b.x, 1e-6);
+    ASSERT_NEAR(a.y, b.y, 1e-6);
+    ASSERT_NEAR(a.z, b.z, 1e-6);
+    ASSERT_NEAR(dot(back->normals[v], model.normals[v]), 1.0f, 1e-6f);
+  }
+}
+
+TEST(GlbWrite, LayoutIsAlignedWithBoundsAndTheRightIndexWidth) {
+  // One object needs 32-bit indices (70,000 vertices), the others 16-bit.
+  Model model = randomModel(2, 2, 100);
+  Model big = randomModel(3, 1, 70'000);
+  ModelBuilder builder(model);
+  builder.beginObject("big");
+  model.positions.insert(model.positions.end(), big.positions.begin(), big.positions.end());
+  model.normals.insert(model.normals.end(), big.normals.begin(), big.normals.end());
+  model.colors.insert(model.colors.end(), big.colors.begin(), big.colors.end());
+  model.indices.insert(model.indices.end(), big.indices.begin(), big.indices.end());
+  builder.beginObject("empty");  // no triangles: a node without a mesh
+  builder.endObject();
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(model, dir.file("m.glb")).ok());
+  const std::string bytes = test::readFile(dir.file("m.glb"));
+  const Glb glb = parseGlb(bytes);
+  EXPECT_EQ(glb.totalLength, bytes.size());
+  EXPECT_EQ(glb.jsonLength % 4, 0u);
+  EXPECT_EQ(glb.binLength % 4, 0u);
+  for (const auto& view : glb.document["bufferViews"])
+    EXPECT_EQ(view["byteOffset"].get<std::uint64_t>() % 4, 0u);
+  const auto& accessors = glb.document["accessors"];
+  const auto& meshes = glb.document["meshes"];
+  ASSERT_EQ(meshes.size(), 3u);
+  EXPECT_EQ(accessors[meshes[0]["primitives"][0]["indices"].get<int>()]["componentType"], 5123);
+  EXPECT_EQ(accessors[meshes[2]["primitives"][0]["indices"].get<int>()]["componentType"], 5125);
+  // POSITION min/max are the exact float bounds.
+  const auto& position = accessors[meshes[0]["primitives"][0]["attributes"]["POSITION"].get<int>()];
+  const Aabb bounds = computeBounds(model.objectPositions(0));
+  EXPECT_EQ(position["min"][0].get<float>(), bounds.min.x);
+  EXPECT_EQ(position["max"][2].get<float>(), bounds.max.z);
+  const auto& nodes = glb.document["nodes"];
+  EXPECT_FALSE(nodes[3].contains("mesh"));
+  EXPECT_EQ(nodes[3]["name"], "empty");
+}
+
+TEST(GlbWrite, SpillingToDiskGivesTheSameFile) {
+  const Model model = randomModel(4, 20, 500);
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(model, dir.file("memory.glb")).ok());
+  GlbWriteOptions spill;
+  spill.spillBytes = 4096;
+  ASSERT_TRUE(writeGlb(model, dir.file("spilled.glb"), spill).ok());
+  EXPECT_EQ(test::readFile(dir.file("memory.glb")), test::readFile(dir.file("spilled.glb")));
+  EXPECT_EQ(test::listFolder(dir.path()).size(), 2u);  // the spill file is gone
+}
+
+TEST(GlbWrite, InstancedMeshesAndTransforms) {
+  test::TempDir dir;
+  Result<GlbWriter> writer = GlbWriter::create(dir.file("inst.glb"));
+  ASSERT_TRUE(writer.ok());
+  const std::vector<Vec3f> positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<std::uint32_t> indices = {0, 1, 2};
+  const std::uint32_t red = writer->addMaterial({1, 0, 0, 1}, "red");
+  Result<std::uint32_t> mesh = writer->addMesh({positions, {}, {}, indices}, "tri", red);
+  ASSERT_TRUE(mesh.ok());
+  for (int i = 0; i < 3; ++i) {
+    const Mat4d place = Mat4d::translation({double(i) * 10, 0, 0});
+    writer->addNode(fmt::format("copy {}", i), *mesh, &place);
+  }
+  ASSERT_TRUE(writer->finish().ok());
+  Result<Model> back = readGltf(dir.file("inst.glb"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->objectCount(), 3u);
+  EXPECT_EQ(toDouble(back->objectPositions(2)[1]) + back->origin, (Vec3d{21, 0, 0}));
+  EXPECT_EQ(back->colors[0], (Rgba8{255, 0, 0, 255}));
+  const Glb glb = parseGlb(test::readFile(dir.file("inst.glb")));
+  EXPECT_EQ(glb.document["meshes"].size(), 1u);
+}
+
+TEST(GlbWrite, RealModelsRoundTrip) {
+  test::TempDir dir;
+  for (const char* file : {"meshes/horse.ply", "meshes/2CylinderEngine.glb"}) {
+    const std::string path = test::dataPath(file);
+    Result<Model> model = fileExtension(path) == "ply" ? readPly(path) : readGltf(path);
+    ASSERT_TRUE(model.ok()) << model.error().message;
+    ASSERT_TRUE(writeGlb(*model, dir.file("copy.glb")).ok());
+    Result<Model> back = readGltf(dir.file("copy.glb"));
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    EXPECT_EQ(back->objectCount(), model->objectCount());
+    EXPECT_EQ(back->indices, model->indices);
+    EXPECT_EQ(back->positions.size(), model->positions.size());
+    for (std::size_t v = 0; v < model->vertexCount(); ++v) {
+      const Vec3d a = model->origin + toDouble(model->positions[v]),
+                  b = back->origin + toDouble(back->positions[v]);
+      ASSERT_LT(length(a - b), 1e-4 * (1 + length(a))) << file << " vertex " << v;
+    }
+  }
+}
+
+TEST(GlbWrite, UnwritableDestinationIsAnIoError) {
+  const Model model = randomModel(5, 1, 10);
+  const Status status = writeGlb(model, "/nonexistent-folder/out.glb");
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.kind(), ErrorKind::kIo);
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Every kind of GLB lodforge writes, checked by the Khronos glTF validator: conversions of the
+# real models in ../shared/data, the generated CAD assembly, a generated scan. Fails on any error.
+set -euo pipefail
+lodforge=$1 data=$2 out=$3
+here=$(cd "$(dirname "$0")" && pwd)
+validator="$here/js/node_modules/gltf-validator"
+[[ -d $validator ]] || { echo "gltf-validator is not installed: run scripts/install-deps.sh" >&2; exit 1; }
+rm -rf "$out" && mkdir -p "$out"
+for model in "$data"/meshes/*; do
+  name=$(basename "${model%.*}")
+  "$lodforge" -q convert "$model" -o "$out/$name.glb"
+done
+"$lodforge" -q convert "$data/meshes/stanford-bunny.obj" -o "$out/bunny-welded.glb" --weld
+"$lodforge" -q generate cad --objects 2000 --seed 5 -o "$out/cad.glb"
+"$lodforge" -q generate scan --triangles 200K -o "$out/scan.ply"
+"$lodforge" -q convert "$out/scan.ply" -o "$out/scan.glb"
+"$lodforge" -q generate cad --objects 300 -o "$out/cad.ply"
+"$lodforge" -q convert "$out/cad.ply" -o "$out/cad-from-ply.glb"
+count=$(ls "$out"/*.glb | wc -l)
+want=$(( $(ls "$data"/meshes | wc -l) + 4 ))
+[[ $count -eq $want ]] || { echo "expected $want GLBs, found $count" >&2; exit 1; }
+node "$here/js/validate-gltf.mjs" "$out"/*.glb

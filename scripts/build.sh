@@ -7,6 +7,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 name=${1:?usage: build.sh release|asan|fuzz}
 jobs=${JOBS:-2}
+# Clean clones (CI) reuse the compiler cache: paths are hashed relative to the checkout.
+export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=1
 case $name in
   release) args=(-DCMAKE_BUILD_TYPE=Release) ;;
   asan) args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DLODFORGE_SANITIZE=ON -DLODFORGE_BENCH=OFF) ;;

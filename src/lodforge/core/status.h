@@ -109,9 +109,13 @@ int exitCodeFor(const Status& status);
 
 }  // namespace lodforge
 
-// Propagate a failed Status/Result from the current function.
-#define LODFORGE_TRY(expr)                                      \
-  do {                                                          \
-    if (auto lodforge_status_ = (expr); !lodforge_status_.ok()) \
-      return lodforge::Status(lodforge_status_.error());        \
+// Propagate a failed Status/Result from the current function. The variable gets a unique name
+// so that uses nest (a lambda inside the expression may use it too).
+#define LODFORGE_TRY(expr) \
+  LODFORGE_TRY_NAMED_(expr, LODFORGE_CONCAT_(lodforge_status_, __COUNTER__))
+#define LODFORGE_CONCAT_(a, b) LODFORGE_CONCAT2_(a, b)
+#define LODFORGE_CONCAT2_(a, b) a##b
+#define LODFORGE_TRY_NAMED_(expr, name)                                        \
+  do {                                                                         \
+    if (auto name = (expr); !name.ok()) return lodforge::Status(name.error()); \
   } while (false)

@@ -6,7 +6,10 @@
 #include <optional>
 #include <vector>
 
-#include <tbb/parallel_for.h>
+#include <memory>
+
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
@@ -274,29 +277,6 @@ std::string partName(const PartPlan& plan, std::uint64_t index) {
   return fmt::format("{}_{:07}", kKindNames[static_cast<int>(plan.kind)], index);
 }
 
-// A batch of parts, planned and built in parallel. Bolts stay empty when `instanceBolts`.
-struct Batch {
-  std::uint64_t first = 0;
-  std::vector<PartPlan> plans;
-  std::vector<PartMesh> meshes;
-
-  void build(const CadOptions& options, std::uint64_t begin, std::uint64_t count,
-             bool instanceBolts) {
-    first = begin;
-    plans.resize(count);
-    meshes.resize(count);
-    tbb::parallel_for(std::uint64_t{0}, count, [&](std::uint64_t i) {
-      plans[i] = planPart(options.seed, begin + i);
-      meshes[i].clear();
-      if (plans[i].kind == Kind::kBolt) {
-        if (!instanceBolts) buildBolt(plans[i].bolt, options.seed, options.detail, meshes[i]);
-      } else {
-        buildPart(plans[i], options.detail, meshes[i]);
-      }
-    });
-  }
-};
-
 Rgba8 finishColor(int finish) {
   const auto& c = kFinishes[finish].color;
   auto channel = [](float x) {
@@ -305,22 +285,78 @@ Rgba8 finishColor(int finish) {
   return {channel(c[0]), channel(c[1]), channel(c[2]), channel(c[3])};
 }
 
+// A few consecutive parts travelling through the pipeline together.
+struct PartGroup {
+  std::uint64_t first = 0;
+  std::vector<PartPlan> plans;
+  std::vector<PartMesh> meshes;
+};
+
+// Plans and builds every part in parallel and hands them to `consume(index, plan, mesh)` in
+// index order. A bounded pipeline: at most kTokens groups of kGroupSize parts exist at once, so
+// memory does not depend on the number of parts. Bolts stay empty when `instanceBolts`. Stops at
+// the first error from `consume` or at Ctrl-C.
+template <class Consume>
+Status forEachPart(const CadOptions& options, bool instanceBolts, Progress& progress,
+                   Consume&& consume) {
+  constexpr std::uint64_t kGroupSize = 16;
+  const std::size_t tokens = 4 * static_cast<std::size_t>(tbb::this_task_arena::max_concurrency());
+  std::uint64_t next = 0;
+  Status status;
+  tbb::parallel_pipeline(
+      tokens, tbb::make_filter<void, PartGroup*>(
+                  tbb::filter_mode::serial_in_order,
+                  [&](tbb::flow_control& control) -> PartGroup* {
+                    if (next >= options.objects || !status.ok() || cancelRequested()) {
+                      control.stop();
+                      return nullptr;
+                    }
+                    auto* group = new PartGroup;
+                    group->first = next;
+                    next = std::min(options.objects, next + kGroupSize);
+                    return group;
+                  }) &
+                  tbb::make_filter<PartGroup*, PartGroup*>(
+                      tbb::filter_mode::parallel,
+                      [&](PartGroup* group) {
+                        const std::uint64_t count =
+                            std::min(kGroupSize, options.objects - group->first);
+                        group->plans.resize(count);
+                        group->meshes.resize(count);
+                        for (std::uint64_t i = 0; i < count; ++i) {
+                          PartPlan& plan = group->plans[i];
+                          plan = planPart(options.seed, group->first + i);
+                          if (plan.kind != Kind::kBolt)
+                            buildPart(plan, options.detail, group->meshes[i]);
+                          else if (!instanceBolts)
+                            buildBolt(plan.bolt, options.seed, options.detail, group->meshes[i]);
+                        }
+                        return group;
+                      }) &
+                  tbb::make_filter<PartGroup*, void>(
+                      tbb::filter_mode::serial_in_order, [&](PartGroup* group) {
+                        const std::unique_ptr<PartGroup> owned(group);
+                        for (std::size_t i = 0; i < group->plans.size() && status.ok(); ++i) {
+                          status = consume(group->first + i, group->plans[i], group->meshes[i]);
+                        }
+                        progress.advance(group->plans.size());
+                      }));
+  LODFORGE_TRY(status);
+  return checkCancelled();
+}
+
 Result<GenerateStats> writePly(const CadOptions& options, const std::string& path) {
   // Pass 1: counts (the PLY header needs them before any data).
   GenerateStats stats;
   stats.objects = options.objects;
-  Batch batch;
   {
     Progress progress("cad: counting", options.objects);
-    for (std::uint64_t first = 0; first < options.objects; first += kBatch) {
-      LODFORGE_TRY(checkCancelled());
-      batch.build(options, first, std::min(kBatch, options.objects - first), false);
-      for (const PartMesh& mesh : batch.meshes) {
-        stats.vertices += mesh.positions.size();
-        stats.triangles += mesh.indices.size() / 3;
-      }
-      progress.advance(batch.plans.size());
-    }
+    LODFORGE_TRY(forEachPart(options, false, progress,
+                             [&](std::uint64_t, const PartPlan&, const PartMesh& mesh) {
+                               stats.vertices += mesh.positions.size();
+                               stats.triangles += mesh.indices.size() / 3;
+                               return Status();
+                             }));
   }
   if (stats.vertices > 0xFFFFFFFFull) {
     return Error{ErrorKind::kLimit,
@@ -339,36 +375,32 @@ Result<GenerateStats> writePly(const CadOptions& options, const std::string& pat
   if (!writer) return writer.status();
 
   // Pass 2: the same parts again, placed in assembly coordinates.
-  Progress progress("cad: writing", options.objects);
   std::uint64_t vertexBase = 0;
   std::vector<Vec3f> positions, normals;
   std::vector<Rgba8> colors;
   std::vector<std::uint32_t> indices, ids;
-  for (std::uint64_t first = 0; first < options.objects; first += kBatch) {
-    LODFORGE_TRY(checkCancelled());
-    batch.build(options, first, std::min(kBatch, options.objects - first), false);
-    for (std::size_t i = 0; i < batch.plans.size(); ++i) {
-      const PartPlan& plan = batch.plans[i];
-      const PartMesh& mesh = batch.meshes[i];
-      const Mat4d normalMatrix = plan.transform.normalMatrix();
-      positions.resize(mesh.positions.size());
-      normals.resize(mesh.positions.size());
-      for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-        positions[v] = toFloat(plan.transform.transformPoint(toDouble(mesh.positions[v])));
-        normals[v] = toFloat(
-            normalizeOr(normalMatrix.transformVector(toDouble(mesh.normals[v])), Vec3d{0, 0, 1}));
-      }
-      colors.assign(mesh.positions.size(), finishColor(plan.finish));
-      indices.resize(mesh.indices.size());
-      for (std::size_t k = 0; k < mesh.indices.size(); ++k)
-        indices[k] = static_cast<std::uint32_t>(mesh.indices[k] + vertexBase);
-      ids.assign(mesh.indices.size() / 3, static_cast<std::uint32_t>(batch.first + i));
-      LODFORGE_TRY(writer->writeVertices(positions, normals, colors));
-      LODFORGE_TRY(writer->writeTriangles(indices, ids));
-      vertexBase += mesh.positions.size();
-    }
-    progress.advance(batch.plans.size());
-  }
+  Progress progress("cad: writing", options.objects);
+  LODFORGE_TRY(forEachPart(
+      options, false, progress,
+      [&](std::uint64_t index, const PartPlan& plan, const PartMesh& mesh) {
+        const Mat4d normalMatrix = plan.transform.normalMatrix();
+        positions.resize(mesh.positions.size());
+        normals.resize(mesh.positions.size());
+        for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+          positions[v] = toFloat(plan.transform.transformPoint(toDouble(mesh.positions[v])));
+          normals[v] = toFloat(
+              normalizeOr(normalMatrix.transformVector(toDouble(mesh.normals[v])), Vec3d{0, 0, 1}));
+        }
+        colors.assign(mesh.positions.size(), finishColor(plan.finish));
+        indices.resize(mesh.indices.size());
+        for (std::size_t k = 0; k < mesh.indices.size(); ++k)
+          indices[k] = static_cast<std::uint32_t>(mesh.indices[k] + vertexBase);
+        ids.assign(mesh.indices.size() / 3, static_cast<std::uint32_t>(index));
+        vertexBase += mesh.positions.size();
+        LODFORGE_TRY(writer->writeVertices(positions, normals, colors));
+        return writer->writeTriangles(indices, ids);
+      }));
+  progress.finish();
   stats.bytes = writer->fileBytes();
   LODFORGE_TRY(writer->finish());
   return stats;
@@ -386,52 +418,48 @@ Result<GenerateStats> writeGlb(const CadOptions& options, const std::string& pat
 
   GenerateStats stats;
   stats.objects = options.objects;
-  Batch batch;
   PartMesh bolt;
   Progress progress("cad", options.objects);
-  for (std::uint64_t first = 0; first < options.objects; first += kBatch) {
-    LODFORGE_TRY(checkCancelled());
-    batch.build(options, first, std::min(kBatch, options.objects - first), true);
-    for (std::size_t i = 0; i < batch.plans.size(); ++i) {
-      const PartPlan& plan = batch.plans[i];
-      std::uint32_t meshIndex = 0;
-      if (plan.kind == Kind::kBolt) {
-        // Standard parts are instanced: the catalogue mesh is written once, at first use.
-        const auto entry = static_cast<std::size_t>(plan.bolt);
-        if (!boltMeshes[entry]) {
-          bolt.clear();
-          buildBolt(plan.bolt, options.seed, options.detail, bolt);
-          Result<std::uint32_t> added = writer->addMesh(
-              {bolt.positions, bolt.normals, {}, bolt.indices}, fmt::format("bolt M{}", entry),
-              materials[static_cast<std::size_t>(plan.finish)]);
+  LODFORGE_TRY(forEachPart(
+      options, true, progress,
+      [&](std::uint64_t index, const PartPlan& plan, const PartMesh& mesh) -> Status {
+        std::uint32_t meshIndex = 0;
+        const auto material = materials[static_cast<std::size_t>(plan.finish)];
+        if (plan.kind == Kind::kBolt) {
+          // Standard parts are instanced: the catalogue mesh is written once, at first use.
+          const auto entry = static_cast<std::size_t>(plan.bolt);
+          if (!boltMeshes[entry]) {
+            bolt.clear();
+            buildBolt(plan.bolt, options.seed, options.detail, bolt);
+            Result<std::uint32_t> added =
+                writer->addMesh({bolt.positions, bolt.normals, {}, bolt.indices},
+                                fmt::format("bolt M{}", entry), material);
+            if (!added) return added.status();
+            boltMeshes[entry] = *added;
+            boltVertices[entry] = bolt.positions.size();
+            boltTriangles[entry] = bolt.indices.size() / 3;
+          }
+          meshIndex = *boltMeshes[entry];
+          stats.vertices += boltVertices[entry];
+          stats.triangles += boltTriangles[entry];
+        } else {
+          Result<std::uint32_t> added =
+              writer->addMesh({mesh.positions, mesh.normals, {}, mesh.indices}, {}, material);
           if (!added) return added.status();
-          boltMeshes[entry] = *added;
-          boltVertices[entry] = bolt.positions.size();
-          boltTriangles[entry] = bolt.indices.size() / 3;
+          meshIndex = *added;
+          stats.vertices += mesh.positions.size();
+          stats.triangles += mesh.indices.size() / 3;
         }
-        meshIndex = *boltMeshes[entry];
-        stats.vertices += boltVertices[entry];
-        stats.triangles += boltTriangles[entry];
-      } else {
-        const PartMesh& mesh = batch.meshes[i];
-        Result<std::uint32_t> added =
-            writer->addMesh({mesh.positions, mesh.normals, {}, mesh.indices}, {},
-                            materials[static_cast<std::size_t>(plan.finish)]);
-        if (!added) return added.status();
-        meshIndex = *added;
-        stats.vertices += mesh.positions.size();
-        stats.triangles += mesh.indices.size() / 3;
-      }
-      writer->addNode(partName(plan, batch.first + i), meshIndex, &plan.transform);
-    }
-    if (writer->binaryBytes() > (std::uint64_t{15} << 28)) {  // 3.75 GiB: stop before 4 GiB
-      return Error{ErrorKind::kLimit,
-                   fmt::format("{}: {} objects do not fit in one GLB (4 GiB); write a .ply "
-                               "instead",
-                               path, options.objects)};
-    }
-    progress.advance(batch.plans.size());
-  }
+        writer->addNode(partName(plan, index), meshIndex, &plan.transform);
+        if (writer->binaryBytes() >
+            (std::uint64_t{15} << 28)) {  // 3.75 GiB: stop before GLB's 4 GiB
+          return Error{
+              ErrorKind::kLimit,
+              fmt::format("{}: {} objects do not fit in one GLB (4 GiB); write a .ply instead",
+                          path, options.objects)};
+        }
+        return Status();
+      }));
   progress.finish();
   LODFORGE_TRY(writer->finish());
   Result<std::uint64_t> size = fileSize(path);

@@ -16,7 +16,9 @@ namespace lodforge {
 namespace {
 
 constexpr std::uint32_t kUnused = ~0u;
-constexpr std::uint64_t kRowsPerBlock = 32;
+// A block holds about this many grid points (positions, normals, colours: ~40 bytes each), so
+// memory stays flat however wide the grid is.
+constexpr std::uint64_t kPointsPerBlock = 1 << 18;
 
 // A triangle of a cell row: corners as (column, 0 = lower vertex row, 1 = upper vertex row).
 struct Corner {
@@ -206,7 +208,7 @@ Result<GenerateStats> generateScan(const ScanOptions& options, const std::string
     const std::uint64_t row = walk.row();
     if (!block.holds(row)) {
       LODFORGE_TRY(checkCancelled());
-      block.compute(row, kRowsPerBlock);
+      block.compute(row, std::clamp<std::uint64_t>(kPointsPerBlock / (columns + 3), 2, 64));
     }
     positions.clear();
     normals.clear();

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
 
 namespace lodforge {
 
@@ -247,7 +248,9 @@ Status GlbWriter::finish() {
 Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptions& options) {
   Result<GlbWriter> writer = GlbWriter::create(path, options);
   if (!writer) return writer.status();
+  Progress progress("writing " + path, model.triangleCount());
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
+    if (o % 1024 == 0) LODFORGE_TRY(checkCancelled());
     const ObjectRecord& record = model.objects[o];
     std::optional<std::uint32_t> mesh;
     if (record.triangleCount > 0) {
@@ -263,7 +266,9 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
       mesh = *added;
     }
     writer->addNode(model.objectName(o), mesh);
+    progress.advance(record.triangleCount);
   }
+  progress.finish();
   writer->setRootTranslation(model.origin);
   return writer->finish();
 }

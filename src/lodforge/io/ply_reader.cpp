@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "lodforge/core/mesh.h"
+#include "lodforge/core/progress.h"
 
 namespace lodforge {
 
@@ -711,7 +712,10 @@ Result<Model> readAll(PlyReader& reader, const std::string& name,
   Model model;
   bool originChosen = false;
   PlyBatch batch;
+  Progress progress("reading " + std::filesystem::path(name).filename().string(),
+                    header.vertexCount + header.faceCount);
   while (true) {
+    LODFORGE_TRY(checkCancelled());
     Result<bool> more = reader.next(batch);
     if (!more) return more.status();
     if (!*more) break;
@@ -731,7 +735,9 @@ Result<Model> readAll(PlyReader& reader, const std::string& name,
       triangleObjects.insert(triangleObjects.end(), batch.triangleObjects.begin(),
                              batch.triangleObjects.end());
     }
+    progress.advance(batch.count);
   }
+  progress.finish();
   if (reader.truncation()) {
     if (warnings) warnings->push_back(*reader.truncation() + "; kept what came before");
     // Salvaged: faces that come before a cut-short vertex list may name missing vertices.

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "lodforge/core/progress.h"
+
 namespace lodforge {
 
 namespace {
@@ -137,7 +139,9 @@ Status writePly(const Model& model, const std::string& path) {
   // Faces per object: local indices become global, the object's index becomes its id.
   std::vector<std::uint32_t> global;
   std::vector<std::uint32_t> ids;
+  Progress progress("writing " + path, model.triangleCount());
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
+    if (o % 1024 == 0) LODFORGE_TRY(checkCancelled());
     const ObjectRecord& record = model.objects[o];
     const auto indices = model.objectIndices(o);
     global.resize(indices.size());
@@ -145,7 +149,9 @@ Status writePly(const Model& model, const std::string& path) {
       global[i] = static_cast<std::uint32_t>(indices[i] + record.vertexOffset);
     if (layout.objectIds) ids.assign(record.triangleCount, static_cast<std::uint32_t>(o));
     LODFORGE_TRY(writer->writeTriangles(global, ids));
+    progress.advance(record.triangleCount);
   }
+  progress.finish();
   return writer->finish();
 }
 

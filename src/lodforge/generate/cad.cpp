@@ -27,7 +27,6 @@ constexpr double kFuselageLength = 64.0;  // metres, about a 777-200
 constexpr double kFuselageRadius = 3.1;
 constexpr double kWingSpan = 30.0;      // half span
 constexpr int kBoltCatalogue = 24;      // standard bolt sizes, instanced in GLB output
-constexpr std::uint64_t kBatch = 1024;  // parts built in parallel, then written in order
 
 enum class Kind : std::uint8_t { kBolt, kTube, kBox, kBracket, kPlate, kBeam, kRod };
 constexpr const char* kKindNames[] = {"bolt", "tube", "box", "bracket", "plate", "beam", "rod"};

@@ -2,7 +2,7 @@
 add_library(lodforge_warnings INTERFACE)
 target_compile_options(lodforge_warnings INTERFACE
   -Wall -Wextra -Wshadow -Wconversion -Wsign-conversion -Wnon-virtual-dtor
-  -Wold-style-cast -Woverloaded-virtual -Wnull-dereference -Werror)
+  -Wold-style-cast -Woverloaded-virtual -Werror)
 if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   # GCC 12 reports false positives inside libstdc++ at -O3 (PR 105651, 106199)
   target_compile_options(lodforge_warnings INTERFACE -Wno-restrict -Wno-array-bounds -Wno-stringop-overflow)

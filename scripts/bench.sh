@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them.
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify runs only the simplifier part.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 lodforge=$(pwd)/build/release/lodforge
@@ -14,9 +14,9 @@ echo "$(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB, $(lscpu | sed -n
 
 echo
 echo "== kernels (Google Benchmark)"
-build/release/bench/bench_kernels --benchmark_min_time=0.5
+[[ ${BENCH_ONLY:-} == simplify ]] || build/release/bench/bench_kernels --benchmark_min_time=0.5
 
-measure() {  # name, then the command; prints a table row and removes the output file
+measure() {  # name, then the command; prints a table row and removes the output file (the last argument)
   local name=$1; shift
   local log=$work/time.log
   /usr/bin/time -v "$@" > /dev/null 2> "$log" || { cat "$log"; exit 1; }
@@ -27,6 +27,41 @@ measure() {  # name, then the command; prints a table row and removes the output
   printf '| %-44s | %9s | %8d MiB | %7s |\n' "$name" "$wall" $((rss / 1024)) "$out"
   rm -f "${@: -1}"
 }
+
+if [[ ${BENCH_ONLY:-} == simplify ]]; then skip_generators=1; fi
+
+simplify_section() {
+  echo
+  echo "== progressive build versus meshoptimizer (bench_simplify, best of 5 runs; 1 run above 5 M triangles)"
+  local data=${LODFORGE_DATA:-../shared/data}
+  [[ -d $data ]] || data=/work/shared/data
+  "$lodforge" -q generate scan --triangles 97K -o "$work/scan97k.ply"
+  "$lodforge" -q generate scan --triangles 10M -o "$work/scan10m.ply"
+  "$lodforge" -q generate cad --objects 100K -o "$work/cad100k.ply"
+  build/release/bench/bench_simplify --quality "$work/scan97k.ply" "$data"/meshes/stanford-bunny.obj \
+    "$data"/meshes/horse.ply "$data"/meshes/2CylinderEngine.glb "$data"/meshes/as1_motor.glb \
+    "$data"/meshes/Motor-c.glb "$work/scan10m.ply"
+  build/release/bench/bench_simplify "$work/cad100k.ply"
+  echo
+  echo "== lodforge build: wall time and peak RSS (1 and 2 threads)"
+  printf '| %-44s | %9s | %12s | %7s |\n' command wall "peak RSS" output
+  printf '|%s|%s|%s|%s|\n' "$(printf -- '-%.0s' {1..46})" "-----------" "--------------" "---------"
+  for input in scan10m cad100k; do
+    for threads in 1 2; do
+      measure "build $input.ply --threads $threads" "$lodforge" -q --threads "$threads" build "$work/$input.ply" -o "$work/$input.lfp"
+    done
+  done
+  "$lodforge" -q build "$work/cad100k.ply" -o "$work/cad100k.lfp"
+  "$lodforge" info "$work/cad100k.lfp" | grep -E "LOD data|triangles|vertices"
+  rm -f "$work"/scan97k.ply "$work"/scan10m.ply "$work"/cad100k.ply "$work"/cad100k.lfp
+  if [[ ${BENCH_LARGE:-0} == 1 ]]; then
+    "$lodforge" -q generate cad --objects 1M -o "$work/cad1m.ply"
+    measure "build cad1m.ply (1,000,000 parts, streamed)" "$lodforge" -q build "$work/cad1m.ply" -o "$work/cad1m.lfp"
+    rm -f "$work/cad1m.ply"
+  fi
+}
+
+if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
 echo "== generators (wall time, peak RSS, output size)"
@@ -43,3 +78,4 @@ for n in "${sizes_scan[@]}"; do
   measure "generate scan --triangles $n" "$lodforge" -q generate scan --triangles "$n" -o "$work/scan.ply"
 done
 measure "generate points --points 10M" "$lodforge" -q generate points --points 10M -o "$work/points.ply"
+simplify_section

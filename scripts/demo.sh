@@ -22,6 +22,13 @@ for model in "$out/cad-assembly.glb" "$out/scan.ply" "$out/points.ply"; do
   "$lodforge" info "$model"
 done
 
+section "progressive meshes for every part of the assembly, and two levels out of them"
+"$lodforge" build "$out/cad-assembly.glb" -o "$out/cad-assembly.lfp"
+"$lodforge" info "$out/cad-assembly.lfp"
+"$lodforge" extract "$out/cad-assembly.lfp" --ratio 0.25 -o "$out/cad-assembly-25pct.glb"
+"$lodforge" build "$out/scan.ply" -o "$out/scan.lfp"
+"$lodforge" extract "$out/scan.lfp" --ratio 0.02 -o "$out/scan-2pct.glb"
+
 if [[ -d $data/meshes ]]; then
   for model in "$data"/meshes/*; do
     name=$(basename "${model%.*}")

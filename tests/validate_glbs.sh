@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Every kind of GLB lodforge writes, checked by the Khronos glTF validator: conversions of the
-# real models in ../shared/data, the generated CAD assembly, a generated scan. Fails on any error.
+# real models in ../shared/data, the generated CAD assembly, a generated scan, levels extracted
+# from a progressive package. Fails on any error.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -17,7 +18,10 @@ done
 "$lodforge" -q convert "$out/scan.ply" -o "$out/scan.glb"
 "$lodforge" -q generate cad --objects 300 -o "$out/cad.ply"
 "$lodforge" -q convert "$out/cad.ply" -o "$out/cad-from-ply.glb"
+"$lodforge" -q build "$out/cad.glb" -o "$out/cad.lfp"
+"$lodforge" -q extract "$out/cad.lfp" --ratio 0.25 -o "$out/cad-lod25.glb"
+"$lodforge" -q extract "$out/cad.lfp" --ratio 0 -o "$out/cad-lod0.glb"
 count=$(ls "$out"/*.glb | wc -l)
-want=$(( $(ls "$data"/meshes | wc -l) + 4 ))
+want=$(( $(ls "$data"/meshes | wc -l) + 6 ))
 [[ $count -eq $want ]] || { echo "expected $want GLBs, found $count" >&2; exit 1; }
 node "$here/js/validate-gltf.mjs" "$out"/*.glb

@@ -33,6 +33,8 @@ void say(const Global& global, const std::string& text);
 void detail(const Global& global, const std::string& text);
 
 void addInfo(CLI::App& app, const Global& global, Run& run);
+void addBuild(CLI::App& app, const Global& global, Run& run);
+void addExtract(CLI::App& app, const Global& global, Run& run);
 void addConvert(CLI::App& app, const Global& global, Run& run);
 void addGenerate(CLI::App& app, const Global& global, Run& run);
 

@@ -12,6 +12,7 @@
 #include "lodforge/core/units.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
+#include "lodforge/simplify/package.h"
 
 namespace lodforge::cli {
 
@@ -115,6 +116,69 @@ void print(const std::string& path, const Summary& s) {
   fmt::print("memory     {} to load\n", formatBytes(s.memoryBytes));
 }
 
+// A progressive package: counts, levels, and what the LOD bookkeeping costs.
+Status describePackage(const std::string& path, bool json) {
+  Result<Package> package = Package::open(path);
+  if (!package) return package.status();
+  const PackageHeader& h = package->header();
+  std::uint64_t minVertices = 0, minTriangles = 0;
+  double maxError = 0;
+  for (std::size_t i = 0; i < package->objectCount(); ++i) {
+    minVertices += package->object(i).minVertexCount;
+    minTriangles += package->object(i).minTriangleCount;
+    if (!package->error(i).empty())
+      maxError = std::max(maxError, static_cast<double>(package->error(i).front()));
+  }
+  const std::uint64_t lodBytes = package->sectionBytes(PackageSection::kEcol) +
+                                 package->sectionBytes(PackageSection::kMap) +
+                                 package->sectionBytes(PackageSection::kError);
+  const double lodShare = static_cast<double>(lodBytes) /
+                          static_cast<double>(std::max<std::uint64_t>(1, package->fileBytes()));
+  if (json) {
+    nlohmann::json j = {{"file", path},
+                        {"format", "lodforge package"},
+                        {"version", h.version},
+                        {"fileBytes", package->fileBytes()},
+                        {"objects", h.objectCount},
+                        {"vertices", h.vertexCount},
+                        {"triangles", h.triangleCount},
+                        {"minVertices", minVertices},
+                        {"minTriangles", minTriangles},
+                        {"levels", h.levelCount},
+                        {"normals", h.hasNormals()},
+                        {"colors", h.hasColors()},
+                        {"lodBytes", lodBytes},
+                        {"maxError", maxError},
+                        {"origin", {h.origin[0], h.origin[1], h.origin[2]}}};
+    for (std::uint32_t s = 0; s < kPackageSections; ++s)
+      j["sections"][std::string(packageSectionName(static_cast<PackageSection>(s)))] =
+          h.sections[s].bytes;
+    fmt::print("{}\n", j.dump(2));
+    return {};
+  }
+  fmt::print("file       {}\n", path);
+  fmt::print("format     lodforge package v{} ({})\n", h.version,
+             formatBytes(package->fileBytes()));
+  fmt::print("objects    {}\n", formatCount(h.objectCount));
+  fmt::print("vertices   {} full, {} at the simplest level{}\n", formatCount(h.vertexCount),
+             formatCount(minVertices), h.hasColors() ? " (normals, colors)" : " (normals)");
+  fmt::print("triangles  {} full, {} at the simplest level\n", formatCount(h.triangleCount),
+             formatCount(minTriangles));
+  fmt::print("levels     {} (every vertex count of every object)\n", formatCount(h.levelCount));
+  fmt::print("error      up to {:.6g} model units at the simplest level\n", maxError);
+  fmt::print("bounds     min ({:.6g}, {:.6g}, {:.6g})  max ({:.6g}, {:.6g}, {:.6g})\n",
+             h.origin[0] + h.boundsMin[0], h.origin[1] + h.boundsMin[1],
+             h.origin[2] + h.boundsMin[2], h.origin[0] + h.boundsMax[0],
+             h.origin[1] + h.boundsMax[1], h.origin[2] + h.boundsMax[2]);
+  fmt::print("LOD data   ECol + Map + error = {} ({:.1f}% of the package)\n", formatBytes(lodBytes),
+             100 * lodShare);
+  fmt::print("sections  ");
+  for (std::uint32_t s = 0; s < kPackageSections; ++s)
+    fmt::print(" {} {}{}", packageSectionName(static_cast<PackageSection>(s)),
+               formatBytes(h.sections[s].bytes), s + 1 < kPackageSections ? "," : "\n");
+  return {};
+}
+
 }  // namespace
 
 void addInfo(CLI::App& app, const Global& global, Run& run) {
@@ -125,12 +189,15 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("info", "Print a file's format, counts, bounds and load cost");
-  sub->add_option("FILE", options->path, "A .ply .obj .stl .gltf or .glb file")->required();
+  sub->add_option("FILE", options->path, "A .ply .obj .stl .gltf .glb model or a .lfp package")
+      ->required();
   sub->add_flag("--json", options->json, "Print JSON instead of text");
   sub->add_flag("--salvage", options->salvage,
                 "Read a truncated PLY up to the cut (with a warning)");
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
+      if (fileExtension(options->path) == "lfp")
+        return describePackage(options->path, options->json);
       const FileFormat format = formatFromPath(options->path);
       if (format == FileFormat::kUnknown)
         return Error{ErrorKind::kUsage,

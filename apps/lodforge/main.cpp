@@ -28,6 +28,8 @@ int main(int argc, char** argv) {
   cli::Run run;
   cli::addInfo(app, global, run);
   cli::addConvert(app, global, run);
+  cli::addBuild(app, global, run);
+  cli::addExtract(app, global, run);
   cli::addGenerate(app, global, run);
 
   try {

@@ -2,6 +2,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -212,6 +213,100 @@ TEST(Cli, CtrlCCancelsAndLeavesNothingBehind) {
       << test::readFile(err);
   std::remove(err.c_str());
   EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{});
+}
+
+}  // namespace
+}  // namespace lodforge
+
+namespace lodforge {
+namespace {
+
+TEST(CliPackage, BuildInfoAndExtract) {
+  test::TempDir dir;
+  const std::string package = dir.file("bunny.lfp");
+  Outcome o =
+      lodforge("build " + test::dataPath("meshes/stanford-bunny.obj") + " -o " + package, dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("69,451 triangles"), std::string::npos) << o.out;
+  const nlohmann::json j = info(package, dir);
+  EXPECT_EQ(j["format"], "lodforge package");
+  EXPECT_EQ(j["objects"], 1u);
+  EXPECT_EQ(j["vertices"], 34'834u);
+  EXPECT_EQ(j["triangles"], 69'451u);
+  EXPECT_LT(j["minTriangles"].get<std::uint64_t>(), 1000u);
+  EXPECT_GT(j["lodBytes"].get<std::uint64_t>(), 0u);
+  const Outcome text = lodforge("info " + package, dir);
+  EXPECT_NE(text.out.find("LOD data   ECol + Map + error"), std::string::npos) << text.out;
+
+  o = lodforge("extract " + package + " --ratio 0.1 -o " + dir.file("tenth.glb"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto tenth = info(dir.file("tenth.glb"), dir);
+  EXPECT_NEAR(tenth["vertices"].get<double>(), 3483, 1);
+  o = lodforge("extract " + package + " --error 0.001 -o " + dir.file("err.ply"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_LT(info(dir.file("err.ply"), dir)["triangles"].get<std::uint64_t>(), 69'451u);
+  EXPECT_EQ(
+      lodforge("extract " + package + " --ratio 0.5 --error 1 -o " + dir.file("x.glb"), dir).code,
+      2);
+  EXPECT_EQ(lodforge("extract " + package + " --ratio 2 -o " + dir.file("x.glb"), dir).code, 2);
+  EXPECT_EQ(
+      lodforge("build " + test::dataPath("meshes/horse.ply") + " -o " + dir.file("horse.glb"), dir)
+          .code,
+      2);
+}
+
+TEST(CliPackage, DamagedPackagesAreRefusedWithExitCode2) {
+  test::TempDir dir;
+  const std::string package = dir.file("m.lfp");
+  ASSERT_EQ(
+      lodforge("-q build " + test::dataPath("meshes/Motor-c.glb") + " -o " + package, dir).code, 0);
+  const std::string bytes = test::readFile(package);
+  test::writeFile(dir.file("cut.lfp"), bytes.substr(0, bytes.size() - 100));
+  std::string flipped = bytes;
+  flipped[flipped.size() / 2] ^= 1;
+  test::writeFile(dir.file("flipped.lfp"), flipped);
+  test::writeFile(dir.file("text.lfp"), "not a package at all, just some text that is long enough");
+  for (const char* name : {"cut.lfp", "flipped.lfp", "text.lfp"}) {
+    for (const std::string& command :
+         {"info " + dir.file(name), "extract " + dir.file(name) + " -o " + dir.file("out.glb")}) {
+      const Outcome o = lodforge(command, dir);
+      EXPECT_EQ(o.code, 2) << name << ": " << o.err;
+      EXPECT_EQ(o.err.rfind("lodforge: " + dir.file(name) + ": byte ", 0), 0u) << o.err;
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out.glb")));
+}
+
+// The memory limit is real: a model several times larger than the limit builds under it.
+TEST(CliPackage, BuildStaysUnderItsMemoryLimit) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate cad --objects 20K --seed 3 -o " + dir.file("big.ply"), dir).code,
+            0);
+  const auto inputBytes = std::filesystem::file_size(dir.file("big.ply"));
+  constexpr std::uint64_t kLimit = 96ull << 20;
+  ASSERT_GT(inputBytes, 2 * kLimit);  // the input is larger than the limit
+  const std::string binary = LODFORGE_BINARY;
+  std::vector<std::string> args = {binary,
+                                   "-q",
+                                   "--memory-limit",
+                                   "96M",
+                                   "build",
+                                   dir.file("big.ply"),
+                                   "-o",
+                                   dir.file("big.lfp")};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), nullptr, nullptr, argv.data(), environ), 0);
+  int status = 0;
+  struct rusage usage {};
+  ASSERT_EQ(::wait4(pid, &status, 0, &usage), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  const std::uint64_t peak = static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;
+  EXPECT_LT(peak, kLimit) << "peak RSS " << peak / (1 << 20) << " MiB";
+  EXPECT_EQ(info(dir.file("big.lfp"), dir)["objects"], 20'000u);
 }
 
 }  // namespace

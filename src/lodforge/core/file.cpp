@@ -17,7 +17,6 @@ namespace lodforge {
 
 namespace {
 constexpr std::size_t kReadBuffer = 1 << 20;
-constexpr std::size_t kWriteBuffer = 4 << 20;
 }  // namespace
 
 // --- ByteSource -------------------------------------------------------------------------------
@@ -153,13 +152,13 @@ std::string temporaryPathFor(const std::string& path) {
   return fmt::format("{}.tmp-{}-{}", path, ::getpid(), counter++);
 }
 
-Result<OutputFile> OutputFile::create(const std::string& path) {
+Result<OutputFile> OutputFile::create(const std::string& path, std::size_t bufferBytes) {
   OutputFile file;
   file.path_ = path;
   file.tempPath_ = temporaryPathFor(path);
   file.fd_ = ::open(file.tempPath_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (file.fd_ < 0) return ioErrorFromErrno(path, "create");
-  file.buffer_.resize(kWriteBuffer);
+  file.buffer_.resize(std::max<std::size_t>(bufferBytes, 4096));
   return file;
 }
 
@@ -240,6 +239,12 @@ Status OutputFile::appendFileContents(const std::string& path, std::uint64_t byt
   const int in = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (in < 0) return ioErrorFromErrno(path, "open");
   std::uint64_t left = bytes;
+  // In-kernel copy first (no trip through user space); plain read/write where it is refused.
+  while (left > 0) {
+    const ssize_t copied = ::copy_file_range(in, nullptr, fd_, nullptr, left, 0);
+    if (copied <= 0) break;
+    left -= static_cast<std::uint64_t>(copied);
+  }
   while (left > 0) {
     const ssize_t got = ::read(in, buffer_.data(), std::min<std::uint64_t>(left, buffer_.size()));
     if (got <= 0) {

@@ -61,7 +61,8 @@ class ByteSource {
 // commit (error, cancel) it removes the temporary, so no half-written output is ever left.
 class OutputFile {
  public:
-  static Result<OutputFile> create(const std::string& path);
+  static Result<OutputFile> create(const std::string& path,
+                                   std::size_t bufferBytes = std::size_t{4} << 20);
   OutputFile(OutputFile&& other) noexcept;
   OutputFile& operator=(OutputFile&& other) noexcept;
   OutputFile(const OutputFile&) = delete;

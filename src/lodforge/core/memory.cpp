@@ -1,5 +1,7 @@
 #include "lodforge/core/memory.h"
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstring>
 
@@ -24,6 +26,13 @@ std::uint64_t statusField(const char* field) {
   return kib * 1024;
 }
 }  // namespace
+
+std::uint64_t physicalMemoryBytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), pageSize = ::sysconf(_SC_PAGESIZE);
+  return pages > 0 && pageSize > 0
+             ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(pageSize)
+             : 0;
+}
 
 std::uint64_t currentRssBytes() {
   return statusField("VmRSS:");

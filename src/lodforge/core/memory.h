@@ -9,6 +9,7 @@
 
 namespace lodforge {
 
+std::uint64_t physicalMemoryBytes();
 std::uint64_t currentRssBytes();
 std::uint64_t peakRssBytes();  // VmHWM: the high-water mark since the process started
 

@@ -15,6 +15,7 @@ int exitCodeFor(const Status& status) {
   switch (status.kind()) {
     case ErrorKind::kBadInput:
     case ErrorKind::kUsage:
+    case ErrorKind::kUnsupported:
       return 2;
     default:
       return 1;

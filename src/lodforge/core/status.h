@@ -14,12 +14,13 @@
 namespace lodforge {
 
 enum class ErrorKind : std::uint8_t {
-  kBadInput,   // the input is malformed or unsupported: exit code 2
-  kUsage,      // the command line is wrong: exit code 2
-  kIo,         // the system failed us (open, write, disk full): exit code 1
-  kCancelled,  // the user interrupted: exit code 1
-  kLimit,      // a memory or size limit would be exceeded: exit code 1
-  kInternal,   // a bug we caught: exit code 1
+  kBadInput,     // the input is malformed or unsupported: exit code 2
+  kUsage,        // the command line is wrong: exit code 2
+  kIo,           // the system failed us (open, write, disk full): exit code 1
+  kCancelled,    // the user interrupted: exit code 1
+  kLimit,        // a memory or size limit would be exceeded: exit code 1
+  kUnsupported,  // valid input this code path cannot take (callers may fall back): exit code 2
+  kInternal,     // a bug we caught: exit code 1
 };
 
 struct Error {

@@ -555,8 +555,9 @@ bool PlyReader::State::next(PlyBatch& batch) {
   try {
     while (element < header.elements.size()) {
       const PlyElement& e = header.elements[element];
-      const bool isVertex = static_cast<int>(element) == roles.vertexElement;
-      const bool isFace = static_cast<int>(element) == roles.faceElement;
+      const bool isVertex =
+          static_cast<int>(element) == roles.vertexElement && options.readVertices;
+      const bool isFace = static_cast<int>(element) == roles.faceElement && options.readFaces;
       if (elementDone == e.count || (!isVertex && !isFace)) {
         if (elementDone < e.count) skipElement(e);
         ++element;

@@ -62,6 +62,9 @@ struct PlyReadOptions {
   // A file that ends early is bad input. With this set, reading stops after the last complete
   // element instead and truncation() tells where the file was cut.
   bool salvageTruncated = false;
+  // Which elements to deliver; the others are skipped (binary fixed-size ones by seeking).
+  bool readVertices = true;
+  bool readFaces = true;
   std::vector<std::string>* warnings = nullptr;  // readPly adds what it salvaged, if anything
   // Face properties recognised as an object (part) id, first match wins.
   std::vector<std::string> objectIdProperties = {"object_id", "objectid", "obj_id",

@@ -1,0 +1,231 @@
+#include "lodforge/core/distance.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include "lodforge/core/random.h"
+
+namespace lodforge {
+
+double pointTriangleDistanceSquared(Vec3d p, Vec3d a, Vec3d b, Vec3d c) {
+  const Vec3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  auto squared = [&](Vec3d q) { return dot(p - q, p - q); };
+  if (d1 <= 0 && d2 <= 0) return squared(a);
+  const Vec3d bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return squared(b);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return squared(a + ab * (d1 / (d1 - d3)));
+  const Vec3d cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return squared(c);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return squared(a + ac * (d2 / (d2 - d6)));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return squared(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
+  const double denominator = va + vb + vc;
+  if (denominator <= 0) {  // degenerate triangle: nearest of the three edges' ends is good enough
+    return std::min({squared(a), squared(b), squared(c)});
+  }
+  const double v = vb / denominator, w = vc / denominator;
+  return squared(a + ab * v + ac * w);
+}
+
+namespace {
+
+// Triangles bucketed by the cells their bounding boxes touch; queries search growing shells of
+// cells until no closer triangle can exist.
+class TriangleGrid {
+ public:
+  TriangleGrid(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+      : positions_(positions), indices_(indices) {
+    Aabb box;
+    for (std::uint32_t i : indices) box.add(positions[i]);
+    const std::size_t triangles = indices.size() / 3;
+    origin_ = toDouble(box.min);
+    const Vec3d size = toDouble(box.size());
+    // About two triangles per cell.
+    const double volume =
+        std::max(size.x, 1e-12) * std::max(size.y, 1e-12) * std::max(size.z, 1e-12);
+    cell_ = std::cbrt(volume / std::max<double>(1, static_cast<double>(triangles) / 2));
+    cell_ = std::max({cell_, box.longestSide() / 1024.0, 1e-9});
+    // Keep the grid within a few cells per triangle (flat or sparse meshes would explode it).
+    const double maxCells = 4.0 * static_cast<double>(triangles) + 1e6;
+    while (true) {
+      for (int k = 0; k < 3; ++k)
+        dims_[k] = std::max(1, std::min(1024, static_cast<int>(std::ceil(size[k] / cell_))));
+      if (static_cast<double>(dims_[0]) * dims_[1] * dims_[2] <= maxCells) break;
+      cell_ *= 1.26;
+    }
+    const std::size_t cells = static_cast<std::size_t>(dims_[0]) *
+                              static_cast<std::size_t>(dims_[1]) *
+                              static_cast<std::size_t>(dims_[2]);
+    std::vector<std::uint32_t> counts(cells + 1, 0);
+    forEachCell([&](std::size_t cell, std::uint32_t) { ++counts[cell + 1]; });
+    for (std::size_t i = 1; i <= cells; ++i) counts[i] += counts[i - 1];
+    start_ = counts;
+    items_.resize(counts[cells]);
+    forEachCell([&](std::size_t cell, std::uint32_t t) { items_[counts[cell]++] = t; });
+  }
+
+  double nearestSquared(Vec3d p) const {
+    const int cx = clampCell(0, p.x), cy = clampCell(1, p.y), cz = clampCell(2, p.z);
+    double best = std::numeric_limits<double>::max();
+    const int maxRing = std::max({dims_[0], dims_[1], dims_[2]});
+    for (int ring = 0; ring <= maxRing; ++ring) {
+      // Everything within `ring` cells is searched; a closer triangle cannot lie further out
+      // than (ring) cells minus the point's offset inside its cell.
+      for (int z = cz - ring; z <= cz + ring; ++z) {
+        for (int y = cy - ring; y <= cy + ring; ++y) {
+          for (int x = cx - ring; x <= cx + ring; ++x) {
+            if (std::max({std::abs(x - cx), std::abs(y - cy), std::abs(z - cz)}) != ring) continue;
+            if (x < 0 || y < 0 || z < 0 || x >= dims_[0] || y >= dims_[1] || z >= dims_[2])
+              continue;
+            const std::size_t cell = index(x, y, z);
+            for (std::uint32_t i = start_[cell]; i < start_[cell + 1]; ++i) {
+              const std::uint32_t t = items_[i];
+              best = std::min(
+                  best, pointTriangleDistanceSquared(p, corner(t, 0), corner(t, 1), corner(t, 2)));
+            }
+          }
+        }
+      }
+      const double reach = ring * cell_;
+      if (best < std::numeric_limits<double>::max() && best <= reach * reach) break;
+    }
+    return best;
+  }
+
+ private:
+  Vec3d corner(std::uint32_t t, int k) const {
+    return toDouble(positions_[indices_[3 * t + static_cast<std::size_t>(k)]]);
+  }
+  int clampCell(int axis, double v) const {
+    return std::clamp(static_cast<int>(std::floor((v - origin_[axis]) / cell_)), 0,
+                      dims_[axis] - 1);
+  }
+  std::size_t index(int x, int y, int z) const {
+    return (static_cast<std::size_t>(z) * static_cast<std::size_t>(dims_[1]) +
+            static_cast<std::size_t>(y)) *
+               static_cast<std::size_t>(dims_[0]) +
+           static_cast<std::size_t>(x);
+  }
+  template <class Fn>
+  void forEachCell(Fn&& fn) const {
+    for (std::uint32_t t = 0; t < indices_.size() / 3; ++t) {
+      Aabb box;
+      for (int k = 0; k < 3; ++k)
+        box.add(positions_[indices_[3 * t + static_cast<std::size_t>(k)]]);
+      const int x0 = clampCell(0, box.min.x), x1 = clampCell(0, box.max.x);
+      const int y0 = clampCell(1, box.min.y), y1 = clampCell(1, box.max.y);
+      const int z0 = clampCell(2, box.min.z), z1 = clampCell(2, box.max.z);
+      for (int z = z0; z <= z1; ++z)
+        for (int y = y0; y <= y1; ++y)
+          for (int x = x0; x <= x1; ++x) fn(index(x, y, z), t);
+    }
+  }
+
+  std::span<const Vec3f> positions_;
+  std::span<const std::uint32_t> indices_;
+  Vec3d origin_;
+  double cell_ = 1;
+  int dims_[3] = {1, 1, 1};
+  std::vector<std::uint32_t> start_, items_;
+};
+
+// Area-uniform sample points on a mesh.
+std::vector<Vec3d> samplePoints(std::span<const Vec3f> positions,
+                                std::span<const std::uint32_t> indices, std::uint32_t count,
+                                std::uint64_t seed) {
+  const std::size_t triangles = indices.size() / 3;
+  std::vector<double> cumulative(triangles);
+  double total = 0;
+  auto corner = [&](std::size_t t, int k) {
+    return toDouble(positions[indices[3 * t + static_cast<std::size_t>(k)]]);
+  };
+  for (std::size_t t = 0; t < triangles; ++t) {
+    total += 0.5 * length(cross(corner(t, 1) - corner(t, 0), corner(t, 2) - corner(t, 0)));
+    cumulative[t] = total;
+  }
+  std::vector<Vec3d> points;
+  if (triangles == 0 || total <= 0) return points;
+  points.reserve(count + triangles);
+  // Every triangle's corners too, so the distance never misses a vertex's excursion.
+  for (std::size_t t = 0; t < triangles; ++t) points.push_back(corner(t, 0));
+  Random random(seed);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const double pick = random.uniform() * total;
+    const std::size_t t = static_cast<std::size_t>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin());
+    double r1 = random.uniform(), r2 = random.uniform();
+    if (r1 + r2 > 1) {
+      r1 = 1 - r1;
+      r2 = 1 - r2;
+    }
+    const std::size_t tt = std::min(t, triangles - 1);
+    points.push_back(corner(tt, 0) + (corner(tt, 1) - corner(tt, 0)) * r1 +
+                     (corner(tt, 2) - corner(tt, 0)) * r2);
+  }
+  return points;
+}
+
+struct OneSided {
+  double max = 0, sumSquares = 0, sum = 0;
+  std::size_t count = 0;
+};
+
+OneSided measure(const std::vector<Vec3d>& points, const TriangleGrid& grid) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, points.size(), 1024), OneSided{},
+      [&](const tbb::blocked_range<std::size_t>& range, OneSided acc) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+          const double squared = grid.nearestSquared(points[i]);
+          const double d = std::sqrt(squared);
+          acc.max = std::max(acc.max, d);
+          acc.sumSquares += squared;
+          acc.sum += d;
+          ++acc.count;
+        }
+        return acc;
+      },
+      [](OneSided a, const OneSided& b) {
+        a.max = std::max(a.max, b.max);
+        a.sumSquares += b.sumSquares;
+        a.sum += b.sum;
+        a.count += b.count;
+        return a;
+      });
+}
+
+}  // namespace
+
+SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
+                                std::span<const std::uint32_t> indicesA,
+                                std::span<const Vec3f> positionsB,
+                                std::span<const std::uint32_t> indicesB,
+                                std::uint32_t samplesPerMesh, std::uint64_t seed) {
+  SurfaceDistance result;
+  if (indicesA.empty() || indicesB.empty()) {
+    result.hausdorff = result.rms = std::numeric_limits<double>::infinity();
+    return result;
+  }
+  const TriangleGrid gridA(positionsA, indicesA), gridB(positionsB, indicesB);
+  const OneSided ab = measure(samplePoints(positionsA, indicesA, samplesPerMesh, seed), gridB);
+  const OneSided ba = measure(samplePoints(positionsB, indicesB, samplesPerMesh, seed + 1), gridA);
+  result.hausdorff = std::max(ab.max, ba.max);
+  result.rms = std::sqrt((ab.sumSquares + ba.sumSquares) /
+                         static_cast<double>(std::max<std::size_t>(1, ab.count + ba.count)));
+  result.meanAB = ab.sum / static_cast<double>(std::max<std::size_t>(1, ab.count));
+  result.meanBA = ba.sum / static_cast<double>(std::max<std::size_t>(1, ba.count));
+  return result;
+}
+
+}  // namespace lodforge

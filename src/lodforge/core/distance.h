@@ -1,0 +1,30 @@
+// Point-to-triangle distance and the surface distance between two meshes, measured by sampling:
+// the quality measure for simplification and tiling (symmetric Hausdorff and RMS distance).
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "lodforge/core/math.h"
+
+namespace lodforge {
+
+// Squared distance from p to triangle abc (closest point by Voronoi regions, Ericson §5.1.5).
+double pointTriangleDistanceSquared(Vec3d p, Vec3d a, Vec3d b, Vec3d c);
+
+struct SurfaceDistance {
+  double hausdorff = 0;  // max over both directions of the max sample distance
+  double rms = 0;        // root mean square over all samples of both directions
+  double meanAB = 0, meanBA = 0;
+};
+
+// Distance between surfaces A and B: `samplesPerMesh` points spread over each surface by area
+// (deterministic for the seed), each measured exactly to the nearest triangle of the other mesh
+// through a uniform grid. Both meshes are plain arrays of positions and triangle indices.
+SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
+                                std::span<const std::uint32_t> indicesA,
+                                std::span<const Vec3f> positionsB,
+                                std::span<const std::uint32_t> indicesB,
+                                std::uint32_t samplesPerMesh = 100'000, std::uint64_t seed = 1);
+
+}  // namespace lodforge

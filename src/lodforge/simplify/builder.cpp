@@ -1,0 +1,152 @@
+#include "lodforge/simplify/builder.h"
+
+#include <chrono>
+#include <optional>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/memory.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/core/units.h"
+#include "lodforge/io/object_stream.h"
+#include "lodforge/simplify/package.h"
+#include "lodforge/simplify/prepare.h"
+
+namespace lodforge {
+
+namespace {
+
+constexpr std::size_t kMaxWaveObjects = 4096;
+// What the build holds besides the objects in flight: the program, TBB, the readers' batches,
+// the package writer's section buffers. Part of any --memory-limit.
+constexpr std::uint64_t kFixedBytes = std::uint64_t{48} << 20;
+
+struct Built {
+  ProgressiveMesh mesh;
+  std::string name;
+  Rgba8 color;
+  std::uint64_t inputTriangles = 0;
+};
+
+// Memory one object needs while it is built: the source, the prepared copy, the simplifier.
+std::uint64_t footprint(const SourceObject& object) {
+  const std::uint64_t vertices = object.positions.size(), triangles = object.indices.size() / 3;
+  return 2 * object.memoryBytes() + progressiveBuildBytes(vertices, triangles);
+}
+
+Built buildOne(SourceObject& source, const ProgressiveOptions& options) {
+  Built built;
+  built.name = std::move(source.name);
+  built.inputTriangles = source.indices.size() / 3;
+  // The base colour: the first vertex's (CAD parts are usually one colour).
+  built.color = source.colors.empty() ? Rgba8{} : source.colors.front();
+  PreparedObject prepared =
+      prepareObject(source.positions, source.normals, source.colors, source.indices);
+  source = SourceObject{};  // release the input before the simplifier allocates
+  built.mesh = buildProgressive(prepared.positions, prepared.indices, prepared.normals,
+                                prepared.colors, options);
+  return built;
+}
+
+Result<BuildStats> build(ObjectStream& stream, const std::string& output,
+                         const BuildOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.memoryLimit && options.memoryLimit < kFixedBytes + (std::uint64_t{4} << 20)) {
+    return Error{ErrorKind::kLimit,
+                 fmt::format("a memory limit of {} is too small to build anything (it needs {} for "
+                             "itself plus the objects in flight)",
+                             formatBytes(options.memoryLimit), formatBytes(kFixedBytes))};
+  }
+  // The objects in flight get what the limit leaves (a quarter of the machine by default).
+  const std::uint64_t budget = options.memoryLimit
+                                   ? options.memoryLimit - kFixedBytes
+                                   : std::max<std::uint64_t>(physicalMemoryBytes() / 4, 256 << 20);
+  Result<PackageWriter> writer =
+      PackageWriter::create(output, stream.origin(), true, stream.hasColors());
+  if (!writer) return writer.status();
+  BuildStats stats;
+  stats.streamed = stream.streaming();
+  Progress progress("building", stream.triangleCountHint());
+  std::optional<SourceObject> carried;
+  std::vector<SourceObject> wave;
+  std::vector<Built> built;
+  while (true) {
+    // A wave: as many objects as fit the budget (at least one).
+    wave.clear();
+    std::uint64_t bytes = 0;
+    while (wave.size() < kMaxWaveObjects) {
+      SourceObject object;
+      if (carried) {
+        object = std::move(*carried);
+        carried.reset();
+      } else {
+        Result<bool> more = stream.next(object);
+        if (!more) return more.status();
+        if (!*more) break;
+      }
+      const std::uint64_t need = footprint(object);
+      if (need > budget) {
+        return Error{
+            ErrorKind::kLimit,
+            fmt::format("object '{}' ({} triangles) needs about {} to build, more than the "
+                        "{} memory limit",
+                        object.name, formatCount(object.indices.size() / 3), formatBytes(need),
+                        formatBytes(budget))};
+      }
+      if (!wave.empty() && bytes + need > budget) {
+        carried = std::move(object);
+        break;
+      }
+      bytes += need;
+      wave.push_back(std::move(object));
+    }
+    if (wave.empty()) break;
+    ++stats.waves;
+    built.clear();
+    built.resize(wave.size());
+    tbb::parallel_for(
+        std::size_t{0}, wave.size(),
+        [&](std::size_t i) { built[i] = buildOne(wave[i], options.progressive); },
+        tbb::simple_partitioner());
+    for (Built& b : built) {
+      LODFORGE_TRY(writer->add(b.mesh, b.name, b.color));
+      stats.objects += 1;
+      stats.inputTriangles += b.inputTriangles;
+      stats.vertices += b.mesh.vertexCount();
+      stats.triangles += b.mesh.triangleCount();
+      stats.minVertices += b.mesh.q;
+      stats.minTriangles += b.mesh.map.empty() ? 0 : b.mesh.map.front();
+      progress.advance(b.inputTriangles);
+      b = Built{};
+    }
+    LODFORGE_TRY(checkCancelled());
+  }
+  LODFORGE_TRY(writer->finish());
+  progress.finish();
+  Result<std::uint64_t> size = fileSize(output);
+  if (!size) return size.status();
+  stats.packageBytes = *size;
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+}  // namespace
+
+Result<BuildStats> buildPackage(const std::string& input, const std::string& output,
+                                const BuildOptions& options) {
+  ObjectStreamOptions streamOptions{options.read, false};
+  Result<std::unique_ptr<ObjectStream>> stream = openObjectStream(input, streamOptions);
+  if (!stream) return stream.status();
+  Result<BuildStats> stats = build(**stream, output, options);
+  if (stats.ok() || stats.error().kind != ErrorKind::kUnsupported) return stats;
+  // The PLY's objects are not grouped: load it whole instead of streaming (objects get grouped
+  // by the reader), as long as it fits.
+  streamOptions.load = true;
+  stream = openObjectStream(input, streamOptions);
+  if (!stream) return stream.status();
+  return build(**stream, output, options);
+}
+
+}  // namespace lodforge

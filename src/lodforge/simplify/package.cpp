@@ -1,0 +1,397 @@
+#include "lodforge/simplify/package.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <mutex>
+
+#include <tbb/blocked_range.h>
+
+#include <tbb/parallel_for.h>
+
+#include "lodforge/core/checksum.h"
+
+namespace lodforge {
+
+std::string_view packageSectionName(PackageSection section) {
+  static constexpr std::string_view kNames[] = {
+      "objects", "names", "positions", "normals", "colors", "triangles", "ecol", "map", "error"};
+  return kNames[static_cast<std::uint32_t>(section)];
+}
+
+bool looksLikePackage(std::span<const std::byte> firstBytes) {
+  return firstBytes.size() >= kPackageMagic.size() &&
+         std::memcmp(firstBytes.data(), kPackageMagic.data(), kPackageMagic.size()) == 0;
+}
+
+namespace {
+
+std::uint64_t headerChecksumOf(const PackageHeader& header) {
+  return checksum64(
+      {reinterpret_cast<const std::byte*>(&header), offsetof(PackageHeader, headerChecksum)});
+}
+
+}  // namespace
+
+// --- writer -----------------------------------------------------------------------------------
+
+struct PackageWriter::State {
+  std::string path;
+  PackageHeader header;
+  Aabb bounds;
+  struct Spill {
+    std::optional<OutputFile> file;
+    std::string path;
+    Checksum64 checksum;
+    std::uint64_t bytes = 0;
+  };
+  std::array<Spill, kPackageSections> spills;
+
+  Status append(PackageSection section, const void* data, std::size_t size) {
+    Spill& spill = spills[static_cast<std::uint32_t>(section)];
+    spill.checksum.update(data, size);
+    spill.bytes += size;
+    return spill.file->write(data, size);
+  }
+  template <class T>
+  Status append(PackageSection section, std::span<const T> values) {
+    return append(section, values.data(), values.size_bytes());
+  }
+  void discard() {
+    for (Spill& spill : spills) {
+      spill.file.reset();  // removes its temporary
+      if (!spill.path.empty()) std::remove(spill.path.c_str());
+    }
+  }
+  ~State() { discard(); }
+};
+
+PackageWriter::PackageWriter(std::unique_ptr<State> state) : state_(std::move(state)) {}
+PackageWriter::PackageWriter(PackageWriter&&) noexcept = default;
+PackageWriter& PackageWriter::operator=(PackageWriter&&) noexcept = default;
+PackageWriter::~PackageWriter() = default;
+std::uint64_t PackageWriter::objectCount() const {
+  return state_->header.objectCount;
+}
+
+Result<PackageWriter> PackageWriter::create(const std::string& path, Vec3d origin, bool normals,
+                                            bool colors) {
+  auto state = std::make_unique<State>();
+  state->path = path;
+  state->header.origin[0] = origin.x;
+  state->header.origin[1] = origin.y;
+  state->header.origin[2] = origin.z;
+  state->header.flags =
+      (normals ? PackageHeader::kHasNormals : 0) | (colors ? PackageHeader::kHasColors : 0);
+  for (std::uint32_t s = 0; s < kPackageSections; ++s) {
+    // Each section is spilled to "<path>.<section>", itself written under a temporary name.
+    auto& spill = state->spills[s];
+    Result<OutputFile> file =
+        OutputFile::create(temporaryPathFor(path) + "." +
+                               std::string(packageSectionName(static_cast<PackageSection>(s))),
+                           1 << 20);
+    if (!file) return file.status();
+    spill.file.emplace(std::move(file.value()));
+  }
+  return PackageWriter(std::move(state));
+}
+
+Status PackageWriter::add(const ProgressiveMesh& mesh, std::string_view name, Rgba8 color) {
+  State& s = *state_;
+  PackageHeader& h = s.header;
+  assert(mesh.normals.empty() != h.hasNormals() || mesh.vertexCount() == 0);
+  assert(mesh.colors.empty() != h.hasColors() || mesh.vertexCount() == 0);
+  PackageObject record;
+  record.vertexOffset = h.vertexCount;
+  record.triangleOffset = h.triangleCount;
+  record.levelOffset = h.levelCount;
+  record.vertexCount = mesh.vertexCount();
+  record.minVertexCount = mesh.q;
+  record.triangleCount = mesh.triangleCount();
+  record.minTriangleCount = mesh.map.empty() ? 0 : mesh.map.front();
+  Aabb box;
+  for (const Vec3f& p : mesh.positions) box.add(p);
+  if (box.empty()) box.add(Vec3f{});
+  std::memcpy(record.boundsMin, &box.min, 12);
+  std::memcpy(record.boundsMax, &box.max, 12);
+  s.bounds.add(box);
+  record.nameOffset = s.spills[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
+  record.nameLength = static_cast<std::uint32_t>(name.size());
+  record.color = color;
+
+  // An empty object still gets its one level (n = q = 0, no triangles).
+  const std::vector<std::uint32_t> emptyMap = {0};
+  const std::vector<float> emptyError = {0.0f};
+  const auto& map = mesh.map.empty() ? emptyMap : mesh.map;
+  const auto& error = mesh.error.empty() ? emptyError : mesh.error;
+
+  LODFORGE_TRY(s.append(PackageSection::kObjects, &record, sizeof record));
+  LODFORGE_TRY(s.append(PackageSection::kNames, name.data(), name.size()));
+  LODFORGE_TRY(s.append<Vec3f>(PackageSection::kPositions, mesh.positions));
+  if (h.hasNormals()) LODFORGE_TRY(s.append<Vec3f>(PackageSection::kNormals, mesh.normals));
+  if (h.hasColors()) LODFORGE_TRY(s.append<Rgba8>(PackageSection::kColors, mesh.colors));
+  LODFORGE_TRY(s.append<std::uint32_t>(PackageSection::kTriangles, mesh.triangles));
+  LODFORGE_TRY(s.append<std::uint32_t>(PackageSection::kEcol, mesh.ecol));
+  LODFORGE_TRY(s.append<std::uint32_t>(PackageSection::kMap, map));
+  LODFORGE_TRY(s.append<float>(PackageSection::kError, error));
+  ++h.objectCount;
+  h.vertexCount += mesh.vertexCount();
+  h.triangleCount += mesh.triangleCount();
+  h.levelCount += map.size();
+  return {};
+}
+
+Status PackageWriter::finish() {
+  State& s = *state_;
+  PackageHeader& h = s.header;
+  const Aabb bounds = s.bounds.empty() ? Aabb{Vec3f{}, Vec3f{}} : s.bounds;
+  std::memcpy(h.boundsMin, &bounds.min, 12);
+  std::memcpy(h.boundsMax, &bounds.max, 12);
+  Result<OutputFile> out = OutputFile::create(s.path);
+  if (!out) return out.status();
+  LODFORGE_TRY(out->write(&h, sizeof h));  // placeholder; rewritten with offsets at the end
+  static const std::byte zeros[kPackageAlignment] = {};
+  for (std::uint32_t i = 0; i < kPackageSections; ++i) {
+    State::Spill& spill = s.spills[i];
+    const std::uint64_t pad =
+        (kPackageAlignment - out->bytesWritten() % kPackageAlignment) % kPackageAlignment;
+    LODFORGE_TRY(out->write(zeros, pad));
+    h.sections[i] = {out->bytesWritten(), spill.bytes, spill.checksum.digest()};
+    spill.path = spill.file->path();
+    LODFORGE_TRY(spill.file->commit());
+    spill.file.reset();
+    LODFORGE_TRY(out->appendFileContents(spill.path, spill.bytes));
+    std::remove(spill.path.c_str());
+    spill.path.clear();
+  }
+  h.headerChecksum = headerChecksumOf(h);
+  LODFORGE_TRY(out->writeAt(0, &h, sizeof h));
+  return out->commit();
+}
+
+// --- reader -----------------------------------------------------------------------------------
+
+template <class T>
+std::span<const T> Package::section(PackageSection s) const {
+  const PackageSectionEntry& e = header_->sections[static_cast<std::uint32_t>(s)];
+  return {reinterpret_cast<const T*>(bytes_.data() + e.offset), e.bytes / sizeof(T)};
+}
+
+std::span<const PackageObject> Package::objects() const {
+  return section<PackageObject>(PackageSection::kObjects);
+}
+std::span<const Vec3f> Package::allPositions() const {
+  return section<Vec3f>(PackageSection::kPositions);
+}
+std::span<const Vec3f> Package::allNormals() const {
+  return section<Vec3f>(PackageSection::kNormals);
+}
+std::span<const std::uint32_t> Package::allTriangles() const {
+  return section<std::uint32_t>(PackageSection::kTriangles);
+}
+std::span<const std::uint32_t> Package::allEcol() const {
+  return section<std::uint32_t>(PackageSection::kEcol);
+}
+
+std::string_view Package::objectName(std::size_t i) const {
+  const auto names = section<char>(PackageSection::kNames);
+  return {names.data() + object(i).nameOffset, object(i).nameLength};
+}
+std::span<const Vec3f> Package::positions(std::size_t i) const {
+  return allPositions().subspan(object(i).vertexOffset, object(i).vertexCount);
+}
+std::span<const Vec3f> Package::normals(std::size_t i) const {
+  if (!header_->hasNormals()) return {};
+  return allNormals().subspan(object(i).vertexOffset, object(i).vertexCount);
+}
+std::span<const Rgba8> Package::colors(std::size_t i) const {
+  if (!header_->hasColors()) return {};
+  return section<Rgba8>(PackageSection::kColors)
+      .subspan(object(i).vertexOffset, object(i).vertexCount);
+}
+std::span<const std::uint32_t> Package::triangles(std::size_t i) const {
+  return allTriangles().subspan(3 * object(i).triangleOffset,
+                                3 * std::size_t{object(i).triangleCount});
+}
+std::span<const std::uint32_t> Package::ecol(std::size_t i) const {
+  return allEcol().subspan(object(i).vertexOffset, object(i).vertexCount);
+}
+std::span<const std::uint32_t> Package::map(std::size_t i) const {
+  const PackageObject& o = object(i);
+  return section<std::uint32_t>(PackageSection::kMap)
+      .subspan(o.levelOffset, o.vertexCount - o.minVertexCount + 1);
+}
+std::span<const float> Package::error(std::size_t i) const {
+  const PackageObject& o = object(i);
+  return section<float>(PackageSection::kError)
+      .subspan(o.levelOffset, o.vertexCount - o.minVertexCount + 1);
+}
+std::uint32_t Package::trianglesAt(std::size_t i, std::uint32_t n) const {
+  const PackageObject& o = object(i);
+  assert(n >= o.minVertexCount && n <= o.vertexCount);
+  return map(i)[n - o.minVertexCount];
+}
+
+Result<Package> Package::open(const std::string& path, const OpenOptions& options) {
+  Result<MappedFile> file = MappedFile::open(path);
+  if (!file) return file.status();
+  Package package;
+  package.name_ = path;
+  package.file_ = std::make_shared<MappedFile>(std::move(file.value()));
+  package.bytes_ = package.file_->bytes();
+  LODFORGE_TRY(package.validate(options));
+  return package;
+}
+
+Result<Package> Package::fromBytes(std::span<const std::byte> bytes, const std::string& name,
+                                   const OpenOptions& options) {
+  Package package;
+  package.name_ = name;
+  package.bytes_ = bytes;
+  LODFORGE_TRY(package.validate(options));
+  return package;
+}
+
+Status Package::validate(const OpenOptions& options) {
+  const std::uint64_t size = bytes_.size();
+  auto bad = [&](std::uint64_t at, std::string_view what) {
+    return Status(badInputAtByte(name_, at, what));
+  };
+  if (size < sizeof(PackageHeader) || !looksLikePackage(bytes_)) {
+    if (looksLikePackage(bytes_))
+      return bad(size, "the package ends inside its 512-byte header (truncated)");
+    return bad(0, "not a lodforge package (wrong magic)");
+  }
+  if (reinterpret_cast<std::uintptr_t>(bytes_.data()) % alignof(std::uint64_t) != 0) {
+    return Error{ErrorKind::kInternal, name_ + ": package bytes are not 8-byte aligned"};
+  }
+  header_ = reinterpret_cast<const PackageHeader*>(bytes_.data());
+  const PackageHeader& h = *header_;
+  if (h.version != kPackageVersion) {
+    return bad(8, fmt::format("package version {} (this lodforge reads version {})", h.version,
+                              kPackageVersion));
+  }
+  if (h.headerChecksum != headerChecksumOf(h))
+    return bad(504, "header checksum mismatch: the package is corrupted");
+  if (h.sectionCount != kPackageSections)
+    return bad(96, fmt::format("{} sections (expected {})", h.sectionCount, kPackageSections));
+
+  // Section sizes follow from the counts; refuse counts the file cannot hold before multiplying.
+  auto sectionAt = [&](std::uint32_t s) {
+    return offsetof(PackageHeader, sections) + s * sizeof(PackageSectionEntry);
+  };
+  for (std::uint64_t count : {h.objectCount, h.vertexCount, h.triangleCount, h.levelCount}) {
+    if (count > size)
+      return bad(16, "counts larger than the file can hold: the package is corrupted");
+  }
+  const std::uint64_t expected[kPackageSections] = {
+      h.objectCount * sizeof(PackageObject),
+      h.sections[static_cast<std::uint32_t>(PackageSection::kNames)].bytes,
+      h.vertexCount * sizeof(Vec3f),
+      h.hasNormals() ? h.vertexCount * sizeof(Vec3f) : 0,
+      h.hasColors() ? h.vertexCount * sizeof(Rgba8) : 0,
+      h.triangleCount * 3 * sizeof(std::uint32_t),
+      h.vertexCount * sizeof(std::uint32_t),
+      h.levelCount * sizeof(std::uint32_t),
+      h.levelCount * sizeof(float)};
+  for (std::uint32_t s = 0; s < kPackageSections; ++s) {
+    const PackageSectionEntry& e = h.sections[s];
+    const auto name = packageSectionName(static_cast<PackageSection>(s));
+    if (e.offset % kPackageAlignment != 0 || e.offset < sizeof(PackageHeader) || e.offset > size ||
+        e.bytes > size - e.offset) {
+      return bad(
+          sectionAt(s),
+          fmt::format("section '{}' ({} bytes at byte {}) lies outside the {}-byte file{}", name,
+                      e.bytes, e.offset, size, e.offset <= size ? " (truncated?)" : ""));
+    }
+    if (e.bytes != expected[s]) {
+      return bad(sectionAt(s), fmt::format("section '{}' has {} bytes, the counts need {}", name,
+                                           e.bytes, expected[s]));
+    }
+  }
+  if (options.verifyChecksums) {
+    std::atomic<int> failed{-1};
+    tbb::parallel_for(std::uint32_t{0}, kPackageSections, [&](std::uint32_t s) {
+      const PackageSectionEntry& e = h.sections[s];
+      if (checksum64(bytes_.subspan(e.offset, e.bytes)) != e.checksum) failed = static_cast<int>(s);
+    });
+    if (failed >= 0) {
+      const auto s = static_cast<std::uint32_t>(failed.load());
+      return bad(h.sections[s].offset,
+                 fmt::format("section '{}' checksum mismatch: the package is corrupted",
+                             packageSectionName(static_cast<PackageSection>(s))));
+    }
+  }
+
+  // Per object: ranges inside the sections, and the invariants the kernels rely on.
+  const auto objectList = objects();
+  const std::uint64_t nameBytes =
+      h.sections[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
+  const std::uint64_t objectsAt =
+      h.sections[static_cast<std::uint32_t>(PackageSection::kObjects)].offset;
+  std::atomic<std::uint64_t> firstBad{std::numeric_limits<std::uint64_t>::max()};
+  std::vector<std::string> why(1);
+  std::mutex whyMutex;
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, objectList.size(), 256),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) {
+          if (i > firstBad.load()) return;
+          const PackageObject& o = objectList[i];
+          std::string problem;
+          const std::uint64_t levels = std::uint64_t{o.vertexCount} - o.minVertexCount + 1;
+          if (o.minVertexCount > o.vertexCount)
+            problem = "q > p";
+          else if (o.vertexOffset > h.vertexCount || o.vertexCount > h.vertexCount - o.vertexOffset)
+            problem = "vertices outside the section";
+          else if (o.triangleOffset > h.triangleCount ||
+                   o.triangleCount > h.triangleCount - o.triangleOffset)
+            problem = "triangles outside the section";
+          else if (o.levelOffset > h.levelCount || levels > h.levelCount - o.levelOffset)
+            problem = "levels outside the section";
+          else if (o.nameOffset > nameBytes || o.nameLength > nameBytes - o.nameOffset)
+            problem = "name outside the section";
+          else if (o.minTriangleCount > o.triangleCount)
+            problem = "map(q) > map(p)";
+          else {
+            const auto e = ecol(i);
+            for (std::uint32_t v = 0; v < o.vertexCount && problem.empty(); ++v) {
+              if (v < o.minVertexCount ? e[v] != v : e[v] >= v)
+                problem = fmt::format("ecol[{}] = {} breaks the decreasing chains", v, e[v]);
+            }
+            for (std::uint32_t c : triangles(i)) {
+              if (c >= o.vertexCount && problem.empty())
+                problem = fmt::format("triangle corner {} >= {} vertices", c, o.vertexCount);
+            }
+            const auto m = map(i);
+            const auto err = error(i);
+            if (problem.empty() && (m.front() != o.minTriangleCount || m.back() != o.triangleCount))
+              problem = "map ends do not match";
+            for (std::size_t k = 1; k < m.size() && problem.empty(); ++k) {
+              if (m[k] < m[k - 1]) problem = "map decreases";
+            }
+            for (std::size_t k = 0; k < err.size() && problem.empty(); ++k) {
+              if (!std::isfinite(err[k]) || err[k] < 0 || (k > 0 && err[k] > err[k - 1]))
+                problem = "error table is not finite and non-increasing";
+            }
+          }
+          if (!problem.empty()) {
+            std::lock_guard lock(whyMutex);
+            if (i < firstBad.load()) {
+              firstBad = i;
+              why[0] = problem;
+            }
+          }
+        }
+      });
+  if (firstBad.load() != std::numeric_limits<std::uint64_t>::max()) {
+    const std::uint64_t i = firstBad.load();
+    return bad(objectsAt + i * sizeof(PackageObject), fmt::format("object {}: {}", i, why[0]));
+  }
+  return {};
+}
+
+}  // namespace lodforge

@@ -1,0 +1,180 @@
+// The progressive package (.lfp): one mmap-able file with every object's progressive mesh, read
+// in place by the runtime. Layout (little-endian, every section 64-byte aligned; also in
+// docs/formats.md):
+//
+//   header        512 bytes: magic, version, counts, origin, bounds, section table, checksum
+//   objects       PackageObject[objectCount]                   (80 bytes each)
+//   names         object names, back to back (UTF-8, no terminator)
+//   positions     float[3] per vertex, rearranged, relative to the origin
+//   normals       float[3] per vertex (flag bit 0)
+//   colors        RGBA8 per vertex (flag bit 1)
+//   triangles     uint32[3] per triangle, rearranged, object-local vertex indices, full detail
+//   ecol          uint32 per vertex, object-local: ecol[i] < i for i >= q, ecol[i] = i below q
+//   map           uint32 per level: triangles at n vertices, n = q..p for each object
+//   error         float per level: geometric error at n vertices (model units)
+//
+// Each section carries an XXH3-64 checksum; the header checksums itself. Package::open checks
+// all of it, and every index a kernel will follow, before handing out a single span.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/math.h"
+#include "lodforge/core/status.h"
+#include "lodforge/simplify/progressive.h"
+
+namespace lodforge {
+
+enum class PackageSection : std::uint32_t {
+  kObjects,
+  kNames,
+  kPositions,
+  kNormals,
+  kColors,
+  kTriangles,
+  kEcol,
+  kMap,
+  kError,
+  kCount
+};
+inline constexpr std::uint32_t kPackageSections =
+    static_cast<std::uint32_t>(PackageSection::kCount);
+std::string_view packageSectionName(PackageSection section);
+
+inline constexpr std::uint32_t kPackageVersion = 1;
+inline constexpr std::size_t kPackageAlignment = 64;
+// PNG-style magic: a high byte and CR LF / ^Z / LF catch text-mode transfers that damage files.
+inline constexpr std::array<char, 8> kPackageMagic = {'\x89', 'L',  'F',    'P',
+                                                      '\r',   '\n', '\x1a', '\n'};
+
+struct PackageSectionEntry {
+  std::uint64_t offset = 0;
+  std::uint64_t bytes = 0;
+  std::uint64_t checksum = 0;
+};
+
+struct PackageHeader {
+  std::array<char, 8> magic = kPackageMagic;
+  std::uint32_t version = kPackageVersion;
+  std::uint32_t flags = 0;  // bit 0: normals, bit 1: colors
+  std::uint64_t objectCount = 0;
+  std::uint64_t vertexCount = 0;
+  std::uint64_t triangleCount = 0;
+  std::uint64_t levelCount = 0;  // entries of map and error: sum over objects of p - q + 1
+  double origin[3] = {0, 0, 0};
+  float boundsMin[3] = {0, 0, 0};
+  float boundsMax[3] = {0, 0, 0};
+  std::uint32_t sectionCount = kPackageSections;
+  std::uint32_t reserved = 0;
+  PackageSectionEntry sections[kPackageSections];
+  std::uint8_t padding[512 - 104 - kPackageSections * sizeof(PackageSectionEntry) - 8] = {};
+  std::uint64_t headerChecksum = 0;  // XXH3-64 of the 504 bytes before it
+
+  static constexpr std::uint32_t kHasNormals = 1, kHasColors = 2;
+  bool hasNormals() const { return (flags & kHasNormals) != 0; }
+  bool hasColors() const { return (flags & kHasColors) != 0; }
+};
+static_assert(sizeof(PackageHeader) == 512);
+
+struct PackageObject {
+  std::uint64_t vertexOffset = 0;      // into positions, normals, colors, ecol (vertices)
+  std::uint64_t triangleOffset = 0;    // into triangles (triangles)
+  std::uint64_t levelOffset = 0;       // into map and error (entries)
+  std::uint32_t vertexCount = 0;       // p
+  std::uint32_t minVertexCount = 0;    // q
+  std::uint32_t triangleCount = 0;     // map(p)
+  std::uint32_t minTriangleCount = 0;  // map(q)
+  float boundsMin[3] = {0, 0, 0};      // relative to the origin
+  float boundsMax[3] = {0, 0, 0};
+  std::uint64_t nameOffset = 0;
+  std::uint32_t nameLength = 0;
+  Rgba8 color;  // the object's base colour
+};
+static_assert(sizeof(PackageObject) == 80);
+
+// Writes a package object by object, each section streamed to its own temporary file, then
+// joined under a temporary name and renamed. Memory does not grow with the number of objects.
+class PackageWriter {
+ public:
+  static Result<PackageWriter> create(const std::string& path, Vec3d origin, bool normals,
+                                      bool colors);
+  PackageWriter(PackageWriter&&) noexcept;
+  PackageWriter& operator=(PackageWriter&&) noexcept;
+  ~PackageWriter();
+
+  Status add(const ProgressiveMesh& mesh, std::string_view name, Rgba8 color);
+  Status finish();
+  std::uint64_t objectCount() const;
+
+ private:
+  struct State;
+  explicit PackageWriter(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+// A package opened for reading, in place (mmap) or over caller-owned bytes. Every accessor is
+// bounds-checked at open time, so the spans it returns are safe to follow.
+struct PackageOpenOptions {
+  // Section checksums cost one pass over the file; the structure and every index are checked
+  // regardless.
+  bool verifyChecksums = true;
+};
+
+class Package {
+ public:
+  using OpenOptions = PackageOpenOptions;
+  static Result<Package> open(const std::string& path, const PackageOpenOptions& options = {});
+  // The bytes must outlive the Package.
+  static Result<Package> fromBytes(std::span<const std::byte> bytes, const std::string& name,
+                                   const PackageOpenOptions& options = {});
+
+  const PackageHeader& header() const { return *header_; }
+  const std::string& name() const { return name_; }
+  std::uint64_t objectCount() const { return header_->objectCount; }
+  Vec3d origin() const { return {header_->origin[0], header_->origin[1], header_->origin[2]}; }
+  std::uint64_t fileBytes() const { return bytes_.size(); }
+
+  const PackageObject& object(std::size_t i) const { return objects()[i]; }
+  std::string_view objectName(std::size_t i) const;
+  std::span<const Vec3f> positions(std::size_t i) const;
+  std::span<const Vec3f> normals(std::size_t i) const;            // empty without normals
+  std::span<const Rgba8> colors(std::size_t i) const;             // empty without colors
+  std::span<const std::uint32_t> triangles(std::size_t i) const;  // 3 x triangleCount
+  std::span<const std::uint32_t> ecol(std::size_t i) const;
+  std::span<const std::uint32_t> map(std::size_t i) const;  // p - q + 1
+  std::span<const float> error(std::size_t i) const;        // p - q + 1
+  std::uint32_t trianglesAt(std::size_t i, std::uint32_t n) const;
+
+  // Whole sections, for kernels that work across objects.
+  std::span<const PackageObject> objects() const;
+  std::span<const Vec3f> allPositions() const;
+  std::span<const Vec3f> allNormals() const;
+  std::span<const std::uint32_t> allTriangles() const;
+  std::span<const std::uint32_t> allEcol() const;
+  std::uint64_t sectionBytes(PackageSection section) const {
+    return header_->sections[static_cast<std::uint32_t>(section)].bytes;
+  }
+
+ private:
+  Package() = default;
+  Status validate(const OpenOptions& options);
+  template <class T>
+  std::span<const T> section(PackageSection s) const;
+
+  std::string name_;
+  std::shared_ptr<MappedFile> file_;
+  std::span<const std::byte> bytes_;
+  const PackageHeader* header_ = nullptr;
+};
+
+// Whether a file starts with the package magic (for `info` and format detection).
+bool looksLikePackage(std::span<const std::byte> firstBytes);
+
+}  // namespace lodforge

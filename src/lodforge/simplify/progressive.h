@@ -1,0 +1,72 @@
+// Progressive meshes as in Peng & Cao, "Parallel LOD for CAD model rendering" §3.1: half-edge
+// collapses (a vertex merges into an existing neighbour; no new vertices) in order of cost down
+// to the simplest version, recorded as ECol / PermuteV / PermuteT / Map, with vertices and
+// triangles rearranged (Algorithm 1) so that the first n vertices and the first map(n)
+// triangles are the mesh after p - n collapses (once re-formed, Algorithm 2 in reform.h).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "lodforge/core/math.h"
+
+namespace lodforge {
+
+enum class CollapseCost : std::uint8_t {
+  kQuadric,  // Garland–Heckbert quadric error evaluated at the target (area-weighted planes)
+  kMelax,    // Melax's edge length x curvature cost, the paper's choice
+};
+
+enum class CollapseDirection : std::uint8_t {
+  // Eq. 1 for boundary vertices (they never move); an interior edge collapses whichever way is
+  // cheaper. Vertex indices carry no geometric meaning, so Eq. 1's index order is not used.
+  kCheaper,
+  // Eq. 1 literally: edge (a, b) with a < b collapses a into b unless a is a boundary vertex.
+  kPaper,
+};
+
+struct ProgressiveOptions {
+  CollapseCost cost = CollapseCost::kQuadric;
+  CollapseDirection direction = CollapseDirection::kCheaper;
+};
+
+// One object after preprocessing. p = vertexCount(), q = the vertices that never collapse (the
+// boundary vertices Q of the paper, plus interior vertices no valid collapse could remove).
+struct ProgressiveMesh {
+  std::uint32_t q = 0;
+  std::vector<Vec3f> positions;          // p, rearranged (Algorithm 1)
+  std::vector<Vec3f> normals;            // p or empty
+  std::vector<Rgba8> colors;             // p or empty
+  std::vector<std::uint32_t> triangles;  // 3 per triangle, rearranged, full-detail corners
+  // ECol': ecol[i] is the vertex that i collapses into; ecol[i] < i for i >= q (chains strictly
+  // decrease), ecol[i] == i for the q vertices that never collapse.
+  std::vector<std::uint32_t> ecol;
+  std::vector<std::uint32_t>
+      map;  // p - q + 1 entries: map[n - q] = triangles of the mesh at n vertices
+  // Geometric error of the mesh at n vertices, model units: error[n - q], non-increasing in n,
+  // error[p - q] = 0 (the monotone maximum of the per-collapse errors, see docs/simplify.md).
+  std::vector<float> error;
+  // The permutations of Algorithm 1: original index -> rearranged index.
+  std::vector<std::uint32_t> permuteV, permuteT;
+
+  std::uint32_t vertexCount() const { return static_cast<std::uint32_t>(positions.size()); }
+  std::uint32_t triangleCount() const { return static_cast<std::uint32_t>(triangles.size() / 3); }
+  std::uint32_t trianglesAt(std::uint32_t n) const { return map[n - q]; }
+  float errorAt(std::uint32_t n) const { return error[n - q]; }
+  // The fewest vertices whose error is at most `error` (q if every level qualifies).
+  std::uint32_t vertexCountForError(float error) const;
+};
+
+// Builds the progressive mesh of one object. Expects a welded, indexed mesh without repeated
+// corners in a triangle and without unreferenced vertices (prepareObject in prepare.h does
+// that). `normals` and `colors` may be empty; they are carried along with their vertex.
+ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
+                                 std::span<const std::uint32_t> indices,
+                                 std::span<const Vec3f> normals, std::span<const Rgba8> colors,
+                                 const ProgressiveOptions& options = {});
+
+// Memory buildProgressive needs for a mesh of this size (for memory budgets).
+std::uint64_t progressiveBuildBytes(std::uint64_t vertices, std::uint64_t triangles);
+
+}  // namespace lodforge

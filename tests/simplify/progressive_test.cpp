@@ -1,0 +1,334 @@
+#include "lodforge/simplify/progressive.h"
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "lodforge/core/mesh.h"
+#include "lodforge/core/random.h"
+#include "lodforge/generate/cad.h"
+#include "lodforge/io/gltf_reader.h"
+#include "lodforge/io/model_io.h"
+#include "lodforge/simplify/prepare.h"
+#include "lodforge/simplify/reform.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+using Triangle = std::array<std::uint32_t, 3>;
+
+// The reference: start from the full rearranged mesh and apply the recorded collapses one by
+// one (vertex p-1 first: every corner k becomes ecol[k], triangles with a repeated corner
+// vanish), comparing with Algorithm 2 at the requested vertex counts. Independent of the build
+// and of the reformation kernel: it walks forward with incidence lists.
+struct ExactnessReport {
+  std::size_t levelsChecked = 0;
+};
+
+ExactnessReport expectExact(const ProgressiveMesh& mesh, const std::vector<std::uint32_t>& levels,
+                            const std::string& what) {
+  ExactnessReport report;
+  const std::uint32_t p = mesh.vertexCount(), q = mesh.q;
+  const std::uint32_t T = mesh.triangleCount();
+  std::vector<Triangle> current(T);
+  std::vector<bool> alive(T, true);
+  std::vector<std::vector<std::uint32_t>> incident(p);
+  for (std::uint32_t t = 0; t < T; ++t) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      current[t][k] = mesh.triangles[3 * t + k];
+      incident[current[t][k]].push_back(t);
+    }
+  }
+  std::uint32_t aliveCount = T;
+  std::set<std::uint32_t> wanted(levels.begin(), levels.end());
+  std::vector<std::uint32_t> reformed;
+  for (std::uint32_t n = p;; --n) {
+    if (wanted.count(n)) {
+      ++report.levelsChecked;
+      // map(n) is the surviving count, and the first map(n) re-formed triangles are exactly the
+      // surviving ones (as a multiset), none degenerate.
+      const std::uint32_t count = mesh.trianglesAt(n);
+      EXPECT_EQ(count, aliveCount) << what << " n=" << n;
+      reformed.resize(3 * std::size_t{count});
+      reformObject(std::span(mesh.triangles).first(3 * std::size_t{count}), mesh.ecol, n, 0,
+                   reformed);
+      // Multisets as sorted vectors.
+      std::vector<Triangle> expected, actual;
+      expected.reserve(aliveCount);
+      actual.reserve(count);
+      for (std::uint32_t t = 0; t < T; ++t) {
+        if (alive[t]) expected.push_back(current[t]);
+      }
+      bool degenerate = false, outOfRange = false;
+      for (std::size_t t = 0; t < count; ++t) {
+        const Triangle tri{reformed[3 * t], reformed[3 * t + 1], reformed[3 * t + 2]};
+        degenerate = degenerate || tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
+        outOfRange = outOfRange || std::max({tri[0], tri[1], tri[2]}) >= n;
+        actual.push_back(tri);
+      }
+      EXPECT_FALSE(degenerate) << what << " degenerate triangle at n=" << n;
+      EXPECT_FALSE(outOfRange) << what << " corner beyond n=" << n;
+      std::sort(expected.begin(), expected.end());
+      std::sort(actual.begin(), actual.end());
+      EXPECT_TRUE(actual == expected) << what << " n=" << n;
+      if (::testing::Test::HasFailure()) return report;
+    }
+    if (n == q) break;
+    // Collapse vertex n-1 into its ECol target.
+    const std::uint32_t from = n - 1, to = mesh.ecol[from];
+    EXPECT_LT(to, from) << what << ": ECol chains must strictly decrease";
+    for (std::uint32_t t : incident[from]) {
+      if (!alive[t]) continue;
+      for (std::uint32_t& c : current[t]) {
+        if (c == from) c = to;
+      }
+      if (current[t][0] == current[t][1] || current[t][1] == current[t][2] ||
+          current[t][0] == current[t][2]) {
+        alive[t] = false;
+        --aliveCount;
+      } else {
+        incident[to].push_back(t);
+      }
+    }
+  }
+  return report;
+}
+
+// Every level for small meshes, a dense spread plus both ends for big ones.
+std::vector<std::uint32_t> levelsOf(const ProgressiveMesh& mesh, std::uint32_t dense = 400) {
+  std::vector<std::uint32_t> levels;
+  const std::uint32_t p = mesh.vertexCount(), q = mesh.q;
+  if (p - q <= dense) {
+    for (std::uint32_t n = q; n <= p; ++n) levels.push_back(n);
+    return levels;
+  }
+  for (std::uint32_t i = 0; i <= dense; ++i)
+    levels.push_back(q + static_cast<std::uint32_t>(std::uint64_t{p - q} * i / dense));
+  for (std::uint32_t n : {q, q + 1, p - 1, p}) levels.push_back(n);
+  return levels;
+}
+
+ProgressiveMesh buildPrepared(std::span<const Vec3f> positions,
+                              std::span<const std::uint32_t> indices,
+                              const ProgressiveOptions& options = {}) {
+  const PreparedObject prepared = prepareObject(positions, {}, {}, indices);
+  return buildProgressive(prepared.positions, prepared.indices, prepared.normals, prepared.colors,
+                          options);
+}
+
+// A bumpy grid with random holes: boundaries inside and out, varied curvature.
+void randomSurface(std::uint64_t seed, std::vector<Vec3f>& positions,
+                   std::vector<std::uint32_t>& indices) {
+  Random random(seed);
+  const int w = 6 + static_cast<int>(random.below(20)), h = 6 + static_cast<int>(random.below(20));
+  positions.clear();
+  indices.clear();
+  for (int y = 0; y <= h; ++y) {
+    for (int x = 0; x <= w; ++x)
+      positions.push_back({float(x), float(y), float(random.uniform(-0.4, 0.4))});
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (random.uniform() < 0.06) continue;  // a hole
+      const auto a = std::uint32_t(y * (w + 1) + x), b = a + 1, c = a + std::uint32_t(w) + 2,
+                 d = a + std::uint32_t(w) + 1;
+      indices.insert(indices.end(), {a, b, c, a, c, d});
+    }
+  }
+}
+
+TEST(Progressive, ExactOnRandomSurfacesAtEveryLevel) {
+  for (std::uint64_t seed = 1; seed <= 25; ++seed) {
+    std::vector<Vec3f> positions;
+    std::vector<std::uint32_t> indices;
+    randomSurface(seed, positions, indices);
+    for (CollapseCost cost : {CollapseCost::kQuadric, CollapseCost::kMelax}) {
+      for (CollapseDirection direction : {CollapseDirection::kCheaper, CollapseDirection::kPaper}) {
+        const ProgressiveMesh mesh = buildPrepared(positions, indices, {cost, direction});
+        EXPECT_LT(mesh.q, mesh.vertexCount());
+        expectExact(mesh, levelsOf(mesh, 100000), fmt::format("seed {}", seed));
+        if (HasFailure()) return;
+      }
+    }
+  }
+}
+
+TEST(Progressive, RealMeshesAreExact) {
+  for (const char* file : {"meshes/stanford-bunny.obj", "meshes/horse.ply"}) {
+    Result<Model> model = readModel(test::dataPath(file));
+    ASSERT_TRUE(model.ok());
+    const ProgressiveMesh mesh = buildPrepared(model->positions, model->indices);
+    const ExactnessReport report = expectExact(mesh, levelsOf(mesh), file);
+    EXPECT_GE(report.levelsChecked, 400u);
+    // Closed or nearly closed scans simplify to a tiny fraction.
+    EXPECT_LT(mesh.trianglesAt(mesh.q), mesh.triangleCount() / 50) << file;
+  }
+}
+
+TEST(Progressive, RealCadPartsAreExactAtEveryLevel) {
+  std::size_t objects = 0;
+  for (const char* file :
+       {"meshes/2CylinderEngine.glb", "meshes/as1_motor.glb", "meshes/Motor-c.glb"}) {
+    Result<Model> model = readModel(test::dataPath(file));
+    ASSERT_TRUE(model.ok());
+    for (std::size_t o = 0; o < model->objectCount(); ++o) {
+      const ProgressiveMesh mesh =
+          buildPrepared(model->objectPositions(o), model->objectIndices(o));
+      expectExact(mesh, levelsOf(mesh), fmt::format("{} object {}", file, o));
+      if (HasFailure()) return;
+      ++objects;
+    }
+  }
+  EXPECT_EQ(objects, 67u + 35u + 17u);
+}
+
+TEST(Progressive, GeneratedCadPartsAreExactAtEveryLevel) {
+  test::TempDir dir;
+  ASSERT_TRUE(generateCad({.objects = 120, .seed = 11}, dir.file("parts.glb")).ok());
+  Result<Model> model = readGltf(dir.file("parts.glb"));
+  ASSERT_TRUE(model.ok());
+  for (std::size_t o = 0; o < model->objectCount(); ++o) {
+    const ProgressiveMesh mesh = buildPrepared(model->objectPositions(o), model->objectIndices(o));
+    expectExact(mesh, levelsOf(mesh), std::string(model->objectName(o)));
+    if (HasFailure()) return;
+  }
+}
+
+TEST(Progressive, BoundaryVerticesNeverMoveAndBoundaryEdgesSurvive) {
+  std::vector<Vec3f> positions;
+  std::vector<std::uint32_t> indices;
+  randomSurface(77, positions, indices);
+  const PreparedObject prepared = prepareObject(positions, {}, {}, indices);
+  const ProgressiveMesh mesh = buildProgressive(prepared.positions, prepared.indices, {}, {});
+  // Boundary edges of the input (one triangle), in rearranged numbering.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> count;
+  for (std::size_t t = 0; t < prepared.indices.size(); t += 3) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = mesh.permuteV[prepared.indices[t + k]],
+                          b = mesh.permuteV[prepared.indices[t + (k + 1) % 3]];
+      count[{std::min(a, b), std::max(a, b)}]++;
+    }
+  }
+  std::set<std::pair<std::uint32_t, std::uint32_t>> boundary;
+  for (const auto& [edge, n] : count) {
+    if (n == 1) boundary.insert(edge);
+  }
+  ASSERT_FALSE(boundary.empty());
+  for (const auto& [a, b] : boundary) {
+    EXPECT_LT(a, mesh.q);  // boundary vertices are among the q that never collapse
+    EXPECT_LT(b, mesh.q);
+  }
+  // At the simplest level every input boundary edge is still an edge of the mesh.
+  const std::uint32_t n = mesh.q;
+  std::vector<std::uint32_t> reformed(3 * std::size_t{mesh.trianglesAt(n)});
+  reformObject(std::span(mesh.triangles).first(reformed.size()), mesh.ecol, n, 0, reformed);
+  std::set<std::pair<std::uint32_t, std::uint32_t>> edges;
+  for (std::size_t t = 0; t < reformed.size(); t += 3) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = reformed[t + k], b = reformed[t + (k + 1) % 3];
+      edges.insert({std::min(a, b), std::max(a, b)});
+    }
+  }
+  for (const auto& edge : boundary) EXPECT_TRUE(edges.count(edge));
+}
+
+TEST(Progressive, NoTriangleEverFlipsOnAPlane) {
+  // A flat, irregular grid: every level must keep every triangle facing +z.
+  Random random(3);
+  std::vector<Vec3f> positions;
+  std::vector<std::uint32_t> indices;
+  const int w = 30;
+  for (int y = 0; y <= w; ++y) {
+    for (int x = 0; x <= w; ++x) {
+      const bool edge = x == 0 || y == 0 || x == w || y == w;
+      positions.push_back({float(x) + (edge ? 0.0f : float(random.uniform(-0.3, 0.3))),
+                           float(y) + (edge ? 0.0f : float(random.uniform(-0.3, 0.3))), 0});
+    }
+  }
+  for (int y = 0; y < w; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const auto a = std::uint32_t(y * (w + 1) + x), b = a + 1, c = a + w + 2, d = a + w + 1;
+      indices.insert(indices.end(), {a, b, c, a, c, d});
+    }
+  }
+  for (CollapseCost cost : {CollapseCost::kQuadric, CollapseCost::kMelax}) {
+    const ProgressiveMesh mesh =
+        buildPrepared(positions, indices, {cost, CollapseDirection::kCheaper});
+    // The interior of a plane collapses almost completely: the last interior vertex may stay,
+    // since collapsing it into a boundary vertex would leave zero-area triangles along a side.
+    EXPECT_GE(mesh.q, std::uint32_t(4 * w));
+    EXPECT_LE(mesh.q, std::uint32_t(4 * w + 2));
+    EXPECT_LT(mesh.errorAt(mesh.q), 1e-9f);  // flat: no error at any level (up to rounding)
+    for (std::uint32_t n = mesh.q; n <= mesh.vertexCount(); ++n) {
+      std::vector<std::uint32_t> reformed(3 * std::size_t{mesh.trianglesAt(n)});
+      reformObject(std::span(mesh.triangles).first(reformed.size()), mesh.ecol, n, 0, reformed);
+      for (std::size_t t = 0; t < reformed.size(); t += 3) {
+        const Vec3f a = mesh.positions[reformed[t]], b = mesh.positions[reformed[t + 1]],
+                    c = mesh.positions[reformed[t + 2]];
+        ASSERT_GT(cross(b - a, c - a).z, 0.0f) << "n=" << n;
+      }
+    }
+  }
+}
+
+TEST(Progressive, ClosedSurfacesStayManifoldDownToTheirMinimum) {
+  Result<Model> model = readModel(test::dataPath("meshes/horse.ply"));
+  ASSERT_TRUE(model.ok());
+  const ProgressiveMesh mesh = buildPrepared(model->positions, model->indices);
+  for (std::uint32_t n : levelsOf(mesh, 40)) {
+    std::vector<std::uint32_t> reformed(3 * std::size_t{mesh.trianglesAt(n)});
+    reformObject(std::span(mesh.triangles).first(reformed.size()), mesh.ecol, n, 0, reformed);
+    EXPECT_EQ(countBoundaryEdges(reformed), 0u)
+        << "n=" << n;  // the horse is closed: it stays closed
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    for (std::size_t t = 0; t < reformed.size(); t += 3) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::uint32_t a = reformed[t + k], b = reformed[t + (k + 1) % 3];
+        const auto edge = std::make_pair(std::min(a, b), std::max(a, b));
+        ASSERT_LE(++uses[edge], 2) << "non-manifold edge at n=" << n;
+      }
+    }
+  }
+  EXPECT_LE(mesh.q, 8u);  // a closed genus-0 surface ends near a tetrahedron
+}
+
+TEST(Progressive, ErrorTableIsMonotoneAndGrowsAsDetailGoes) {
+  Result<Model> model = readModel(test::dataPath("meshes/stanford-bunny.obj"));
+  ASSERT_TRUE(model.ok());
+  const ProgressiveMesh mesh = buildPrepared(model->positions, model->indices);
+  ASSERT_EQ(mesh.error.size(), mesh.vertexCount() - mesh.q + 1);
+  EXPECT_EQ(mesh.error.back(), 0.0f);
+  for (std::size_t i = 1; i < mesh.error.size(); ++i) ASSERT_LE(mesh.error[i], mesh.error[i - 1]);
+  EXPECT_GT(mesh.error.front(), 0.0f);
+  // vertexCountForError inverts the table.
+  const float e = mesh.errorAt((mesh.q + mesh.vertexCount()) / 2);
+  const std::uint32_t n = mesh.vertexCountForError(e);
+  EXPECT_LE(mesh.errorAt(n), e);
+  EXPECT_TRUE(n == mesh.q || mesh.errorAt(n - 1) > e);
+}
+
+TEST(Progressive, AttributesFollowTheirVertices) {
+  std::vector<Vec3f> positions;
+  std::vector<std::uint32_t> indices;
+  randomSurface(5, positions, indices);
+  std::vector<Rgba8> colors(positions.size());
+  for (std::size_t v = 0; v < colors.size(); ++v)
+    colors[v] = {std::uint8_t(v), std::uint8_t(v >> 8), 7, 255};
+  std::vector<Vec3f> normals(positions.size(), Vec3f{0, 0, 1});
+  const ProgressiveMesh mesh = buildProgressive(positions, indices, normals, colors);
+  for (std::size_t v = 0; v < positions.size(); ++v) {
+    EXPECT_EQ(mesh.positions[mesh.permuteV[v]], positions[v]);
+    EXPECT_EQ(mesh.colors[mesh.permuteV[v]], colors[v]);
+  }
+  for (std::size_t t = 0; t < indices.size() / 3; ++t) {
+    for (std::size_t k = 0; k < 3; ++k)
+      EXPECT_EQ(mesh.triangles[3 * mesh.permuteT[t] + k], mesh.permuteV[indices[3 * t + k]]);
+  }
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -35,6 +35,7 @@ constexpr std::uint32_t kNone = ~0u;
 // the distance to the original within ~1.2x of meshoptimizer's at 10 % and 1 % (bench_simplify)
 // at about 0.4x its speed; 1.0 would be ~10 % faster and clearly worse in between.
 constexpr double kPassShare = 0.2;
+constexpr std::size_t kBuckets = 32;  // cost buckets per pass, each walked in vertex order
 
 // Collapses happen in passes over flat arrays (as meshoptimizer does), not through one global
 // priority queue: each pass ranks every vertex's cheapest valid-looking collapse, sorts them,
@@ -428,6 +429,15 @@ void Simplifier::collapseAll() {
     std::nth_element(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(share - 1),
                      ranked.end());
     std::sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(share));
+    // Within each of many small cost buckets, walk in vertex order: neighbours in memory are
+    // neighbours on the surface (fewer cache misses on big meshes), and the cost order barely
+    // changes.
+    const std::size_t bucket = std::max<std::size_t>(1, share / kBuckets);
+    for (std::size_t b = 0; b < share; b += bucket) {
+      const auto first = ranked.begin() + static_cast<std::ptrdiff_t>(b);
+      const auto last = ranked.begin() + static_cast<std::ptrdiff_t>(std::min(share, b + bucket));
+      std::sort(first, last, [](const auto& x, const auto& y) { return x.second < y.second; });
+    }
     const std::size_t before = collapsed_.size();
     for (std::size_t limit : {share, ranked.size()}) {
       if (limit == ranked.size() && limit > share)

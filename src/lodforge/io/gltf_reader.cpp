@@ -625,35 +625,40 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
   std::uint64_t binOffset = 0;
   bool ok = false;
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  std::uint32_t magic = 0;
-  if (bytes.size() >= 4) std::memcpy(&magic, bytes.data(), 4);
-  if (magic == kGlbMagic) {
-    LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset));
-    Result<std::optional<std::string>> rewritten = withoutDracoIndices(bytes, name, true);
-    if (!rewritten) return rewritten.status();
-    if (*rewritten) {
-      // Same BIN chunk, new JSON length: keep reporting byte offsets of the original file.
-      const std::string& copy = **rewritten;
-      ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings,
-                                       reinterpret_cast<const unsigned char*>(copy.data()),
-                                       static_cast<unsigned>(copy.size()), baseDir);
+  // tinygltf throws (nlohmann::json conversions of out-of-range numbers) on some bad files.
+  try {
+    std::uint32_t magic = 0;
+    if (bytes.size() >= 4) std::memcpy(&magic, bytes.data(), 4);
+    if (magic == kGlbMagic) {
+      LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset));
+      Result<std::optional<std::string>> rewritten = withoutDracoIndices(bytes, name, true);
+      if (!rewritten) return rewritten.status();
+      if (*rewritten) {
+        // Same BIN chunk, new JSON length: keep reporting byte offsets of the original file.
+        const std::string& copy = **rewritten;
+        ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings,
+                                         reinterpret_cast<const unsigned char*>(copy.data()),
+                                         static_cast<unsigned>(copy.size()), baseDir);
+      } else {
+        ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings, data,
+                                         static_cast<unsigned>(bytes.size()), baseDir);
+      }
     } else {
-      ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings, data,
-                                       static_cast<unsigned>(bytes.size()), baseDir);
+      const auto first = std::find_if(bytes.begin(), bytes.end(), [](std::byte b) {
+        return !std::isspace(static_cast<unsigned char>(b));
+      });
+      if (first == bytes.end() || *first != std::byte{'{'})
+        return badInputAtByte(name, 0, "neither GLB (magic 'glTF') nor glTF JSON");
+      Result<std::optional<std::string>> rewritten = withoutDracoIndices(bytes, name, false);
+      if (!rewritten) return rewritten.status();
+      const std::string_view text =
+          *rewritten ? std::string_view(**rewritten)
+                     : std::string_view(reinterpret_cast<const char*>(data), bytes.size());
+      ok = loader.LoadASCIIFromString(&gltf, &errors, &warnings, text.data(),
+                                      static_cast<unsigned>(text.size()), baseDir);
     }
-  } else {
-    const auto first = std::find_if(bytes.begin(), bytes.end(), [](std::byte b) {
-      return !std::isspace(static_cast<unsigned char>(b));
-    });
-    if (first == bytes.end() || *first != std::byte{'{'})
-      return badInputAtByte(name, 0, "neither GLB (magic 'glTF') nor glTF JSON");
-    Result<std::optional<std::string>> rewritten = withoutDracoIndices(bytes, name, false);
-    if (!rewritten) return rewritten.status();
-    const std::string_view text =
-        *rewritten ? std::string_view(**rewritten)
-                   : std::string_view(reinterpret_cast<const char*>(data), bytes.size());
-    ok = loader.LoadASCIIFromString(&gltf, &errors, &warnings, text.data(),
-                                    static_cast<unsigned>(text.size()), baseDir);
+  } catch (const std::exception& e) {
+    return badInput(name, fmt::format("tinygltf cannot parse the file: {}", e.what()));
   }
   if (!ok) {
     while (!errors.empty() && (errors.back() == '\n' || errors.back() == ' ')) errors.pop_back();

@@ -119,6 +119,9 @@ doc['accessors'][0] = {'componentType': 5126, 'count': 10**12, 'type': 'VEC3',
                        'sparse': {'count': 0, 'indices': {'bufferView': 1, 'componentType': 5125},
                                   'values': {'bufferView': 0}}}
 write('glb-huge-count.glb', glb(doc, good_binary), '1000000000000 elements without a bufferView')
+doc = triangle_document()
+doc['buffers'][0]['byteLength'] = 0  # tinygltf throws std::out_of_range on this one
+write('glb-empty-buffer.glb', glb(doc, good_binary), 'tinygltf cannot parse the file')
 write('gltf-not-json.gltf', 'this is not glTF', 'byte 0: neither GLB')
 write('gltf-broken-json.gltf', '{"asset": {"version": "2.0"}, "nodes": [', 'gltf-broken-json.gltf')
 

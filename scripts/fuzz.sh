@@ -15,8 +15,16 @@ run() {
        "$work" fuzz/corpus/"$reader" tests/data/malformed > build/fuzz/"$reader".log 2>&1; then
     echo "fuzz_$reader: $(grep -m1 number_of_executed_units build/fuzz/"$reader".log | awk '{print $2}') inputs, no findings"
   else
-    echo "fuzz_$reader FAILED; the log follows" >&2
-    tail -60 build/fuzz/"$reader".log >&2
+    echo "fuzz_$reader FAILED; the report follows" >&2
+    # The sanitizer's own report (what and where) first, then how libFuzzer ended.
+    grep -m1 -A45 -E "ERROR: (AddressSanitizer|UndefinedBehaviorSanitizer|libFuzzer|LeakSanitizer)|runtime error:" \
+      build/fuzz/"$reader".log >&2 || true
+    tail -8 build/fuzz/"$reader".log >&2
+    # The input itself, so a crash found on a CI machine can be replayed anywhere.
+    for artifact in build/fuzz/artifacts/"$reader"-*; do
+      [ -f "$artifact" ] && [ "$(stat -c %s "$artifact")" -le 65536 ] &&
+        echo "$artifact (base64): $(base64 -w0 "$artifact")" >&2
+    done
     return 1
   fi
 }

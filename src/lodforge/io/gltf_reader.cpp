@@ -22,6 +22,12 @@ constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort 
               kUnsignedInt = 5125, kFloat = 5126;
 constexpr std::uint32_t kGlbMagic = 0x46546C67;  // "glTF"
 constexpr std::uint32_t kChunkJson = 0x4E4F534A;
+constexpr std::uint32_t kChunkBin = 0x004E4942;
+// Debian's tinygltf (2.8) sizes the BIN chunk as everything after the JSON chunk, its 8-byte
+// header included, so it copies a buffer up to 8 bytes longer than the chunk from past the end
+// of the file. GLB is parsed from a copy with that many zero bytes after the end, and the
+// buffer is checked against the real chunk length afterwards.
+constexpr std::size_t kTinygltfOverread = 8;
 
 std::size_t componentSize(int type) {
   switch (type) {
@@ -542,7 +548,7 @@ class Loader {
 
 // Checks the GLB container before tinygltf does, so errors carry byte offsets.
 Status checkGlbContainer(std::span<const std::byte> bytes, const std::string& name,
-                         std::uint64_t& binOffset) {
+                         std::uint64_t& binOffset, std::uint64_t& binLength) {
   auto u32 = [&](std::size_t at) {
     std::uint32_t v;
     std::memcpy(&v, bytes.data() + at, 4);
@@ -561,6 +567,17 @@ Status checkGlbContainer(std::span<const std::byte> bytes, const std::string& na
     return badInputAtByte(
         name, 12, fmt::format("JSON chunk of {} bytes runs past the end of the file", jsonLength));
   binOffset = 20 + jsonLength + 8;
+  binLength = 0;
+  if (20 + jsonLength < bytes.size()) {
+    if (bytes.size() - (20 + jsonLength) < 8)
+      return badInputAtByte(name, 20 + jsonLength, "GLB ends inside a chunk header");
+    const std::uint64_t length = u32(20 + jsonLength);
+    if (length > bytes.size() - binOffset)
+      return badInputAtByte(
+          name, 20 + jsonLength,
+          fmt::format("BIN chunk of {} bytes runs past the end of the file", length));
+    if (u32(24 + jsonLength) == kChunkBin) binLength = length;
+  }
   return {};
 }
 
@@ -622,7 +639,7 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
   }
   tinygltf::Model gltf;
   std::string errors, warnings;
-  std::uint64_t binOffset = 0;
+  std::uint64_t binOffset = 0, binLength = 0;
   bool ok = false;
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   // tinygltf throws (nlohmann::json conversions of out-of-range numbers) on some bad files.
@@ -630,19 +647,23 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
     std::uint32_t magic = 0;
     if (bytes.size() >= 4) std::memcpy(&magic, bytes.data(), 4);
     if (magic == kGlbMagic) {
-      LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset));
+      LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset, binLength));
       Result<std::optional<std::string>> rewritten = withoutDracoIndices(bytes, name, true);
       if (!rewritten) return rewritten.status();
-      if (*rewritten) {
-        // Same BIN chunk, new JSON length: keep reporting byte offsets of the original file.
-        const std::string& copy = **rewritten;
-        ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings,
-                                         reinterpret_cast<const unsigned char*>(copy.data()),
-                                         static_cast<unsigned>(copy.size()), baseDir);
-      } else {
-        ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings, data,
-                                         static_cast<unsigned>(bytes.size()), baseDir);
-      }
+      // Same BIN chunk, maybe a new JSON length: byte offsets reported are the original file's.
+      std::string copy = *rewritten
+                             ? std::move(**rewritten)
+                             : std::string(reinterpret_cast<const char*>(data), bytes.size());
+      const std::size_t size = copy.size();
+      copy.append(kTinygltfOverread, '\0');
+      ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings,
+                                       reinterpret_cast<const unsigned char*>(copy.data()),
+                                       static_cast<unsigned>(size), baseDir);
+      if (ok && !gltf.buffers.empty() && gltf.buffers[0].uri.empty() &&
+          gltf.buffers[0].data.size() > binLength)
+        return badInputAtByte(name, binOffset - 8,
+                              fmt::format("buffer 0 declares {} bytes but the BIN chunk holds {}",
+                                          gltf.buffers[0].data.size(), binLength));
     } else {
       const auto first = std::find_if(bytes.begin(), bytes.end(), [](std::byte b) {
         return !std::isspace(static_cast<unsigned char>(b));

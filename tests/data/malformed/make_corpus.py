@@ -122,6 +122,13 @@ write('glb-huge-count.glb', glb(doc, good_binary), '1000000000000 elements witho
 doc = triangle_document()
 doc['buffers'][0]['byteLength'] = 0  # tinygltf throws std::out_of_range on this one
 write('glb-empty-buffer.glb', glb(doc, good_binary), 'tinygltf cannot parse the file')
+doc = triangle_document()
+doc['buffers'][0]['byteLength'] = 48
+overrun = bytearray(glb(doc, good_binary))
+chunk = len(overrun) - 8 - (len(good_binary) + -len(good_binary) % 4)
+overrun[chunk:chunk + 4] = struct.pack('<I', 48)  # 4 bytes more than the file holds
+write('glb-bin-chunk-overrun.glb', bytes(overrun), 'BIN chunk of 48 bytes runs past the end of the file')
+write('glb-buffer-beyond-bin.glb', glb(doc, good_binary), 'Must be equal or less than binary size')
 write('gltf-not-json.gltf', 'this is not glTF', 'byte 0: neither GLB')
 write('gltf-broken-json.gltf', '{"asset": {"version": "2.0"}, "nodes": [', 'gltf-broken-json.gltf')
 

@@ -189,11 +189,18 @@ std::span<const Vec3f> Package::allPositions() const {
 std::span<const Vec3f> Package::allNormals() const {
   return section<Vec3f>(PackageSection::kNormals);
 }
+std::span<const Rgba8> Package::allColors() const {
+  return section<Rgba8>(PackageSection::kColors);
+}
 std::span<const std::uint32_t> Package::allTriangles() const {
   return section<std::uint32_t>(PackageSection::kTriangles);
 }
 std::span<const std::uint32_t> Package::allEcol() const {
   return section<std::uint32_t>(PackageSection::kEcol);
+}
+
+std::span<const std::uint32_t> Package::allMap() const {
+  return section<std::uint32_t>(PackageSection::kMap);
 }
 
 std::string_view Package::objectName(std::size_t i) const {
@@ -209,8 +216,7 @@ std::span<const Vec3f> Package::normals(std::size_t i) const {
 }
 std::span<const Rgba8> Package::colors(std::size_t i) const {
   if (!header_->hasColors()) return {};
-  return section<Rgba8>(PackageSection::kColors)
-      .subspan(object(i).vertexOffset, object(i).vertexCount);
+  return allColors().subspan(object(i).vertexOffset, object(i).vertexCount);
 }
 std::span<const std::uint32_t> Package::triangles(std::size_t i) const {
   return allTriangles().subspan(3 * object(i).triangleOffset,

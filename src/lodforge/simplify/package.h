@@ -156,8 +156,10 @@ class Package {
   std::span<const PackageObject> objects() const;
   std::span<const Vec3f> allPositions() const;
   std::span<const Vec3f> allNormals() const;
+  std::span<const Rgba8> allColors() const;
   std::span<const std::uint32_t> allTriangles() const;
   std::span<const std::uint32_t> allEcol() const;
+  std::span<const std::uint32_t> allMap() const;  // every object's map, at its levelOffset
   std::uint64_t sectionBytes(PackageSection section) const {
     return header_->sections[static_cast<std::uint32_t>(section)].bytes;
   }

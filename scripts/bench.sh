@@ -2,7 +2,9 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify runs only the simplifier part.
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify or BENCH_ONLY=runtime runs
+# only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
+# paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 lodforge=$(pwd)/build/release/lodforge
@@ -25,10 +27,33 @@ measure() {  # name, then the command; prints a table row and removes the output
   rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
   out=$(du -h "${@: -1}" | cut -f1)
   printf '| %-44s | %9s | %8d MiB | %7s |\n' "$name" "$wall" $((rss / 1024)) "$out"
-  rm -f "${@: -1}"
+  [[ -n ${KEEP_OUTPUT:-} ]] || rm -f "${@: -1}"
 }
 
-if [[ ${BENCH_ONLY:-} == simplify ]]; then skip_generators=1; fi
+if [[ -n ${BENCH_ONLY:-} ]]; then skip_generators=1; fi
+
+runtime_section() {
+  echo
+  echo "== runtime: LOD selection and coherent streaming along orbit and fly-through paths (lodforge bench)"
+  # A tenth of the paper's assembly with budgets scaled alike; BENCH_LARGE adds the full size.
+  "$lodforge" -q generate cad --objects 71800 --detail 1.5 -o "$work/cad72k.ply"
+  "$lodforge" -q build "$work/cad72k.ply" -o "$work/cad72k.lfp"
+  rm -f "$work/cad72k.ply"
+  for path in orbit fly; do
+    "$lodforge" bench "$work/cad72k.lfp" --path "$path" --budget 300K,1.05M,1.8M --json "$work/bench-72k-$path.json"
+  done
+  rm -f "$work/cad72k.lfp"
+  if [[ ${BENCH_LARGE:-0} == 1 ]]; then
+    "$lodforge" -q generate cad --objects 718K --detail 1.5 -o "$work/cad718k.ply"
+    KEEP_OUTPUT=1 measure "build cad718k.ply (718,000 parts, 330 M triangles)" "$lodforge" -q build "$work/cad718k.ply" -o "$work/cad718k.lfp"
+    rm -f "$work/cad718k.ply"
+    for path in orbit fly; do
+      "$lodforge" bench "$work/cad718k.lfp" --path "$path" --budget 3M,10.5M,18M -v --json "$work/bench-718k-$path.json"
+    done
+    rm -f "$work/cad718k.lfp"
+  fi
+}
+if [[ ${BENCH_ONLY:-} == runtime ]]; then runtime_section; exit 0; fi
 
 simplify_section() {
   echo
@@ -79,3 +104,4 @@ for n in "${sizes_scan[@]}"; do
 done
 measure "generate points --points 10M" "$lodforge" -q generate points --points 10M -o "$work/points.ply"
 simplify_section
+runtime_section

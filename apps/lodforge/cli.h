@@ -37,5 +37,6 @@ void addBuild(CLI::App& app, const Global& global, Run& run);
 void addExtract(CLI::App& app, const Global& global, Run& run);
 void addConvert(CLI::App& app, const Global& global, Run& run);
 void addGenerate(CLI::App& app, const Global& global, Run& run);
+void addBench(CLI::App& app, const Global& global, Run& run);
 
 }  // namespace lodforge::cli

@@ -280,7 +280,8 @@ TEST(CliPackage, DamagedPackagesAreRefusedWithExitCode2) {
 // The memory limit is real: a model several times larger than the limit builds under it.
 TEST(CliPackage, BuildStaysUnderItsMemoryLimit) {
 #ifdef LODFORGE_SANITIZED
-  GTEST_SKIP() << "peak RSS means nothing under ASan (shadow memory, quarantine); the release build checks it";
+  GTEST_SKIP() << "peak RSS means nothing under ASan (shadow memory, quarantine); the release "
+                  "build checks it";
 #endif
   test::TempDir dir;
   ASSERT_EQ(lodforge("-q generate cad --objects 20K --seed 3 -o " + dir.file("big.ply"), dir).code,
@@ -310,6 +311,67 @@ TEST(CliPackage, BuildStaysUnderItsMemoryLimit) {
   const std::uint64_t peak = static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;
   EXPECT_LT(peak, kLimit) << "peak RSS " << peak / (1 << 20) << " MiB";
   EXPECT_EQ(info(dir.file("big.lfp"), dir)["objects"], 20'000u);
+}
+
+TEST(CliBench, RunsEveryBudgetAndHitsItExactly) {
+  test::TempDir dir;
+  const std::string package = dir.file("engine.lfp");
+  ASSERT_EQ(
+      lodforge("build " + test::dataPath("meshes/2CylinderEngine.glb") + " -o " + package, dir)
+          .code,
+      0);
+  const std::uint64_t vertices = info(package, dir)["vertices"].get<std::uint64_t>();
+  Outcome o = lodforge("bench " + package + " --frames 8 --budget 10%,20K,100% --json " +
+                           dir.file("b.json") + " --record-path " + dir.file("path.json"),
+                       dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("sel ms"), std::string::npos) << o.out;
+  const auto j = nlohmann::json::parse(test::readFile(dir.file("b.json")));
+  ASSERT_EQ(j["runs"].size(), 3u);
+  EXPECT_EQ(j["runs"][0]["budget"].get<std::uint64_t>(), (vertices + 5) / 10);
+  EXPECT_EQ(j["runs"][1]["budget"].get<std::uint64_t>(), 20'000u);
+  for (const auto& run : j["runs"]) {
+    EXPECT_EQ(run["exact_frames"], 8u);
+    EXPECT_EQ(run["frames"], 7u);  // the first frame is reported as the load
+    EXPECT_EQ(run["load"]["bytes_moved"], 0u);
+    EXPECT_EQ(run["mean"]["vertices"].get<double>(),
+              static_cast<double>(std::min(run["budget"].get<std::uint64_t>(), vertices)));
+  }
+  // At 100 % nothing changes after the load: no reads, no re-formation.
+  EXPECT_EQ(j["runs"][2]["mean"]["bytes_read"].get<double>(), 0.0);
+  EXPECT_EQ(j["runs"][2]["mean"]["triangles_reformed"].get<double>(), 0.0);
+  // The recorded path replays.
+  o = lodforge(
+      "bench " + package + " --path " + dir.file("path.json") + " --budget 5% --first-pass-only",
+      dir);
+  EXPECT_EQ(o.code, 0) << o.err;
+  o = lodforge("bench " + package + " --path fly --frames 4 --target-error 2", dir);
+  EXPECT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("error px"), std::string::npos) << o.out;
+}
+
+TEST(CliBench, BadArgumentsAndPathsGetExitCode2) {
+  test::TempDir dir;
+  const std::string package = dir.file("motor.lfp");
+  ASSERT_EQ(
+      lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
+  test::writeFile(dir.file("bad.json"), R"({"frames": [{"position": [0, 0, 0], "target": [0, 0)");
+  Outcome o = lodforge("bench " + package + " --path " + dir.file("bad.json"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find(dir.file("bad.json") + ": byte "), std::string::npos) << o.err;
+  o = lodforge("bench " + package + " --path " + dir.file("missing.json"), dir);
+  EXPECT_EQ(o.code, 1);
+  EXPECT_NE(o.err.find("missing.json"), std::string::npos) << o.err;
+  o = lodforge("bench " + package + " --budget 5%,lots", dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("'lots' is not a vertex count"), std::string::npos) << o.err;
+  EXPECT_EQ(lodforge("bench " + package + " --budget 120%", dir).code, 2);
+  EXPECT_EQ(lodforge("bench " + package + " --size 100", dir).code, 2);
+  o = lodforge("bench " + package + " --budget 100% --gpu-memory 64K", dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("does not fit --gpu-memory"), std::string::npos) << o.err;
+  o = lodforge("bench " + dir.file("motor.lfp.missing"), dir);
+  EXPECT_NE(o.code, 0);
 }
 
 }  // namespace

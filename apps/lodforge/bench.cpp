@@ -1,0 +1,390 @@
+// `lodforge bench model.lfp`: the CAD paper's Table 1 on the CPU. Along a camera path, every
+// frame selects vertex counts under the budget (§4) and brings the stream buffer up to date
+// (§3.3 reassembly, then Algorithm 2 reformation); per budget it prints the mean per-frame
+// milliseconds of each stage, what was read and moved, and whether Σ vc hit the budget.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/core/threads.h"
+#include "lodforge/core/units.h"
+#include "lodforge/runtime/path.h"
+#include "lodforge/runtime/selection.h"
+#include "lodforge/runtime/stream.h"
+
+namespace lodforge::cli {
+namespace {
+
+struct BenchOptions {
+  std::string input;
+  std::string path = "orbit";  // orbit, fly, or a path file
+  std::uint64_t frames = 120;
+  std::string budgets = "1%,5%,20%";
+  std::uint64_t gpuMemory = 0;
+  std::string size = "1280x720";
+  double fovY = 60;
+  bool firstPassOnly = false;
+  double minT = 0.65;
+  double exponent = 3.0;
+  std::optional<double> targetError;
+  std::string json;
+  std::string recordPath;
+};
+
+// One frame's costs.
+struct FrameTimes {
+  double selectionMs = 0;
+  Selection::Timings selectionSteps;
+  FrameStats stream;
+  std::uint64_t vertices = 0, triangles = 0, visible = 0;
+  bool exact = true;
+};
+
+// A budget's run: the first frame (everything read) apart from the coherent frames after it.
+struct BudgetRun {
+  std::uint64_t budget = 0;  // 0 in error-driven mode
+  std::uint64_t capacityVertices = 0, capacityBytes = 0;
+  FrameTimes load;
+  std::vector<FrameTimes> frames;
+};
+
+Result<std::uint64_t> parseBudget(std::string_view text, std::uint64_t full) {
+  if (text.ends_with('%')) {
+    double percent = 0;
+    const std::string number(text.substr(0, text.size() - 1));
+    char* end = nullptr;
+    percent = std::strtod(number.c_str(), &end);
+    if (number.empty() || end != number.c_str() + number.size() || !(percent > 0) || percent > 100)
+      return Error{ErrorKind::kUsage,
+                   fmt::format("--budget: '{}' is not a percentage in (0, 100]", text)};
+    return static_cast<std::uint64_t>(std::llround(percent / 100.0 * static_cast<double>(full)));
+  }
+  const auto count = parseCount(text);
+  if (!count || *count == 0)
+    return Error{
+        ErrorKind::kUsage,
+        fmt::format("--budget: '{}' is not a vertex count (5000, 3M, 10.5M) or a percentage (5%)",
+                    text)};
+  return *count;
+}
+
+Result<std::vector<std::uint64_t>> parseBudgets(const std::string& list, std::uint64_t full) {
+  std::vector<std::uint64_t> budgets;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    auto budget = parseBudget(std::string_view(list).substr(start, comma - start), full);
+    if (!budget) return budget.status();
+    budgets.push_back(*budget);
+    start = comma + 1;
+  }
+  return budgets;
+}
+
+Result<std::vector<Camera>> cameraPath(const BenchOptions& o, const Package& package) {
+  const auto& h = package.header();
+  Aabbd bounds;
+  bounds.add(Vec3d{h.boundsMin[0], h.boundsMin[1], h.boundsMin[2]});
+  bounds.add(Vec3d{h.boundsMax[0], h.boundsMax[1], h.boundsMax[2]});
+  unsigned width = 0, height = 0;
+  char x = 0;
+  if (std::sscanf(o.size.c_str(), "%u%c%u", &width, &x, &height) != 3 || x != 'x' ||
+      width - 1 >= 16384 || height - 1 >= 16384)
+    return Error{ErrorKind::kUsage,
+                 fmt::format("--size: '{}' is not WIDTHxHEIGHT (e.g. 1280x720)", o.size)};
+  const PathOptions options{
+      .frames = o.frames, .width = width, .height = height, .fovYDegrees = o.fovY};
+  if (o.path == "orbit") return orbitPath(bounds, options);
+  if (o.path == "fly") return flyThroughPath(bounds, options);
+  auto cameras = readCameraPath(o.path, package.origin(), bounds);
+  if (cameras && cameras->size() > o.frames) cameras->resize(o.frames);
+  return cameras;
+}
+
+double milliseconds(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration<double, std::milli>(d).count();
+}
+
+// One frame: select, then stream.
+Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const Camera& camera,
+                            std::uint64_t budget, Selection& selection, StreamBuffer& buffer) {
+  FrameTimes t;
+  const auto start = std::chrono::steady_clock::now();
+  if (o.targetError) {
+    selectByError(scene, camera, *o.targetError, selection);
+  } else {
+    selectTwoPass(scene, camera, budget,
+                  {.exponent = o.exponent, .minT = o.minT, .firstPassOnly = o.firstPassOnly},
+                  selection);
+  }
+  t.selectionMs = milliseconds(std::chrono::steady_clock::now() - start);
+  t.selectionSteps = selection.timings;
+  auto stream = buffer.update(selection.vertexCounts, selection.triangleCounts);
+  if (!stream) return stream.status();
+  t.stream = *stream;
+  t.vertices = selection.totalVertices;
+  t.triangles = selection.totalTriangles;
+  t.visible = selection.visibleObjects;
+  t.exact = o.targetError || o.firstPassOnly ||
+            selection.totalVertices == std::min(budget, scene.totalMaxVertices());
+  return t;
+}
+
+Result<BudgetRun> runBudget(const BenchOptions& o, const Package& package, const LodScene& scene,
+                            const std::vector<Camera>& cameras, std::uint64_t budget,
+                            Progress& progress) {
+  BudgetRun run;
+  run.budget = budget;
+  const std::uint64_t full = scene.totalMaxVertices();
+  StreamCapacity capacity =
+      o.gpuMemory ? StreamCapacity::forMemory(package, o.gpuMemory)
+                  : StreamCapacity::forVertices(package, o.targetError ? full : budget);
+  if (!o.targetError && std::min(budget, full) > capacity.vertices)
+    return Error{
+        ErrorKind::kUsage,
+        fmt::format(
+            "--budget {} does not fit --gpu-memory {}: it holds {} vertices of this package",
+            formatCount(budget), formatBytes(o.gpuMemory), formatCount(capacity.vertices))};
+  run.capacityVertices = capacity.vertices;
+  run.capacityBytes = capacity.bytes(package);
+  StreamBuffer buffer(package, capacity);
+  Selection selection;
+  for (std::size_t f = 0; f < cameras.size(); ++f) {
+    LODFORGE_TRY(checkCancelled());
+    auto frame = runFrame(o, scene, cameras[f], budget, selection, buffer);
+    if (!frame) return frame.status();
+    (f == 0 ? run.load : run.frames.emplace_back()) = *frame;
+    progress.advance(1);
+  }
+  return run;
+}
+
+// Mean of a per-frame quantity over the coherent frames.
+template <class F>
+double mean(const std::vector<FrameTimes>& frames, F f) {
+  if (frames.empty()) return 0;
+  double sum = 0;
+  for (const FrameTimes& t : frames) sum += static_cast<double>(f(t));
+  return sum / static_cast<double>(frames.size());
+}
+
+template <class F>
+double percentile95(const std::vector<FrameTimes>& frames, F f) {
+  if (frames.empty()) return 0;
+  std::vector<double> values;
+  for (const FrameTimes& t : frames) values.push_back(static_cast<double>(f(t)));
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1,
+                         static_cast<std::size_t>(0.95 * static_cast<double>(values.size())))];
+}
+
+double generationMs(const FrameTimes& t) {
+  return t.stream.reassemblyMs + t.stream.reformationMs;
+}
+
+nlohmann::json frameJson(const FrameTimes& t) {
+  return {{"selection_ms", t.selectionMs},
+          {"reassembly_ms", t.stream.reassemblyMs},
+          {"reformation_ms", t.stream.reformationMs},
+          {"generation_ms", generationMs(t)},
+          {"bytes_read", t.stream.bytesRead},
+          {"bytes_moved", t.stream.bytesMoved},
+          {"triangles_reformed", t.stream.trianglesReformed},
+          {"triangles_kept", t.stream.trianglesKept},
+          {"objects_changed", t.stream.objectsChanged},
+          {"vertices", t.vertices},
+          {"triangles", t.triangles},
+          {"visible_objects", t.visible}};
+}
+
+nlohmann::json runJson(const BudgetRun& run) {
+  nlohmann::json means = nlohmann::json::object();
+  const auto add = [&](const char* name, auto f) { means[name] = mean(run.frames, f); };
+  add("selection_ms", [](const FrameTimes& t) { return t.selectionMs; });
+  add("importance_ms", [](const FrameTimes& t) { return t.selectionSteps.importance; });
+  add("first_pass_ms", [](const FrameTimes& t) { return t.selectionSteps.firstPass; });
+  add("second_pass_ms", [](const FrameTimes& t) { return t.selectionSteps.secondPass; });
+  add("triangle_counts_ms", [](const FrameTimes& t) { return t.selectionSteps.finish; });
+  add("reassembly_ms", [](const FrameTimes& t) { return t.stream.reassemblyMs; });
+  add("reformation_ms", [](const FrameTimes& t) { return t.stream.reformationMs; });
+  add("generation_ms", generationMs);
+  add("bytes_read", [](const FrameTimes& t) { return t.stream.bytesRead; });
+  add("bytes_moved", [](const FrameTimes& t) { return t.stream.bytesMoved; });
+  add("triangles_reformed", [](const FrameTimes& t) { return t.stream.trianglesReformed; });
+  add("triangles_kept", [](const FrameTimes& t) { return t.stream.trianglesKept; });
+  add("objects_changed", [](const FrameTimes& t) { return t.stream.objectsChanged; });
+  add("vertices", [](const FrameTimes& t) { return t.vertices; });
+  add("triangles", [](const FrameTimes& t) { return t.triangles; });
+  add("visible_objects", [](const FrameTimes& t) { return t.visible; });
+  const auto exactFrames = static_cast<std::uint64_t>(std::count_if(
+      run.frames.begin(), run.frames.end(), [](const FrameTimes& t) { return t.exact; }));
+  return {{"budget", run.budget},
+          {"capacity_vertices", run.capacityVertices},
+          {"capacity_bytes", run.capacityBytes},
+          {"load", frameJson(run.load)},
+          {"frames", run.frames.size()},
+          {"mean", means},
+          {"triangles_per_second", 1e3 * means["triangles"].get<double>() /
+                                       std::max(1e-9, means["selection_ms"].get<double>() +
+                                                          means["generation_ms"].get<double>())},
+          {"p95_selection_ms",
+           percentile95(run.frames, [](const FrameTimes& t) { return t.selectionMs; })},
+          {"p95_generation_ms", percentile95(run.frames, generationMs)},
+          {"exact_frames", exactFrames + (run.load.exact ? 1 : 0)}};
+}
+
+std::string megabytes(double bytes) {
+  return fmt::format("{:.1f}", bytes / 1e6);
+}
+
+void printTable(const Global& global, const BenchOptions& o, const std::vector<BudgetRun>& runs) {
+  say(global,
+      fmt::format(
+          "{:>12} {:>9} | {:>9} {:>9} {:>9} | {:>8} {:>8} {:>8} {:>8} | {:>10} {:>9} {:>7} | {:>6}",
+          o.targetError ? "error px" : "budget N", "visible", "sel ms", "reasm ms", "reform ms",
+          "gen ms", "gen p95", "read MB", "moved MB", "reformed", "Mtri/s", "load ms", "Σ=N"));
+  for (const BudgetRun& r : runs) {
+    const double gen = mean(r.frames, generationMs);
+    const double reformMs =
+        mean(r.frames, [](const FrameTimes& t) { return t.stream.reformationMs; });
+    const double triangles = mean(r.frames, [](const FrameTimes& t) { return t.triangles; });
+    // The paper's throughput: triangles in the frame over the time to produce it (its Table 1
+    // adds the OpenGL draw, which the rendering issue brings).
+    const double frameMs = mean(r.frames, [](const FrameTimes& t) { return t.selectionMs; }) + gen;
+    const auto exact = std::count_if(r.frames.begin(), r.frames.end(),
+                                     [](const FrameTimes& t) { return t.exact; }) +
+                       (r.load.exact ? 1 : 0);
+    say(global,
+        fmt::format(
+            "{:>12} {:>9} | {:>9.2f} {:>9.2f} {:>9.2f} | {:>8.2f} {:>8.2f} {:>8} {:>8} | {:>10} "
+            "{:>9.0f} {:>7.1f} | {:>6}",
+            o.targetError ? fmt::format("{:g}", *o.targetError) : formatCount(r.budget),
+            formatCount(static_cast<std::uint64_t>(
+                mean(r.frames, [](const FrameTimes& t) { return t.visible; }))),
+            mean(r.frames, [](const FrameTimes& t) { return t.selectionMs; }),
+            mean(r.frames, [](const FrameTimes& t) { return t.stream.reassemblyMs; }), reformMs,
+            gen, percentile95(r.frames, generationMs),
+            megabytes(mean(r.frames, [](const FrameTimes& t) { return t.stream.bytesRead; })),
+            megabytes(mean(r.frames, [](const FrameTimes& t) { return t.stream.bytesMoved; })),
+            formatCount(static_cast<std::uint64_t>(
+                mean(r.frames, [](const FrameTimes& t) { return t.stream.trianglesReformed; }))),
+            frameMs > 0 ? triangles / frameMs / 1e3 : 0.0,
+            r.load.selectionMs + generationMs(r.load),
+            o.targetError || o.firstPassOnly ? std::string("-")
+                                             : fmt::format("{}/{}", exact, r.frames.size() + 1)));
+    detail(global,
+           fmt::format(
+               "  selection steps (ms): importance {:.2f}, first pass {:.2f}, second pass {:.2f}, "
+               "triangle counts {:.2f}",
+               mean(r.frames, [](const FrameTimes& t) { return t.selectionSteps.importance; }),
+               mean(r.frames, [](const FrameTimes& t) { return t.selectionSteps.firstPass; }),
+               mean(r.frames, [](const FrameTimes& t) { return t.selectionSteps.secondPass; }),
+               mean(r.frames, [](const FrameTimes& t) { return t.selectionSteps.finish; })));
+  }
+}
+
+Status writeJson(const BenchOptions& o, const Package& package, const std::vector<BudgetRun>& runs,
+                 std::size_t frames) {
+  nlohmann::json runsJson = nlohmann::json::array();
+  for (const BudgetRun& r : runs) runsJson.push_back(runJson(r));
+  const nlohmann::json document = {
+      {"package", o.input},
+      {"objects", package.objectCount()},
+      {"vertices", package.header().vertexCount},
+      {"triangles", package.header().triangleCount},
+      {"threads", hardwareThreads()},
+      {"path", o.path},
+      {"frames", frames},
+      {"mode", o.targetError ? "error" : (o.firstPassOnly ? "first-pass" : "two-pass")},
+      {"min_t", o.minT},
+      {"exponent", o.exponent},
+      {"runs", runsJson}};
+  const std::string text = document.dump(2);
+  auto file = OutputFile::create(o.json);
+  if (!file) return file.status();
+  LODFORGE_TRY(file->write(text.data(), text.size()));
+  return file->commit();
+}
+
+Status runBench(const Global& global, const BenchOptions& o) {
+  Result<Package> package = Package::open(o.input);
+  if (!package) return package.status();
+  const LodScene scene = LodScene::fromPackage(*package, o.exponent);
+  auto cameras = cameraPath(o, *package);
+  if (!cameras) return cameras.status();
+  if (!o.recordPath.empty())
+    LODFORGE_TRY(writeCameraPath(o.recordPath, *cameras, package->origin()));
+  std::vector<std::uint64_t> budgets{0};
+  if (!o.targetError) {
+    auto parsed = parseBudgets(o.budgets, scene.totalMaxVertices());
+    if (!parsed) return parsed.status();
+    budgets = *parsed;
+  }
+  say(global,
+      fmt::format("{}: {} objects, {} vertices, {} triangles; {} frames along {} at {}, {} threads",
+                  o.input, formatCount(package->objectCount()),
+                  formatCount(scene.totalMaxVertices()),
+                  formatCount(package->header().triangleCount), cameras->size(), o.path, o.size,
+                  hardwareThreads()));
+  std::vector<BudgetRun> runs;
+  Progress progress("frames", budgets.size() * cameras->size());
+  for (const std::uint64_t budget : budgets) {
+    auto run = runBudget(o, *package, scene, *cameras, budget, progress);
+    if (!run) return run.status();
+    runs.push_back(std::move(*run));
+  }
+  progress.finish();
+  printTable(global, o, runs);
+  if (!o.json.empty()) LODFORGE_TRY(writeJson(o, *package, runs, cameras->size()));
+  return {};
+}
+
+}  // namespace
+
+void addBench(CLI::App& app, const Global& global, Run& run) {
+  auto o = std::make_shared<BenchOptions>();
+  CLI::App* sub =
+      app.add_subcommand("bench", "Time LOD selection and coherent streaming along a camera path");
+  sub->add_option("PACKAGE", o->input, "A .lfp package")->required();
+  sub->add_option("--path", o->path, "orbit, fly, or a camera path JSON file (docs/formats.md)")
+      ->capture_default_str();
+  sub->add_option("--frames", o->frames, "Frames along the path (a file's path is cut to this)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000}));
+  sub->add_option(
+         "--budget", o->budgets,
+         "Budgets N in vertices, comma-separated: counts (3M, 10.5M) or shares of the model (5%)")
+      ->capture_default_str();
+  addByteSizeOption(
+      *sub, "--gpu-memory", o->gpuMemory,
+      "Size the stream buffer (both copies) from this many bytes instead of the budget");
+  sub->add_option("--size", o->size, "Viewport WIDTHxHEIGHT in pixels")->capture_default_str();
+  sub->add_option("--fov", o->fovY, "Vertical field of view, degrees")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 179.0));
+  sub->add_flag("--first-pass-only", o->firstPassOnly,
+                "Eq. 2 and 3 only (no second pass; Σ is not N)");
+  sub->add_option("--min-t", o->minT, "Eq. 3's MinT")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--exponent", o->exponent, "Eq. 2's 1/α")
+      ->capture_default_str()
+      ->check(CLI::Range(0.5, 8.0));
+  auto* error =
+      sub->add_option("--target-error", o->targetError,
+                      "Error-driven instead of budgeted: projected error at most this many pixels")
+          ->check(CLI::PositiveNumber);
+  error->excludes("--first-pass-only");
+  sub->add_option("--json", o->json, "Also write the results as JSON");
+  sub->add_option("--record-path", o->recordPath, "Write the cameras used as a path JSON file");
+  sub->callback([&global, &run, o] { run = [&global, o] { return runBench(global, *o); }; });
+}
+
+}  // namespace lodforge::cli

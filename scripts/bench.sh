@@ -16,7 +16,7 @@ echo "$(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB, $(lscpu | sed -n
 
 echo
 echo "== kernels (Google Benchmark)"
-[[ ${BENCH_ONLY:-} == simplify ]] || build/release/bench/bench_kernels --benchmark_min_time=0.5
+[[ -n ${BENCH_ONLY:-} ]] || build/release/bench/bench_kernels --benchmark_min_time=0.5
 
 measure() {  # name, then the command; prints a table row and removes the output file (the last argument)
   local name=$1; shift

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `make demo`: generates a CAD assembly and a scanned surface, reads them and the real models in
-# ../shared/data, prints `lodforge info` for each and writes GLBs under out/demo/.
+# ../shared/data, prints `lodforge info` for each, builds progressive packages, times budgeted
+# selection and streaming along an orbit, and writes GLBs and JSON under out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 lodforge=build/release/lodforge
@@ -26,6 +27,9 @@ section "progressive meshes for every part of the assembly, and two levels out o
 "$lodforge" build "$out/cad-assembly.glb" -o "$out/cad-assembly.lfp"
 "$lodforge" info "$out/cad-assembly.lfp"
 "$lodforge" extract "$out/cad-assembly.lfp" --ratio 0.25 -o "$out/cad-assembly-25pct.glb"
+section "budgeted LOD selection and coherent streaming along an orbit (the CAD paper's Table 1 on the CPU)"
+"$lodforge" bench "$out/cad-assembly.lfp" --frames 60 --budget 5%,20%,50% --json "$out/bench.json" \
+  --record-path "$out/orbit-path.json"
 "$lodforge" build "$out/scan.ply" -o "$out/scan.lfp"
 "$lodforge" extract "$out/scan.lfp" --ratio 0.02 -o "$out/scan-2pct.glb"
 

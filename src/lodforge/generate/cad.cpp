@@ -25,8 +25,8 @@ namespace {
 constexpr double kPi = 3.141592653589793;
 constexpr double kFuselageLength = 64.0;  // metres, about a 777-200
 constexpr double kFuselageRadius = 3.1;
-constexpr double kWingSpan = 30.0;      // half span
-constexpr int kBoltCatalogue = 24;      // standard bolt sizes, instanced in GLB output
+constexpr double kWingSpan = 30.0;  // half span
+constexpr int kBoltCatalogue = 24;  // standard bolt sizes, instanced in GLB output
 
 enum class Kind : std::uint8_t { kBolt, kTube, kBox, kBracket, kPlate, kBeam, kRod };
 constexpr const char* kKindNames[] = {"bolt", "tube", "box", "bracket", "plate", "beam", "rod"};

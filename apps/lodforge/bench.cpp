@@ -244,56 +244,43 @@ std::string megabytes(double bytes) {
   return fmt::format("{:.1f}", bytes / 1e6);
 }
 
-void printTable(const Global& global, const BenchOptions& o, const std::vector<BudgetRun>& runs) {
+// The table reads the same per-run summaries the JSON holds, so the two never disagree.
+void printTable(const Global& global, const BenchOptions& o, const nlohmann::json& runs) {
   say(global,
       fmt::format(
           "{:>12} {:>9} | {:>9} {:>9} {:>9} | {:>8} {:>8} {:>8} {:>8} | {:>10} {:>9} {:>7} | {:>6}",
           o.targetError ? "error px" : "budget N", "visible", "sel ms", "reasm ms", "reform ms",
           "gen ms", "gen p95", "read MB", "moved MB", "reformed", "Mtri/s", "load ms", "Σ=N"));
-  for (const BudgetRun& r : runs) {
-    const double gen = mean(r.frames, generationMs);
-    const double reformMs =
-        mean(r.frames, [](const FrameTimes& t) { return t.stream.reformationMs; });
-    const double triangles = mean(r.frames, [](const FrameTimes& t) { return t.triangles; });
-    // The paper's throughput: triangles in the frame over the time to produce it (its Table 1
-    // adds the OpenGL draw, which the rendering issue brings).
-    const double frameMs = mean(r.frames, [](const FrameTimes& t) { return t.selectionMs; }) + gen;
-    const auto exact = std::count_if(r.frames.begin(), r.frames.end(),
-                                     [](const FrameTimes& t) { return t.exact; }) +
-                       (r.load.exact ? 1 : 0);
+  for (const nlohmann::json& r : runs) {
+    const nlohmann::json& m = r["mean"];
+    const auto number = [&](const char* key) { return m[key].get<double>(); };
+    const auto count = [&](const char* key) {
+      return formatCount(static_cast<std::uint64_t>(number(key)));
+    };
     say(global,
         fmt::format(
             "{:>12} {:>9} | {:>9.2f} {:>9.2f} {:>9.2f} | {:>8.2f} {:>8.2f} {:>8} {:>8} | {:>10} "
             "{:>9.0f} {:>7.1f} | {:>6}",
-            o.targetError ? fmt::format("{:g}", *o.targetError) : formatCount(r.budget),
-            formatCount(static_cast<std::uint64_t>(
-                mean(r.frames, [](const FrameTimes& t) { return t.visible; }))),
-            mean(r.frames, [](const FrameTimes& t) { return t.selectionMs; }),
-            mean(r.frames, [](const FrameTimes& t) { return t.stream.reassemblyMs; }), reformMs,
-            gen, percentile95(r.frames, generationMs),
-            megabytes(mean(r.frames, [](const FrameTimes& t) { return t.stream.bytesRead; })),
-            megabytes(mean(r.frames, [](const FrameTimes& t) { return t.stream.bytesMoved; })),
-            formatCount(static_cast<std::uint64_t>(
-                mean(r.frames, [](const FrameTimes& t) { return t.stream.trianglesReformed; }))),
-            frameMs > 0 ? triangles / frameMs / 1e3 : 0.0,
-            r.load.selectionMs + generationMs(r.load),
-            o.targetError || o.firstPassOnly ? std::string("-")
-                                             : fmt::format("{}/{}", exact, r.frames.size() + 1)));
-    detail(global,
-           fmt::format(
-               "  selection steps (ms): importance {:.2f}, first pass {:.2f}, second pass {:.2f}, "
-               "triangle counts {:.2f}",
-               mean(r.frames, [](const FrameTimes& t) { return t.selectionSteps.importance; }),
-               mean(r.frames, [](const FrameTimes& t) { return t.selectionSteps.firstPass; }),
-               mean(r.frames, [](const FrameTimes& t) { return t.selectionSteps.secondPass; }),
-               mean(r.frames, [](const FrameTimes& t) { return t.selectionSteps.finish; })));
+            o.targetError ? fmt::format("{:g}", *o.targetError)
+                          : formatCount(r["budget"].get<std::uint64_t>()),
+            count("visible_objects"), number("selection_ms"), number("reassembly_ms"),
+            number("reformation_ms"), number("generation_ms"), r["p95_generation_ms"].get<double>(),
+            megabytes(number("bytes_read")), megabytes(number("bytes_moved")),
+            count("triangles_reformed"), r["triangles_per_second"].get<double>() / 1e6,
+            r["load"]["selection_ms"].get<double>() + r["load"]["generation_ms"].get<double>(),
+            o.targetError || o.firstPassOnly
+                ? std::string("-")
+                : fmt::format("{}/{}", r["exact_frames"].get<std::uint64_t>(),
+                              r["frames"].get<std::uint64_t>() + 1)));
+    detail(global, fmt::format("  selection steps (ms): importance {:.2f}, first pass {:.2f}, "
+                               "second pass {:.2f}, triangle counts {:.2f}",
+                               number("importance_ms"), number("first_pass_ms"),
+                               number("second_pass_ms"), number("triangle_counts_ms")));
   }
 }
 
-Status writeJson(const BenchOptions& o, const Package& package, const std::vector<BudgetRun>& runs,
+Status writeJson(const BenchOptions& o, const Package& package, const nlohmann::json& runsJson,
                  std::size_t frames) {
-  nlohmann::json runsJson = nlohmann::json::array();
-  for (const BudgetRun& r : runs) runsJson.push_back(runJson(r));
   const nlohmann::json document = {
       {"package", o.input},
       {"objects", package.objectCount()},
@@ -333,12 +320,12 @@ Status runBench(const Global& global, const BenchOptions& o) {
                   formatCount(scene.totalMaxVertices()),
                   formatCount(package->header().triangleCount), cameras->size(), o.path, o.size,
                   hardwareThreads()));
-  std::vector<BudgetRun> runs;
+  nlohmann::json runs = nlohmann::json::array();
   Progress progress("frames", budgets.size() * cameras->size());
   for (const std::uint64_t budget : budgets) {
     auto run = runBudget(o, *package, scene, *cameras, budget, progress);
     if (!run) return run.status();
-    runs.push_back(std::move(*run));
+    runs.push_back(runJson(*run));
   }
   progress.finish();
   printTable(global, o, runs);

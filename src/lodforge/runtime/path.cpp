@@ -39,12 +39,17 @@ std::optional<Vec3d> vec3(const nlohmann::json& value) {
   return isFinite(v) ? std::optional<Vec3d>(v) : std::nullopt;
 }
 
-std::optional<double> positiveNumber(const nlohmann::json& object, const char* key) {
+// An optional number field: nothing when absent, NaN when present but not a finite number (so
+// every range check below refuses it).
+std::optional<double> numberField(const nlohmann::json& object, const char* key) {
   if (!object.contains(key)) return std::nullopt;
   const nlohmann::json& value = object[key];
-  if (!value.is_number()) return -1.0;
-  const double x = value.get<double>();
-  return std::isfinite(x) && x > 0 ? x : -1.0;
+  const double x = value.is_number() ? value.get<double>() : std::nan("");
+  return std::isfinite(x) ? x : std::nan("");
+}
+
+bool isDegrees(double x) {
+  return x > 0 && x < 180;
 }
 
 }  // namespace
@@ -122,8 +127,8 @@ Result<std::vector<Camera>> readCameraPath(const std::string& path, Vec3d origin
     height = viewport[1].get<std::uint32_t>();
   }
   double fovY = 60.0;
-  if (auto f = positiveNumber(document, "fovY")) {
-    if (*f <= 0 || *f >= 180) return badInput(path, "\"fovY\" must be degrees in (0, 180)");
+  if (auto f = numberField(document, "fovY")) {
+    if (!isDegrees(*f)) return badInput(path, "\"fovY\" must be degrees in (0, 180)");
     fovY = *f;
   }
   if (!document.contains("frames") || !document["frames"].is_array() || document["frames"].empty())
@@ -148,17 +153,18 @@ Result<std::vector<Camera>> readCameraPath(const std::string& path, Vec3d origin
       up = *u;
     }
     double frameFov = fovY;
-    if (auto f = positiveNumber(frame, "fovY")) {
-      if (*f <= 0 || *f >= 180) return frameError(path, i, "\"fovY\" must be degrees in (0, 180)");
+    if (auto f = numberField(frame, "fovY")) {
+      if (!isDegrees(*f)) return frameError(path, i, "\"fovY\" must be degrees in (0, 180)");
       frameFov = *f;
     }
     Camera camera =
         Camera::lookAt(*position - origin, *target - origin, up, frameFov, width, height);
     fitClipPlanes(camera, bounds);
-    const auto nearPlane = positiveNumber(frame, "near"), farPlane = positiveNumber(frame, "far");
-    if (nearPlane && *nearPlane <= 0)
+    const auto nearPlane = numberField(frame, "near"), farPlane = numberField(frame, "far");
+    if (nearPlane && !(*nearPlane > 0))
       return frameError(path, i, "\"near\" must be a positive number");
-    if (farPlane && *farPlane <= 0) return frameError(path, i, "\"far\" must be a positive number");
+    if (farPlane && !(*farPlane > 0))
+      return frameError(path, i, "\"far\" must be a positive number");
     if (nearPlane) camera.nearPlane = *nearPlane;
     if (farPlane) camera.farPlane = *farPlane;
     if (camera.farPlane <= camera.nearPlane)

@@ -1,7 +1,6 @@
 #include "lodforge/runtime/selection.h"
 
 #include <algorithm>
-#include <array>
 #include <cassert>
 #include <chrono>
 #include <cmath>
@@ -133,7 +132,6 @@ void firstPass(const LodScene& scene, std::uint64_t budget, double minT, Selecti
   out.vertexCounts.resize(n);
   const double total = out.importanceTotal;
   const double scale = total > 0 ? static_cast<double>(budget) / total : 0.0;
-  out.visibleObjects = 0;
   std::tie(out.firstPassVertices, out.visibleObjects) = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, n, 16384), std::pair<std::uint64_t, std::uint64_t>{0, 0},
       [&](const tbb::blocked_range<std::size_t>& r, std::pair<std::uint64_t, std::uint64_t> acc) {
@@ -158,46 +156,6 @@ void firstPass(const LodScene& scene, std::uint64_t budget, double minT, Selecti
       [](auto a, auto b) {
         return std::pair{a.first + b.first, a.second + b.second};
       });
-}
-
-// Visible objects (importance > 0) ordered by importance, ties by index; with `appendHidden`,
-// the hidden ones follow by index. An LSD radix sort on the float bits (positive floats order
-// like their bit patterns): 3 passes of 11 bits, a few ms for 700K objects where a comparison
-// sort takes tens (docs/runtime.md has the measurement).
-void rankObjects(std::span<const float> importance, bool descending, bool appendHidden,
-                 Selection::Workspace& work) {
-  const std::size_t n = importance.size();
-  auto& keys = work.keys;
-  auto& scratch = work.scratch;
-  keys.clear();
-  for (std::uint32_t i = 0; i < n; ++i) {
-    if (!(importance[i] > 0)) continue;
-    std::uint32_t bits;
-    std::memcpy(&bits, &importance[i], sizeof bits);
-    if (descending) bits = ~bits;
-    keys.push_back(std::uint64_t{bits} << 32 | i);
-  }
-  scratch.resize(keys.size());
-  constexpr std::size_t kDigitBits = 11, kDigits = std::size_t{1} << kDigitBits;
-  std::array<std::array<std::uint32_t, kDigits>, 3> counts{};
-  for (const std::uint64_t key : keys) {
-    for (std::size_t pass = 0; pass < 3; ++pass)
-      ++counts[pass][(key >> (32 + kDigitBits * pass)) & (kDigits - 1)];
-  }
-  for (std::size_t pass = 0; pass < 3; ++pass) {
-    std::uint32_t sum = 0;
-    for (auto& c : counts[pass]) sum += std::exchange(c, sum);
-    for (const std::uint64_t key : keys)
-      scratch[counts[pass][(key >> (32 + kDigitBits * pass)) & (kDigits - 1)]++] = key;
-    keys.swap(scratch);
-  }
-  work.order.resize(keys.size());
-  for (std::size_t j = 0; j < keys.size(); ++j) work.order[j] = static_cast<std::uint32_t>(keys[j]);
-  if (appendHidden) {
-    for (std::uint32_t i = 0; i < n; ++i) {
-      if (!(importance[i] > 0)) work.order.push_back(i);
-    }
-  }
 }
 
 // Gives `remaining` vertices to objects in `order` (most important first): an object already
@@ -343,22 +301,38 @@ RankBuckets partitionByRank(std::span<const float> importance, bool descending, 
   return {work.bucketIds, work.bucketStart, work.bucketWeight};
 }
 
-// The ids of one bucket in exact rank order (key, then id).
+// Appends the ids of one bucket to `out` in exact rank order (key, then id).
+void appendSortedBucket(const RankBuckets& buckets, std::size_t b,
+                        std::span<const float> importance, bool descending,
+                        std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& out) {
+  const auto ids = buckets.ids.subspan(buckets.start[b], buckets.start[b + 1] - buckets.start[b]);
+  if (b == kHiddenBucket) {
+    out.insert(out.end(), ids.begin(), ids.end());
+    return;
+  }
+  keys.resize(ids.size());
+  for (std::size_t j = 0; j < ids.size(); ++j)
+    keys[j] = std::uint64_t{rankKey(importance[ids[j]], descending)} << 32 | ids[j];
+  std::sort(keys.begin(), keys.end());
+  for (const std::uint64_t key : keys) out.push_back(static_cast<std::uint32_t>(key));
+}
+
+// One bucket in rank order, in the workspace's `order`.
 std::span<const std::uint32_t> sortedBucket(const RankBuckets& buckets, std::size_t b,
                                             std::span<const float> importance, bool descending,
                                             Selection::Workspace& work) {
-  const auto ids = buckets.ids.subspan(buckets.start[b], buckets.start[b + 1] - buckets.start[b]);
-  if (b == kHiddenBucket) {
-    work.order.assign(ids.begin(), ids.end());
-    return work.order;
-  }
-  work.keys.resize(ids.size());
-  for (std::size_t j = 0; j < ids.size(); ++j)
-    work.keys[j] = std::uint64_t{rankKey(importance[ids[j]], descending)} << 32 | ids[j];
-  std::sort(work.keys.begin(), work.keys.end());
-  work.order.resize(ids.size());
-  for (std::size_t j = 0; j < ids.size(); ++j)
-    work.order[j] = static_cast<std::uint32_t>(work.keys[j]);
+  work.order.clear();
+  appendSortedBucket(buckets, b, importance, descending, work.keys, work.order);
+  return work.order;
+}
+
+// Every partitioned object in rank order (all buckets sorted), in the workspace's `order`.
+std::span<const std::uint32_t> wholeOrder(const RankBuckets& buckets,
+                                          std::span<const float> importance, bool descending,
+                                          Selection::Workspace& work) {
+  work.order.clear();
+  for (std::size_t b = 0; b < kRankBuckets; ++b)
+    appendSortedBucket(buckets, b, importance, descending, work.keys, work.order);
   return work.order;
 }
 
@@ -437,10 +411,13 @@ void secondPass(const LodScene& scene, std::uint64_t budget, Selection& out) {
   const std::uint64_t left = up ? raise(scene, out.importance, target - current, out)
                                 : lower(scene, out.importance, current - target, out);
   if (left == 0) return;
-  // Rare (tiny budgets): trade an object at zero in, which needs the whole order.
-  rankObjects(out.importance, up, up, out.workspace);
-  if (!up) std::reverse(out.workspace.order.begin(), out.workspace.order.end());
-  settle(scene, out.importance, out.workspace.order, left, out.vertexCounts);
+  // Rare (tiny budgets): trade an object at zero in, which needs the whole order, most
+  // important first; the walk's partition still stands in the workspace.
+  auto& work = out.workspace;
+  const RankBuckets buckets{work.bucketIds, work.bucketStart, work.bucketWeight};
+  wholeOrder(buckets, out.importance, up, work);
+  if (!up) std::reverse(work.order.begin(), work.order.end());
+  settle(scene, out.importance, work.order, left, out.vertexCounts);
 }
 
 // tc_i = map(vc_i), looked up only where vc_i changed since the last frame (a few percent of

@@ -53,8 +53,8 @@ struct Selection {
 
   // Reused from frame to frame so selection allocates nothing once warm.
   struct Workspace {
-    std::vector<std::uint64_t> keys, scratch;  // (importance bits, id) for the radix sort
-    std::vector<std::uint32_t> order;          // object ids by importance
+    std::vector<std::uint64_t> keys;                       // (rank key, id) of one bucket, to sort
+    std::vector<std::uint32_t> order;                      // object ids by importance
     std::vector<std::uint64_t> chunkCounts, chunkWeights;  // per chunk and rank bucket
     std::vector<std::uint64_t> bucketStart, bucketWeight;  // prefix sums of Algorithm 3's VDif
     std::vector<std::uint32_t> bucketIds;                  // object ids grouped by rank bucket

@@ -21,10 +21,11 @@ std::uint32_t ProgressiveMesh::vertexCountForError(float wanted) const {
 }
 
 std::uint64_t progressiveBuildBytes(std::uint64_t vertices, std::uint64_t triangles) {
-  // Per vertex: quadric 80, incidence ~28, ranking 8, flags and stamps 6, error 8, the
-  // rearranged output and permutation ~48. Per triangle: corners 12, flags and removal order 5,
-  // rearranged output and permutation 16, Melax's face normals 24, the edge sort 24 (transient).
-  return vertices * 200 + triangles * 84 + 4096;
+  // Per vertex: quadric 80, position and self cost 32, incidence ~36, ranking 8, flags and
+  // stamps 6, error 8, the rearranged output and permutation ~48 (boundary counts reuse them).
+  // Per triangle: corners 12, removal order 4, rearranged output and permutation 16, Melax's
+  // face normals 24, lists of live triangles and new neighbours ~8.
+  return vertices * 220 + triangles * 64 + 4096;
 }
 
 namespace {
@@ -37,10 +38,30 @@ constexpr std::uint32_t kNone = ~0u;
 constexpr double kPassShare = 0.2;
 constexpr std::size_t kBuckets = 32;  // cost buckets per pass, each walked in vertex order
 
+// Puts buckets [firstBucket, lastBucket) of `bucket` elements each (the share ends at `share`)
+// in cost order among themselves, leaving each bucket unsorted: selections, not a sort.
+template <class It>
+void partitionBuckets(It begin, std::size_t firstBucket, std::size_t lastBucket, std::size_t bucket,
+                      std::size_t share) {
+  if (lastBucket - firstBucket < 2) return;
+  const std::size_t middle = firstBucket + (lastBucket - firstBucket) / 2;
+  std::nth_element(begin + static_cast<std::ptrdiff_t>(firstBucket * bucket),
+                   begin + static_cast<std::ptrdiff_t>(middle * bucket),
+                   begin + static_cast<std::ptrdiff_t>(std::min(share, lastBucket * bucket)));
+  partitionBuckets(begin, firstBucket, middle, bucket, share);
+  partitionBuckets(begin, middle, lastBucket, bucket, share);
+}
+
+// What ranking reads of a neighbour, in one 32-byte load: its position and the cost of its own
+// quadric there (Q_v(p_v)).
+struct RankPoint {
+  double x, y, z, selfCost;
+};
+
 // Collapses happen in passes over flat arrays (as meshoptimizer does), not through one global
-// priority queue: each pass ranks every vertex's cheapest valid-looking collapse, sorts them,
-// and applies the cheapest quarter that do not touch one another, in cost order. Collapses in a
-// pass never share a neighbourhood, so every validity check sees the current mesh, and the
+// priority queue: each pass ranks every vertex's cheapest valid-looking collapse, buckets them
+// by cost, and applies the cheapest fifth that do not touch one another, in cost order. Collapses
+// in a pass never share a neighbourhood, so every validity check sees the current mesh, and the
 // recorded sequence is a true collapse sequence.
 class Simplifier {
  public:
@@ -58,14 +79,18 @@ class Simplifier {
   ProgressiveMesh rearrange(std::span<const Vec3f> normals, std::span<const Rgba8> colors) const;
 
  private:
-  Vec3d position(std::uint32_t v) const { return points_[v]; }
+  Vec3d position(std::uint32_t v) const {
+    const RankPoint& r = rankPoints_[v];
+    return {r.x, r.y, r.z};
+  }
+  // The dead mark shares the cache line the corners are read from anyway.
+  bool alive(std::uint32_t t) const { return corners_[t][0] != kNone; }
   bool contains(std::uint32_t t, std::uint32_t v) const {
     return corners_[t][0] == v || corners_[t][1] == v || corners_[t][2] == v;
   }
-  // The triangles around v as of the pass start; some may have died since (check alive_).
+  // The triangles around v as of the pass start; some may have died since (check alive()).
   std::span<const std::uint32_t> around(std::uint32_t v) const {
-    return std::span(incident_).subspan(incidentStart_[v],
-                                        incidentStart_[v + 1] - incidentStart_[v]);
+    return std::span(incident_).subspan(incidentStart_[v], incidentCount_[v]);
   }
   bool allowed(std::uint32_t from, std::uint32_t to) const;
   void buildIncidence();
@@ -75,28 +100,31 @@ class Simplifier {
   // The cheapest valid, untouched target of `from` (its ranked best first); kNone if none.
   std::uint32_t validTarget(std::uint32_t from, float bestCost);
   void collapse(std::uint32_t from, std::uint32_t to);
+  void markChanged(std::uint32_t from, std::uint32_t to);
+  void rankNewNeighbours();
 
   std::span<const Vec3f> positions_;
   std::span<const std::uint32_t> indices_;
   ProgressiveOptions options_;
   std::uint32_t vertexCount_, triangleCount_;
 
-  std::vector<Vec3d> points_;                          // positions in double, read often
-  std::vector<std::array<std::uint32_t, 3>> corners_;  // current (re-formed) corners
-  std::vector<std::uint8_t> alive_;                    // per triangle
+  std::vector<RankPoint> rankPoints_;                  // positions in double + self costs
+  std::vector<std::array<std::uint32_t, 3>> corners_;  // current (re-formed); dead: all kNone
   std::vector<std::uint8_t> locked_;                   // Q: boundary or non-manifold
   std::vector<std::uint8_t> removed_;                  // per vertex: collapsed already
   std::vector<Quadric> quadrics_;
-  std::vector<double> selfCost_;     // Q_v(p_v): the quadric of a vertex at its own position
   std::vector<double> vertexError_;  // error carried by each live vertex
   std::vector<Vec3d> faceNormals_;   // per pass, for Melax's cost
 
   // Per pass: vertex -> live triangles (CSR), and each vertex's best collapse.
-  std::vector<std::uint32_t> incidentStart_, incident_;
+  std::vector<std::uint32_t> incidentStart_, incidentCount_, incident_;
+  std::vector<std::uint32_t> liveVertices_;  // not collapsed yet
   std::vector<float> bestCost_;
   std::vector<std::uint32_t> bestTarget_;
   std::vector<std::uint8_t> dirty_;  // must be re-ranked next pass
-  std::vector<std::uint32_t> live_, fill_;
+  // (vertex, new neighbour): the one new cost to compare next pass.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> newNeighbour_;
+  std::vector<std::uint32_t> live_;
   std::vector<std::uint32_t> active_;         // vertices that may still collapse
   std::vector<std::uint32_t> nearTo_, seen_;  // stamps for valid()
   std::uint32_t stampToken_ = 0;
@@ -114,10 +142,12 @@ class Simplifier {
 };
 
 void Simplifier::classifyBoundary() {
-  points_.resize(vertexCount_);
-  for (std::uint32_t v = 0; v < vertexCount_; ++v) points_[v] = toDouble(positions_[v]);
+  rankPoints_.resize(vertexCount_);
+  for (std::uint32_t v = 0; v < vertexCount_; ++v) {
+    const Vec3d p = toDouble(positions_[v]);
+    rankPoints_[v] = {p.x, p.y, p.z, 0};
+  }
   corners_.resize(triangleCount_);
-  alive_.assign(triangleCount_, 1);
   locked_.assign(vertexCount_, 0);
   removed_.assign(vertexCount_, 0);
   target_.assign(vertexCount_, kNone);
@@ -134,23 +164,24 @@ void Simplifier::classifyBoundary() {
            corners_[t][0] != corners_[t][2]);
   }
   // Q: endpoints of boundary edges (one triangle) and of non-manifold edges (three or more).
-  std::vector<std::uint64_t> edges;
-  edges.reserve(3 * std::size_t{triangleCount_});
-  for (const auto& c : corners_) {
-    for (std::size_t k = 0; k < 3; ++k) {
-      const std::uint64_t a = c[k], b = c[(k + 1) % 3];
-      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+  // Each triangle around u holds the edge u-w for exactly one other corner w, as the corner
+  // after or before u, so counting the corners around u counts the triangles on each edge u-w.
+  // Every edge is seen from both ends, so each end locks itself.
+  buildIncidence();
+  std::vector<std::uint32_t> edgeCount(vertexCount_, 0);
+  for (std::uint32_t u = 0; u < vertexCount_; ++u) {
+    const auto fan = around(u);
+    for (std::uint32_t t : fan) {
+      for (std::uint32_t w : corners_[t]) edgeCount[w] = 0;
     }
-  }
-  std::sort(edges.begin(), edges.end());
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i != 2) {
-      locked_[edges[i] >> 32] = 1;
-      locked_[edges[i] & 0xFFFFFFFFu] = 1;
+    for (std::uint32_t t : fan) {
+      for (std::uint32_t w : corners_[t]) ++edgeCount[w];
     }
-    i = j;
+    for (std::uint32_t t : fan) {
+      for (std::uint32_t w : corners_[t]) {
+        if (w != u && edgeCount[w] != 2) locked_[u] = 1;
+      }
+    }
   }
 }
 
@@ -166,9 +197,8 @@ void Simplifier::computeQuadrics() {
     const Quadric plane = Quadric::fromPlane(n / twiceArea, a, 0.5 * twiceArea);
     for (std::uint32_t v : c) quadrics_[v] += plane;
   }
-  selfCost_.resize(vertexCount_);
   for (std::uint32_t v = 0; v < vertexCount_; ++v)
-    selfCost_[v] = quadrics_[v].evaluate(position(v));
+    rankPoints_[v].selfCost = quadrics_[v].evaluate(position(v));
 }
 
 bool Simplifier::allowed(std::uint32_t from, std::uint32_t to) const {
@@ -180,24 +210,34 @@ bool Simplifier::allowed(std::uint32_t from, std::uint32_t to) const {
 }
 
 void Simplifier::buildIncidence() {
-  // Only the live triangles: the list shrinks pass after pass.
-  if (live_.empty() && pass_ == 1) {
+  // Only the live triangles and vertices: the lists shrink pass after pass, and so does this
+  // work. The first pass reuses the incidence that classifyBoundary() built.
+  if (live_.empty()) {
     live_.resize(triangleCount_);
     for (std::uint32_t t = 0; t < triangleCount_; ++t) live_[t] = t;
+    liveVertices_.resize(vertexCount_);
+    for (std::uint32_t v = 0; v < vertexCount_; ++v) liveVertices_[v] = v;
+    incidentStart_.resize(vertexCount_);
+    incidentCount_.resize(vertexCount_);
+  } else if (pass_ == 1) {
+    return;
   } else {
-    live_.erase(
-        std::remove_if(live_.begin(), live_.end(), [&](std::uint32_t t) { return !alive_[t]; }),
-        live_.end());
+    std::erase_if(live_, [&](std::uint32_t t) { return !alive(t); });
+    std::erase_if(liveVertices_, [&](std::uint32_t v) { return removed_[v] != 0; });
   }
-  incidentStart_.assign(std::size_t{vertexCount_} + 1, 0);
+  for (std::uint32_t v : liveVertices_) incidentCount_[v] = 0;
   for (std::uint32_t t : live_) {
-    for (std::uint32_t v : corners_[t]) ++incidentStart_[v + 1];
+    for (std::uint32_t v : corners_[t]) ++incidentCount_[v];
   }
-  for (std::uint32_t v = 0; v < vertexCount_; ++v) incidentStart_[v + 1] += incidentStart_[v];
-  incident_.resize(incidentStart_[vertexCount_]);
-  fill_.assign(incidentStart_.begin(), incidentStart_.end() - 1);
-  for (std::uint32_t t : live_) {
-    for (std::uint32_t v : corners_[t]) incident_[fill_[v]++] = t;
+  std::uint32_t end = 0;
+  for (std::uint32_t v : liveVertices_) {
+    end += incidentCount_[v];
+    incidentStart_[v] = end;  // filled backwards below, so it ends at the start
+  }
+  incident_.resize(end);
+  // Backwards, so that each fan lists its triangles in increasing order.
+  for (auto t = live_.rbegin(); t != live_.rend(); ++t) {
+    for (std::uint32_t v : corners_[*t]) incident_[--incidentStart_[v]] = *t;
   }
   if (options_.cost == CollapseCost::kMelax) {
     faceNormals_.resize(triangleCount_);
@@ -220,10 +260,10 @@ float Simplifier::cost(std::uint32_t from, std::uint32_t to) const {
   double curvature = 0;
   const auto fan = around(from);
   for (std::uint32_t t : fan) {
-    if (!alive_[t]) continue;
+    if (!alive(t)) continue;
     double smallest = 1;
     for (std::uint32_t s : fan) {
-      if (alive_[s] && contains(s, to))
+      if (alive(s) && contains(s, to))
         smallest = std::min(smallest, (1 - dot(faceNormals_[t], faceNormals_[s])) / 2);
     }
     curvature = std::max(curvature, smallest);
@@ -249,6 +289,7 @@ void Simplifier::rankCollapses() {
                                  [&](std::uint32_t u) { return removed_[u] != 0; }),
                   active_.end());
   }
+  rankNewNeighbours();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active_.size(), 512),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t a = range.begin(); a < range.end(); ++a) {
@@ -267,10 +308,11 @@ void Simplifier::rankCollapses() {
                           if (!allowed(u, v)) continue;
                           // (Q_u + Q_v)(p_v) = Q_u(p_v) + Q_v(p_v); the second term is cached per
                           // vertex.
-                          const float cost = options_.cost == CollapseCost::kQuadric
-                                                 ? static_cast<float>(std::max(
-                                                       0.0, q.evaluate(position(v)) + selfCost_[v]))
-                                                 : this->cost(u, v);
+                          const float cost =
+                              options_.cost == CollapseCost::kQuadric
+                                  ? static_cast<float>(std::max(
+                                        0.0, q.evaluate(position(v)) + rankPoints_[v].selfCost))
+                                  : this->cost(u, v);
                           if (cost < best || (cost == best && v < bestTarget_[u])) {
                             best = cost;
                             bestTarget_[u] = v;
@@ -286,12 +328,12 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
   // has targeted (dead triangles skipped, moved corners updated). Stamps instead of sets.
   const std::uint32_t stamp = ++stampToken_;
   for (std::uint32_t t : around(to)) {
-    if (!alive_[t]) continue;
+    if (!alive(t)) continue;
     for (std::uint32_t w : corners_[t]) nearTo_[w] = stamp;
   }
   std::uint32_t shared = 0, common = 0, fan = 0;
   for (std::uint32_t t : around(from)) {
-    if (!alive_[t]) continue;
+    if (!alive(t)) continue;
     ++fan;
     shared += contains(t, to) ? 1u : 0u;
     for (std::uint32_t w : corners_[t]) {
@@ -307,7 +349,7 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
   const Vec3d target = position(to);
   const bool tetrahedron = fan == 3;
   for (std::uint32_t t : around(from)) {
-    if (!alive_[t] || contains(t, to)) continue;
+    if (!alive(t) || contains(t, to)) continue;
     if (tetrahedron) {
       // Only a valence-3 vertex can pass the link condition and still recreate a triangle that
       // exists around `to` (the last collapse of a closed tetrahedron).
@@ -317,7 +359,7 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
         (x == kNone ? x : y) = w;
       }
       for (std::uint32_t s : around(to)) {
-        if (alive_[s] && contains(s, x) && contains(s, y)) return false;
+        if (alive(s) && contains(s, x) && contains(s, y)) return false;
       }
     }
     // No flip and no degenerate result.
@@ -346,7 +388,7 @@ std::uint32_t Simplifier::validTarget(std::uint32_t from, float bestCost) {
   std::array<std::pair<float, std::uint32_t>, 64> others;
   std::size_t count = 0;
   for (std::uint32_t t : around(from)) {
-    if (!alive_[t]) continue;
+    if (!alive(t)) continue;
     for (std::uint32_t v : corners_[t]) {
       if (v == from || v == best || touched_[v] == pass_ || !allowed(from, v) ||
           count == others.size())
@@ -367,6 +409,47 @@ std::uint32_t Simplifier::validTarget(std::uint32_t from, float bestCost) {
   return kNone;
 }
 
+void Simplifier::markChanged(std::uint32_t from, std::uint32_t to) {
+  // Who must be re-ranked after `from` collapses into `to`. Half-edge collapses move no vertex
+  // and only Q_to changes, growing, so around the two ends only costs to `to` change: up for
+  // the old neighbours of `to`, new for those `from` hands over. A vertex whose best was one of
+  // the ends is re-ranked in full; one that gains `to` compares that one cost; the rest keep
+  // their best. Melax's cost looks at whole fans: everyone around is re-ranked.
+  dirty_[to] = 1;
+  const bool melax = options_.cost == CollapseCost::kMelax;
+  const std::uint32_t stamp = ++stampToken_;
+  for (std::uint32_t v : {from, to}) {
+    for (std::uint32_t t : around(v)) {
+      if (!alive(t)) continue;
+      const bool gainsTo = v == from && !contains(t, to);
+      for (std::uint32_t w : corners_[t]) {
+        if (w == from || w == to || dirty_[w]) continue;
+        if (melax || bestTarget_[w] == from || bestTarget_[w] == to) {
+          dirty_[w] = 1;
+        } else if (gainsTo && seen_[w] != stamp) {
+          seen_[w] = stamp;
+          newNeighbour_.emplace_back(w, to);
+        }
+      }
+    }
+  }
+}
+
+void Simplifier::rankNewNeighbours() {
+  // The same result as a full re-rank of these vertices: their other costs did not change, and
+  // ties go to the lower index as there.
+  for (const auto& [w, to] : newNeighbour_) {
+    if (dirty_[w] || removed_[w] || !allowed(w, to)) continue;
+    const float cost = static_cast<float>(
+        std::max(0.0, quadrics_[w].evaluate(position(to)) + rankPoints_[to].selfCost));
+    if (cost < bestCost_[w] || (cost == bestCost_[w] && to < bestTarget_[w])) {
+      bestCost_[w] = cost;
+      bestTarget_[w] = to;
+    }
+  }
+  newNeighbour_.clear();
+}
+
 void Simplifier::collapse(std::uint32_t from, std::uint32_t to) {
   const Vec3d moved = position(from);
   double distance = std::numeric_limits<double>::max();
@@ -376,16 +459,11 @@ void Simplifier::collapse(std::uint32_t from, std::uint32_t to) {
   // place), so later checks in the pass still see the current mesh. Everyone whose cost inputs
   // change is re-ranked next pass.
   touched_[from] = touched_[to] = pass_;
-  for (std::uint32_t v : {from, to}) {
-    for (std::uint32_t t : around(v)) {
-      if (!alive_[t]) continue;
-      for (std::uint32_t w : corners_[t]) dirty_[w] = 1;
-    }
-  }
+  markChanged(from, to);
   for (std::uint32_t t : around(from)) {
-    if (!alive_[t]) continue;
+    if (!alive(t)) continue;
     if (contains(t, to)) {
-      alive_[t] = 0;
+      corners_[t] = {kNone, kNone, kNone};
       removedTriangles_.push_back(t);
       continue;
     }
@@ -400,7 +478,7 @@ void Simplifier::collapse(std::uint32_t from, std::uint32_t to) {
   removed_[from] = 1;
   target_[from] = to;
   quadrics_[to] += quadrics_[from];
-  selfCost_[to] = quadrics_[to].evaluate(position(to));
+  rankPoints_[to].selfCost = quadrics_[to].evaluate(position(to));
   // Per-vertex error bound: what `from` already stood for, plus how far it just moved off the
   // surface (model units). The table keeps the running maximum so it is monotone.
   const double step = distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
@@ -428,11 +506,12 @@ void Simplifier::collapseAll() {
         1, static_cast<std::size_t>(kPassShare * static_cast<double>(ranked.size())));
     std::nth_element(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(share - 1),
                      ranked.end());
-    std::sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(share));
-    // Within each of many small cost buckets, walk in vertex order: neighbours in memory are
-    // neighbours on the surface (fewer cache misses on big meshes), and the cost order barely
-    // changes.
+    // Many small cost buckets, each walked in vertex order: neighbours in memory are neighbours
+    // on the surface (fewer cache misses on big meshes), and the cost order barely changes. Only
+    // the bucket boundaries need the cost order (pairs are unique, so the buckets hold exactly
+    // what a full sort would put there).
     const std::size_t bucket = std::max<std::size_t>(1, share / kBuckets);
+    partitionBuckets(ranked.begin(), 0, (share + bucket - 1) / bucket, bucket, share);
     for (std::size_t b = 0; b < share; b += bucket) {
       const auto first = ranked.begin() + static_cast<std::ptrdiff_t>(b);
       const auto last = ranked.begin() + static_cast<std::ptrdiff_t>(std::min(share, b + bucket));
@@ -472,7 +551,7 @@ ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
   mesh.permuteT.assign(triangleCount_, kNone);
   next = 0;
   for (std::uint32_t t = 0; t < triangleCount_; ++t) {
-    if (alive_[t]) mesh.permuteT[t] = next++;
+    if (alive(t)) mesh.permuteT[t] = next++;
   }
   const auto removedCount = static_cast<std::uint32_t>(removedTriangles_.size());
   for (std::uint32_t r = 0; r < removedCount; ++r)

@@ -38,5 +38,6 @@ void addExtract(CLI::App& app, const Global& global, Run& run);
 void addConvert(CLI::App& app, const Global& global, Run& run);
 void addGenerate(CLI::App& app, const Global& global, Run& run);
 void addBench(CLI::App& app, const Global& global, Run& run);
+void addCompare(CLI::App& app, const Global& global, Run& run);
 
 }  // namespace lodforge::cli

@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   cli::addExtract(app, global, run);
   cli::addGenerate(app, global, run);
   cli::addBench(app, global, run);
+  cli::addCompare(app, global, run);
 
   try {
     app.parse(argc, argv);

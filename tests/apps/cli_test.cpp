@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -14,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/render/image.h"
 #include "test_support.h"
 
 extern char** environ;
@@ -372,6 +374,71 @@ TEST(CliBench, BadArgumentsAndPathsGetExitCode2) {
   EXPECT_NE(o.err.find("does not fit --gpu-memory"), std::string::npos) << o.err;
   o = lodforge("bench " + dir.file("motor.lfp.missing"), dir);
   EXPECT_NE(o.code, 0);
+}
+
+}  // namespace
+}  // namespace lodforge
+
+namespace lodforge {
+namespace {
+
+Image gradient(std::uint32_t w, std::uint32_t h, std::uint8_t shift) {
+  Image image(w, h);
+  for (std::size_t i = 0; i < image.pixelCount(); ++i) {
+    image.rgba[4 * i] = static_cast<std::uint8_t>(i + shift);
+    image.rgba[4 * i + 1] = static_cast<std::uint8_t>(i / 3);
+    image.rgba[4 * i + 2] = 90;
+    image.rgba[4 * i + 3] = 255;
+  }
+  return image;
+}
+
+TEST(CliCompare, FilesAndFoldersWithHeatMapsAndJson) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("a"));
+  std::filesystem::create_directories(dir.file("b"));
+  ASSERT_TRUE(writePng(dir.file("a/f0.png"), gradient(64, 32, 0)).ok());
+  ASSERT_TRUE(writePng(dir.file("b/f0.png"), gradient(64, 32, 0)).ok());
+  ASSERT_TRUE(writePng(dir.file("a/f1.png"), gradient(64, 32, 0)).ok());
+  ASSERT_TRUE(writePng(dir.file("b/f1.png"), gradient(64, 32, 40)).ok());
+  // Two equal files: nothing above the threshold, infinite PSNR.
+  Outcome o = lodforge("compare " + dir.file("a/f0.png") + " " + dir.file("b/f0.png") + " --json " +
+                           dir.file("one.json"),
+                       dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("inf"), std::string::npos) << o.out;
+  auto j = nlohmann::json::parse(test::readFile(dir.file("one.json")));
+  EXPECT_EQ(j["frames"][0]["share_above"], 0.0);
+  // Folders: frames pair by name; the shifted one differs, and its heat map is written.
+  o = lodforge("compare " + dir.file("a") + " " + dir.file("b") + " --diff " + dir.file("heat") +
+                   " --json " + dir.file("two.json"),
+               dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  j = nlohmann::json::parse(test::readFile(dir.file("two.json")));
+  ASSERT_EQ(j["frames"].size(), 2u);
+  EXPECT_EQ(j["frames"][0]["share_above"], 0.0);
+  EXPECT_GT(j["frames"][1]["share_above"].get<double>(), 0.5);
+  const auto heat = readPng(dir.file("heat/f1.png"));
+  ASSERT_TRUE(heat.ok());
+  EXPECT_EQ(heat->width, 64u);
+  // The library's own figures agree with the command's.
+  const ImageDifference d = compareImages(gradient(64, 32, 0), gradient(64, 32, 40));
+  EXPECT_NEAR(j["frames"][1]["mean_delta_e"].get<double>(), d.meanDeltaE, 1e-9);
+}
+
+TEST(CliCompare, MismatchedOrBadImagesAreExitCode2) {
+  test::TempDir dir;
+  ASSERT_TRUE(writePng(dir.file("small.png"), gradient(8, 8, 0)).ok());
+  ASSERT_TRUE(writePng(dir.file("big.png"), gradient(9, 8, 0)).ok());
+  test::writeFile(dir.file("text.png"), "not an image");
+  Outcome o = lodforge("compare " + dir.file("small.png") + " " + dir.file("big.png"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("big.png"), std::string::npos) << o.err;
+  o = lodforge("compare " + dir.file("small.png") + " " + dir.file("text.png"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("text.png"), std::string::npos) << o.err;
+  o = lodforge("compare " + dir.file("small.png") + " " + dir.path().string(), dir);
+  EXPECT_EQ(o.code, 2) << "a file and a folder";
 }
 
 }  // namespace

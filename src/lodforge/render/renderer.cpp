@@ -1,0 +1,378 @@
+#include "lodforge/render/renderer.h"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+#include "lodforge/render/shader.h"
+
+namespace lodforge {
+
+Result<ColorMode> parseColorMode(std::string_view text) {
+  if (text == "shaded") return ColorMode::kShaded;
+  if (text == "object") return ColorMode::kObject;
+  if (text == "lod") return ColorMode::kLodRatio;
+  if (text == "normal") return ColorMode::kNormal;
+  return Error{ErrorKind::kUsage,
+               fmt::format("colour mode '{}': expected shaded, object, lod or normal", text)};
+}
+
+const char* colorModeName(ColorMode mode) {
+  switch (mode) {
+    case ColorMode::kShaded:
+      return "shaded";
+    case ColorMode::kObject:
+      return "object";
+    case ColorMode::kLodRatio:
+      return "lod";
+    case ColorMode::kNormal:
+      return "normal";
+  }
+  return "?";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Framebuffer
+
+Result<Framebuffer> Framebuffer::create(std::uint32_t width, std::uint32_t height) {
+  Framebuffer f;
+  f.width_ = width;
+  f.height_ = height;
+  glCreateRenderbuffers(1, &f.color_);
+  glNamedRenderbufferStorage(f.color_, GL_RGBA8, static_cast<GLsizei>(width),
+                             static_cast<GLsizei>(height));
+  glCreateRenderbuffers(1, &f.depth_);
+  glNamedRenderbufferStorage(f.depth_, GL_DEPTH_COMPONENT32F, static_cast<GLsizei>(width),
+                             static_cast<GLsizei>(height));
+  glCreateFramebuffers(1, &f.framebuffer_);
+  glNamedFramebufferRenderbuffer(f.framebuffer_, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f.color_);
+  glNamedFramebufferRenderbuffer(f.framebuffer_, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, f.depth_);
+  if (glCheckNamedFramebufferStatus(f.framebuffer_, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    return Error{ErrorKind::kUnsupported,
+                 fmt::format("cannot create a {}x{} framebuffer", width, height)};
+  return f;
+}
+
+Framebuffer::Framebuffer(Framebuffer&& o) noexcept {
+  *this = std::move(o);
+}
+
+Framebuffer& Framebuffer::operator=(Framebuffer&& o) noexcept {
+  std::swap(width_, o.width_);
+  std::swap(height_, o.height_);
+  std::swap(framebuffer_, o.framebuffer_);
+  std::swap(color_, o.color_);
+  std::swap(depth_, o.depth_);
+  return *this;
+}
+
+Framebuffer::~Framebuffer() {
+  if (framebuffer_) glDeleteFramebuffers(1, &framebuffer_);
+  if (color_) glDeleteRenderbuffers(1, &color_);
+  if (depth_) glDeleteRenderbuffers(1, &depth_);
+}
+
+void Framebuffer::bind() const {
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
+}
+
+Image Framebuffer::read() const {
+  Image image(width_, height_);
+  glNamedFramebufferReadBuffer(framebuffer_, GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, static_cast<GLsizei>(width_), static_cast<GLsizei>(height_), GL_RGBA,
+               GL_UNSIGNED_BYTE, image.rgba.data());
+  // GL's rows start at the bottom; images start at the top.
+  const std::size_t row = std::size_t{width_} * 4;
+  std::vector<std::uint8_t> swap(row);
+  for (std::uint32_t y = 0; y < height_ / 2; ++y) {
+    std::uint8_t* a = image.rgba.data() + y * row;
+    std::uint8_t* b = image.rgba.data() + (height_ - 1 - y) * row;
+    std::memcpy(swap.data(), a, row);
+    std::memcpy(a, b, row);
+    std::memcpy(b, swap.data(), row);
+  }
+  return image;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Renderer
+
+namespace {
+
+constexpr const char* kVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec4 color;
+layout(location = 3) in vec4 objectColor;  // per object (instanced)
+layout(location = 4) in float lodRatio;    // per object (instanced)
+uniform mat4 viewProjection;
+uniform int mode;
+uniform bool useVertexColor;
+out vec3 worldPosition;
+out vec3 worldNormal;
+out vec4 baseColor;
+
+vec3 ramp(float t) {  // blue, cyan, green, yellow, red
+  return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)),
+               0.0, 1.0);
+}
+
+void main() {
+  gl_Position = viewProjection * vec4(position, 1.0);
+  worldPosition = position;
+  worldNormal = normal;
+  if (mode == 0) baseColor = useVertexColor ? color : objectColor;
+  else if (mode == 1) baseColor = objectColor;
+  else baseColor = vec4(ramp(lodRatio), 1.0);
+}
+)";
+
+constexpr const char* kFragmentShader = R"(#version 450 core
+in vec3 worldPosition;
+in vec3 worldNormal;
+in vec4 baseColor;
+uniform vec3 eye;
+uniform int mode;
+uniform bool useVertexNormal;
+out vec4 fragColor;
+
+void main() {
+  // Without stored normals, the face normal from screen-space derivatives (flat shading).
+  vec3 n = useVertexNormal ? normalize(worldNormal)
+                           : normalize(cross(dFdx(worldPosition), dFdy(worldPosition)));
+  if (mode == 3) {
+    fragColor = vec4(0.5 * n + 0.5, 1.0);
+    return;
+  }
+  // A headlight, two-sided: CAD parts are often open shells.
+  float diffuse = abs(dot(n, normalize(eye - worldPosition)));
+  fragColor = vec4(baseColor.rgb * (0.3 + 0.7 * diffuse), 1.0);
+}
+)";
+
+// A distinct, stable colour per object id (golden-ratio hue steps).
+Rgba8 objectIdColor(std::size_t id) {
+  const double hue = std::fmod(static_cast<double>(id) * 0.6180339887498949, 1.0) * 6.0;
+  const double f = hue - std::floor(hue);
+  const double s = 0.65, v = 0.9;
+  const double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  double r = v, g = t, b = p;
+  switch (static_cast<int>(hue)) {
+    case 0:
+      r = v, g = t, b = p;
+      break;
+    case 1:
+      r = q, g = v, b = p;
+      break;
+    case 2:
+      r = p, g = v, b = t;
+      break;
+    case 3:
+      r = p, g = q, b = v;
+      break;
+    case 4:
+      r = t, g = p, b = v;
+      break;
+    default:
+      r = v, g = p, b = q;
+      break;
+  }
+  const auto byte = [](double x) { return static_cast<std::uint8_t>(std::lround(x * 255)); };
+  return {byte(r), byte(g), byte(b), 255};
+}
+
+struct DrawCommand {  // GL's DrawElementsIndirectCommand
+  GLuint count, instanceCount, firstIndex;
+  GLint baseVertex;
+  GLuint baseInstance;
+};
+
+}  // namespace
+
+struct Renderer::State {
+  const Package* package = nullptr;
+  StreamCapacity capacity;
+  bool normals = false, colors = false;
+  Program program;
+  GLuint vertexArray = 0;
+  GLuint positions = 0, normalBuffer = 0, colorBuffer = 0, indices = 0;
+  GLuint objectColors = 0, lodRatios = 0, commands = 0;
+  GLsizei commandCount = 0;
+  std::vector<DrawCommand> commandList;
+  std::vector<Rgba8> baseColors, idColors;
+  std::vector<float> ratios;
+  std::uint64_t uploaded = 0;
+
+  ~State() {
+    const GLuint buffers[] = {positions,    normalBuffer, colorBuffer, indices,
+                              objectColors, lodRatios,    commands};
+    for (GLuint b : buffers) {
+      if (b) glDeleteBuffers(1, &b);
+    }
+    if (vertexArray) glDeleteVertexArrays(1, &vertexArray);
+  }
+};
+
+namespace {
+
+GLuint makeBuffer(std::uint64_t bytes, const void* data = nullptr) {
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  // At least one byte: a zero-size store is an error.
+  glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(std::max<std::uint64_t>(bytes, 4)), data,
+                       GL_DYNAMIC_STORAGE_BIT);
+  return buffer;
+}
+
+}  // namespace
+
+Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& capacity) {
+  auto s = std::make_unique<State>();
+  s->package = &package;
+  s->capacity = capacity;
+  s->normals = package.header().hasNormals();
+  s->colors = package.header().hasColors();
+  auto program =
+      Program::link({{GL_VERTEX_SHADER, kVertexShader}, {GL_FRAGMENT_SHADER, kFragmentShader}});
+  if (!program) return program.status();
+  s->program = std::move(*program);
+
+  const std::size_t objects = package.objectCount();
+  s->baseColors.resize(objects);
+  s->idColors.resize(objects);
+  for (std::size_t i = 0; i < objects; ++i) {
+    s->baseColors[i] = package.object(i).color;
+    s->idColors[i] = objectIdColor(i);
+  }
+  s->ratios.assign(objects, 1.0f);
+
+  s->positions = makeBuffer(capacity.vertices * sizeof(Vec3f));
+  if (s->normals) s->normalBuffer = makeBuffer(capacity.vertices * sizeof(Vec3f));
+  if (s->colors) s->colorBuffer = makeBuffer(capacity.vertices * sizeof(Rgba8));
+  s->indices = makeBuffer(capacity.triangles * 3 * sizeof(std::uint32_t));
+  s->objectColors = makeBuffer(objects * sizeof(Rgba8), s->baseColors.data());
+  s->lodRatios = makeBuffer(objects * sizeof(float), s->ratios.data());
+  s->commands = makeBuffer(objects * sizeof(DrawCommand));
+
+  GLuint& vao = s->vertexArray;
+  glCreateVertexArrays(1, &vao);
+  const auto attribute = [&](GLuint location, GLuint buffer, GLint size, GLenum type,
+                             GLboolean normalized, GLsizei stride, GLuint divisor) {
+    glEnableVertexArrayAttrib(vao, location);
+    glVertexArrayVertexBuffer(vao, location, buffer, 0, stride);
+    glVertexArrayAttribFormat(vao, location, size, type, normalized, 0);
+    glVertexArrayAttribBinding(vao, location, location);
+    glVertexArrayBindingDivisor(vao, location, divisor);
+  };
+  attribute(0, s->positions, 3, GL_FLOAT, GL_FALSE, sizeof(Vec3f), 0);
+  if (s->normals) attribute(1, s->normalBuffer, 3, GL_FLOAT, GL_FALSE, sizeof(Vec3f), 0);
+  if (s->colors) attribute(2, s->colorBuffer, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(Rgba8), 0);
+  attribute(3, s->objectColors, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(Rgba8), 1);
+  attribute(4, s->lodRatios, 1, GL_FLOAT, GL_FALSE, sizeof(float), 1);
+  glVertexArrayElementBuffer(vao, s->indices);
+  return Renderer(std::move(s));
+}
+
+Renderer::Renderer(std::unique_ptr<State> state) : state_(std::move(state)) {}
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+Renderer::~Renderer() = default;
+
+void Renderer::upload(const StreamBuffer& buffer) {
+  State& s = *state_;
+  const auto upload = [&](GLuint target, const auto& span) {
+    if (span.empty()) return;
+    glNamedBufferSubData(target, 0, static_cast<GLsizeiptr>(span.size_bytes()), span.data());
+    s.uploaded += span.size_bytes();
+  };
+  s.uploaded = 0;
+  upload(s.positions, buffer.positions());
+  if (s.normals) upload(s.normalBuffer, buffer.normals());
+  if (s.colors) upload(s.colorBuffer, buffer.colors());
+  upload(s.indices, buffer.indices());
+
+  // One command per object with triangles; its base instance is the object id.
+  const auto counts = buffer.vertexCounts();
+  const auto triangleStart = buffer.triangleStart();
+  s.commandList.clear();
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    const std::uint64_t triangles = triangleStart[i + 1] - triangleStart[i];
+    s.ratios[i] = static_cast<float>(counts[i]) /
+                  static_cast<float>(std::max<std::uint32_t>(1, s.package->object(i).vertexCount));
+    if (triangles == 0) continue;
+    s.commandList.push_back({static_cast<GLuint>(3 * triangles), 1,
+                             static_cast<GLuint>(3 * triangleStart[i]), 0, static_cast<GLuint>(i)});
+  }
+  s.commandCount = static_cast<GLsizei>(s.commandList.size());
+  upload(s.commands, std::span<const DrawCommand>(s.commandList));
+  upload(s.lodRatios, std::span<const float>(s.ratios));
+}
+
+void viewProjectionMatrix(const Camera& camera, float out[16]) {
+  // View: x right, y up, looking down -z; projection: GL's symmetric perspective.
+  const Vec3d f = camera.forward, u = camera.up, r = camera.right(), e = camera.position;
+  const double t = 1.0 / std::tan(camera.fovY / 2), a = camera.aspect();
+  const double n = camera.nearPlane, fa = camera.farPlane;
+  const double view[4][4] = {{r.x, r.y, r.z, -dot(r, e)},
+                             {u.x, u.y, u.z, -dot(u, e)},
+                             {-f.x, -f.y, -f.z, dot(f, e)},
+                             {0, 0, 0, 1}};
+  const double projection[4][4] = {{t / a, 0, 0, 0},
+                                   {0, t, 0, 0},
+                                   {0, 0, (fa + n) / (n - fa), 2 * fa * n / (n - fa)},
+                                   {0, 0, -1, 0}};
+  for (int row = 0; row < 4; ++row) {
+    for (int column = 0; column < 4; ++column) {
+      double sum = 0;
+      for (int k = 0; k < 4; ++k) sum += projection[row][k] * view[k][column];
+      out[column * 4 + row] = static_cast<float>(sum);
+    }
+  }
+}
+
+void Renderer::draw(const Camera& camera, const DrawOptions& options) const {
+  const State& s = *state_;
+  glViewport(0, 0, static_cast<GLsizei>(camera.width), static_cast<GLsizei>(camera.height));
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  glClearColor(options.background[0] / 255.0f, options.background[1] / 255.0f,
+               options.background[2] / 255.0f, 1);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (s.commandCount == 0) return;
+
+  // Per-object colours: the base colours, or a distinct one per object.
+  const auto& colors = options.colorMode == ColorMode::kObject ? s.idColors : s.baseColors;
+  glNamedBufferSubData(s.objectColors, 0, static_cast<GLsizeiptr>(colors.size() * sizeof(Rgba8)),
+                       colors.data());
+  float matrix[16];
+  viewProjectionMatrix(camera, matrix);
+  const GLuint p = s.program.id();
+  glUseProgram(p);
+  glUniformMatrix4fv(glGetUniformLocation(p, "viewProjection"), 1, GL_FALSE, matrix);
+  glUniform3f(glGetUniformLocation(p, "eye"), static_cast<float>(camera.position.x),
+              static_cast<float>(camera.position.y), static_cast<float>(camera.position.z));
+  glUniform1i(glGetUniformLocation(p, "mode"), static_cast<int>(options.colorMode));
+  glUniform1i(glGetUniformLocation(p, "useVertexColor"), s.colors ? 1 : 0);
+  glUniform1i(glGetUniformLocation(p, "useVertexNormal"), s.normals ? 1 : 0);
+  glBindVertexArray(s.vertexArray);
+  glBindBuffer(GL_DRAW_INDIRECT_BUFFER, s.commands);
+  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, nullptr, s.commandCount, 0);
+  glBindVertexArray(0);
+}
+
+std::uint64_t Renderer::uploadedBytes() const {
+  return state_->uploaded;
+}
+unsigned Renderer::indexBuffer() const {
+  return state_->indices;
+}
+
+}  // namespace lodforge

@@ -1,0 +1,81 @@
+// Draws the streamed buffer (runtime/stream.h) with OpenGL 4.5: one vertex and one index buffer
+// sized to the stream's capacity, one multi-draw per frame whose commands are the objects'
+// triangle ranges (each command's base instance is the object id, so per-object colour and LOD
+// ratio reach the shaders as instanced attributes), headlight shading. Offscreen rendering goes
+// into a Framebuffer and reads back as an Image.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "lodforge/core/status.h"
+#include "lodforge/render/image.h"
+#include "lodforge/runtime/camera.h"
+#include "lodforge/runtime/stream.h"
+#include "lodforge/simplify/package.h"
+
+namespace lodforge {
+
+enum class ColorMode : std::uint8_t {
+  kShaded,    // vertex colours when the package has them, else each object's base colour
+  kObject,    // a distinct colour per object
+  kLodRatio,  // vc / p: blue (coarsest) to red (full detail)
+  kNormal,    // the normal as a colour
+};
+
+// "shaded", "object", "lod", "normal".
+Result<ColorMode> parseColorMode(std::string_view text);
+const char* colorModeName(ColorMode mode);
+
+// An offscreen colour + depth target.
+class Framebuffer {
+ public:
+  static Result<Framebuffer> create(std::uint32_t width, std::uint32_t height);
+  Framebuffer(Framebuffer&&) noexcept;
+  Framebuffer& operator=(Framebuffer&&) noexcept;
+  ~Framebuffer();
+
+  void bind() const;
+  Image read() const;  // RGBA8, top row first
+  std::uint32_t width() const { return width_; }
+  std::uint32_t height() const { return height_; }
+
+ private:
+  Framebuffer() = default;
+  std::uint32_t width_ = 0, height_ = 0;
+  unsigned framebuffer_ = 0, color_ = 0, depth_ = 0;
+};
+
+struct DrawOptions {
+  ColorMode colorMode = ColorMode::kShaded;
+  // Dark slate: white and light grey parts (common CAD base colours) stay visible.
+  std::array<std::uint8_t, 3> background = {40, 44, 52};
+};
+
+class Renderer {
+ public:
+  // Needs a current GL 4.5 context. Buffers hold `capacity` (what the StreamBuffer holds).
+  static Result<Renderer> create(const Package& package, const StreamCapacity& capacity);
+  Renderer(Renderer&&) noexcept;
+  Renderer& operator=(Renderer&&) noexcept;
+  ~Renderer();
+
+  // Makes the GL buffers hold the stream's current contents and draw commands.
+  void upload(const StreamBuffer& buffer);
+  // Draws into the bound framebuffer (viewport = camera's size).
+  void draw(const Camera& camera, const DrawOptions& options) const;
+  std::uint64_t uploadedBytes() const;  // by the last upload
+  // The GL buffer holding the indices (for the compute-shader reformation).
+  unsigned indexBuffer() const;
+
+ private:
+  struct State;
+  explicit Renderer(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+// Column-major 4x4 view-projection of a camera (OpenGL clip space), in float.
+void viewProjectionMatrix(const Camera& camera, float out[16]);
+
+}  // namespace lodforge

@@ -1,0 +1,53 @@
+#include "lodforge/render/shader.h"
+
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+namespace lodforge {
+
+Program::~Program() {
+  if (id_) glDeleteProgram(id_);
+}
+
+Result<Program> Program::link(std::initializer_list<Stage> stages) {
+  Program program;
+  program.id_ = glCreateProgram();
+  std::vector<GLuint> shaders;
+  Status status;
+  for (const Stage& stage : stages) {
+    const GLuint shader = glCreateShader(stage.type);
+    shaders.push_back(shader);
+    glShaderSource(shader, 1, &stage.source, nullptr);
+    glCompileShader(shader);
+    GLint ok = 0;
+    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      std::string log(4096, '\0');
+      GLsizei length = 0;
+      glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), &length, log.data());
+      log.resize(static_cast<std::size_t>(length));
+      status = Error{ErrorKind::kInternal, fmt::format("shader compile error: {}", log)};
+      break;
+    }
+    glAttachShader(program.id_, shader);
+  }
+  if (status.ok()) {
+    glLinkProgram(program.id_);
+    GLint ok = 0;
+    glGetProgramiv(program.id_, GL_LINK_STATUS, &ok);
+    if (!ok) {
+      std::string log(4096, '\0');
+      GLsizei length = 0;
+      glGetProgramInfoLog(program.id_, static_cast<GLsizei>(log.size()), &length, log.data());
+      log.resize(static_cast<std::size_t>(length));
+      status = Error{ErrorKind::kInternal, fmt::format("shader link error: {}", log)};
+    }
+  }
+  for (GLuint shader : shaders) glDeleteShader(shader);
+  if (!status.ok()) return status;
+  return program;
+}
+
+}  // namespace lodforge

@@ -18,18 +18,15 @@
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
 #include "lodforge/runtime/stream.h"
+#include "view_options.h"
 
 namespace lodforge::cli {
 namespace {
 
-struct BenchOptions {
+struct BenchOptions : PathChoice {
   std::string input;
-  std::string path = "orbit";  // orbit, fly, or a path file
-  std::uint64_t frames = 120;
   std::string budgets = "1%,5%,20%";
   std::uint64_t gpuMemory = 0;
-  std::string size = "1280x720";
-  double fovY = 60;
   bool firstPassOnly = false;
   double minT = 0.65;
   double exponent = 3.0;
@@ -54,59 +51,6 @@ struct BudgetRun {
   FrameTimes load;
   std::vector<FrameTimes> frames;
 };
-
-Result<std::uint64_t> parseBudget(std::string_view text, std::uint64_t full) {
-  if (text.ends_with('%')) {
-    double percent = 0;
-    const std::string number(text.substr(0, text.size() - 1));
-    char* end = nullptr;
-    percent = std::strtod(number.c_str(), &end);
-    if (number.empty() || end != number.c_str() + number.size() || !(percent > 0) || percent > 100)
-      return Error{ErrorKind::kUsage,
-                   fmt::format("--budget: '{}' is not a percentage in (0, 100]", text)};
-    return static_cast<std::uint64_t>(std::llround(percent / 100.0 * static_cast<double>(full)));
-  }
-  const auto count = parseCount(text);
-  if (!count || *count == 0)
-    return Error{
-        ErrorKind::kUsage,
-        fmt::format("--budget: '{}' is not a vertex count (5000, 3M, 10.5M) or a percentage (5%)",
-                    text)};
-  return *count;
-}
-
-Result<std::vector<std::uint64_t>> parseBudgets(const std::string& list, std::uint64_t full) {
-  std::vector<std::uint64_t> budgets;
-  std::size_t start = 0;
-  while (start <= list.size()) {
-    const std::size_t comma = std::min(list.find(',', start), list.size());
-    auto budget = parseBudget(std::string_view(list).substr(start, comma - start), full);
-    if (!budget) return budget.status();
-    budgets.push_back(*budget);
-    start = comma + 1;
-  }
-  return budgets;
-}
-
-Result<std::vector<Camera>> cameraPath(const BenchOptions& o, const Package& package) {
-  const auto& h = package.header();
-  Aabbd bounds;
-  bounds.add(Vec3d{h.boundsMin[0], h.boundsMin[1], h.boundsMin[2]});
-  bounds.add(Vec3d{h.boundsMax[0], h.boundsMax[1], h.boundsMax[2]});
-  unsigned width = 0, height = 0;
-  char x = 0;
-  if (std::sscanf(o.size.c_str(), "%u%c%u", &width, &x, &height) != 3 || x != 'x' ||
-      width - 1 >= 16384 || height - 1 >= 16384)
-    return Error{ErrorKind::kUsage,
-                 fmt::format("--size: '{}' is not WIDTHxHEIGHT (e.g. 1280x720)", o.size)};
-  const PathOptions options{
-      .frames = o.frames, .width = width, .height = height, .fovYDegrees = o.fovY};
-  if (o.path == "orbit") return orbitPath(bounds, options);
-  if (o.path == "fly") return flyThroughPath(bounds, options);
-  auto cameras = readCameraPath(o.path, package.origin(), bounds);
-  if (cameras && cameras->size() > o.frames) cameras->resize(o.frames);
-  return cameras;
-}
 
 double milliseconds(std::chrono::steady_clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();

@@ -39,5 +39,6 @@ void addConvert(CLI::App& app, const Global& global, Run& run);
 void addGenerate(CLI::App& app, const Global& global, Run& run);
 void addBench(CLI::App& app, const Global& global, Run& run);
 void addCompare(CLI::App& app, const Global& global, Run& run);
+void addRender(CLI::App& app, const Global& global, Run& run);
 
 }  // namespace lodforge::cli

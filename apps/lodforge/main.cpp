@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   cli::addGenerate(app, global, run);
   cli::addBench(app, global, run);
   cli::addCompare(app, global, run);
+  cli::addRender(app, global, run);
 
   try {
     app.parse(argc, argv);

@@ -443,3 +443,74 @@ TEST(CliCompare, MismatchedOrBadImagesAreExitCode2) {
 
 }  // namespace
 }  // namespace lodforge
+
+namespace lodforge {
+namespace {
+
+TEST(CliRender, FramesAlongAPathMatchTheReferenceAtFullBudget) {
+  test::TempDir dir;
+  const std::string package = dir.file("engine.lfp");
+  ASSERT_EQ(
+      lodforge("build " + test::dataPath("meshes/2CylinderEngine.glb") + " -o " + package, dir)
+          .code,
+      0);
+  Outcome o = lodforge(
+      "render " + package + " --reference --frames 3 --size 200x150 -o " + dir.file("ref"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  o = lodforge("render " + package + " --budget 100% --frames 3 --size 200x150 -o " +
+                   dir.file("full") + " --json " + dir.file("full.json"),
+               dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  o = lodforge("render " + package + " --budget 5% --frames 3 --size 200x150 --color lod -o " +
+                   dir.file("low"),
+               dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  // Three frames each, and nothing else but the summary (no temporary left behind).
+  auto files = test::listFolder(dir.file("ref"));
+  std::sort(files.begin(), files.end());
+  EXPECT_EQ(files, (std::vector<std::string>{"frame_0000.png", "frame_0001.png", "frame_0002.png",
+                                             "render.json"}));
+  for (const auto& name : test::listFolder(dir.path()))
+    EXPECT_EQ(name.find(".tmp"), std::string::npos) << name;
+  const auto frame = readPng(dir.file("ref/frame_0001.png"));
+  ASSERT_TRUE(frame.ok());
+  EXPECT_EQ(frame->width, 200u);
+  EXPECT_EQ(frame->height, 150u);
+  // 100 % of the budget is the full model: identical pixels.
+  o = lodforge(
+      "compare " + dir.file("ref") + " " + dir.file("full") + " --json " + dir.file("c.json"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto c = nlohmann::json::parse(test::readFile(dir.file("c.json")));
+  EXPECT_EQ(c["mean_delta_e"], 0.0);
+  const auto j = nlohmann::json::parse(test::readFile(dir.file("full.json")));
+  ASSERT_EQ(j["frames"].size(), 3u);
+  EXPECT_EQ(j["frames"][0]["vertices"].get<std::uint64_t>(),
+            info(package, dir)["vertices"].get<std::uint64_t>());
+  // 5 % in LOD colours differs from the reference.
+  o = lodforge(
+      "compare " + dir.file("ref") + " " + dir.file("low") + " --json " + dir.file("d.json"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_GT(
+      nlohmann::json::parse(test::readFile(dir.file("d.json")))["mean_share_above"].get<double>(),
+      0.01);
+}
+
+TEST(CliRender, BadArgumentsAndPackagesAreExitCode2) {
+  test::TempDir dir;
+  test::writeFile(dir.file("bad.lfp"), "not a package");
+  Outcome o = lodforge("render " + dir.file("bad.lfp") + " -o " + dir.file("out"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("bad.lfp"), std::string::npos) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out")));
+  const std::string package = dir.file("motor.lfp");
+  ASSERT_EQ(
+      lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
+  EXPECT_EQ(lodforge("render " + package + " --budget 0 -o " + dir.file("out"), dir).code, 2);
+  EXPECT_EQ(lodforge("render " + package + " --budget 150% -o " + dir.file("out"), dir).code, 2);
+  EXPECT_EQ(lodforge("render " + package + " --size 10 -o " + dir.file("out"), dir).code, 2);
+  EXPECT_EQ(lodforge("render " + package + " --color rainbow -o " + dir.file("out"), dir).code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out")));
+}
+
+}  // namespace
+}  // namespace lodforge

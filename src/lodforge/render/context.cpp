@@ -112,6 +112,10 @@ void GlContext::makeCurrent() {
   }
 }
 
+void GlContext::finish() {
+  glFinish();
+}
+
 std::string GlContext::renderer() const {
   const auto* text = glGetString(GL_RENDERER);
   return text ? reinterpret_cast<const char*>(text) : "";

@@ -24,6 +24,7 @@ class GlContext {
   GlContext& operator=(const GlContext&) = delete;
 
   void makeCurrent();
+  void finish();                   // glFinish: waits until every command issued so far has run
   std::string renderer() const;    // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   std::string version() const;     // GL_VERSION
   GLFWwindow* glfwWindow() const;  // null when headless

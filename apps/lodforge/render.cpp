@@ -1,0 +1,193 @@
+// `lodforge render model.lfp -o frames/`: headless PNG frames along a camera path, each frame
+// selected under the budget (§4), streamed (§3.3) and drawn with OpenGL (EGL surfaceless, so it
+// runs without a display or a GPU). `--reference` draws the full-detail model instead, for
+// `lodforge compare`.
+#include <chrono>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/core/units.h"
+#include "lodforge/render/context.h"
+#include "lodforge/render/renderer.h"
+#include "lodforge/runtime/selection.h"
+#include "lodforge/runtime/stream.h"
+#include "view_options.h"
+
+namespace lodforge::cli {
+namespace {
+
+struct RenderOptions : PathChoice {
+  std::string input, output;
+  std::string budget = "10%";
+  bool reference = false;
+  bool firstPassOnly = false;
+  double minT = 0.65;
+  std::string color = "shaded";
+  std::string json;
+
+  RenderOptions() { frames = 8; }
+};
+
+double milliseconds(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration<double, std::milli>(d).count();
+}
+
+// The counts of the reference: every object at full detail.
+void fullDetail(const Package& package, Selection& selection) {
+  const std::size_t n = package.objectCount();
+  selection.vertexCounts.resize(n);
+  selection.triangleCounts.resize(n);
+  selection.totalVertices = selection.totalTriangles = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    selection.vertexCounts[i] = package.object(i).vertexCount;
+    selection.triangleCounts[i] = package.object(i).triangleCount;
+    selection.totalVertices += selection.vertexCounts[i];
+    selection.totalTriangles += selection.triangleCounts[i];
+  }
+}
+
+Status runRender(const Global& global, const RenderOptions& o) {
+  Result<Package> package = Package::open(o.input);
+  if (!package) return package.status();
+  auto colorMode = parseColorMode(o.color);
+  if (!colorMode) return colorMode.status();
+  auto cameras = cameraPath(o, *package);
+  if (!cameras) return cameras.status();
+  const LodScene scene = LodScene::fromPackage(*package);
+  const std::uint64_t full = scene.totalMaxVertices();
+  auto budget = parseBudget(o.budget, full);
+  if (!budget) return budget.status();
+
+  auto gl = GlContext::headless();
+  if (!gl) return gl.status();
+  const StreamCapacity capacity =
+      StreamCapacity::forVertices(*package, o.reference ? full : *budget);
+  StreamBuffer buffer(*package, capacity);
+  auto renderer = Renderer::create(*package, capacity);
+  if (!renderer) return renderer.status();
+  auto target = Framebuffer::create(cameras->front().width, cameras->front().height);
+  if (!target) return target.status();
+
+  // Frames go into a temporary folder beside the output and move in when all are written.
+  const std::filesystem::path out(o.output);
+  const std::filesystem::path temporary(temporaryPathFor(o.output));
+  std::filesystem::create_directories(temporary);
+  struct Cleanup {
+    std::filesystem::path path;
+    ~Cleanup() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  } cleanup{temporary};
+
+  say(global, fmt::format("{}: {} objects, {} vertices; {} frames at {} ({}), {} on {}", o.input,
+                          formatCount(package->objectCount()), formatCount(full), cameras->size(),
+                          o.size, o.reference ? "full detail" : "budget " + formatCount(*budget),
+                          colorModeName(*colorMode), (*gl)->renderer()));
+  Selection selection;
+  nlohmann::json frames = nlohmann::json::array();
+  Progress progress("frames", cameras->size());
+  for (std::size_t f = 0; f < cameras->size(); ++f) {
+    LODFORGE_TRY(checkCancelled());
+    const Camera& camera = (*cameras)[f];
+    const auto start = std::chrono::steady_clock::now();
+    if (o.reference) {
+      fullDetail(*package, selection);
+    } else {
+      selectTwoPass(scene, camera, *budget, {.minT = o.minT, .firstPassOnly = o.firstPassOnly},
+                    selection);
+    }
+    const auto selected = std::chrono::steady_clock::now();
+    auto stream = buffer.update(selection.vertexCounts, selection.triangleCounts);
+    if (!stream) return stream.status();
+    const auto streamed = std::chrono::steady_clock::now();
+    renderer->upload(buffer);
+    target->bind();
+    renderer->draw(camera, {.colorMode = *colorMode});
+    (*gl)->finish();  // the draw's own time, not the read-back's
+    const auto drawn = std::chrono::steady_clock::now();
+    const std::string name = fmt::format("frame_{:04}.png", f);
+    LODFORGE_TRY(writePng((temporary / name).string(), target->read()));
+    frames.push_back({{"frame", name},
+                      {"vertices", selection.totalVertices},
+                      {"triangles", selection.totalTriangles},
+                      {"selection_ms", milliseconds(selected - start)},
+                      {"generation_ms", milliseconds(streamed - selected)},
+                      {"render_ms", milliseconds(drawn - streamed)},
+                      {"bytes_read", stream->bytesRead}});
+    progress.advance(1);
+  }
+  progress.finish();
+  const nlohmann::json report = {
+      {"package", o.input},
+      {"budget", o.reference ? full : *budget},
+      {"reference", o.reference},
+      {"mode", o.reference ? "full" : (o.firstPassOnly ? "first-pass" : "two-pass")},
+      {"color", colorModeName(*colorMode)},
+      {"renderer", (*gl)->renderer()},
+      {"frames", frames}};
+  const std::string text = report.dump(2) + "\n";
+  {
+    auto file = OutputFile::create((temporary / "render.json").string());
+    if (!file) return file.status();
+    LODFORGE_TRY(file->write(text.data(), text.size()));
+    LODFORGE_TRY(file->commit());
+  }
+  std::error_code error;
+  std::filesystem::create_directories(out, error);
+  if (error) return Error{ErrorKind::kIo, fmt::format("{}: {}", o.output, error.message())};
+  for (const auto& entry : std::filesystem::directory_iterator(temporary)) {
+    std::filesystem::rename(entry.path(), out / entry.path().filename(), error);
+    if (error) return Error{ErrorKind::kIo, fmt::format("{}: {}", o.output, error.message())};
+  }
+  if (!o.json.empty()) {
+    auto file = OutputFile::create(o.json);
+    if (!file) return file.status();
+    LODFORGE_TRY(file->write(text.data(), text.size()));
+    LODFORGE_TRY(file->commit());
+  }
+  double drawMs = 0;
+  for (const auto& frame : frames) drawMs += frame["render_ms"].get<double>();
+  say(global, fmt::format("wrote {} frames to {} (mean draw {:.1f} ms)", frames.size(), o.output,
+                          drawMs / static_cast<double>(std::max<std::size_t>(1, frames.size()))));
+  return {};
+}
+
+}  // namespace
+
+void addRender(CLI::App& app, const Global& global, Run& run) {
+  auto o = std::make_shared<RenderOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "render", "Headless PNG frames along a camera path, under a vertex budget");
+  sub->add_option("PACKAGE", o->input, "A .lfp package")->required();
+  sub->add_option("-o,--output", o->output, "Folder for frame_NNNN.png and render.json")
+      ->required();
+  sub->add_option("--path", o->path, "orbit, fly, or a camera path JSON file (docs/formats.md)")
+      ->capture_default_str();
+  sub->add_option("--frames", o->frames, "Frames along the path (a file's path is cut to this)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1'000'000}));
+  sub->add_option("--budget", o->budget, "Vertex budget N: a count (3M) or a share (10%)")
+      ->capture_default_str();
+  sub->add_flag("--reference", o->reference, "Draw the full-detail model (no budget)")
+      ->excludes("--budget");
+  sub->add_flag("--first-pass-only", o->firstPassOnly, "Eq. 2 and 3 only (no second pass)");
+  sub->add_option("--min-t", o->minT, "Eq. 3's MinT")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--size", o->size, "Image WIDTHxHEIGHT in pixels")->capture_default_str();
+  sub->add_option("--fov", o->fovY, "Vertical field of view, degrees")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 179.0));
+  sub->add_option("--color", o->color, "shaded, object, lod (vc/p) or normal")
+      ->capture_default_str();
+  sub->add_option("--json", o->json, "Also write the per-frame figures here");
+  sub->callback([&global, &run, o] { run = [&global, o] { return runRender(global, *o); }; });
+}
+
+}  // namespace lodforge::cli

@@ -4,6 +4,7 @@
 // `lodforge compare`.
 #include <chrono>
 #include <filesystem>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -13,6 +14,7 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
+#include "lodforge/render/gpu_reform.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/selection.h"
 #include "lodforge/runtime/stream.h"
@@ -29,6 +31,7 @@ struct RenderOptions : PathChoice {
   double minT = 0.65;
   std::string color = "shaded";
   std::string json;
+  bool gpuReform = false;
 
   RenderOptions() { frames = 8; }
 };
@@ -70,6 +73,12 @@ Status runRender(const Global& global, const RenderOptions& o) {
   StreamBuffer buffer(*package, capacity);
   auto renderer = Renderer::create(*package, capacity);
   if (!renderer) return renderer.status();
+  std::optional<GpuReformer> reformer;
+  if (o.gpuReform) {
+    auto created = GpuReformer::create(*package, capacity);
+    if (!created) return created.status();
+    reformer.emplace(std::move(*created));
+  }
   auto target = Framebuffer::create(cameras->front().width, cameras->front().height);
   if (!target) return target.status();
 
@@ -106,7 +115,9 @@ Status runRender(const Global& global, const RenderOptions& o) {
     auto stream = buffer.update(selection.vertexCounts, selection.triangleCounts);
     if (!stream) return stream.status();
     const auto streamed = std::chrono::steady_clock::now();
-    renderer->upload(buffer);
+    // Indices from the CPU's Algorithm 2, or re-formed on the GPU from the source triangles.
+    renderer->upload(buffer, !reformer);
+    if (reformer) reformer->reform(buffer, renderer->indexBuffer());
     target->bind();
     renderer->draw(camera, {.colorMode = *colorMode});
     (*gl)->finish();  // the draw's own time, not the read-back's
@@ -187,6 +198,8 @@ void addRender(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("--color", o->color, "shaded, object, lod (vc/p) or normal")
       ->capture_default_str();
   sub->add_option("--json", o->json, "Also write the per-frame figures here");
+  sub->add_flag("--gpu-reform", o->gpuReform,
+                "Re-form triangles in a compute shader (§3.2) instead of on the CPU");
   sub->callback([&global, &run, o] { run = [&global, o] { return runRender(global, *o); }; });
 }
 

@@ -465,6 +465,17 @@ TEST(CliRender, FramesAlongAPathMatchTheReferenceAtFullBudget) {
                    dir.file("low"),
                dir);
   ASSERT_EQ(o.code, 0) << o.err;
+  // The compute-shader reformation draws the same frames as the CPU path.
+  o = lodforge("render " + package +
+                   " --budget 5% --frames 3 --size 200x150 --color lod --gpu-reform -o " +
+                   dir.file("low-gpu"),
+               dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  o = lodforge(
+      "compare " + dir.file("low") + " " + dir.file("low-gpu") + " --json " + dir.file("g.json"),
+      dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(nlohmann::json::parse(test::readFile(dir.file("g.json")))["mean_delta_e"], 0.0);
   // Three frames each, and nothing else but the summary (no temporary left behind).
   auto files = test::listFolder(dir.file("ref"));
   std::sort(files.begin(), files.end());

@@ -285,7 +285,7 @@ Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 Renderer::~Renderer() = default;
 
-void Renderer::upload(const StreamBuffer& buffer) {
+void Renderer::upload(const StreamBuffer& buffer, bool indices) {
   State& s = *state_;
   const auto upload = [&](GLuint target, const auto& span) {
     if (span.empty()) return;
@@ -296,7 +296,7 @@ void Renderer::upload(const StreamBuffer& buffer) {
   upload(s.positions, buffer.positions());
   if (s.normals) upload(s.normalBuffer, buffer.normals());
   if (s.colors) upload(s.colorBuffer, buffer.colors());
-  upload(s.indices, buffer.indices());
+  if (indices) upload(s.indices, buffer.indices());
 
   // One command per object with triangles; its base instance is the object id.
   const auto counts = buffer.vertexCounts();

@@ -61,8 +61,9 @@ class Renderer {
   Renderer& operator=(Renderer&&) noexcept;
   ~Renderer();
 
-  // Makes the GL buffers hold the stream's current contents and draw commands.
-  void upload(const StreamBuffer& buffer);
+  // Makes the GL buffers hold the stream's current contents and draw commands. With
+  // `indices` false the index buffer is left alone (GpuReformer writes it).
+  void upload(const StreamBuffer& buffer, bool indices = true);
   // Draws into the bound framebuffer (viewport = camera's size).
   void draw(const Camera& camera, const DrawOptions& options) const;
   std::uint64_t uploadedBytes() const;  // by the last upload

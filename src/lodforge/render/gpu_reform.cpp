@@ -1,0 +1,137 @@
+#include "lodforge/render/gpu_reform.h"
+
+#include <algorithm>
+#include <array>
+
+#include <epoxy/gl.h>
+
+#include "lodforge/render/shader.h"
+
+namespace lodforge {
+
+namespace {
+
+constexpr GLuint kGroupSize = 256;
+constexpr GLuint kMaxGroupsX = 65535;  // the minimum GL 4.5 guarantees per dimension
+
+// Algorithm 2, one invocation per selected triangle.
+constexpr const char* kReformShader = R"(#version 450 core
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer Ecol { uint ecol[]; };      // every object, resident
+layout(std430, binding = 1) readonly buffer Source { uint source[]; };  // object-local corners
+// Per selected object: first triangle in the frame, ECol offset, first vertex in the frame, vc.
+layout(std430, binding = 2) readonly buffer Objects { uvec4 objects[]; };
+layout(std430, binding = 3) writeonly buffer Indices { uint indices[]; };
+uniform uint triangleCount;
+uniform uint objectCount;
+
+void main() {
+  uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u + gl_LocalInvocationID.x;
+  if (t >= triangleCount) return;
+  // The owning object: the last whose first triangle is at most t (§3.2's binary search).
+  uint lo = 0u, hi = objectCount - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi + 1u) / 2u;
+    if (objects[mid].x <= t) lo = mid; else hi = mid - 1u;
+  }
+  uvec4 o = objects[lo];
+  for (uint k = 0u; k < 3u; ++k) {
+    uint c = source[3u * t + k];
+    while (c >= o.w) c = ecol[o.y + c];  // chains strictly decrease (Algorithm 1)
+    indices[3u * t + k] = o.z + c;
+  }
+}
+)";
+
+GLuint makeBuffer(std::uint64_t bytes, const void* data, GLbitfield flags) {
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(std::max<std::uint64_t>(bytes, 16)), data,
+                       flags);
+  return buffer;
+}
+
+}  // namespace
+
+struct GpuReformer::State {
+  Program program;
+  GLuint ecol = 0, source = 0, objects = 0;
+  std::uint64_t objectCapacity = 0;
+  std::vector<std::array<std::uint32_t, 4>> table;
+  const Package* package = nullptr;
+
+  ~State() {
+    for (GLuint b : {ecol, source, objects}) {
+      if (b) glDeleteBuffers(1, &b);
+    }
+  }
+};
+
+Result<GpuReformer> GpuReformer::create(const Package& package, const StreamCapacity& capacity) {
+  auto s = std::make_unique<State>();
+  s->package = &package;
+  const std::uint64_t vertices = package.header().vertexCount;
+  if (vertices >= (std::uint64_t{1} << 32))
+    return Error{ErrorKind::kUnsupported,
+                 "GPU reformation addresses ECol with 32-bit offsets: this package has more than "
+                 "4 G vertices; use the CPU path"};
+  auto program = Program::link({{GL_COMPUTE_SHADER, kReformShader}});
+  if (!program) return program.status();
+  s->program = std::move(*program);
+  // The package's ECol section is one array over all objects (each at its vertex offset).
+  const std::uint32_t* ecol = package.objectCount() ? package.ecol(0).data() : nullptr;
+  s->ecol = makeBuffer(vertices * sizeof(std::uint32_t), ecol, 0);
+  s->source =
+      makeBuffer(capacity.triangles * 3 * sizeof(std::uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  s->objectCapacity = package.objectCount();
+  s->objects = makeBuffer(s->objectCapacity * 16, nullptr, GL_DYNAMIC_STORAGE_BIT);
+  return GpuReformer(std::move(s));
+}
+
+GpuReformer::GpuReformer(std::unique_ptr<State> state) : state_(std::move(state)) {}
+GpuReformer::GpuReformer(GpuReformer&&) noexcept = default;
+GpuReformer& GpuReformer::operator=(GpuReformer&&) noexcept = default;
+GpuReformer::~GpuReformer() = default;
+
+void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
+  State& s = *state_;
+  const std::uint64_t triangles = buffer.triangleCount();
+  if (triangles == 0) return;
+  // The frame's object table: only objects with triangles, so the search needs no tie rule.
+  const auto counts = buffer.vertexCounts();
+  const auto vertexStart = buffer.vertexStart();
+  const auto triangleStart = buffer.triangleStart();
+  s.table.clear();
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    if (triangleStart[i + 1] == triangleStart[i]) continue;
+    s.table.push_back({static_cast<std::uint32_t>(triangleStart[i]),
+                       static_cast<std::uint32_t>(s.package->object(i).vertexOffset),
+                       static_cast<std::uint32_t>(vertexStart[i]), counts[i]});
+  }
+  const auto source = buffer.sourceTriangles();
+  glNamedBufferSubData(s.source, 0, static_cast<GLsizeiptr>(source.size_bytes()), source.data());
+  glNamedBufferSubData(s.objects, 0, static_cast<GLsizeiptr>(s.table.size() * 16), s.table.data());
+  const GLuint p = s.program.id();
+  glUseProgram(p);
+  glUniform1ui(glGetUniformLocation(p, "triangleCount"), static_cast<GLuint>(triangles));
+  glUniform1ui(glGetUniformLocation(p, "objectCount"), static_cast<GLuint>(s.table.size()));
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.ecol);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.source);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.objects);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, indexBuffer);
+  const std::uint64_t groups = (triangles + kGroupSize - 1) / kGroupSize;
+  const auto x = static_cast<GLuint>(std::min<std::uint64_t>(groups, kMaxGroupsX));
+  const auto y = static_cast<GLuint>((groups + x - 1) / x);
+  glDispatchCompute(x, y, 1);
+  // The next draw reads the indices; a read-back reads the buffer.
+  glMemoryBarrier(GL_ELEMENT_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+}
+
+std::vector<std::uint32_t> GpuReformer::readIndices(unsigned indexBuffer, std::uint64_t triangles) {
+  std::vector<std::uint32_t> indices(triangles * 3);
+  glGetNamedBufferSubData(indexBuffer, 0, static_cast<GLsizeiptr>(indices.size() * 4),
+                          indices.data());
+  return indices;
+}
+
+}  // namespace lodforge

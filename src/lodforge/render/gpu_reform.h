@@ -1,0 +1,38 @@
+// Algorithm 2 on the GPU, as the CAD paper runs it (§3.2): ECol of every object stays resident in
+// a shader storage buffer; per frame the stream's source triangles and a table of the selected
+// objects go up, and one compute invocation per triangle finds its object by binary search over
+// the prefix sums of the selected triangle counts, then follows ECol until every corner is below
+// the object's vertex count. The result lands in the renderer's index buffer.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "lodforge/core/status.h"
+#include "lodforge/runtime/stream.h"
+#include "lodforge/simplify/package.h"
+
+namespace lodforge {
+
+class GpuReformer {
+ public:
+  // Needs a current GL 4.5 context; uploads the package's ECol once.
+  static Result<GpuReformer> create(const Package& package, const StreamCapacity& capacity);
+  GpuReformer(GpuReformer&&) noexcept;
+  GpuReformer& operator=(GpuReformer&&) noexcept;
+  ~GpuReformer();
+
+  // Re-forms the stream buffer's source triangles into `indexBuffer` (a GL buffer of at least
+  // 3 x triangleCount uint32): the same indices the CPU path puts in buffer.indices().
+  void reform(const StreamBuffer& buffer, unsigned indexBuffer);
+  // Reads back the first `triangles` triangles of a GL index buffer (tests, debugging).
+  static std::vector<std::uint32_t> readIndices(unsigned indexBuffer, std::uint64_t triangles);
+
+ private:
+  struct State;
+  explicit GpuReformer(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace lodforge

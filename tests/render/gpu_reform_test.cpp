@@ -1,0 +1,92 @@
+// The compute-shader reformation against the CPU path (Algorithm 2 in runtime/stream), on
+// llvmpipe: identical index buffers for random selections.
+#include "lodforge/render/gpu_reform.h"
+
+#include <gtest/gtest.h>
+
+#include "lodforge/core/random.h"
+#include "lodforge/render/context.h"
+#include "lodforge/render/renderer.h"
+#include "lodforge/runtime/path.h"
+#include "lodforge/runtime/selection.h"
+#include "runtime/packages.h"
+
+namespace lodforge {
+namespace {
+
+GlContext& context() {
+  // Kept alive to the end: see renderer_test.cpp.
+  static auto* created = new Result<std::unique_ptr<GlContext>>(GlContext::headless());
+  EXPECT_TRUE(created->ok()) << created->error().message;
+  return ***created;
+}
+
+TEST(GpuReform, EqualsTheCpuIndicesForRandomSelections) {
+  context();
+  Random random(2024);
+  for (const char* key : {"engine", "motor", "cad", "crowd"}) {
+    const Package& package = test::RuntimePackages::get(key);
+    const LodScene scene = LodScene::fromPackage(package);
+    const std::uint64_t full = scene.totalMaxVertices();
+    StreamBuffer buffer(package, StreamCapacity::forVertices(package, full));
+    auto renderer = Renderer::create(package, buffer.capacity());
+    ASSERT_TRUE(renderer.ok()) << renderer.error().message;
+    auto reformer = GpuReformer::create(package, buffer.capacity());
+    ASSERT_TRUE(reformer.ok()) << reformer.error().message;
+    std::vector<std::uint32_t> vc(package.objectCount()), tc(package.objectCount());
+    std::uint64_t checked = 0;
+    for (int round = 0; round < 12; ++round) {
+      // Every object at a random level of its own (0, q..p), some rounds with most objects out.
+      const double absent = round % 3 == 0 ? 0.8 : 0.1;
+      for (std::size_t i = 0; i < vc.size(); ++i) {
+        const auto& o = package.object(i);
+        if (random.uniform(0, 1) < absent) {
+          vc[i] = tc[i] = 0;
+          continue;
+        }
+        vc[i] = o.minVertexCount +
+                static_cast<std::uint32_t>(random.below(o.vertexCount - o.minVertexCount + 1));
+        tc[i] = package.map(i)[vc[i] - o.minVertexCount];
+      }
+      ASSERT_TRUE(buffer.update(vc, tc).ok());
+      renderer->upload(buffer, /*indices=*/false);
+      reformer->reform(buffer, renderer->indexBuffer());
+      const auto gpu = GpuReformer::readIndices(renderer->indexBuffer(), buffer.triangleCount());
+      const auto cpu = buffer.indices();
+      ASSERT_EQ(gpu.size(), cpu.size());
+      EXPECT_TRUE(std::equal(gpu.begin(), gpu.end(), cpu.begin())) << key << " round " << round;
+      checked += buffer.triangleCount();
+    }
+    EXPECT_GT(checked, 0u) << key;
+  }
+}
+
+TEST(GpuReform, RendersTheSameImageAsTheCpuPath) {
+  context();
+  const Package& package = test::RuntimePackages::get("engine");
+  const LodScene scene = LodScene::fromPackage(package);
+  StreamBuffer buffer(package, StreamCapacity::forVertices(package, scene.totalMaxVertices()));
+  auto renderer = Renderer::create(package, buffer.capacity());
+  auto reformer = GpuReformer::create(package, buffer.capacity());
+  ASSERT_TRUE(renderer.ok() && reformer.ok());
+  auto target = Framebuffer::create(240, 180);
+  ASSERT_TRUE(target.ok());
+  Selection selection;
+  for (const Camera& camera :
+       orbitPath(test::packageBounds(package), {.frames = 3, .width = 240, .height = 180})) {
+    selectTwoPass(scene, camera, scene.totalMaxVertices() / 10, {}, selection);
+    ASSERT_TRUE(buffer.update(selection.vertexCounts, selection.triangleCounts).ok());
+    target->bind();
+    renderer->upload(buffer);
+    renderer->draw(camera, {});
+    const Image cpu = target->read();
+    renderer->upload(buffer, /*indices=*/false);
+    reformer->reform(buffer, renderer->indexBuffer());
+    renderer->draw(camera, {});
+    const Image gpu = target->read();
+    EXPECT_EQ(compareImages(cpu, gpu).maxDeltaE, 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace lodforge

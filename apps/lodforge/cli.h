@@ -40,5 +40,6 @@ void addGenerate(CLI::App& app, const Global& global, Run& run);
 void addBench(CLI::App& app, const Global& global, Run& run);
 void addCompare(CLI::App& app, const Global& global, Run& run);
 void addRender(CLI::App& app, const Global& global, Run& run);
+void addView(CLI::App& app, const Global& global, Run& run);
 
 }  // namespace lodforge::cli

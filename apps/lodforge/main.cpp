@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   cli::addBench(app, global, run);
   cli::addCompare(app, global, run);
   cli::addRender(app, global, run);
+  cli::addView(app, global, run);
 
   try {
     app.parse(argc, argv);

@@ -525,3 +525,72 @@ TEST(CliRender, BadArgumentsAndPackagesAreExitCode2) {
 
 }  // namespace
 }  // namespace lodforge
+
+namespace lodforge {
+namespace {
+
+// The viewer needs a display: the tests give it a virtual one (Debian's xvfb, installed by
+// scripts/install-deps.sh; missing, the test fails rather than skips).
+Outcome viewUnderXvfb(const std::string& args, const test::TempDir& dir) {
+  const std::string out = dir.file(".stdout"), err = dir.file(".stderr");
+  const std::string command = "xvfb-run -a -s '-screen 0 1280x1024x24' " +
+                              std::string(LODFORGE_BINARY) + " view " + args + " >" + out + " 2>" +
+                              err;
+  const int status = std::system(command.c_str());
+  Outcome o;
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  o.out = test::readFile(out);
+  o.err = test::readFile(err);
+  return o;
+}
+
+TEST(CliView, WithoutADisplayItSaysSoAndPointsAtRender) {
+  test::TempDir dir;
+  const std::string package = dir.file("motor.lfp");
+  ASSERT_EQ(
+      lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
+  const std::string out = dir.file(".o"), err = dir.file(".e");
+  const int status =
+      std::system(("env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(LODFORGE_BINARY) + " view " +
+                   package + " >" + out + " 2>" + err)
+                      .c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(test::readFile(err).find("lodforge render"), std::string::npos) << test::readFile(err);
+}
+
+TEST(CliView, ScriptedRunRecordsAPathWhoseReplayMatchesHeadlessRender) {
+  test::TempDir dir;
+  const std::string package = dir.file("engine.lfp");
+  ASSERT_EQ(
+      lodforge("build " + test::dataPath("meshes/2CylinderEngine.glb") + " -o " + package, dir)
+          .code,
+      0);
+  // An orbit played in the window, recorded, with a screenshot of the last frame.
+  Outcome o = viewUnderXvfb(package + " --play orbit --frames 12 --stop-after 12 --size 320x240" +
+                                " --budget 10% --record " + dir.file("rec.json") +
+                                " --screenshot " + dir.file("a.png"),
+                            dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto path = nlohmann::json::parse(test::readFile(dir.file("rec.json")));
+  ASSERT_EQ(path["frames"].size(), 12u);
+  const auto shot = readPng(dir.file("a.png"));
+  ASSERT_TRUE(shot.ok());
+  EXPECT_EQ(shot->width, 320u);
+  // The recorded path replayed headless at the same budget draws the same last frame.
+  o = lodforge("render " + package + " --path " + dir.file("rec.json") +
+                   " --frames 12 --budget 10% -o " + dir.file("r"),
+               dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto frame = readPng(dir.file("r/frame_0011.png"));
+  ASSERT_TRUE(frame.ok());
+  ASSERT_EQ(frame->width, 320u);
+  const ImageDifference d = compareImages(*shot, *frame);
+  EXPECT_LT(d.maxDeltaE, kJustNoticeableDeltaE) << "window and offscreen frames should agree";
+  // And the frame shows the model.
+  const ImageDifference empty = compareImages(*shot, Image(320, 240));
+  EXPECT_GT(empty.shareAbove, 0.05);
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -47,7 +47,7 @@ Result<Framebuffer> Framebuffer::create(std::uint32_t width, std::uint32_t heigh
   glNamedRenderbufferStorage(f.color_, GL_RGBA8, static_cast<GLsizei>(width),
                              static_cast<GLsizei>(height));
   glCreateRenderbuffers(1, &f.depth_);
-  glNamedRenderbufferStorage(f.depth_, GL_DEPTH_COMPONENT32F, static_cast<GLsizei>(width),
+  glNamedRenderbufferStorage(f.depth_, GL_DEPTH_COMPONENT24, static_cast<GLsizei>(width),
                              static_cast<GLsizei>(height));
   glCreateFramebuffers(1, &f.framebuffer_);
   glNamedFramebufferRenderbuffer(f.framebuffer_, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, f.color_);
@@ -82,18 +82,26 @@ void Framebuffer::bind() const {
 }
 
 Image Framebuffer::read() const {
-  Image image(width_, height_);
-  glNamedFramebufferReadBuffer(framebuffer_, GL_COLOR_ATTACHMENT0);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_);
+  return readPixels(framebuffer_, width_, height_);
+}
+
+void bindWindowFramebuffer() {
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+Image readPixels(unsigned framebuffer, std::uint32_t width, std::uint32_t height) {
+  Image image(width, height);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  if (framebuffer == 0) glReadBuffer(GL_BACK);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, static_cast<GLsizei>(width_), static_cast<GLsizei>(height_), GL_RGBA,
+  glReadPixels(0, 0, static_cast<GLsizei>(width), static_cast<GLsizei>(height), GL_RGBA,
                GL_UNSIGNED_BYTE, image.rgba.data());
   // GL's rows start at the bottom; images start at the top.
-  const std::size_t row = std::size_t{width_} * 4;
+  const std::size_t row = std::size_t{width} * 4;
   std::vector<std::uint8_t> swap(row);
-  for (std::uint32_t y = 0; y < height_ / 2; ++y) {
+  for (std::uint32_t y = 0; y < height / 2; ++y) {
     std::uint8_t* a = image.rgba.data() + y * row;
-    std::uint8_t* b = image.rgba.data() + (height_ - 1 - y) * row;
+    std::uint8_t* b = image.rgba.data() + (height - 1 - y) * row;
     std::memcpy(swap.data(), a, row);
     std::memcpy(a, b, row);
     std::memcpy(b, swap.data(), row);
@@ -352,8 +360,26 @@ void Renderer::draw(const Camera& camera, const DrawOptions& options) const {
   const auto& colors = options.colorMode == ColorMode::kObject ? s.idColors : s.baseColors;
   glNamedBufferSubData(s.objectColors, 0, static_cast<GLsizeiptr>(colors.size() * sizeof(Rgba8)),
                        colors.data());
+  // Depth range fitted to the model each frame: the path's planes are chosen for selection
+  // (near ~1e-5 of the size) and would waste a 24-bit depth buffer, making coincident faces
+  // fight differently from one framebuffer format to the next.
+  Camera fitted = camera;
+  const auto& h = s.package->header();
+  double nearest = 0, farthest = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double e =
+        axis == 0 ? camera.position.x : (axis == 1 ? camera.position.y : camera.position.z);
+    const double lo = h.boundsMin[axis], hi = h.boundsMax[axis];
+    const double inside = std::max({lo - e, 0.0, e - hi});
+    nearest += inside * inside;
+    const double outside = std::max(std::abs(e - lo), std::abs(e - hi));
+    farthest += outside * outside;
+  }
+  fitted.farPlane = 1.01 * std::sqrt(farthest) + 1e-6;
+  fitted.nearPlane =
+      std::max({camera.nearPlane, 0.99 * std::sqrt(nearest), fitted.farPlane * 1e-4});
   float matrix[16];
-  viewProjectionMatrix(camera, matrix);
+  viewProjectionMatrix(fitted, matrix);
   const GLuint p = s.program.id();
   glUseProgram(p);
   glUniformMatrix4fv(glGetUniformLocation(p, "viewProjection"), 1, GL_FALSE, matrix);

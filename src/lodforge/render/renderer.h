@@ -28,6 +28,11 @@ enum class ColorMode : std::uint8_t {
 Result<ColorMode> parseColorMode(std::string_view text);
 const char* colorModeName(ColorMode mode);
 
+// Draw into the window again (after offscreen work).
+void bindWindowFramebuffer();
+// The pixels of a framebuffer (0: the window's back buffer), RGBA8, top row first.
+Image readPixels(unsigned framebuffer, std::uint32_t width, std::uint32_t height);
+
 // An offscreen colour + depth target.
 class Framebuffer {
  public:

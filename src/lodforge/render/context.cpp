@@ -38,15 +38,14 @@ Status requireVersion45() {
 GlContext::GlContext(std::unique_ptr<State> state) : state_(std::move(state)) {}
 
 GlContext::~GlContext() {
-  if (state_->window) {
-    glfwDestroyWindow(state_->window);
-    glfwTerminate();
-  }
+  // Neither glfwTerminate nor eglTerminate: both unload the GL driver, and Mesa's few
+  // process-lifetime allocations would then show as leaks from an unknown module; the display
+  // connection is the process's until exit anyway.
+  if (state_->window) glfwDestroyWindow(state_->window);
   if (state_->context != EGL_NO_CONTEXT) {
     eglMakeCurrent(state_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(state_->display, state_->context);
   }
-  if (state_->display != EGL_NO_DISPLAY) eglTerminate(state_->display);
 }
 
 Result<std::unique_ptr<GlContext>> GlContext::headless() {

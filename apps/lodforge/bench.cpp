@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,9 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/threads.h"
 #include "lodforge/core/units.h"
+#include "lodforge/render/context.h"
+#include "lodforge/render/gpu_reform.h"
+#include "lodforge/render/renderer.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
 #include "lodforge/runtime/stream.h"
@@ -33,15 +37,23 @@ struct BenchOptions : PathChoice {
   std::optional<double> targetError;
   std::string json;
   std::string recordPath;
+  bool render = false;     // draw every frame headless (OpenGL; llvmpipe without a GPU)
+  bool gpuReform = false;  // with --render: re-form in a compute shader
 };
 
-// One frame's costs.
+// What --render draws with: one headless context for the whole run.
+struct RenderTarget {
+  std::unique_ptr<GlContext> context;
+  std::optional<Framebuffer> framebuffer;
+};
 struct FrameTimes {
   double selectionMs = 0;
   Selection::Timings selectionSteps;
   FrameStats stream;
   std::uint64_t vertices = 0, triangles = 0, visible = 0;
   bool exact = true;
+  double uploadMs = 0;  // --render: buffers to the GL (and the GPU reformation)
+  double renderMs = 0;  // --render: the draw, to glFinish
 };
 
 // A budget's run: the first frame (everything read) apart from the coherent frames after it.
@@ -58,7 +70,8 @@ double milliseconds(std::chrono::steady_clock::duration d) {
 
 // One frame: select, then stream.
 Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const Camera& camera,
-                            std::uint64_t budget, Selection& selection, StreamBuffer& buffer) {
+                            std::uint64_t budget, Selection& selection, StreamBuffer& buffer,
+                            RenderTarget* target, Renderer* renderer, GpuReformer* reformer) {
   FrameTimes t;
   const auto start = std::chrono::steady_clock::now();
   if (o.targetError) {
@@ -78,12 +91,26 @@ Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const 
   t.visible = selection.visibleObjects;
   t.exact = o.targetError || o.firstPassOnly ||
             selection.totalVertices == std::min(budget, scene.totalMaxVertices());
+  if (renderer) {
+    // The paper's third column: the frame on screen (here offscreen, timed to glFinish).
+    const auto uploadStart = std::chrono::steady_clock::now();
+    renderer->upload(buffer, reformer == nullptr);
+    if (reformer) reformer->reform(buffer, renderer->indexBuffer());
+    target->context->finish();
+    const auto drawStart = std::chrono::steady_clock::now();
+    target->framebuffer->bind();
+    renderer->draw(camera, {});
+    target->context->finish();
+    const auto end = std::chrono::steady_clock::now();
+    t.uploadMs = milliseconds(drawStart - uploadStart);
+    t.renderMs = milliseconds(end - drawStart);
+  }
   return t;
 }
 
 Result<BudgetRun> runBudget(const BenchOptions& o, const Package& package, const LodScene& scene,
                             const std::vector<Camera>& cameras, std::uint64_t budget,
-                            Progress& progress) {
+                            Progress& progress, RenderTarget* target) {
   BudgetRun run;
   run.budget = budget;
   const std::uint64_t full = scene.totalMaxVertices();
@@ -99,10 +126,23 @@ Result<BudgetRun> runBudget(const BenchOptions& o, const Package& package, const
   run.capacityVertices = capacity.vertices;
   run.capacityBytes = capacity.bytes(package);
   StreamBuffer buffer(package, capacity);
+  std::optional<Renderer> renderer;
+  std::optional<GpuReformer> reformer;
+  if (target) {
+    auto created = Renderer::create(package, capacity);
+    if (!created) return created.status();
+    renderer.emplace(std::move(*created));
+    if (o.gpuReform) {
+      auto gpu = GpuReformer::create(package, capacity);
+      if (!gpu) return gpu.status();
+      reformer.emplace(std::move(*gpu));
+    }
+  }
   Selection selection;
   for (std::size_t f = 0; f < cameras.size(); ++f) {
     LODFORGE_TRY(checkCancelled());
-    auto frame = runFrame(o, scene, cameras[f], budget, selection, buffer);
+    auto frame = runFrame(o, scene, cameras[f], budget, selection, buffer, target,
+                          renderer ? &*renderer : nullptr, reformer ? &*reformer : nullptr);
     if (!frame) return frame.status();
     (f == 0 ? run.load : run.frames.emplace_back()) = *frame;
     progress.advance(1);
@@ -145,7 +185,9 @@ nlohmann::json frameJson(const FrameTimes& t) {
           {"objects_changed", t.stream.objectsChanged},
           {"vertices", t.vertices},
           {"triangles", t.triangles},
-          {"visible_objects", t.visible}};
+          {"visible_objects", t.visible},
+          {"upload_ms", t.uploadMs},
+          {"render_ms", t.renderMs}};
 }
 
 nlohmann::json runJson(const BudgetRun& run) {
@@ -167,6 +209,8 @@ nlohmann::json runJson(const BudgetRun& run) {
   add("vertices", [](const FrameTimes& t) { return t.vertices; });
   add("triangles", [](const FrameTimes& t) { return t.triangles; });
   add("visible_objects", [](const FrameTimes& t) { return t.visible; });
+  add("upload_ms", [](const FrameTimes& t) { return t.uploadMs; });
+  add("render_ms", [](const FrameTimes& t) { return t.renderMs; });
   const auto exactFrames = static_cast<std::uint64_t>(std::count_if(
       run.frames.begin(), run.frames.end(), [](const FrameTimes& t) { return t.exact; }));
   return {{"budget", run.budget},
@@ -192,9 +236,11 @@ std::string megabytes(double bytes) {
 void printTable(const Global& global, const BenchOptions& o, const nlohmann::json& runs) {
   say(global,
       fmt::format(
-          "{:>12} {:>9} | {:>9} {:>9} {:>9} | {:>8} {:>8} {:>8} {:>8} | {:>10} {:>9} {:>7} | {:>6}",
+          "{:>12} {:>9} | {:>9} {:>9} {:>9} | {:>8} {:>8} {:>8} {:>8} | {:>10} {:>9} {:>7} | {:>9} "
+          "{:>9} | {:>6}",
           o.targetError ? "error px" : "budget N", "visible", "sel ms", "reasm ms", "reform ms",
-          "gen ms", "gen p95", "read MB", "moved MB", "reformed", "Mtri/s", "load ms", "Σ=N"));
+          "gen ms", "gen p95", "read MB", "moved MB", "reformed", "Mtri/s", "load ms", "upload ms",
+          "render ms", "Σ=N"));
   for (const nlohmann::json& r : runs) {
     const nlohmann::json& m = r["mean"];
     const auto number = [&](const char* key) { return m[key].get<double>(); };
@@ -204,7 +250,7 @@ void printTable(const Global& global, const BenchOptions& o, const nlohmann::jso
     say(global,
         fmt::format(
             "{:>12} {:>9} | {:>9.2f} {:>9.2f} {:>9.2f} | {:>8.2f} {:>8.2f} {:>8} {:>8} | {:>10} "
-            "{:>9.0f} {:>7.1f} | {:>6}",
+            "{:>9.0f} {:>7.1f} | {:>9} {:>9} | {:>6}",
             o.targetError ? fmt::format("{:g}", *o.targetError)
                           : formatCount(r["budget"].get<std::uint64_t>()),
             count("visible_objects"), number("selection_ms"), number("reassembly_ms"),
@@ -212,6 +258,8 @@ void printTable(const Global& global, const BenchOptions& o, const nlohmann::jso
             megabytes(number("bytes_read")), megabytes(number("bytes_moved")),
             count("triangles_reformed"), r["triangles_per_second"].get<double>() / 1e6,
             r["load"]["selection_ms"].get<double>() + r["load"]["generation_ms"].get<double>(),
+            o.render ? fmt::format("{:.2f}", number("upload_ms")) : std::string("-"),
+            o.render ? fmt::format("{:.2f}", number("render_ms")) : std::string("-"),
             o.targetError || o.firstPassOnly
                 ? std::string("-")
                 : fmt::format("{}/{}", r["exact_frames"].get<std::uint64_t>(),
@@ -234,6 +282,7 @@ Status writeJson(const BenchOptions& o, const Package& package, const nlohmann::
       {"path", o.path},
       {"frames", frames},
       {"mode", o.targetError ? "error" : (o.firstPassOnly ? "first-pass" : "two-pass")},
+      {"render", o.render ? (o.gpuReform ? "gpu-reform" : "cpu-reform") : "none"},
       {"min_t", o.minT},
       {"exponent", o.exponent},
       {"runs", runsJson}};
@@ -264,10 +313,22 @@ Status runBench(const Global& global, const BenchOptions& o) {
                   formatCount(scene.totalMaxVertices()),
                   formatCount(package->header().triangleCount), cameras->size(), o.path, o.size,
                   hardwareThreads()));
+  std::optional<RenderTarget> target;
+  std::string rendererName;
+  if (o.render) {
+    auto context = GlContext::headless();
+    if (!context) return context.status();
+    auto framebuffer = Framebuffer::create(cameras->front().width, cameras->front().height);
+    if (!framebuffer) return framebuffer.status();
+    rendererName = (*context)->renderer();
+    target.emplace(RenderTarget{std::move(*context), std::move(*framebuffer)});
+    say(global, "rendering on " + rendererName);
+  }
   nlohmann::json runs = nlohmann::json::array();
   Progress progress("frames", budgets.size() * cameras->size());
   for (const std::uint64_t budget : budgets) {
-    auto run = runBudget(o, *package, scene, *cameras, budget, progress);
+    auto run =
+        runBudget(o, *package, scene, *cameras, budget, progress, target ? &*target : nullptr);
     if (!run) return run.status();
     runs.push_back(runJson(*run));
   }
@@ -315,6 +376,10 @@ void addBench(CLI::App& app, const Global& global, Run& run) {
   error->excludes("--first-pass-only");
   sub->add_option("--json", o->json, "Also write the results as JSON");
   sub->add_option("--record-path", o->recordPath, "Write the cameras used as a path JSON file");
+  sub->add_flag("--render", o->render,
+                "Also draw every frame headless (OpenGL 4.5; on llvmpipe these are CPU times)");
+  sub->add_flag("--gpu-reform", o->gpuReform, "With --render: re-form in a compute shader")
+      ->needs("--render");
   sub->callback([&global, &run, o] { run = [&global, o] { return runBench(global, *o); }; });
 }
 

@@ -594,3 +594,29 @@ TEST(CliView, ScriptedRunRecordsAPathWhoseReplayMatchesHeadlessRender) {
 
 }  // namespace
 }  // namespace lodforge
+
+namespace lodforge {
+namespace {
+
+TEST(CliBench, RenderAddsTheOpenGlColumn) {
+  test::TempDir dir;
+  const std::string package = dir.file("motor.lfp");
+  ASSERT_EQ(
+      lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
+  for (const char* extra : {"", " --gpu-reform"}) {
+    const Outcome o =
+        lodforge("bench " + package + " --frames 4 --budget 10%,100% --size 160x120 --render" +
+                     extra + " --json " + dir.file("b.json"),
+                 dir);
+    ASSERT_EQ(o.code, 0) << o.err;
+    EXPECT_NE(o.out.find("render ms"), std::string::npos) << o.out;
+    const auto j = nlohmann::json::parse(test::readFile(dir.file("b.json")));
+    EXPECT_EQ(j["render"], std::string(extra).empty() ? "cpu-reform" : "gpu-reform");
+    for (const auto& run : j["runs"]) EXPECT_GT(run["mean"]["render_ms"].get<double>(), 0.0);
+  }
+  // Without --render the column stays empty and --gpu-reform alone is a usage error.
+  EXPECT_EQ(lodforge("bench " + package + " --frames 2 --gpu-reform", dir).code, 2);
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify or BENCH_ONLY=runtime runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime or render runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -42,6 +42,8 @@ runtime_section() {
   for path in orbit fly; do
     "$lodforge" bench "$work/cad72k.lfp" --path "$path" --budget 300K,1.05M,1.8M --json "$work/bench-72k-$path.json"
   done
+  # Table 1's OpenGL column: the same budgets drawn headless (llvmpipe: CPU times), fewer frames.
+  "$lodforge" bench "$work/cad72k.lfp" --path orbit --frames 20 --budget 300K,1.05M,1.8M --render --json "$work/bench-72k-render.json"
   rm -f "$work/cad72k.lfp"
   if [[ ${BENCH_LARGE:-0} == 1 ]]; then
     "$lodforge" -q generate cad --objects 718K --detail 1.5 -o "$work/cad718k.ply"
@@ -54,6 +56,26 @@ runtime_section() {
   fi
 }
 if [[ ${BENCH_ONLY:-} == runtime ]]; then runtime_section; exit 0; fi
+
+render_section() {
+  echo
+  echo "== rendering: two-pass versus first pass only against the full-detail render (bench_render, Fig. 7)"
+  local data=${LODFORGE_DATA:-../shared/data}
+  [[ -d $data ]] || data=/work/shared/data
+  "$lodforge" -q generate cad --objects 2000 -o "$work/cad2k.ply"
+  "$lodforge" -q build "$work/cad2k.ply" -o "$work/cad2k.lfp"
+  local packages=("$work/cad2k.lfp@fly" "$work/cad2k.lfp@orbit")
+  for model in 2CylinderEngine as1_motor Motor-c; do
+    "$lodforge" -q build "$data/meshes/$model.glb" -o "$work/$model.lfp"
+    packages+=("$work/$model.lfp@orbit")
+  done
+  "$lodforge" -q build "$data/meshes/horse.ply" -o "$work/horse.lfp"
+  packages+=("$work/horse.lfp@orbit")
+  build/release/bench/bench_render --pictures "$work/pictures" "${packages[@]}"
+  echo "(side-by-side pictures at 5 %: $work/pictures)"
+  rm -f "$work/cad2k.ply"
+}
+if [[ ${BENCH_ONLY:-} == render ]]; then render_section; exit 0; fi
 
 simplify_section() {
   echo
@@ -104,4 +126,5 @@ for n in "${sizes_scan[@]}"; do
 done
 measure "generate points --points 10M" "$lodforge" -q generate points --points 10M -o "$work/points.ply"
 simplify_section
+render_section
 runtime_section

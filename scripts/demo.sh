@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `make demo`: generates a CAD assembly and a scanned surface, reads them and the real models in
 # ../shared/data, prints `lodforge info` for each, builds progressive packages, times budgeted
-# selection and streaming along an orbit, and writes GLBs and JSON under out/demo/.
+# selection and streaming along an orbit, renders frames headless at three budgets and full
+# detail with their image difference, and writes GLBs, PNGs and JSON under out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 lodforge=build/release/lodforge
@@ -30,6 +31,19 @@ section "progressive meshes for every part of the assembly, and two levels out o
 section "budgeted LOD selection and coherent streaming along an orbit (the CAD paper's Table 1 on the CPU)"
 "$lodforge" bench "$out/cad-assembly.lfp" --frames 60 --budget 5%,20%,50% --json "$out/bench.json" \
   --record-path "$out/orbit-path.json"
+section "headless renders along the orbit: full detail and budgets of 1 %, 5 % and 20 %, compared"
+"$lodforge" render "$out/cad-assembly.lfp" --path "$out/orbit-path.json" --frames 6 \
+  --reference -o "$out/render/reference"
+for budget in 1 5 20; do
+  "$lodforge" render "$out/cad-assembly.lfp" --path "$out/orbit-path.json" --frames 6 \
+    --budget "$budget%" -o "$out/render/budget-$budget"
+done
+for budget in 1 5 20; do
+  echo
+  echo "budget $budget % against the full-detail frames (CIE76 ΔE, the share above 2.3 is visible):"
+  "$lodforge" compare "$out/render/reference" "$out/render/budget-$budget" \
+    --diff "$out/render/difference-$budget" --json "$out/render/compare-$budget.json"
+done
 "$lodforge" build "$out/scan.ply" -o "$out/scan.lfp"
 "$lodforge" extract "$out/scan.lfp" --ratio 0.02 -o "$out/scan-2pct.glb"
 
@@ -48,3 +62,5 @@ section "results"
 ls -l "$out"
 echo
 echo "The GLBs in $(pwd)/$out open in any glTF 2.0 viewer (Blender, the three.js editor, ...)."
+echo "Frames: $(pwd)/$out/render/ (reference, budget-1/5/20, difference heat maps)."
+echo "Interactive: $lodforge view $out/cad-assembly.lfp   (needs a display)"

@@ -18,6 +18,7 @@
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
 #include "lodforge/render/gpu_reform.h"
+#include "lodforge/render/gpu_stream.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
@@ -39,6 +40,7 @@ struct BenchOptions : PathChoice {
   std::string recordPath;
   bool render = false;     // draw every frame headless (OpenGL; llvmpipe without a GPU)
   bool gpuReform = false;  // with --render: re-form in a compute shader
+  bool gpuStream = false;  // with --render: stream on the GPU (§3.3), re-form there
 };
 
 // What --render draws with: one headless context for the whole run.
@@ -70,8 +72,9 @@ double milliseconds(std::chrono::steady_clock::duration d) {
 
 // One frame: select, then stream.
 Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const Camera& camera,
-                            std::uint64_t budget, Selection& selection, StreamBuffer& buffer,
-                            RenderTarget* target, Renderer* renderer, GpuReformer* reformer) {
+                            std::uint64_t budget, Selection& selection, StreamBuffer* buffer,
+                            RenderTarget* target, Renderer* renderer, GpuReformer* reformer,
+                            GpuStream* gpuStream) {
   FrameTimes t;
   const auto start = std::chrono::steady_clock::now();
   if (o.targetError) {
@@ -83,9 +86,25 @@ Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const 
   }
   t.selectionMs = milliseconds(std::chrono::steady_clock::now() - start);
   t.selectionSteps = selection.timings;
-  auto stream = buffer.update(selection.vertexCounts, selection.triangleCounts);
-  if (!stream) return stream.status();
-  t.stream = *stream;
+  if (gpuStream) {
+    // The paper's path: generation = the Δ upload and reassembly on the GPU, then Algorithm 2
+    // there, each timed to glFinish.
+    const auto streamStart = std::chrono::steady_clock::now();
+    auto stream = gpuStream->update(selection.vertexCounts, selection.triangleCounts);
+    if (!stream) return stream.status();
+    target->context->finish();
+    const auto reformStart = std::chrono::steady_clock::now();
+    renderer->attach(*gpuStream);
+    reformer->reform(*gpuStream, renderer->indexBuffer());
+    target->context->finish();
+    t.stream = *stream;
+    t.stream.reassemblyMs = milliseconds(reformStart - streamStart);
+    t.stream.reformationMs = milliseconds(std::chrono::steady_clock::now() - reformStart);
+  } else {
+    auto stream = buffer->update(selection.vertexCounts, selection.triangleCounts);
+    if (!stream) return stream.status();
+    t.stream = *stream;
+  }
   t.vertices = selection.totalVertices;
   t.triangles = selection.totalTriangles;
   t.visible = selection.visibleObjects;
@@ -94,9 +113,11 @@ Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const 
   if (renderer) {
     // The paper's third column: the frame on screen (here offscreen, timed to glFinish).
     const auto uploadStart = std::chrono::steady_clock::now();
-    renderer->upload(buffer, reformer == nullptr);
-    if (reformer) reformer->reform(buffer, renderer->indexBuffer());
-    target->context->finish();
+    if (!gpuStream) {
+      renderer->upload(*buffer, reformer == nullptr);
+      if (reformer) reformer->reform(*buffer, renderer->indexBuffer());
+      target->context->finish();
+    }
     const auto drawStart = std::chrono::steady_clock::now();
     target->framebuffer->bind();
     renderer->draw(camera, {});
@@ -125,14 +146,21 @@ Result<BudgetRun> runBudget(const BenchOptions& o, const Package& package, const
             formatCount(budget), formatBytes(o.gpuMemory), formatCount(capacity.vertices))};
   run.capacityVertices = capacity.vertices;
   run.capacityBytes = capacity.bytes(package);
-  StreamBuffer buffer(package, capacity);
+  std::optional<StreamBuffer> buffer;  // the CPU stream, unless the GPU streams
+  if (!o.gpuStream) buffer.emplace(package, capacity);
   std::optional<Renderer> renderer;
   std::optional<GpuReformer> reformer;
+  std::optional<GpuStream> gpuStream;
   if (target) {
     auto created = Renderer::create(package, capacity);
     if (!created) return created.status();
     renderer.emplace(std::move(*created));
-    if (o.gpuReform) {
+    if (o.gpuStream) {
+      auto stream = GpuStream::create(package, capacity);
+      if (!stream) return stream.status();
+      gpuStream.emplace(std::move(*stream));
+    }
+    if (o.gpuReform || o.gpuStream) {
       auto gpu = GpuReformer::create(package, capacity);
       if (!gpu) return gpu.status();
       reformer.emplace(std::move(*gpu));
@@ -141,8 +169,9 @@ Result<BudgetRun> runBudget(const BenchOptions& o, const Package& package, const
   Selection selection;
   for (std::size_t f = 0; f < cameras.size(); ++f) {
     LODFORGE_TRY(checkCancelled());
-    auto frame = runFrame(o, scene, cameras[f], budget, selection, buffer, target,
-                          renderer ? &*renderer : nullptr, reformer ? &*reformer : nullptr);
+    auto frame = runFrame(o, scene, cameras[f], budget, selection, buffer ? &*buffer : nullptr,
+                          target, renderer ? &*renderer : nullptr, reformer ? &*reformer : nullptr,
+                          gpuStream ? &*gpuStream : nullptr);
     if (!frame) return frame.status();
     (f == 0 ? run.load : run.frames.emplace_back()) = *frame;
     progress.advance(1);
@@ -282,7 +311,9 @@ Status writeJson(const BenchOptions& o, const Package& package, const nlohmann::
       {"path", o.path},
       {"frames", frames},
       {"mode", o.targetError ? "error" : (o.firstPassOnly ? "first-pass" : "two-pass")},
-      {"render", o.render ? (o.gpuReform ? "gpu-reform" : "cpu-reform") : "none"},
+      {"render", o.render
+                     ? (o.gpuStream ? "gpu-stream" : (o.gpuReform ? "gpu-reform" : "cpu-reform"))
+                     : "none"},
       {"min_t", o.minT},
       {"exponent", o.exponent},
       {"runs", runsJson}};
@@ -379,6 +410,10 @@ void addBench(CLI::App& app, const Global& global, Run& run) {
   sub->add_flag("--render", o->render,
                 "Also draw every frame headless (OpenGL 4.5; on llvmpipe these are CPU times)");
   sub->add_flag("--gpu-reform", o->gpuReform, "With --render: re-form in a compute shader")
+      ->needs("--render");
+  sub->add_flag("--gpu-stream", o->gpuStream,
+                "With --render: stream on the GPU as the paper does (only the Δ is uploaded; "
+                "reassembly and reformation in compute shaders)")
       ->needs("--render");
   sub->callback([&global, &run, o] { run = [&global, o] { return runBench(global, *o); }; });
 }

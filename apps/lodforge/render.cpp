@@ -15,6 +15,7 @@
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
 #include "lodforge/render/gpu_reform.h"
+#include "lodforge/render/gpu_stream.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/selection.h"
 #include "lodforge/runtime/stream.h"
@@ -32,6 +33,7 @@ struct RenderOptions : PathChoice {
   std::string color = "shaded";
   std::string json;
   bool gpuReform = false;
+  bool gpuStream = false;  // §3.3 on the GPU: Δ upload, compute reassembly, GPU reformation
 
   RenderOptions() { frames = 8; }
 };
@@ -70,11 +72,18 @@ Status runRender(const Global& global, const RenderOptions& o) {
   if (!gl) return gl.status();
   const StreamCapacity capacity =
       StreamCapacity::forVertices(*package, o.reference ? full : *budget);
-  StreamBuffer buffer(*package, capacity);
+  std::optional<StreamBuffer> buffer;  // the CPU stream, unless the GPU streams
+  if (!o.gpuStream) buffer.emplace(*package, capacity);
   auto renderer = Renderer::create(*package, capacity);
   if (!renderer) return renderer.status();
   std::optional<GpuReformer> reformer;
-  if (o.gpuReform) {
+  std::optional<GpuStream> gpuStream;
+  if (o.gpuStream) {
+    auto created = GpuStream::create(*package, capacity);
+    if (!created) return created.status();
+    gpuStream.emplace(std::move(*created));
+  }
+  if (o.gpuReform || o.gpuStream) {
     auto created = GpuReformer::create(*package, capacity);
     if (!created) return created.status();
     reformer.emplace(std::move(*created));
@@ -112,12 +121,19 @@ Status runRender(const Global& global, const RenderOptions& o) {
                     selection);
     }
     const auto selected = std::chrono::steady_clock::now();
-    auto stream = buffer.update(selection.vertexCounts, selection.triangleCounts);
+    // The CPU stream and upload, or the paper's GPU path (only the Δ crosses over).
+    auto stream = gpuStream ? gpuStream->update(selection.vertexCounts, selection.triangleCounts)
+                            : buffer->update(selection.vertexCounts, selection.triangleCounts);
     if (!stream) return stream.status();
     const auto streamed = std::chrono::steady_clock::now();
-    // Indices from the CPU's Algorithm 2, or re-formed on the GPU from the source triangles.
-    renderer->upload(buffer, !reformer);
-    if (reformer) reformer->reform(buffer, renderer->indexBuffer());
+    if (gpuStream) {
+      renderer->attach(*gpuStream);
+      reformer->reform(*gpuStream, renderer->indexBuffer());
+    } else {
+      // Indices from the CPU's Algorithm 2, or re-formed on the GPU from the source triangles.
+      renderer->upload(*buffer, !reformer);
+      if (reformer) reformer->reform(*buffer, renderer->indexBuffer());
+    }
     target->bind();
     renderer->draw(camera, {.colorMode = *colorMode});
     (*gl)->finish();  // the draw's own time, not the read-back's
@@ -200,6 +216,8 @@ void addRender(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("--json", o->json, "Also write the per-frame figures here");
   sub->add_flag("--gpu-reform", o->gpuReform,
                 "Re-form triangles in a compute shader (§3.2) instead of on the CPU");
+  sub->add_flag("--gpu-stream", o->gpuStream,
+                "Stream on the GPU (§3.3): upload only the Δ, reassemble and re-form there");
   sub->callback([&global, &run, o] { run = [&global, o] { return runRender(global, *o); }; });
 }
 

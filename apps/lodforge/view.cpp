@@ -19,6 +19,7 @@
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
 #include "lodforge/render/gpu_reform.h"
+#include "lodforge/render/gpu_stream.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
@@ -39,6 +40,7 @@ struct ViewOptions : PathChoice {
   std::uint64_t stopAfter = 0;  // frames, 0: until the window closes
   std::string color = "shaded";
   bool gpuReform = false;
+  bool gpuStream = false;
   bool firstPassOnly = false;
   double minT = 0.65;
 };
@@ -106,6 +108,8 @@ Status runView(const Global& global, const ViewOptions& o) {
   if (!renderer) return renderer.status();
   auto reformer = GpuReformer::create(*package, capacity);
   if (!reformer) return reformer.status();
+  auto gpuStream = GpuStream::create(*package, capacity);
+  if (!gpuStream) return gpuStream.status();
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -130,7 +134,7 @@ Status runView(const Global& global, const ViewOptions& o) {
   float budgetPercent =
       static_cast<float>(100.0 * static_cast<double>(*budget) / static_cast<double>(full));
   std::uint64_t n = *budget;
-  bool firstPassOnly = o.firstPassOnly, gpuReform = o.gpuReform;
+  bool firstPassOnly = o.firstPassOnly, gpuReform = o.gpuReform, gpuStreaming = o.gpuStream;
   float minT = static_cast<float>(o.minT);
   int mode = static_cast<int>(*colorMode);
   bool recording = !o.record.empty();
@@ -208,12 +212,23 @@ Status runView(const Global& global, const ViewOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
     selectTwoPass(scene, camera, n, {.minT = minT, .firstPassOnly = firstPassOnly}, selection);
     const auto t1 = std::chrono::steady_clock::now();
-    auto stream = buffer.update(selection.vertexCounts, selection.triangleCounts);
+    // CPU stream + upload, or the paper's GPU path where only the Δ crosses over.
+    auto stream = gpuStreaming ? gpuStream->update(selection.vertexCounts, selection.triangleCounts)
+                               : buffer.update(selection.vertexCounts, selection.triangleCounts);
     if (!stream) return stream.status();
+    if (gpuStreaming) (*gl)->finish();
     const auto t2 = std::chrono::steady_clock::now();
-    renderer->upload(buffer, !gpuReform);
+    if (gpuStreaming) {
+      renderer->attach(*gpuStream);
+    } else {
+      renderer->upload(buffer, !gpuReform);
+    }
     const auto t3 = std::chrono::steady_clock::now();
-    if (gpuReform) reformer->reform(buffer, renderer->indexBuffer());
+    if (gpuStreaming) {
+      reformer->reform(*gpuStream, renderer->indexBuffer());
+    } else if (gpuReform) {
+      reformer->reform(buffer, renderer->indexBuffer());
+    }
     (*gl)->finish();
     const auto t4 = std::chrono::steady_clock::now();
     bindWindowFramebuffer();
@@ -250,16 +265,19 @@ Status runView(const Global& global, const ViewOptions& o) {
     ImGui::Text("N = %s of %s vertices", formatCount(n).c_str(), formatCount(full).c_str());
     ImGui::Checkbox("first pass only (Eq. 2-3)", &firstPassOnly);
     ImGui::SliderFloat("MinT (Eq. 3)", &minT, 0.0f, 1.0f);
-    ImGui::Checkbox("GPU reformation (compute shader)", &gpuReform);
+    ImGui::Checkbox("GPU streaming (Δ upload, reassembly and reformation on the GPU)",
+                    &gpuStreaming);
+    if (!gpuStreaming) ImGui::Checkbox("GPU reformation (compute shader)", &gpuReform);
     const char* modes[] = {"shaded", "object", "LOD ratio", "normal"};
     ImGui::Combo("colour", &mode, modes, 4);
     ImGui::Separator();
     ImGui::Text("selection   %7.2f ms", figures.selectionMs);
     ImGui::Text("generation  %7.2f ms", figures.generationMs);
     ImGui::Text("upload      %7.2f ms", figures.uploadMs);
+    const bool onGpu = gpuStreaming || gpuReform;
     ImGui::Text("reformation %7.2f ms (%s)",
-                gpuReform ? figures.reformMs : figures.stream.reformationMs,
-                gpuReform ? "GPU" : "CPU, in generation");
+                onGpu ? figures.reformMs : figures.stream.reformationMs,
+                onGpu ? "GPU" : "CPU, in generation");
     ImGui::Text("draw        %7.2f ms", figures.drawMs);
     ImGui::Text("drawn: %s vertices, %s triangles, %s objects visible",
                 formatCount(figures.vertices).c_str(), formatCount(figures.triangles).c_str(),
@@ -309,6 +327,8 @@ void addView(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("--screenshot", o->screenshot, "With --stop-after: a PNG of the last frame");
   sub->add_option("--color", o->color, "shaded, object, lod or normal")->capture_default_str();
   sub->add_flag("--gpu-reform", o->gpuReform, "Start with the compute-shader reformation");
+  sub->add_flag("--gpu-stream", o->gpuStream,
+                "Start streaming on the GPU (§3.3 as the paper runs it)");
   sub->add_flag("--first-pass-only", o->firstPassOnly, "Start with Eq. 2 and 3 only");
   sub->add_option("--min-t", o->minT, "Eq. 3's MinT")
       ->capture_default_str()

@@ -587,6 +587,15 @@ TEST(CliView, ScriptedRunRecordsAPathWhoseReplayMatchesHeadlessRender) {
   ASSERT_EQ(frame->width, 320u);
   const ImageDifference d = compareImages(*shot, *frame);
   EXPECT_LT(d.maxDeltaE, kJustNoticeableDeltaE) << "window and offscreen frames should agree";
+  // Replayed in the window with the paper's GPU streaming: the same frame again.
+  o = viewUnderXvfb(package + " --play " + dir.file("rec.json") +
+                        " --stop-after 12 --size 320x240" +
+                        " --budget 10% --gpu-stream --screenshot " + dir.file("b.png"),
+                    dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto replay = readPng(dir.file("b.png"));
+  ASSERT_TRUE(replay.ok());
+  EXPECT_LT(compareImages(*replay, *frame).maxDeltaE, kJustNoticeableDeltaE);
   // And the frame shows the model.
   const ImageDifference empty = compareImages(*shot, Image(320, 240));
   EXPECT_GT(empty.shareAbove, 0.05);
@@ -603,7 +612,7 @@ TEST(CliBench, RenderAddsTheOpenGlColumn) {
   const std::string package = dir.file("motor.lfp");
   ASSERT_EQ(
       lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
-  for (const char* extra : {"", " --gpu-reform"}) {
+  for (const char* extra : {"", " --gpu-reform", " --gpu-stream"}) {
     const Outcome o =
         lodforge("bench " + package + " --frames 4 --budget 10%,100% --size 160x120 --render" +
                      extra + " --json " + dir.file("b.json"),
@@ -611,7 +620,11 @@ TEST(CliBench, RenderAddsTheOpenGlColumn) {
     ASSERT_EQ(o.code, 0) << o.err;
     EXPECT_NE(o.out.find("render ms"), std::string::npos) << o.out;
     const auto j = nlohmann::json::parse(test::readFile(dir.file("b.json")));
-    EXPECT_EQ(j["render"], std::string(extra).empty() ? "cpu-reform" : "gpu-reform");
+    const std::string mode = extra;
+    EXPECT_EQ(j["render"], mode.empty() ? "cpu-reform" : mode.substr(3));
+    // Σ vc = N and what was read match whichever side streams.
+    EXPECT_EQ(j["runs"][1]["mean"]["bytes_read"], 0.0)
+        << "100 % after the first frame reads nothing";
     for (const auto& run : j["runs"]) EXPECT_GT(run["mean"]["render_ms"].get<double>(), 0.0);
   }
   // Without --render the column stays empty and --gpu-reform alone is a usage error.

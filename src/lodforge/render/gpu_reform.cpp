@@ -94,13 +94,25 @@ GpuReformer& GpuReformer::operator=(GpuReformer&&) noexcept = default;
 GpuReformer::~GpuReformer() = default;
 
 void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
+  const auto source = buffer.sourceTriangles();
+  glNamedBufferSubData(state_->source, 0, static_cast<GLsizeiptr>(source.size_bytes()),
+                       source.data());
+  run(state_->source, buffer.vertexCounts(), buffer.vertexStart(), buffer.triangleStart(),
+      indexBuffer);
+}
+
+void GpuReformer::reform(const GpuStream& stream, unsigned indexBuffer) {
+  run(stream.sourceBuffer(), stream.vertexCounts(), stream.vertexStart(), stream.triangleStart(),
+      indexBuffer);
+}
+
+void GpuReformer::run(unsigned sourceBuffer, std::span<const std::uint32_t> counts,
+                      std::span<const std::uint64_t> vertexStart,
+                      std::span<const std::uint64_t> triangleStart, unsigned indexBuffer) {
   State& s = *state_;
-  const std::uint64_t triangles = buffer.triangleCount();
+  const std::uint64_t triangles = triangleStart.back();
   if (triangles == 0) return;
   // The frame's object table: only objects with triangles, so the search needs no tie rule.
-  const auto counts = buffer.vertexCounts();
-  const auto vertexStart = buffer.vertexStart();
-  const auto triangleStart = buffer.triangleStart();
   s.table.clear();
   for (std::size_t i = 0; i < counts.size(); ++i) {
     if (triangleStart[i + 1] == triangleStart[i]) continue;
@@ -108,15 +120,13 @@ void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
                        static_cast<std::uint32_t>(s.package->object(i).vertexOffset),
                        static_cast<std::uint32_t>(vertexStart[i]), counts[i]});
   }
-  const auto source = buffer.sourceTriangles();
-  glNamedBufferSubData(s.source, 0, static_cast<GLsizeiptr>(source.size_bytes()), source.data());
   glNamedBufferSubData(s.objects, 0, static_cast<GLsizeiptr>(s.table.size() * 16), s.table.data());
   const GLuint p = s.program.id();
   glUseProgram(p);
   glUniform1ui(glGetUniformLocation(p, "triangleCount"), static_cast<GLuint>(triangles));
   glUniform1ui(glGetUniformLocation(p, "objectCount"), static_cast<GLuint>(s.table.size()));
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.ecol);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.source);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, sourceBuffer);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.objects);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, indexBuffer);
   const std::uint64_t groups = (triangles + kGroupSize - 1) / kGroupSize;
@@ -128,10 +138,7 @@ void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
 }
 
 std::vector<std::uint32_t> GpuReformer::readIndices(unsigned indexBuffer, std::uint64_t triangles) {
-  std::vector<std::uint32_t> indices(triangles * 3);
-  glGetNamedBufferSubData(indexBuffer, 0, static_cast<GLsizeiptr>(indices.size() * 4),
-                          indices.data());
-  return indices;
+  return readBufferWords(indexBuffer, 3 * triangles);
 }
 
 }  // namespace lodforge

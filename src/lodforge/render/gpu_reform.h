@@ -7,9 +7,11 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "lodforge/core/status.h"
+#include "lodforge/render/gpu_stream.h"
 #include "lodforge/runtime/stream.h"
 #include "lodforge/simplify/package.h"
 
@@ -26,12 +28,17 @@ class GpuReformer {
   // Re-forms the stream buffer's source triangles into `indexBuffer` (a GL buffer of at least
   // 3 x triangleCount uint32): the same indices the CPU path puts in buffer.indices().
   void reform(const StreamBuffer& buffer, unsigned indexBuffer);
+  // The same from a GPU stream, whose source triangles are already on the GPU.
+  void reform(const GpuStream& stream, unsigned indexBuffer);
   // Reads back the first `triangles` triangles of a GL index buffer (tests, debugging).
   static std::vector<std::uint32_t> readIndices(unsigned indexBuffer, std::uint64_t triangles);
 
  private:
   struct State;
   explicit GpuReformer(std::unique_ptr<State> state);
+  void run(unsigned sourceBuffer, std::span<const std::uint32_t> counts,
+           std::span<const std::uint64_t> vertexStart, std::span<const std::uint64_t> triangleStart,
+           unsigned indexBuffer);
   std::unique_ptr<State> state_;
 };
 

@@ -217,6 +217,7 @@ struct Renderer::State {
   std::vector<Rgba8> baseColors, idColors;
   std::vector<float> ratios;
   std::uint64_t uploaded = 0;
+  bool attached = false;  // drawing from a GpuStream's buffers
 
   ~State() {
     const GLuint buffers[] = {positions,    normalBuffer, colorBuffer, indices,
@@ -306,9 +307,31 @@ void Renderer::upload(const StreamBuffer& buffer, bool indices) {
   if (s.colors) upload(s.colorBuffer, buffer.colors());
   if (indices) upload(s.indices, buffer.indices());
 
+  setCommands(buffer.vertexCounts(), buffer.triangleStart());
+  if (s.attached) {
+    // Back to the renderer's own buffers after drawing from a GPU stream.
+    glVertexArrayVertexBuffer(s.vertexArray, 0, s.positions, 0, sizeof(Vec3f));
+    if (s.normals) glVertexArrayVertexBuffer(s.vertexArray, 1, s.normalBuffer, 0, sizeof(Vec3f));
+    if (s.colors) glVertexArrayVertexBuffer(s.vertexArray, 2, s.colorBuffer, 0, sizeof(Rgba8));
+    s.attached = false;
+  }
+}
+
+void Renderer::attach(const GpuStream& stream) {
+  State& s = *state_;
+  s.uploaded = 0;
+  glVertexArrayVertexBuffer(s.vertexArray, 0, stream.positionBuffer(), 0, sizeof(Vec3f));
+  if (s.normals)
+    glVertexArrayVertexBuffer(s.vertexArray, 1, stream.normalBuffer(), 0, sizeof(Vec3f));
+  if (s.colors) glVertexArrayVertexBuffer(s.vertexArray, 2, stream.colorBuffer(), 0, sizeof(Rgba8));
+  s.attached = true;
+  setCommands(stream.vertexCounts(), stream.triangleStart());
+}
+
+void Renderer::setCommands(std::span<const std::uint32_t> counts,
+                           std::span<const std::uint64_t> triangleStart) {
   // One command per object with triangles; its base instance is the object id.
-  const auto counts = buffer.vertexCounts();
-  const auto triangleStart = buffer.triangleStart();
+  State& s = *state_;
   s.commandList.clear();
   for (std::size_t i = 0; i < counts.size(); ++i) {
     const std::uint64_t triangles = triangleStart[i + 1] - triangleStart[i];
@@ -319,6 +342,10 @@ void Renderer::upload(const StreamBuffer& buffer, bool indices) {
                              static_cast<GLuint>(3 * triangleStart[i]), 0, static_cast<GLuint>(i)});
   }
   s.commandCount = static_cast<GLsizei>(s.commandList.size());
+  const auto upload = [&](GLuint target, const auto& span) {
+    glNamedBufferSubData(target, 0, static_cast<GLsizeiptr>(span.size_bytes()), span.data());
+    s.uploaded += span.size_bytes();
+  };
   upload(s.commands, std::span<const DrawCommand>(s.commandList));
   upload(s.lodRatios, std::span<const float>(s.ratios));
 }

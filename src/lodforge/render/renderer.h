@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "lodforge/core/status.h"
+#include "lodforge/render/gpu_stream.h"
 #include "lodforge/render/image.h"
 #include "lodforge/runtime/camera.h"
 #include "lodforge/runtime/stream.h"
@@ -69,6 +70,9 @@ class Renderer {
   // Makes the GL buffers hold the stream's current contents and draw commands. With
   // `indices` false the index buffer is left alone (GpuReformer writes it).
   void upload(const StreamBuffer& buffer, bool indices = true);
+  // Draws from a GPU stream's buffers instead (nothing is copied; the indices come from
+  // GpuReformer::reform(stream, indexBuffer())).
+  void attach(const GpuStream& stream);
   // Draws into the bound framebuffer (viewport = camera's size).
   void draw(const Camera& camera, const DrawOptions& options) const;
   std::uint64_t uploadedBytes() const;  // by the last upload
@@ -79,6 +83,8 @@ class Renderer {
   struct State;
   explicit Renderer(std::unique_ptr<State> state);
   std::unique_ptr<State> state_;
+  void setCommands(std::span<const std::uint32_t> counts,
+                   std::span<const std::uint64_t> triangleStart);
 };
 
 // Column-major 4x4 view-projection of a camera (OpenGL clip space), in float.

@@ -50,4 +50,10 @@ Result<Program> Program::link(std::initializer_list<Stage> stages) {
   return program;
 }
 
+std::vector<std::uint32_t> readBufferWords(unsigned buffer, std::size_t words) {
+  std::vector<std::uint32_t> out(words);
+  if (words) glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(words * 4), out.data());
+  return out;
+}
+
 }  // namespace lodforge

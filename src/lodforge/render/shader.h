@@ -1,8 +1,10 @@
 // A linked GLSL program; compile and link errors come back with the driver's log.
 #pragma once
 
+#include <cstdint>
 #include <initializer_list>
 #include <utility>
+#include <vector>
 
 #include "lodforge/core/status.h"
 
@@ -27,5 +29,8 @@ class Program {
  private:
   unsigned id_ = 0;
 };
+
+// The first `words` 32-bit words of a GL buffer (tests, debugging).
+std::vector<std::uint32_t> readBufferWords(unsigned buffer, std::size_t words);
 
 }  // namespace lodforge

@@ -1,0 +1,278 @@
+#include "lodforge/render/gpu_stream.h"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <chrono>
+#include <cstring>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+#include "lodforge/render/shader.h"
+
+namespace lodforge {
+
+namespace {
+
+constexpr GLuint kMaxGroupsX = 65535;
+
+// §3.3's reassembly, one invocation per destination element: element l of object i comes from
+// the old copy while l < kept_i, else from the Δ ranges uploaded this frame.
+constexpr const char* kAssembleShader = R"(#version 450 core
+layout(local_size_x = 256) in;
+layout(std430, binding = 0) readonly buffer Old { uint old[]; };
+layout(std430, binding = 1) readonly buffer Delta { uint delta[]; };
+// Per object present in the new frame: new start, old start, kept count, start in Delta.
+layout(std430, binding = 2) readonly buffer Table { uvec4 table[]; };
+layout(std430, binding = 3) writeonly buffer New { uint dst[]; };
+uniform uint count;
+uniform uint entries;
+uniform uint components;  // uints per element: 3 for a vec3 or a triangle, 1 for a colour
+
+void main() {
+  uint j = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u + gl_LocalInvocationID.x;
+  if (j >= count) return;
+  uint lo = 0u, hi = entries - 1u;
+  while (lo < hi) {
+    uint mid = (lo + hi + 1u) / 2u;
+    if (table[mid].x <= j) lo = mid; else hi = mid - 1u;
+  }
+  uvec4 e = table[lo];
+  uint l = j - e.x;
+  for (uint c = 0u; c < components; ++c) {
+    dst[components * j + c] = l < e.z ? old[components * (e.y + l) + c]
+                                      : delta[components * (e.w + l - e.z) + c];
+  }
+}
+)";
+
+GLuint makeBuffer(std::uint64_t bytes) {
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(std::max<std::uint64_t>(bytes, 16)), nullptr,
+                       GL_DYNAMIC_STORAGE_BIT);
+  return buffer;
+}
+
+// One array's two copies and its staging buffer for the Δ.
+struct Stream {
+  std::array<GLuint, 2> copies{};
+  GLuint delta = 0;
+  GLuint components = 0;  // uint32 per element
+  std::vector<std::uint32_t> staged;
+
+  void create(std::uint64_t elements, GLuint uintsPerElement) {
+    components = uintsPerElement;
+    for (GLuint& b : copies) b = makeBuffer(elements * 4 * uintsPerElement);
+    delta = makeBuffer(elements * 4 * uintsPerElement);
+  }
+  void destroy() {
+    for (GLuint b : {copies[0], copies[1], delta}) {
+      if (b) glDeleteBuffers(1, &b);
+    }
+  }
+};
+
+}  // namespace
+
+struct GpuStream::State {
+  const Package* package = nullptr;
+  StreamCapacity capacity;
+  bool normals = false, colors = false;
+  Program program;
+  Stream positions, normalStream, colorStream, source;
+  GLuint vertexTable = 0, triangleTable = 0;
+  int current = 0;  // which copy holds the frame
+  std::vector<std::uint64_t> vertexStart, triangleStart, oldVertexStart, oldTriangleStart;
+  std::vector<std::uint32_t> vertexCounts, triangleCounts;
+  std::vector<std::array<std::uint32_t, 4>> vertexRows, triangleRows;
+
+  ~State() {
+    for (Stream* s : {&positions, &normalStream, &colorStream, &source}) s->destroy();
+    for (GLuint b : {vertexTable, triangleTable}) {
+      if (b) glDeleteBuffers(1, &b);
+    }
+  }
+
+  void assemble(Stream& s, std::uint64_t count, GLuint table, std::size_t entries) {
+    if (count == 0) return;
+    glNamedBufferSubData(s.delta, 0, static_cast<GLsizeiptr>(s.staged.size() * 4), s.staged.data());
+    const GLuint p = program.id();
+    glUniform1ui(glGetUniformLocation(p, "count"), static_cast<GLuint>(count));
+    glUniform1ui(glGetUniformLocation(p, "entries"), static_cast<GLuint>(entries));
+    glUniform1ui(glGetUniformLocation(p, "components"), s.components);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.copies[static_cast<std::size_t>(current)]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.delta);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, table);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.copies[static_cast<std::size_t>(1 - current)]);
+    const std::uint64_t groups = (count + 255) / 256;
+    const auto x = static_cast<GLuint>(std::min<std::uint64_t>(groups, kMaxGroupsX));
+    glDispatchCompute(x, static_cast<GLuint>((groups + x - 1) / x), 1);
+  }
+};
+
+Result<GpuStream> GpuStream::create(const Package& package, const StreamCapacity& capacity) {
+  if (capacity.vertices >= (std::uint64_t{1} << 30) ||
+      capacity.triangles >= (std::uint64_t{1} << 30))
+    return Error{
+        ErrorKind::kUnsupported,
+        "GPU streaming addresses elements with 32-bit offsets: capacity over 1 G elements"};
+  auto s = std::make_unique<State>();
+  s->package = &package;
+  s->capacity = capacity;
+  s->normals = package.header().hasNormals();
+  s->colors = package.header().hasColors();
+  auto program = Program::link({{GL_COMPUTE_SHADER, kAssembleShader}});
+  if (!program) return program.status();
+  s->program = std::move(*program);
+  s->positions.create(capacity.vertices, 3);
+  if (s->normals) s->normalStream.create(capacity.vertices, 3);
+  if (s->colors) s->colorStream.create(capacity.vertices, 1);
+  s->source.create(capacity.triangles, 3);
+  const std::size_t objects = package.objectCount();
+  s->vertexTable = makeBuffer(objects * 16);
+  s->triangleTable = makeBuffer(objects * 16);
+  s->vertexStart.assign(objects + 1, 0);
+  s->triangleStart.assign(objects + 1, 0);
+  s->vertexCounts.assign(objects, 0);
+  s->triangleCounts.assign(objects, 0);
+  return GpuStream(std::move(s));
+}
+
+GpuStream::GpuStream(std::unique_ptr<State> state) : state_(std::move(state)) {}
+GpuStream::GpuStream(GpuStream&&) noexcept = default;
+GpuStream& GpuStream::operator=(GpuStream&&) noexcept = default;
+GpuStream::~GpuStream() = default;
+
+Result<FrameStats> GpuStream::update(std::span<const std::uint32_t> vc,
+                                     std::span<const std::uint32_t> tc) {
+  State& s = *state_;
+  const Package& package = *s.package;
+  const std::size_t objects = package.objectCount();
+  assert(vc.size() == objects && tc.size() == objects);
+  const auto start = std::chrono::steady_clock::now();
+  std::uint64_t vertices = 0, triangles = 0;
+  for (std::size_t i = 0; i < objects; ++i) {
+    vertices += vc[i];
+    triangles += tc[i];
+  }
+  if (vertices > s.capacity.vertices || triangles > s.capacity.triangles)
+    return Error{ErrorKind::kLimit,
+                 fmt::format("selection of {} vertices and {} triangles exceeds the GPU stream's "
+                             "capacity of {} and {}",
+                             vertices, triangles, s.capacity.vertices, s.capacity.triangles)};
+  // An unchanged selection costs nothing: the current copy already holds it.
+  if (std::equal(vc.begin(), vc.end(), s.vertexCounts.begin()) &&
+      std::equal(tc.begin(), tc.end(), s.triangleCounts.begin()))
+    return FrameStats{};
+  std::swap(s.oldVertexStart, s.vertexStart);
+  std::swap(s.oldTriangleStart, s.triangleStart);
+  s.vertexStart.assign(objects + 1, 0);
+  s.triangleStart.assign(objects + 1, 0);
+  for (Stream* stream : {&s.positions, &s.normalStream, &s.colorStream, &s.source})
+    stream->staged.clear();
+  s.vertexRows.clear();
+  s.triangleRows.clear();
+  FrameStats stats;
+  std::uint64_t vertexDelta = 0, triangleDelta = 0, keptVertices = 0, keptTriangles = 0;
+  const auto stage = [](std::vector<std::uint32_t>& to, const void* from, std::size_t bytes) {
+    const std::size_t at = to.size();
+    to.resize(at + bytes / 4);
+    std::memcpy(to.data() + at, from, bytes);
+  };
+  for (std::size_t i = 0; i < objects; ++i) {
+    s.vertexStart[i + 1] = s.vertexStart[i] + vc[i];
+    s.triangleStart[i + 1] = s.triangleStart[i] + tc[i];
+    if (vc[i] != s.vertexCounts[i]) ++stats.objectsChanged;
+    if (vc[i] > 0) {
+      // The prefix both selections share stays on the GPU; the rest comes from the package.
+      const std::uint32_t kept = std::min(vc[i], s.vertexCounts[i]);
+      s.vertexRows.push_back(
+          {static_cast<std::uint32_t>(s.vertexStart[i]),
+           static_cast<std::uint32_t>(s.oldVertexStart.empty() ? 0 : s.oldVertexStart[i]), kept,
+           static_cast<std::uint32_t>(vertexDelta)});
+      const std::size_t fresh = vc[i] - kept;
+      stage(s.positions.staged, package.positions(i).data() + kept, fresh * sizeof(Vec3f));
+      if (s.normals)
+        stage(s.normalStream.staged, package.normals(i).data() + kept, fresh * sizeof(Vec3f));
+      if (s.colors)
+        stage(s.colorStream.staged, package.colors(i).data() + kept, fresh * sizeof(Rgba8));
+      vertexDelta += fresh;
+      keptVertices += kept;
+    }
+    if (tc[i] > 0) {
+      const std::uint32_t kept = std::min(tc[i], s.triangleCounts[i]);
+      s.triangleRows.push_back(
+          {static_cast<std::uint32_t>(s.triangleStart[i]),
+           static_cast<std::uint32_t>(s.oldTriangleStart.empty() ? 0 : s.oldTriangleStart[i]), kept,
+           static_cast<std::uint32_t>(triangleDelta)});
+      const std::size_t fresh = tc[i] - kept;
+      stage(s.source.staged, package.triangles(i).data() + 3 * std::size_t{kept},
+            fresh * 3 * sizeof(std::uint32_t));
+      triangleDelta += fresh;
+      keptTriangles += kept;
+    }
+  }
+  glNamedBufferSubData(s.vertexTable, 0, static_cast<GLsizeiptr>(s.vertexRows.size() * 16),
+                       s.vertexRows.data());
+  glNamedBufferSubData(s.triangleTable, 0, static_cast<GLsizeiptr>(s.triangleRows.size() * 16),
+                       s.triangleRows.data());
+  glUseProgram(s.program.id());
+  s.assemble(s.positions, vertices, s.vertexTable, s.vertexRows.size());
+  if (s.normals) s.assemble(s.normalStream, vertices, s.vertexTable, s.vertexRows.size());
+  if (s.colors) s.assemble(s.colorStream, vertices, s.vertexTable, s.vertexRows.size());
+  s.assemble(s.source, triangles, s.triangleTable, s.triangleRows.size());
+  // Draws read the vertices; the reformation reads the source triangles.
+  glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT |
+                  GL_BUFFER_UPDATE_BARRIER_BIT);
+  s.current = 1 - s.current;
+  s.vertexCounts.assign(vc.begin(), vc.end());
+  s.triangleCounts.assign(tc.begin(), tc.end());
+
+  const std::uint64_t vertexBytes = StreamCapacity::vertexBytes(package);
+  stats.verticesRead = vertexDelta;
+  stats.trianglesRead = triangleDelta;
+  stats.bytesRead = vertexDelta * vertexBytes + triangleDelta * 12;
+  stats.bytesMoved = keptVertices * vertexBytes + keptTriangles * 12;
+  stats.reassemblyMs =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+const Package& GpuStream::package() const {
+  return *state_->package;
+}
+const StreamCapacity& GpuStream::capacity() const {
+  return state_->capacity;
+}
+std::uint64_t GpuStream::vertexCount() const {
+  return state_->vertexStart.back();
+}
+std::uint64_t GpuStream::triangleCount() const {
+  return state_->triangleStart.back();
+}
+std::span<const std::uint64_t> GpuStream::vertexStart() const {
+  return state_->vertexStart;
+}
+std::span<const std::uint64_t> GpuStream::triangleStart() const {
+  return state_->triangleStart;
+}
+std::span<const std::uint32_t> GpuStream::vertexCounts() const {
+  return state_->vertexCounts;
+}
+unsigned GpuStream::positionBuffer() const {
+  return state_->positions.copies[static_cast<std::size_t>(state_->current)];
+}
+unsigned GpuStream::normalBuffer() const {
+  return state_->normals ? state_->normalStream.copies[static_cast<std::size_t>(state_->current)]
+                         : 0;
+}
+unsigned GpuStream::colorBuffer() const {
+  return state_->colors ? state_->colorStream.copies[static_cast<std::size_t>(state_->current)] : 0;
+}
+unsigned GpuStream::sourceBuffer() const {
+  return state_->source.copies[static_cast<std::size_t>(state_->current)];
+}
+
+}  // namespace lodforge

@@ -115,5 +115,33 @@ TEST(Png, BadFilesAreBadInputNamingTheFile) {
   EXPECT_FALSE(readPng(folder.file("missing.png")).ok());
 }
 
+TEST(Png, ChunksBeyondTheEndAreRefusedWithTheirOffset) {
+  test::TempDir folder;
+  ASSERT_TRUE(writePng(folder.file("ok.png"), Image(3, 2)).ok());
+  std::string bytes = test::readFile(folder.file("ok.png"));
+  const auto span = [](const std::string& b) {
+    return std::span(reinterpret_cast<const std::byte*>(b.data()), b.size());
+  };
+  ASSERT_TRUE(readPngFromMemory(span(bytes), "ok.png").ok());
+  // The IHDR chunk (at byte 8) claims 2 GiB of data.
+  std::string huge = bytes;
+  huge[8] = '\x7f';
+  auto r = readPngFromMemory(span(huge), "huge.png");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().kind, ErrorKind::kBadInput);
+  EXPECT_NE(r.error().message.find("chunk at byte 8"), std::string::npos) << r.error().message;
+  // Cut inside the last chunk, and without IEND.
+  for (std::size_t cut : {bytes.size() - 5, bytes.size() - 12}) {
+    r = readPngFromMemory(span(bytes.substr(0, cut)), "cut.png");
+    ASSERT_FALSE(r.ok()) << cut;
+    EXPECT_EQ(r.error().kind, ErrorKind::kBadInput);
+    EXPECT_EQ(r.error().message.rfind("cut.png: ", 0), 0u) << r.error().message;
+  }
+  // Bigger than the caller allows: refused before decoding.
+  r = readPngFromMemory(span(bytes), "small.png", 5);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("3x2"), std::string::npos) << r.error().message;
+}
+
 }  // namespace
 }  // namespace lodforge

@@ -6,35 +6,77 @@
 #include <cmath>
 #include <cstring>
 
-#include <stb_image.h>
-#include <stb_image_write.h>
-
 #include "lodforge/core/file.h"
+#include "lodforge/render/stb_png.h"
 
 namespace lodforge {
 
 Result<Image> readPng(const std::string& path) {
   auto file = MappedFile::open(path);
   if (!file) return file.status();
-  const auto bytes = file->bytes();
+  return readPngFromMemory(file->bytes(), path);
+}
+
+namespace {
+
+std::uint32_t bigEndian32(const std::byte* p) {
+  return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 |
+         std::uint32_t(p[3]);
+}
+
+// The chunk structure (length, type, data, CRC) must fit the file: stb trusts an IDAT's length
+// and would allocate up to 2 GiB for a few bytes of input.
+Status checkChunks(std::span<const std::byte> bytes, const std::string& name) {
+  std::size_t at = 8;
+  while (at < bytes.size()) {
+    if (bytes.size() - at < 12)
+      return Error{ErrorKind::kBadInput,
+                   fmt::format("{}: PNG chunk at byte {} is cut off (12 bytes of length, type and "
+                               "CRC needed, {} left)",
+                               name, at, bytes.size() - at)};
+    const std::uint32_t length = bigEndian32(bytes.data() + at);
+    if (length > bytes.size() - at - 12)
+      return Error{ErrorKind::kBadInput,
+                   fmt::format("{}: PNG chunk at byte {} claims {} bytes of data, beyond the end "
+                               "of the file ({} bytes)",
+                               name, at, length, bytes.size())};
+    const bool end = std::memcmp(bytes.data() + at + 4, "IEND", 4) == 0;
+    at += 12 + std::size_t{length};
+    if (end) return {};
+  }
+  return Error{ErrorKind::kBadInput,
+               fmt::format("{}: PNG ends at byte {} without an IEND chunk", name, bytes.size())};
+}
+
+}  // namespace
+
+Result<Image> readPngFromMemory(std::span<const std::byte> bytes, const std::string& name,
+                                std::uint64_t maxPixels) {
   static constexpr std::array<unsigned char, 8> kSignature = {0x89, 'P',  'N',  'G',
                                                               '\r', '\n', 0x1a, '\n'};
   if (bytes.size() < kSignature.size() ||
       std::memcmp(bytes.data(), kSignature.data(), kSignature.size()) != 0)
     return Error{ErrorKind::kBadInput,
-                 fmt::format("{}: not a PNG (no PNG signature at byte 0)", path)};
+                 fmt::format("{}: not a PNG (no PNG signature at byte 0)", name)};
   if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-    return Error{ErrorKind::kBadInput, fmt::format("{}: PNG larger than 2 GiB", path)};
-  int width = 0, height = 0, channels = 0;
-  stbi_uc* pixels =
-      stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()),
-                            static_cast<int>(bytes.size()), &width, &height, &channels, 4);
-  if (pixels == nullptr)
+    return Error{ErrorKind::kBadInput, fmt::format("{}: PNG larger than 2 GiB", name)};
+  LODFORGE_TRY(checkChunks(bytes, name));
+  int width = 0, height = 0;
+  std::string why;
+  // The header's size before decoding: a few bytes must not make us allocate gigabytes.
+  if (!stb::pngInfo(bytes, width, height, why))
     return Error{ErrorKind::kBadInput,
-                 fmt::format("{}: cannot decode PNG ({})", path, stbi_failure_reason())};
-  Image image(static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height));
-  std::memcpy(image.rgba.data(), pixels, image.rgba.size());
-  stbi_image_free(pixels);
+                 fmt::format("{}: cannot read the PNG header ({})", name, why)};
+  if (width <= 0 || height <= 0 ||
+      static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) > maxPixels)
+    return Error{ErrorKind::kBadInput,
+                 fmt::format("{}: PNG of {}x{} pixels is larger than {} megapixels", name, width,
+                             height, maxPixels / 1000000)};
+  Image image;
+  if (!stb::decodePng(bytes, width, height, image.rgba, why))
+    return Error{ErrorKind::kBadInput, fmt::format("{}: cannot decode PNG ({})", name, why)};
+  image.width = static_cast<std::uint32_t>(width);
+  image.height = static_cast<std::uint32_t>(height);
   return image;
 }
 
@@ -42,19 +84,14 @@ Status writePng(const std::string& path, const Image& image) {
   assert(image.rgba.size() == image.pixelCount() * 4);
   auto file = OutputFile::create(path);
   if (!file) return file.status();
-  struct Sink {
-    OutputFile* file;
-    Status status;
-  } sink{&*file, {}};
-  const int ok = stbi_write_png_to_func(
-      [](void* context, void* data, int size) {
-        auto* s = static_cast<Sink*>(context);
-        if (s->status.ok()) s->status = s->file->write(data, static_cast<std::size_t>(size));
-      },
-      &sink, static_cast<int>(image.width), static_cast<int>(image.height), 4, image.rgba.data(),
-      static_cast<int>(image.width * 4));
-  if (!sink.status.ok()) return sink.status;
-  if (ok == 0) return Error{ErrorKind::kIo, fmt::format("{}: PNG encoding failed", path)};
+  Status status;
+  const bool ok = stb::encodePng(image.rgba.data(), static_cast<int>(image.width),
+                                 static_cast<int>(image.height), [&](const void* data, int size) {
+                                   if (status.ok())
+                                     status = file->write(data, static_cast<std::size_t>(size));
+                                 });
+  if (!status.ok()) return status;
+  if (!ok) return Error{ErrorKind::kIo, fmt::format("{}: PNG encoding failed", path)};
   return file->commit();
 }
 

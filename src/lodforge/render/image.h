@@ -23,6 +23,10 @@ struct Image {
 
 // A PNG of any channel count becomes RGBA8; a file that is not a PNG is kBadInput naming it.
 Result<Image> readPng(const std::string& path);
+// Larger PNGs are refused before decoding (a frame of 16384 x 16384 is 268 megapixels).
+constexpr std::uint64_t kMaxPngPixels = 300'000'000;
+Result<Image> readPngFromMemory(std::span<const std::byte> bytes, const std::string& name,
+                                std::uint64_t maxPixels = kMaxPngPixels);
 // Written under a temporary name and renamed when complete.
 Status writePng(const std::string& path, const Image& image);
 

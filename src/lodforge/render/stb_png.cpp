@@ -1,0 +1,51 @@
+#include "lodforge/render/stb_png.h"
+
+#include <cstring>
+
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#define STBI_NO_STDIO
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STBI_WRITE_NO_STDIO
+#include <stb_image.h>
+#include <stb_image_write.h>
+
+namespace lodforge::stb {
+
+bool pngInfo(std::span<const std::byte> bytes, int& width, int& height, std::string& why) {
+  int channels = 0;
+  if (stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()),
+                            static_cast<int>(bytes.size()), &width, &height, &channels))
+    return true;
+  why = stbi_failure_reason();
+  return false;
+}
+
+bool decodePng(std::span<const std::byte> bytes, int& width, int& height,
+               std::vector<std::uint8_t>& rgba, std::string& why) {
+  int channels = 0;
+  stbi_uc* pixels =
+      stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()),
+                            static_cast<int>(bytes.size()), &width, &height, &channels, 4);
+  if (pixels == nullptr) {
+    why = stbi_failure_reason();
+    return false;
+  }
+  rgba.assign(pixels, pixels + std::size_t(width) * std::size_t(height) * 4);
+  stbi_image_free(pixels);
+  return true;
+}
+
+bool encodePng(const std::uint8_t* rgba, int width, int height,
+               const std::function<void(const void*, int)>& sink) {
+  return stbi_write_png_to_func(
+             [](void* context, void* data, int size) {
+               (*static_cast<const std::function<void(const void*, int)>*>(context))(data, size);
+             },
+             const_cast<std::function<void(const void*, int)>*>(&sink), width, height, 4, rgba,
+             width * 4) != 0;
+}
+
+}  // namespace lodforge::stb

@@ -415,7 +415,10 @@ void addBench(CLI::App& app, const Global& global, Run& run) {
                 "With --render: stream on the GPU as the paper does (only the Δ is uploaded; "
                 "reassembly and reformation in compute shaders)")
       ->needs("--render");
-  sub->callback([&global, &run, o] { run = [&global, o] { return runBench(global, *o); }; });
+  sub->callback([&global, &run, o, sub] {
+    o->sizeGiven = sub->count("--size") > 0;
+    run = [&global, o] { return runBench(global, *o); };
+  });
 }
 
 }  // namespace lodforge::cli

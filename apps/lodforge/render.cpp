@@ -218,7 +218,10 @@ void addRender(CLI::App& app, const Global& global, Run& run) {
                 "Re-form triangles in a compute shader (§3.2) instead of on the CPU");
   sub->add_flag("--gpu-stream", o->gpuStream,
                 "Stream on the GPU (§3.3): upload only the Δ, reassemble and re-form there");
-  sub->callback([&global, &run, o] { run = [&global, o] { return runRender(global, *o); }; });
+  sub->callback([&global, &run, o, sub] {
+    o->sizeGiven = sub->count("--size") > 0;
+    run = [&global, o] { return runRender(global, *o); };
+  });
 }
 
 }  // namespace lodforge::cli

@@ -73,6 +73,12 @@ Result<std::vector<Camera>> cameraPath(const PathChoice& choice, const Package& 
   if (choice.path == "fly") return flyThroughPath(bounds, options);
   auto cameras = readCameraPath(choice.path, package.origin(), bounds);
   if (cameras && cameras->size() > choice.frames) cameras->resize(choice.frames);
+  if (cameras && choice.sizeGiven) {
+    for (Camera& camera : *cameras) {
+      camera.width = width;
+      camera.height = height;
+    }
+  }
   return cameras;
 }
 

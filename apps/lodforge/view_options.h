@@ -24,6 +24,7 @@ struct PathChoice {
   std::string path = "orbit";  // orbit, fly, or a path file
   std::uint64_t frames = 120;  // a file's path is cut to this
   std::string size = "1280x720";
+  bool sizeGiven = false;  // --size on the command line: it also overrides a path file's viewport
   double fovY = 60;
 };
 // The package's bounds relative to its origin.

@@ -288,7 +288,20 @@ Status runView(const Global& global, const ViewOptions& o) {
     ImGui::Text("camera: %s (drag, wheel; WASD/QE fly)", control.fly ? "fly" : "orbit");
     if (ImGui::Button("orbit")) control.fly = false;
     ImGui::SameLine();
-    if (ImGui::Button(recording ? "stop recording" : "record path")) recording = !recording;
+    if (ImGui::Button(recording ? "stop recording" : "record path")) {
+      recording = !recording;
+      if (recording) {
+        recorded.clear();
+      } else if (!recorded.empty()) {
+        // Saved at once (to --record or a numbered file), and ready to play back.
+        const std::string file =
+            o.record.empty() ? fmt::format("lodforge-path-{:04}.json", frame) : o.record;
+        LODFORGE_TRY(writeCameraPath(file, recorded, package->origin()));
+        message = fmt::format("saved {} cameras to {}", recorded.size(), file);
+        played = recorded;
+        playIndex = 0;
+      }
+    }
     ImGui::SameLine();
     if (!played.empty() && ImGui::Button(playing ? "pause" : "play")) playing = !playing;
     if (ImGui::Button("screenshot (P)")) screenshotNow = true;
@@ -300,7 +313,8 @@ Status runView(const Global& global, const ViewOptions& o) {
     if (last) break;
     ++frame;
   }
-  if (!o.record.empty() && !recorded.empty())
+  // Still recording at exit (always so with --record and no button pressed): save it.
+  if (recording && !o.record.empty() && !recorded.empty())
     LODFORGE_TRY(writeCameraPath(o.record, recorded, package->origin()));
   say(global, fmt::format("{} frames shown{}", frame + 1,
                           o.record.empty() ? "" : fmt::format(", path written to {}", o.record)));

@@ -17,8 +17,7 @@
 #include "lodforge/core/threads.h"
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
-#include "lodforge/render/gpu_reform.h"
-#include "lodforge/render/gpu_stream.h"
+#include "lodforge/render/pipeline.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
@@ -42,6 +41,10 @@ struct BenchOptions : PathChoice {
   bool gpuReform = false;  // with --render: re-form in a compute shader
   bool gpuStream = false;  // with --render: stream on the GPU (§3.3), re-form there
 };
+
+Streaming streaming(const BenchOptions& o) {
+  return o.gpuStream ? Streaming::kGpu : (o.gpuReform ? Streaming::kCpuGpuReform : Streaming::kCpu);
+}
 
 // What --render draws with: one headless context for the whole run.
 struct RenderTarget {
@@ -73,8 +76,7 @@ double milliseconds(std::chrono::steady_clock::duration d) {
 // One frame: select, then stream.
 Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const Camera& camera,
                             std::uint64_t budget, Selection& selection, StreamBuffer* buffer,
-                            RenderTarget* target, Renderer* renderer, GpuReformer* reformer,
-                            GpuStream* gpuStream) {
+                            RenderTarget* target, FramePipeline* pipeline) {
   FrameTimes t;
   const auto start = std::chrono::steady_clock::now();
   if (o.targetError) {
@@ -86,46 +88,31 @@ Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const 
   }
   t.selectionMs = milliseconds(std::chrono::steady_clock::now() - start);
   t.selectionSteps = selection.timings;
-  if (gpuStream) {
-    // The paper's path: generation = the Δ upload and reassembly on the GPU, then Algorithm 2
-    // there, each timed to glFinish.
-    const auto streamStart = std::chrono::steady_clock::now();
-    auto stream = gpuStream->update(selection.vertexCounts, selection.triangleCounts);
-    if (!stream) return stream.status();
-    target->context->finish();
-    const auto reformStart = std::chrono::steady_clock::now();
-    renderer->attach(*gpuStream);
-    reformer->reform(*gpuStream, renderer->indexBuffer());
-    target->context->finish();
-    t.stream = *stream;
-    t.stream.reassemblyMs = milliseconds(reformStart - streamStart);
-    t.stream.reformationMs = milliseconds(std::chrono::steady_clock::now() - reformStart);
-  } else {
-    auto stream = buffer->update(selection.vertexCounts, selection.triangleCounts);
-    if (!stream) return stream.status();
-    t.stream = *stream;
-  }
   t.vertices = selection.totalVertices;
   t.triangles = selection.totalTriangles;
   t.visible = selection.visibleObjects;
   t.exact = o.targetError || o.firstPassOnly ||
             selection.totalVertices == std::min(budget, scene.totalMaxVertices());
-  if (renderer) {
-    // The paper's third column: the frame on screen (here offscreen, timed to glFinish).
-    const auto uploadStart = std::chrono::steady_clock::now();
-    if (!gpuStream) {
-      renderer->upload(*buffer, reformer == nullptr);
-      if (reformer) reformer->reform(*buffer, renderer->indexBuffer());
-      target->context->finish();
-    }
-    const auto drawStart = std::chrono::steady_clock::now();
-    target->framebuffer->bind();
-    renderer->draw(camera, {});
-    target->context->finish();
-    const auto end = std::chrono::steady_clock::now();
-    t.uploadMs = milliseconds(drawStart - uploadStart);
-    t.renderMs = milliseconds(end - drawStart);
+  if (!pipeline) {
+    auto stream = buffer->update(selection.vertexCounts, selection.triangleCounts);
+    if (!stream) return stream.status();
+    t.stream = *stream;
+    return t;
   }
+  // With --render, the paper's third column too: the frame drawn (offscreen, to glFinish).
+  auto stream = pipeline->update(selection.vertexCounts, selection.triangleCounts);
+  if (!stream) return stream.status();
+  t.stream = *stream;
+  target->framebuffer->bind();
+  pipeline->draw(camera, {});
+  const PipelineTimings& p = pipeline->timings();
+  if (pipeline->streaming() == Streaming::kGpu) {
+    // Generation is the GPU's: Δ upload and reassembly, then Algorithm 2.
+    t.stream.reassemblyMs = p.streamMs;
+    t.stream.reformationMs = p.reformMs;
+  }
+  t.uploadMs = p.uploadMs + (pipeline->streaming() == Streaming::kCpuGpuReform ? p.reformMs : 0);
+  t.renderMs = p.drawMs;
   return t;
 }
 
@@ -146,32 +133,20 @@ Result<BudgetRun> runBudget(const BenchOptions& o, const Package& package, const
             formatCount(budget), formatBytes(o.gpuMemory), formatCount(capacity.vertices))};
   run.capacityVertices = capacity.vertices;
   run.capacityBytes = capacity.bytes(package);
-  std::optional<StreamBuffer> buffer;  // the CPU stream, unless the GPU streams
-  if (!o.gpuStream) buffer.emplace(package, capacity);
-  std::optional<Renderer> renderer;
-  std::optional<GpuReformer> reformer;
-  std::optional<GpuStream> gpuStream;
+  std::optional<StreamBuffer> buffer;  // without --render: the CPU stream alone
+  std::optional<FramePipeline> pipeline;
   if (target) {
-    auto created = Renderer::create(package, capacity);
+    auto created = FramePipeline::create(package, capacity, streaming(o));
     if (!created) return created.status();
-    renderer.emplace(std::move(*created));
-    if (o.gpuStream) {
-      auto stream = GpuStream::create(package, capacity);
-      if (!stream) return stream.status();
-      gpuStream.emplace(std::move(*stream));
-    }
-    if (o.gpuReform || o.gpuStream) {
-      auto gpu = GpuReformer::create(package, capacity);
-      if (!gpu) return gpu.status();
-      reformer.emplace(std::move(*gpu));
-    }
+    pipeline.emplace(std::move(*created));
+  } else {
+    buffer.emplace(package, capacity);
   }
   Selection selection;
   for (std::size_t f = 0; f < cameras.size(); ++f) {
     LODFORGE_TRY(checkCancelled());
     auto frame = runFrame(o, scene, cameras[f], budget, selection, buffer ? &*buffer : nullptr,
-                          target, renderer ? &*renderer : nullptr, reformer ? &*reformer : nullptr,
-                          gpuStream ? &*gpuStream : nullptr);
+                          target, pipeline ? &*pipeline : nullptr);
     if (!frame) return frame.status();
     (f == 0 ? run.load : run.frames.emplace_back()) = *frame;
     progress.advance(1);
@@ -311,9 +286,7 @@ Status writeJson(const BenchOptions& o, const Package& package, const nlohmann::
       {"path", o.path},
       {"frames", frames},
       {"mode", o.targetError ? "error" : (o.firstPassOnly ? "first-pass" : "two-pass")},
-      {"render", o.render
-                     ? (o.gpuStream ? "gpu-stream" : (o.gpuReform ? "gpu-reform" : "cpu-reform"))
-                     : "none"},
+      {"render", o.render ? streamingName(streaming(o)) : "none"},
       {"min_t", o.minT},
       {"exponent", o.exponent},
       {"runs", runsJson}};

@@ -4,7 +4,6 @@
 // `lodforge compare`.
 #include <chrono>
 #include <filesystem>
-#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -14,8 +13,7 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
-#include "lodforge/render/gpu_reform.h"
-#include "lodforge/render/gpu_stream.h"
+#include "lodforge/render/pipeline.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/selection.h"
 #include "lodforge/runtime/stream.h"
@@ -72,22 +70,11 @@ Status runRender(const Global& global, const RenderOptions& o) {
   if (!gl) return gl.status();
   const StreamCapacity capacity =
       StreamCapacity::forVertices(*package, o.reference ? full : *budget);
-  std::optional<StreamBuffer> buffer;  // the CPU stream, unless the GPU streams
-  if (!o.gpuStream) buffer.emplace(*package, capacity);
-  auto renderer = Renderer::create(*package, capacity);
-  if (!renderer) return renderer.status();
-  std::optional<GpuReformer> reformer;
-  std::optional<GpuStream> gpuStream;
-  if (o.gpuStream) {
-    auto created = GpuStream::create(*package, capacity);
-    if (!created) return created.status();
-    gpuStream.emplace(std::move(*created));
-  }
-  if (o.gpuReform || o.gpuStream) {
-    auto created = GpuReformer::create(*package, capacity);
-    if (!created) return created.status();
-    reformer.emplace(std::move(*created));
-  }
+  const Streaming streaming = o.gpuStream   ? Streaming::kGpu
+                              : o.gpuReform ? Streaming::kCpuGpuReform
+                                            : Streaming::kCpu;
+  auto pipeline = FramePipeline::create(*package, capacity, streaming);
+  if (!pipeline) return pipeline.status();
   auto target = Framebuffer::create(cameras->front().width, cameras->front().height);
   if (!target) return target.status();
 
@@ -121,31 +108,20 @@ Status runRender(const Global& global, const RenderOptions& o) {
                     selection);
     }
     const auto selected = std::chrono::steady_clock::now();
-    // The CPU stream and upload, or the paper's GPU path (only the Δ crosses over).
-    auto stream = gpuStream ? gpuStream->update(selection.vertexCounts, selection.triangleCounts)
-                            : buffer->update(selection.vertexCounts, selection.triangleCounts);
+    auto stream = pipeline->update(selection.vertexCounts, selection.triangleCounts);
     if (!stream) return stream.status();
-    const auto streamed = std::chrono::steady_clock::now();
-    if (gpuStream) {
-      renderer->attach(*gpuStream);
-      reformer->reform(*gpuStream, renderer->indexBuffer());
-    } else {
-      // Indices from the CPU's Algorithm 2, or re-formed on the GPU from the source triangles.
-      renderer->upload(*buffer, !reformer);
-      if (reformer) reformer->reform(*buffer, renderer->indexBuffer());
-    }
     target->bind();
-    renderer->draw(camera, {.colorMode = *colorMode});
-    (*gl)->finish();  // the draw's own time, not the read-back's
-    const auto drawn = std::chrono::steady_clock::now();
+    pipeline->draw(camera, {.colorMode = *colorMode});
+    const PipelineTimings& t = pipeline->timings();
     const std::string name = fmt::format("frame_{:04}.png", f);
     LODFORGE_TRY(writePng((temporary / name).string(), target->read()));
     frames.push_back({{"frame", name},
                       {"vertices", selection.totalVertices},
                       {"triangles", selection.totalTriangles},
                       {"selection_ms", milliseconds(selected - start)},
-                      {"generation_ms", milliseconds(streamed - selected)},
-                      {"render_ms", milliseconds(drawn - streamed)},
+                      {"generation_ms", t.streamMs + t.reformMs},
+                      {"upload_ms", t.uploadMs},
+                      {"render_ms", t.drawMs},
                       {"bytes_read", stream->bytesRead}});
     progress.advance(1);
   }

@@ -18,8 +18,7 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
-#include "lodforge/render/gpu_reform.h"
-#include "lodforge/render/gpu_stream.h"
+#include "lodforge/render/pipeline.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
@@ -103,13 +102,9 @@ Status runView(const Global& global, const ViewOptions& o) {
 
   // Buffers for the whole model, so the budget slider can go to 100 %.
   const StreamCapacity capacity = StreamCapacity::forVertices(*package, full);
-  StreamBuffer buffer(*package, capacity);
-  auto renderer = Renderer::create(*package, capacity);
-  if (!renderer) return renderer.status();
-  auto reformer = GpuReformer::create(*package, capacity);
-  if (!reformer) return reformer.status();
-  auto gpuStream = GpuStream::create(*package, capacity);
-  if (!gpuStream) return gpuStream.status();
+  // Every arrangement prepared: the panel switches between them.
+  auto pipeline = FramePipeline::create(*package, capacity, Streaming::kCpu, /*switchable=*/true);
+  if (!pipeline) return pipeline.status();
 
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -213,31 +208,23 @@ Status runView(const Global& global, const ViewOptions& o) {
     selectTwoPass(scene, camera, n, {.minT = minT, .firstPassOnly = firstPassOnly}, selection);
     const auto t1 = std::chrono::steady_clock::now();
     // CPU stream + upload, or the paper's GPU path where only the Δ crosses over.
-    auto stream = gpuStreaming ? gpuStream->update(selection.vertexCounts, selection.triangleCounts)
-                               : buffer.update(selection.vertexCounts, selection.triangleCounts);
+    pipeline->setStreaming(gpuStreaming ? Streaming::kGpu
+                           : gpuReform  ? Streaming::kCpuGpuReform
+                                        : Streaming::kCpu);
+    auto stream = pipeline->update(selection.vertexCounts, selection.triangleCounts);
     if (!stream) return stream.status();
-    if (gpuStreaming) (*gl)->finish();
-    const auto t2 = std::chrono::steady_clock::now();
-    if (gpuStreaming) {
-      renderer->attach(*gpuStream);
-    } else {
-      renderer->upload(buffer, !gpuReform);
-    }
-    const auto t3 = std::chrono::steady_clock::now();
-    if (gpuStreaming) {
-      reformer->reform(*gpuStream, renderer->indexBuffer());
-    } else if (gpuReform) {
-      reformer->reform(buffer, renderer->indexBuffer());
-    }
-    (*gl)->finish();
-    const auto t4 = std::chrono::steady_clock::now();
     bindWindowFramebuffer();
-    renderer->draw(camera, {.colorMode = static_cast<ColorMode>(mode)});
-    (*gl)->finish();
-    const auto t5 = std::chrono::steady_clock::now();
-    figures = {milliseconds(t1 - t0),   milliseconds(t2 - t1),    milliseconds(t3 - t2),
-               milliseconds(t4 - t3),   milliseconds(t5 - t4),    *stream,
-               selection.totalVertices, selection.totalTriangles, selection.visibleObjects};
+    pipeline->draw(camera, {.colorMode = static_cast<ColorMode>(mode)});
+    const PipelineTimings& p = pipeline->timings();
+    figures = {milliseconds(t1 - t0),
+               p.streamMs,
+               p.uploadMs,
+               p.reformMs,
+               p.drawMs,
+               *stream,
+               selection.totalVertices,
+               selection.totalTriangles,
+               selection.visibleObjects};
 
     // The last frame of a scripted run, or P: a screenshot of the model without the panel.
     const bool last = o.stopAfter != 0 && frame + 1 >= o.stopAfter;

@@ -621,7 +621,9 @@ TEST(CliBench, RenderAddsTheOpenGlColumn) {
     EXPECT_NE(o.out.find("render ms"), std::string::npos) << o.out;
     const auto j = nlohmann::json::parse(test::readFile(dir.file("b.json")));
     const std::string mode = extra;
-    EXPECT_EQ(j["render"], mode.empty() ? "cpu-reform" : mode.substr(3));
+    EXPECT_EQ(j["render"], mode.empty()              ? "cpu"
+                           : mode == " --gpu-reform" ? "cpu-stream-gpu-reform"
+                                                     : "gpu");
     // Σ vc = N and what was read match whichever side streams.
     EXPECT_EQ(j["runs"][1]["mean"]["bytes_read"], 0.0)
         << "100 % after the first frame reads nothing";

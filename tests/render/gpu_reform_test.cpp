@@ -5,24 +5,17 @@
 #include <gtest/gtest.h>
 
 #include "lodforge/core/random.h"
-#include "lodforge/render/context.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
+#include "render/headless.h"
 #include "runtime/packages.h"
 
 namespace lodforge {
 namespace {
 
-GlContext& context() {
-  // Kept alive to the end: see renderer_test.cpp.
-  static auto* created = new Result<std::unique_ptr<GlContext>>(GlContext::headless());
-  EXPECT_TRUE(created->ok()) << created->error().message;
-  return ***created;
-}
-
 TEST(GpuReform, EqualsTheCpuIndicesForRandomSelections) {
-  context();
+  test::headlessContext();
   Random random(2024);
   for (const char* key : {"engine", "motor", "cad", "crowd"}) {
     const Package& package = test::RuntimePackages::get(key);
@@ -62,7 +55,7 @@ TEST(GpuReform, EqualsTheCpuIndicesForRandomSelections) {
 }
 
 TEST(GpuReform, RendersTheSameImageAsTheCpuPath) {
-  context();
+  test::headlessContext();
   const Package& package = test::RuntimePackages::get("engine");
   const LodScene scene = LodScene::fromPackage(package);
   StreamBuffer buffer(package, StreamCapacity::forVertices(package, scene.totalMaxVertices()));

@@ -7,23 +7,16 @@
 #include <gtest/gtest.h>
 
 #include "lodforge/core/random.h"
-#include "lodforge/render/context.h"
 #include "lodforge/render/gpu_reform.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/render/shader.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
+#include "render/headless.h"
 #include "runtime/packages.h"
 
 namespace lodforge {
 namespace {
-
-GlContext& context() {
-  // Kept alive to the end: see renderer_test.cpp.
-  static auto* created = new Result<std::unique_ptr<GlContext>>(GlContext::headless());
-  EXPECT_TRUE(created->ok()) << created->error().message;
-  return ***created;
-}
 
 template <class T>
 std::vector<std::uint32_t> words(std::span<const T> values) {
@@ -33,7 +26,7 @@ std::vector<std::uint32_t> words(std::span<const T> values) {
 }
 
 TEST(GpuStream, EveryFrameEqualsTheCpuStreamAndReadsOnlyTheDelta) {
-  context();
+  test::headlessContext();
   Random random(77);
   for (const char* key : {"engine", "motor", "cad", "crowd"}) {
     const Package& package = test::RuntimePackages::get(key);
@@ -91,7 +84,7 @@ TEST(GpuStream, EveryFrameEqualsTheCpuStreamAndReadsOnlyTheDelta) {
 }
 
 TEST(GpuStream, OverCapacityIsRefusedAndTheFrameKept) {
-  context();
+  test::headlessContext();
   const Package& package = test::RuntimePackages::get("motor");
   const LodScene scene = LodScene::fromPackage(package);
   const std::uint64_t capacityVertices = scene.totalMaxVertices() / 4;
@@ -111,7 +104,7 @@ TEST(GpuStream, OverCapacityIsRefusedAndTheFrameKept) {
 }
 
 TEST(GpuStream, DrawsTheSameFramesAsTheCpuStream) {
-  context();
+  test::headlessContext();
   const Package& package = test::RuntimePackages::get("engine");
   const LodScene scene = LodScene::fromPackage(package);
   const StreamCapacity capacity = StreamCapacity::forVertices(package, scene.totalMaxVertices());

@@ -4,21 +4,13 @@
 
 #include <gtest/gtest.h>
 
-#include "lodforge/render/context.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
+#include "render/headless.h"
 #include "runtime/packages.h"
 
 namespace lodforge {
 namespace {
-
-GlContext& context() {
-  // Never torn down: unloading Mesa's driver at exit would leave its few internal allocations
-  // unattributable for LeakSanitizer; kept alive, they stay reachable.
-  static auto* created = new Result<std::unique_ptr<GlContext>>(GlContext::headless());
-  EXPECT_TRUE(created->ok()) << created->error().message;
-  return ***created;
-}
 
 // Share of pixels that differ from the background colour.
 double coverage(const Image& image) {
@@ -45,14 +37,14 @@ Image render(const Package& package, const StreamBuffer& buffer, const Camera& c
 }
 
 TEST(Context, HeadlessOpenGl45) {
-  GlContext& gl = context();
+  GlContext& gl = test::headlessContext();
   EXPECT_FALSE(gl.renderer().empty());
   EXPECT_NE(gl.version().find("4."), std::string::npos) << gl.version();
   EXPECT_EQ(gl.glfwWindow(), nullptr);
 }
 
 TEST(Renderer, ASquareCoversTheShareItsProjectionPredicts) {
-  context();
+  test::headlessContext();
   test::TempDir folder;
   // One square of side 2 in the z = 0 plane, seen straight down from height 4.
   const std::string ply = folder.file("square.ply");
@@ -91,7 +83,7 @@ TEST(Renderer, ASquareCoversTheShareItsProjectionPredicts) {
 }
 
 TEST(Renderer, FullBudgetAfterCoherentFramesEqualsTheReferenceRender) {
-  context();
+  test::headlessContext();
   for (const char* key : {"engine", "cad"}) {
     const Package& package = test::RuntimePackages::get(key);
     const LodScene scene = LodScene::fromPackage(package);
@@ -127,7 +119,7 @@ TEST(Renderer, FullBudgetAfterCoherentFramesEqualsTheReferenceRender) {
 }
 
 TEST(Renderer, LowerBudgetsStayWithinStatedImageDifference) {
-  context();
+  test::headlessContext();
   const Package& package = test::RuntimePackages::get("engine");
   const LodScene scene = LodScene::fromPackage(package);
   const std::uint64_t full = scene.totalMaxVertices();
@@ -158,7 +150,7 @@ TEST(Renderer, LowerBudgetsStayWithinStatedImageDifference) {
 }
 
 TEST(Renderer, ColourModesDiffer) {
-  context();
+  test::headlessContext();
   const Package& package = test::RuntimePackages::get("engine");
   const LodScene scene = LodScene::fromPackage(package);
   StreamBuffer buffer(package, StreamCapacity::forVertices(package, scene.totalMaxVertices()));

@@ -217,7 +217,8 @@ struct Renderer::State {
   std::vector<Rgba8> baseColors, idColors;
   std::vector<float> ratios;
   std::uint64_t uploaded = 0;
-  bool attached = false;  // drawing from a GpuStream's buffers
+  bool attached = false;                  // drawing from a GpuStream's buffers
+  mutable bool idColorsUploaded = false;  // which colours the object colour buffer holds
 
   ~State() {
     const GLuint buffers[] = {positions,    normalBuffer, colorBuffer, indices,
@@ -383,10 +384,15 @@ void Renderer::draw(const Camera& camera, const DrawOptions& options) const {
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   if (s.commandCount == 0) return;
 
-  // Per-object colours: the base colours, or a distinct one per object.
-  const auto& colors = options.colorMode == ColorMode::kObject ? s.idColors : s.baseColors;
-  glNamedBufferSubData(s.objectColors, 0, static_cast<GLsizeiptr>(colors.size() * sizeof(Rgba8)),
-                       colors.data());
+  // Per-object colours: the base colours, or a distinct one per object (re-sent only when the
+  // choice changes: 4 bytes per object).
+  const bool idColors = options.colorMode == ColorMode::kObject;
+  if (idColors != s.idColorsUploaded) {
+    const auto& colors = idColors ? s.idColors : s.baseColors;
+    glNamedBufferSubData(s.objectColors, 0, static_cast<GLsizeiptr>(colors.size() * sizeof(Rgba8)),
+                         colors.data());
+    s.idColorsUploaded = idColors;
+  }
   // Depth range fitted to the model each frame: the path's planes are chosen for selection
   // (near ~1e-5 of the size) and would waste a 24-bit depth buffer, making coincident faces
   // fight differently from one framebuffer format to the next.

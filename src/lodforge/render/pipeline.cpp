@@ -50,7 +50,8 @@ Result<FramePipeline> FramePipeline::create(const Package& package, const Stream
   auto s = std::make_unique<State>();
   s->mode = mode;
   s->switchable = switchable;
-  auto renderer = Renderer::create(package, capacity);
+  // The GPU arrangement draws from the stream's own buffers: no second copy.
+  auto renderer = Renderer::create(package, capacity, switchable || mode != Streaming::kGpu);
   if (!renderer) return renderer.status();
   s->renderer.emplace(std::move(*renderer));
   if (switchable || mode != Streaming::kGpu) s->cpu.emplace(package, capacity);

@@ -243,7 +243,8 @@ GLuint makeBuffer(std::uint64_t bytes, const void* data = nullptr) {
 
 }  // namespace
 
-Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& capacity) {
+Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& capacity,
+                                  bool vertexBuffers) {
   auto s = std::make_unique<State>();
   s->package = &package;
   s->capacity = capacity;
@@ -263,9 +264,11 @@ Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& 
   }
   s->ratios.assign(objects, 1.0f);
 
-  s->positions = makeBuffer(capacity.vertices * sizeof(Vec3f));
-  if (s->normals) s->normalBuffer = makeBuffer(capacity.vertices * sizeof(Vec3f));
-  if (s->colors) s->colorBuffer = makeBuffer(capacity.vertices * sizeof(Rgba8));
+  if (vertexBuffers) {
+    s->positions = makeBuffer(capacity.vertices * sizeof(Vec3f));
+    if (s->normals) s->normalBuffer = makeBuffer(capacity.vertices * sizeof(Vec3f));
+    if (s->colors) s->colorBuffer = makeBuffer(capacity.vertices * sizeof(Rgba8));
+  }
   s->indices = makeBuffer(capacity.triangles * 3 * sizeof(std::uint32_t));
   s->objectColors = makeBuffer(objects * sizeof(Rgba8), s->baseColors.data());
   s->lodRatios = makeBuffer(objects * sizeof(float), s->ratios.data());
@@ -297,6 +300,7 @@ Renderer::~Renderer() = default;
 
 void Renderer::upload(const StreamBuffer& buffer, bool indices) {
   State& s = *state_;
+  assert(s.positions != 0 && "created without vertex buffers: attach a GpuStream instead");
   const auto upload = [&](GLuint target, const auto& span) {
     if (span.empty()) return;
     glNamedBufferSubData(target, 0, static_cast<GLsizeiptr>(span.size_bytes()), span.data());

@@ -62,7 +62,10 @@ struct DrawOptions {
 class Renderer {
  public:
   // Needs a current GL 4.5 context. Buffers hold `capacity` (what the StreamBuffer holds).
-  static Result<Renderer> create(const Package& package, const StreamCapacity& capacity);
+  // Without `vertexBuffers` only the index buffer is made: the renderer then draws from a
+  // GpuStream's buffers (attach) and upload() may not be used.
+  static Result<Renderer> create(const Package& package, const StreamCapacity& capacity,
+                                 bool vertexBuffers = true);
   Renderer(Renderer&&) noexcept;
   Renderer& operator=(Renderer&&) noexcept;
   ~Renderer();

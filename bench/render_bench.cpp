@@ -177,7 +177,8 @@ int run(int argc, char** argv) {
       }
     }
     if (!pictures.empty()) {
-      const std::string out = (std::filesystem::path(pictures) / (name + "-" + pathName + "-5pct.png")).string();
+      const std::string out =
+          (std::filesystem::path(pictures) / (name + "-" + pathName + "-5pct.png")).string();
       if (!writePng(out, sideBySide(picture))) return 1;
     }
   }

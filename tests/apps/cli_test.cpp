@@ -28,10 +28,13 @@ struct Outcome {
   std::string out, err;
 };
 
-// Runs `lodforge ARGS` through the shell, capturing stdout and stderr.
-Outcome lodforge(const std::string& args, const test::TempDir& dir) {
+// Runs `lodforge ARGS` through the shell, capturing stdout and stderr; `wrapper` goes in front
+// of the binary (an environment change, a virtual display).
+Outcome lodforge(const std::string& args, const test::TempDir& dir,
+                 const std::string& wrapper = "") {
   const std::string out = dir.file(".stdout"), err = dir.file(".stderr");
-  const std::string command = std::string(LODFORGE_BINARY) + " " + args + " >" + out + " 2>" + err;
+  const std::string command =
+      wrapper + std::string(LODFORGE_BINARY) + " " + args + " >" + out + " 2>" + err;
   const int status = std::system(command.c_str());
   Outcome o;
   o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -217,12 +220,6 @@ TEST(Cli, CtrlCCancelsAndLeavesNothingBehind) {
   EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{});
 }
 
-}  // namespace
-}  // namespace lodforge
-
-namespace lodforge {
-namespace {
-
 TEST(CliPackage, BuildInfoAndExtract) {
   test::TempDir dir;
   const std::string package = dir.file("bunny.lfp");
@@ -376,12 +373,6 @@ TEST(CliBench, BadArgumentsAndPathsGetExitCode2) {
   EXPECT_NE(o.code, 0);
 }
 
-}  // namespace
-}  // namespace lodforge
-
-namespace lodforge {
-namespace {
-
 Image gradient(std::uint32_t w, std::uint32_t h, std::uint8_t shift) {
   Image image(w, h);
   for (std::size_t i = 0; i < image.pixelCount(); ++i) {
@@ -440,12 +431,6 @@ TEST(CliCompare, MismatchedOrBadImagesAreExitCode2) {
   o = lodforge("compare " + dir.file("small.png") + " " + dir.path().string(), dir);
   EXPECT_EQ(o.code, 2) << "a file and a folder";
 }
-
-}  // namespace
-}  // namespace lodforge
-
-namespace lodforge {
-namespace {
 
 TEST(CliRender, FramesAlongAPathMatchTheReferenceAtFullBudget) {
   test::TempDir dir;
@@ -523,25 +508,10 @@ TEST(CliRender, BadArgumentsAndPackagesAreExitCode2) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("out")));
 }
 
-}  // namespace
-}  // namespace lodforge
-
-namespace lodforge {
-namespace {
-
 // The viewer needs a display: the tests give it a virtual one (Debian's xvfb, installed by
 // scripts/install-deps.sh; missing, the test fails rather than skips).
 Outcome viewUnderXvfb(const std::string& args, const test::TempDir& dir) {
-  const std::string out = dir.file(".stdout"), err = dir.file(".stderr");
-  const std::string command = "xvfb-run -a -s '-screen 0 1280x1024x24' " +
-                              std::string(LODFORGE_BINARY) + " view " + args + " >" + out + " 2>" +
-                              err;
-  const int status = std::system(command.c_str());
-  Outcome o;
-  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  o.out = test::readFile(out);
-  o.err = test::readFile(err);
-  return o;
+  return lodforge("view " + args, dir, "xvfb-run -a -s '-screen 0 1280x1024x24' ");
 }
 
 TEST(CliView, WithoutADisplayItSaysSoAndPointsAtRender) {
@@ -549,14 +519,10 @@ TEST(CliView, WithoutADisplayItSaysSoAndPointsAtRender) {
   const std::string package = dir.file("motor.lfp");
   ASSERT_EQ(
       lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
-  const std::string out = dir.file(".o"), err = dir.file(".e");
-  const int status =
-      std::system(("env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(LODFORGE_BINARY) + " view " +
-                   package + " >" + out + " 2>" + err)
-                      .c_str());
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 2);
-  EXPECT_NE(test::readFile(err).find("lodforge render"), std::string::npos) << test::readFile(err);
+  const Outcome o = lodforge("view " + package, dir, "env -u DISPLAY -u WAYLAND_DISPLAY ");
+  ASSERT_NE(o.code, -1) << "exited normally";
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("lodforge render"), std::string::npos) << o.err;
 }
 
 TEST(CliView, ScriptedRunRecordsAPathWhoseReplayMatchesHeadlessRender) {
@@ -600,12 +566,6 @@ TEST(CliView, ScriptedRunRecordsAPathWhoseReplayMatchesHeadlessRender) {
   const ImageDifference empty = compareImages(*shot, Image(320, 240));
   EXPECT_GT(empty.shareAbove, 0.05);
 }
-
-}  // namespace
-}  // namespace lodforge
-
-namespace lodforge {
-namespace {
 
 TEST(CliBench, RenderAddsTheOpenGlColumn) {
   test::TempDir dir;

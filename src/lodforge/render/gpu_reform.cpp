@@ -11,30 +11,20 @@ namespace lodforge {
 
 namespace {
 
-constexpr GLuint kGroupSize = 256;
-constexpr GLuint kMaxGroupsX = 65535;  // the minimum GL 4.5 guarantees per dimension
-
 // Algorithm 2, one invocation per selected triangle.
-constexpr const char* kReformShader = R"(#version 450 core
-layout(local_size_x = 256) in;
+// Per selected object in `table`: first triangle in the frame, ECol offset, first vertex in the
+// frame, vc.
+constexpr const char* kReformMain = R"(
 layout(std430, binding = 0) readonly buffer Ecol { uint ecol[]; };      // every object, resident
 layout(std430, binding = 1) readonly buffer Source { uint source[]; };  // object-local corners
-// Per selected object: first triangle in the frame, ECol offset, first vertex in the frame, vc.
-layout(std430, binding = 2) readonly buffer Objects { uvec4 objects[]; };
 layout(std430, binding = 3) writeonly buffer Indices { uint indices[]; };
 uniform uint triangleCount;
 uniform uint objectCount;
 
 void main() {
-  uint t = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u + gl_LocalInvocationID.x;
+  uint t = elementIndex();
   if (t >= triangleCount) return;
-  // The owning object: the last whose first triangle is at most t (§3.2's binary search).
-  uint lo = 0u, hi = objectCount - 1u;
-  while (lo < hi) {
-    uint mid = (lo + hi + 1u) / 2u;
-    if (objects[mid].x <= t) lo = mid; else hi = mid - 1u;
-  }
-  uvec4 o = objects[lo];
+  uvec4 o = table[owner(t, objectCount)];
   for (uint k = 0u; k < 3u; ++k) {
     uint c = source[3u * t + k];
     while (c >= o.w) c = ecol[o.y + c];  // chains strictly decrease (Algorithm 1)
@@ -42,14 +32,6 @@ void main() {
   }
 }
 )";
-
-GLuint makeBuffer(std::uint64_t bytes, const void* data, GLbitfield flags) {
-  GLuint buffer = 0;
-  glCreateBuffers(1, &buffer);
-  glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(std::max<std::uint64_t>(bytes, 16)), data,
-                       flags);
-  return buffer;
-}
 
 }  // namespace
 
@@ -75,16 +57,15 @@ Result<GpuReformer> GpuReformer::create(const Package& package, const StreamCapa
     return Error{ErrorKind::kUnsupported,
                  "GPU reformation addresses ECol with 32-bit offsets: this package has more than "
                  "4 G vertices; use the CPU path"};
-  auto program = Program::link({{GL_COMPUTE_SHADER, kReformShader}});
+  auto program = Program::link({{GL_COMPUTE_SHADER, std::string(kElementGlsl) + kReformMain}});
   if (!program) return program.status();
   s->program = std::move(*program);
   // The package's ECol section is one array over all objects (each at its vertex offset).
   const std::uint32_t* ecol = package.objectCount() ? package.ecol(0).data() : nullptr;
-  s->ecol = makeBuffer(vertices * sizeof(std::uint32_t), ecol, 0);
-  s->source =
-      makeBuffer(capacity.triangles * 3 * sizeof(std::uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
+  s->ecol = makeBuffer(vertices * sizeof(std::uint32_t), ecol, 0);  // immutable
+  s->source = makeBuffer(capacity.triangles * 3 * sizeof(std::uint32_t));
   s->objectCapacity = package.objectCount();
-  s->objects = makeBuffer(s->objectCapacity * 16, nullptr, GL_DYNAMIC_STORAGE_BIT);
+  s->objects = makeBuffer(s->objectCapacity * 16);
   return GpuReformer(std::move(s));
 }
 
@@ -129,10 +110,7 @@ void GpuReformer::run(unsigned sourceBuffer, std::span<const std::uint32_t> coun
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, sourceBuffer);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.objects);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, indexBuffer);
-  const std::uint64_t groups = (triangles + kGroupSize - 1) / kGroupSize;
-  const auto x = static_cast<GLuint>(std::min<std::uint64_t>(groups, kMaxGroupsX));
-  const auto y = static_cast<GLuint>((groups + x - 1) / x);
-  glDispatchCompute(x, y, 1);
+  dispatchElements(triangles);
   // The next draw reads the indices; a read-back reads the buffer.
   glMemoryBarrier(GL_ELEMENT_ARRAY_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
 }

@@ -15,30 +15,22 @@ namespace lodforge {
 
 namespace {
 
-constexpr GLuint kMaxGroupsX = 65535;
-
 // §3.3's reassembly, one invocation per destination element: element l of object i comes from
 // the old copy while l < kept_i, else from the Δ ranges uploaded this frame.
-constexpr const char* kAssembleShader = R"(#version 450 core
-layout(local_size_x = 256) in;
+// Per object present in the new frame, in `table`: new start, old start, kept count, start in
+// Delta.
+constexpr const char* kAssembleMain = R"(
 layout(std430, binding = 0) readonly buffer Old { uint old[]; };
 layout(std430, binding = 1) readonly buffer Delta { uint delta[]; };
-// Per object present in the new frame: new start, old start, kept count, start in Delta.
-layout(std430, binding = 2) readonly buffer Table { uvec4 table[]; };
 layout(std430, binding = 3) writeonly buffer New { uint dst[]; };
 uniform uint count;
 uniform uint entries;
 uniform uint components;  // uints per element: 3 for a vec3 or a triangle, 1 for a colour
 
 void main() {
-  uint j = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u + gl_LocalInvocationID.x;
+  uint j = elementIndex();
   if (j >= count) return;
-  uint lo = 0u, hi = entries - 1u;
-  while (lo < hi) {
-    uint mid = (lo + hi + 1u) / 2u;
-    if (table[mid].x <= j) lo = mid; else hi = mid - 1u;
-  }
-  uvec4 e = table[lo];
+  uvec4 e = table[owner(j, entries)];
   uint l = j - e.x;
   for (uint c = 0u; c < components; ++c) {
     dst[components * j + c] = l < e.z ? old[components * (e.y + l) + c]
@@ -46,14 +38,6 @@ void main() {
   }
 }
 )";
-
-GLuint makeBuffer(std::uint64_t bytes) {
-  GLuint buffer = 0;
-  glCreateBuffers(1, &buffer);
-  glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(std::max<std::uint64_t>(bytes, 16)), nullptr,
-                       GL_DYNAMIC_STORAGE_BIT);
-  return buffer;
-}
 
 // One array's two copies and its staging buffer for the Δ.
 struct Stream {
@@ -106,9 +90,7 @@ struct GpuStream::State {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.delta);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, table);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.copies[static_cast<std::size_t>(1 - current)]);
-    const std::uint64_t groups = (count + 255) / 256;
-    const auto x = static_cast<GLuint>(std::min<std::uint64_t>(groups, kMaxGroupsX));
-    glDispatchCompute(x, static_cast<GLuint>((groups + x - 1) / x), 1);
+    dispatchElements(count);
   }
 };
 
@@ -123,7 +105,7 @@ Result<GpuStream> GpuStream::create(const Package& package, const StreamCapacity
   s->capacity = capacity;
   s->normals = package.header().hasNormals();
   s->colors = package.header().hasColors();
-  auto program = Program::link({{GL_COMPUTE_SHADER, kAssembleShader}});
+  auto program = Program::link({{GL_COMPUTE_SHADER, std::string(kElementGlsl) + kAssembleMain}});
   if (!program) return program.status();
   s->program = std::move(*program);
   s->positions.create(capacity.vertices, 3);

@@ -165,35 +165,16 @@ void main() {
 }
 )";
 
-// A distinct, stable colour per object id (golden-ratio hue steps).
+// A distinct, stable colour per object id: golden-ratio hue steps, HSV (s 0.65, v 0.9) to RGB.
 Rgba8 objectIdColor(std::size_t id) {
   const double hue = std::fmod(static_cast<double>(id) * 0.6180339887498949, 1.0) * 6.0;
-  const double f = hue - std::floor(hue);
   const double s = 0.65, v = 0.9;
-  const double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
-  double r = v, g = t, b = p;
-  switch (static_cast<int>(hue)) {
-    case 0:
-      r = v, g = t, b = p;
-      break;
-    case 1:
-      r = q, g = v, b = p;
-      break;
-    case 2:
-      r = p, g = v, b = t;
-      break;
-    case 3:
-      r = p, g = q, b = v;
-      break;
-    case 4:
-      r = t, g = p, b = v;
-      break;
-    default:
-      r = v, g = p, b = q;
-      break;
-  }
-  const auto byte = [](double x) { return static_cast<std::uint8_t>(std::lround(x * 255)); };
-  return {byte(r), byte(g), byte(b), 255};
+  const auto channel = [&](double n) {
+    const double k = std::fmod(n + hue, 6.0);
+    const double c = v - v * s * std::clamp(std::min(k, 4.0 - k), 0.0, 1.0);
+    return static_cast<std::uint8_t>(std::lround(c * 255));
+  };
+  return {channel(5), channel(3), channel(1), 255};
 }
 
 struct DrawCommand {  // GL's DrawElementsIndirectCommand
@@ -229,19 +210,6 @@ struct Renderer::State {
     if (vertexArray) glDeleteVertexArrays(1, &vertexArray);
   }
 };
-
-namespace {
-
-GLuint makeBuffer(std::uint64_t bytes, const void* data = nullptr) {
-  GLuint buffer = 0;
-  glCreateBuffers(1, &buffer);
-  // At least one byte: a zero-size store is an error.
-  glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(std::max<std::uint64_t>(bytes, 4)), data,
-                       GL_DYNAMIC_STORAGE_BIT);
-  return buffer;
-}
-
-}  // namespace
 
 Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& capacity,
                                   bool vertexBuffers) {

@@ -1,5 +1,6 @@
 #include "lodforge/render/shader.h"
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,8 @@ Result<Program> Program::link(std::initializer_list<Stage> stages) {
   for (const Stage& stage : stages) {
     const GLuint shader = glCreateShader(stage.type);
     shaders.push_back(shader);
-    glShaderSource(shader, 1, &stage.source, nullptr);
+    const char* text = stage.source.c_str();
+    glShaderSource(shader, 1, &text, nullptr);
     glCompileShader(shader);
     GLint ok = 0;
     glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
@@ -48,6 +50,22 @@ Result<Program> Program::link(std::initializer_list<Stage> stages) {
   for (GLuint shader : shaders) glDeleteShader(shader);
   if (!status.ok()) return status;
   return program;
+}
+
+unsigned makeBuffer(std::uint64_t bytes, const void* data, unsigned flags) {
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(std::max<std::uint64_t>(bytes, 16)), data,
+                       flags);
+  return buffer;
+}
+
+void dispatchElements(std::uint64_t elements) {
+  constexpr std::uint64_t kGroupSize = 256, kMaxGroupsX = 65535;
+  const std::uint64_t groups = (elements + kGroupSize - 1) / kGroupSize;
+  if (groups == 0) return;
+  const std::uint64_t x = std::min(groups, kMaxGroupsX);
+  glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>((groups + x - 1) / x), 1);
 }
 
 std::vector<std::uint32_t> readBufferWords(unsigned buffer, std::size_t words) {

@@ -1,6 +1,8 @@
 #include "lodforge/render/shader.h"
 
 #include <algorithm>
+#include <cstddef>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -55,6 +57,13 @@ Result<Program> Program::link(std::initializer_list<Stage> stages) {
 unsigned makeBuffer(std::uint64_t bytes, const void* data, unsigned flags) {
   GLuint buffer = 0;
   glCreateBuffers(1, &buffer);
+  // GL reads the whole store from `data`: a padded store needs a padded copy.
+  std::vector<std::byte> padded;
+  if (data != nullptr && bytes < 16) {
+    padded.resize(16);
+    std::memcpy(padded.data(), data, bytes);
+    data = padded.data();
+  }
   glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(std::max<std::uint64_t>(bytes, 16)), data,
                        flags);
   return buffer;

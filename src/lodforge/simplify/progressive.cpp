@@ -21,11 +21,11 @@ std::uint32_t ProgressiveMesh::vertexCountForError(float wanted) const {
 }
 
 std::uint64_t progressiveBuildBytes(std::uint64_t vertices, std::uint64_t triangles) {
-  // Per vertex: quadric 80, position and self cost 32, incidence ~36, ranking 8, flags and
-  // stamps 6, error 8, the rearranged output and permutation ~48 (boundary counts reuse them).
-  // Per triangle: corners 12, removal order 4, rearranged output and permutation 16, Melax's
-  // face normals 24, lists of live triangles and new neighbours ~8.
-  return vertices * 220 + triangles * 64 + 4096;
+  // Per vertex: state line 64, quadric 80, lists of live and active vertices and candidates ~16,
+  // the rearranged output and permutation ~48, collapse target 4. Per triangle: corners 12,
+  // fans 12 (up to twice that before a compaction), removal order 4, rearranged output and
+  // permutation 16, live list 4, Melax's face normals 24.
+  return vertices * 212 + triangles * 84 + 4096;
 }
 
 namespace {
@@ -52,11 +52,24 @@ void partitionBuckets(It begin, std::size_t firstBucket, std::size_t lastBucket,
   partitionBuckets(begin, middle, lastBucket, bucket, share);
 }
 
-// What ranking reads of a neighbour, in one 32-byte load: its position and the cost of its own
-// quadric there (Q_v(p_v)).
-struct RankPoint {
-  double x, y, z, selfCost;
+// Everything a collapse reads or writes about one vertex, in one cache line: a collapse visits
+// a dozen vertices spread over the mesh, and separate arrays cost a miss per array per vertex.
+// The position stays float as given (widened exactly to double where used).
+struct alignas(64) VertexState {
+  float x = 0, y = 0, z = 0;
+  std::uint32_t incidentStart = 0, incidentCount = 0;  // this pass's fan in incident_
+  std::uint32_t bestTarget = ~0u;                      // cheapest collapse as ranked
+  float bestCost = 0;
+  std::uint32_t touched = 0;                   // pass that last collapsed into or out of it
+  std::uint32_t nearStamp = 0, seenStamp = 0;  // scratch marks for valid()
+  double selfCost = 0;                         // Q_v(p_v), for (Q_u + Q_v)(p_v)
+  double error = 0;                            // distance carried by this live vertex
+  std::uint8_t locked = 0;                     // Q: boundary or non-manifold
+  std::uint8_t removed = 0;                    // collapsed already
+  std::uint8_t dirty = 1;                      // must be re-ranked next pass
+  std::uint8_t gains = 0;                      // valid(): on a triangle around `from` without `to`
 };
+static_assert(sizeof(VertexState) == 64);
 
 // Collapses happen in passes over flat arrays (as meshoptimizer does), not through one global
 // priority queue: each pass ranks every vertex's cheapest valid-looking collapse, buckets them
@@ -80,23 +93,30 @@ class Simplifier {
 
  private:
   Vec3d position(std::uint32_t v) const {
-    const RankPoint& r = rankPoints_[v];
-    return {r.x, r.y, r.z};
+    const VertexState& s = vertex_[v];
+    return {s.x, s.y, s.z};
   }
   // The dead mark shares the cache line the corners are read from anyway.
   bool alive(std::uint32_t t) const { return corners_[t][0] != kNone; }
   bool contains(std::uint32_t t, std::uint32_t v) const {
-    return corners_[t][0] == v || corners_[t][1] == v || corners_[t][2] == v;
+    // Bitwise, not short-circuit: which corner matches is unpredictable.
+    const auto& c = corners_[t];
+    return (c[0] == v) | (c[1] == v) | (c[2] == v);
   }
-  // The triangles around v as of the pass start; some may have died since (check alive()).
+  // The triangles around v in increasing order; some may have died since (check alive()).
   std::span<const std::uint32_t> around(std::uint32_t v) const {
-    return std::span(incident_).subspan(incidentStart_[v], incidentCount_[v]);
+    return std::span(incident_).subspan(vertex_[v].incidentStart, vertex_[v].incidentCount);
   }
   bool allowed(std::uint32_t from, std::uint32_t to) const;
   void buildIncidence();
+  void mergeFans(std::uint32_t from, std::uint32_t to);
+  void updateFaceNormals();
   void rankCollapses();
   float cost(std::uint32_t from, std::uint32_t to) const;
   bool valid(std::uint32_t from, std::uint32_t to);
+  std::uint32_t removedTriangleCount() const {
+    return static_cast<std::uint32_t>(removedTriangles_.size());
+  }
   // The cheapest valid, untouched target of `from` (its ranked best first); kNone if none.
   std::uint32_t validTarget(std::uint32_t from, float bestCost);
   void collapse(std::uint32_t from, std::uint32_t to);
@@ -108,27 +128,23 @@ class Simplifier {
   ProgressiveOptions options_;
   std::uint32_t vertexCount_, triangleCount_;
 
-  std::vector<RankPoint> rankPoints_;                  // positions in double + self costs
+  std::vector<VertexState> vertex_;
   std::vector<std::array<std::uint32_t, 3>> corners_;  // current (re-formed); dead: all kNone
-  std::vector<std::uint8_t> locked_;                   // Q: boundary or non-manifold
-  std::vector<std::uint8_t> removed_;                  // per vertex: collapsed already
   std::vector<Quadric> quadrics_;
-  std::vector<double> vertexError_;  // error carried by each live vertex
-  std::vector<Vec3d> faceNormals_;   // per pass, for Melax's cost
+  std::vector<Vec3d> faceNormals_;  // per pass, for Melax's cost
 
-  // Per pass: vertex -> live triangles (CSR), and each vertex's best collapse.
-  std::vector<std::uint32_t> incidentStart_, incidentCount_, incident_;
+  // Vertex -> triangles (ranges in VertexState); a grown fan is appended, stale lists stay
+  // behind until buildIncidence() compacts.
+  std::vector<std::uint32_t> incident_;
   std::vector<std::uint32_t> liveVertices_;  // not collapsed yet
-  std::vector<float> bestCost_;
-  std::vector<std::uint32_t> bestTarget_;
-  std::vector<std::uint8_t> dirty_;  // must be re-ranked next pass
   // (vertex, new neighbour): the one new cost to compare next pass.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> newNeighbour_;
+  std::size_t newNeighbourCount_ = 0;
+  std::vector<std::uint32_t> ringFrom_, ringTo_;  // valid(): the last pair's rings
+  std::size_t ringFromCount_ = 0, ringToCount_ = 0;
   std::vector<std::uint32_t> live_;
-  std::vector<std::uint32_t> active_;         // vertices that may still collapse
-  std::vector<std::uint32_t> nearTo_, seen_;  // stamps for valid()
+  std::vector<std::uint32_t> active_;  // vertices that may still collapse
   std::uint32_t stampToken_ = 0;
-  std::vector<std::uint32_t> touched_;  // pass number that last touched the vertex
   std::uint32_t pass_ = 0;
   float passLimit_ = 0;  // the dearest cost this pass may collapse
 
@@ -142,19 +158,14 @@ class Simplifier {
 };
 
 void Simplifier::classifyBoundary() {
-  rankPoints_.resize(vertexCount_);
+  vertex_.assign(vertexCount_, VertexState{});
   for (std::uint32_t v = 0; v < vertexCount_; ++v) {
-    const Vec3d p = toDouble(positions_[v]);
-    rankPoints_[v] = {p.x, p.y, p.z, 0};
+    vertex_[v].x = positions_[v].x;
+    vertex_[v].y = positions_[v].y;
+    vertex_[v].z = positions_[v].z;
   }
   corners_.resize(triangleCount_);
-  locked_.assign(vertexCount_, 0);
-  removed_.assign(vertexCount_, 0);
   target_.assign(vertexCount_, kNone);
-  vertexError_.assign(vertexCount_, 0.0);
-  touched_.assign(vertexCount_, 0);
-  nearTo_.assign(vertexCount_, 0);
-  seen_.assign(vertexCount_, 0);
   for (std::uint32_t t = 0; t < triangleCount_; ++t) {
     for (std::size_t k = 0; k < 3; ++k) {
       corners_[t][k] = indices_[3 * t + k];
@@ -179,7 +190,7 @@ void Simplifier::classifyBoundary() {
     }
     for (std::uint32_t t : fan) {
       for (std::uint32_t w : corners_[t]) {
-        if (w != u && edgeCount[w] != 2) locked_[u] = 1;
+        if (w != u && edgeCount[w] != 2) vertex_[u].locked = 1;
       }
     }
   }
@@ -198,56 +209,78 @@ void Simplifier::computeQuadrics() {
     for (std::uint32_t v : c) quadrics_[v] += plane;
   }
   for (std::uint32_t v = 0; v < vertexCount_; ++v)
-    rankPoints_[v].selfCost = quadrics_[v].evaluate(position(v));
+    vertex_[v].selfCost = quadrics_[v].evaluate(position(v));
 }
 
 bool Simplifier::allowed(std::uint32_t from, std::uint32_t to) const {
   // Eq. 1: a boundary vertex never moves; an edge between two is never collapsed.
-  if (locked_[from]) return false;
+  if (vertex_[from].locked) return false;
   if (options_.direction == CollapseDirection::kCheaper) return true;
   // Eq. 1 literally: the lower index moves unless it is a boundary vertex.
-  return from < to || locked_[to];
+  return from < to || vertex_[to].locked;
 }
 
 void Simplifier::buildIncidence() {
-  // Only the live triangles and vertices: the lists shrink pass after pass, and so does this
-  // work. The first pass reuses the incidence that classifyBoundary() built.
+  // Only the live triangles and vertices. Between rebuilds, collapse() appends the one fan that
+  // grows, so the array fills with stale lists; a rebuild compacts it.
   if (live_.empty()) {
     live_.resize(triangleCount_);
     for (std::uint32_t t = 0; t < triangleCount_; ++t) live_[t] = t;
     liveVertices_.resize(vertexCount_);
     for (std::uint32_t v = 0; v < vertexCount_; ++v) liveVertices_[v] = v;
-    incidentStart_.resize(vertexCount_);
-    incidentCount_.resize(vertexCount_);
-  } else if (pass_ == 1) {
-    return;
   } else {
     std::erase_if(live_, [&](std::uint32_t t) { return !alive(t); });
-    std::erase_if(liveVertices_, [&](std::uint32_t v) { return removed_[v] != 0; });
+    std::erase_if(liveVertices_, [&](std::uint32_t v) { return vertex_[v].removed != 0; });
   }
-  for (std::uint32_t v : liveVertices_) incidentCount_[v] = 0;
+  for (std::uint32_t v : liveVertices_) vertex_[v].incidentCount = 0;
   for (std::uint32_t t : live_) {
-    for (std::uint32_t v : corners_[t]) ++incidentCount_[v];
+    for (std::uint32_t v : corners_[t]) ++vertex_[v].incidentCount;
   }
   std::uint32_t end = 0;
   for (std::uint32_t v : liveVertices_) {
-    end += incidentCount_[v];
-    incidentStart_[v] = end;  // filled backwards below, so it ends at the start
+    end += vertex_[v].incidentCount;
+    vertex_[v].incidentStart = end;  // filled backwards below, so it ends at the start
   }
   incident_.resize(end);
   // Backwards, so that each fan lists its triangles in increasing order.
   for (auto t = live_.rbegin(); t != live_.rend(); ++t) {
-    for (std::uint32_t v : corners_[*t]) incident_[--incidentStart_[v]] = *t;
+    for (std::uint32_t v : corners_[*t]) incident_[--vertex_[v].incidentStart] = *t;
   }
-  if (options_.cost == CollapseCost::kMelax) {
-    faceNormals_.resize(triangleCount_);
-    tbb::parallel_for(std::size_t{0}, live_.size(), [&](std::size_t i) {
-      const std::uint32_t t = live_[i];
-      const Vec3d a = position(corners_[t][0]), b = position(corners_[t][1]),
-                  c = position(corners_[t][2]);
-      faceNormals_[t] = normalizeOr(cross(b - a, c - a), Vec3d{});
-    });
+}
+
+void Simplifier::mergeFans(std::uint32_t from, std::uint32_t to) {
+  // After the collapse, the fan of `to` is its own live triangles and those `from` handed over
+  // (the two sets are disjoint: a triangle with both ends died). Both lists are in increasing
+  // order and so is the merge, as a rebuild would list them.
+  const std::size_t start = incident_.size();
+  VertexState& target = vertex_[to];
+  const VertexState& source = vertex_[from];
+  incident_.resize(start + target.incidentCount + source.incidentCount);
+  const std::uint32_t* a = incident_.data() + target.incidentStart;
+  const std::uint32_t* const aEnd = a + target.incidentCount;
+  const std::uint32_t* b = incident_.data() + source.incidentStart;
+  const std::uint32_t* const bEnd = b + source.incidentCount;
+  std::uint32_t* const first = incident_.data() + start;
+  std::uint32_t* out = first;
+  while (a != aEnd || b != bEnd) {
+    const std::uint32_t t = b == bEnd || (a != aEnd && *a < *b) ? *a++ : *b++;
+    *out = t;
+    out += alive(t);
   }
+  target.incidentStart = static_cast<std::uint32_t>(start);
+  target.incidentCount = static_cast<std::uint32_t>(out - first);
+  incident_.resize(start + target.incidentCount);
+}
+
+void Simplifier::updateFaceNormals() {
+  std::erase_if(live_, [&](std::uint32_t t) { return !alive(t); });
+  faceNormals_.resize(triangleCount_);
+  tbb::parallel_for(std::size_t{0}, live_.size(), [&](std::size_t i) {
+    const std::uint32_t t = live_[i];
+    const Vec3d a = position(corners_[t][0]), b = position(corners_[t][1]),
+                c = position(corners_[t][2]);
+    faceNormals_[t] = normalizeOr(cross(b - a, c - a), Vec3d{});
+  });
 }
 
 float Simplifier::cost(std::uint32_t from, std::uint32_t to) const {
@@ -272,21 +305,16 @@ float Simplifier::cost(std::uint32_t from, std::uint32_t to) const {
 }
 
 void Simplifier::rankCollapses() {
-  if (bestCost_.empty()) {
-    bestCost_.assign(vertexCount_, 0);
-    bestTarget_.assign(vertexCount_, kNone);
-    dirty_.assign(vertexCount_, 1);
-  }
   // Only vertices whose cost inputs changed last pass (Melax's cost looks at whole fans, so
   // it re-ranks everything).
   const bool all = options_.cost == CollapseCost::kMelax;
   if (active_.empty() && pass_ == 1) {
     for (std::uint32_t u = 0; u < vertexCount_; ++u) {
-      if (!locked_[u]) active_.push_back(u);
+      if (!vertex_[u].locked) active_.push_back(u);
     }
   } else {
     active_.erase(std::remove_if(active_.begin(), active_.end(),
-                                 [&](std::uint32_t u) { return removed_[u] != 0; }),
+                                 [&](std::uint32_t u) { return vertex_[u].removed != 0; }),
                   active_.end());
   }
   rankNewNeighbours();
@@ -294,15 +322,16 @@ void Simplifier::rankCollapses() {
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t a = range.begin(); a < range.end(); ++a) {
                         const std::uint32_t u = active_[a];
-                        if (!all && !dirty_[u]) continue;
-                        dirty_[u] = 0;
-                        bestTarget_[u] = kNone;
+                        if (!all && !vertex_[u].dirty) continue;
+                        vertex_[u].dirty = 0;
+                        vertex_[u].bestTarget = kNone;
                         // Each neighbour once: the corner after u in each triangle of its fan (an
                         // interior vertex of a consistently oriented manifold sees every neighbour
                         // exactly so).
                         float best = std::numeric_limits<float>::max();
                         const Quadric& q = quadrics_[u];
                         for (std::uint32_t t : around(u)) {
+                          if (!alive(t)) continue;
                           const auto& c = corners_[t];
                           const std::uint32_t v = c[0] == u ? c[1] : (c[1] == u ? c[2] : c[0]);
                           if (!allowed(u, v)) continue;
@@ -311,14 +340,14 @@ void Simplifier::rankCollapses() {
                           const float cost =
                               options_.cost == CollapseCost::kQuadric
                                   ? static_cast<float>(std::max(
-                                        0.0, q.evaluate(position(v)) + rankPoints_[v].selfCost))
+                                        0.0, q.evaluate(position(v)) + vertex_[v].selfCost))
                                   : this->cost(u, v);
-                          if (cost < best || (cost == best && v < bestTarget_[u])) {
+                          if (cost < best || (cost == best && v < vertex_[u].bestTarget)) {
                             best = cost;
-                            bestTarget_[u] = v;
+                            vertex_[u].bestTarget = v;
                           }
                         }
-                        bestCost_[u] = best;
+                        vertex_[u].bestCost = best;
                       }
                     });
 }
@@ -326,22 +355,41 @@ void Simplifier::rankCollapses() {
 bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
   // Neighbourhoods from the pass's incidence: complete for any vertex no collapse of this pass
   // has targeted (dead triangles skipped, moved corners updated). Stamps instead of sets.
+  // Both rings are kept (each vertex once, the ends left out): if the collapse goes ahead,
+  // markChanged() walks them instead of the fans. Branch-free: which corner is new is random.
   const std::uint32_t stamp = ++stampToken_;
-  for (std::uint32_t t : around(to)) {
+  const auto toFan = around(to), fromFan = around(from);
+  if (ringTo_.size() < 3 * toFan.size()) ringTo_.resize(6 * toFan.size());
+  if (ringFrom_.size() < 3 * fromFan.size()) ringFrom_.resize(6 * fromFan.size());
+  std::size_t ringTo = 0, ringFrom = 0;
+  for (std::uint32_t t : toFan) {
     if (!alive(t)) continue;
-    for (std::uint32_t w : corners_[t]) nearTo_[w] = stamp;
-  }
-  std::uint32_t shared = 0, common = 0, fan = 0;
-  for (std::uint32_t t : around(from)) {
-    if (!alive(t)) continue;
-    ++fan;
-    shared += contains(t, to) ? 1u : 0u;
     for (std::uint32_t w : corners_[t]) {
-      if (w == from || w == to || seen_[w] == stamp) continue;
-      seen_[w] = stamp;
-      common += nearTo_[w] == stamp ? 1u : 0u;
+      VertexState& sw = vertex_[w];
+      ringTo_[ringTo] = w;
+      ringTo += (w != from) & (w != to) & (sw.nearStamp != stamp);
+      sw.nearStamp = stamp;
     }
   }
+  ringToCount_ = ringTo;
+  std::uint32_t shared = 0, common = 0, fan = 0;
+  for (std::uint32_t t : fromFan) {
+    if (!alive(t)) continue;
+    ++fan;
+    const bool onEdge = contains(t, to);
+    shared += onEdge;
+    for (std::uint32_t w : corners_[t]) {
+      // Marking the two ends as seen is harmless (stamps are per call).
+      VertexState& sw = vertex_[w];
+      const bool fresh = (w != from) & (w != to) & (sw.seenStamp != stamp);
+      common += fresh & (sw.nearStamp == stamp);
+      sw.gains = static_cast<std::uint8_t>((fresh ? 0 : sw.gains) | !onEdge);
+      sw.seenStamp = stamp;
+      ringFrom_[ringFrom] = w;
+      ringFrom += fresh;
+    }
+  }
+  ringFromCount_ = ringFrom;
   if (shared == 0) return false;  // the edge is gone
   // Link condition: the common neighbours of the two ends are exactly the opposite corners of
   // the triangles on the edge; otherwise the collapse would create a non-manifold edge.
@@ -379,9 +427,9 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
 }
 
 std::uint32_t Simplifier::validTarget(std::uint32_t from, float bestCost) {
-  const std::uint32_t best = bestTarget_[from];
+  const std::uint32_t best = vertex_[from].bestTarget;
   // A touched target has a new quadric and fan: `from` is dirty and re-ranked next pass.
-  if (touched_[best] == pass_) return kNone;
+  if (vertex_[best].touched == pass_) return kNone;
   if (valid(from, best)) return best;
   // The best is blocked: the others in cost order, as long as they are not much dearer than
   // what this pass is collapsing anyway.
@@ -390,7 +438,7 @@ std::uint32_t Simplifier::validTarget(std::uint32_t from, float bestCost) {
   for (std::uint32_t t : around(from)) {
     if (!alive(t)) continue;
     for (std::uint32_t v : corners_[t]) {
-      if (v == from || v == best || touched_[v] == pass_ || !allowed(from, v) ||
+      if (v == from || v == best || vertex_[v].touched == pass_ || !allowed(from, v) ||
           count == others.size())
         continue;
       if (std::find_if(others.begin(), others.begin() + static_cast<std::ptrdiff_t>(count),
@@ -415,50 +463,50 @@ void Simplifier::markChanged(std::uint32_t from, std::uint32_t to) {
   // the old neighbours of `to`, new for those `from` hands over. A vertex whose best was one of
   // the ends is re-ranked in full; one that gains `to` compares that one cost; the rest keep
   // their best. Melax's cost looks at whole fans: everyone around is re-ranked.
-  dirty_[to] = 1;
+  vertex_[to].dirty = 1;
   const bool melax = options_.cost == CollapseCost::kMelax;
-  const std::uint32_t stamp = ++stampToken_;
-  for (std::uint32_t v : {from, to}) {
-    for (std::uint32_t t : around(v)) {
-      if (!alive(t)) continue;
-      const bool gainsTo = v == from && !contains(t, to);
-      for (std::uint32_t w : corners_[t]) {
-        if (w == from || w == to || dirty_[w]) continue;
-        if (melax || bestTarget_[w] == from || bestTarget_[w] == to) {
-          dirty_[w] = 1;
-        } else if (gainsTo && seen_[w] != stamp) {
-          seen_[w] = stamp;
-          newNeighbour_.emplace_back(w, to);
-        }
-      }
-    }
+  // The rings valid() just collected: from's ring first (who gains `to`), then to's.
+  if (newNeighbour_.size() < newNeighbourCount_ + ringFromCount_)
+    newNeighbour_.resize(2 * (newNeighbourCount_ + ringFromCount_));
+  for (std::uint32_t w : std::span(ringFrom_).first(ringFromCount_)) {
+    VertexState& sw = vertex_[w];
+    const bool other = !sw.dirty;
+    const bool redo = other & (melax | (sw.bestTarget == from) | (sw.bestTarget == to));
+    sw.dirty = static_cast<std::uint8_t>(sw.dirty | redo);
+    newNeighbour_[newNeighbourCount_] = {w, to};
+    newNeighbourCount_ += other & !redo & (sw.gains != 0);
+  }
+  for (std::uint32_t w : std::span(ringTo_).first(ringToCount_)) {
+    VertexState& sw = vertex_[w];
+    sw.dirty = static_cast<std::uint8_t>(sw.dirty | melax | (sw.bestTarget == from) |
+                                         (sw.bestTarget == to));
   }
 }
 
 void Simplifier::rankNewNeighbours() {
   // The same result as a full re-rank of these vertices: their other costs did not change, and
   // ties go to the lower index as there.
-  for (const auto& [w, to] : newNeighbour_) {
-    if (dirty_[w] || removed_[w] || !allowed(w, to)) continue;
+  for (const auto& [w, to] : std::span(newNeighbour_).first(newNeighbourCount_)) {
+    if (vertex_[w].dirty || vertex_[w].removed || !allowed(w, to)) continue;
     const float cost = static_cast<float>(
-        std::max(0.0, quadrics_[w].evaluate(position(to)) + rankPoints_[to].selfCost));
-    if (cost < bestCost_[w] || (cost == bestCost_[w] && to < bestTarget_[w])) {
-      bestCost_[w] = cost;
-      bestTarget_[w] = to;
+        std::max(0.0, quadrics_[w].evaluate(position(to)) + vertex_[to].selfCost));
+    if (cost < vertex_[w].bestCost || (cost == vertex_[w].bestCost && to < vertex_[w].bestTarget)) {
+      vertex_[w].bestCost = cost;
+      vertex_[w].bestTarget = to;
     }
   }
-  newNeighbour_.clear();
+  newNeighbourCount_ = 0;
 }
 
 void Simplifier::collapse(std::uint32_t from, std::uint32_t to) {
   const Vec3d moved = position(from);
   double distance = std::numeric_limits<double>::max();
   // Only the two ends are off limits for the rest of the pass: `to` is the one vertex whose fan
-  // grows (its incidence list would be stale) and whose quadric changes. Every other vertex
-  // keeps a complete incidence list (dead triangles are skipped, moved corners are updated in
-  // place), so later checks in the pass still see the current mesh. Everyone whose cost inputs
-  // change is re-ranked next pass.
-  touched_[from] = touched_[to] = pass_;
+  // grows (merged below) and whose quadric changes, so its ranked costs are stale. Every other
+  // vertex keeps a complete fan (dead triangles are skipped, moved corners are updated in
+  // place), so later checks in the pass see the current mesh. Everyone whose cost inputs change
+  // is re-ranked next pass.
+  vertex_[from].touched = vertex_[to].touched = pass_;
   markChanged(from, to);
   for (std::uint32_t t : around(from)) {
     if (!alive(t)) continue;
@@ -475,15 +523,16 @@ void Simplifier::collapse(std::uint32_t from, std::uint32_t to) {
         distance, pointTriangleDistanceSquared(moved, position(corners_[t][0]),
                                                position(corners_[t][1]), position(corners_[t][2])));
   }
-  removed_[from] = 1;
+  mergeFans(from, to);
+  vertex_[from].removed = 1;
   target_[from] = to;
   quadrics_[to] += quadrics_[from];
-  rankPoints_[to].selfCost = quadrics_[to].evaluate(position(to));
+  vertex_[to].selfCost = quadrics_[to].evaluate(position(to));
   // Per-vertex error bound: what `from` already stood for, plus how far it just moved off the
   // surface (model units). The table keeps the running maximum so it is monotone.
   const double step = distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
-  vertexError_[to] = std::max(vertexError_[to], vertexError_[from] + step);
-  maxError_ = std::max(maxError_, vertexError_[to]);
+  vertex_[to].error = std::max(vertex_[to].error, vertex_[from].error + step);
+  maxError_ = std::max(maxError_, vertex_[to].error);
   collapsed_.push_back(from);
   trianglesAfter_.push_back(triangleCount_ - static_cast<std::uint32_t>(removedTriangles_.size()));
   errorAfter_.push_back(static_cast<float>(maxError_));
@@ -493,11 +542,14 @@ void Simplifier::collapseAll() {
   std::vector<std::pair<float, std::uint32_t>> ranked;
   while (true) {
     ++pass_;
-    buildIncidence();
+    // Compact the fans once stale lists fill half the array.
+    if (incident_.size() > 6 * std::size_t{triangleCount_ - removedTriangleCount()} + 4096)
+      buildIncidence();
+    if (options_.cost == CollapseCost::kMelax) updateFaceNormals();
     rankCollapses();
     ranked.clear();
     for (std::uint32_t u : active_) {
-      if (bestTarget_[u] != kNone) ranked.emplace_back(bestCost_[u], u);
+      if (vertex_[u].bestTarget != kNone) ranked.emplace_back(vertex_[u].bestCost, u);
     }
     if (ranked.empty()) break;
     // The cheapest share first, in cost order; if none of those can collapse, the rest before
@@ -524,7 +576,7 @@ void Simplifier::collapseAll() {
       passLimit_ = ranked[limit - 1].first;
       for (std::size_t i = 0; i < limit; ++i) {
         const std::uint32_t from = ranked[i].second;
-        if (touched_[from] == pass_ || removed_[from]) continue;
+        if (vertex_[from].touched == pass_ || vertex_[from].removed) continue;
         const std::uint32_t to = validTarget(from, ranked[i].first);
         if (to != kNone) collapse(from, to);
       }
@@ -544,7 +596,7 @@ ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
   mesh.permuteV.assign(vertexCount_, kNone);
   std::uint32_t next = 0;
   for (std::uint32_t v = 0; v < vertexCount_; ++v) {
-    if (!removed_[v]) mesh.permuteV[v] = next++;
+    if (!vertex_[v].removed) mesh.permuteV[v] = next++;
   }
   for (std::uint32_t k = 0; k < collapses; ++k) mesh.permuteV[collapsed_[k]] = vertexCount_ - 1 - k;
   // PermuteT: surviving triangles first, then the removed ones, latest removal first.
@@ -568,9 +620,9 @@ ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
     mesh.positions[to] = positions_[v];
     if (!normals.empty()) mesh.normals[to] = normals[v];
     if (!colors.empty()) mesh.colors[to] = colors[v];
-    mesh.ecol[to] = removed_[v] ? mesh.permuteV[target_[v]] : to;
+    mesh.ecol[to] = vertex_[v].removed ? mesh.permuteV[target_[v]] : to;
     // The target always outlives the collapsed vertex, so it sits earlier: chains decrease.
-    assert(!removed_[v] || mesh.ecol[to] < to);
+    assert(!vertex_[v].removed || mesh.ecol[to] < to);
   }
   mesh.triangles.resize(3 * std::size_t{triangleCount_});
   for (std::uint32_t t = 0; t < triangleCount_; ++t) {

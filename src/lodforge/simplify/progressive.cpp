@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "lodforge/core/distance.h"
 #include "lodforge/core/quadric.h"
@@ -38,18 +40,33 @@ constexpr std::uint32_t kNone = ~0u;
 constexpr double kPassShare = 0.2;
 constexpr std::size_t kBuckets = 32;  // cost buckets per pass, each walked in vertex order
 
-// Puts buckets [firstBucket, lastBucket) of `bucket` elements each (the share ends at `share`)
-// in cost order among themselves, leaving each bucket unsorted: selections, not a sort.
-template <class It>
-void partitionBuckets(It begin, std::size_t firstBucket, std::size_t lastBucket, std::size_t bucket,
-                      std::size_t share) {
-  if (lastBucket - firstBucket < 2) return;
-  const std::size_t middle = firstBucket + (lastBucket - firstBucket) / 2;
-  std::nth_element(begin + static_cast<std::ptrdiff_t>(firstBucket * bucket),
-                   begin + static_cast<std::ptrdiff_t>(middle * bucket),
-                   begin + static_cast<std::ptrdiff_t>(std::min(share, lastBucket * bucket)));
-  partitionBuckets(begin, firstBucket, middle, bucket, share);
-  partitionBuckets(begin, middle, lastBucket, bucket, share);
+using Candidate = std::pair<float, std::uint32_t>;  // (cost, vertex)
+
+// Sorts candidates by (cost, vertex) — for input in vertex order, which a stable LSD radix sort
+// on the cost's bits keeps among equal costs. Costs are >= 0, so their bits order as integers.
+void sortByCost(std::vector<Candidate>& items, std::vector<Candidate>& scratch) {
+  if (items.size() < 4096) {
+    std::sort(items.begin(), items.end());
+    return;
+  }
+  constexpr std::uint32_t kBits = 11, kDigits = 3;
+  constexpr std::uint32_t kMask = (1u << kBits) - 1;
+  std::vector<std::array<std::uint32_t, 1u << kBits>> counts(kDigits);
+  for (const Candidate& c : items) {
+    const auto key = std::bit_cast<std::uint32_t>(c.first);
+    for (std::uint32_t d = 0; d < kDigits; ++d) ++counts[d][(key >> (d * kBits)) & kMask];
+  }
+  scratch.resize(items.size());
+  for (std::uint32_t d = 0; d < kDigits; ++d) {
+    auto& count = counts[d];
+    const auto key0 = std::bit_cast<std::uint32_t>(items[0].first);
+    if (count[(key0 >> (d * kBits)) & kMask] == items.size()) continue;  // one digit value
+    std::uint32_t sum = 0;
+    for (std::uint32_t& c : count) sum += std::exchange(c, sum);
+    for (const Candidate& c : items)
+      scratch[count[(std::bit_cast<std::uint32_t>(c.first) >> (d * kBits)) & kMask]++] = c;
+    items.swap(scratch);
+  }
 }
 
 // Everything a collapse reads or writes about one vertex, in one cache line: a collapse visits
@@ -112,6 +129,7 @@ class Simplifier {
   void mergeFans(std::uint32_t from, std::uint32_t to);
   void updateFaceNormals();
   void rankCollapses();
+  void rankVertex(std::uint32_t u);
   float cost(std::uint32_t from, std::uint32_t to) const;
   bool valid(std::uint32_t from, std::uint32_t to);
   std::uint32_t removedTriangleCount() const {
@@ -306,50 +324,51 @@ float Simplifier::cost(std::uint32_t from, std::uint32_t to) const {
 
 void Simplifier::rankCollapses() {
   // Only vertices whose cost inputs changed last pass (Melax's cost looks at whole fans, so
-  // it re-ranks everything).
-  const bool all = options_.cost == CollapseCost::kMelax;
-  if (active_.empty() && pass_ == 1) {
+  // it re-ranks everything). In vertex order: neighbours in memory are neighbours on the surface.
+  if (pass_ == 1) {
     for (std::uint32_t u = 0; u < vertexCount_; ++u) {
       if (!vertex_[u].locked) active_.push_back(u);
     }
-  } else {
-    active_.erase(std::remove_if(active_.begin(), active_.end(),
-                                 [&](std::uint32_t u) { return vertex_[u].removed != 0; }),
-                  active_.end());
   }
+  const bool all = options_.cost == CollapseCost::kMelax;
   rankNewNeighbours();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active_.size(), 512),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t a = range.begin(); a < range.end(); ++a) {
-                        const std::uint32_t u = active_[a];
-                        if (!all && !vertex_[u].dirty) continue;
-                        vertex_[u].dirty = 0;
-                        vertex_[u].bestTarget = kNone;
-                        // Each neighbour once: the corner after u in each triangle of its fan (an
-                        // interior vertex of a consistently oriented manifold sees every neighbour
-                        // exactly so).
-                        float best = std::numeric_limits<float>::max();
-                        const Quadric& q = quadrics_[u];
-                        for (std::uint32_t t : around(u)) {
-                          if (!alive(t)) continue;
-                          const auto& c = corners_[t];
-                          const std::uint32_t v = c[0] == u ? c[1] : (c[1] == u ? c[2] : c[0]);
-                          if (!allowed(u, v)) continue;
-                          // (Q_u + Q_v)(p_v) = Q_u(p_v) + Q_v(p_v); the second term is cached per
-                          // vertex.
-                          const float cost =
-                              options_.cost == CollapseCost::kQuadric
-                                  ? static_cast<float>(std::max(
-                                        0.0, q.evaluate(position(v)) + vertex_[v].selfCost))
-                                  : this->cost(u, v);
-                          if (cost < best || (cost == best && v < vertex_[u].bestTarget)) {
-                            best = cost;
-                            vertex_[u].bestTarget = v;
-                          }
-                        }
-                        vertex_[u].bestCost = best;
+                        const VertexState& su = vertex_[active_[a]];
+                        if (!su.removed && (all || su.dirty)) rankVertex(active_[a]);
                       }
                     });
+}
+
+void Simplifier::rankVertex(std::uint32_t u) {
+  // Each neighbour once: the corner after u in each triangle of its fan (an interior vertex of a
+  // consistently oriented manifold sees every neighbour exactly so). u is active, so not locked.
+  // Branch-free where the data decides: u's corner and the running minimum.
+  static constexpr std::array<std::uint8_t, 3> kNext = {1, 2, 0};
+  const bool paper = options_.direction != CollapseDirection::kCheaper;
+  const bool quadric = options_.cost == CollapseCost::kQuadric;
+  const Quadric& q = quadrics_[u];
+  float best = std::numeric_limits<float>::max();
+  std::uint32_t bestTarget = kNone;
+  for (std::uint32_t t : around(u)) {
+    const auto& c = corners_[t];
+    if (c[0] == kNone) continue;  // died since the fan was listed
+    const std::uint32_t k = (c[1] == u) + 2u * (c[2] == u);
+    const std::uint32_t v = c[kNext[k]];
+    if (paper && !allowed(u, v)) continue;
+    // (Q_u + Q_v)(p_v) = Q_u(p_v) + Q_v(p_v); the second term is cached per vertex.
+    const float cost =
+        quadric ? static_cast<float>(std::max(0.0, q.evaluate(position(v)) + vertex_[v].selfCost))
+                : this->cost(u, v);
+    const bool better = (cost < best) | ((cost == best) & (v < bestTarget));
+    best = better ? cost : best;
+    bestTarget = better ? v : bestTarget;
+  }
+  VertexState& su = vertex_[u];
+  su.dirty = 0;
+  su.bestTarget = bestTarget;
+  su.bestCost = best;
 }
 
 bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
@@ -463,8 +482,8 @@ void Simplifier::markChanged(std::uint32_t from, std::uint32_t to) {
   // the old neighbours of `to`, new for those `from` hands over. A vertex whose best was one of
   // the ends is re-ranked in full; one that gains `to` compares that one cost; the rest keep
   // their best. Melax's cost looks at whole fans: everyone around is re-ranked.
-  vertex_[to].dirty = 1;
   const bool melax = options_.cost == CollapseCost::kMelax;
+  vertex_[to].dirty = 1;
   // The rings valid() just collected: from's ring first (who gains `to`), then to's.
   if (newNeighbour_.size() < newNeighbourCount_ + ringFromCount_)
     newNeighbour_.resize(2 * (newNeighbourCount_ + ringFromCount_));
@@ -478,8 +497,8 @@ void Simplifier::markChanged(std::uint32_t from, std::uint32_t to) {
   }
   for (std::uint32_t w : std::span(ringTo_).first(ringToCount_)) {
     VertexState& sw = vertex_[w];
-    sw.dirty = static_cast<std::uint8_t>(sw.dirty | melax | (sw.bestTarget == from) |
-                                         (sw.bestTarget == to));
+    const bool redo = (sw.dirty == 0) & (melax | (sw.bestTarget == from) | (sw.bestTarget == to));
+    sw.dirty = static_cast<std::uint8_t>(sw.dirty | redo);
   }
 }
 
@@ -539,7 +558,7 @@ void Simplifier::collapse(std::uint32_t from, std::uint32_t to) {
 }
 
 void Simplifier::collapseAll() {
-  std::vector<std::pair<float, std::uint32_t>> ranked;
+  std::vector<Candidate> ranked, scratch;
   while (true) {
     ++pass_;
     // Compact the fans once stale lists fill half the array.
@@ -547,23 +566,25 @@ void Simplifier::collapseAll() {
       buildIncidence();
     if (options_.cost == CollapseCost::kMelax) updateFaceNormals();
     rankCollapses();
+    // Drop the collapsed from the active list and list the candidates, in vertex order.
     ranked.clear();
+    std::size_t kept = 0;
     for (std::uint32_t u : active_) {
-      if (vertex_[u].bestTarget != kNone) ranked.emplace_back(vertex_[u].bestCost, u);
+      const VertexState& su = vertex_[u];
+      if (su.removed) continue;
+      active_[kept++] = u;
+      if (su.bestTarget != kNone) ranked.emplace_back(su.bestCost, u);
     }
+    active_.resize(kept);
     if (ranked.empty()) break;
     // The cheapest share first, in cost order; if none of those can collapse, the rest before
     // giving up.
     const std::size_t share = std::max<std::size_t>(
         1, static_cast<std::size_t>(kPassShare * static_cast<double>(ranked.size())));
-    std::nth_element(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(share - 1),
-                     ranked.end());
+    sortByCost(ranked, scratch);
     // Many small cost buckets, each walked in vertex order: neighbours in memory are neighbours
-    // on the surface (fewer cache misses on big meshes), and the cost order barely changes. Only
-    // the bucket boundaries need the cost order (pairs are unique, so the buckets hold exactly
-    // what a full sort would put there).
+    // on the surface (fewer cache misses on big meshes), and the cost order barely changes.
     const std::size_t bucket = std::max<std::size_t>(1, share / kBuckets);
-    partitionBuckets(ranked.begin(), 0, (share + bucket - 1) / bucket, bucket, share);
     for (std::size_t b = 0; b < share; b += bucket) {
       const auto first = ranked.begin() + static_cast<std::ptrdiff_t>(b);
       const auto last = ranked.begin() + static_cast<std::ptrdiff_t>(std::min(share, b + bucket));
@@ -571,10 +592,23 @@ void Simplifier::collapseAll() {
     }
     const std::size_t before = collapsed_.size();
     for (std::size_t limit : {share, ranked.size()}) {
-      if (limit == ranked.size() && limit > share)
-        std::sort(ranked.begin() + static_cast<std::ptrdiff_t>(share), ranked.end());
       passLimit_ = ranked[limit - 1].first;
       for (std::size_t i = 0; i < limit; ++i) {
+        // The candidates are known ahead and scattered over the mesh: fetch their lines early.
+        if (i + 8 < limit) {
+          const std::uint32_t ahead = ranked[i + 8].second;
+          __builtin_prefetch(&vertex_[ahead]);
+        }
+        if (i + 4 < limit) {
+          const VertexState& ahead = vertex_[ranked[i + 4].second];
+          __builtin_prefetch(&incident_[ahead.incidentStart]);
+          __builtin_prefetch(&vertex_[ahead.bestTarget]);
+        }
+        if (i + 2 < limit) {
+          const VertexState& ahead = vertex_[ranked[i + 2].second];
+          for (std::uint32_t t : around(ranked[i + 2].second)) __builtin_prefetch(&corners_[t]);
+          __builtin_prefetch(&incident_[vertex_[ahead.bestTarget].incidentStart]);
+        }
         const std::uint32_t from = ranked[i].second;
         if (vertex_[from].touched == pass_ || vertex_[from].removed) continue;
         const std::uint32_t to = validTarget(from, ranked[i].first);

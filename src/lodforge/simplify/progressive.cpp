@@ -115,6 +115,12 @@ class Simplifier {
   }
   // The dead mark shares the cache line the corners are read from anyway.
   bool alive(std::uint32_t t) const { return corners_[t][0] != kNone; }
+  // The corners of t other than v, which t holds (branch-free: where v sits is random).
+  std::array<std::uint32_t, 2> otherCorners(std::uint32_t t, std::uint32_t v) const {
+    const auto& c = corners_[t];
+    const std::uint32_t k = (c[1] == v) + 2u * (c[2] == v);
+    return {c[k == 2 ? 0 : k + 1], c[k == 0 ? 2 : k - 1]};
+  }
   bool contains(std::uint32_t t, std::uint32_t v) const {
     // Bitwise, not short-circuit: which corner matches is unpredictable.
     const auto& c = corners_[t];
@@ -201,16 +207,16 @@ void Simplifier::classifyBoundary() {
   for (std::uint32_t u = 0; u < vertexCount_; ++u) {
     const auto fan = around(u);
     for (std::uint32_t t : fan) {
-      for (std::uint32_t w : corners_[t]) edgeCount[w] = 0;
+      for (std::uint32_t w : otherCorners(t, u)) edgeCount[w] = 0;
     }
     for (std::uint32_t t : fan) {
-      for (std::uint32_t w : corners_[t]) ++edgeCount[w];
+      for (std::uint32_t w : otherCorners(t, u)) ++edgeCount[w];
     }
+    bool locked = false;
     for (std::uint32_t t : fan) {
-      for (std::uint32_t w : corners_[t]) {
-        if (w != u && edgeCount[w] != 2) vertex_[u].locked = 1;
-      }
+      for (std::uint32_t w : otherCorners(t, u)) locked |= edgeCount[w] != 2;
     }
+    vertex_[u].locked = locked;
   }
 }
 
@@ -345,7 +351,6 @@ void Simplifier::rankVertex(std::uint32_t u) {
   // Each neighbour once: the corner after u in each triangle of its fan (an interior vertex of a
   // consistently oriented manifold sees every neighbour exactly so). u is active, so not locked.
   // Branch-free where the data decides: u's corner and the running minimum.
-  static constexpr std::array<std::uint8_t, 3> kNext = {1, 2, 0};
   const bool paper = options_.direction != CollapseDirection::kCheaper;
   const bool quadric = options_.cost == CollapseCost::kQuadric;
   const Quadric& q = quadrics_[u];
@@ -354,8 +359,7 @@ void Simplifier::rankVertex(std::uint32_t u) {
   for (std::uint32_t t : around(u)) {
     const auto& c = corners_[t];
     if (c[0] == kNone) continue;  // died since the fan was listed
-    const std::uint32_t k = (c[1] == u) + 2u * (c[2] == u);
-    const std::uint32_t v = c[kNext[k]];
+    const std::uint32_t v = otherCorners(t, u)[0];
     if (paper && !allowed(u, v)) continue;
     // (Q_u + Q_v)(p_v) = Q_u(p_v) + Q_v(p_v); the second term is cached per vertex.
     const float cost =
@@ -380,13 +384,14 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
   const auto toFan = around(to), fromFan = around(from);
   if (ringTo_.size() < 3 * toFan.size()) ringTo_.resize(6 * toFan.size());
   if (ringFrom_.size() < 3 * fromFan.size()) ringFrom_.resize(6 * fromFan.size());
+  // Every triangle of a fan holds its centre once, so only the other two corners are walked.
   std::size_t ringTo = 0, ringFrom = 0;
   for (std::uint32_t t : toFan) {
     if (!alive(t)) continue;
-    for (std::uint32_t w : corners_[t]) {
+    for (std::uint32_t w : otherCorners(t, to)) {
       VertexState& sw = vertex_[w];
       ringTo_[ringTo] = w;
-      ringTo += (w != from) & (w != to) & (sw.nearStamp != stamp);
+      ringTo += (w != from) & (sw.nearStamp != stamp);
       sw.nearStamp = stamp;
     }
   }
@@ -395,12 +400,13 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
   for (std::uint32_t t : fromFan) {
     if (!alive(t)) continue;
     ++fan;
-    const bool onEdge = contains(t, to);
+    const auto others = otherCorners(t, from);
+    const bool onEdge = (others[0] == to) | (others[1] == to);
     shared += onEdge;
-    for (std::uint32_t w : corners_[t]) {
-      // Marking the two ends as seen is harmless (stamps are per call).
+    for (std::uint32_t w : others) {
+      // Marking `to` as seen is harmless (stamps are per call).
       VertexState& sw = vertex_[w];
-      const bool fresh = (w != from) & (w != to) & (sw.seenStamp != stamp);
+      const bool fresh = (w != to) & (sw.seenStamp != stamp);
       common += fresh & (sw.nearStamp == stamp);
       sw.gains = static_cast<std::uint8_t>((fresh ? 0 : sw.gains) | !onEdge);
       sw.seenStamp = stamp;

@@ -1,6 +1,10 @@
 #include "lodforge/core/math.h"
 
+#include <bit>
+
 #include <gtest/gtest.h>
+
+#include "lodforge/core/quadric.h"
 
 #include "lodforge/core/random.h"
 
@@ -57,6 +61,38 @@ TEST(Mat4d, NormalMatrixKeepsNormalsPerpendicularUnderShearAndMirror) {
         dot(transformed, cross(m.transformVector(t1), m.transformVector(t2))) * m.determinant3(),
         0.0);
   }
+}
+
+TEST(Quadric, PairEvaluationEqualsSingleEvaluationToTheBit) {
+  // The progressive build ranks two neighbours at a time; its collapse order (and so every
+  // package) depends on these costs being exactly the single-point values.
+  Random random(5);
+  for (int i = 0; i < 2000; ++i) {
+    Quadric q;
+    const Vec3d origin{random.uniform(-1e4, 1e4), random.uniform(-1e4, 1e4),
+                       random.uniform(-10, 10)};
+    for (int plane = 0; plane < 6; ++plane) {
+      const Vec3d normal =
+          normalizeOr(Vec3d{random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1)},
+                      Vec3d{0, 0, 1});
+      q += Quadric::fromPlane(normal, origin + Vec3d{random.uniform(-1, 1), 0, 0},
+                              random.uniform(1e-6, 10));
+    }
+    const Vec3d p =
+        origin + Vec3d{random.uniform(-2, 2), random.uniform(-2, 2), random.uniform(-2, 2)};
+    const Vec3d r =
+        origin + Vec3d{random.uniform(-2, 2), random.uniform(-2, 2), random.uniform(-2, 2)};
+    double atP = 0, atR = 0;
+    q.evaluate(p, r, atP, atR);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(atP), std::bit_cast<std::uint64_t>(q.evaluate(p)));
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(atR), std::bit_cast<std::uint64_t>(q.evaluate(r)));
+  }
+  // And it is the quadric: zero on the plane, the squared distance off it.
+  const Quadric floor = Quadric::fromPlane({0, 0, 1}, {0, 0, 2}, 1);
+  double on = -1, off = -1;
+  floor.evaluate({5, -3, 2}, {1, 1, 5}, on, off);
+  EXPECT_DOUBLE_EQ(on, 0.0);
+  EXPECT_DOUBLE_EQ(off, 9.0);
 }
 
 TEST(Box3, EmptyAbsorbsPoints) {

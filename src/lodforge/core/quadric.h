@@ -31,6 +31,17 @@ struct Quadric {
     return a2 * x * x + 2 * ab * x * y + 2 * ac * x * z + 2 * ad * x + b2 * y * y + 2 * bc * y * z +
            2 * bd * y + c2 * z * z + 2 * cd * z + d2;
   }
+
+  // evaluate() at two points at once, in SSE2 lanes: the same operations in the same order,
+  // so each lane equals evaluate() to the bit (no fused multiply-add on the x86-64 baseline).
+  void evaluate(Vec3d p, Vec3d r, double& atP, double& atR) const {
+    using Pair = double __attribute__((vector_size(16)));
+    const Pair x = {p.x, r.x}, y = {p.y, r.y}, z = {p.z, r.z};
+    const Pair sum = a2 * x * x + 2 * ab * x * y + 2 * ac * x * z + 2 * ad * x + b2 * y * y +
+                     2 * bc * y * z + 2 * bd * y + c2 * z * z + 2 * cd * z + d2;
+    atP = sum[0];
+    atR = sum[1];
+  }
 };
 
 }  // namespace lodforge

@@ -356,19 +356,35 @@ void Simplifier::rankVertex(std::uint32_t u) {
   const Quadric& q = quadrics_[u];
   float best = std::numeric_limits<float>::max();
   std::uint32_t bestTarget = kNone;
+  const auto consider = [&](std::uint32_t v, float cost) {
+    const bool better = (cost < best) | ((cost == best) & (v < bestTarget));
+    best = better ? cost : best;
+    bestTarget = better ? v : bestTarget;
+  };
+  // (Q_u + Q_v)(p_v) = Q_u(p_v) + Q_v(p_v); the second term is cached per vertex. Quadric costs
+  // go two neighbours at a time (the minimum does not depend on the order).
+  const auto quadricCost = [&](double atV, std::uint32_t v) {
+    return static_cast<float>(std::max(0.0, atV + vertex_[v].selfCost));
+  };
+  std::uint32_t pending = kNone;
   for (std::uint32_t t : around(u)) {
     const auto& c = corners_[t];
     if (c[0] == kNone) continue;  // died since the fan was listed
     const std::uint32_t v = otherCorners(t, u)[0];
     if (paper && !allowed(u, v)) continue;
-    // (Q_u + Q_v)(p_v) = Q_u(p_v) + Q_v(p_v); the second term is cached per vertex.
-    const float cost =
-        quadric ? static_cast<float>(std::max(0.0, q.evaluate(position(v)) + vertex_[v].selfCost))
-                : this->cost(u, v);
-    const bool better = (cost < best) | ((cost == best) & (v < bestTarget));
-    best = better ? cost : best;
-    bestTarget = better ? v : bestTarget;
+    if (!quadric) {
+      consider(v, this->cost(u, v));
+    } else if (pending == kNone) {
+      pending = v;
+    } else {
+      double atPending = 0, atV = 0;
+      q.evaluate(position(pending), position(v), atPending, atV);
+      consider(pending, quadricCost(atPending, pending));
+      consider(v, quadricCost(atV, v));
+      pending = kNone;
+    }
   }
+  if (pending != kNone) consider(pending, quadricCost(q.evaluate(position(pending)), pending));
   VertexState& su = vertex_[u];
   su.dirty = 0;
   su.bestTarget = bestTarget;

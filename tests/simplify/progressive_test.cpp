@@ -1,6 +1,7 @@
 #include "lodforge/simplify/progressive.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 #include <vector>
@@ -309,6 +310,62 @@ TEST(Progressive, ErrorTableIsMonotoneAndGrowsAsDetailGoes) {
   const std::uint32_t n = mesh.vertexCountForError(e);
   EXPECT_LE(mesh.errorAt(n), e);
   EXPECT_TRUE(n == mesh.q || mesh.errorAt(n - 1) > e);
+}
+
+TEST(SimplifyMesh, StopsAtTheTargetKeepsLockedVerticesAndHonoursTheNormalLimit) {
+  Result<Model> model = readModel(test::dataPath("meshes/stanford-bunny.obj"));
+  ASSERT_TRUE(model.ok());
+  const PreparedObject bunny =
+      prepareObject(model->positions, {}, {}, model->indices, {.normals = false});
+  const std::uint32_t triangles = static_cast<std::uint32_t>(bunny.indices.size() / 3);
+
+  ProgressiveOptions options;
+  options.stopAtTriangles = triangles / 10;
+  const SimplifiedMesh tenth = simplifyMesh(bunny.positions, bunny.indices, options);
+  EXPECT_LE(tenth.indices.size() / 3, options.stopAtTriangles);
+  EXPECT_GE(tenth.indices.size() / 3, options.stopAtTriangles - 2);  // one collapse removes <= 2
+  EXPECT_GT(tenth.error, 0.0f);
+  // The same mesh as the progressive build's level with that many triangles.
+  const ProgressiveMesh full = buildProgressive(bunny.positions, bunny.indices, {}, {});
+  std::uint32_t n = full.q;
+  while (full.trianglesAt(n) < tenth.indices.size() / 3) ++n;
+  std::vector<std::uint32_t> level(3 * std::size_t{full.trianglesAt(n)});
+  reformObject(std::span(full.triangles).first(level.size()), full.ecol, n, 0, level);
+  std::multiset<std::array<Vec3f, 3>, bool (*)(const std::array<Vec3f, 3>&,
+                                               const std::array<Vec3f, 3>&)>
+      a([](const auto& x, const auto& y) {
+        return std::lexicographical_compare(&x[0].x, &x[0].x + 9, &y[0].x, &y[0].x + 9);
+      }),
+      b(a.key_comp());
+  for (std::size_t t = 0; t < level.size(); t += 3)
+    a.insert({full.positions[level[t]], full.positions[level[t + 1]], full.positions[level[t + 2]]});
+  for (std::size_t t = 0; t < tenth.indices.size(); t += 3) {
+    const auto at = [&](std::size_t k) { return bunny.positions[tenth.vertices[tenth.indices[t + k]]]; };
+    b.insert({at(0), at(1), at(2)});
+  }
+  EXPECT_TRUE(a == b);
+
+  // Locked vertices stay.
+  std::vector<std::uint8_t> locked(bunny.positions.size(), 0);
+  for (std::size_t v = 0; v < locked.size(); v += 17) locked[v] = 1;
+  options.locked = locked;
+  const SimplifiedMesh pinned = simplifyMesh(bunny.positions, bunny.indices, options);
+  std::vector<std::uint8_t> kept(bunny.positions.size(), 0);
+  for (std::uint32_t v : pinned.vertices) kept[v] = 1;
+  for (std::size_t v = 0; v < locked.size(); ++v) {
+    if (locked[v]) {
+      ASSERT_TRUE(kept[v]) << v;
+    }
+  }
+
+  // A strict normal limit stops earlier than the default one, and no face turns past it.
+  options.locked = {};
+  options.stopAtTriangles = 1;
+  options.minNormalCos = std::cos(10 * 3.14159265358979 / 180);
+  const SimplifiedMesh strict = simplifyMesh(bunny.positions, bunny.indices, options);
+  options.minNormalCos = 0.25;
+  const SimplifiedMesh loose = simplifyMesh(bunny.positions, bunny.indices, options);
+  EXPECT_GT(strict.indices.size(), 2 * loose.indices.size());
 }
 
 TEST(Progressive, AttributesFollowTheirVertices) {

@@ -10,6 +10,7 @@
 
 #include "lodforge/core/distance.h"
 #include "lodforge/core/quadric.h"
+#include "lodforge/simplify/reform.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -101,7 +102,10 @@ class Simplifier {
         indices_(indices),
         options_(options),
         vertexCount_(static_cast<std::uint32_t>(positions.size())),
-        triangleCount_(static_cast<std::uint32_t>(indices.size() / 3)) {}
+        triangleCount_(static_cast<std::uint32_t>(indices.size() / 3)),
+        minNormalCos2_(options.minNormalCos * options.minNormalCos) {
+    assert(options.locked.empty() || options.locked.size() == positions.size());
+  }
 
   void classifyBoundary();
   void computeQuadrics();
@@ -151,6 +155,7 @@ class Simplifier {
   std::span<const std::uint32_t> indices_;
   ProgressiveOptions options_;
   std::uint32_t vertexCount_, triangleCount_;
+  double minNormalCos2_;  // squared: compared without roots
 
   std::vector<VertexState> vertex_;
   std::vector<std::array<std::uint32_t, 3>> corners_;  // current (re-formed); dead: all kNone
@@ -216,7 +221,7 @@ void Simplifier::classifyBoundary() {
     for (std::uint32_t t : fan) {
       for (std::uint32_t w : otherCorners(t, u)) locked |= edgeCount[w] != 2;
     }
-    vertex_[u].locked = locked;
+    vertex_[u].locked = locked || (!options_.locked.empty() && options_.locked[u] != 0);
   }
 }
 
@@ -462,7 +467,7 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
     // No flip, and no face turned by more than ~75 degrees either: near-flips make slivers
     // that stick out of the surface.
     const double d = dot(n0, n1), l0 = dot(n0, n0), l1 = dot(n1, n1);
-    if (d <= 0 || l1 <= 0 || d * d <= 0.0625 * l0 * l1) return false;  // cos <= 0.25, without roots
+    if (d <= 0 || l1 <= 0 || d * d <= minNormalCos2_ * l0 * l1) return false;  // without roots
   }
   return true;
 }
@@ -634,7 +639,9 @@ void Simplifier::collapseAll() {
         const std::uint32_t from = ranked[i].second;
         if (vertex_[from].touched == pass_ || vertex_[from].removed) continue;
         const std::uint32_t to = validTarget(from, ranked[i].first);
-        if (to != kNone) collapse(from, to);
+        if (to == kNone) continue;
+        collapse(from, to);
+        if (triangleCount_ - removedTriangleCount() <= options_.stopAtTriangles) return;
       }
       if (collapsed_.size() > before) break;
     }
@@ -711,6 +718,22 @@ ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
   simplifier.computeQuadrics();
   simplifier.collapseAll();
   return simplifier.rearrange(normals, colors);
+}
+
+SimplifiedMesh simplifyMesh(std::span<const Vec3f> positions,
+                            std::span<const std::uint32_t> indices,
+                            const ProgressiveOptions& options) {
+  const ProgressiveMesh mesh = buildProgressive(positions, indices, {}, {}, options);
+  SimplifiedMesh out;
+  const std::uint32_t n = mesh.q;  // the collapses stopped at the target: q is that level
+  out.indices.resize(3 * std::size_t{mesh.trianglesAt(n)});
+  reformObject(std::span(mesh.triangles).first(out.indices.size()), mesh.ecol, n, 0, out.indices);
+  out.vertices.resize(n);
+  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
+    if (mesh.permuteV[v] < n) out.vertices[mesh.permuteV[v]] = v;
+  }
+  out.error = mesh.errorAt(n);
+  return out;
 }
 
 }  // namespace lodforge

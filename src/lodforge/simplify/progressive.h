@@ -29,6 +29,13 @@ enum class CollapseDirection : std::uint8_t {
 struct ProgressiveOptions {
   CollapseCost cost = CollapseCost::kQuadric;
   CollapseDirection direction = CollapseDirection::kCheaper;
+  // A collapse may turn no face by more than this (the cosine of the angle between its normals
+  // before and after): 0.25 (~75.5 degrees) stops near-flips; tiles ask for cos 30 degrees.
+  double minNormalCos = 0.25;
+  // Vertices that must never move, beside the boundary (one flag per vertex, or empty).
+  std::span<const std::uint8_t> locked{};
+  // Stop once the mesh has at most this many triangles (0: collapse down to the minimum).
+  std::uint32_t stopAtTriangles = 0;
 };
 
 // One object after preprocessing. p = vertexCount(), q = the vertices that never collapse (the
@@ -65,6 +72,20 @@ ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
                                  std::span<const std::uint32_t> indices,
                                  std::span<const Vec3f> normals, std::span<const Rgba8> colors,
                                  const ProgressiveOptions& options = {});
+
+// One simplified version of a mesh, by the same collapses: the kept input vertices and the
+// triangles over them (indices into `vertices`), and the recorded error of that level.
+struct SimplifiedMesh {
+  std::vector<std::uint32_t> vertices;  // input index of each kept vertex
+  std::vector<std::uint32_t> indices;   // 3 per triangle, < vertices.size()
+  float error = 0;                      // model units, as in ProgressiveMesh::error
+};
+
+// Collapses until at most `options.stopAtTriangles` triangles remain or nothing more may
+// collapse (borders, `options.locked`, the normal limit), and returns that mesh.
+SimplifiedMesh simplifyMesh(std::span<const Vec3f> positions,
+                            std::span<const std::uint32_t> indices,
+                            const ProgressiveOptions& options);
 
 // Memory buildProgressive needs for a mesh of this size (for memory budgets).
 std::uint64_t progressiveBuildBytes(std::uint64_t vertices, std::uint64_t triangles);

@@ -41,5 +41,6 @@ void addBench(CLI::App& app, const Global& global, Run& run);
 void addCompare(CLI::App& app, const Global& global, Run& run);
 void addRender(CLI::App& app, const Global& global, Run& run);
 void addView(CLI::App& app, const Global& global, Run& run);
+void addTiles(CLI::App& app, const Global& global, Run& run);
 
 }  // namespace lodforge::cli

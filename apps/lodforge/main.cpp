@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   cli::addConvert(app, global, run);
   cli::addBuild(app, global, run);
   cli::addExtract(app, global, run);
+  cli::addTiles(app, global, run);
   cli::addGenerate(app, global, run);
   cli::addBench(app, global, run);
   cli::addCompare(app, global, run);

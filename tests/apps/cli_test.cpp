@@ -312,6 +312,50 @@ TEST(CliPackage, BuildStaysUnderItsMemoryLimit) {
   EXPECT_EQ(info(dir.file("big.lfp"), dir)["objects"], 20'000u);
 }
 
+TEST(CliTiles, WritesATilesetAndReplacesOnlyATileset) {
+  test::TempDir dir;
+  const std::string out = dir.file("horse-tiles");
+  Outcome o = lodforge("tiles " + test::dataPath("meshes/horse.ply") + " -o " + out +
+                           " --chunk-size 0.05 --reduction 0.25 --max-normal-deviation 20",
+                       dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("tiles ("), std::string::npos) << o.out;
+  std::ifstream in(out + "/tileset.json");
+  const nlohmann::json tileset = nlohmann::json::parse(in);
+  EXPECT_EQ(tileset["asset"]["version"], "1.1");
+  EXPECT_TRUE(tileset["root"].contains("children"));
+  const std::size_t tiles = test::listFolder(out + "/tiles").size();
+  EXPECT_GT(tiles, 9u);
+  // Again over the previous tileset: replaced, nothing else left in the folder.
+  o = lodforge("tiles " + test::dataPath("meshes/horse.ply") + " -o " + out + " --levels 1", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_LT(test::listFolder(out + "/tiles").size(), tiles);
+  EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"horse-tiles"});
+  // A folder that is not a tileset is not overwritten.
+  std::filesystem::create_directories(dir.file("mine"));
+  std::ofstream(dir.file("mine/notes.txt")) << "mine";
+  o = lodforge("tiles " + test::dataPath("meshes/horse.ply") + " -o " + dir.file("mine"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("not a tileset"), std::string::npos) << o.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("mine/notes.txt")));
+}
+
+TEST(CliTiles, BadInputAndArgumentsAreExitCode2AndLeaveNothing) {
+  test::TempDir dir;
+  std::ofstream(dir.file("cut.ply"))
+      << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+         "property float y\nproperty float z\nend_header\n0 0 0\n";
+  Outcome o = lodforge("tiles " + dir.file("cut.ply") + " -o " + dir.file("out"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("cut.ply"), std::string::npos) << o.err;
+  EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"cut.ply"});
+  o = lodforge(
+      "tiles " + test::dataPath("meshes/horse.ply") + " -o " + dir.file("out") + " --reduction 1.5",
+      dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"cut.ply"});
+}
+
 TEST(CliBench, RunsEveryBudgetAndHitsItExactly) {
   test::TempDir dir;
   const std::string package = dir.file("engine.lfp");

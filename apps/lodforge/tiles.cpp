@@ -1,0 +1,61 @@
+// `lodforge tiles INPUT -o DIR`: a mesh of any size as a 3D Tiles 1.1 tileset (large-meshes
+// paper §3.2–3.4): chunk grid, octree of simplified super-chunks, one GLB per tile.
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "lodforge/core/memory.h"
+#include "lodforge/core/units.h"
+#include "lodforge/tiles/tileset.h"
+
+namespace lodforge::cli {
+
+void addTiles(CLI::App& app, const Global& global, Run& run) {
+  struct Options {
+    std::string input, output;
+    double chunkSize = 0;
+    int levels = 0;
+    double reduction = 0.2;
+    double maxNormalDeviation = 30;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh");
+  sub->add_option("INPUT", options->input, "A .ply .obj .stl .gltf or .glb mesh")->required();
+  sub->add_option("-o,--output", options->output, "The tileset directory to write")->required();
+  sub->add_option("--chunk-size", options->chunkSize,
+                  "Edge of a leaf chunk in model units (default: about 64K triangles per leaf)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--levels", options->levels, "Levels above the leaves (default: up to one root)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--reduction", options->reduction,
+                  "Share of its children's triangles a parent tile keeps (default 0.2)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--max-normal-deviation", options->maxNormalDeviation,
+                  "Largest angle in degrees a simplification step may turn a face (default 30)")
+      ->check(CLI::Range(0.0, 90.0));
+  sub->callback([&global, &run, options] {
+    run = [&global, options]() -> Status {
+      TilesOptions tiles;
+      tiles.chunkSize = options->chunkSize;
+      tiles.octree.levels = options->levels;
+      tiles.octree.keep = options->reduction;
+      tiles.octree.maxNormalDeviationDegrees = options->maxNormalDeviation;
+      tiles.octree.threads = static_cast<int>(global.threads);
+      Result<TilesStats> stats = writeTiles(options->input, options->output, tiles);
+      if (!stats) return stats.status();
+      say(global,
+          fmt::format(
+              "wrote {}: {} tiles ({} leaves, {} levels above them), {} in {:.1f} s ({} "
+              "input triangles/s)",
+              options->output, formatCount(stats->tiles), formatCount(stats->leaves), stats->levels,
+              formatBytes(stats->outputBytes), stats->seconds,
+              formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->inputTriangles) /
+                                                     std::max(stats->seconds, 1e-9)))));
+      detail(global, fmt::format("chunk size {:.4g}; {} triangles after cutting; peak memory {}",
+                                 stats->chunkSize, formatCount(stats->leafTriangles),
+                                 formatBytes(peakRssBytes())));
+      return {};
+    };
+  });
+}
+
+}  // namespace lodforge::cli

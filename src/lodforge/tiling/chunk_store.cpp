@@ -1,0 +1,225 @@
+#include "lodforge/tiling/chunk_store.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+
+#include <fmt/format.h>
+
+namespace lodforge {
+
+void weldExact(MeshPart& mesh) {
+  const std::uint32_t count = mesh.vertexCount();
+  std::vector<std::uint32_t> order(count);
+  std::iota(order.begin(), order.end(), 0u);
+  const auto less = [&](std::uint32_t a, std::uint32_t b) {
+    const Vec3d& p = mesh.positions[a];
+    const Vec3d& q = mesh.positions[b];
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    if (p.z != q.z) return p.z < q.z;
+    return a < b;
+  };
+  std::sort(order.begin(), order.end(), less);
+  // Each vertex points at the first vertex (lowest index) with its position.
+  std::vector<std::uint32_t> representative(count);
+  for (std::size_t i = 0; i < order.size();) {
+    std::size_t j = i;
+    while (j < order.size() && mesh.positions[order[j]] == mesh.positions[order[i]]) ++j;
+    for (std::size_t k = i; k < j; ++k) representative[order[k]] = order[i];
+    i = j;
+  }
+  // Triangles over representatives; drop those that repeat a corner.
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const std::uint32_t a = representative[mesh.indices[t]],
+                        b = representative[mesh.indices[t + 1]],
+                        c = representative[mesh.indices[t + 2]];
+    if (a == b || b == c || a == c) continue;
+    mesh.indices[kept++] = a, mesh.indices[kept++] = b, mesh.indices[kept++] = c;
+  }
+  mesh.indices.resize(kept);
+  // Renumber the used vertices in order of first use.
+  std::vector<std::uint32_t> remap(count, ~0u);
+  std::uint32_t next = 0;
+  for (std::uint32_t& v : mesh.indices) {
+    if (remap[v] == ~0u) remap[v] = next++;
+    v = remap[v];
+  }
+  std::vector<Vec3d> positions(next);
+  std::vector<Rgba8> colors(mesh.colors.empty() ? 0 : next);
+  for (std::uint32_t v = 0; v < count; ++v) {
+    if (remap[v] == ~0u) continue;
+    positions[remap[v]] = mesh.positions[v];
+    if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
+  }
+  mesh.positions = std::move(positions);
+  mesh.colors = std::move(colors);
+}
+
+MeshPart concatenate(std::span<const MeshPart> parts) {
+  MeshPart out;
+  const bool colors =
+      std::any_of(parts.begin(), parts.end(), [](const MeshPart& p) { return !p.colors.empty(); });
+  for (const MeshPart& part : parts) {
+    const std::uint32_t base = out.vertexCount();
+    out.positions.insert(out.positions.end(), part.positions.begin(), part.positions.end());
+    if (colors) {
+      if (part.colors.empty()) {
+        out.colors.resize(out.positions.size(), Rgba8{255, 255, 255, 255});
+      } else {
+        out.colors.insert(out.colors.end(), part.colors.begin(), part.colors.end());
+      }
+    }
+    for (std::uint32_t i : part.indices) out.indices.push_back(base + i);
+  }
+  return out;
+}
+
+namespace {
+
+constexpr char kMeshMagic[8] = {'L', 'F', 'M', 'E', 'S', 'H', '1', '\0'};
+constexpr std::size_t kCornerBytes = 3 * sizeof(double) + sizeof(Rgba8);
+constexpr std::size_t kTriangleBytes = 3 * kCornerBytes;
+
+Result<std::vector<std::byte>> readWhole(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return ioError(path, "cannot open");
+  const auto size = static_cast<std::size_t>(in.tellg());
+  std::vector<std::byte> bytes(size);
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size)))
+    return ioError(path, "cannot read");
+  return bytes;
+}
+
+Status appendTo(const std::string& path, std::span<const std::byte> bytes) {
+  std::FILE* file = std::fopen(path.c_str(), "ab");
+  if (file == nullptr) return ioErrorFromErrno(path, "open for appending");
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
+  const bool closed = std::fclose(file) == 0;
+  if (!ok || !closed) return ioErrorFromErrno(path, "append");
+  return {};
+}
+
+}  // namespace
+
+Status saveMesh(const MeshPart& mesh, const std::string& path) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return ioError(path, "cannot create");
+  const std::uint64_t header[3] = {mesh.positions.size(), mesh.colors.size(), mesh.indices.size()};
+  out.write(kMeshMagic, sizeof kMeshMagic);
+  out.write(reinterpret_cast<const char*>(header), sizeof header);
+  out.write(reinterpret_cast<const char*>(mesh.positions.data()),
+            static_cast<std::streamsize>(mesh.positions.size() * sizeof(Vec3d)));
+  out.write(reinterpret_cast<const char*>(mesh.colors.data()),
+            static_cast<std::streamsize>(mesh.colors.size() * sizeof(Rgba8)));
+  out.write(reinterpret_cast<const char*>(mesh.indices.data()),
+            static_cast<std::streamsize>(mesh.indices.size() * sizeof(std::uint32_t)));
+  if (!out.flush()) return ioError(path, "cannot write");
+  return {};
+}
+
+Result<MeshPart> loadMesh(const std::string& path) {
+  Result<std::vector<std::byte>> read = readWhole(path);
+  if (!read) return read.error();
+  const std::vector<std::byte>& bytes = read.value();
+  std::uint64_t header[3];
+  if (bytes.size() < sizeof kMeshMagic + sizeof header ||
+      std::memcmp(bytes.data(), kMeshMagic, sizeof kMeshMagic) != 0)
+    return badInputAtByte(path, 0, "not a lodforge mesh file (work file of `lodforge tiles`)");
+  std::memcpy(header, bytes.data() + sizeof kMeshMagic, sizeof header);
+  const std::uint64_t expected = sizeof kMeshMagic + sizeof header + header[0] * sizeof(Vec3d) +
+                                 header[1] * sizeof(Rgba8) + header[2] * sizeof(std::uint32_t);
+  if (bytes.size() != expected || (header[1] != 0 && header[1] != header[0]) || header[2] % 3 != 0)
+    return badInputAtByte(path, sizeof kMeshMagic, "mesh file sizes do not match its counts");
+  MeshPart mesh;
+  mesh.positions.resize(header[0]);
+  mesh.colors.resize(header[1]);
+  mesh.indices.resize(header[2]);
+  const std::byte* at = bytes.data() + sizeof kMeshMagic + sizeof header;
+  std::memcpy(mesh.positions.data(), at, header[0] * sizeof(Vec3d));
+  at += header[0] * sizeof(Vec3d);
+  std::memcpy(mesh.colors.data(), at, header[1] * sizeof(Rgba8));
+  at += header[1] * sizeof(Rgba8);
+  std::memcpy(mesh.indices.data(), at, header[2] * sizeof(std::uint32_t));
+  for (std::uint32_t i : mesh.indices) {
+    if (i >= header[0]) return badInputAtByte(path, 0, "mesh file index out of range");
+  }
+  return mesh;
+}
+
+ChunkWriter::ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bufferBytes)
+    : grid_(grid), directory_(std::move(directory)), bufferBytes_(bufferBytes) {
+  std::filesystem::create_directories(directory_);
+}
+
+std::string ChunkWriter::chunkPath(const ChunkCell& cell) const {
+  return fmt::format("{}/{}_{}_{}.tri", directory_, cell[0], cell[1], cell[2]);
+}
+
+Status ChunkWriter::add(const ChunkCell& cell, std::span<const CutCorner, 3> corners) {
+  const std::uint64_t index = grid_.cellIndex(cell);
+  std::vector<std::byte>& buffer = buffers_[index];
+  const std::size_t at = buffer.size();
+  buffer.resize(at + kTriangleBytes);
+  std::byte* out = buffer.data() + at;
+  for (const CutCorner& corner : corners) {
+    const double xyz[3] = {corner.position.x, corner.position.y, corner.position.z};
+    std::memcpy(out, xyz, sizeof xyz);
+    std::memcpy(out + sizeof xyz, &corner.color, sizeof(Rgba8));
+    out += kCornerBytes;
+  }
+  ++counts_[index];
+  ++triangles_;
+  buffered_ += kTriangleBytes;
+  if (buffered_ >= bufferBytes_) return flush();
+  return {};
+}
+
+Status ChunkWriter::flush() {
+  for (auto& [index, buffer] : buffers_) {
+    if (buffer.empty()) continue;
+    LODFORGE_TRY(appendTo(chunkPath(cellOfIndex(grid_, index)), buffer));
+    buffer.clear();
+    buffer.shrink_to_fit();
+  }
+  buffers_.clear();
+  buffered_ = 0;
+  return {};
+}
+
+Result<MeshPart> loadChunk(const std::string& path) {
+  Result<std::vector<std::byte>> read = readWhole(path);
+  if (!read) return read.error();
+  const std::vector<std::byte>& bytes = read.value();
+  if (bytes.size() % kTriangleBytes != 0)
+    return badInputAtByte(path, bytes.size() / kTriangleBytes * kTriangleBytes,
+                          "chunk file ends inside a triangle");
+  const std::size_t corners = bytes.size() / kCornerBytes;
+  MeshPart mesh;
+  mesh.positions.resize(corners);
+  mesh.colors.resize(corners);
+  mesh.indices.resize(corners);
+  for (std::size_t i = 0; i < corners; ++i) {
+    double xyz[3];
+    std::memcpy(xyz, bytes.data() + i * kCornerBytes, sizeof xyz);
+    mesh.positions[i] = {xyz[0], xyz[1], xyz[2]};
+    std::memcpy(&mesh.colors[i], bytes.data() + i * kCornerBytes + sizeof xyz, sizeof(Rgba8));
+    mesh.indices[i] = static_cast<std::uint32_t>(i);
+  }
+  weldExact(mesh);
+  return mesh;
+}
+
+ChunkCell cellOfIndex(const ChunkGrid& grid, std::uint64_t index) {
+  const auto dx = static_cast<std::uint64_t>(grid.dims[0]);
+  const auto dy = static_cast<std::uint64_t>(grid.dims[1]);
+  return {static_cast<std::int32_t>(index % dx), static_cast<std::int32_t>(index / dx % dy),
+          static_cast<std::int32_t>(index / (dx * dy))};
+}
+
+}  // namespace lodforge

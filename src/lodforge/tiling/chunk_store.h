@@ -1,0 +1,73 @@
+// Chunks on disk (large-meshes paper §3.3–3.4): the input streamed into the chunk grid as
+// triangle soups, one file per non-empty chunk, buffered in memory up to a budget and appended
+// to disk when it is reached; and meshes (a chunk once welded, an octree node once simplified)
+// saved and reloaded on demand, so only the nodes being built are ever in memory.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lodforge/core/math.h"
+#include "lodforge/core/status.h"
+#include "lodforge/tiling/chunk_grid.h"
+
+namespace lodforge {
+
+// An indexed mesh with exact (double) positions: what the octree passes between levels.
+struct MeshPart {
+  std::vector<Vec3d> positions;
+  std::vector<Rgba8> colors;  // empty or one per vertex
+  std::vector<std::uint32_t> indices;
+
+  std::uint32_t vertexCount() const { return static_cast<std::uint32_t>(positions.size()); }
+  std::uint64_t triangleCount() const { return indices.size() / 3; }
+  std::uint64_t memoryBytes() const {
+    return positions.size() * sizeof(Vec3d) + colors.size() * sizeof(Rgba8) +
+           indices.size() * sizeof(std::uint32_t);
+  }
+};
+
+// Welds bit-identical positions (cut vertices are made identical on purpose), drops triangles
+// that repeat a corner and vertices no triangle uses. The first vertex of a group keeps its
+// colour. Deterministic.
+void weldExact(MeshPart& mesh);
+
+// Appends `parts`, renumbering their indices.
+MeshPart concatenate(std::span<const MeshPart> parts);
+
+Status saveMesh(const MeshPart& mesh, const std::string& path);
+Result<MeshPart> loadMesh(const std::string& path);
+
+class ChunkWriter {
+ public:
+  // Chunk files go to `directory` (created); at most `bufferBytes` are held before appending.
+  ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bufferBytes);
+
+  // One triangle piece (3 corners) for `cell`.
+  Status add(const ChunkCell& cell, std::span<const CutCorner, 3> corners);
+  Status flush();
+
+  const ChunkGrid& grid() const { return grid_; }
+  // Non-empty chunks and their triangle counts, in cell order.
+  const std::map<std::uint64_t, std::uint64_t>& triangleCounts() const { return counts_; }
+  std::uint64_t triangleCount() const { return triangles_; }
+  std::string chunkPath(const ChunkCell& cell) const;
+
+ private:
+  ChunkGrid grid_;
+  std::string directory_;
+  std::uint64_t bufferBytes_ = 0, buffered_ = 0, triangles_ = 0;
+  std::map<std::uint64_t, std::vector<std::byte>> buffers_;  // by cell index
+  std::map<std::uint64_t, std::uint64_t> counts_;
+};
+
+// A chunk file read back as a welded mesh.
+Result<MeshPart> loadChunk(const std::string& path);
+
+// The cell of a cell index (inverse of ChunkGrid::cellIndex).
+ChunkCell cellOfIndex(const ChunkGrid& grid, std::uint64_t index);
+
+}  // namespace lodforge

@@ -1,0 +1,220 @@
+#include "lodforge/tiling/octree.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <numbers>
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "lodforge/core/distance.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/simplify/progressive.h"
+
+namespace lodforge {
+namespace {
+
+Aabbd boundsOf(const MeshPart& mesh) {
+  Aabbd box;
+  for (const Vec3d& p : mesh.positions) box.add(p);
+  return box;
+}
+
+// Float positions relative to `center`: what the simplifier and the distance kernel take.
+std::vector<Vec3f> relativeTo(const MeshPart& mesh, Vec3d center) {
+  std::vector<Vec3f> out(mesh.positions.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = toFloat(mesh.positions[i] - center);
+  return out;
+}
+
+// A sampling seed per node, so errors are reproducible.
+std::uint64_t seedOf(const OctreeNode& node) {
+  std::uint64_t seed = static_cast<std::uint64_t>(node.level) + 1;
+  for (std::int32_t c : node.cell) seed = seed * 1'000'003 + static_cast<std::uint32_t>(c);
+  return seed;
+}
+
+// Endpoints of edges with one triangle: the border the simplification keeps.
+std::uint64_t countBorderVertices(const MeshPart& mesh) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  edges.reserve(mesh.indices.size());
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = mesh.indices[t + k], b = mesh.indices[t + (k + 1) % 3];
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::uint8_t> border(mesh.positions.size(), 0);
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i == 1) border[edges[i].first] = border[edges[i].second] = 1;
+    i = j;
+  }
+  return static_cast<std::uint64_t>(std::count(border.begin(), border.end(), 1));
+}
+
+struct Builder {
+  const ChunkWriter& chunks;
+  const OctreeOptions& options;
+  const NodeSink& sink;
+  OctreeResult result;
+
+  std::string meshPath(const OctreeNode& node) const {
+    return fmt::format("{}/L{}_{}_{}_{}.mesh", options.workDirectory, node.level, node.cell[0],
+                       node.cell[1], node.cell[2]);
+  }
+
+  // Runs `work` for every node in `indices`, in parallel; the first failure wins.
+  Status forEach(const std::vector<std::uint32_t>& indices, const std::string& label,
+                 const std::function<Status(OctreeNode&)>& work) {
+    Progress progress(label, indices.size());
+    std::mutex mutex;
+    Status failure;
+    tbb::parallel_for(std::size_t{0}, indices.size(), [&](std::size_t i) {
+      {
+        std::lock_guard lock(mutex);
+        if (!failure.ok()) return;
+      }
+      Status status = checkCancelled();
+      if (status.ok()) status = work(result.nodes[indices[i]]);
+      progress.advance(1);
+      if (!status.ok()) {
+        std::lock_guard lock(mutex);
+        if (failure.ok()) failure = std::move(status);
+      }
+    });
+    progress.finish();
+    return failure;
+  }
+
+  Status buildLeaf(OctreeNode& node) {
+    Result<MeshPart> mesh = loadChunk(chunks.chunkPath(node.cell));
+    if (!mesh) return mesh.status();
+    node.bounds = boundsOf(*mesh);
+    node.triangles = mesh->triangleCount();
+    node.vertices = mesh->vertexCount();
+    node.meshPath = meshPath(node);
+    LODFORGE_TRY(saveMesh(*mesh, node.meshPath));
+    return sink(node, *mesh);
+  }
+
+  Status buildParent(OctreeNode& node) {
+    std::vector<MeshPart> parts;
+    double childError = 0;
+    for (std::uint32_t c : node.children) {
+      const OctreeNode& child = result.nodes[c];
+      Result<MeshPart> part = loadMesh(child.meshPath);
+      if (!part) return part.status();
+      parts.push_back(std::move(*part));
+      node.bounds.add(child.bounds);
+      childError = std::max(childError, child.geometricError);
+    }
+    // Weld the children along their shared borders: the cut vertices are bit-identical.
+    MeshPart merged = concatenate(parts);
+    parts.clear();
+    weldExact(merged);
+    node.lockedVertices = countBorderVertices(merged);
+    const Vec3d center = node.bounds.center();
+    const std::vector<Vec3f> positions = relativeTo(merged, center);
+    ProgressiveOptions simplify;
+    simplify.minNormalCos = std::cos(options.maxNormalDeviationDegrees * std::numbers::pi / 180);
+    simplify.stopAtTriangles = static_cast<std::uint32_t>(std::max<double>(
+        1, std::floor(options.keep * static_cast<double>(merged.triangleCount()))));
+    const SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
+    MeshPart mesh;
+    mesh.positions.resize(simplified.vertices.size());
+    if (!merged.colors.empty()) mesh.colors.resize(simplified.vertices.size());
+    for (std::size_t i = 0; i < simplified.vertices.size(); ++i) {
+      mesh.positions[i] = merged.positions[simplified.vertices[i]];
+      if (!mesh.colors.empty()) mesh.colors[i] = merged.colors[simplified.vertices[i]];
+    }
+    mesh.indices = simplified.indices;
+    // Geometric error: measured against the children's geometry, plus what they already
+    // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
+    // non-increasing from parent to child).
+    const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);
+    const SurfaceDistance distance =
+        surfaceDistance(simplifiedPositions, mesh.indices, positions, merged.indices,
+                        options.errorSamples, seedOf(node));
+    node.geometricError = childError + distance.hausdorff;
+    node.triangles = mesh.triangleCount();
+    node.vertices = mesh.vertexCount();
+    node.meshPath = meshPath(node);
+    LODFORGE_TRY(saveMesh(mesh, node.meshPath));
+    return sink(node, mesh);
+  }
+
+  Status run() {
+    std::vector<std::uint32_t> level;
+    for (const auto& [index, count] : chunks.triangleCounts()) {
+      OctreeNode node;
+      node.cell = cellOfIndex(chunks.grid(), index);
+      level.push_back(static_cast<std::uint32_t>(result.nodes.size()));
+      result.nodes.push_back(std::move(node));
+    }
+    if (level.empty()) return Error{ErrorKind::kBadInput, "the input has no triangles"};
+    LODFORGE_TRY(forEach(level, "tiles: leaves", [&](OctreeNode& n) { return buildLeaf(n); }));
+    int depth = 0;
+    while (level.size() > 1 && (options.levels == 0 || depth < options.levels)) {
+      ++depth;
+      // 2x2x2 nodes of this level share a parent.
+      std::map<ChunkCell, std::vector<std::uint32_t>> groups;
+      for (std::uint32_t i : level) {
+        const ChunkCell& c = result.nodes[i].cell;
+        groups[{c[0] >> 1, c[1] >> 1, c[2] >> 1}].push_back(i);
+      }
+      std::vector<std::uint32_t> parents;
+      for (auto& [cell, children] : groups) {
+        OctreeNode node;
+        node.level = depth;
+        node.cell = cell;
+        node.children = std::move(children);
+        parents.push_back(static_cast<std::uint32_t>(result.nodes.size()));
+        result.nodes.push_back(std::move(node));
+      }
+      LODFORGE_TRY(forEach(parents, fmt::format("tiles: level {}", depth),
+                           [&](OctreeNode& n) { return buildParent(n); }));
+      level = std::move(parents);
+    }
+    result.levels = depth;
+    if (level.size() == 1) {
+      result.root = level[0];
+      return {};
+    }
+    // Stopped below a single root (--levels): a root without content over the top level.
+    OctreeNode root;
+    root.level = depth + 1;
+    root.children = level;
+    for (std::uint32_t c : level) {
+      root.bounds.add(result.nodes[c].bounds);
+      root.geometricError = std::max(root.geometricError, result.nodes[c].geometricError);
+    }
+    root.geometricError = std::max(root.geometricError * 2, root.bounds.longestSide() / 100);
+    result.root = static_cast<std::uint32_t>(result.nodes.size());
+    result.nodes.push_back(std::move(root));
+    return {};
+  }
+};
+
+}  // namespace
+
+Result<OctreeResult> buildOctree(const ChunkWriter& chunks, const OctreeOptions& options,
+                                 const NodeSink& sink) {
+  Builder builder{chunks, options, sink, {}};
+  Status status;
+  if (options.threads > 0) {
+    tbb::task_arena arena(options.threads);
+    arena.execute([&] { status = builder.run(); });
+  } else {
+    status = builder.run();
+  }
+  if (!status.ok()) return status;
+  return std::move(builder.result);
+}
+
+}  // namespace lodforge

@@ -1,0 +1,119 @@
+#include "lodforge/tiling/chunk_grid.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "lodforge/core/mesh.h"
+#include "lodforge/core/random.h"
+#include "lodforge/io/model_io.h"
+#include "lodforge/tiling/chunk_store.h"
+
+namespace lodforge {
+namespace {
+
+double area(Vec3d a, Vec3d b, Vec3d c) {
+  return 0.5 * length(cross(b - a, c - a));
+}
+
+TEST(ChunkGrid, CellsCoverTheBoundsAndClampTheFarFace) {
+  Aabbd box;
+  box.add(Vec3d{-1, 2, 3});
+  box.add(Vec3d{9, 4.5, 3});  // flat in z
+  const ChunkGrid grid = ChunkGrid::over(box, 2.5);
+  EXPECT_EQ(grid.dims, (ChunkCell{4, 1, 1}));
+  EXPECT_EQ(grid.cellOf({9, 4.5, 3}), (ChunkCell{3, 0, 0}));
+  EXPECT_EQ(grid.cellOf({-1, 2, 3}), (ChunkCell{0, 0, 0}));
+  EXPECT_EQ(grid.cellOf({1.5, 3, 3}), (ChunkCell{1, 0, 0}));
+  EXPECT_DOUBLE_EQ(grid.plane(0, 2), 4.0);
+}
+
+TEST(ChunkGrid, DerivedSizeGivesAboutTheWantedTrianglesPerChunkOnASurface) {
+  Aabbd box;
+  box.add(Vec3d{0, 0, 0});
+  box.add(Vec3d{1000, 500, 20});
+  const double size = ChunkGrid::sizeFor(box, 10'000'000, 64 * 1024);
+  const double chunks = (1000 / size) * (500 / size);
+  EXPECT_NEAR(chunks, 10'000'000.0 / (64 * 1024), 1.0);
+  EXPECT_DOUBLE_EQ(ChunkGrid::sizeFor(box, 1000, 64 * 1024), 1000.0);  // small: one chunk
+}
+
+TEST(CutTriangle, PiecesKeepTheAreaAndLieInTheirCells) {
+  Random random(3);
+  Aabbd box;
+  box.add(Vec3d{0, 0, 0});
+  box.add(Vec3d{10, 10, 10});
+  const ChunkGrid grid = ChunkGrid::over(box, 1.7);
+  std::vector<ChunkCell> cells;
+  std::vector<CutCorner> corners;
+  for (int i = 0; i < 2000; ++i) {
+    std::array<CutCorner, 3> t;
+    const double spread = i % 2 == 0 ? 10 : 2;  // big ones cross many planes
+    const Vec3d base{random.uniform(0, 10 - spread), random.uniform(0, 10 - spread),
+                     random.uniform(0, 10 - spread)};
+    for (auto& c : t) {
+      c.position = base + Vec3d{random.uniform(0, spread), random.uniform(0, spread),
+                                random.uniform(0, spread)};
+      c.color = {static_cast<std::uint8_t>(random.uniform(0, 255)), 10, 20, 255};
+    }
+    cells.clear();
+    corners.clear();
+    cutTriangle(grid, t, cells, corners);
+    ASSERT_EQ(corners.size(), 3 * cells.size());
+    double sum = 0;
+    const Vec3d normal =
+        normalizeOr(cross(t[1].position - t[0].position, t[2].position - t[0].position), Vec3d{});
+    for (std::size_t p = 0; p < cells.size(); ++p) {
+      const Vec3d a = corners[3 * p].position, b = corners[3 * p + 1].position,
+                  c = corners[3 * p + 2].position;
+      sum += area(a, b, c);
+      // Same winding as the triangle it came from.
+      EXPECT_GE(dot(cross(b - a, c - a), normal), -1e-12);
+      const Aabbd cell = grid.cellBounds(cells[p]);
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Vec3d q = corners[3 * p + k].position;
+        for (int axis = 0; axis < 3; ++axis) {
+          EXPECT_GE(q[axis], cell.min[axis] - 1e-12);
+          EXPECT_LE(q[axis], cell.max[axis] + 1e-12);
+        }
+      }
+    }
+    EXPECT_NEAR(sum, area(t[0].position, t[1].position, t[2].position), 1e-9);
+  }
+}
+
+TEST(CutTriangle, TrianglesSharingAnEdgeGetBitIdenticalCutVertices) {
+  // A closed surface cut into chunks and welded exactly is still closed: every cut vertex on a
+  // shared edge came out the same from both triangles, and no T-junction appeared.
+  Result<Model> horse = readModel(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply");
+  ASSERT_TRUE(horse.ok()) << horse.error().message;
+  MeshPart welded;
+  for (const Vec3f& p : horse->positions) welded.positions.push_back(horse->origin + toDouble(p));
+  welded.indices = horse->indices;
+  weldExact(welded);
+  ASSERT_EQ(countBoundaryEdges(welded.indices), 0u);  // the horse is closed
+  Aabbd box;
+  for (const Vec3d& p : welded.positions) box.add(p);
+  for (double size : {box.longestSide() / 3.3, box.longestSide() / 7.1}) {
+    const ChunkGrid grid = ChunkGrid::over(box, size);
+    std::vector<ChunkCell> cells;
+    std::vector<CutCorner> corners;
+    for (std::size_t t = 0; t < welded.indices.size(); t += 3) {
+      std::array<CutCorner, 3> triangle;
+      for (std::size_t k = 0; k < 3; ++k)
+        triangle[k] = {welded.positions[welded.indices[t + k]], {255, 255, 255, 255}};
+      cutTriangle(grid, triangle, cells, corners);
+    }
+    EXPECT_GT(cells.size(), welded.indices.size() / 3);  // something was cut
+    MeshPart pieces;
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+      pieces.positions.push_back(corners[i].position);
+      pieces.indices.push_back(static_cast<std::uint32_t>(i));
+    }
+    weldExact(pieces);
+    EXPECT_EQ(countBoundaryEdges(pieces.indices), 0u) << "chunk size " << size;
+  }
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -1,0 +1,234 @@
+#include "lodforge/tiling/octree.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "lodforge/core/distance.h"
+#include "lodforge/core/mesh.h"
+#include "lodforge/core/random.h"
+#include "lodforge/io/model_io.h"
+
+namespace lodforge {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A wavy open surface: its rim is the only boundary.
+MeshPart heightfield(int n) {
+  MeshPart mesh;
+  for (int y = 0; y <= n; ++y) {
+    for (int x = 0; x <= n; ++x) {
+      const double z =
+          0.8 * std::sin(x * 0.21) * std::cos(y * 0.17) + 0.05 * std::sin(x * y * 0.01);
+      mesh.positions.push_back({1000.0 + x, 2000.0 + y, z});
+    }
+  }
+  const auto at = [n](int x, int y) { return static_cast<std::uint32_t>(y * (n + 1) + x); };
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      mesh.indices.insert(mesh.indices.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1)});
+      mesh.indices.insert(mesh.indices.end(), {at(x, y), at(x + 1, y + 1), at(x, y + 1)});
+    }
+  }
+  return mesh;
+}
+
+MeshPart horse() {
+  Result<Model> model = readModel(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply");
+  EXPECT_TRUE(model.ok());
+  MeshPart mesh;
+  for (const Vec3f& p : model->positions) mesh.positions.push_back(model->origin + toDouble(p));
+  mesh.indices = model->indices;
+  weldExact(mesh);
+  return mesh;
+}
+
+using Edge = std::pair<Vec3d, Vec3d>;
+struct EdgeLess {
+  static bool less(const Vec3d& a, const Vec3d& b) {
+    if (a.x != b.x) return a.x < b.x;
+    if (a.y != b.y) return a.y < b.y;
+    return a.z < b.z;
+  }
+  bool operator()(const Edge& a, const Edge& b) const {
+    if (a.first != b.first) return less(a.first, b.first);
+    return less(a.second, b.second);
+  }
+};
+
+// Boundary edges as position pairs (smaller end first).
+std::set<Edge, EdgeLess> boundaryEdges(MeshPart mesh) {
+  weldExact(mesh);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = mesh.indices[t + k], b = mesh.indices[t + (k + 1) % 3];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  std::set<Edge, EdgeLess> out;
+  for (const auto& [edge, count] : uses) {
+    if (count != 1) continue;
+    Vec3d a = mesh.positions[edge.first], b = mesh.positions[edge.second];
+    if (EdgeLess::less(b, a)) std::swap(a, b);
+    out.insert({a, b});
+  }
+  return out;
+}
+
+struct Built {
+  OctreeResult tree;
+  std::map<std::uint32_t, MeshPart> meshes;  // by node index... filled through the cell key
+};
+
+// Cuts `input` into a grid and builds the octree, keeping every node's mesh.
+Built build(const MeshPart& input, double chunkSize, const OctreeOptions& base,
+            const std::string& work) {
+  fs::remove_all(work);
+  fs::create_directories(work + "/nodes");
+  Aabbd box;
+  for (const Vec3d& p : input.positions) box.add(p);
+  ChunkWriter chunks(ChunkGrid::over(box, chunkSize), work + "/chunks", 1 << 20);
+  std::vector<ChunkCell> cells;
+  std::vector<CutCorner> corners;
+  for (std::size_t t = 0; t < input.indices.size(); t += 3) {
+    std::array<CutCorner, 3> triangle;
+    for (std::size_t k = 0; k < 3; ++k)
+      triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}};
+    cells.clear();
+    corners.clear();
+    cutTriangle(chunks.grid(), triangle, cells, corners);
+    for (std::size_t p = 0; p < cells.size(); ++p)
+      EXPECT_TRUE(
+          chunks.add(cells[p], std::span<const CutCorner, 3>(corners.data() + 3 * p, 3)).ok());
+  }
+  EXPECT_TRUE(chunks.flush().ok());
+  OctreeOptions options = base;
+  options.workDirectory = work + "/nodes";
+  std::mutex mutex;
+  std::map<std::string, MeshPart> byPath;
+  Result<OctreeResult> tree =
+      buildOctree(chunks, options, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
+        std::lock_guard lock(mutex);
+        byPath[node.meshPath] = mesh;
+        return {};
+      });
+  EXPECT_TRUE(tree.ok()) << (tree.ok() ? "" : tree.error().message);
+  Built built{std::move(*tree), {}};
+  for (std::uint32_t i = 0; i < built.tree.nodes.size(); ++i) {
+    const auto it = byPath.find(built.tree.nodes[i].meshPath);
+    if (it != byPath.end()) built.meshes[i] = it->second;
+  }
+  return built;
+}
+
+// A random cut through the tree: each node with children is refined with probability 1/2.
+void randomMix(const Built& built, std::uint32_t node, Random& random,
+               std::vector<std::uint32_t>& selected) {
+  const OctreeNode& n = built.tree.nodes[node];
+  const bool hasMesh = built.meshes.count(node) != 0;
+  if (!n.children.empty() && (!hasMesh || random.uniform(0, 1) < 0.5)) {
+    for (std::uint32_t c : n.children) randomMix(built, c, random, selected);
+  } else {
+    selected.push_back(node);
+  }
+}
+
+TEST(Octree, AnyMixOfLevelsHasNoBoundaryTheInputDidNotHave) {
+  OctreeOptions options;
+  options.errorSamples = 2000;
+  for (const bool open : {true, false}) {
+    const MeshPart input = open ? heightfield(120) : horse();
+    Aabbd box;
+    for (const Vec3d& p : input.positions) box.add(p);
+    const Built built =
+        build(input, box.longestSide() / 7.5, options, ::testing::TempDir() + "/octree-mix");
+    ASSERT_GE(built.tree.levels, 2);
+    const std::set<Edge, EdgeLess> original = boundaryEdges(input);
+    // The input's rim, cut at the chunk planes, is made of pieces of the original edges: compare
+    // against the finest level's boundary (all leaves), which must itself lie on the rim.
+    std::vector<MeshPart> leaves;
+    for (const auto& [index, mesh] : built.meshes)
+      if (built.tree.nodes[index].level == 0) leaves.push_back(mesh);
+    const std::set<Edge, EdgeLess> finest = boundaryEdges(concatenate(leaves));
+    EXPECT_EQ(finest.empty(), original.empty());
+    for (const Edge& e : finest) {  // the heightfield's rim: x or y at the grid's ends
+      for (const Vec3d& p : {e.first, e.second}) {
+        EXPECT_TRUE(p.x == 1000 || p.x == 1120 || p.y == 2000 || p.y == 2120) << p.x << " " << p.y;
+      }
+    }
+    Random random(open ? 7 : 8);
+    for (int mix = 0; mix < 40; ++mix) {
+      std::vector<std::uint32_t> selected;
+      randomMix(built, built.tree.root, random, selected);
+      std::vector<MeshPart> parts;
+      for (std::uint32_t s : selected) parts.push_back(built.meshes.at(s));
+      const std::set<Edge, EdgeLess> edges = boundaryEdges(concatenate(parts));
+      std::size_t extra = 0;
+      for (const Edge& e : edges) extra += finest.count(e) == 0 ? 1 : 0;
+      EXPECT_EQ(extra, 0u) << (open ? "heightfield" : "horse") << ", mix " << mix << " of "
+                           << selected.size() << " tiles";
+    }
+  }
+}
+
+TEST(Octree, ParentsAreSimplerAndTheirErrorBoundsTheirChildren) {
+  OctreeOptions options;
+  options.errorSamples = 4000;
+  const MeshPart input = heightfield(160);
+  const Built built = build(input, 20, options, ::testing::TempDir() + "/octree-error");
+  ASSERT_GE(built.tree.levels, 2);
+  std::uint64_t leafTriangles = 0;
+  for (const OctreeNode& node : built.tree.nodes) {
+    if (node.level == 0) {
+      EXPECT_EQ(node.geometricError, 0.0);
+      leafTriangles += node.triangles;
+      continue;
+    }
+    std::uint64_t childTriangles = 0;
+    for (std::uint32_t c : node.children) {
+      const OctreeNode& child = built.tree.nodes[c];
+      EXPECT_GE(node.geometricError, child.geometricError);
+      childTriangles += child.triangles;
+      for (int axis = 0; axis < 3; ++axis) {
+        EXPECT_LE(node.bounds.min[axis], child.bounds.min[axis]);
+        EXPECT_GE(node.bounds.max[axis], child.bounds.max[axis]);
+      }
+    }
+    EXPECT_LT(node.triangles, childTriangles);  // simplified
+    EXPECT_GT(node.geometricError, 0.0);
+    EXPECT_GT(node.lockedVertices, 0u);  // its outer border
+  }
+  const OctreeNode& root = built.tree.nodes[built.tree.root];
+  EXPECT_LT(root.triangles, leafTriangles / 4);
+  // The root's own error, measured directly against the input, stays under its bound.
+  const MeshPart& rootMesh = built.meshes.at(built.tree.root);
+  const Vec3d center = root.bounds.center();
+  std::vector<Vec3f> a, b;
+  for (const Vec3d& p : rootMesh.positions) a.push_back(toFloat(p - center));
+  for (const Vec3d& p : input.positions) b.push_back(toFloat(p - center));
+  const SurfaceDistance direct = surfaceDistance(a, rootMesh.indices, b, input.indices, 20000);
+  EXPECT_LE(direct.hausdorff, root.geometricError * 1.05 + 1e-6);
+}
+
+TEST(Octree, LevelsOptionStopsBelowTheRootWithAContentlessRoot) {
+  OctreeOptions options;
+  options.errorSamples = 1000;
+  options.levels = 1;
+  const Built built = build(heightfield(100), 12, options, ::testing::TempDir() + "/octree-lv");
+  EXPECT_EQ(built.tree.levels, 1);
+  const OctreeNode& root = built.tree.nodes[built.tree.root];
+  EXPECT_GT(root.children.size(), 1u);
+  EXPECT_TRUE(root.meshPath.empty());
+  for (std::uint32_t c : root.children)
+    EXPECT_GE(root.geometricError, built.tree.nodes[c].geometricError);
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -52,10 +52,19 @@ class TriangleGrid {
     const std::size_t triangles = indices.size() / 3;
     origin_ = toDouble(box.min);
     const Vec3d size = toDouble(box.size());
-    // About two triangles per cell.
-    const double volume =
-        std::max(size.x, 1e-12) * std::max(size.y, 1e-12) * std::max(size.z, 1e-12);
-    cell_ = std::cbrt(volume / std::max<double>(1, static_cast<double>(triangles) / 2));
+    // Cells about twice the typical triangle's size: a few triangles per non-empty cell whether
+    // the mesh fills a volume or lies on a surface (a volume-based size puts dozens of a flat
+    // scan's triangles in every cell, or spreads a flat mesh's few big triangles over a million).
+    double area = 0;
+    for (std::uint32_t t = 0; t < triangles; ++t)
+      area += 0.5 * length(cross(corner(t, 1) - corner(t, 0), corner(t, 2) - corner(t, 0)));
+    if (triangles > 0 && area > 0) {
+      cell_ = 2 * std::sqrt(area / static_cast<double>(triangles));
+    } else {
+      const double volume =
+          std::max(size.x, 1e-12) * std::max(size.y, 1e-12) * std::max(size.z, 1e-12);
+      cell_ = std::cbrt(volume / std::max<double>(1, static_cast<double>(triangles) / 2));
+    }
     cell_ = std::max({cell_, box.longestSide() / 1024.0, 1e-9});
     // Keep the grid within a few cells per triangle (flat or sparse meshes would explode it).
     const double maxCells = 4.0 * static_cast<double>(triangles) + 1e6;
@@ -81,25 +90,41 @@ class TriangleGrid {
     double best = std::numeric_limits<double>::max();
     const int maxRing = std::max({dims_[0], dims_[1], dims_[2]});
     for (int ring = 0; ring <= maxRing; ++ring) {
-      // Everything within `ring` cells is searched; a closer triangle cannot lie further out
-      // than (ring) cells minus the point's offset inside its cell.
-      for (int z = cz - ring; z <= cz + ring; ++z) {
-        for (int y = cy - ring; y <= cy + ring; ++y) {
-          for (int x = cx - ring; x <= cx + ring; ++x) {
-            if (std::max({std::abs(x - cx), std::abs(y - cy), std::abs(z - cz)}) != ring) continue;
-            if (x < 0 || y < 0 || z < 0 || x >= dims_[0] || y >= dims_[1] || z >= dims_[2])
-              continue;
-            const std::size_t cell = index(x, y, z);
-            for (std::uint32_t i = start_[cell]; i < start_[cell + 1]; ++i) {
-              const std::uint32_t t = items_[i];
-              best = std::min(
-                  best, pointTriangleDistanceSquared(p, corner(t, 0), corner(t, 1), corner(t, 2)));
-            }
+      // The shell of cells exactly `ring` away, clipped to the grid (a flat grid has one layer).
+      const int z0 = std::max(cz - ring, 0), z1 = std::min(cz + ring, dims_[2] - 1);
+      const int y0 = std::max(cy - ring, 0), y1 = std::min(cy + ring, dims_[1] - 1);
+      const int x0 = std::max(cx - ring, 0), x1 = std::min(cx + ring, dims_[0] - 1);
+      const auto visit = [&](int x, int y, int z) {
+        const std::size_t cell = index(x, y, z);
+        for (std::uint32_t i = start_[cell]; i < start_[cell + 1]; ++i) {
+          const std::uint32_t t = items_[i];
+          best = std::min(
+              best, pointTriangleDistanceSquared(p, corner(t, 0), corner(t, 1), corner(t, 2)));
+        }
+      };
+      for (int z = z0; z <= z1; ++z) {
+        for (int y = y0; y <= y1; ++y) {
+          if (std::abs(z - cz) == ring || std::abs(y - cy) == ring) {
+            for (int x = x0; x <= x1; ++x) visit(x, y, z);
+          } else {
+            if (cx - ring >= 0) visit(cx - ring, y, z);
+            if (ring > 0 && cx + ring < dims_[0]) visit(cx + ring, y, z);
           }
         }
       }
-      const double reach = ring * cell_;
-      if (best < std::numeric_limits<double>::max() && best <= reach * reach) break;
+      // Anything not searched yet lies outside the block of cells within `ring`: at least as
+      // far as p is from the block's nearest inner face (faces on the grid's edge have
+      // nothing beyond them).
+      double reach = std::numeric_limits<double>::infinity();
+      const int c[3] = {cx, cy, cz};
+      for (int axis = 0; axis < 3; ++axis) {
+        if (c[axis] - ring > 0)
+          reach = std::min(reach, p[axis] - (origin_[axis] + (c[axis] - ring) * cell_));
+        if (c[axis] + ring < dims_[axis] - 1)
+          reach = std::min(reach, origin_[axis] + (c[axis] + ring + 1) * cell_ - p[axis]);
+      }
+      if (best < std::numeric_limits<double>::max() && (reach < 0 ? 0 : reach * reach) >= best)
+        break;
     }
     return best;
   }
@@ -144,7 +169,7 @@ class TriangleGrid {
 // Area-uniform sample points on a mesh.
 std::vector<Vec3d> samplePoints(std::span<const Vec3f> positions,
                                 std::span<const std::uint32_t> indices, std::uint32_t count,
-                                std::uint64_t seed) {
+                                std::uint64_t seed, bool corners) {
   const std::size_t triangles = indices.size() / 3;
   std::vector<double> cumulative(triangles);
   double total = 0;
@@ -157,9 +182,11 @@ std::vector<Vec3d> samplePoints(std::span<const Vec3f> positions,
   }
   std::vector<Vec3d> points;
   if (triangles == 0 || total <= 0) return points;
-  points.reserve(count + triangles);
+  points.reserve(count + (corners ? triangles : 0));
   // Every triangle's corners too, so the distance never misses a vertex's excursion.
-  for (std::size_t t = 0; t < triangles; ++t) points.push_back(corner(t, 0));
+  if (corners) {
+    for (std::size_t t = 0; t < triangles; ++t) points.push_back(corner(t, 0));
+  }
   Random random(seed);
   for (std::uint32_t i = 0; i < count; ++i) {
     const double pick = random.uniform() * total;
@@ -211,15 +238,17 @@ SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
                                 std::span<const std::uint32_t> indicesA,
                                 std::span<const Vec3f> positionsB,
                                 std::span<const std::uint32_t> indicesB,
-                                std::uint32_t samplesPerMesh, std::uint64_t seed) {
+                                std::uint32_t samplesPerMesh, std::uint64_t seed, bool corners) {
   SurfaceDistance result;
   if (indicesA.empty() || indicesB.empty()) {
     result.hausdorff = result.rms = std::numeric_limits<double>::infinity();
     return result;
   }
   const TriangleGrid gridA(positionsA, indicesA), gridB(positionsB, indicesB);
-  const OneSided ab = measure(samplePoints(positionsA, indicesA, samplesPerMesh, seed), gridB);
-  const OneSided ba = measure(samplePoints(positionsB, indicesB, samplesPerMesh, seed + 1), gridA);
+  const OneSided ab =
+      measure(samplePoints(positionsA, indicesA, samplesPerMesh, seed, corners), gridB);
+  const OneSided ba =
+      measure(samplePoints(positionsB, indicesB, samplesPerMesh, seed + 1, corners), gridA);
   result.hausdorff = std::max(ab.max, ba.max);
   result.rms = std::sqrt((ab.sumSquares + ba.sumSquares) /
                          static_cast<double>(std::max<std::size_t>(1, ab.count + ba.count)));

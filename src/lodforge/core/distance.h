@@ -19,12 +19,14 @@ struct SurfaceDistance {
 };
 
 // Distance between surfaces A and B: `samplesPerMesh` points spread over each surface by area
-// (deterministic for the seed), each measured exactly to the nearest triangle of the other mesh
-// through a uniform grid. Both meshes are plain arrays of positions and triangle indices.
+// (deterministic for the seed) plus, with `corners`, a corner of every triangle, each measured
+// exactly to the nearest triangle of the other mesh through a uniform grid. Both meshes are
+// plain arrays of positions and triangle indices.
 SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
                                 std::span<const std::uint32_t> indicesA,
                                 std::span<const Vec3f> positionsB,
                                 std::span<const std::uint32_t> indicesB,
-                                std::uint32_t samplesPerMesh = 100'000, std::uint64_t seed = 1);
+                                std::uint32_t samplesPerMesh = 100'000, std::uint64_t seed = 1,
+                                bool corners = true);
 
 }  // namespace lodforge

@@ -136,12 +136,14 @@ struct Builder {
     mesh.indices = simplified.indices;
     // Geometric error: measured against the children's geometry, plus what they already
     // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
-    // non-increasing from parent to child).
+    // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
+    // excursions, which area samples could miss, are bounded by the simplifier's own record.
     const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);
     const SurfaceDistance distance =
         surfaceDistance(simplifiedPositions, mesh.indices, positions, merged.indices,
-                        options.errorSamples, seedOf(node));
-    node.geometricError = childError + distance.hausdorff;
+                        options.errorSamples, seedOf(node), /*corners=*/false);
+    node.geometricError =
+        childError + std::max(distance.hausdorff, static_cast<double>(simplified.error));
     node.triangles = mesh.triangleCount();
     node.vertices = mesh.vertexCount();
     node.meshPath = meshPath(node);

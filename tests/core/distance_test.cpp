@@ -1,0 +1,123 @@
+#include "lodforge/core/distance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "lodforge/core/random.h"
+
+namespace lodforge {
+namespace {
+
+// Nearest point of a triangle by brute force: a dense barycentric lattice plus the edges.
+double bruteForceSquared(Vec3d p, Vec3d a, Vec3d b, Vec3d c) {
+  double best = std::numeric_limits<double>::max();
+  const int n = 200;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; i + j <= n; ++j) {
+      const double u = double(i) / n, v = double(j) / n;
+      const Vec3d q = a + (b - a) * u + (c - a) * v;
+      best = std::min(best, dot(p - q, p - q));
+    }
+  }
+  return best;
+}
+
+TEST(PointTriangleDistance, MatchesBruteForceInEveryRegion) {
+  Random random(2);
+  for (int i = 0; i < 300; ++i) {
+    const Vec3d a{random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1)};
+    const Vec3d b{random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1)};
+    const Vec3d c{random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1)};
+    const Vec3d p{random.uniform(-2, 2), random.uniform(-2, 2), random.uniform(-2, 2)};
+    const double exact = pointTriangleDistanceSquared(p, a, b, c);
+    const double brute = bruteForceSquared(p, a, b, c);
+    EXPECT_LE(exact, brute + 1e-12);  // never farther than any point of the triangle
+    EXPECT_NEAR(std::sqrt(exact), std::sqrt(brute), 0.02);
+  }
+  // Known answers: over the face, beyond an edge, beyond a corner.
+  const Vec3d a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0};
+  EXPECT_DOUBLE_EQ(pointTriangleDistanceSquared({0.25, 0.25, 2}, a, b, c), 4.0);
+  EXPECT_DOUBLE_EQ(pointTriangleDistanceSquared({0.5, -3, 0}, a, b, c), 9.0);
+  EXPECT_DOUBLE_EQ(pointTriangleDistanceSquared({-3, -4, 0}, a, b, c), 25.0);
+}
+
+// A z = height grid over [0, size]^2, n x n squares.
+void plane(int n, double size, double height, std::vector<Vec3f>& positions,
+           std::vector<std::uint32_t>& indices) {
+  positions.clear();
+  indices.clear();
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x)
+      positions.push_back({float(size * x / n), float(size * y / n), float(height)});
+  const auto at = [n](int x, int y) { return std::uint32_t(y * (n + 1) + x); };
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      indices.insert(indices.end(), {at(x, y), at(x + 1, y), at(x + 1, y + 1)});
+      indices.insert(indices.end(), {at(x, y), at(x + 1, y + 1), at(x, y + 1)});
+    }
+  }
+}
+
+TEST(SurfaceDistance, ParallelPlanesAreTheirOffsetApart) {
+  std::vector<Vec3f> pa, pb;
+  std::vector<std::uint32_t> ia, ib;
+  plane(40, 10, 0, pa, ia);
+  plane(7, 10, 0.25, pb, ib);  // coarser, lifted
+  const SurfaceDistance d = surfaceDistance(pa, ia, pb, ib, 5000);
+  EXPECT_NEAR(d.hausdorff, 0.25, 1e-6);
+  EXPECT_NEAR(d.rms, 0.25, 1e-6);
+  EXPECT_NEAR(d.meanAB, 0.25, 1e-6);
+  const SurfaceDistance same = surfaceDistance(pa, ia, pa, ia, 5000);
+  EXPECT_LT(same.hausdorff, 1e-9);
+}
+
+TEST(SurfaceDistance, GridSearchEqualsBruteForceOnEveryCorner) {
+  // With no area samples, the samples are each triangle's first corner: the grid's answers can
+  // be checked against a brute-force nearest over all triangles.
+  Random random(9);
+  std::vector<Vec3f> pa, pb;
+  std::vector<std::uint32_t> ia, ib;
+  plane(12, 4, 0, pa, ia);
+  for (Vec3f& p : pa) p.z = float(random.uniform(-0.3, 0.3));  // rough
+  plane(9, 4, 0, pb, ib);
+  for (Vec3f& p : pb) p.z = float(0.5 * std::sin(p.x) * std::cos(p.y));
+  for (Vec3f& p : pb) p.x += 0.7f;  // partly beside A: far points hit the grid's edges
+  const SurfaceDistance d = surfaceDistance(pa, ia, pb, ib, 0, 1, /*corners=*/true);
+  const auto nearest = [](Vec3f q, const std::vector<Vec3f>& p,
+                          const std::vector<std::uint32_t>& i) {
+    double best = std::numeric_limits<double>::max();
+    for (std::size_t t = 0; t < i.size(); t += 3)
+      best = std::min(
+          best, pointTriangleDistanceSquared(toDouble(q), toDouble(p[i[t]]), toDouble(p[i[t + 1]]),
+                                             toDouble(p[i[t + 2]])));
+    return std::sqrt(best);
+  };
+  double maxAB = 0, sumAB = 0, maxBA = 0;
+  for (std::size_t t = 0; t < ia.size(); t += 3) {
+    const double e = nearest(pa[ia[t]], pb, ib);
+    maxAB = std::max(maxAB, e);
+    sumAB += e;
+  }
+  for (std::size_t t = 0; t < ib.size(); t += 3)
+    maxBA = std::max(maxBA, nearest(pb[ib[t]], pa, ia));
+  EXPECT_DOUBLE_EQ(d.hausdorff, std::max(maxAB, maxBA));
+  EXPECT_NEAR(d.meanAB, sumAB / double(ia.size() / 3), 1e-12);
+}
+
+TEST(SurfaceDistance, CornerSamplesCatchASpikeThatAreaSamplesMiss) {
+  std::vector<Vec3f> pa, pb;
+  std::vector<std::uint32_t> ia, ib;
+  plane(50, 10, 0, pa, ia);
+  plane(1, 10, 0, pb, ib);
+  pa[25 * 51 + 25].z = 3;  // one tall, thin spike
+  const SurfaceDistance with = surfaceDistance(pa, ia, pb, ib, 200, 1, true);
+  const SurfaceDistance without = surfaceDistance(pa, ia, pb, ib, 200, 1, false);
+  EXPECT_NEAR(with.hausdorff, 3.0, 1e-6);
+  EXPECT_LT(without.hausdorff, 3.0);
+}
+
+}  // namespace
+}  // namespace lodforge

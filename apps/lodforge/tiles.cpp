@@ -1,5 +1,7 @@
 // `lodforge tiles INPUT -o DIR`: a mesh of any size as a 3D Tiles 1.1 tileset (large-meshes
 // paper §3.2–3.4): chunk grid, octree of simplified super-chunks, one GLB per tile.
+#include <filesystem>
+
 #include <fmt/format.h>
 
 #include "cli.h"
@@ -16,6 +18,8 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
     int levels = 0;
     double reduction = 0.2;
     double maxNormalDeviation = 30;
+    std::string memory = "moderate";
+    bool resume = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh");
@@ -32,16 +36,37 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("--max-normal-deviation", options->maxNormalDeviation,
                   "Largest angle in degrees a simplification step may turn a face (default 30)")
       ->check(CLI::Range(0.0, 90.0));
+  sub->add_option("--memory", options->memory,
+                  "minimal (one thread), moderate (--threads, default a quarter of the cores) or "
+                  "unbounded (every core, chunks kept in memory); --memory-limit caps the whole "
+                  "build")
+      ->check(CLI::IsMember({"minimal", "moderate", "unbounded"}));
+  sub->add_flag("--resume", options->resume,
+                "Continue an interrupted run from OUTPUT.work and OUTPUT.partial (same input and "
+                "options)");
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
       TilesOptions tiles;
-      tiles.chunkSize = options->chunkSize;
+      tiles.input.chunkSize = options->chunkSize;
       tiles.octree.levels = options->levels;
       tiles.octree.keep = options->reduction;
       tiles.octree.maxNormalDeviationDegrees = options->maxNormalDeviation;
-      tiles.octree.threads = static_cast<int>(global.threads);
+      tiles.memory = options->memory == "minimal"     ? TilesMemory::kMinimal
+                     : options->memory == "unbounded" ? TilesMemory::kUnbounded
+                                                      : TilesMemory::kModerate;
+      tiles.threads = static_cast<int>(global.threads);
+      tiles.memoryLimit = global.memoryLimit;
+      tiles.resume = options->resume;
       Result<TilesStats> stats = writeTiles(options->input, options->output, tiles);
-      if (!stats) return stats.status();
+      if (!stats) {
+        if (std::filesystem::exists(options->output + ".work/state.json"))
+          fmt::print(
+              stderr,
+              "lodforge: the finished chunks and tiles are kept in {0}.work and {0}.partial: "
+              "run again with --resume to continue, or delete them\n",
+              options->output);
+        return stats.status();
+      }
       say(global,
           fmt::format(
               "wrote {}: {} tiles ({} leaves, {} levels above them), {} in {:.1f} s ({} "
@@ -50,9 +75,20 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
               formatBytes(stats->outputBytes), stats->seconds,
               formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->inputTriangles) /
                                                      std::max(stats->seconds, 1e-9)))));
-      detail(global, fmt::format("chunk size {:.4g}; {} triangles after cutting; peak memory {}",
-                                 stats->chunkSize, formatCount(stats->leafTriangles),
-                                 formatBytes(peakRssBytes())));
+      detail(global,
+             fmt::format("{} ({:.1f} s to chunks); {} threads; chunk size {:.4g}; {} triangles "
+                         "after cutting; parents "
+                         "kept {} border vertices of {} ({:.1f} %, at most {} in one tile); peak "
+                         "memory {}",
+                         stats->resumed    ? "chunks resumed"
+                         : stats->streamed ? "streamed"
+                                           : "loaded whole",
+                         stats->chunkSeconds, stats->threads, stats->chunkSize,
+                         formatCount(stats->leafTriangles), formatCount(stats->lockedVertices),
+                         formatCount(stats->vertices),
+                         100.0 * static_cast<double>(stats->lockedVertices) /
+                             static_cast<double>(std::max<std::uint64_t>(1, stats->vertices)),
+                         formatCount(stats->maxLockedVertices), formatBytes(peakRssBytes())));
       return {};
     };
   });

@@ -51,6 +51,40 @@ nlohmann::json info(const std::string& path, const test::TempDir& dir) {
   return nlohmann::json::parse(o.out);
 }
 
+// Starts `lodforge ARGS` without a shell (so signals reach it), stderr to `errPath` if given.
+pid_t spawnLodforge(std::vector<std::string> args, const std::string& errPath = "") {
+  const std::string binary = LODFORGE_BINARY;
+  args.insert(args.begin(), binary);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  if (!errPath.empty())
+    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+  pid_t pid = 0;
+  const int started = posix_spawn(&pid, binary.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  EXPECT_EQ(started, 0);
+  return pid;
+}
+
+struct Finished {
+  int code = -1;           // exit code, -1 if killed
+  std::uint64_t peak = 0;  // peak RSS in bytes
+};
+
+Finished waitFor(pid_t pid) {
+  int status = 0;
+  struct rusage usage {};
+  EXPECT_EQ(::wait4(pid, &status, 0, &usage), pid);
+  Finished f;
+  f.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  f.peak = static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;
+  return f;
+}
+
 TEST(Cli, VersionHelpAndUsageErrors) {
   test::TempDir dir;
   Outcome o = lodforge("--version", dir);
@@ -288,27 +322,10 @@ TEST(CliPackage, BuildStaysUnderItsMemoryLimit) {
   const auto inputBytes = std::filesystem::file_size(dir.file("big.ply"));
   constexpr std::uint64_t kLimit = 96ull << 20;
   ASSERT_GT(inputBytes, 2 * kLimit);  // the input is larger than the limit
-  const std::string binary = LODFORGE_BINARY;
-  std::vector<std::string> args = {binary,
-                                   "-q",
-                                   "--memory-limit",
-                                   "96M",
-                                   "build",
-                                   dir.file("big.ply"),
-                                   "-o",
-                                   dir.file("big.lfp")};
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  ASSERT_EQ(posix_spawn(&pid, binary.c_str(), nullptr, nullptr, argv.data(), environ), 0);
-  int status = 0;
-  struct rusage usage {};
-  ASSERT_EQ(::wait4(pid, &status, 0, &usage), pid);
-  ASSERT_TRUE(WIFEXITED(status));
-  ASSERT_EQ(WEXITSTATUS(status), 0);
-  const std::uint64_t peak = static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;
-  EXPECT_LT(peak, kLimit) << "peak RSS " << peak / (1 << 20) << " MiB";
+  const Finished run = waitFor(spawnLodforge(
+      {"-q", "--memory-limit", "96M", "build", dir.file("big.ply"), "-o", dir.file("big.lfp")}));
+  ASSERT_EQ(run.code, 0);
+  EXPECT_LT(run.peak, kLimit) << "peak RSS " << run.peak / (1 << 20) << " MiB";
   EXPECT_EQ(info(dir.file("big.lfp"), dir)["objects"], 20'000u);
 }
 
@@ -354,6 +371,76 @@ TEST(CliTiles, BadInputAndArgumentsAreExitCode2AndLeaveNothing) {
       dir);
   EXPECT_EQ(o.code, 2);
   EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"cut.ply"});
+}
+
+TEST(CliTiles, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {
+#ifdef LODFORGE_SANITIZED
+  GTEST_SKIP() << "peak RSS means nothing under ASan; the release build checks it";
+#endif
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate scan --triangles 5M -o " + dir.file("scan.ply"), dir).code, 0);
+  constexpr std::uint64_t kLimit = 96ull << 20;
+  ASSERT_GT(std::filesystem::file_size(dir.file("scan.ply")), kLimit);
+  const Finished run = waitFor(spawnLodforge(
+      {"-q", "--memory-limit", "96M", "tiles", dir.file("scan.ply"), "-o", dir.file("tiles")}));
+  ASSERT_EQ(run.code, 0);
+  EXPECT_LT(run.peak, kLimit) << "peak RSS " << run.peak / (1 << 20) << " MiB";
+  EXPECT_TRUE(std::filesystem::exists(dir.file("tiles/tileset.json")));
+  // A limit too small for the program itself is refused up front.
+  const Outcome small = lodforge(
+      "--memory-limit 20M tiles " + dir.file("scan.ply") + " -o " + dir.file("small"), dir);
+  EXPECT_EQ(small.code, 1);
+  EXPECT_NE(small.err.find("too small"), std::string::npos) << small.err;
+}
+
+TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate scan --triangles 1M -o " + dir.file("scan.ply"), dir).code, 0);
+  const std::vector<std::string> args = {"-q", "--threads",  "1", "tiles", dir.file("scan.ply"),
+                                         "-o", dir.file("b")};
+  ASSERT_EQ(
+      lodforge("-q --threads 1 tiles " + dir.file("scan.ply") + " -o " + dir.file("a"), dir).code,
+      0);
+  const pid_t pid = spawnLodforge(args, dir.file(".stderr"));
+  // Stop it once the chunks are done and a few tiles are written.
+  const std::filesystem::path nodes = dir.file("b.work/nodes");
+  bool started = false;
+  for (int i = 0; i < 600 && !started; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::error_code ignored;
+    started = std::filesystem::exists(dir.file("b.work/state.json")) &&
+              std::distance(std::filesystem::directory_iterator(nodes, ignored),
+                            std::filesystem::directory_iterator{}) >= 6;
+  }
+  ASSERT_TRUE(started);
+  ::kill(pid, SIGINT);
+  const Finished stopped = waitFor(pid);
+  const std::string err = test::readFile(dir.file(".stderr"));
+  std::remove(dir.file(".stderr").c_str());
+  if (stopped.code == 0) GTEST_SKIP() << "the run finished before it could be interrupted";
+  EXPECT_EQ(stopped.code, 1);
+  EXPECT_NE(err.find("--resume"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("b")));
+  const std::size_t kept = test::listFolder(dir.file("b.partial/tiles")).size();
+  EXPECT_GT(kept, 0u);
+
+  std::vector<std::string> resume = args;
+  resume.push_back("--resume");
+  resume.erase(resume.begin());  // -v instead of -q, to see that the chunks were reused
+  resume.insert(resume.begin(), "-v");
+  std::string line;
+  for (const std::string& a : resume) line += a + " ";
+  const Outcome o = lodforge(line, dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE((o.out + o.err).find("chunks resumed"), std::string::npos) << o.out << o.err;
+  // Byte for byte the tileset of an uninterrupted run, and nothing left over.
+  const std::vector<std::string> files = test::listFolder(dir.file("a/tiles"));
+  ASSERT_EQ(test::listFolder(dir.file("b/tiles")), files);
+  for (const std::string& f : files)
+    ASSERT_EQ(test::readFile(dir.file("a/tiles/" + f)), test::readFile(dir.file("b/tiles/" + f)))
+        << f;
+  EXPECT_EQ(test::readFile(dir.file("a/tileset.json")), test::readFile(dir.file("b/tileset.json")));
+  EXPECT_EQ(test::listFolder(dir.path()), (std::vector<std::string>{"a", "b", "scan.ply"}));
 }
 
 TEST(CliBench, RunsEveryBudgetAndHitsItExactly) {

@@ -58,7 +58,7 @@ TEST(Tiles, HorseTilesetFollowsTheRules) {
   const fs::path out = fs::path(::testing::TempDir()) / "horse-tiles";
   fs::remove_all(out);
   TilesOptions options;
-  options.chunkSize = 0.05;  // the horse is ~0.2 m long: a few chunks per axis
+  options.input.chunkSize = 0.05;  // the horse is ~0.2 m long: a few chunks per axis
   options.octree.errorSamples = 2000;
   Result<TilesStats> stats =
       writeTiles(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply", out.string(), options);

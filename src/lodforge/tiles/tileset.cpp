@@ -1,9 +1,10 @@
 #include "lodforge/tiles/tileset.h"
 
-#include <unistd.h>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <thread>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -11,7 +12,6 @@
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/glb_writer.h"
-#include "lodforge/io/model_io.h"
 #include "lodforge/tiling/chunk_grid.h"
 
 namespace lodforge {
@@ -40,6 +40,68 @@ struct ScopedDirectory {
     if (!path.empty()) fs::remove_all(path, ignored);
   }
 };
+
+// After chunking: what the chunks were made from and of, so that --resume can trust them.
+Status saveChunkState(const std::string& path, const nlohmann::json& identity,
+                      const ChunkInput& input) {
+  const ChunkGrid& grid = input.chunks->grid();
+  nlohmann::json counts = nlohmann::json::array();
+  for (const auto& [index, count] : input.chunks->triangleCounts())
+    counts.push_back({index, count});
+  const nlohmann::json state = {{"identity", identity},
+                                {"grid",
+                                 {{"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
+                                  {"size", grid.size},
+                                  {"dims", grid.dims}}},
+                                {"bounds",
+                                 {input.bounds.min.x, input.bounds.min.y, input.bounds.min.z,
+                                  input.bounds.max.x, input.bounds.max.y, input.bounds.max.z}},
+                                {"inputTriangles", input.inputTriangles},
+                                {"colors", input.colors},
+                                {"streamed", input.streamed},
+                                {"counts", counts}};
+  const std::string temp = path + ".tmp";
+  {
+    std::ofstream out(temp);
+    out << state.dump();
+    if (!out.flush()) return ioError(temp, "cannot write");
+  }
+  std::error_code error;
+  fs::rename(temp, path, error);
+  if (error) return ioError(path, error.message());
+  return {};
+}
+
+std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::json& identity,
+                                       const std::string& chunkDirectory) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  try {
+    const nlohmann::json state = nlohmann::json::parse(in);
+    if (state.at("identity") != identity) return std::nullopt;  // other input or options
+    ChunkGrid grid;
+    const auto& g = state.at("grid");
+    grid.origin = {g.at("origin").at(0).get<double>(), g.at("origin").at(1).get<double>(),
+                   g.at("origin").at(2).get<double>()};
+    grid.size = g.at("size").get<double>();
+    grid.dims = g.at("dims").get<ChunkCell>();
+    std::map<std::uint64_t, std::uint64_t> counts;
+    for (const auto& entry : state.at("counts"))
+      counts[entry.at(0).get<std::uint64_t>()] = entry.at(1).get<std::uint64_t>();
+    ChunkInput input;
+    const auto& b = state.at("bounds");
+    input.bounds.min = {b.at(0).get<double>(), b.at(1).get<double>(), b.at(2).get<double>()};
+    input.bounds.max = {b.at(3).get<double>(), b.at(4).get<double>(), b.at(5).get<double>()};
+    input.inputTriangles = state.at("inputTriangles").get<std::uint64_t>();
+    input.colors = state.at("colors").get<bool>();
+    input.streamed = state.at("streamed").get<bool>();
+    input.chunks =
+        std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
+    return input;
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;  // damaged: chunk again
+  }
+}
 
 }  // namespace
 
@@ -96,7 +158,7 @@ Status writeTilesetJson(const OctreeResult& octree, const std::string& path) {
   return {};
 }
 
-Result<TilesStats> writeTiles(const std::string& input, const std::string& outputDirectory,
+Result<TilesStats> writeTiles(const std::string& path, const std::string& outputDirectory,
                               const TilesOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   TilesStats stats;
@@ -107,64 +169,105 @@ Result<TilesStats> writeTiles(const std::string& input, const std::string& outpu
         ErrorKind::kUsage,
         fmt::format("{}: exists and is not a tileset; not overwriting it", outputDirectory)};
   }
-  const std::string suffix = fmt::format(".tmp-{}", ::getpid());
-  ScopedDirectory staging{outputDirectory + suffix};
-  ScopedDirectory work{outputDirectory + ".work" + suffix};
+  // Stable names, so that an interrupted run can be resumed; removed once the tileset is done.
+  ScopedDirectory staging{outputDirectory + ".partial"};
+  ScopedDirectory work{outputDirectory + ".work"};
+  if (!options.resume) {
+    fs::remove_all(staging.path, error);
+    fs::remove_all(work.path, error);
+  }
   fs::create_directories(fs::path(staging.path) / "tiles");
   fs::create_directories(fs::path(work.path) / "nodes");
-
-  // Read, then cut into the chunk grid on disk.
-  Result<Model> model = readModel(input);
-  if (!model) return model.status();
-  stats.inputTriangles = model->triangleCount();
-  if (stats.inputTriangles == 0) return badInput(input, "the model has no triangles");
-  const Aabb local = model->bounds();
-  Aabbd bounds;
-  bounds.add(model->origin + toDouble(local.min));
-  bounds.add(model->origin + toDouble(local.max));
-  stats.chunkSize = options.chunkSize > 0 ? options.chunkSize
-                                          : ChunkGrid::sizeFor(bounds, stats.inputTriangles,
-                                                               options.trianglesPerLeaf);
-  ChunkWriter chunks(ChunkGrid::over(bounds, stats.chunkSize), work.path + "/chunks",
-                     options.chunkBufferBytes);
-  {
-    Progress progress("tiles: chunks", stats.inputTriangles);
-    std::vector<ChunkCell> cells;
-    std::vector<CutCorner> corners;
-    const bool colors = model->hasColors();
-    for (std::size_t o = 0; o < model->objectCount(); ++o) {
-      const ObjectRecord& object = model->objects[o];
-      const auto positions = model->objectPositions(o);
-      const auto indices = model->objectIndices(o);
-      for (std::size_t t = 0; t < indices.size(); t += 3) {
-        std::array<CutCorner, 3> triangle;
-        for (std::size_t k = 0; k < 3; ++k) {
-          const std::uint32_t v = indices[t + k];
-          triangle[k].position = model->origin + toDouble(positions[v]);
-          triangle[k].color =
-              colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
-        }
-        cells.clear();
-        corners.clear();
-        cutTriangle(chunks.grid(), triangle, cells, corners);
-        for (std::size_t p = 0; p < cells.size(); ++p)
-          LODFORGE_TRY(
-              chunks.add(cells[p], std::span<const CutCorner, 3>(corners.data() + 3 * p, 3)));
-        if (t % (3 * 65536) == 0) {
-          LODFORGE_TRY(checkCancelled());
-          progress.advance(std::min<std::uint64_t>(65536, (indices.size() - t) / 3));
-        }
-      }
+  // On failure or Ctrl-C after the chunks are complete, both stay for --resume; otherwise (bad
+  // input, or success) they go.
+  struct KeepOnFailure {
+    ScopedDirectory& staging;
+    ScopedDirectory& work;
+    bool done = false;
+    ~KeepOnFailure() {
+      if (!done && fs::exists(work.path + "/state.json")) staging.path.clear(), work.path.clear();
     }
-    LODFORGE_TRY(chunks.flush());
-    progress.finish();
+  } keep{staging, work};
+
+  // The memory mode and limit decide threads and buffers.
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  ChunkInputOptions input = options.input;
+  OctreeOptions octree = options.octree;
+  switch (options.memory) {
+    case TilesMemory::kMinimal:
+      octree.threads = 1;
+      input.chunkBufferBytes = std::min<std::uint64_t>(input.chunkBufferBytes, 32 << 20);
+      input.vertexCacheBytes = std::min<std::uint64_t>(input.vertexCacheBytes, 32 << 20);
+      break;
+    case TilesMemory::kModerate:
+      octree.threads = options.threads > 0 ? options.threads : std::max(1, cores / 4);
+      break;
+    case TilesMemory::kUnbounded:
+      octree.threads = options.threads > 0 ? options.threads : cores;
+      input.keepInMemory = true;
+      octree.keepInMemory = true;
+      break;
   }
-  stats.leafTriangles = chunks.triangleCount();
-  const bool colors = model->hasColors();
-  model = Model{};  // the chunks hold it now
+  if (options.memoryLimit > 0) {
+    // The program itself (code, libraries, thread stacks, I/O buffers) takes about 32 MiB; of
+    // the rest a quarter goes to the chunk buffer, an eighth to the vertex cache and half to the
+    // nodes in flight (the octree lowers its parallelism to fit).
+    constexpr std::uint64_t kProgram = std::uint64_t{32} << 20;
+    if (options.memoryLimit < kProgram + (std::uint64_t{16} << 20))
+      return Error{ErrorKind::kLimit,
+                   fmt::format("--memory-limit {} MiB is too small for tiles: at least 48 MiB",
+                               options.memoryLimit >> 20)};
+    const std::uint64_t usable = options.memoryLimit - kProgram;
+    input.chunkBufferBytes = std::min(input.chunkBufferBytes, usable / 4);
+    input.vertexCacheBytes = std::min(input.vertexCacheBytes, usable / 8);
+    octree.memoryBudget = usable / 2;
+    // A parent holds about four children (eight in a volume) while it is simplified, at ~200
+    // bytes per triangle: smaller leaves when the budget cannot hold that for the default size.
+    if (input.chunkSize == 0) {
+      input.trianglesPerChunk =
+          std::clamp<std::uint64_t>(octree.memoryBudget / (4 * 200), 4096, input.trianglesPerChunk);
+    }
+    input.keepInMemory = false;
+    octree.keepInMemory = false;
+  }
+  stats.threads = octree.threads;
+
+  // Stream the input into the chunk grid, or take the chunks of an interrupted run.
+  input.workDirectory = work.path;
+  const std::string statePath = work.path + "/state.json";
+  const nlohmann::json identity = {
+      {"input", fs::absolute(path).string()},
+      {"bytes", fs::exists(path) ? fs::file_size(path) : 0},
+      {"modified", fs::exists(path) ? fs::last_write_time(path).time_since_epoch().count() : 0},
+      {"chunkSize", input.chunkSize},
+      {"trianglesPerChunk", input.trianglesPerChunk},
+      {"keep", octree.keep},
+      {"maxNormalDeviation", octree.maxNormalDeviationDegrees},
+      {"errorSamples", octree.errorSamples}};
+  std::optional<ChunkInput> chunked;
+  if (options.resume) chunked = resumeChunks(statePath, identity, work.path + "/chunks");
+  if (chunked) {
+    stats.resumed = true;
+  } else {
+    fs::remove_all(work.path + "/nodes", error);
+    fs::remove_all(fs::path(staging.path) / "tiles", error);
+    fs::create_directories(fs::path(staging.path) / "tiles");
+    Result<ChunkInput> fresh = chunkInput(path, input);
+    if (!fresh) return fresh.status();
+    chunked = std::move(*fresh);
+    if (!input.keepInMemory) LODFORGE_TRY(saveChunkState(statePath, identity, *chunked));
+  }
+  octree.resume = stats.resumed;
+  stats.inputTriangles = chunked->inputTriangles;
+  stats.streamed = chunked->streamed;
+  stats.chunkSize = chunked->chunks->grid().size;
+  stats.leafTriangles = chunked->chunks->triangleCount();
+  stats.chunkSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const bool colors = chunked->colors;
+  const ChunkWriter& chunks = *chunked->chunks;
 
   // The octree, each tile written as soon as it is built.
-  OctreeOptions octree = options.octree;
   octree.workDirectory = work.path + "/nodes";
   const std::string tilesDirectory = staging.path;
   Result<OctreeResult> tree =
@@ -179,14 +282,20 @@ Result<TilesStats> writeTiles(const std::string& input, const std::string& outpu
   for (const OctreeNode& node : tree->nodes) {
     stats.tiles += node.triangles > 0 ? 1 : 0;
     stats.leaves += node.level == 0 ? 1 : 0;
+    if (node.level > 0) {
+      stats.lockedVertices += node.lockedVertices;
+      stats.vertices += node.vertices;
+      stats.maxLockedVertices = std::max(stats.maxLockedVertices, node.lockedVertices);
+    }
   }
   stats.levels = tree->levels;
   for (const auto& entry : fs::recursive_directory_iterator(staging.path))
     if (entry.is_regular_file()) stats.outputBytes += entry.file_size();
 
   // Complete: replace the previous tileset, if any, by the new one.
+  keep.done = true;
   if (fs::exists(outputDirectory)) {
-    const std::string old = outputDirectory + ".old" + suffix;
+    const std::string old = outputDirectory + ".old";
     fs::rename(outputDirectory, old, error);
     if (error) return ioError(outputDirectory, error.message());
     ScopedDirectory removeOld{old};

@@ -7,16 +7,25 @@
 #include <string>
 
 #include "lodforge/core/status.h"
+#include "lodforge/tiling/chunk_input.h"
 #include "lodforge/tiling/chunk_store.h"
 #include "lodforge/tiling/octree.h"
 
 namespace lodforge {
 
+// The paper's memory modes (§3.4): one thread; a few threads (25 % of the cores unless
+// --threads says otherwise); every core with chunks and node meshes kept in memory.
+enum class TilesMemory : std::uint8_t { kMinimal, kModerate, kUnbounded };
+
 struct TilesOptions {
-  double chunkSize = 0;                        // 0: from the bounds and trianglesPerLeaf
-  std::uint64_t trianglesPerLeaf = 64 * 1024;  // target for the derived chunk size
-  OctreeOptions octree;
-  std::uint64_t chunkBufferBytes = std::uint64_t{256} << 20;
+  ChunkInputOptions input;  // chunk size, buffers (its work directory is set by writeTiles)
+  OctreeOptions octree;     // reduction, normal limit, levels, error samples
+  TilesMemory memory = TilesMemory::kModerate;
+  std::uint64_t memoryLimit = 0;  // bytes for the whole build, 0: none
+  int threads = 0;                // moderate mode: 0 means 25 % of the cores
+  // Continue an interrupted build from <out>.work and <out>.partial: finished chunks and tiles
+  // are kept when the input and the options are the same.
+  bool resume = false;
 };
 
 struct TilesStats {
@@ -26,7 +35,11 @@ struct TilesStats {
   int levels = 0;
   double chunkSize = 0;
   std::uint64_t outputBytes = 0;
-  double seconds = 0;
+  double seconds = 0, chunkSeconds = 0;  // all, and reading + cutting into chunks
+  bool streamed = false;                 // the input was never held in memory whole
+  bool resumed = false;                  // chunks came from an interrupted run
+  int threads = 0;
+  std::uint64_t maxLockedVertices = 0, lockedVertices = 0, vertices = 0;  // over parents
 };
 
 // The GLB of one tile: positions relative to the bounds' centre (float), that centre as the

@@ -1,36 +1,47 @@
 #include "lodforge/tiling/chunk_store.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <numeric>
 
 #include <fmt/format.h>
 
 namespace lodforge {
 
+namespace {
+
+// Bits of a coordinate with -0 folded into +0 (they compare equal, so they must hash equal).
+std::uint64_t coordinateBits(double v) {
+  return v == 0 ? 0 : std::bit_cast<std::uint64_t>(v);
+}
+
+std::uint64_t hashPosition(const Vec3d& p) {
+  std::uint64_t h = coordinateBits(p.x) * 0x9E3779B97F4A7C15ull;
+  h = (h ^ (h >> 29) ^ coordinateBits(p.y)) * 0xBF58476D1CE4E5B9ull;
+  h = (h ^ (h >> 32) ^ coordinateBits(p.z)) * 0x94D049BB133111EBull;
+  return h ^ (h >> 31);
+}
+
+}  // namespace
+
 void weldExact(MeshPart& mesh) {
   const std::uint32_t count = mesh.vertexCount();
-  std::vector<std::uint32_t> order(count);
-  std::iota(order.begin(), order.end(), 0u);
-  const auto less = [&](std::uint32_t a, std::uint32_t b) {
-    const Vec3d& p = mesh.positions[a];
-    const Vec3d& q = mesh.positions[b];
-    if (p.x != q.x) return p.x < q.x;
-    if (p.y != q.y) return p.y < q.y;
-    if (p.z != q.z) return p.z < q.z;
-    return a < b;
-  };
-  std::sort(order.begin(), order.end(), less);
-  // Each vertex points at the first vertex (lowest index) with its position.
+  // Each vertex points at the first vertex (lowest index) with its position: an open-addressing
+  // table keyed by position, filled in vertex order.
+  std::size_t capacity = 16;
+  while (capacity < 2 * std::size_t{count}) capacity *= 2;
+  std::vector<std::uint32_t> table(capacity, ~0u);
   std::vector<std::uint32_t> representative(count);
-  for (std::size_t i = 0; i < order.size();) {
-    std::size_t j = i;
-    while (j < order.size() && mesh.positions[order[j]] == mesh.positions[order[i]]) ++j;
-    for (std::size_t k = i; k < j; ++k) representative[order[k]] = order[i];
-    i = j;
+  for (std::uint32_t v = 0; v < count; ++v) {
+    const Vec3d& p = mesh.positions[v];
+    std::size_t slot = hashPosition(p) & (capacity - 1);
+    while (table[slot] != ~0u && !(mesh.positions[table[slot]] == p))
+      slot = (slot + 1) & (capacity - 1);
+    if (table[slot] == ~0u) table[slot] = v;
+    representative[v] = table[slot];
   }
   // Triangles over representatives; drop those that repeat a corner.
   std::size_t kept = 0;
@@ -152,9 +163,21 @@ Result<MeshPart> loadMesh(const std::string& path) {
   return mesh;
 }
 
-ChunkWriter::ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bufferBytes)
-    : grid_(grid), directory_(std::move(directory)), bufferBytes_(bufferBytes) {
+ChunkWriter::ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bufferBytes,
+                         bool keepInMemory)
+    : grid_(grid),
+      directory_(std::move(directory)),
+      bufferBytes_(bufferBytes),
+      keepInMemory_(keepInMemory) {
   std::filesystem::create_directories(directory_);
+}
+
+ChunkWriter ChunkWriter::reopen(ChunkGrid grid, std::string directory,
+                                std::map<std::uint64_t, std::uint64_t> counts) {
+  ChunkWriter writer(grid, std::move(directory), 0);
+  for (const auto& [index, count] : counts) writer.triangles_ += count;
+  writer.counts_ = std::move(counts);
+  return writer;
 }
 
 std::string ChunkWriter::chunkPath(const ChunkCell& cell) const {
@@ -176,11 +199,12 @@ Status ChunkWriter::add(const ChunkCell& cell, std::span<const CutCorner, 3> cor
   ++counts_[index];
   ++triangles_;
   buffered_ += kTriangleBytes;
-  if (buffered_ >= bufferBytes_) return flush();
+  if (buffered_ >= bufferBytes_ && !keepInMemory_) return flush();
   return {};
 }
 
 Status ChunkWriter::flush() {
+  if (keepInMemory_) return {};
   for (auto& [index, buffer] : buffers_) {
     if (buffer.empty()) continue;
     LODFORGE_TRY(appendTo(chunkPath(cellOfIndex(grid_, index)), buffer));
@@ -192,12 +216,11 @@ Status ChunkWriter::flush() {
   return {};
 }
 
-Result<MeshPart> loadChunk(const std::string& path) {
-  Result<std::vector<std::byte>> read = readWhole(path);
-  if (!read) return read.error();
-  const std::vector<std::byte>& bytes = read.value();
+namespace {
+
+Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string& name) {
   if (bytes.size() % kTriangleBytes != 0)
-    return badInputAtByte(path, bytes.size() / kTriangleBytes * kTriangleBytes,
+    return badInputAtByte(name, bytes.size() / kTriangleBytes * kTriangleBytes,
                           "chunk file ends inside a triangle");
   const std::size_t corners = bytes.size() / kCornerBytes;
   MeshPart mesh;
@@ -213,6 +236,20 @@ Result<MeshPart> loadChunk(const std::string& path) {
   }
   weldExact(mesh);
   return mesh;
+}
+
+}  // namespace
+
+Result<MeshPart> loadChunk(const std::string& path) {
+  Result<std::vector<std::byte>> read = readWhole(path);
+  if (!read) return read.error();
+  return parseChunk(read.value(), path);
+}
+
+Result<MeshPart> ChunkWriter::load(const ChunkCell& cell) const {
+  const auto it = buffers_.find(grid_.cellIndex(cell));
+  if (it != buffers_.end()) return parseChunk(it->second, chunkPath(cell));
+  return loadChunk(chunkPath(cell));
 }
 
 ChunkCell cellOfIndex(const ChunkGrid& grid, std::uint64_t index) {

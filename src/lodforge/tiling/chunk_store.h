@@ -44,7 +44,13 @@ Result<MeshPart> loadMesh(const std::string& path);
 class ChunkWriter {
  public:
   // Chunk files go to `directory` (created); at most `bufferBytes` are held before appending.
-  ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bufferBytes);
+  // With `keepInMemory` nothing is written: the chunks stay in their buffers.
+  ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bufferBytes,
+              bool keepInMemory = false);
+
+  // Chunk files written by an earlier, interrupted run (--resume): the grid and the counts.
+  static ChunkWriter reopen(ChunkGrid grid, std::string directory,
+                            std::map<std::uint64_t, std::uint64_t> counts);
 
   // One triangle piece (3 corners) for `cell`.
   Status add(const ChunkCell& cell, std::span<const CutCorner, 3> corners);
@@ -55,11 +61,14 @@ class ChunkWriter {
   const std::map<std::uint64_t, std::uint64_t>& triangleCounts() const { return counts_; }
   std::uint64_t triangleCount() const { return triangles_; }
   std::string chunkPath(const ChunkCell& cell) const;
+  // A chunk as a welded mesh, from its buffer or its file.
+  Result<MeshPart> load(const ChunkCell& cell) const;
 
  private:
   ChunkGrid grid_;
   std::string directory_;
   std::uint64_t bufferBytes_ = 0, buffered_ = 0, triangles_ = 0;
+  bool keepInMemory_ = false;
   std::map<std::uint64_t, std::vector<std::byte>> buffers_;  // by cell index
   std::map<std::uint64_t, std::uint64_t> counts_;
 };

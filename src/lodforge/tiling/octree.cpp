@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <numbers>
@@ -9,6 +11,7 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <nlohmann/json.hpp>
 
 #include "lodforge/core/distance.h"
 #include "lodforge/core/progress.h"
@@ -39,12 +42,12 @@ std::uint64_t seedOf(const OctreeNode& node) {
 
 // Endpoints of edges with one triangle: the border the simplification keeps.
 std::uint64_t countBorderVertices(const MeshPart& mesh) {
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+  std::vector<std::uint64_t> edges;
   edges.reserve(mesh.indices.size());
   for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
     for (std::size_t k = 0; k < 3; ++k) {
-      const std::uint32_t a = mesh.indices[t + k], b = mesh.indices[t + (k + 1) % 3];
-      edges.emplace_back(std::min(a, b), std::max(a, b));
+      const std::uint64_t a = mesh.indices[t + k], b = mesh.indices[t + (k + 1) % 3];
+      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
     }
   }
   std::sort(edges.begin(), edges.end());
@@ -52,7 +55,7 @@ std::uint64_t countBorderVertices(const MeshPart& mesh) {
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
     while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) border[edges[i].first] = border[edges[i].second] = 1;
+    if (j - i == 1) border[edges[i] >> 32] = border[edges[i] & 0xFFFFFFFFu] = 1;
     i = j;
   }
   return static_cast<std::uint64_t>(std::count(border.begin(), border.end(), 1));
@@ -63,6 +66,27 @@ struct Builder {
   const OctreeOptions& options;
   const NodeSink& sink;
   OctreeResult result;
+  std::mutex memoryMutex;
+  std::map<std::string, MeshPart> inMemory;  // keepInMemory: node meshes by path
+
+  Status save(const MeshPart& mesh, const std::string& path) {
+    if (!options.keepInMemory) return saveMesh(mesh, path);
+    std::lock_guard lock(memoryMutex);
+    inMemory[path] = mesh;
+    return {};
+  }
+  Result<MeshPart> take(const std::string& path) {
+    if (!options.keepInMemory) return loadMesh(path);  // kept for a resumed run
+    std::lock_guard lock(memoryMutex);
+    auto node = inMemory.extract(path);
+    if (node.empty()) return Error{ErrorKind::kInternal, path + ": node mesh missing"};
+    return std::move(node.mapped());
+  }
+
+  // Bytes one node takes while it is built: its mesh, the simplifier, the distance grids.
+  static std::uint64_t estimateBytes(std::uint64_t triangles) {
+    return triangles * 320 + (1 << 20);
+  }
 
   std::string meshPath(const OctreeNode& node) const {
     return fmt::format("{}/L{}_{}_{}_{}.mesh", options.workDirectory, node.level, node.cell[0],
@@ -71,44 +95,103 @@ struct Builder {
 
   // Runs `work` for every node in `indices`, in parallel; the first failure wins.
   Status forEach(const std::vector<std::uint32_t>& indices, const std::string& label,
-                 const std::function<Status(OctreeNode&)>& work) {
+                 std::uint64_t largestTriangles, const std::function<Status(OctreeNode&)>& work) {
     Progress progress(label, indices.size());
     std::mutex mutex;
     Status failure;
-    tbb::parallel_for(std::size_t{0}, indices.size(), [&](std::size_t i) {
-      {
-        std::lock_guard lock(mutex);
-        if (!failure.ok()) return;
-      }
-      Status status = checkCancelled();
-      if (status.ok()) status = work(result.nodes[indices[i]]);
-      progress.advance(1);
-      if (!status.ok()) {
-        std::lock_guard lock(mutex);
-        if (failure.ok()) failure = std::move(status);
-      }
+    // As many at once as the memory budget allows for the largest node of the level.
+    int concurrency =
+        options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
+    if (options.memoryBudget > 0) {
+      const std::uint64_t fit = options.memoryBudget / estimateBytes(largestTriangles);
+      concurrency = static_cast<int>(
+          std::clamp<std::uint64_t>(fit, 1, static_cast<std::uint64_t>(concurrency)));
+    }
+    tbb::task_arena arena(concurrency);
+    arena.execute([&] {
+      tbb::parallel_for(std::size_t{0}, indices.size(), [&](std::size_t i) {
+        {
+          std::lock_guard lock(mutex);
+          if (!failure.ok()) return;
+        }
+        Status status = checkCancelled();
+        if (status.ok()) status = work(result.nodes[indices[i]]);
+        progress.advance(1);
+        if (!status.ok()) {
+          std::lock_guard lock(mutex);
+          if (failure.ok()) failure = std::move(status);
+        }
+      });
     });
     progress.finish();
     return failure;
   }
 
+  // A finished node's summary beside its mesh file: written last, so its presence means done.
+  static std::string summaryPath(const std::string& mesh) { return mesh + ".json"; }
+
+  Status writeSummary(const OctreeNode& node) const {
+    if (options.keepInMemory) return {};
+    const nlohmann::json summary = {{"bounds",
+                                     {node.bounds.min.x, node.bounds.min.y, node.bounds.min.z,
+                                      node.bounds.max.x, node.bounds.max.y, node.bounds.max.z}},
+                                    {"geometricError", node.geometricError},
+                                    {"triangles", node.triangles},
+                                    {"vertices", node.vertices},
+                                    {"lockedVertices", node.lockedVertices}};
+    const std::string path = summaryPath(node.meshPath), temp = path + ".tmp";
+    {
+      std::ofstream out(temp);
+      out << summary.dump();
+      if (!out.flush()) return ioError(temp, "cannot write");
+    }
+    std::error_code error;
+    std::filesystem::rename(temp, path, error);
+    if (error) return ioError(path, error.message());
+    return {};
+  }
+
+  bool readSummary(OctreeNode& node) const {
+    if (!options.resume || options.keepInMemory) return false;
+    const std::string mesh = meshPath(node);
+    std::ifstream in(summaryPath(mesh));
+    if (!in || !std::filesystem::exists(mesh)) return false;
+    try {
+      const nlohmann::json summary = nlohmann::json::parse(in);
+      const auto& b = summary.at("bounds");
+      node.bounds.min = {b.at(0).get<double>(), b.at(1).get<double>(), b.at(2).get<double>()};
+      node.bounds.max = {b.at(3).get<double>(), b.at(4).get<double>(), b.at(5).get<double>()};
+      node.geometricError = summary.at("geometricError").get<double>();
+      node.triangles = summary.at("triangles").get<std::uint64_t>();
+      node.vertices = summary.at("vertices").get<std::uint64_t>();
+      node.lockedVertices = summary.at("lockedVertices").get<std::uint64_t>();
+    } catch (const nlohmann::json::exception&) {
+      return false;  // a damaged summary: build the node again
+    }
+    node.meshPath = mesh;
+    return true;
+  }
+
   Status buildLeaf(OctreeNode& node) {
-    Result<MeshPart> mesh = loadChunk(chunks.chunkPath(node.cell));
+    if (readSummary(node)) return {};
+    Result<MeshPart> mesh = chunks.load(node.cell);
     if (!mesh) return mesh.status();
     node.bounds = boundsOf(*mesh);
     node.triangles = mesh->triangleCount();
     node.vertices = mesh->vertexCount();
     node.meshPath = meshPath(node);
-    LODFORGE_TRY(saveMesh(*mesh, node.meshPath));
-    return sink(node, *mesh);
+    LODFORGE_TRY(sink(node, *mesh));
+    LODFORGE_TRY(save(*mesh, node.meshPath));
+    return writeSummary(node);
   }
 
   Status buildParent(OctreeNode& node) {
+    if (readSummary(node)) return {};
     std::vector<MeshPart> parts;
     double childError = 0;
     for (std::uint32_t c : node.children) {
       const OctreeNode& child = result.nodes[c];
-      Result<MeshPart> part = loadMesh(child.meshPath);
+      Result<MeshPart> part = take(child.meshPath);
       if (!part) return part.status();
       parts.push_back(std::move(*part));
       node.bounds.add(child.bounds);
@@ -147,8 +230,9 @@ struct Builder {
     node.triangles = mesh.triangleCount();
     node.vertices = mesh.vertexCount();
     node.meshPath = meshPath(node);
-    LODFORGE_TRY(saveMesh(mesh, node.meshPath));
-    return sink(node, mesh);
+    LODFORGE_TRY(sink(node, mesh));
+    LODFORGE_TRY(save(mesh, node.meshPath));
+    return writeSummary(node);
   }
 
   Status run() {
@@ -160,7 +244,10 @@ struct Builder {
       result.nodes.push_back(std::move(node));
     }
     if (level.empty()) return Error{ErrorKind::kBadInput, "the input has no triangles"};
-    LODFORGE_TRY(forEach(level, "tiles: leaves", [&](OctreeNode& n) { return buildLeaf(n); }));
+    std::uint64_t largest = 0;
+    for (const auto& [index, count] : chunks.triangleCounts()) largest = std::max(largest, count);
+    LODFORGE_TRY(
+        forEach(level, "tiles: leaves", largest, [&](OctreeNode& n) { return buildLeaf(n); }));
     int depth = 0;
     while (level.size() > 1 && (options.levels == 0 || depth < options.levels)) {
       ++depth;
@@ -179,7 +266,13 @@ struct Builder {
         parents.push_back(static_cast<std::uint32_t>(result.nodes.size()));
         result.nodes.push_back(std::move(node));
       }
-      LODFORGE_TRY(forEach(parents, fmt::format("tiles: level {}", depth),
+      largest = 0;
+      for (std::uint32_t p : parents) {
+        std::uint64_t sum = 0;
+        for (std::uint32_t c : result.nodes[p].children) sum += result.nodes[c].triangles;
+        largest = std::max(largest, sum);
+      }
+      LODFORGE_TRY(forEach(parents, fmt::format("tiles: level {}", depth), largest,
                            [&](OctreeNode& n) { return buildParent(n); }));
       level = std::move(parents);
     }
@@ -207,15 +300,9 @@ struct Builder {
 
 Result<OctreeResult> buildOctree(const ChunkWriter& chunks, const OctreeOptions& options,
                                  const NodeSink& sink) {
-  Builder builder{chunks, options, sink, {}};
-  Status status;
-  if (options.threads > 0) {
-    tbb::task_arena arena(options.threads);
-    arena.execute([&] { status = builder.run(); });
-  } else {
-    status = builder.run();
-  }
-  if (!status.ok()) return status;
+  Builder builder{chunks, options, sink, {}, {}, {}};
+  if (!options.keepInMemory) std::filesystem::create_directories(options.workDirectory);
+  LODFORGE_TRY(builder.run());
   return std::move(builder.result);
 }
 

@@ -26,8 +26,14 @@ struct OctreeOptions {
   // Levels above the leaves (0: up to a single root).
   int levels = 0;
   // Surface samples per mesh for the geometric error (Hausdorff by sampling).
-  std::uint32_t errorSamples = 20'000;
+  std::uint32_t errorSamples = 10'000;
   int threads = 0;  // 0: all allowed by the process limit
+  // Bytes the nodes being built at once may take (0: no limit): fewer run in parallel.
+  std::uint64_t memoryBudget = 0;
+  bool keepInMemory = false;  // node meshes stay in memory instead of work files
+  // Nodes finished by an earlier, interrupted run (their mesh file and a summary beside it)
+  // are taken as they are: the sink is not called for them again.
+  bool resume = false;
   std::string workDirectory;
 };
 

@@ -1,0 +1,211 @@
+#include "lodforge/tiling/chunk_input.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/io/model_io.h"
+#include "lodforge/io/ply_reader.h"
+#include "lodforge/tiling/chunk_grid.h"
+
+namespace lodforge {
+namespace {
+
+constexpr std::size_t kVertexBytes = 3 * sizeof(double) + sizeof(Rgba8);
+constexpr std::uint64_t kBlockVertices = 1 << 14;
+
+// Corners of the faces, fetched from the vertex work file through a direct-mapped cache of
+// fixed-size blocks: meshes written in scan or grid order touch a few blocks at a time.
+class VertexCache {
+ public:
+  VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes) : fd_(fd), vertices_(vertices) {
+    const std::uint64_t blockBytes = kBlockVertices * kVertexBytes;
+    slots_ = std::max<std::uint64_t>(4, bytes / blockBytes);
+    data_.resize(slots_ * blockBytes);
+    tags_.assign(slots_, ~std::uint64_t{0});
+  }
+
+  bool fetch(std::uint64_t vertex, CutCorner& out) {
+    if (vertex >= vertices_) return false;
+    const std::uint64_t block = vertex / kBlockVertices;
+    const std::uint64_t slot = block % slots_;
+    std::byte* base = data_.data() + slot * kBlockVertices * kVertexBytes;
+    if (tags_[slot] != block) {
+      const std::uint64_t first = block * kBlockVertices;
+      const std::uint64_t count = std::min(kBlockVertices, vertices_ - first);
+      const auto wanted = static_cast<std::size_t>(count * kVertexBytes);
+      if (::pread(fd_, base, wanted, static_cast<off_t>(first * kVertexBytes)) !=
+          static_cast<ssize_t>(wanted))
+        return false;
+      tags_[slot] = block;
+    }
+    const std::byte* at = base + (vertex % kBlockVertices) * kVertexBytes;
+    double xyz[3];
+    std::memcpy(xyz, at, sizeof xyz);
+    out.position = {xyz[0], xyz[1], xyz[2]};
+    std::memcpy(&out.color, at + sizeof xyz, sizeof(Rgba8));
+    return true;
+  }
+
+ private:
+  int fd_;
+  std::uint64_t vertices_, slots_ = 0;
+  std::vector<std::byte> data_;
+  std::vector<std::uint64_t> tags_;
+};
+
+double chunkSizeFor(const ChunkInputOptions& options, const Aabbd& bounds,
+                    std::uint64_t triangles) {
+  return options.chunkSize > 0 ? options.chunkSize
+                               : ChunkGrid::sizeFor(bounds, triangles, options.trianglesPerChunk);
+}
+
+Status addTriangle(ChunkWriter& chunks, const std::array<CutCorner, 3>& triangle,
+                   std::vector<ChunkCell>& cells, std::vector<CutCorner>& corners) {
+  cells.clear();
+  corners.clear();
+  cutTriangle(chunks.grid(), triangle, cells, corners);
+  for (std::size_t p = 0; p < cells.size(); ++p)
+    LODFORGE_TRY(chunks.add(cells[p], std::span<const CutCorner, 3>(corners.data() + 3 * p, 3)));
+  return {};
+}
+
+Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& options) {
+  ChunkInput input;
+  input.streamed = true;
+  // Pass 1: vertices to the work file, and the bounds.
+  PlyReadOptions read;
+  read.readFaces = false;
+  Result<PlyReader> vertices = PlyReader::open(path, read);
+  if (!vertices) return vertices.status();
+  const PlyHeader header = vertices->header();
+  if (header.faceCount == 0) return badInput(path, "no faces: a tileset needs a mesh");
+  input.colors = header.hasColors;
+  const std::string vertexPath = options.workDirectory + "/vertices.bin";
+  const int fd = ::open(vertexPath.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) return ioErrorFromErrno(vertexPath, "create");
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  {
+    Progress progress("tiles: vertices", header.vertexCount);
+    PlyBatch batch;
+    std::vector<std::byte> buffer;
+    while (true) {
+      Result<bool> more = vertices->next(batch);
+      if (!more) return more.status();
+      if (!*more) break;
+      if (batch.kind != PlyBatch::Kind::kVertices) continue;
+      buffer.resize(batch.positions.size() * kVertexBytes);
+      for (std::size_t i = 0; i < batch.positions.size(); ++i) {
+        const Vec3d p = batch.positions[i];
+        input.bounds.add(p);
+        const double xyz[3] = {p.x, p.y, p.z};
+        const Rgba8 color = batch.colors.empty() ? Rgba8{255, 255, 255, 255} : batch.colors[i];
+        std::memcpy(buffer.data() + i * kVertexBytes, xyz, sizeof xyz);
+        std::memcpy(buffer.data() + i * kVertexBytes + sizeof xyz, &color, sizeof color);
+      }
+      if (::write(fd, buffer.data(), buffer.size()) != static_cast<ssize_t>(buffer.size()))
+        return ioErrorFromErrno(vertexPath, "write");
+      progress.advance(batch.positions.size());
+      LODFORGE_TRY(checkCancelled());
+    }
+    progress.finish();
+  }
+  if (input.bounds.empty()) return badInput(path, "no vertices");
+
+  // Pass 2: faces, corners from the cache, cut into the chunk files.
+  const ChunkGrid grid =
+      ChunkGrid::over(input.bounds, chunkSizeFor(options, input.bounds, header.faceCount));
+  input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
+                                               options.chunkBufferBytes, options.keepInMemory);
+  read.readFaces = true;
+  read.readVertices = false;
+  Result<PlyReader> faces = PlyReader::open(path, read);
+  if (!faces) return faces.status();
+  VertexCache cache(fd, header.vertexCount, options.vertexCacheBytes);
+  Progress progress("tiles: chunks", header.faceCount);
+  PlyBatch batch;
+  std::vector<ChunkCell> cells;
+  std::vector<CutCorner> corners;
+  while (true) {
+    Result<bool> more = faces->next(batch);
+    if (!more) return more.status();
+    if (!*more) break;
+    if (batch.kind != PlyBatch::Kind::kFaces) continue;
+    for (std::size_t t = 0; t + 2 < batch.triangles.size(); t += 3) {
+      std::array<CutCorner, 3> triangle;
+      for (std::size_t k = 0; k < 3; ++k) {
+        if (!cache.fetch(batch.triangles[t + k], triangle[k]))
+          return badInput(path, fmt::format("face {}: vertex {} is not in the file (or the "
+                                            "vertex work file could not be read)",
+                                            batch.first, batch.triangles[t + k]));
+      }
+      LODFORGE_TRY(addTriangle(*input.chunks, triangle, cells, corners));
+    }
+    input.inputTriangles += batch.triangles.size() / 3;
+    progress.advance(batch.count);
+    LODFORGE_TRY(checkCancelled());
+  }
+  LODFORGE_TRY(input.chunks->flush());
+  progress.finish();
+  std::filesystem::remove(vertexPath);
+  return input;
+}
+
+Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& options) {
+  ChunkInput input;
+  Result<Model> model = readModel(path);
+  if (!model) return model.status();
+  input.inputTriangles = model->triangleCount();
+  if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");
+  input.colors = model->hasColors();
+  const Aabb local = model->bounds();
+  input.bounds.add(model->origin + toDouble(local.min));
+  input.bounds.add(model->origin + toDouble(local.max));
+  const ChunkGrid grid =
+      ChunkGrid::over(input.bounds, chunkSizeFor(options, input.bounds, input.inputTriangles));
+  input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
+                                               options.chunkBufferBytes, options.keepInMemory);
+  Progress progress("tiles: chunks", input.inputTriangles);
+  std::vector<ChunkCell> cells;
+  std::vector<CutCorner> corners;
+  for (std::size_t o = 0; o < model->objectCount(); ++o) {
+    const ObjectRecord& object = model->objects[o];
+    const auto positions = model->objectPositions(o);
+    const auto indices = model->objectIndices(o);
+    for (std::size_t t = 0; t < indices.size(); t += 3) {
+      std::array<CutCorner, 3> triangle;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::uint32_t v = indices[t + k];
+        triangle[k].position = model->origin + toDouble(positions[v]);
+        triangle[k].color =
+            input.colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
+      }
+      LODFORGE_TRY(addTriangle(*input.chunks, triangle, cells, corners));
+    }
+    progress.advance(indices.size() / 3);
+    LODFORGE_TRY(checkCancelled());
+  }
+  LODFORGE_TRY(input.chunks->flush());
+  progress.finish();
+  return input;
+}
+
+}  // namespace
+
+Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options) {
+  std::filesystem::create_directories(options.workDirectory);
+  if (fileExtension(path) == "ply") return chunkPly(path, options);
+  return chunkModel(path, options);
+}
+
+}  // namespace lodforge

@@ -1,0 +1,37 @@
+// The input streamed into the chunk grid (large-meshes paper §3.3–3.4). A PLY is never held in
+// memory: a first pass copies its vertices to a work file (exact doubles) and finds the bounds,
+// a second pass reads the faces, fetches their corners through a fixed block cache over that
+// file, cuts them and hands the pieces to the chunk files. Other formats are read whole first
+// (their readers do not stream).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "lodforge/core/math.h"
+#include "lodforge/core/status.h"
+#include "lodforge/tiling/chunk_store.h"
+
+namespace lodforge {
+
+struct ChunkInputOptions {
+  double chunkSize = 0;  // 0: from the bounds and trianglesPerChunk
+  std::uint64_t trianglesPerChunk = 64 * 1024;
+  std::uint64_t chunkBufferBytes = std::uint64_t{64} << 20;  // before chunk files are appended
+  std::uint64_t vertexCacheBytes = std::uint64_t{64} << 20;  // PLY corner lookups
+  std::string workDirectory;                                 // chunk files and the vertex file
+  bool keepInMemory = false;  // chunks stay in memory (the unbounded mode), never written
+};
+
+struct ChunkInput {
+  std::unique_ptr<ChunkWriter> chunks;
+  std::uint64_t inputTriangles = 0;
+  Aabbd bounds;
+  bool colors = false;
+  bool streamed = false;  // a PLY read in two passes, never whole
+};
+
+Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options);
+
+}  // namespace lodforge

@@ -1,0 +1,92 @@
+#include "lodforge/tiling/chunk_input.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "lodforge/io/model_io.h"
+#include "lodforge/io/ply_writer.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Every chunk's welded mesh, as sorted position triples (order-free comparison).
+std::vector<std::array<double, 9>> contents(const ChunkWriter& chunks) {
+  std::vector<std::array<double, 9>> out;
+  for (const auto& [index, count] : chunks.triangleCounts()) {
+    Result<MeshPart> mesh = chunks.load(cellOfIndex(chunks.grid(), index));
+    EXPECT_TRUE(mesh.ok());
+    for (std::size_t t = 0; t < mesh->indices.size(); t += 3) {
+      std::array<double, 9> tri{};
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Vec3d p = mesh->positions[mesh->indices[t + k]];
+        tri[3 * k] = p.x, tri[3 * k + 1] = p.y, tri[3 * k + 2] = p.z;
+      }
+      out.push_back(tri);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(ChunkInput, StreamedPlyGivesTheSameChunksAsTheLoadedModel) {
+  test::TempDir dir;
+  // The horse as a binary PLY (streamed) and as a GLB (loaded whole).
+  Result<Model> horse = readModel(test::dataPath("meshes/horse.ply"));
+  ASSERT_TRUE(horse.ok());
+  ASSERT_TRUE(writeModel(*horse, dir.file("horse.glb")).ok());
+  ChunkInputOptions options;
+  options.chunkSize = 0.04;
+  options.vertexCacheBytes = 1;  // the smallest cache: four blocks, many misses
+  options.workDirectory = dir.file("streamed");
+  Result<ChunkInput> streamed = chunkInput(test::dataPath("meshes/horse.ply"), options);
+  ASSERT_TRUE(streamed.ok()) << streamed.error().message;
+  EXPECT_TRUE(streamed->streamed);
+  options.workDirectory = dir.file("loaded");
+  Result<ChunkInput> loaded = chunkInput(dir.file("horse.glb"), options);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  EXPECT_FALSE(loaded->streamed);
+  EXPECT_EQ(streamed->inputTriangles, horse->triangleCount());
+  EXPECT_EQ(streamed->chunks->triangleCounts(), loaded->chunks->triangleCounts());
+  EXPECT_GT(streamed->chunks->triangleCounts().size(), 8u);
+  EXPECT_EQ(contents(*streamed->chunks), contents(*loaded->chunks));
+  EXPECT_FALSE(fs::exists(dir.file("streamed/vertices.bin")));  // the work file is gone
+}
+
+TEST(ChunkInput, KeptInMemoryEqualsWrittenToDisk) {
+  test::TempDir dir;
+  ChunkInputOptions options;
+  options.chunkSize = 0.05;
+  options.chunkBufferBytes = 4096;  // many appends
+  options.workDirectory = dir.file("disk");
+  Result<ChunkInput> disk = chunkInput(test::dataPath("meshes/stanford-bunny.obj"), options);
+  ASSERT_TRUE(disk.ok());
+  options.keepInMemory = true;
+  options.workDirectory = dir.file("memory");
+  Result<ChunkInput> memory = chunkInput(test::dataPath("meshes/stanford-bunny.obj"), options);
+  ASSERT_TRUE(memory.ok());
+  EXPECT_TRUE(test::listFolder(dir.file("memory/chunks")).empty());
+  EXPECT_EQ(contents(*disk->chunks), contents(*memory->chunks));
+}
+
+TEST(ChunkInput, AFaceOutsideTheVerticesIsBadInputNamingTheFile) {
+  test::TempDir dir;
+  std::ofstream(dir.file("bad.ply"))
+      << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+         "property float y\nproperty float z\nelement face 1\n"
+         "property list uchar int vertex_indices\nend_header\n"
+         "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n";
+  ChunkInputOptions options;
+  options.workDirectory = dir.file("work");
+  Result<ChunkInput> input = chunkInput(dir.file("bad.ply"), options);
+  ASSERT_FALSE(input.ok());
+  EXPECT_EQ(input.error().kind, ErrorKind::kBadInput);
+  EXPECT_NE(input.error().message.find("bad.ply"), std::string::npos) << input.error().message;
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -20,6 +20,7 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
     double maxNormalDeviation = 30;
     std::string memory = "moderate";
     bool resume = false;
+    std::string origin, crs;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh");
@@ -41,6 +42,11 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
                   "unbounded (every core, chunks kept in memory); --memory-limit caps the whole "
                   "build")
       ->check(CLI::IsMember({"minimal", "moderate", "unbounded"}));
+  sub->add_option("--origin", options->origin,
+                  "Place the model's (0,0,0) at LON,LAT,HEIGHT (degrees, metres) with x east, y "
+                  "north, z up");
+  sub->add_option("--crs", options->crs,
+                  "The input's coordinate system (e.g. EPSG:32633), placed on Earth through PROJ");
   sub->add_flag("--resume", options->resume,
                 "Continue an interrupted run from OUTPUT.work and OUTPUT.partial (same input and "
                 "options)");
@@ -57,6 +63,15 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
       tiles.threads = static_cast<int>(global.threads);
       tiles.memoryLimit = global.memoryLimit;
       tiles.resume = options->resume;
+      tiles.crs = options->crs;
+      if (!options->origin.empty()) {
+        if (!options->crs.empty())
+          return Error{ErrorKind::kUsage,
+                       "--origin and --crs: give one (a CRS already places the model)"};
+        Result<Geodetic> origin = parseOrigin(options->origin);
+        if (!origin) return origin.status();
+        tiles.origin = *origin;
+      }
       Result<TilesStats> stats = writeTiles(options->input, options->output, tiles);
       if (!stats) {
         if (std::filesystem::exists(options->output + ".work/state.json"))

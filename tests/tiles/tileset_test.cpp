@@ -1,5 +1,6 @@
 #include "lodforge/tiles/tileset.h"
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -78,6 +79,64 @@ TEST(Tiles, HorseTilesetFollowsTheRules) {
   for (const auto& entry : fs::directory_iterator(out.parent_path()))
     EXPECT_EQ(entry.path().filename().string().find("horse-tiles."), std::string::npos)
         << entry.path();
+}
+
+TEST(Tiles, GeoreferencedByOriginOrByCrs) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "geo-tiles";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  // A 200 m x 200 m terrain patch in UTM 33N, in doubles (centimetres matter at 5e6 m).
+  {
+    std::ofstream ply(dir / "utm.ply");
+    const int n = 40;
+    ply << "ply\nformat ascii 1.0\nelement vertex " << (n + 1) * (n + 1)
+        << "\nproperty double x\nproperty double y\nproperty double z\nelement face " << 2 * n * n
+        << "\nproperty list uchar int vertex_indices\nend_header\n";
+    ply.precision(17);
+    for (int y = 0; y <= n; ++y)
+      for (int x = 0; x <= n; ++x)
+        ply << 500000.0 + 5 * x << " " << 5200000.0 + 5 * y << " " << 300 + std::sin(x * 0.3)
+            << "\n";
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const int a = y * (n + 1) + x;
+        ply << "3 " << a << " " << a + 1 << " " << a + n + 2 << "\n3 " << a << " " << a + n + 2
+            << " " << a + n + 1 << "\n";
+      }
+    }
+  }
+  TilesOptions options;
+  options.input.chunkSize = 60;
+  options.octree.errorSamples = 1000;
+  options.crs = "EPSG:32633";
+  Result<TilesStats> stats =
+      writeTiles((dir / "utm.ply").string(), (dir / "crs").string(), options);
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  std::ifstream in(dir / "crs" / "tileset.json");
+  const nlohmann::json tileset = nlohmann::json::parse(in);
+  const auto transform = tileset["root"]["transform"].get<std::array<double, 16>>();
+  // The frame sits on the first vertex (500000, 5200000, 300 m): near 15 E, 46.9 N.
+  const Vec3d origin{transform[12], transform[13], transform[14]};
+  EXPECT_NEAR(length(origin), 6'367'000, 10'000);
+  EXPECT_NEAR(std::atan2(origin.y, origin.x) * 180 / 3.14159265358979, 15.0, 1e-6);
+  // Contents are local: the box centre is ~100 m from the frame's origin, not 5e6 m.
+  const Box box = boxOf(tileset["root"]);
+  EXPECT_NEAR(box.c[0], 100, 2);
+  EXPECT_NEAR(box.c[1], 100, 2);
+  EXPECT_LT(std::abs(box.c[2]), 5);
+
+  // --origin: the model's (0,0,0) at the given place, east-north-up.
+  TilesOptions placed;
+  placed.input.chunkSize = 0.05;
+  placed.octree.errorSamples = 1000;
+  placed.origin = Geodetic{8.5417, 47.3769, 408};
+  stats = writeTiles(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply",
+                     (dir / "origin").string(), placed);
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  std::ifstream in2(dir / "origin" / "tileset.json");
+  const nlohmann::json horse = nlohmann::json::parse(in2);
+  const auto placedTransform = horse["root"]["transform"].get<std::array<double, 16>>();
+  EXPECT_EQ(placedTransform, eastNorthUpToEcef(*placed.origin).m);
 }
 
 TEST(Tiles, BadInputIsRefusedWithoutLeavingAnything) {

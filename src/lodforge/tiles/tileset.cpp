@@ -48,18 +48,20 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
   nlohmann::json counts = nlohmann::json::array();
   for (const auto& [index, count] : input.chunks->triangleCounts())
     counts.push_back({index, count});
-  const nlohmann::json state = {{"identity", identity},
-                                {"grid",
-                                 {{"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
-                                  {"size", grid.size},
-                                  {"dims", grid.dims}}},
-                                {"bounds",
-                                 {input.bounds.min.x, input.bounds.min.y, input.bounds.min.z,
-                                  input.bounds.max.x, input.bounds.max.y, input.bounds.max.z}},
-                                {"inputTriangles", input.inputTriangles},
-                                {"colors", input.colors},
-                                {"streamed", input.streamed},
-                                {"counts", counts}};
+  const nlohmann::json state = {
+      {"identity", identity},
+      {"grid",
+       {{"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
+        {"size", grid.size},
+        {"dims", grid.dims}}},
+      {"bounds",
+       {input.bounds.min.x, input.bounds.min.y, input.bounds.min.z, input.bounds.max.x,
+        input.bounds.max.y, input.bounds.max.z}},
+      {"inputTriangles", input.inputTriangles},
+      {"colors", input.colors},
+      {"streamed", input.streamed},
+      {"frame", input.frame ? nlohmann::json(input.frame->m) : nlohmann::json()},
+      {"counts", counts}};
   const std::string temp = path + ".tmp";
   {
     std::ofstream out(temp);
@@ -95,6 +97,8 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
     input.inputTriangles = state.at("inputTriangles").get<std::uint64_t>();
     input.colors = state.at("colors").get<bool>();
     input.streamed = state.at("streamed").get<bool>();
+    if (!state.at("frame").is_null())
+      input.frame = Mat4d{state.at("frame").get<std::array<double, 16>>()};
     input.chunks =
         std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
     return input;
@@ -128,7 +132,8 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   return writer->finish();
 }
 
-Status writeTilesetJson(const OctreeResult& octree, const std::string& path) {
+Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
+                        const std::optional<Mat4d>& rootTransform) {
   // Depth first; children listed in node order.
   std::function<nlohmann::json(std::uint32_t)> tile = [&](std::uint32_t index) {
     const OctreeNode& node = octree.nodes[index];
@@ -147,10 +152,11 @@ Status writeTilesetJson(const OctreeResult& octree, const std::string& path) {
   // Above the root: the error of showing nothing at all, the size of the model.
   const Vec3d size = root.bounds.size();
   const double nothing = std::max(root.geometricError * 2, length(size));
-  const nlohmann::json tileset = {
+  nlohmann::json tileset = {
       {"asset", {{"version", "1.1"}, {"generator", "lodforge " LODFORGE_VERSION}}},
       {"geometricError", nothing},
       {"root", tile(octree.root)}};
+  if (rootTransform) tileset["root"]["transform"] = rootTransform->m;
   std::ofstream out(path);
   if (!out) return ioError(path, "cannot create");
   out << tileset.dump(1) << '\n';
@@ -232,6 +238,27 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   }
   stats.threads = octree.threads;
 
+  // Georeferencing: a CRS is set up on the first input point (the local frame's origin).
+  struct LazyCrs {
+    std::string crs;
+    std::optional<CrsToLocal> transform;
+    Status error;
+  };
+  auto lazy = std::make_shared<LazyCrs>(LazyCrs{options.crs, std::nullopt, {}});
+  if (!options.crs.empty()) {
+    input.transform = [lazy](Vec3d in, Vec3d& out) {
+      if (!lazy->transform) {
+        Result<CrsToLocal> created = CrsToLocal::create(lazy->crs, in);
+        if (!created) {
+          lazy->error = created.status();
+          return false;
+        }
+        lazy->transform = std::move(*created);
+      }
+      return lazy->transform->apply(in, out);
+    };
+  }
+
   // Stream the input into the chunk grid, or take the chunks of an interrupted run.
   input.workDirectory = work.path;
   const std::string statePath = work.path + "/state.json";
@@ -243,7 +270,11 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
       {"trianglesPerChunk", input.trianglesPerChunk},
       {"keep", octree.keep},
       {"maxNormalDeviation", octree.maxNormalDeviationDegrees},
-      {"errorSamples", octree.errorSamples}};
+      {"errorSamples", octree.errorSamples},
+      {"crs", options.crs},
+      {"origin", options.origin ? fmt::format("{},{},{}", options.origin->longitude,
+                                              options.origin->latitude, options.origin->height)
+                                : ""}};
   std::optional<ChunkInput> chunked;
   if (options.resume) chunked = resumeChunks(statePath, identity, work.path + "/chunks");
   if (chunked) {
@@ -253,8 +284,10 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
     fs::remove_all(fs::path(staging.path) / "tiles", error);
     fs::create_directories(fs::path(staging.path) / "tiles");
     Result<ChunkInput> fresh = chunkInput(path, input);
-    if (!fresh) return fresh.status();
+    if (!fresh) return lazy->error.ok() ? fresh.status() : lazy->error;
     chunked = std::move(*fresh);
+    if (options.origin) chunked->frame = eastNorthUpToEcef(*options.origin);
+    if (lazy->transform) chunked->frame = lazy->transform->localToEcef();
     if (!input.keepInMemory) LODFORGE_TRY(saveChunkState(statePath, identity, *chunked));
   }
   octree.resume = stats.resumed;
@@ -278,7 +311,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
         return writeTileContent(content, node.bounds, tilesDirectory + "/" + tileContentUri(node));
       });
   if (!tree) return tree.status();
-  LODFORGE_TRY(writeTilesetJson(*tree, staging.path + "/tileset.json"));
+  LODFORGE_TRY(writeTilesetJson(*tree, staging.path + "/tileset.json", chunked->frame));
   for (const OctreeNode& node : tree->nodes) {
     stats.tiles += node.triangles > 0 ? 1 : 0;
     stats.leaves += node.level == 0 ? 1 : 0;

@@ -4,9 +4,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "lodforge/core/status.h"
+#include "lodforge/tiles/georeference.h"
 #include "lodforge/tiling/chunk_input.h"
 #include "lodforge/tiling/chunk_store.h"
 #include "lodforge/tiling/octree.h"
@@ -26,6 +28,10 @@ struct TilesOptions {
   // Continue an interrupted build from <out>.work and <out>.partial: finished chunks and tiles
   // are kept when the input and the options are the same.
   bool resume = false;
+  // Georeferencing: the model's (0, 0, 0) at this place, axes east, north, up (metres); or the
+  // input in this CRS ("EPSG:32633"), placed through PROJ.
+  std::optional<Geodetic> origin;
+  std::string crs;
 };
 
 struct TilesStats {
@@ -47,8 +53,10 @@ struct TilesStats {
 Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path);
 
 // tileset.json for a built octree: asset 1.1, REPLACE refinement, box volumes, geometric errors,
-// contents at tiles/<name>.glb for the nodes with triangles.
-Status writeTilesetJson(const OctreeResult& octree, const std::string& path);
+// contents at tiles/<name>.glb for the nodes with triangles, and the root's transform (local
+// frame to ECEF) when georeferenced.
+Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
+                        const std::optional<Mat4d>& rootTransform = std::nullopt);
 
 // The relative URI of a node's content.
 std::string tileContentUri(const OctreeNode& node);

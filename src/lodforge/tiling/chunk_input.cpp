@@ -106,7 +106,11 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
       if (batch.kind != PlyBatch::Kind::kVertices) continue;
       buffer.resize(batch.positions.size() * kVertexBytes);
       for (std::size_t i = 0; i < batch.positions.size(); ++i) {
-        const Vec3d p = batch.positions[i];
+        Vec3d p = batch.positions[i];
+        if (options.transform && !options.transform(batch.positions[i], p))
+          return badInput(path, fmt::format("vertex {}: cannot be transformed to the tileset's "
+                                            "frame (outside the coordinate system?)",
+                                            batch.first + i));
         input.bounds.add(p);
         const double xyz[3] = {p.x, p.y, p.z};
         const Rgba8 color = batch.colors.empty() ? Rgba8{255, 255, 255, 255} : batch.colors[i];
@@ -168,9 +172,16 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
   input.inputTriangles = model->triangleCount();
   if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");
   input.colors = model->hasColors();
-  const Aabb local = model->bounds();
-  input.bounds.add(model->origin + toDouble(local.min));
-  input.bounds.add(model->origin + toDouble(local.max));
+  // World positions (through the transform, if any) and their bounds.
+  std::vector<Vec3d> world(model->vertexCount());
+  for (std::size_t v = 0; v < world.size(); ++v) {
+    world[v] = model->origin + toDouble(model->positions[v]);
+    if (options.transform && !options.transform(world[v], world[v]))
+      return badInput(path, fmt::format("vertex {}: cannot be transformed to the tileset's frame "
+                                        "(outside the coordinate system?)",
+                                        v));
+    input.bounds.add(world[v]);
+  }
   const ChunkGrid grid =
       ChunkGrid::over(input.bounds, chunkSizeFor(options, input.bounds, input.inputTriangles));
   input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
@@ -180,13 +191,12 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
   std::vector<CutCorner> corners;
   for (std::size_t o = 0; o < model->objectCount(); ++o) {
     const ObjectRecord& object = model->objects[o];
-    const auto positions = model->objectPositions(o);
     const auto indices = model->objectIndices(o);
     for (std::size_t t = 0; t < indices.size(); t += 3) {
       std::array<CutCorner, 3> triangle;
       for (std::size_t k = 0; k < 3; ++k) {
         const std::uint32_t v = indices[t + k];
-        triangle[k].position = model->origin + toDouble(positions[v]);
+        triangle[k].position = world[object.vertexOffset + v];
         triangle[k].color =
             input.colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
       }

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "lodforge/core/math.h"
@@ -22,6 +24,9 @@ struct ChunkInputOptions {
   std::uint64_t vertexCacheBytes = std::uint64_t{64} << 20;  // PLY corner lookups
   std::string workDirectory;                                 // chunk files and the vertex file
   bool keepInMemory = false;  // chunks stay in memory (the unbounded mode), never written
+  // Applied to every input position before anything else (a CRS to a local frame); false:
+  // the point cannot be transformed, which is bad input.
+  std::function<bool(Vec3d, Vec3d&)> transform;
 };
 
 struct ChunkInput {
@@ -29,7 +34,8 @@ struct ChunkInput {
   std::uint64_t inputTriangles = 0;
   Aabbd bounds;
   bool colors = false;
-  bool streamed = false;  // a PLY read in two passes, never whole
+  bool streamed = false;       // a PLY read in two passes, never whole
+  std::optional<Mat4d> frame;  // the local frame's place on Earth (ECEF), when georeferenced
 };
 
 Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options);

@@ -21,6 +21,7 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
     std::string memory = "moderate";
     bool resume = false;
     std::string origin, crs;
+    std::string compress = "none";
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh");
@@ -47,6 +48,10 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
                   "north, z up");
   sub->add_option("--crs", options->crs,
                   "The input's coordinate system (e.g. EPSG:32633), placed on Earth through PROJ");
+  sub->add_option("--compress", options->compress,
+                  "none, or meshopt: EXT_meshopt_compression (smaller tiles; CesiumJS and "
+                  "three.js decode it)")
+      ->check(CLI::IsMember({"none", "meshopt"}));
   sub->add_flag("--resume", options->resume,
                 "Continue an interrupted run from OUTPUT.work and OUTPUT.partial (same input and "
                 "options)");
@@ -64,6 +69,7 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
       tiles.memoryLimit = global.memoryLimit;
       tiles.resume = options->resume;
       tiles.crs = options->crs;
+      tiles.meshoptCompression = options->compress == "meshopt";
       if (!options->origin.empty()) {
         if (!options->crs.empty())
           return Error{ErrorKind::kUsage,

@@ -1,6 +1,8 @@
+#include <array>
 #include <cstring>
 
 #include <gtest/gtest.h>
+#include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/mesh.h"
@@ -111,6 +113,62 @@ TEST(GlbWrite, LayoutIsAlignedWithBoundsAndTheRightIndexWidth) {
   const auto& nodes = glb.document["nodes"];
   EXPECT_FALSE(nodes[3].contains("mesh"));
   EXPECT_EQ(nodes[3]["name"], "empty");
+}
+
+TEST(GlbWrite, MeshoptCompressedViewsDecodeToTheUncompressedBytes) {
+  // The glTF validator cannot look inside EXT_meshopt_compression; decode every view here and
+  // compare it with the same file written uncompressed.
+  test::TempDir dir;
+  for (const int vertices : {300, 70'000}) {  // 16- and 32-bit indices
+    const Model model = randomModel(11, 1, vertices);
+    ASSERT_TRUE(writeGlb(model, dir.file("plain.glb")).ok());
+    ASSERT_TRUE(writeGlb(model, dir.file("packed.glb"), {.meshoptCompression = true}).ok());
+    const std::string plainBytes = test::readFile(dir.file("plain.glb"));
+    const std::string packedBytes = test::readFile(dir.file("packed.glb"));
+    EXPECT_LT(packedBytes.size(), plainBytes.size());
+    const Glb plain = parseGlb(plainBytes), packed = parseGlb(packedBytes);
+    EXPECT_EQ(packed.document["extensionsRequired"][0], "EXT_meshopt_compression");
+    const auto& plainViews = plain.document["bufferViews"];
+    const auto& packedViews = packed.document["bufferViews"];
+    ASSERT_EQ(plainViews.size(), packedViews.size());
+    const char* plainBin = plainBytes.data() + 20 + plain.jsonLength + 8;
+    const char* packedBin = packedBytes.data() + 20 + packed.jsonLength + 8;
+    for (std::size_t v = 0; v < plainViews.size(); ++v) {
+      const auto& ext = packedViews[v]["extensions"]["EXT_meshopt_compression"];
+      const std::size_t count = ext["count"], stride = ext["byteStride"];
+      const std::size_t length = plainViews[v]["byteLength"];
+      ASSERT_EQ(count * stride, length);
+      std::vector<unsigned char> decoded(length);
+      const auto* source =
+          reinterpret_cast<const unsigned char*>(packedBin) + ext["byteOffset"].get<std::size_t>();
+      const std::size_t sourceLength = ext["byteLength"];
+      const int result =
+          ext["mode"] == "TRIANGLES"
+              ? meshopt_decodeIndexBuffer(decoded.data(), count, stride, source, sourceLength)
+              : meshopt_decodeVertexBuffer(decoded.data(), count, stride, source, sourceLength);
+      ASSERT_EQ(result, 0) << "view " << v;
+      const char* original = plainBin + plainViews[v]["byteOffset"].get<std::size_t>();
+      if (ext["mode"] == "ATTRIBUTES") {
+        EXPECT_EQ(std::memcmp(decoded.data(), original, length), 0) << "view " << v;
+        continue;
+      }
+      // The index codec may rotate a triangle's corners (winding kept): compare triangles.
+      const auto index = [&](const void* base, std::size_t i) -> std::uint32_t {
+        std::uint32_t value = 0;
+        std::memcpy(&value, static_cast<const char*>(base) + i * stride, stride);
+        return value;
+      };
+      for (std::size_t t = 0; t < count; t += 3) {
+        const std::array<std::uint32_t, 3> a = {index(original, t), index(original, t + 1),
+                                                index(original, t + 2)};
+        const std::array<std::uint32_t, 3> b = {
+            index(decoded.data(), t), index(decoded.data(), t + 1), index(decoded.data(), t + 2)};
+        const bool same =
+            b == a || b == std::array{a[1], a[2], a[0]} || b == std::array{a[2], a[0], a[1]};
+        ASSERT_TRUE(same) << "triangle " << t / 3;
+      }
+    }
+  }
 }
 
 TEST(GlbWrite, SpillingToDiskGivesTheSameFile) {

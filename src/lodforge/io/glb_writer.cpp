@@ -5,6 +5,7 @@
 #include <cstring>
 #include <vector>
 
+#include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
@@ -34,8 +35,9 @@ struct GlbWriter::State {
   std::vector<std::byte> binary;
   std::optional<OutputFile> spill;
   std::string spillPath;
-  std::uint64_t binaryBytes = 0;  // total, memory + spilled
-  std::vector<std::byte> scratch;
+  std::uint64_t binaryBytes = 0;    // total, memory + spilled
+  std::uint64_t fallbackBytes = 0;  // meshopt: the uncompressed layout the views describe
+  std::vector<std::byte> scratch, encoded;
 
   Status appendBinary(const void* data, std::size_t size) {
     const auto* bytes = static_cast<const std::byte*>(data);
@@ -59,15 +61,58 @@ struct GlbWriter::State {
     return {};
   }
 
-  // Writes one view + accessor; returns the accessor index.
+  // Writes one view + accessor; returns the accessor index. `stride` is one element's size;
+  // `vertices` bounds the index codec.
   Result<std::uint32_t> addAccessor(const void* data, std::size_t bytes, std::size_t count,
                                     int componentType, const char* type, int target,
                                     bool normalized, const nlohmann::json* min,
-                                    const nlohmann::json* max) {
-    const std::uint64_t offset = binaryBytes;
-    LODFORGE_TRY(appendBinary(data, bytes));
-    bufferViews.push_back(
-        {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}});
+                                    const nlohmann::json* max, std::size_t stride,
+                                    std::size_t vertices) {
+    nlohmann::json view;
+    if (options.meshoptCompression) {
+      const bool triangles = target == kElementArrayBuffer;
+      if (triangles) {
+        // The codec reads 32-bit indices whatever size they decode to.
+        std::vector<std::uint32_t> wide(count);
+        for (std::size_t i = 0; i < count; ++i) {
+          if (stride == 2) {
+            std::uint16_t v;
+            std::memcpy(&v, static_cast<const std::byte*>(data) + 2 * i, 2);
+            wide[i] = v;
+          } else {
+            std::memcpy(&wide[i], static_cast<const std::byte*>(data) + 4 * i, 4);
+          }
+        }
+        encoded.resize(meshopt_encodeIndexBufferBound(count, vertices));
+        encoded.resize(meshopt_encodeIndexBuffer(reinterpret_cast<unsigned char*>(encoded.data()),
+                                                 encoded.size(), wide.data(), count));
+      } else {
+        encoded.resize(meshopt_encodeVertexBufferBound(count, stride));
+        encoded.resize(meshopt_encodeVertexBuffer(reinterpret_cast<unsigned char*>(encoded.data()),
+                                                  encoded.size(), data, count, stride));
+      }
+      const std::uint64_t offset = binaryBytes;
+      LODFORGE_TRY(appendBinary(encoded.data(), encoded.size()));
+      view = {{"buffer", 1},
+              {"byteOffset", fallbackBytes},
+              {"byteLength", bytes},
+              {"target", target},
+              {"extensions",
+               {{"EXT_meshopt_compression",
+                 {{"buffer", 0},
+                  {"byteOffset", offset},
+                  {"byteLength", encoded.size()},
+                  {"byteStride", stride},
+                  {"mode", triangles ? "TRIANGLES" : "ATTRIBUTES"},
+                  {"count", count}}}}}};
+      if (!triangles) view["byteStride"] = stride;
+      fallbackBytes += (bytes + 3) / 4 * 4;
+    } else {
+      const std::uint64_t offset = binaryBytes;
+      LODFORGE_TRY(appendBinary(data, bytes));
+      view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}};
+    }
+    bufferViews.push_back(std::move(view));
     nlohmann::json accessor = {{"bufferView", bufferViews.size() - 1},
                                {"componentType", componentType},
                                {"count", count},
@@ -125,7 +170,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
   nlohmann::json attributes;
   Result<std::uint32_t> position =
       s.addAccessor(mesh.positions.data(), mesh.positions.size_bytes(), vertexCount, kFloat, "VEC3",
-                    kArrayBuffer, false, &min, &max);
+                    kArrayBuffer, false, &min, &max, sizeof(Vec3f), vertexCount);
   if (!position) return position.status();
   attributes["POSITION"] = *position;
   if (!mesh.normals.empty()) {
@@ -134,14 +179,14 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
     for (Vec3f& n : unit) n = normalizeOr(n, Vec3f{0, 0, 1});
     Result<std::uint32_t> normal =
         s.addAccessor(unit.data(), unit.size() * sizeof(Vec3f), vertexCount, kFloat, "VEC3",
-                      kArrayBuffer, false, nullptr, nullptr);
+                      kArrayBuffer, false, nullptr, nullptr, sizeof(Vec3f), vertexCount);
     if (!normal) return normal.status();
     attributes["NORMAL"] = *normal;
   }
   if (!mesh.colors.empty()) {
     Result<std::uint32_t> color =
         s.addAccessor(mesh.colors.data(), mesh.colors.size_bytes(), vertexCount, kUnsignedByte,
-                      "VEC4", kArrayBuffer, true, nullptr, nullptr);
+                      "VEC4", kArrayBuffer, true, nullptr, nullptr, sizeof(Rgba8), vertexCount);
     if (!color) return color.status();
     attributes["COLOR_0"] = *color;
   }
@@ -154,10 +199,11 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
         std::memcpy(s.scratch.data() + 2 * i, &v, 2);
       }
       return s.addAccessor(s.scratch.data(), s.scratch.size(), mesh.indices.size(), kUnsignedShort,
-                           "SCALAR", kElementArrayBuffer, false, nullptr, nullptr);
+                           "SCALAR", kElementArrayBuffer, false, nullptr, nullptr, 2, vertexCount);
     }
     return s.addAccessor(mesh.indices.data(), mesh.indices.size_bytes(), mesh.indices.size(),
-                         kUnsignedInt, "SCALAR", kElementArrayBuffer, false, nullptr, nullptr);
+                         kUnsignedInt, "SCALAR", kElementArrayBuffer, false, nullptr, nullptr, 4,
+                         vertexCount);
   }();
   if (!indices) return indices.status();
 
@@ -209,6 +255,14 @@ Status GlbWriter::finish() {
     document["accessors"] = std::move(s.accessors);
     document["bufferViews"] = std::move(s.bufferViews);
     document["buffers"] = {{{"byteLength", s.binaryBytes}}};
+    if (s.options.meshoptCompression) {
+      // The views describe an uncompressed buffer that exists only once decoded.
+      document["buffers"].push_back(
+          {{"byteLength", s.fallbackBytes},
+           {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
+      document["extensionsUsed"] = {"EXT_meshopt_compression"};
+      document["extensionsRequired"] = {"EXT_meshopt_compression"};
+    }
   }
   if (!s.materials.empty()) document["materials"] = std::move(s.materials);
   std::string json = document.dump();

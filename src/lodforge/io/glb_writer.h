@@ -30,6 +30,9 @@ struct GlbWriteOptions {
   bool doubleSided = true;
   // Binary data beyond this stays on disk until finish() instead of in memory.
   std::size_t spillBytes = std::size_t{64} << 20;
+  // EXT_meshopt_compression: vertex and index data encoded with meshoptimizer's codecs (a
+  // required extension: viewers without it cannot read the file).
+  bool meshoptCompression = false;
 };
 
 class GlbWriter {

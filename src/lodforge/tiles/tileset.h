@@ -32,6 +32,7 @@ struct TilesOptions {
   // input in this CRS ("EPSG:32633"), placed through PROJ.
   std::optional<Geodetic> origin;
   std::string crs;
+  bool meshoptCompression = false;  // --compress meshopt: EXT_meshopt_compression contents
 };
 
 struct TilesStats {
@@ -49,8 +50,10 @@ struct TilesStats {
 };
 
 // The GLB of one tile: positions relative to the bounds' centre (float), that centre as the
-// root translation, area-weighted normals, colours when the mesh has them.
-Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path);
+// root translation, area-weighted normals, colours when the mesh has them; triangles ordered
+// for the vertex cache and vertices for fetch (meshoptimizer), optionally meshopt-compressed.
+Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path,
+                        bool meshoptCompression = false);
 
 // tileset.json for a built octree: asset 1.1, REPLACE refinement, box volumes, geometric errors,
 // contents at tiles/<name>.glb for the nodes with triangles, and the root's transform (local

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Tilesets lodforge writes, loaded by CesiumJS in Debian's headless chromium from a local HTTP
+# server (tests/js/cesium-tiles.mjs): the horse georeferenced with --origin, and a generated scan
+# with meshopt-compressed contents. Fails on any tile failure, failed request or console error,
+# or if the screenshot does not show the model.
+set -euo pipefail
+lodforge=$1 data=$2 out=$3
+here=$(cd "$(dirname "$0")" && pwd)
+for package in cesium playwright-core; do
+  [[ -d $here/js/node_modules/$package ]] ||
+    { echo "$package is not installed: run scripts/install-deps.sh" >&2; exit 1; }
+done
+[[ -x /usr/bin/chromium ]] || { echo "chromium is not installed: run scripts/install-deps.sh" >&2; exit 1; }
+rm -rf "$out" && mkdir -p "$out"
+"$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse" --chunk-size 0.05 \
+  --origin 8.5417,47.3769,408
+node "$here/js/cesium-tiles.mjs" "$out/horse" "$out/horse.png" --min-coverage 0.05
+"$lodforge" -q generate scan --triangles 200K -o "$out/scan.ply"
+"$lodforge" -q tiles "$out/scan.ply" -o "$out/scan" --chunk-size 150 --compress meshopt \
+  --origin -122.4,37.8,10
+node "$here/js/cesium-tiles.mjs" "$out/scan" "$out/scan.png" --min-coverage 0.2

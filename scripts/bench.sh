@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime or render runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render or tiles runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -108,6 +108,35 @@ simplify_section() {
   fi
 }
 
+tiles_section() {
+  echo
+  echo "== lodforge tiles: generated scans in each memory mode (the large-meshes paper's Table 2 / Fig. 10)"
+  printf '| %-5s | %-22s | %9s | %9s | %14s | %8s |\n' scan mode wall "peak RSS" "input tri/s" tileset
+  printf '|%s|%s|%s|%s|%s|%s|\n' ------- ------------------------ ----------- ----------- ---------------- ----------
+  local sizes=(1M 10M)
+  [[ ${BENCH_LARGE:-0} == 1 ]] && sizes+=(100M)
+  local log=$work/time.log
+  for n in "${sizes[@]}"; do
+    "$lodforge" -q generate scan --triangles "$n" -o "$work/tiles-scan.ply"
+    for mode in "minimal" "moderate" "moderate --threads 2" "unbounded"; do
+      local threads="" memory=$mode
+      if [[ $mode == "moderate --threads 2" ]]; then threads="--threads 2"; memory=moderate; fi
+      # shellcheck disable=SC2086
+      /usr/bin/time -v "$lodforge" $threads tiles "$work/tiles-scan.ply" -o "$work/tiles-out" \
+        --memory "$memory" > "$work/tiles.out" 2> "$log" || { cat "$log"; exit 1; }
+      local wall rss rate size
+      wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
+      rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
+      rate=$(sed -n 's/.*(\([0-9,]*\) input triangles\/s).*/\1/p' "$work/tiles.out")
+      size=$(du -sh "$work/tiles-out" | cut -f1)
+      printf '| %-5s | %-22s | %9s | %5d MiB | %14s | %8s |\n' "$n" "$mode" "$wall" $((rss / 1024)) "$rate" "$size"
+      rm -rf "$work/tiles-out"
+    done
+    rm -f "$work/tiles-scan.ply"
+  done
+}
+if [[ ${BENCH_ONLY:-} == tiles ]]; then tiles_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -126,5 +155,6 @@ for n in "${sizes_scan[@]}"; do
 done
 measure "generate points --points 10M" "$lodforge" -q generate points --points 10M -o "$work/points.ply"
 simplify_section
+tiles_section
 render_section
 runtime_section

@@ -563,6 +563,19 @@ TEST(CliCompare, MismatchedOrBadImagesAreExitCode2) {
   EXPECT_EQ(o.code, 2) << "a file and a folder";
 }
 
+// Under ASan, LeakSanitizer's exit-time tracer crashes reading the main thread's TLS in a render
+// subprocess started from this test (Mesa's driver loaded; since PROJ joined the link), though
+// the same command passes on its own. Leaks of the render code stay checked in-process by
+// tests/render/*; the subprocess keeps ASan and UBSan, without the leak pass.
+std::string glSubprocess() {
+#ifdef LODFORGE_SANITIZED
+  const char* options = std::getenv("ASAN_OPTIONS");
+  return std::string("ASAN_OPTIONS=") + (options ? options : "") + ":detect_leaks=0 ";
+#else
+  return "";
+#endif
+}
+
 TEST(CliRender, FramesAlongAPathMatchTheReferenceAtFullBudget) {
   test::TempDir dir;
   const std::string package = dir.file("engine.lfp");
@@ -570,22 +583,23 @@ TEST(CliRender, FramesAlongAPathMatchTheReferenceAtFullBudget) {
       lodforge("build " + test::dataPath("meshes/2CylinderEngine.glb") + " -o " + package, dir)
           .code,
       0);
-  Outcome o = lodforge(
-      "render " + package + " --reference --frames 3 --size 200x150 -o " + dir.file("ref"), dir);
+  Outcome o =
+      lodforge("render " + package + " --reference --frames 3 --size 200x150 -o " + dir.file("ref"),
+               dir, glSubprocess());
   ASSERT_EQ(o.code, 0) << o.err;
   o = lodforge("render " + package + " --budget 100% --frames 3 --size 200x150 -o " +
                    dir.file("full") + " --json " + dir.file("full.json"),
-               dir);
+               dir, glSubprocess());
   ASSERT_EQ(o.code, 0) << o.err;
   o = lodforge("render " + package + " --budget 5% --frames 3 --size 200x150 --color lod -o " +
                    dir.file("low"),
-               dir);
+               dir, glSubprocess());
   ASSERT_EQ(o.code, 0) << o.err;
   // The compute-shader reformation draws the same frames as the CPU path.
   o = lodforge("render " + package +
                    " --budget 5% --frames 3 --size 200x150 --color lod --gpu-reform -o " +
                    dir.file("low-gpu"),
-               dir);
+               dir, glSubprocess());
   ASSERT_EQ(o.code, 0) << o.err;
   o = lodforge(
       "compare " + dir.file("low") + " " + dir.file("low-gpu") + " --json " + dir.file("g.json"),

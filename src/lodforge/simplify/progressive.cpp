@@ -128,7 +128,7 @@ class Simplifier {
   bool contains(std::uint32_t t, std::uint32_t v) const {
     // Bitwise, not short-circuit: which corner matches is unpredictable.
     const auto& c = corners_[t];
-    return (c[0] == v) | (c[1] == v) | (c[2] == v);
+    return ((c[0] == v) + (c[1] == v) + (c[2] == v)) != 0;
   }
   // The triangles around v in increasing order; some may have died since (check alive()).
   std::span<const std::uint32_t> around(std::uint32_t v) const {
@@ -422,7 +422,7 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
     if (!alive(t)) continue;
     ++fan;
     const auto others = otherCorners(t, from);
-    const bool onEdge = (others[0] == to) | (others[1] == to);
+    const bool onEdge = ((others[0] == to) + (others[1] == to)) != 0;
     shared += onEdge;
     for (std::uint32_t w : others) {
       // Marking `to` as seen is harmless (stamps are per call).

@@ -137,28 +137,38 @@ Status saveMesh(const MeshPart& mesh, const std::string& path) {
 Result<MeshPart> loadMesh(const std::string& path) {
   Result<std::vector<std::byte>> read = readWhole(path);
   if (!read) return read.error();
-  const std::vector<std::byte>& bytes = read.value();
+  return parseMesh(read.value(), path);
+}
+
+Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& name) {
   std::uint64_t header[3];
   if (bytes.size() < sizeof kMeshMagic + sizeof header ||
       std::memcmp(bytes.data(), kMeshMagic, sizeof kMeshMagic) != 0)
-    return badInputAtByte(path, 0, "not a lodforge mesh file (work file of `lodforge tiles`)");
+    return badInputAtByte(name, 0, "not a lodforge mesh file (work file of `lodforge tiles`)");
   std::memcpy(header, bytes.data() + sizeof kMeshMagic, sizeof header);
-  const std::uint64_t expected = sizeof kMeshMagic + sizeof header + header[0] * sizeof(Vec3d) +
-                                 header[1] * sizeof(Rgba8) + header[2] * sizeof(std::uint32_t);
-  if (bytes.size() != expected || (header[1] != 0 && header[1] != header[0]) || header[2] % 3 != 0)
-    return badInputAtByte(path, sizeof kMeshMagic, "mesh file sizes do not match its counts");
+  // Counts first, in a way that cannot overflow: each must fit the bytes that are there.
+  const std::uint64_t body = bytes.size() - sizeof kMeshMagic - sizeof header;
+  if (header[0] > body / sizeof(Vec3d) || header[1] > body / sizeof(Rgba8) ||
+      header[2] > body / sizeof(std::uint32_t) ||
+      header[0] * sizeof(Vec3d) + header[1] * sizeof(Rgba8) + header[2] * sizeof(std::uint32_t) !=
+          body ||
+      (header[1] != 0 && header[1] != header[0]) || header[2] % 3 != 0)
+    return badInputAtByte(name, sizeof kMeshMagic, "mesh file sizes do not match its counts");
   MeshPart mesh;
   mesh.positions.resize(header[0]);
   mesh.colors.resize(header[1]);
   mesh.indices.resize(header[2]);
   const std::byte* at = bytes.data() + sizeof kMeshMagic + sizeof header;
-  std::memcpy(mesh.positions.data(), at, header[0] * sizeof(Vec3d));
+  // (memcpy of nothing from or to an empty vector's null data() is undefined, hence the guards)
+  if (header[0] > 0) std::memcpy(mesh.positions.data(), at, header[0] * sizeof(Vec3d));
   at += header[0] * sizeof(Vec3d);
-  std::memcpy(mesh.colors.data(), at, header[1] * sizeof(Rgba8));
+  if (header[1] > 0) std::memcpy(mesh.colors.data(), at, header[1] * sizeof(Rgba8));
   at += header[1] * sizeof(Rgba8);
-  std::memcpy(mesh.indices.data(), at, header[2] * sizeof(std::uint32_t));
-  for (std::uint32_t i : mesh.indices) {
-    if (i >= header[0]) return badInputAtByte(path, 0, "mesh file index out of range");
+  if (header[2] > 0) std::memcpy(mesh.indices.data(), at, header[2] * sizeof(std::uint32_t));
+  for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
+    if (mesh.indices[i] >= header[0])
+      return badInputAtByte(name, static_cast<std::uint64_t>(at - bytes.data()) + 4 * i,
+                            "mesh file index out of range");
   }
   return mesh;
 }
@@ -216,8 +226,6 @@ Status ChunkWriter::flush() {
   return {};
 }
 
-namespace {
-
 Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string& name) {
   if (bytes.size() % kTriangleBytes != 0)
     return badInputAtByte(name, bytes.size() / kTriangleBytes * kTriangleBytes,
@@ -237,8 +245,6 @@ Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string&
   weldExact(mesh);
   return mesh;
 }
-
-}  // namespace
 
 Result<MeshPart> loadChunk(const std::string& path) {
   Result<std::vector<std::byte>> read = readWhole(path);

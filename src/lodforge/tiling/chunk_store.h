@@ -40,6 +40,9 @@ MeshPart concatenate(std::span<const MeshPart> parts);
 
 Status saveMesh(const MeshPart& mesh, const std::string& path);
 Result<MeshPart> loadMesh(const std::string& path);
+// The same from bytes in memory (`name` for messages): what loadMesh and loadChunk parse.
+Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& name);
+Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string& name);
 
 class ChunkWriter {
  public:

@@ -331,16 +331,19 @@ TEST(SimplifyMesh, StopsAtTheTargetKeepsLockedVerticesAndHonoursTheNormalLimit) 
   while (full.trianglesAt(n) < tenth.indices.size() / 3) ++n;
   std::vector<std::uint32_t> level(3 * std::size_t{full.trianglesAt(n)});
   reformObject(std::span(full.triangles).first(level.size()), full.ecol, n, 0, level);
-  std::multiset<std::array<Vec3f, 3>, bool (*)(const std::array<Vec3f, 3>&,
-                                               const std::array<Vec3f, 3>&)>
-      a([](const auto& x, const auto& y) {
+  std::multiset<std::array<Vec3f, 3>,
+                bool (*)(const std::array<Vec3f, 3>&, const std::array<Vec3f, 3>&)>
+      a([](const auto&x, const auto&y) {
         return std::lexicographical_compare(&x[0].x, &x[0].x + 9, &y[0].x, &y[0].x + 9);
       }),
       b(a.key_comp());
   for (std::size_t t = 0; t < level.size(); t += 3)
-    a.insert({full.positions[level[t]], full.positions[level[t + 1]], full.positions[level[t + 2]]});
+    a.insert(
+        {full.positions[level[t]], full.positions[level[t + 1]], full.positions[level[t + 2]]});
   for (std::size_t t = 0; t < tenth.indices.size(); t += 3) {
-    const auto at = [&](std::size_t k) { return bunny.positions[tenth.vertices[tenth.indices[t + k]]]; };
+    const auto at = [&](std::size_t k) {
+      return bunny.positions[tenth.vertices[tenth.indices[t + k]]];
+    };
     b.insert({at(0), at(1), at(2)});
   }
   EXPECT_TRUE(a == b);

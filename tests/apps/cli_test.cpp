@@ -45,6 +45,11 @@ Outcome lodforge(const std::string& args, const test::TempDir& dir,
   return o;
 }
 
+// `lodforge build` of a model in ../shared/data/meshes into `package`; the exit code.
+int buildPackage(const std::string& model, const std::string& package, const test::TempDir& dir) {
+  return lodforge("build " + test::dataPath("meshes/" + model) + " -o " + package, dir).code;
+}
+
 nlohmann::json info(const std::string& path, const test::TempDir& dir) {
   const Outcome o = lodforge("info --json " + path, dir);
   EXPECT_EQ(o.code, 0) << o.err;
@@ -446,10 +451,7 @@ TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
 TEST(CliBench, RunsEveryBudgetAndHitsItExactly) {
   test::TempDir dir;
   const std::string package = dir.file("engine.lfp");
-  ASSERT_EQ(
-      lodforge("build " + test::dataPath("meshes/2CylinderEngine.glb") + " -o " + package, dir)
-          .code,
-      0);
+  ASSERT_EQ(buildPackage("2CylinderEngine.glb", package, dir), 0);
   const std::uint64_t vertices = info(package, dir)["vertices"].get<std::uint64_t>();
   Outcome o = lodforge("bench " + package + " --frames 8 --budget 10%,20K,100% --json " +
                            dir.file("b.json") + " --record-path " + dir.file("path.json"),
@@ -483,8 +485,7 @@ TEST(CliBench, RunsEveryBudgetAndHitsItExactly) {
 TEST(CliBench, BadArgumentsAndPathsGetExitCode2) {
   test::TempDir dir;
   const std::string package = dir.file("motor.lfp");
-  ASSERT_EQ(
-      lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
+  ASSERT_EQ(buildPackage("as1_motor.glb", package, dir), 0);
   test::writeFile(dir.file("bad.json"), R"({"frames": [{"position": [0, 0, 0], "target": [0, 0)");
   Outcome o = lodforge("bench " + package + " --path " + dir.file("bad.json"), dir);
   EXPECT_EQ(o.code, 2);
@@ -579,10 +580,7 @@ std::string glSubprocess() {
 TEST(CliRender, FramesAlongAPathMatchTheReferenceAtFullBudget) {
   test::TempDir dir;
   const std::string package = dir.file("engine.lfp");
-  ASSERT_EQ(
-      lodforge("build " + test::dataPath("meshes/2CylinderEngine.glb") + " -o " + package, dir)
-          .code,
-      0);
+  ASSERT_EQ(buildPackage("2CylinderEngine.glb", package, dir), 0);
   Outcome o =
       lodforge("render " + package + " --reference --frames 3 --size 200x150 -o " + dir.file("ref"),
                dir, glSubprocess());
@@ -644,8 +642,7 @@ TEST(CliRender, BadArgumentsAndPackagesAreExitCode2) {
   EXPECT_NE(o.err.find("bad.lfp"), std::string::npos) << o.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("out")));
   const std::string package = dir.file("motor.lfp");
-  ASSERT_EQ(
-      lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
+  ASSERT_EQ(buildPackage("as1_motor.glb", package, dir), 0);
   EXPECT_EQ(lodforge("render " + package + " --budget 0 -o " + dir.file("out"), dir).code, 2);
   EXPECT_EQ(lodforge("render " + package + " --budget 150% -o " + dir.file("out"), dir).code, 2);
   EXPECT_EQ(lodforge("render " + package + " --size 10 -o " + dir.file("out"), dir).code, 2);
@@ -662,8 +659,7 @@ Outcome viewUnderXvfb(const std::string& args, const test::TempDir& dir) {
 TEST(CliView, WithoutADisplayItSaysSoAndPointsAtRender) {
   test::TempDir dir;
   const std::string package = dir.file("motor.lfp");
-  ASSERT_EQ(
-      lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
+  ASSERT_EQ(buildPackage("as1_motor.glb", package, dir), 0);
   const Outcome o = lodforge("view " + package, dir, "env -u DISPLAY -u WAYLAND_DISPLAY ");
   ASSERT_NE(o.code, -1) << "exited normally";
   EXPECT_EQ(o.code, 2);
@@ -673,10 +669,7 @@ TEST(CliView, WithoutADisplayItSaysSoAndPointsAtRender) {
 TEST(CliView, ScriptedRunRecordsAPathWhoseReplayMatchesHeadlessRender) {
   test::TempDir dir;
   const std::string package = dir.file("engine.lfp");
-  ASSERT_EQ(
-      lodforge("build " + test::dataPath("meshes/2CylinderEngine.glb") + " -o " + package, dir)
-          .code,
-      0);
+  ASSERT_EQ(buildPackage("2CylinderEngine.glb", package, dir), 0);
   // An orbit played in the window, recorded, with a screenshot of the last frame.
   Outcome o = viewUnderXvfb(package + " --play orbit --frames 12 --stop-after 12 --size 320x240" +
                                 " --budget 10% --record " + dir.file("rec.json") +
@@ -715,8 +708,7 @@ TEST(CliView, ScriptedRunRecordsAPathWhoseReplayMatchesHeadlessRender) {
 TEST(CliBench, RenderAddsTheOpenGlColumn) {
   test::TempDir dir;
   const std::string package = dir.file("motor.lfp");
-  ASSERT_EQ(
-      lodforge("build " + test::dataPath("meshes/as1_motor.glb") + " -o " + package, dir).code, 0);
+  ASSERT_EQ(buildPackage("as1_motor.glb", package, dir), 0);
   for (const char* extra : {"", " --gpu-reform", " --gpu-stream"}) {
     const Outcome o =
         lodforge("bench " + package + " --frames 4 --budget 10%,100% --size 160x120 --render" +

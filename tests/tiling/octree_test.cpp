@@ -95,18 +95,11 @@ Built build(const MeshPart& input, double chunkSize, const OctreeOptions& base,
   Aabbd box;
   for (const Vec3d& p : input.positions) box.add(p);
   ChunkWriter chunks(ChunkGrid::over(box, chunkSize), work + "/chunks", 1 << 20);
-  std::vector<ChunkCell> cells;
-  std::vector<CutCorner> corners;
   for (std::size_t t = 0; t < input.indices.size(); t += 3) {
     std::array<CutCorner, 3> triangle;
     for (std::size_t k = 0; k < 3; ++k)
       triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}};
-    cells.clear();
-    corners.clear();
-    cutTriangle(chunks.grid(), triangle, cells, corners);
-    for (std::size_t p = 0; p < cells.size(); ++p)
-      EXPECT_TRUE(
-          chunks.add(cells[p], std::span<const CutCorner, 3>(corners.data() + 3 * p, 3)).ok());
+    EXPECT_TRUE(chunks.addTriangle(triangle).ok());
   }
   EXPECT_TRUE(chunks.flush().ok());
   OctreeOptions options = base;

@@ -67,16 +67,6 @@ double chunkSizeFor(const ChunkInputOptions& options, const Aabbd& bounds,
                                : ChunkGrid::sizeFor(bounds, triangles, options.trianglesPerChunk);
 }
 
-Status addTriangle(ChunkWriter& chunks, const std::array<CutCorner, 3>& triangle,
-                   std::vector<ChunkCell>& cells, std::vector<CutCorner>& corners) {
-  cells.clear();
-  corners.clear();
-  cutTriangle(chunks.grid(), triangle, cells, corners);
-  for (std::size_t p = 0; p < cells.size(); ++p)
-    LODFORGE_TRY(chunks.add(cells[p], std::span<const CutCorner, 3>(corners.data() + 3 * p, 3)));
-  return {};
-}
-
 Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& options) {
   ChunkInput input;
   input.streamed = true;
@@ -138,8 +128,6 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   VertexCache cache(fd, header.vertexCount, options.vertexCacheBytes);
   Progress progress("tiles: chunks", header.faceCount);
   PlyBatch batch;
-  std::vector<ChunkCell> cells;
-  std::vector<CutCorner> corners;
   while (true) {
     Result<bool> more = faces->next(batch);
     if (!more) return more.status();
@@ -153,7 +141,7 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
                                             "vertex work file could not be read)",
                                             batch.first, batch.triangles[t + k]));
       }
-      LODFORGE_TRY(addTriangle(*input.chunks, triangle, cells, corners));
+      LODFORGE_TRY(input.chunks->addTriangle(triangle));
     }
     input.inputTriangles += batch.triangles.size() / 3;
     progress.advance(batch.count);
@@ -187,8 +175,6 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
   input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
                                                options.chunkBufferBytes, options.keepInMemory);
   Progress progress("tiles: chunks", input.inputTriangles);
-  std::vector<ChunkCell> cells;
-  std::vector<CutCorner> corners;
   for (std::size_t o = 0; o < model->objectCount(); ++o) {
     const ObjectRecord& object = model->objects[o];
     const auto indices = model->objectIndices(o);
@@ -200,7 +186,7 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
         triangle[k].color =
             input.colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
       }
-      LODFORGE_TRY(addTriangle(*input.chunks, triangle, cells, corners));
+      LODFORGE_TRY(input.chunks->addTriangle(triangle));
     }
     progress.advance(indices.size() / 3);
     LODFORGE_TRY(checkCancelled());

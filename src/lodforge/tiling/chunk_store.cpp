@@ -196,7 +196,12 @@ std::string ChunkWriter::chunkPath(const ChunkCell& cell) const {
 
 Status ChunkWriter::add(const ChunkCell& cell, std::span<const CutCorner, 3> corners) {
   const std::uint64_t index = grid_.cellIndex(cell);
-  std::vector<std::byte>& buffer = buffers_[index];
+  if (index != lastIndex_ || lastBuffer_ == nullptr) {
+    lastIndex_ = index;
+    lastBuffer_ = &buffers_[index];
+    lastCount_ = &counts_[index];
+  }
+  std::vector<std::byte>& buffer = *lastBuffer_;
   const std::size_t at = buffer.size();
   buffer.resize(at + kTriangleBytes);
   std::byte* out = buffer.data() + at;
@@ -206,10 +211,20 @@ Status ChunkWriter::add(const ChunkCell& cell, std::span<const CutCorner, 3> cor
     std::memcpy(out + sizeof xyz, &corner.color, sizeof(Rgba8));
     out += kCornerBytes;
   }
-  ++counts_[index];
+  ++*lastCount_;
   ++triangles_;
   buffered_ += kTriangleBytes;
   if (buffered_ >= bufferBytes_ && !keepInMemory_) return flush();
+  return {};
+}
+
+Status ChunkWriter::addTriangle(const std::array<CutCorner, 3>& triangle) {
+  pieceCells_.clear();
+  pieceCorners_.clear();
+  cutTriangle(grid_, triangle, pieceCells_, pieceCorners_);
+  for (std::size_t p = 0; p < pieceCells_.size(); ++p)
+    LODFORGE_TRY(
+        add(pieceCells_[p], std::span<const CutCorner, 3>(pieceCorners_.data() + 3 * p, 3)));
   return {};
 }
 
@@ -222,6 +237,7 @@ Status ChunkWriter::flush() {
     buffer.shrink_to_fit();
   }
   buffers_.clear();
+  lastBuffer_ = nullptr;
   buffered_ = 0;
   return {};
 }

@@ -4,6 +4,7 @@
 // saved and reloaded on demand, so only the nodes being built are ever in memory.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <span>
@@ -57,6 +58,8 @@ class ChunkWriter {
 
   // One triangle piece (3 corners) for `cell`.
   Status add(const ChunkCell& cell, std::span<const CutCorner, 3> corners);
+  // A whole triangle: cut at the grid planes it crosses, each piece added to its chunk.
+  Status addTriangle(const std::array<CutCorner, 3>& triangle);
   Status flush();
 
   const ChunkGrid& grid() const { return grid_; }
@@ -74,6 +77,13 @@ class ChunkWriter {
   bool keepInMemory_ = false;
   std::map<std::uint64_t, std::vector<std::byte>> buffers_;  // by cell index
   std::map<std::uint64_t, std::uint64_t> counts_;
+  // The chunk the last piece went to: neighbouring triangles mostly share it, so the two map
+  // lookups are skipped (map nodes do not move; flush() forgets the buffer).
+  std::uint64_t lastIndex_ = ~std::uint64_t{0};
+  std::vector<std::byte>* lastBuffer_ = nullptr;
+  std::uint64_t* lastCount_ = nullptr;
+  std::vector<ChunkCell> pieceCells_;  // addTriangle's scratch
+  std::vector<CutCorner> pieceCorners_;
 };
 
 // A chunk file read back as a welded mesh.

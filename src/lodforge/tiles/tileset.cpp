@@ -115,7 +115,7 @@ std::string tileContentUri(const OctreeNode& node) {
 }
 
 Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path,
-                        bool meshoptCompression) {
+                        const TileContentOptions& options) {
   const Vec3d center = bounds.center();
   // Triangles in vertex-cache order, then vertices in first-use order (faster to draw, and what
   // the meshopt codec compresses best).
@@ -127,7 +127,7 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
                                                             indices.size(), mesh.positions.size());
   meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
   std::vector<Vec3f> positions(used);
-  std::vector<Rgba8> colors(mesh.colors.empty() ? 0 : used);
+  std::vector<Rgba8> colors(options.colors && !mesh.colors.empty() ? used : 0);
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
     if (remap[v] == ~0u) continue;
     positions[remap[v]] = toFloat(mesh.positions[v] - center);
@@ -137,8 +137,8 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   computeVertexNormals(positions, indices, normals);
   for (Vec3f& p : positions) p = toYUp(p);
   for (Vec3f& n : normals) n = toYUp(n);
-  Result<GlbWriter> writer =
-      GlbWriter::create(path, {.doubleSided = false, .meshoptCompression = meshoptCompression});
+  Result<GlbWriter> writer = GlbWriter::create(
+      path, {.doubleSided = false, .meshoptCompression = options.meshoptCompression});
   if (!writer) return writer.status();
   Result<std::uint32_t> glbMesh = writer->addMesh({positions, normals, colors, indices}, "tile");
   if (!glbMesh) return glbMesh.status();
@@ -322,10 +322,9 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   Result<OctreeResult> tree =
       buildOctree(chunks, octree, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
         if (mesh.triangleCount() == 0) return {};
-        MeshPart content = mesh;
-        if (!colors) content.colors.clear();
-        return writeTileContent(content, node.bounds, tilesDirectory + "/" + tileContentUri(node),
-                                options.meshoptCompression);
+        return writeTileContent(
+            mesh, node.bounds, tilesDirectory + "/" + tileContentUri(node),
+            {.colors = colors, .meshoptCompression = options.meshoptCompression});
       });
   if (!tree) return tree.status();
   LODFORGE_TRY(writeTilesetJson(*tree, staging.path + "/tileset.json", chunked->frame));

@@ -50,10 +50,15 @@ struct TilesStats {
 };
 
 // The GLB of one tile: positions relative to the bounds' centre (float), that centre as the
-// root translation, area-weighted normals, colours when the mesh has them; triangles ordered
-// for the vertex cache and vertices for fetch (meshoptimizer), optionally meshopt-compressed.
+// root translation, area-weighted normals, colours when asked and the mesh has them; triangles
+// ordered for the vertex cache and vertices for fetch (meshoptimizer), optionally
+// meshopt-compressed.
+struct TileContentOptions {
+  bool colors = true;
+  bool meshoptCompression = false;
+};
 Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path,
-                        bool meshoptCompression = false);
+                        const TileContentOptions& options = {});
 
 // tileset.json for a built octree: asset 1.1, REPLACE refinement, box volumes, geometric errors,
 // contents at tiles/<name>.glb for the nodes with triangles, and the root's transform (local

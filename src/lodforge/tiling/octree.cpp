@@ -69,10 +69,11 @@ struct Builder {
   std::mutex memoryMutex;
   std::map<std::string, MeshPart> inMemory;  // keepInMemory: node meshes by path
 
-  Status save(const MeshPart& mesh, const std::string& path) {
+  // Takes the mesh: kept in memory it moves into the map, on disk it is written.
+  Status save(MeshPart&& mesh, const std::string& path) {
     if (!options.keepInMemory) return saveMesh(mesh, path);
     std::lock_guard lock(memoryMutex);
-    inMemory[path] = mesh;
+    inMemory[path] = std::move(mesh);
     return {};
   }
   Result<MeshPart> take(const std::string& path) {
@@ -181,7 +182,7 @@ struct Builder {
     node.vertices = mesh->vertexCount();
     node.meshPath = meshPath(node);
     LODFORGE_TRY(sink(node, *mesh));
-    LODFORGE_TRY(save(*mesh, node.meshPath));
+    LODFORGE_TRY(save(std::move(*mesh), node.meshPath));
     return writeSummary(node);
   }
 
@@ -231,7 +232,7 @@ struct Builder {
     node.vertices = mesh.vertexCount();
     node.meshPath = meshPath(node);
     LODFORGE_TRY(sink(node, mesh));
-    LODFORGE_TRY(save(mesh, node.meshPath));
+    LODFORGE_TRY(save(std::move(mesh), node.meshPath));
     return writeSummary(node);
   }
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Tilesets lodforge writes, loaded by CesiumJS in Debian's headless chromium from a local HTTP
 # server (tests/js/cesium-tiles.mjs): the horse georeferenced with --origin, and a generated scan
-# with meshopt-compressed contents. Fails on any tile failure, failed request or console error,
+# with meshopt-compressed contents, both with KHR_mesh_quantization (the default). Fails on any tile failure, failed request or console error,
 # or if the screenshot does not show the model.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3

@@ -24,7 +24,7 @@ done
 count=$(ls "$out"/*.glb | wc -l)
 want=$(( $(ls "$data"/meshes | wc -l) + 6 ))
 [[ $count -eq $want ]] || { echo "expected $want GLBs, found $count" >&2; exit 1; }
-"$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse-tiles" --chunk-size 0.05
+"$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse-tiles" --chunk-size 0.05 --no-quantization
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan-tiles" --chunk-size 60 --compress meshopt
 tiles=$(ls "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb | wc -l)
 [[ $tiles -ge 20 ]] || { echo "expected at least 20 tile GLBs, found $tiles" >&2; exit 1; }

@@ -22,6 +22,7 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
     bool resume = false;
     std::string origin, crs;
     std::string compress = "none";
+    bool noQuantization = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh");
@@ -52,6 +53,9 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
                   "none, or meshopt: EXT_meshopt_compression (smaller tiles; CesiumJS and "
                   "three.js decode it)")
       ->check(CLI::IsMember({"none", "meshopt"}));
+  sub->add_flag("--no-quantization", options->noQuantization,
+                "Float positions and normals everywhere instead of KHR_mesh_quantization (16-bit "
+                "positions, 8-bit normals) in the tiles where it is invisible");
   sub->add_flag("--resume", options->resume,
                 "Continue an interrupted run from OUTPUT.work and OUTPUT.partial (same input and "
                 "options)");
@@ -70,6 +74,7 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
       tiles.resume = options->resume;
       tiles.crs = options->crs;
       tiles.meshoptCompression = options->compress == "meshopt";
+      tiles.quantize = !options->noQuantization;
       if (!options->origin.empty()) {
         if (!options->crs.empty())
           return Error{ErrorKind::kUsage,

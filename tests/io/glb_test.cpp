@@ -1,5 +1,7 @@
 #include <array>
+#include <cmath>
 #include <cstring>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 #include <meshoptimizer.h>
@@ -166,6 +168,72 @@ TEST(GlbWrite, MeshoptCompressedViewsDecodeToTheUncompressedBytes) {
         const bool same =
             b == a || b == std::array{a[1], a[2], a[0]} || b == std::array{a[2], a[0], a[1]};
         ASSERT_TRUE(same) << "triangle " << t / 3;
+      }
+    }
+  }
+}
+
+TEST(GlbWrite, QuantizedMeshesReadBackWithinHalfAGridStep) {
+  // KHR_mesh_quantization: 16-bit positions on a grid over the mesh's box, 8-bit normals. Read
+  // back through our reader (which applies node transforms), every position is within half a
+  // step per axis and every normal within a degree; a mesh placed by its own transform keeps it.
+  const Model model = randomModel(21, 2, 2'000);
+  test::TempDir dir;
+  const Mat4d moved = Mat4d::translation({10, -4, 2}) * Mat4d::scale({2, 2, 2});
+  const auto write = [&](const std::string& path, bool quantized, bool meshopt) {
+    Result<GlbWriter> writer = GlbWriter::create(path, {.meshoptCompression = meshopt});
+    ASSERT_TRUE(writer.ok());
+    for (std::size_t o = 0; o < 2; ++o) {
+      GlbMeshData data;
+      data.positions = model.objectPositions(o);
+      const ObjectRecord& record = model.objects[o];
+      data.normals = std::span(model.normals).subspan(record.vertexOffset, record.vertexCount);
+      data.indices = model.objectIndices(o);
+      data.quantized = quantized;
+      Result<std::uint32_t> mesh = writer->addMesh(data, model.objectName(o));
+      ASSERT_TRUE(mesh.ok());
+      writer->addNode(model.objectName(o), *mesh, o == 1 ? &moved : nullptr);
+    }
+    ASSERT_TRUE(writer->finish().ok());
+  };
+  for (const bool meshopt : {false, true}) {
+    const std::string path = dir.file(meshopt ? "packed.glb" : "plain.glb");
+    write(path, true, meshopt);
+    write(dir.file("float.glb"), false, meshopt);
+    const std::string bytes = test::readFile(path);
+    const Glb glb = parseGlb(bytes);
+    EXPECT_EQ(glb.document["extensionsRequired"].back(), "KHR_mesh_quantization");
+    const auto& attributes = glb.document["meshes"][0]["primitives"][0]["attributes"];
+    const auto& position = glb.document["accessors"][attributes["POSITION"].get<int>()];
+    const auto& normal = glb.document["accessors"][attributes["NORMAL"].get<int>()];
+    EXPECT_EQ(position["componentType"], 5123);
+    EXPECT_EQ(normal["componentType"], 5120);
+    EXPECT_TRUE(normal["normalized"].get<bool>());
+    if (!meshopt) {  // padded elements: the views say their stride
+      EXPECT_EQ(glb.document["bufferViews"][position["bufferView"].get<int>()]["byteStride"], 8);
+      EXPECT_EQ(glb.document["bufferViews"][normal["bufferView"].get<int>()]["byteStride"], 4);
+    }
+    EXPECT_LT(static_cast<double>(bytes.size()),
+              0.75 * static_cast<double>(std::filesystem::file_size(dir.file("float.glb"))));
+    if (meshopt) continue;  // our reader does not decode meshopt (checked above for the codec)
+    Result<Model> back = readGltf(path);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    ASSERT_EQ(back->objectCount(), 2u);
+    EXPECT_EQ(back->indices, model.indices);
+    for (std::size_t o = 0; o < 2; ++o) {
+      const Aabb box = computeBounds(model.objectPositions(o));
+      const double step = glbQuantizationStep(Aabbd{toDouble(box.min), toDouble(box.max)});
+      const double tolerance = (o == 1 ? 2.0 : 1.0) * (0.5 * step + 1e-5);
+      const ObjectRecord& record = model.objects[o];
+      for (std::uint32_t v = 0; v < record.vertexCount; ++v) {
+        const Vec3d original = toDouble(model.positions[record.vertexOffset + v]);
+        const Vec3d want = o == 1 ? moved.transformPoint(original) : original;
+        const Vec3d got = back->origin + toDouble(back->positions[record.vertexOffset + v]);
+        ASSERT_NEAR(got.x, want.x, tolerance) << "object " << o << " vertex " << v;
+        ASSERT_NEAR(got.y, want.y, tolerance);
+        ASSERT_NEAR(got.z, want.z, tolerance);
+        const Vec3f n = normalizeOr(back->normals[record.vertexOffset + v], Vec3f{});
+        ASSERT_GT(dot(n, model.normals[record.vertexOffset + v]), std::cos(1.0 * 3.14159265 / 180));
       }
     }
   }

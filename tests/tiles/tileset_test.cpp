@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/io/gltf_reader.h"
+
 namespace lodforge {
 namespace {
 
@@ -79,6 +81,74 @@ TEST(Tiles, HorseTilesetFollowsTheRules) {
   for (const auto& entry : fs::directory_iterator(out.parent_path()))
     EXPECT_EQ(entry.path().filename().string().find("horse-tiles."), std::string::npos)
         << entry.path();
+}
+
+TEST(Tiles, QuantizedContentsStayWithinTheErrorTheyAddToTheTileset) {
+  // The same horse tileset with and without KHR_mesh_quantization: the contents hold the same
+  // vertices in the same order, each quantised one within the error the tile's geometricError
+  // gained, and the tileset is smaller.
+  const fs::path root = fs::path(::testing::TempDir()) / "quantized";
+  fs::remove_all(root);
+  TilesOptions options;
+  options.input.chunkSize = 0.05;
+  options.octree.errorSamples = 2000;
+  const std::string horse = std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply";
+  options.quantize = false;
+  Result<TilesStats> plain = writeTiles(horse, (root / "float").string(), options);
+  options.quantize = true;
+  Result<TilesStats> quantized = writeTiles(horse, (root / "quantized").string(), options);
+  ASSERT_TRUE(plain.ok() && quantized.ok());
+  EXPECT_LT(static_cast<double>(quantized->outputBytes),
+            0.8 * static_cast<double>(plain->outputBytes));
+  const auto load = [](const fs::path& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+  };
+  int compared = 0, quantizedTiles = 0;
+  std::function<void(const nlohmann::json&, const nlohmann::json&)> compare =
+      [&](const nlohmann::json& a, const nlohmann::json& b) {
+        const double added =
+            b.at("geometricError").get<double>() - a.at("geometricError").get<double>();
+        EXPECT_GE(added, 0);
+        if (a.contains("content")) {
+          const std::string uri = a["content"]["uri"];
+          Result<Model> floats = readGltf((root / "float" / uri).string());
+          Result<Model> ints = readGltf((root / "quantized" / uri).string());
+          ASSERT_TRUE(floats.ok() && ints.ok());
+          ASSERT_EQ(floats->indices, ints->indices) << uri;
+          double worst = 0;
+          for (std::size_t v = 0; v < floats->vertexCount(); ++v) {
+            const Vec3d f = floats->origin + toDouble(floats->positions[v]);
+            const Vec3d q = ints->origin + toDouble(ints->positions[v]);
+            worst = std::max(worst, length(f - q));
+          }
+          EXPECT_LE(worst, added + 1e-6) << uri;
+          quantizedTiles += worst > 0 ? 1 : 0;
+          ++compared;
+        }
+        ASSERT_EQ(a.value("children", nlohmann::json::array()).size(),
+                  b.value("children", nlohmann::json::array()).size());
+        for (std::size_t c = 0; c < a.value("children", nlohmann::json::array()).size(); ++c)
+          compare(a["children"][c], b["children"][c]);
+      };
+  compare(load(root / "float/tileset.json").at("root"),
+          load(root / "quantized/tileset.json").at("root"));
+  EXPECT_EQ(static_cast<std::uint64_t>(compared), quantized->tiles);
+  EXPECT_GE(static_cast<std::uint64_t>(quantizedTiles), quantized->leaves);
+}
+
+TEST(Tiles, ParentsAreQuantizedOnlyWhenTheGridIsFarBelowTheirError) {
+  OctreeNode node;
+  node.bounds = Aabbd{{0, 0, 0}, {65.535, 10, 10}};  // a grid step of 1 mm
+  node.triangles = 100;
+  EXPECT_TRUE(tileQuantized(node));  // a leaf
+  EXPECT_NEAR(tileQuantizationError(node, true), 0.5e-3 * std::sqrt(3.0), 1e-12);
+  EXPECT_EQ(tileQuantizationError(node, false), 0);
+  node.level = 2;
+  node.geometricError = 0.032;  // 32 x 0.87 mm would be 0.0277: inside
+  EXPECT_TRUE(tileQuantized(node));
+  node.geometricError = 0.02;
+  EXPECT_FALSE(tileQuantized(node));
 }
 
 TEST(Tiles, GeoreferencedByOriginOrByCrs) {

@@ -15,10 +15,24 @@ namespace lodforge {
 
 namespace {
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
-constexpr int kUnsignedByte = 5121, kUnsignedShort = 5123, kUnsignedInt = 5125, kFloat = 5126;
+constexpr int kByte = 5120, kUnsignedByte = 5121, kUnsignedShort = 5123, kUnsignedInt = 5125,
+              kFloat = 5126;
 constexpr std::uint32_t kGlbMagic = 0x46546C67, kChunkJson = 0x4E4F534A, kChunkBin = 0x004E4942;
 constexpr const char* kGenerator = "lodforge " LODFORGE_VERSION;
+std::size_t elementBytes(int componentType, std::string_view type) {
+  const std::size_t component = componentType == kByte || componentType == kUnsignedByte ? 1
+                                : componentType == kUnsignedShort                        ? 2
+                                                                                         : 4;
+  const std::size_t components = type == "SCALAR" ? 1 : type == "VEC3" ? 3 : 4;
+  return component * components;
+}
+
 }  // namespace
+
+double glbQuantizationStep(const Aabbd& bounds) {
+  const double side = bounds.longestSide();
+  return side > 0 ? side / 65535.0 : 1.0;
+}
 
 struct GlbWriter::State {
   std::string path;
@@ -31,6 +45,8 @@ struct GlbWriter::State {
   std::vector<std::uint32_t> rootChildren;
   std::optional<Vec3d> rootTranslation;
   std::optional<std::uint32_t> defaultMaterial;
+  // Per mesh: the grid of its quantised positions (origin, step), for the nodes that draw it.
+  std::vector<std::optional<std::pair<Vec3d, double>>> dequantize;
   // Binary chunk: in memory until it exceeds options.spillBytes, then appended to `spill`.
   std::vector<std::byte> binary;
   std::optional<OutputFile> spill;
@@ -111,6 +127,9 @@ struct GlbWriter::State {
       const std::uint64_t offset = binaryBytes;
       LODFORGE_TRY(appendBinary(data, bytes));
       view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}};
+      // Padded elements (a quantised vec3 in 4 or 8 bytes) need their stride spelled out.
+      if (target == kArrayBuffer && stride != elementBytes(componentType, type))
+        view["byteStride"] = stride;
     }
     bufferViews.push_back(std::move(view));
     nlohmann::json accessor = {{"bufferView", bufferViews.size() - 1},
@@ -165,23 +184,64 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
     for (const Vec3f& p : mesh.positions) box.add(p);
     return box;
   }();
-  const nlohmann::json min = {bounds.min.x, bounds.min.y, bounds.min.z};
-  const nlohmann::json max = {bounds.max.x, bounds.max.y, bounds.max.z};
   nlohmann::json attributes;
-  Result<std::uint32_t> position =
-      s.addAccessor(mesh.positions.data(), mesh.positions.size_bytes(), vertexCount, kFloat, "VEC3",
-                    kArrayBuffer, false, &min, &max, sizeof(Vec3f), vertexCount);
-  if (!position) return position.status();
-  attributes["POSITION"] = *position;
-  if (!mesh.normals.empty()) {
-    // The validator requires unit normals; fix up zero or unnormalised ones here.
-    std::vector<Vec3f> unit(mesh.normals.begin(), mesh.normals.end());
-    for (Vec3f& n : unit) n = normalizeOr(n, Vec3f{0, 0, 1});
-    Result<std::uint32_t> normal =
-        s.addAccessor(unit.data(), unit.size() * sizeof(Vec3f), vertexCount, kFloat, "VEC3",
-                      kArrayBuffer, false, nullptr, nullptr, sizeof(Vec3f), vertexCount);
-    if (!normal) return normal.status();
-    attributes["NORMAL"] = *normal;
+  if (mesh.quantized) {
+    // KHR_mesh_quantization: integer positions on a uniform grid (a uniform scale leaves the
+    // normals' directions alone), padded to 8 bytes; normals as normalised bytes, padded to 4.
+    const Aabbd box{toDouble(bounds.min), toDouble(bounds.max)};
+    const double step = glbQuantizationStep(box);
+    std::vector<std::uint16_t> grid(vertexCount * 4, 0);
+    std::array<std::uint16_t, 3> lo{65535, 65535, 65535}, hi{0, 0, 0};
+    for (std::size_t v = 0; v < vertexCount; ++v) {
+      const Vec3d p = (toDouble(mesh.positions[v]) - box.min) * (1.0 / step);
+      const double axes[3] = {p.x, p.y, p.z};
+      for (std::size_t a = 0; a < 3; ++a) {
+        const auto q = static_cast<std::uint16_t>(std::clamp(std::lround(axes[a]), 0L, 65535L));
+        grid[4 * v + a] = q;
+        lo[a] = std::min(lo[a], q);
+        hi[a] = std::max(hi[a], q);
+      }
+    }
+    const nlohmann::json min = lo, max = hi;
+    Result<std::uint32_t> position =
+        s.addAccessor(grid.data(), grid.size() * 2, vertexCount, kUnsignedShort, "VEC3",
+                      kArrayBuffer, false, &min, &max, 8, vertexCount);
+    if (!position) return position.status();
+    attributes["POSITION"] = *position;
+    s.dequantize.emplace_back(std::pair{box.min, step});
+    if (!mesh.normals.empty()) {
+      std::vector<std::int8_t> packed(vertexCount * 4, 0);
+      for (std::size_t v = 0; v < vertexCount; ++v) {
+        const Vec3f n = normalizeOr(mesh.normals[v], Vec3f{0, 0, 1});
+        const float axes[3] = {n.x, n.y, n.z};
+        for (std::size_t a = 0; a < 3; ++a)
+          packed[4 * v + a] = static_cast<std::int8_t>(std::lround(axes[a] * 127.0f));
+      }
+      Result<std::uint32_t> normal =
+          s.addAccessor(packed.data(), packed.size(), vertexCount, kByte, "VEC3", kArrayBuffer,
+                        true, nullptr, nullptr, 4, vertexCount);
+      if (!normal) return normal.status();
+      attributes["NORMAL"] = *normal;
+    }
+  } else {
+    const nlohmann::json min = {bounds.min.x, bounds.min.y, bounds.min.z};
+    const nlohmann::json max = {bounds.max.x, bounds.max.y, bounds.max.z};
+    Result<std::uint32_t> position =
+        s.addAccessor(mesh.positions.data(), mesh.positions.size_bytes(), vertexCount, kFloat,
+                      "VEC3", kArrayBuffer, false, &min, &max, sizeof(Vec3f), vertexCount);
+    if (!position) return position.status();
+    attributes["POSITION"] = *position;
+    s.dequantize.emplace_back(std::nullopt);
+    if (!mesh.normals.empty()) {
+      // The validator requires unit normals; fix up zero or unnormalised ones here.
+      std::vector<Vec3f> unit(mesh.normals.begin(), mesh.normals.end());
+      for (Vec3f& n : unit) n = normalizeOr(n, Vec3f{0, 0, 1});
+      Result<std::uint32_t> normal =
+          s.addAccessor(unit.data(), unit.size() * sizeof(Vec3f), vertexCount, kFloat, "VEC3",
+                        kArrayBuffer, false, nullptr, nullptr, sizeof(Vec3f), vertexCount);
+      if (!normal) return normal.status();
+      attributes["NORMAL"] = *normal;
+    }
   }
   if (!mesh.colors.empty()) {
     Result<std::uint32_t> color =
@@ -224,7 +284,18 @@ void GlbWriter::addNode(std::string_view name, std::optional<std::uint32_t> mesh
   nlohmann::json node = nlohmann::json::object();
   if (!name.empty()) node["name"] = std::string(name);
   if (mesh) node["mesh"] = *mesh;
-  if (transform && transform->m != Mat4d{}.m) node["matrix"] = transform->m;
+  const auto& grid = mesh ? state_->dequantize[*mesh] : std::nullopt;
+  if (grid && !transform) {
+    // Integer grid coordinates back to the mesh's own units.
+    node["translation"] = {grid->first.x, grid->first.y, grid->first.z};
+    node["scale"] = {grid->second, grid->second, grid->second};
+  } else if (grid) {
+    node["matrix"] = (*transform * Mat4d::translation(grid->first) *
+                      Mat4d::scale({grid->second, grid->second, grid->second}))
+                         .m;
+  } else if (transform && transform->m != Mat4d{}.m) {
+    node["matrix"] = transform->m;
+  }
   state_->nodes.push_back(std::move(node));
   state_->rootChildren.push_back(static_cast<std::uint32_t>(state_->nodes.size() - 1));
 }
@@ -260,8 +331,14 @@ Status GlbWriter::finish() {
       document["buffers"].push_back(
           {{"byteLength", s.fallbackBytes},
            {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
-      document["extensionsUsed"] = {"EXT_meshopt_compression"};
-      document["extensionsRequired"] = {"EXT_meshopt_compression"};
+      document["extensionsUsed"].push_back("EXT_meshopt_compression");
+      document["extensionsRequired"].push_back("EXT_meshopt_compression");
+    }
+    const bool quantized = std::any_of(s.dequantize.begin(), s.dequantize.end(),
+                                       [](const auto& grid) { return grid.has_value(); });
+    if (quantized) {
+      document["extensionsUsed"].push_back("KHR_mesh_quantization");
+      document["extensionsRequired"].push_back("KHR_mesh_quantization");
     }
   }
   if (!s.materials.empty()) document["materials"] = std::move(s.materials);

@@ -23,7 +23,14 @@ struct GlbMeshData {
   std::span<const Vec3f> normals;          // empty or one per vertex (normalised on write)
   std::span<const Rgba8> colors;           // empty or one per vertex
   std::span<const std::uint32_t> indices;  // 3 per triangle, < positions.size()
+  // KHR_mesh_quantization: positions as 16-bit integers on a grid over the mesh's box (the node
+  // drawing it scales them back; error at most half a step, glbQuantizationStep), normals as
+  // normalised 8-bit integers. A required extension.
+  bool quantized = false;
 };
+
+// The grid step of a quantised mesh inside `bounds`: its longest side over 65535.
+double glbQuantizationStep(const Aabbd& bounds);
 
 struct GlbWriteOptions {
   // CAD parts are often open sheets: draw both sides unless told otherwise.

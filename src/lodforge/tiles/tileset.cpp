@@ -140,20 +140,39 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   Result<GlbWriter> writer = GlbWriter::create(
       path, {.doubleSided = false, .meshoptCompression = options.meshoptCompression});
   if (!writer) return writer.status();
-  Result<std::uint32_t> glbMesh = writer->addMesh({positions, normals, colors, indices}, "tile");
+  Result<std::uint32_t> glbMesh =
+      writer->addMesh({positions, normals, colors, indices, options.quantize}, "tile");
   if (!glbMesh) return glbMesh.status();
   writer->addNode("tile", *glbMesh);
   writer->setRootTranslation(toYUp(center));
   return writer->finish();
 }
 
+bool tileQuantized(const OctreeNode& node) {
+  return node.level == 0 || tileQuantizationError(node, true) <= node.geometricError / 32;
+}
+
+double tileQuantizationError(const OctreeNode& node, bool quantize) {
+  if (!quantize || node.triangles == 0) return 0;
+  return 0.5 * std::sqrt(3.0) * glbQuantizationStep(node.bounds);
+}
+
 Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
-                        const std::optional<Mat4d>& rootTransform) {
+                        const std::optional<Mat4d>& rootTransform, bool quantized) {
+  // Children come before their parents in the node list: one pass collects each subtree's
+  // largest quantisation error.
+  std::vector<double> quantization(octree.nodes.size(), 0.0);
+  for (std::size_t i = 0; i < octree.nodes.size(); ++i) {
+    const OctreeNode& node = octree.nodes[i];
+    quantization[i] = tileQuantizationError(node, quantized && tileQuantized(node));
+    for (std::uint32_t c : node.children)
+      quantization[i] = std::max(quantization[i], quantization[c]);
+  }
   // Depth first; children listed in node order.
   std::function<nlohmann::json(std::uint32_t)> tile = [&](std::uint32_t index) {
     const OctreeNode& node = octree.nodes[index];
     nlohmann::json out = {{"boundingVolume", boxOf(node.bounds)},
-                          {"geometricError", node.geometricError},
+                          {"geometricError", node.geometricError + quantization[index]},
                           {"refine", "REPLACE"}};
     if (node.triangles > 0 && !node.meshPath.empty())
       out["content"] = {{"uri", tileContentUri(node)}};
@@ -166,7 +185,8 @@ Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
   const OctreeNode& root = octree.nodes[octree.root];
   // Above the root: the error of showing nothing at all, the size of the model.
   const Vec3d size = root.bounds.size();
-  const double nothing = std::max(root.geometricError * 2, length(size));
+  const double nothing =
+      std::max((root.geometricError + quantization[octree.root]) * 2, length(size));
   nlohmann::json tileset = {
       {"asset", {{"version", "1.1"}, {"generator", "lodforge " LODFORGE_VERSION}}},
       {"geometricError", nothing},
@@ -288,6 +308,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
       {"errorSamples", octree.errorSamples},
       {"crs", options.crs},
       {"meshopt", options.meshoptCompression},
+      {"quantize", options.quantize},
       {"origin", options.origin ? fmt::format("{},{},{}", options.origin->longitude,
                                               options.origin->latitude, options.origin->height)
                                 : ""}};
@@ -322,12 +343,14 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   Result<OctreeResult> tree =
       buildOctree(chunks, octree, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
         if (mesh.triangleCount() == 0) return {};
-        return writeTileContent(
-            mesh, node.bounds, tilesDirectory + "/" + tileContentUri(node),
-            {.colors = colors, .meshoptCompression = options.meshoptCompression});
+        return writeTileContent(mesh, node.bounds, tilesDirectory + "/" + tileContentUri(node),
+                                {.colors = colors,
+                                 .meshoptCompression = options.meshoptCompression,
+                                 .quantize = options.quantize && tileQuantized(node)});
       });
   if (!tree) return tree.status();
-  LODFORGE_TRY(writeTilesetJson(*tree, staging.path + "/tileset.json", chunked->frame));
+  LODFORGE_TRY(
+      writeTilesetJson(*tree, staging.path + "/tileset.json", chunked->frame, options.quantize));
   for (const OctreeNode& node : tree->nodes) {
     stats.tiles += node.triangles > 0 ? 1 : 0;
     stats.leaves += node.level == 0 ? 1 : 0;

@@ -33,6 +33,7 @@ struct TilesOptions {
   std::optional<Geodetic> origin;
   std::string crs;
   bool meshoptCompression = false;  // --compress meshopt: EXT_meshopt_compression contents
+  bool quantize = true;             // KHR_mesh_quantization where it is invisible (tileQuantized)
 };
 
 struct TilesStats {
@@ -56,15 +57,27 @@ struct TilesStats {
 struct TileContentOptions {
   bool colors = true;
   bool meshoptCompression = false;
+  bool quantize = false;  // KHR_mesh_quantization over the tile's box
 };
 Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path,
                         const TileContentOptions& options = {});
 
+// Whether a tile's content is quantised (KHR_mesh_quantization) when quantisation is on: always
+// for leaves (16 bits over a box of ~64 K triangles put the grid a few hundred times finer than
+// an edge), and for a parent when the grid's error stays under 1/32 of its geometric error,
+// i.e. half a pixel wherever a viewer at 16 pixels of screen-space error shows it.
+bool tileQuantized(const OctreeNode& node);
+// The largest position error quantisation adds to a tile (half a grid step along each axis of
+// its box), 0 when the tile is not quantised.
+double tileQuantizationError(const OctreeNode& node, bool quantize);
+
 // tileset.json for a built octree: asset 1.1, REPLACE refinement, box volumes, geometric errors,
 // contents at tiles/<name>.glb for the nodes with triangles, and the root's transform (local
-// frame to ECEF) when georeferenced.
+// frame to ECEF) when georeferenced. With `quantized` contents, each geometric error also holds
+// the largest quantisation error in the tile's subtree (still non-increasing parent to child).
 Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
-                        const std::optional<Mat4d>& rootTransform = std::nullopt);
+                        const std::optional<Mat4d>& rootTransform = std::nullopt,
+                        bool quantized = false);
 
 // The relative URI of a node's content.
 std::string tileContentUri(const OctreeNode& node);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Tilesets lodforge writes, loaded by CesiumJS in Debian's headless chromium from a local HTTP
 # server (tests/js/cesium-tiles.mjs): the horse georeferenced with --origin, and a generated scan
-# with meshopt-compressed contents, both with KHR_mesh_quantization (the default). Fails on any tile failure, failed request or console error,
+# with meshopt-compressed contents, both with KHR_mesh_quantization (the default), and a
+# generated 2,000-part assembly (tiled by part, colours per part). Fails on any tile failure, failed request or console error,
 # or if the screenshot does not show the model.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
@@ -19,3 +20,6 @@ node "$here/js/cesium-tiles.mjs" "$out/horse" "$out/horse.png" --min-coverage 0.
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan" --chunk-size 150 --compress meshopt \
   --origin -122.4,37.8,10
 node "$here/js/cesium-tiles.mjs" "$out/scan" "$out/scan.png" --min-coverage 0.2
+"$lodforge" -q generate cad --objects 2000 --seed 5 -o "$out/cad.glb"
+"$lodforge" -q tiles "$out/cad.glb" -o "$out/cad" --origin 2.35,48.85,35
+node "$here/js/cesium-tiles.mjs" "$out/cad" "$out/cad.png" --min-coverage 0.05

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every kind of GLB lodforge writes, checked by the Khronos glTF validator: conversions of the
 # real models in ../shared/data, the generated CAD assembly, a generated scan, levels extracted
-# from a progressive package, 3D Tiles contents. Fails on any error.
+# from a progressive package, 3D Tiles contents (the horse, a scan, an assembly's package).
+# Fails on any error.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -26,6 +27,8 @@ want=$(( $(ls "$data"/meshes | wc -l) + 6 ))
 [[ $count -eq $want ]] || { echo "expected $want GLBs, found $count" >&2; exit 1; }
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse-tiles" --chunk-size 0.05 --no-quantization
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan-tiles" --chunk-size 60 --compress meshopt
+"$lodforge" -q tiles "$out/cad.lfp" -o "$out/cad-tiles"
 tiles=$(ls "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb | wc -l)
 [[ $tiles -ge 20 ]] || { echo "expected at least 20 tile GLBs, found $tiles" >&2; exit 1; }
-node "$here/js/validate-gltf.mjs" "$out"/*.glb "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb
+node "$here/js/validate-gltf.mjs" "$out"/*.glb "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb \
+  "$out"/cad-tiles/tiles/*.glb

@@ -25,8 +25,11 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
     bool noQuantization = false;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* sub = app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh");
-  sub->add_option("INPUT", options->input, "A .ply .obj .stl .gltf or .glb mesh")->required();
+  CLI::App* sub =
+      app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh or an assembly");
+  sub->add_option("INPUT", options->input,
+                  "A .ply .obj .stl .gltf or .glb mesh or assembly, or an .lfp package")
+      ->required();
   sub->add_option("-o,--output", options->output, "The tileset directory to write")->required();
   sub->add_option("--chunk-size", options->chunkSize,
                   "Edge of a leaf chunk in model units (default: about 64K triangles per leaf)")
@@ -104,8 +107,8 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
       detail(global,
              fmt::format("{} ({:.1f} s to chunks); {} threads; chunk size {:.4g}; {} triangles "
                          "after cutting; parents "
-                         "kept {} border vertices of {} ({:.1f} %, at most {} in one tile); peak "
-                         "memory {}",
+                         "kept {} border vertices of {} ({:.1f} %, at most {} in one tile) and "
+                         "left out {} small segments; peak memory {}",
                          stats->resumed    ? "chunks resumed"
                          : stats->streamed ? "streamed"
                                            : "loaded whole",
@@ -114,7 +117,8 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
                          formatCount(stats->vertices),
                          100.0 * static_cast<double>(stats->lockedVertices) /
                              static_cast<double>(std::max<std::uint64_t>(1, stats->vertices)),
-                         formatCount(stats->maxLockedVertices), formatBytes(peakRssBytes())));
+                         formatCount(stats->maxLockedVertices), formatCount(stats->droppedSegments),
+                         formatBytes(peakRssBytes())));
       return {};
     };
   });

@@ -107,6 +107,32 @@ TEST(SurfaceDistance, GridSearchEqualsBruteForceOnEveryCorner) {
   EXPECT_NEAR(d.meanAB, sumAB / double(ia.size() / 3), 1e-12);
 }
 
+TEST(FarthestDistance, EqualsTheBruteForceFarthestOfRandomPoints) {
+  // One-sided: the farthest of 500 random points (some far outside the surface's grid) from a
+  // wavy surface, against a brute-force nearest over every triangle.
+  Random random(13);
+  std::vector<Vec3f> positions;
+  std::vector<std::uint32_t> indices;
+  plane(10, 4, 0, positions, indices);
+  for (Vec3f& p : positions) p.z = float(0.4 * std::sin(2 * p.x) * std::cos(p.y));
+  std::vector<Vec3f> points(500);
+  for (Vec3f& p : points)
+    p = {float(random.uniform(-3, 7)), float(random.uniform(-3, 7)), float(random.uniform(-2, 2))};
+  double want = 0;
+  for (const Vec3f& p : points) {
+    double best = std::numeric_limits<double>::max();
+    for (std::size_t t = 0; t < indices.size(); t += 3)
+      best =
+          std::min(best, pointTriangleDistanceSquared(toDouble(p), toDouble(positions[indices[t]]),
+                                                      toDouble(positions[indices[t + 1]]),
+                                                      toDouble(positions[indices[t + 2]])));
+    want = std::max(want, std::sqrt(best));
+  }
+  EXPECT_DOUBLE_EQ(farthestDistance(points, positions, indices), want);
+  EXPECT_EQ(farthestDistance({}, positions, indices), 0);
+  EXPECT_TRUE(std::isinf(farthestDistance(points, positions, {})));
+}
+
 TEST(SurfaceDistance, CornerSamplesCatchASpikeThatAreaSamplesMiss) {
   std::vector<Vec3f> pa, pb;
   std::vector<std::uint32_t> ia, ib;

@@ -9,7 +9,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/generate/cad.h"
 #include "lodforge/io/gltf_reader.h"
+#include "lodforge/simplify/builder.h"
 
 namespace lodforge {
 namespace {
@@ -149,6 +151,38 @@ TEST(Tiles, ParentsAreQuantizedOnlyWhenTheGridIsFarBelowTheirError) {
   EXPECT_TRUE(tileQuantized(node));
   node.geometricError = 0.02;
   EXPECT_FALSE(tileQuantized(node));
+}
+
+TEST(Tiles, AssembliesAndPackagesAreTiledByPart) {
+  // A generated 600-part assembly as GLB and as a progressive package (.lfp, read at full
+  // detail): the same leaves, tilesets that follow the rules, and coarse tiles that shrink
+  // because parents leave out the smallest whole parts.
+  const fs::path root = fs::path(::testing::TempDir()) / "assembly";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  ASSERT_TRUE(generateCad({.objects = 600, .seed = 9}, (root / "cad.glb").string()).ok());
+  ASSERT_TRUE(buildPackage((root / "cad.glb").string(), (root / "cad.lfp").string()).ok());
+  TilesOptions options;
+  options.octree.errorSamples = 2000;
+  options.input.trianglesPerChunk = 8192;  // a few levels for ~160 K triangles
+  std::vector<TilesStats> stats;
+  for (const char* input : {"cad.glb", "cad.lfp"}) {
+    const fs::path out = root / (std::string(input) + "-tiles");
+    Result<TilesStats> built = writeTiles((root / input).string(), out.string(), options);
+    ASSERT_TRUE(built.ok()) << built.error().message;
+    std::ifstream in(out / "tileset.json");
+    const nlohmann::json tileset = nlohmann::json::parse(in);
+    int contents = 0;
+    checkTile(tileset.at("root"), out, tileset.at("geometricError").get<double>(), nullptr,
+              contents);
+    EXPECT_EQ(static_cast<std::uint64_t>(contents), built->tiles);
+    EXPECT_GE(built->levels, 2);
+    EXPECT_GT(built->droppedSegments, 0u);
+    stats.push_back(*built);
+  }
+  EXPECT_EQ(stats[0].inputTriangles, stats[1].inputTriangles);
+  EXPECT_EQ(stats[0].leafTriangles, stats[1].leafTriangles);
+  EXPECT_EQ(stats[0].leaves, stats[1].leaves);
 }
 
 TEST(Tiles, GeoreferencedByOriginOrByCrs) {

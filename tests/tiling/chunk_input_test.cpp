@@ -2,9 +2,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 
 #include <gtest/gtest.h>
 
+#include "lodforge/core/mesh.h"
+#include "lodforge/generate/cad.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_writer.h"
 #include "test_support.h"
@@ -71,6 +75,73 @@ TEST(ChunkInput, KeptInMemoryEqualsWrittenToDisk) {
   ASSERT_TRUE(memory.ok());
   EXPECT_TRUE(test::listFolder(dir.file("memory/chunks")).empty());
   EXPECT_EQ(contents(*disk->chunks), contents(*memory->chunks));
+}
+
+// Every chunk's triangles as position triples, with the chunk each is in.
+std::map<std::array<double, 9>, std::uint64_t> chunkOfTriangle(const ChunkWriter& chunks) {
+  std::map<std::array<double, 9>, std::uint64_t> out;
+  for (const auto& [index, count] : chunks.triangleCounts()) {
+    Result<MeshPart> mesh = chunks.load(cellOfIndex(chunks.grid(), index));
+    EXPECT_TRUE(mesh.ok());
+    for (std::size_t t = 0; t < mesh->indices.size(); t += 3) {
+      std::array<double, 9> tri{};
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Vec3d p = mesh->positions[mesh->indices[t + k]];
+        tri[3 * k] = p.x, tri[3 * k + 1] = p.y, tri[3 * k + 2] = p.z;
+      }
+      out[tri] = index;
+    }
+  }
+  return out;
+}
+
+TEST(ChunkInput, SmallSegmentsStayWholeAndLargeOnesAreCut) {
+  // A generated assembly, loaded whole (GLB: segments are the parts' connected components) and
+  // streamed (PLY with object ids: segments are the objects). Every part smaller than a chunk
+  // arrives uncut (each of its triangles is in some chunk as it was), and from the PLY all in
+  // one chunk; parts larger than a chunk are cut (more triangles come out than went in).
+  test::TempDir dir;
+  ASSERT_TRUE(generateCad({.objects = 300, .seed = 5}, dir.file("cad.glb")).ok());
+  ASSERT_TRUE(generateCad({.objects = 300, .seed = 5}, dir.file("cad.ply")).ok());
+  for (const std::string name : {"cad.glb", "cad.ply"}) {
+    Result<Model> model = readModel(dir.file(name));
+    ASSERT_TRUE(model.ok());
+    const Aabb box = computeBounds(model->positions);
+    ChunkInputOptions options;
+    options.chunkSize = box.longestSide() / 6;
+    options.workDirectory = dir.file(name + ".work");
+    Result<ChunkInput> input = chunkInput(dir.file(name), options);
+    ASSERT_TRUE(input.ok()) << input.error().message;
+    EXPECT_EQ(input->streamed, name == "cad.ply");
+    const auto chunkOf = chunkOfTriangle(*input->chunks);
+    std::size_t small = 0, large = 0;
+    for (std::size_t o = 0; o < model->objectCount(); ++o) {
+      const Aabb bounds = computeBounds(model->objectPositions(o));
+      if (bounds.longestSide() >= options.chunkSize * 0.999) {
+        ++large;
+        continue;
+      }
+      ++small;
+      std::set<std::uint64_t> chunks;
+      const auto indices = model->objectIndices(o);
+      for (std::size_t t = 0; t < indices.size(); t += 3) {
+        std::array<double, 9> tri{};
+        for (std::size_t k = 0; k < 3; ++k) {
+          const Vec3d p = model->origin + toDouble(model->objectPositions(o)[indices[t + k]]);
+          tri[3 * k] = p.x, tri[3 * k + 1] = p.y, tri[3 * k + 2] = p.z;
+        }
+        const auto found = chunkOf.find(tri);
+        ASSERT_NE(found, chunkOf.end()) << name << ": object " << o << " triangle " << t / 3;
+        chunks.insert(found->second);
+      }
+      if (name == "cad.ply") {
+        EXPECT_EQ(chunks.size(), 1u) << "object " << o;
+      }
+    }
+    EXPECT_GT(small, 200u);
+    EXPECT_GT(large, 0u);
+    EXPECT_GT(input->chunks->triangleCount(), input->inputTriangles);
+  }
 }
 
 TEST(ChunkInput, AFaceOutsideTheVerticesIsBadInputNamingTheFile) {

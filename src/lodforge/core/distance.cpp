@@ -257,4 +257,14 @@ SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
   return result;
 }
 
+double farthestDistance(std::span<const Vec3f> points, std::span<const Vec3f> positions,
+                        std::span<const std::uint32_t> indices) {
+  if (points.empty()) return 0;
+  if (indices.empty()) return std::numeric_limits<double>::infinity();
+  const TriangleGrid grid(positions, indices);
+  std::vector<Vec3d> wide(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) wide[i] = toDouble(points[i]);
+  return measure(wide, grid).max;
+}
+
 }  // namespace lodforge

@@ -29,4 +29,9 @@ SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
                                 std::uint32_t samplesPerMesh = 100'000, std::uint64_t seed = 1,
                                 bool corners = true);
 
+// The largest exact distance from any of `points` to the surface (one-sided; infinity when the
+// surface has no triangles).
+double farthestDistance(std::span<const Vec3f> points, std::span<const Vec3f> positions,
+                        std::span<const std::uint32_t> indices);
+
 }  // namespace lodforge

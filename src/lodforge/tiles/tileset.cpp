@@ -357,6 +357,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
     if (node.level > 0) {
       stats.lockedVertices += node.lockedVertices;
       stats.vertices += node.vertices;
+      stats.droppedSegments += node.droppedSegments;
       stats.maxLockedVertices = std::max(stats.maxLockedVertices, node.lockedVertices);
     }
   }

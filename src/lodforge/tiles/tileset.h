@@ -48,6 +48,7 @@ struct TilesStats {
   bool resumed = false;                  // chunks came from an interrupted run
   int threads = 0;
   std::uint64_t maxLockedVertices = 0, lockedVertices = 0, vertices = 0;  // over parents
+  std::uint64_t droppedSegments = 0;  // small whole segments parents left out (over parents)
 };
 
 // The GLB of one tile: positions relative to the bounds' centre (float), that centre as the

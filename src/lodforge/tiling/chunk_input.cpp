@@ -6,13 +6,17 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <unordered_map>
 
 #include <fmt/format.h>
 
 #include "lodforge/core/file.h"
+#include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
+#include "lodforge/simplify/extract.h"
+#include "lodforge/simplify/package.h"
 #include "lodforge/tiling/chunk_grid.h"
 
 namespace lodforge {
@@ -67,6 +71,46 @@ double chunkSizeFor(const ChunkInputOptions& options, const Aabbd& bounds,
                                : ChunkGrid::sizeFor(bounds, triangles, options.trianglesPerChunk);
 }
 
+// A model file, or a progressive package (.lfp) at full detail: every object's mesh as it was
+// before simplification.
+Result<Model> readInputModel(const std::string& path) {
+  if (fileExtension(path) != "lfp") return readModel(path);
+  Result<Package> package = Package::open(path);
+  if (!package) return package.status();
+  return extractModel(*package, vertexCountsForRatio(*package, 1.0));
+}
+
+// The surface estimate of ChunkGrid::sizeFor, halved while the chunk a triangle lands in holds
+// on average more than 1.5 x the target (parts clustered in a volume, as in a CAD assembly,
+// crowd into far fewer chunks than a surface would).
+double fitChunkSize(const Model& model, std::span<const Vec3d> world, const Aabbd& bounds,
+                    double size, const ChunkInputOptions& options) {
+  const double smallest = bounds.longestSide() / 4096;
+  std::unordered_map<std::uint64_t, std::uint64_t> load;
+  while (size / 2 >= smallest) {
+    const ChunkGrid grid = ChunkGrid::over(bounds, size);
+    load.clear();
+    for (std::size_t o = 0; o < model.objectCount(); ++o) {
+      const std::uint64_t offset = model.objects[o].vertexOffset;
+      const auto indices = model.objectIndices(o);
+      for (std::size_t t = 0; t < indices.size(); t += 3) {
+        const Vec3d centroid = (world[offset + indices[t]] + world[offset + indices[t + 1]] +
+                                world[offset + indices[t + 2]]) *
+                               (1.0 / 3.0);
+        ++load[grid.cellIndex(grid.cellOf(centroid))];
+      }
+    }
+    double squares = 0, triangles = 0;
+    for (const auto& [cell, count] : load) {
+      squares += static_cast<double>(count) * static_cast<double>(count);
+      triangles += static_cast<double>(count);
+    }
+    if (squares / triangles <= 1.5 * static_cast<double>(options.trianglesPerChunk)) break;
+    size /= 2;
+  }
+  return size;
+}
+
 Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& options) {
   ChunkInput input;
   input.streamed = true;
@@ -116,18 +160,53 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   }
   if (input.bounds.empty()) return badInput(path, "no vertices");
 
-  // Pass 2: faces, corners from the cache, cut into the chunk files.
+  VertexCache cache(fd, header.vertexCount, options.vertexCacheBytes);
+  const auto fetch = [&](const PlyBatch& batch, std::size_t t,
+                         std::array<CutCorner, 3>& triangle) -> Status {
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (!cache.fetch(batch.triangles[t + k], triangle[k]))
+        return badInput(path, fmt::format("face {}: vertex {} is not in the file (or the "
+                                          "vertex work file could not be read)",
+                                          batch.first, batch.triangles[t + k]));
+    }
+    return {};
+  };
+  read.readFaces = true;
+  read.readVertices = false;
+  PlyBatch batch;
+
+  // With object ids, the objects are the segments (§3.3): one more pass over the faces finds
+  // their bounds (memory per object, not per triangle), so that small ones stay whole.
+  std::unordered_map<std::uint32_t, Aabbd> objectBounds;
+  if (header.hasObjectIds) {
+    Result<PlyReader> faces = PlyReader::open(path, read);
+    if (!faces) return faces.status();
+    Progress progress("tiles: objects", header.faceCount);
+    while (true) {
+      Result<bool> more = faces->next(batch);
+      if (!more) return more.status();
+      if (!*more) break;
+      if (batch.kind != PlyBatch::Kind::kFaces) continue;
+      for (std::size_t t = 0; t + 2 < batch.triangles.size(); t += 3) {
+        std::array<CutCorner, 3> triangle;
+        LODFORGE_TRY(fetch(batch, t, triangle));
+        Aabbd& bounds = objectBounds[batch.triangleObjects[t / 3]];
+        for (const CutCorner& corner : triangle) bounds.add(corner.position);
+      }
+      progress.advance(batch.count);
+      LODFORGE_TRY(checkCancelled());
+    }
+    progress.finish();
+  }
+
+  // Pass 2: faces, corners from the cache, into the chunk files (cut, or whole by segment).
   const ChunkGrid grid =
       ChunkGrid::over(input.bounds, chunkSizeFor(options, input.bounds, header.faceCount));
   input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
                                                options.chunkBufferBytes, options.keepInMemory);
-  read.readFaces = true;
-  read.readVertices = false;
   Result<PlyReader> faces = PlyReader::open(path, read);
   if (!faces) return faces.status();
-  VertexCache cache(fd, header.vertexCount, options.vertexCacheBytes);
   Progress progress("tiles: chunks", header.faceCount);
-  PlyBatch batch;
   while (true) {
     Result<bool> more = faces->next(batch);
     if (!more) return more.status();
@@ -135,13 +214,13 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
     if (batch.kind != PlyBatch::Kind::kFaces) continue;
     for (std::size_t t = 0; t + 2 < batch.triangles.size(); t += 3) {
       std::array<CutCorner, 3> triangle;
-      for (std::size_t k = 0; k < 3; ++k) {
-        if (!cache.fetch(batch.triangles[t + k], triangle[k]))
-          return badInput(path, fmt::format("face {}: vertex {} is not in the file (or the "
-                                            "vertex work file could not be read)",
-                                            batch.first, batch.triangles[t + k]));
+      LODFORGE_TRY(fetch(batch, t, triangle));
+      if (header.hasObjectIds) {
+        LODFORGE_TRY(
+            input.chunks->addSegmentTriangle(objectBounds[batch.triangleObjects[t / 3]], triangle));
+      } else {
+        LODFORGE_TRY(input.chunks->addTriangle(triangle));
       }
-      LODFORGE_TRY(input.chunks->addTriangle(triangle));
     }
     input.inputTriangles += batch.triangles.size() / 3;
     progress.advance(batch.count);
@@ -155,7 +234,7 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
 
 Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& options) {
   ChunkInput input;
-  Result<Model> model = readModel(path);
+  Result<Model> model = readInputModel(path);
   if (!model) return model.status();
   input.inputTriangles = model->triangleCount();
   if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");
@@ -170,14 +249,28 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
                                         v));
     input.bounds.add(world[v]);
   }
-  const ChunkGrid grid =
-      ChunkGrid::over(input.bounds, chunkSizeFor(options, input.bounds, input.inputTriangles));
+  double size = chunkSizeFor(options, input.bounds, input.inputTriangles);
+  if (options.chunkSize == 0) size = fitChunkSize(*model, world, input.bounds, size, options);
+  const ChunkGrid grid = ChunkGrid::over(input.bounds, size);
   input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
                                                options.chunkBufferBytes, options.keepInMemory);
   Progress progress("tiles: chunks", input.inputTriangles);
+  std::vector<std::uint32_t> welded, weldedIndices, component;
+  std::vector<Aabbd> segmentBounds;
   for (std::size_t o = 0; o < model->objectCount(); ++o) {
     const ObjectRecord& object = model->objects[o];
     const auto indices = model->objectIndices(o);
+    // Segments (§3.3): the object's connected components, over positions welded exactly so
+    // that attribute splits (a box's hard edges) do not break a part into faces.
+    welded.resize(object.vertexCount);
+    const std::uint32_t weldedCount = weldVertices(model->objectPositions(o), {}, {}, {}, welded);
+    weldedIndices.assign(indices.begin(), indices.end());
+    remapIndices(weldedIndices, welded);
+    component.resize(indices.size() / 3);
+    const std::uint32_t segments = connectedComponents(weldedCount, weldedIndices, component);
+    segmentBounds.assign(segments, Aabbd{});
+    for (std::size_t t = 0; t < indices.size(); ++t)
+      segmentBounds[component[t / 3]].add(world[object.vertexOffset + indices[t]]);
     for (std::size_t t = 0; t < indices.size(); t += 3) {
       std::array<CutCorner, 3> triangle;
       for (std::size_t k = 0; k < 3; ++k) {
@@ -186,7 +279,7 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
         triangle[k].color =
             input.colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
       }
-      LODFORGE_TRY(input.chunks->addTriangle(triangle));
+      LODFORGE_TRY(input.chunks->addSegmentTriangle(segmentBounds[component[t / 3]], triangle));
     }
     progress.advance(indices.size() / 3);
     LODFORGE_TRY(checkCancelled());

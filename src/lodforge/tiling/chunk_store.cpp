@@ -228,6 +228,12 @@ Status ChunkWriter::addTriangle(const std::array<CutCorner, 3>& triangle) {
   return {};
 }
 
+Status ChunkWriter::addSegmentTriangle(const Aabbd& segment,
+                                       const std::array<CutCorner, 3>& triangle) {
+  if (segment.longestSide() < grid_.size) return add(grid_.cellOf(segment.center()), triangle);
+  return addTriangle(triangle);
+}
+
 Status ChunkWriter::flush() {
   if (keepInMemory_) return {};
   for (auto& [index, buffer] : buffers_) {

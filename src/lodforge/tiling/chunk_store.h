@@ -60,6 +60,10 @@ class ChunkWriter {
   Status add(const ChunkCell& cell, std::span<const CutCorner, 3> corners);
   // A whole triangle: cut at the grid planes it crosses, each piece added to its chunk.
   Status addTriangle(const std::array<CutCorner, 3>& triangle);
+  // A triangle of a segment (a connected part, §3.3) with these bounds: whole, in the chunk of
+  // the segment's centre, when the segment is smaller than a chunk along every axis (it may
+  // stick out of that chunk); cut like addTriangle otherwise.
+  Status addSegmentTriangle(const Aabbd& segment, const std::array<CutCorner, 3>& triangle);
   Status flush();
 
   const ChunkGrid& grid() const { return grid_; }

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/distance.h"
+#include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/simplify/progressive.h"
 
@@ -59,6 +60,93 @@ std::uint64_t countBorderVertices(const MeshPart& mesh) {
     i = j;
   }
   return static_cast<std::uint64_t>(std::count(border.begin(), border.end(), 1));
+}
+
+// Whether p lies on a grid plane: every cut vertex does (its coordinate is set to the plane's).
+bool onGridPlane(const ChunkGrid& grid, Vec3d p) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const double k = std::round((p[axis] - grid.origin[axis]) / grid.size);
+    if (std::abs(k) < 1e9 && grid.plane(axis, static_cast<std::int32_t>(k)) == p[axis]) return true;
+  }
+  return false;
+}
+
+struct Dropped {
+  std::uint64_t segments = 0;
+  double error = 0;  // bound on the distance from any dropped point to what remains
+};
+
+// Whole segments too small to matter at this level: a CAD part that cannot simplify further (a
+// closed tube at the normal limit, a plate whose holes are locked borders) would otherwise keep
+// every parent above its target. When the simplified mesh is over its target, its connected
+// components that have no vertex on a grid plane — so no neighbouring tile meets them — go,
+// smallest first, until the target is met or one component is left.
+Dropped dropSmallSegments(MeshPart& mesh, std::uint64_t target, const ChunkGrid& grid,
+                          Vec3d center) {
+  if (mesh.triangleCount() <= target) return {};
+  std::vector<std::uint32_t> component(mesh.triangleCount());
+  const std::uint32_t count = connectedComponents(mesh.vertexCount(), mesh.indices, component);
+  if (count < 2) return {};
+  std::vector<Aabbd> bounds(count);
+  std::vector<std::uint64_t> triangles(count, 0);
+  std::vector<std::uint8_t> touchesPlane(count, 0);
+  for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
+    const std::uint32_t c = component[i / 3];
+    const Vec3d& p = mesh.positions[mesh.indices[i]];
+    bounds[c].add(p);
+    if (onGridPlane(grid, p)) touchesPlane[c] = 1;
+    if (i % 3 == 0) ++triangles[c];
+  }
+  std::vector<std::uint32_t> order;
+  for (std::uint32_t c = 0; c < count; ++c)
+    if (touchesPlane[c] == 0) order.push_back(c);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return length(bounds[a].size()) < length(bounds[b].size());
+  });
+  std::vector<std::uint8_t> drop(count, 0);
+  Dropped dropped;
+  std::uint64_t remaining = mesh.triangleCount();
+  for (std::uint32_t c : order) {
+    if (remaining <= target || dropped.segments + 1 == count) break;
+    drop[c] = 1;
+    remaining -= triangles[c];
+    ++dropped.segments;
+  }
+  if (dropped.segments == 0) return {};
+
+  // Keep the rest; the dropped corners and longest dropped edge give the error bound (the
+  // distance to a surface is 1-Lipschitz: a point of a dropped triangle is within its longest
+  // edge of one of its corners).
+  std::vector<std::uint32_t> remap(mesh.vertexCount(), ~0u);
+  std::vector<std::uint8_t> droppedVertex(mesh.vertexCount(), 0);
+  MeshPart kept;
+  double longestEdge = 0;
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    if (drop[component[t / 3]] != 0) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        droppedVertex[mesh.indices[t + k]] = 1;
+        longestEdge = std::max(longestEdge, length(mesh.positions[mesh.indices[t + k]] -
+                                                   mesh.positions[mesh.indices[t + (k + 1) % 3]]));
+      }
+      continue;
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      std::uint32_t& to = remap[mesh.indices[t + k]];
+      if (to == ~0u) {
+        to = kept.vertexCount();
+        kept.positions.push_back(mesh.positions[mesh.indices[t + k]]);
+        if (!mesh.colors.empty()) kept.colors.push_back(mesh.colors[mesh.indices[t + k]]);
+      }
+      kept.indices.push_back(to);
+    }
+  }
+  std::vector<Vec3f> droppedPoints;
+  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v)
+    if (droppedVertex[v] != 0) droppedPoints.push_back(toFloat(mesh.positions[v] - center));
+  dropped.error =
+      farthestDistance(droppedPoints, relativeTo(kept, center), kept.indices) + longestEdge;
+  mesh = std::move(kept);
+  return dropped;
 }
 
 struct Builder {
@@ -139,7 +227,8 @@ struct Builder {
                                     {"geometricError", node.geometricError},
                                     {"triangles", node.triangles},
                                     {"vertices", node.vertices},
-                                    {"lockedVertices", node.lockedVertices}};
+                                    {"lockedVertices", node.lockedVertices},
+                                    {"droppedSegments", node.droppedSegments}};
     const std::string path = summaryPath(node.meshPath), temp = path + ".tmp";
     {
       std::ofstream out(temp);
@@ -166,6 +255,7 @@ struct Builder {
       node.triangles = summary.at("triangles").get<std::uint64_t>();
       node.vertices = summary.at("vertices").get<std::uint64_t>();
       node.lockedVertices = summary.at("lockedVertices").get<std::uint64_t>();
+      node.droppedSegments = summary.at("droppedSegments").get<std::uint64_t>();
     } catch (const nlohmann::json::exception&) {
       return false;  // a damaged summary: build the node again
     }
@@ -218,6 +308,9 @@ struct Builder {
       if (!mesh.colors.empty()) mesh.colors[i] = merged.colors[simplified.vertices[i]];
     }
     mesh.indices = simplified.indices;
+    const Dropped dropped =
+        dropSmallSegments(mesh, simplify.stopAtTriangles, chunks.grid(), center);
+    node.droppedSegments = dropped.segments;
     // Geometric error: measured against the children's geometry, plus what they already
     // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
     // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
@@ -226,8 +319,9 @@ struct Builder {
     const SurfaceDistance distance =
         surfaceDistance(simplifiedPositions, mesh.indices, positions, merged.indices,
                         options.errorSamples, seedOf(node), /*corners=*/false);
-    node.geometricError =
-        childError + std::max(distance.hausdorff, static_cast<double>(simplified.error));
+    node.geometricError = childError +
+                          std::max(distance.hausdorff, static_cast<double>(simplified.error)) +
+                          dropped.error;
     node.triangles = mesh.triangleCount();
     node.vertices = mesh.vertexCount();
     node.meshPath = meshPath(node);

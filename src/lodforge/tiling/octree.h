@@ -2,7 +2,8 @@
 // level, 2x2x2 nodes are combined into a parent whose mesh is their meshes welded along the
 // shared borders and simplified with its outer border locked. A border of a level is interior at
 // the next, so seams do not stay frozen; the outer border never moves, so any mix of levels
-// fits together without cracks.
+// fits together without cracks. Small whole segments that keep a parent over its target are left
+// out of it (smallest first), their bounded distance added to its error.
 #pragma once
 
 #include <cstdint>
@@ -45,6 +46,7 @@ struct OctreeNode {
   std::uint64_t triangles = 0;
   std::uint64_t lockedVertices = 0;  // border vertices its simplification had to keep
   std::uint64_t vertices = 0;
+  std::uint64_t droppedSegments = 0;    // small whole segments left out of this (parent) tile
   std::vector<std::uint32_t> children;  // indices into OctreeResult::nodes
   std::string meshPath;                 // the node's mesh in the work directory
 };

@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "lodforge/core/mesh.h"
@@ -59,6 +60,26 @@ TEST(ChunkInput, StreamedPlyGivesTheSameChunksAsTheLoadedModel) {
   EXPECT_GT(streamed->chunks->triangleCounts().size(), 8u);
   EXPECT_EQ(contents(*streamed->chunks), contents(*loaded->chunks));
   EXPECT_FALSE(fs::exists(dir.file("streamed/vertices.bin")));  // the work file is gone
+}
+
+TEST(ChunkInput, ReadingCuttingAndWritingInParallelWritesTheSameFiles) {
+  // The face pass runs as a pipeline (read, cut in parallel, add in file order): the chunk files
+  // are byte-identical whatever the thread count.
+  test::TempDir dir;
+  std::map<std::string, std::string> files[2];
+  for (const int threads : {1, 2}) {
+    ChunkInputOptions options;
+    options.chunkSize = 0.03;
+    options.chunkBufferBytes = 1 << 16;  // many appends while the pipeline runs
+    options.threads = threads;
+    options.workDirectory = dir.file(fmt::format("t{}", threads));
+    Result<ChunkInput> input = chunkInput(test::dataPath("meshes/horse.ply"), options);
+    ASSERT_TRUE(input.ok()) << input.error().message;
+    for (const std::string& name : test::listFolder(options.workDirectory + "/chunks"))
+      files[threads - 1][name] = test::readFile(options.workDirectory + "/chunks/" + name);
+  }
+  EXPECT_GT(files[0].size(), 20u);
+  EXPECT_EQ(files[0], files[1]);
 }
 
 TEST(ChunkInput, KeptInMemoryEqualsWrittenToDisk) {

@@ -184,6 +184,7 @@ class Simplifier {
   std::vector<std::uint32_t> trianglesAfter_;    // triangle count after collapse k
   std::vector<float> errorAfter_;                // monotone error after collapse k
   double maxError_ = 0;
+  std::uint32_t borderVertices_ = 0;  // on a boundary or non-manifold edge
 };
 
 void Simplifier::classifyBoundary() {
@@ -222,6 +223,7 @@ void Simplifier::classifyBoundary() {
       for (std::uint32_t w : otherCorners(t, u)) locked |= edgeCount[w] != 2;
     }
     vertex_[u].locked = locked || (!options_.locked.empty() && options_.locked[u] != 0);
+    borderVertices_ += locked ? 1 : 0;
   }
 }
 
@@ -652,6 +654,7 @@ void Simplifier::collapseAll() {
 ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
                                       std::span<const Rgba8> colors) const {
   ProgressiveMesh mesh;
+  mesh.borderVertices = borderVertices_;
   const auto collapses = static_cast<std::uint32_t>(collapsed_.size());
   mesh.q = vertexCount_ - collapses;
   // PermuteV: vertices that never collapse keep their order at the front; the k-th collapsed
@@ -733,6 +736,7 @@ SimplifiedMesh simplifyMesh(std::span<const Vec3f> positions,
     if (mesh.permuteV[v] < n) out.vertices[mesh.permuteV[v]] = v;
   }
   out.error = mesh.errorAt(n);
+  out.borderVertices = mesh.borderVertices;
   return out;
 }
 

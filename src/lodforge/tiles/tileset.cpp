@@ -272,6 +272,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
     octree.keepInMemory = false;
   }
   stats.threads = octree.threads;
+  input.threads = octree.threads;
 
   // Georeferencing: a CRS is set up on the first input point (the local frame's origin).
   struct LazyCrs {

@@ -3,10 +3,15 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <unordered_map>
+
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 
 #include <fmt/format.h>
 
@@ -173,6 +178,7 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   };
   read.readFaces = true;
   read.readVertices = false;
+  read.batchSize = 1 << 14;  // the batches in flight below stay a few MiB each
   PlyBatch batch;
 
   // With object ids, the objects are the segments (§3.3): one more pass over the faces finds
@@ -207,25 +213,85 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   Result<PlyReader> faces = PlyReader::open(path, read);
   if (!faces) return faces.status();
   Progress progress("tiles: chunks", header.faceCount);
-  while (true) {
-    Result<bool> more = faces->next(batch);
-    if (!more) return more.status();
-    if (!*more) break;
-    if (batch.kind != PlyBatch::Kind::kFaces) continue;
-    for (std::size_t t = 0; t + 2 < batch.triangles.size(); t += 3) {
-      std::array<CutCorner, 3> triangle;
-      LODFORGE_TRY(fetch(batch, t, triangle));
-      if (header.hasObjectIds) {
-        LODFORGE_TRY(
-            input.chunks->addSegmentTriangle(objectBounds[batch.triangleObjects[t / 3]], triangle));
-      } else {
-        LODFORGE_TRY(input.chunks->addTriangle(triangle));
+  // Three stages over batches of faces, so reading, cutting and writing overlap: read and fetch
+  // corners (the reader and the cache are sequential), cut (in parallel), add the pieces in file
+  // order (the chunk files come out the same as from one thread).
+  struct Batch {
+    std::vector<CutCorner> corners;      // 3 per triangle
+    std::vector<const Aabbd*> segments;  // per triangle, with object ids
+    std::vector<ChunkCell> cells;        // per piece
+    std::vector<CutCorner> pieces;       // 3 per piece
+    std::uint64_t faces = 0, triangles = 0;
+  };
+  std::mutex failureMutex;
+  Status failure;
+  std::atomic<bool> failed = false;
+  const auto fail = [&](Status status, tbb::flow_control* control) {
+    std::lock_guard lock(failureMutex);
+    if (failure.ok()) failure = std::move(status);
+    failed = true;
+    if (control) control->stop();
+  };
+  const auto readBatch = [&](tbb::flow_control& control) -> std::shared_ptr<Batch> {
+    while (true) {
+      if (failed) return control.stop(), nullptr;
+      Status status = checkCancelled();
+      Result<bool> more = status.ok() ? faces->next(batch) : Result<bool>(status);
+      if (!more) return fail(more.status(), &control), nullptr;
+      if (!*more) return control.stop(), nullptr;
+      if (batch.kind != PlyBatch::Kind::kFaces) continue;
+      auto next = std::make_shared<Batch>();
+      next->faces = batch.count;
+      next->triangles = batch.triangles.size() / 3;
+      next->corners.resize(batch.triangles.size());
+      next->pieces.reserve(batch.triangles.size() + batch.triangles.size() / 8);
+      next->cells.reserve(next->triangles + next->triangles / 8);
+      for (std::size_t t = 0; t + 2 < batch.triangles.size(); t += 3) {
+        std::array<CutCorner, 3> triangle;
+        if (status = fetch(batch, t, triangle); !status.ok())
+          return fail(std::move(status), &control), nullptr;
+        std::copy(triangle.begin(), triangle.end(), next->corners.data() + t);
+        if (header.hasObjectIds) {
+          const auto found = objectBounds.find(batch.triangleObjects[t / 3]);
+          next->segments.push_back(found == objectBounds.end() ? nullptr : &found->second);
+        }
       }
+      return next;
     }
-    input.inputTriangles += batch.triangles.size() / 3;
-    progress.advance(batch.count);
-    LODFORGE_TRY(checkCancelled());
+  };
+  const auto cutBatch = [&](std::shared_ptr<Batch> work) {
+    std::array<CutCorner, 3> triangle;
+    for (std::size_t t = 0; t < work->corners.size(); t += 3) {
+      std::copy_n(work->corners.data() + t, 3, triangle.begin());
+      cutSegmentTriangle(grid, work->segments.empty() ? nullptr : work->segments[t / 3], triangle,
+                         work->cells, work->pieces);
+    }
+    work->corners = {};
+    return work;
+  };
+  const auto addBatch = [&](std::shared_ptr<Batch> work) {
+    if (failed) return;
+    if (Status status = input.chunks->addPieces(work->cells, work->pieces); !status.ok())
+      return fail(std::move(status), nullptr);
+    input.inputTriangles += work->triangles;
+    progress.advance(work->faces);
+  };
+  // A few batches in flight: enough to keep every thread busy, little memory.
+  const std::size_t tokens = static_cast<std::size_t>(std::max(2, options.threads + 1));
+  const auto pipeline = [&] {
+    using Work = std::shared_ptr<Batch>;
+    tbb::parallel_pipeline(
+        tokens, tbb::make_filter<void, Work>(tbb::filter_mode::serial_in_order, readBatch) &
+                    tbb::make_filter<Work, Work>(tbb::filter_mode::parallel, cutBatch) &
+                    tbb::make_filter<Work, void>(tbb::filter_mode::serial_in_order, addBatch));
+  };
+  if (options.threads > 0) {
+    tbb::task_arena arena(options.threads);
+    arena.execute(pipeline);
+  } else {
+    pipeline();
   }
+  LODFORGE_TRY(failure);
   LODFORGE_TRY(input.chunks->flush());
   progress.finish();
   std::filesystem::remove(vertexPath);

@@ -26,6 +26,7 @@ struct ChunkInputOptions {
   std::uint64_t vertexCacheBytes = std::uint64_t{64} << 20;  // PLY corner lookups
   std::string workDirectory;                                 // chunk files and the vertex file
   bool keepInMemory = false;  // chunks stay in memory (the unbounded mode), never written
+  int threads = 0;            // reading, cutting and writing overlap on this many (0: all)
   // Applied to every input position before anything else (a CRS to a local frame); false:
   // the point cannot be transformed, which is bad input.
   std::function<bool(Vec3d, Vec3d&)> transform;

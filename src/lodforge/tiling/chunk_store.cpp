@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -222,16 +223,34 @@ Status ChunkWriter::addTriangle(const std::array<CutCorner, 3>& triangle) {
   pieceCells_.clear();
   pieceCorners_.clear();
   cutTriangle(grid_, triangle, pieceCells_, pieceCorners_);
-  for (std::size_t p = 0; p < pieceCells_.size(); ++p)
-    LODFORGE_TRY(
-        add(pieceCells_[p], std::span<const CutCorner, 3>(pieceCorners_.data() + 3 * p, 3)));
-  return {};
+  return addPieces(pieceCells_, pieceCorners_);
 }
 
 Status ChunkWriter::addSegmentTriangle(const Aabbd& segment,
                                        const std::array<CutCorner, 3>& triangle) {
-  if (segment.longestSide() < grid_.size) return add(grid_.cellOf(segment.center()), triangle);
-  return addTriangle(triangle);
+  pieceCells_.clear();
+  pieceCorners_.clear();
+  cutSegmentTriangle(grid_, &segment, triangle, pieceCells_, pieceCorners_);
+  return addPieces(pieceCells_, pieceCorners_);
+}
+
+Status ChunkWriter::addPieces(std::span<const ChunkCell> cells,
+                              std::span<const CutCorner> corners) {
+  assert(corners.size() == 3 * cells.size());
+  for (std::size_t p = 0; p < cells.size(); ++p)
+    LODFORGE_TRY(add(cells[p], std::span<const CutCorner, 3>(corners.data() + 3 * p, 3)));
+  return {};
+}
+
+void cutSegmentTriangle(const ChunkGrid& grid, const Aabbd* segment,
+                        const std::array<CutCorner, 3>& triangle, std::vector<ChunkCell>& cells,
+                        std::vector<CutCorner>& corners) {
+  if (segment != nullptr && segment->longestSide() < grid.size) {
+    cells.push_back(grid.cellOf(segment->center()));
+    corners.insert(corners.end(), triangle.begin(), triangle.end());
+    return;
+  }
+  cutTriangle(grid, triangle, cells, corners);
 }
 
 Status ChunkWriter::flush() {

@@ -64,6 +64,8 @@ class ChunkWriter {
   // the segment's centre, when the segment is smaller than a chunk along every axis (it may
   // stick out of that chunk); cut like addTriangle otherwise.
   Status addSegmentTriangle(const Aabbd& segment, const std::array<CutCorner, 3>& triangle);
+  // Pieces made by cutSegmentTriangle: cells[i] gets corners 3i..3i+2.
+  Status addPieces(std::span<const ChunkCell> cells, std::span<const CutCorner> corners);
   Status flush();
 
   const ChunkGrid& grid() const { return grid_; }
@@ -89,6 +91,12 @@ class ChunkWriter {
   std::vector<ChunkCell> pieceCells_;  // addTriangle's scratch
   std::vector<CutCorner> pieceCorners_;
 };
+
+// The pieces addSegmentTriangle adds (`segment` null: a triangle of no segment, cut), appended
+// to `cells` and `corners`, so that cutting can run apart from adding.
+void cutSegmentTriangle(const ChunkGrid& grid, const Aabbd* segment,
+                        const std::array<CutCorner, 3>& triangle, std::vector<ChunkCell>& cells,
+                        std::vector<CutCorner>& corners);
 
 // A chunk file read back as a welded mesh.
 Result<MeshPart> loadChunk(const std::string& path);

@@ -41,27 +41,6 @@ std::uint64_t seedOf(const OctreeNode& node) {
   return seed;
 }
 
-// Endpoints of edges with one triangle: the border the simplification keeps.
-std::uint64_t countBorderVertices(const MeshPart& mesh) {
-  std::vector<std::uint64_t> edges;
-  edges.reserve(mesh.indices.size());
-  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
-    for (std::size_t k = 0; k < 3; ++k) {
-      const std::uint64_t a = mesh.indices[t + k], b = mesh.indices[t + (k + 1) % 3];
-      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
-    }
-  }
-  std::sort(edges.begin(), edges.end());
-  std::vector<std::uint8_t> border(mesh.positions.size(), 0);
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    while (j < edges.size() && edges[j] == edges[i]) ++j;
-    if (j - i == 1) border[edges[i] >> 32] = border[edges[i] & 0xFFFFFFFFu] = 1;
-    i = j;
-  }
-  return static_cast<std::uint64_t>(std::count(border.begin(), border.end(), 1));
-}
-
 // Whether p lies on a grid plane: every cut vertex does (its coordinate is set to the plane's).
 bool onGridPlane(const ChunkGrid& grid, Vec3d p) {
   for (int axis = 0; axis < 3; ++axis) {
@@ -292,7 +271,6 @@ struct Builder {
     MeshPart merged = concatenate(parts);
     parts.clear();
     weldExact(merged);
-    node.lockedVertices = countBorderVertices(merged);
     const Vec3d center = node.bounds.center();
     const std::vector<Vec3f> positions = relativeTo(merged, center);
     ProgressiveOptions simplify;
@@ -300,6 +278,7 @@ struct Builder {
     simplify.stopAtTriangles = static_cast<std::uint32_t>(std::max<double>(
         1, std::floor(options.keep * static_cast<double>(merged.triangleCount()))));
     const SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
+    node.lockedVertices = simplified.borderVertices;  // the price of locking
     MeshPart mesh;
     mesh.positions.resize(simplified.vertices.size());
     if (!merged.colors.empty()) mesh.colors.resize(simplified.vertices.size());

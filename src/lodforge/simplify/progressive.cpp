@@ -111,6 +111,7 @@ class Simplifier {
   void computeQuadrics();
   void collapseAll();
   ProgressiveMesh rearrange(std::span<const Vec3f> normals, std::span<const Rgba8> colors) const;
+  SimplifiedMesh current() const;
 
  private:
   Vec3d position(std::uint32_t v) const {
@@ -707,6 +708,26 @@ ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
   return mesh;
 }
 
+// The mesh as the collapses left it: live triangles (corners are kept re-formed), vertices in
+// order of first use.
+SimplifiedMesh Simplifier::current() const {
+  SimplifiedMesh out;
+  std::vector<std::uint32_t> remap(vertexCount_, kNone);
+  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
+    if (!alive(t)) continue;
+    for (const std::uint32_t v : corners_[t]) {
+      if (remap[v] == kNone) {
+        remap[v] = static_cast<std::uint32_t>(out.vertices.size());
+        out.vertices.push_back(v);
+      }
+      out.indices.push_back(remap[v]);
+    }
+  }
+  out.error = errorAfter_.empty() ? 0.0f : errorAfter_.back();
+  out.borderVertices = borderVertices_;
+  return out;
+}
+
 }  // namespace
 
 ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
@@ -726,18 +747,13 @@ ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
 SimplifiedMesh simplifyMesh(std::span<const Vec3f> positions,
                             std::span<const std::uint32_t> indices,
                             const ProgressiveOptions& options) {
-  const ProgressiveMesh mesh = buildProgressive(positions, indices, {}, {}, options);
-  SimplifiedMesh out;
-  const std::uint32_t n = mesh.q;  // the collapses stopped at the target: q is that level
-  out.indices.resize(3 * std::size_t{mesh.trianglesAt(n)});
-  reformObject(std::span(mesh.triangles).first(out.indices.size()), mesh.ecol, n, 0, out.indices);
-  out.vertices.resize(n);
-  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
-    if (mesh.permuteV[v] < n) out.vertices[mesh.permuteV[v]] = v;
-  }
-  out.error = mesh.errorAt(n);
-  out.borderVertices = mesh.borderVertices;
-  return out;
+  // The collapses of buildProgressive up to the target, without rearranging a progressive mesh
+  // only to re-form one level of it.
+  Simplifier simplifier(positions, indices, options);
+  simplifier.classifyBoundary();
+  simplifier.computeQuadrics();
+  simplifier.collapseAll();
+  return simplifier.current();
 }
 
 }  // namespace lodforge

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -137,6 +138,45 @@ TEST(Tiles, QuantizedContentsStayWithinTheErrorTheyAddToTheTileset) {
           load(root / "quantized/tileset.json").at("root"));
   EXPECT_EQ(static_cast<std::uint64_t>(compared), quantized->tiles);
   EXPECT_GE(static_cast<std::uint64_t>(quantizedTiles), quantized->leaves);
+}
+
+TEST(Tiles, NeighbouringTilesAgreeOnTheNormalsOfTheirSharedVertices) {
+  // Shading seams: a vertex on a chunk border is in two or more tiles; its normal must be the
+  // same in each (the input's, not one from each tile's half of its fan). The horse has normals
+  // in its file; the bunny has none, so they are computed over the whole input.
+  for (const char* name : {"meshes/horse.ply", "meshes/stanford-bunny.obj"}) {
+    const fs::path out = fs::path(::testing::TempDir()) / "normals";
+    fs::remove_all(out);
+    TilesOptions options;
+    options.input.chunkSize = std::string(name).find("horse") != std::string::npos ? 0.04 : 0.03;
+    options.octree.errorSamples = 1000;
+    options.quantize = false;
+    Result<TilesStats> stats =
+        writeTiles(std::string(LODFORGE_DATA_DIR) + "/" + name, out.string(), options);
+    ASSERT_TRUE(stats.ok()) << stats.error().message;
+    // Per level: position (to 1e-7) -> the normals every tile of that level gives it.
+    std::map<std::pair<int, std::array<std::int64_t, 3>>, std::vector<Vec3f>> seen;
+    for (const auto& entry : fs::directory_iterator(out / "tiles")) {
+      const int level = std::stoi(entry.path().filename().string());
+      Result<Model> tile = readGltf(entry.path().string());
+      ASSERT_TRUE(tile.ok());
+      for (std::size_t v = 0; v < tile->vertexCount(); ++v) {
+        const Vec3d p = tile->origin + toDouble(tile->positions[v]);
+        const std::array<std::int64_t, 3> key = {std::llround(p.x * 1e7), std::llround(p.y * 1e7),
+                                                 std::llround(p.z * 1e7)};
+        seen[{level, key}].push_back(tile->normals[v]);
+      }
+    }
+    std::size_t shared = 0;
+    float worst = 1;
+    for (const auto& [key, normals] : seen) {
+      if (normals.size() < 2) continue;
+      ++shared;
+      for (const Vec3f& n : normals) worst = std::min(worst, dot(n, normals[0]));
+    }
+    EXPECT_GT(shared, 200u) << name;
+    EXPECT_GE(static_cast<double>(worst), std::cos(0.05 * 3.14159265358979 / 180)) << name;
+  }
 }
 
 TEST(Tiles, ParentsAreQuantizedOnlyWhenTheGridIsFarBelowTheirError) {

@@ -101,7 +101,7 @@ TEST(CutTriangle, TrianglesSharingAnEdgeGetBitIdenticalCutVertices) {
     for (std::size_t t = 0; t < welded.indices.size(); t += 3) {
       std::array<CutCorner, 3> triangle;
       for (std::size_t k = 0; k < 3; ++k)
-        triangle[k] = {welded.positions[welded.indices[t + k]], {255, 255, 255, 255}};
+        triangle[k] = {welded.positions[welded.indices[t + k]], {255, 255, 255, 255}, {0, 0, 1}};
       cutTriangle(grid, triangle, cells, corners);
     }
     EXPECT_GT(cells.size(), welded.indices.size() / 3);  // something was cut

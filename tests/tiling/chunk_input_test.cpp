@@ -1,5 +1,6 @@
 #include "lodforge/tiling/chunk_input.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -80,6 +81,50 @@ TEST(ChunkInput, ReadingCuttingAndWritingInParallelWritesTheSameFiles) {
   }
   EXPECT_GT(files[0].size(), 20u);
   EXPECT_EQ(files[0], files[1]);
+}
+
+TEST(ChunkInput, NormalsOfAPlyWithoutThemAreTheWholeInputsAreaWeightedNormals) {
+  // A PLY without normals gets them in an extra face pass, summed in the vertex work file through
+  // the block cache (the smallest cache: blocks are written back and read again): they match the
+  // area-weighted normals of the whole mesh at every chunk vertex, and cut vertices get normals
+  // between their edge's ends.
+  test::TempDir dir;
+  Result<Model> horse = readModel(test::dataPath("meshes/horse.ply"));
+  ASSERT_TRUE(horse.ok());
+  horse->normals.clear();
+  ASSERT_TRUE(writeModel(*horse, dir.file("bare.ply")).ok());
+  std::vector<Vec3f> expected(horse->vertexCount());
+  computeVertexNormals(horse->positions, horse->indices, expected);
+  std::map<std::array<double, 3>, Vec3f> normalAt;
+  for (std::size_t v = 0; v < horse->vertexCount(); ++v) {
+    const Vec3d p = horse->origin + toDouble(horse->positions[v]);
+    normalAt[{p.x, p.y, p.z}] = expected[v];
+  }
+  ChunkInputOptions options;
+  options.chunkSize = 0.04;
+  options.vertexCacheBytes = 1;
+  options.workDirectory = dir.file("work");
+  Result<ChunkInput> input = chunkInput(dir.file("bare.ply"), options);
+  ASSERT_TRUE(input.ok()) << input.error().message;
+  std::size_t original = 0, cut = 0;
+  for (const auto& [index, count] : input->chunks->triangleCounts()) {
+    Result<MeshPart> mesh = input->chunks->load(cellOfIndex(input->chunks->grid(), index));
+    ASSERT_TRUE(mesh.ok());
+    ASSERT_EQ(mesh->normals.size(), mesh->positions.size());
+    for (std::size_t v = 0; v < mesh->positions.size(); ++v) {
+      const Vec3d& p = mesh->positions[v];
+      ASSERT_NEAR(length(mesh->normals[v]), 1.0f, 1e-4f);
+      const auto found = normalAt.find({p.x, p.y, p.z});
+      if (found == normalAt.end()) {
+        ++cut;
+        continue;
+      }
+      ++original;
+      EXPECT_GT(dot(mesh->normals[v], found->second), std::cos(0.1 * 3.14159265 / 180)) << v;
+    }
+  }
+  EXPECT_GT(original, horse->vertexCount() * 9 / 10);
+  EXPECT_GT(cut, 100u);
 }
 
 TEST(ChunkInput, KeptInMemoryEqualsWrittenToDisk) {

@@ -51,8 +51,9 @@ TEST(ChunkWriter, AppendsPastItsBufferAndReadsEveryTriangleBack) {
   box.add(Vec3d{0, 0, 0});
   box.add(Vec3d{4, 4, 4});
   ChunkWriter writer(ChunkGrid::over(box, 2), dir.file("chunks"), 200);  // flushes often
-  const std::array<CutCorner, 3> a = {CutCorner{{0.1, 0.1, 0.1}, {}}, CutCorner{{1, 0.1, 0.1}, {}},
-                                      CutCorner{{0.1, 1, 0.1}, {}}};
+  const std::array<CutCorner, 3> a = {CutCorner{{0.1, 0.1, 0.1}, {}, {0, 0, 1}},
+                                      CutCorner{{1, 0.1, 0.1}, {}, {0, 0, 1}},
+                                      CutCorner{{0.1, 1, 0.1}, {}, {0, 0, 1}}};
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(writer.add({0, 0, 0}, a).ok());
   ASSERT_TRUE(writer.add({1, 1, 1}, a).ok());
   ASSERT_TRUE(writer.flush().ok());

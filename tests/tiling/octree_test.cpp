@@ -128,7 +128,7 @@ Built build(const MeshPart& input, double chunkSize, const OctreeOptions& base,
   for (std::size_t t = 0; t < input.indices.size(); t += 3) {
     std::array<CutCorner, 3> triangle;
     for (std::size_t k = 0; k < 3; ++k)
-      triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}};
+      triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}, {0, 0, 1}};
     EXPECT_TRUE((segments ? chunks.addSegmentTriangle(segmentBounds[component[t / 3]], triangle)
                           : chunks.addTriangle(triangle))
                     .ok());

@@ -128,13 +128,16 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
   std::vector<Vec3f> positions(used);
   std::vector<Rgba8> colors(options.colors && !mesh.colors.empty() ? used : 0);
+  std::vector<Vec3f> normals(used);
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
     if (remap[v] == ~0u) continue;
     positions[remap[v]] = toFloat(mesh.positions[v] - center);
     if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
+    if (!mesh.normals.empty()) normals[remap[v]] = mesh.normals[v];
   }
-  std::vector<Vec3f> normals(positions.size());
-  computeVertexNormals(positions, indices, normals);
+  // The input's normals, the same in every tile that holds a vertex; from this mesh alone only
+  // when there are none (which leaves shading seams along tile borders).
+  if (mesh.normals.empty()) computeVertexNormals(positions, indices, normals);
   for (Vec3f& p : positions) p = toYUp(p);
   for (Vec3f& n : normals) n = toYUp(n);
   Result<GlbWriter> writer = GlbWriter::create(

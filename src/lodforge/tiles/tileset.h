@@ -52,7 +52,8 @@ struct TilesStats {
 };
 
 // The GLB of one tile: positions relative to the bounds' centre (float), that centre as the
-// root translation, area-weighted normals, colours when asked and the mesh has them; triangles
+// root translation, the mesh's normals (area-weighted over this mesh alone if it has none),
+// colours when asked and the mesh has them; triangles
 // ordered for the vertex cache and vertices for fetch (meshoptimizer), optionally
 // meshopt-compressed.
 struct TileContentOptions {

@@ -75,6 +75,8 @@ CutCorner crossing(const CutCorner& p, const CutCorner& q, int axis, double coor
   };
   out.color = {lerp(a.color.r, b.color.r), lerp(a.color.g, b.color.g), lerp(a.color.b, b.color.b),
                lerp(a.color.a, b.color.a)};
+  const auto f = static_cast<float>(t);
+  out.normal = normalizeOr(a.normal + (b.normal - a.normal) * f, a.normal);
   return out;
 }
 
@@ -113,9 +115,11 @@ struct Emitter {
       unique.pop_back();
     if (unique.size() < 3) return;
     Vec3d sum{};
+    Vec3f normalSum{};
     std::array<double, 4> colorSum{};
     for (const CutCorner& c : unique) {
       sum = sum + c.position;
+      normalSum = normalSum + c.normal;
       colorSum[0] += c.color.r, colorSum[1] += c.color.g;
       colorSum[2] += c.color.b, colorSum[3] += c.color.a;
     }
@@ -124,7 +128,8 @@ struct Emitter {
                              {static_cast<std::uint8_t>(std::lround(colorSum[0] / n)),
                               static_cast<std::uint8_t>(std::lround(colorSum[1] / n)),
                               static_cast<std::uint8_t>(std::lround(colorSum[2] / n)),
-                              static_cast<std::uint8_t>(std::lround(colorSum[3] / n))}};
+                              static_cast<std::uint8_t>(std::lround(colorSum[3] / n))},
+                             normalizeOr(normalSum, unique[0].normal)};
     const ChunkCell cell = grid.cellOf(centroid.position);
     if (unique.size() == 3) {
       const Vec3d normal =

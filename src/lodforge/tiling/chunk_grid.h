@@ -45,10 +45,12 @@ struct ChunkGrid {
   }
 };
 
-// A corner of a triangle being cut: exact position and colour.
+// A corner of a triangle being cut: exact position, colour and unit normal (the input's, or
+// area-weighted over the whole input, so tiles agree on the normals of the vertices they share).
 struct CutCorner {
   Vec3d position;
   Rgba8 color;
+  Vec3f normal;
 };
 
 // Cuts one triangle at every grid plane it crosses and returns the pieces, each inside one cell:

@@ -27,11 +27,15 @@
 namespace lodforge {
 namespace {
 
-constexpr std::size_t kVertexBytes = 3 * sizeof(double) + sizeof(Rgba8);
+// A vertex in the work file: position (3 doubles), colour, normal (3 floats; a sum of face
+// normals while a normals pass accumulates it).
+constexpr std::size_t kVertexBytes = 3 * sizeof(double) + sizeof(Rgba8) + 3 * sizeof(float);
+constexpr std::size_t kNormalOffset = 3 * sizeof(double) + sizeof(Rgba8);
 constexpr std::uint64_t kBlockVertices = 1 << 14;
 
 // Corners of the faces, fetched from the vertex work file through a direct-mapped cache of
-// fixed-size blocks: meshes written in scan or grid order touch a few blocks at a time.
+// fixed-size blocks: meshes written in scan or grid order touch a few blocks at a time. Blocks
+// changed by addNormal are written back when evicted and by flush().
 class VertexCache {
  public:
   VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes) : fd_(fd), vertices_(vertices) {
@@ -39,35 +43,77 @@ class VertexCache {
     slots_ = std::max<std::uint64_t>(4, bytes / blockBytes);
     data_.resize(slots_ * blockBytes);
     tags_.assign(slots_, ~std::uint64_t{0});
+    dirty_.assign(slots_, 0);
   }
 
   bool fetch(std::uint64_t vertex, CutCorner& out) {
-    if (vertex >= vertices_) return false;
-    const std::uint64_t block = vertex / kBlockVertices;
-    const std::uint64_t slot = block % slots_;
-    std::byte* base = data_.data() + slot * kBlockVertices * kVertexBytes;
-    if (tags_[slot] != block) {
-      const std::uint64_t first = block * kBlockVertices;
-      const std::uint64_t count = std::min(kBlockVertices, vertices_ - first);
-      const auto wanted = static_cast<std::size_t>(count * kVertexBytes);
-      if (::pread(fd_, base, wanted, static_cast<off_t>(first * kVertexBytes)) !=
-          static_cast<ssize_t>(wanted))
-        return false;
-      tags_[slot] = block;
-    }
-    const std::byte* at = base + (vertex % kBlockVertices) * kVertexBytes;
+    const std::byte* at = record(vertex);
+    if (at == nullptr) return false;
     double xyz[3];
+    float normal[3];
     std::memcpy(xyz, at, sizeof xyz);
-    out.position = {xyz[0], xyz[1], xyz[2]};
     std::memcpy(&out.color, at + sizeof xyz, sizeof(Rgba8));
+    std::memcpy(normal, at + kNormalOffset, sizeof normal);
+    out.position = {xyz[0], xyz[1], xyz[2]};
+    out.normal = normalizeOr(Vec3f{normal[0], normal[1], normal[2]}, Vec3f{0, 0, 1});
+    return true;
+  }
+
+  bool addNormal(std::uint64_t vertex, Vec3f add) {
+    std::byte* at = record(vertex);
+    if (at == nullptr) return false;
+    float normal[3];
+    std::memcpy(normal, at + kNormalOffset, sizeof normal);
+    normal[0] += add.x, normal[1] += add.y, normal[2] += add.z;
+    std::memcpy(at + kNormalOffset, normal, sizeof normal);
+    dirty_[vertex / kBlockVertices % slots_] = 1;
+    return true;
+  }
+
+  bool flush() {
+    for (std::uint64_t slot = 0; slot < slots_; ++slot)
+      if (dirty_[slot] != 0 && !writeBack(slot)) return false;
     return true;
   }
 
  private:
+  std::byte* record(std::uint64_t vertex) {
+    if (vertex >= vertices_) return nullptr;
+    const std::uint64_t block = vertex / kBlockVertices;
+    const std::uint64_t slot = block % slots_;
+    std::byte* base = data_.data() + slot * kBlockVertices * kVertexBytes;
+    if (tags_[slot] != block) {
+      if (dirty_[slot] != 0 && !writeBack(slot)) return nullptr;
+      const std::uint64_t first = block * kBlockVertices;
+      const auto wanted = static_cast<std::size_t>(blockVertices(block) * kVertexBytes);
+      if (::pread(fd_, base, wanted, static_cast<off_t>(first * kVertexBytes)) !=
+          static_cast<ssize_t>(wanted))
+        return nullptr;
+      tags_[slot] = block;
+    }
+    return base + (vertex % kBlockVertices) * kVertexBytes;
+  }
+
+  std::uint64_t blockVertices(std::uint64_t block) const {
+    return std::min(kBlockVertices, vertices_ - block * kBlockVertices);
+  }
+
+  bool writeBack(std::uint64_t slot) {
+    const std::uint64_t block = tags_[slot];
+    const auto bytes = static_cast<std::size_t>(blockVertices(block) * kVertexBytes);
+    const std::byte* base = data_.data() + slot * kBlockVertices * kVertexBytes;
+    if (::pwrite(fd_, base, bytes, static_cast<off_t>(block * kBlockVertices * kVertexBytes)) !=
+        static_cast<ssize_t>(bytes))
+      return false;
+    dirty_[slot] = 0;
+    return true;
+  }
+
   int fd_;
   std::uint64_t vertices_, slots_ = 0;
   std::vector<std::byte> data_;
   std::vector<std::uint64_t> tags_;
+  std::vector<std::uint8_t> dirty_;
 };
 
 double chunkSizeFor(const ChunkInputOptions& options, const Aabbd& bounds,
@@ -116,6 +162,15 @@ double fitChunkSize(const Model& model, std::span<const Vec3d> world, const Aabb
   return size;
 }
 
+// A normal carried through the input transform (a CRS to a local frame): the direction from the
+// transformed point to the transformed point one unit along the normal. Without a transform, or
+// where that fails, the normal as it was.
+Vec3f transformNormal(const ChunkInputOptions& options, Vec3d in, Vec3d out, Vec3f normal) {
+  Vec3d ahead;
+  if (!options.transform || !options.transform(in + toDouble(normal), ahead)) return normal;
+  return normalizeOr(toFloat(ahead - out), normal);
+}
+
 Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& options) {
   ChunkInput input;
   input.streamed = true;
@@ -153,8 +208,15 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
         input.bounds.add(p);
         const double xyz[3] = {p.x, p.y, p.z};
         const Rgba8 color = batch.colors.empty() ? Rgba8{255, 255, 255, 255} : batch.colors[i];
-        std::memcpy(buffer.data() + i * kVertexBytes, xyz, sizeof xyz);
-        std::memcpy(buffer.data() + i * kVertexBytes + sizeof xyz, &color, sizeof color);
+        // The file's normals (turned with the positions), or zero for the normals pass to fill.
+        const Vec3f n = batch.normals.empty()
+                            ? Vec3f{}
+                            : transformNormal(options, batch.positions[i], p, batch.normals[i]);
+        const float normal[3] = {n.x, n.y, n.z};
+        std::byte* record = buffer.data() + i * kVertexBytes;
+        std::memcpy(record, xyz, sizeof xyz);
+        std::memcpy(record + sizeof xyz, &color, sizeof color);
+        std::memcpy(record + kNormalOffset, normal, sizeof normal);
       }
       if (::write(fd, buffer.data(), buffer.size()) != static_cast<ssize_t>(buffer.size()))
         return ioErrorFromErrno(vertexPath, "write");
@@ -181,13 +243,15 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   read.batchSize = 1 << 14;  // the batches in flight below stay a few MiB each
   PlyBatch batch;
 
-  // With object ids, the objects are the segments (§3.3): one more pass over the faces finds
-  // their bounds (memory per object, not per triangle), so that small ones stay whole.
+  // One more pass over the faces when the file has no normals (area-weighted sums of the face
+  // normals, over the whole input, so that tiles agree along their borders) or has object ids
+  // (the objects are the segments, §3.3: their bounds, memory per object, so that small ones
+  // stay whole).
   std::unordered_map<std::uint32_t, Aabbd> objectBounds;
-  if (header.hasObjectIds) {
+  if (!header.hasNormals || header.hasObjectIds) {
     Result<PlyReader> faces = PlyReader::open(path, read);
     if (!faces) return faces.status();
-    Progress progress("tiles: objects", header.faceCount);
+    Progress progress(header.hasNormals ? "tiles: objects" : "tiles: normals", header.faceCount);
     while (true) {
       Result<bool> more = faces->next(batch);
       if (!more) return more.status();
@@ -196,8 +260,18 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
       for (std::size_t t = 0; t + 2 < batch.triangles.size(); t += 3) {
         std::array<CutCorner, 3> triangle;
         LODFORGE_TRY(fetch(batch, t, triangle));
-        Aabbd& bounds = objectBounds[batch.triangleObjects[t / 3]];
-        for (const CutCorner& corner : triangle) bounds.add(corner.position);
+        if (header.hasObjectIds) {
+          Aabbd& bounds = objectBounds[batch.triangleObjects[t / 3]];
+          for (const CutCorner& corner : triangle) bounds.add(corner.position);
+        }
+        if (!header.hasNormals) {
+          const Vec3f face = toFloat(cross(triangle[1].position - triangle[0].position,
+                                           triangle[2].position - triangle[0].position));
+          for (std::size_t k = 0; k < 3; ++k) {
+            if (!cache.addNormal(batch.triangles[t + k], face))
+              return ioErrorFromErrno(vertexPath, "update");
+          }
+        }
       }
       progress.advance(batch.count);
       LODFORGE_TRY(checkCancelled());
@@ -315,6 +389,21 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
                                         v));
     input.bounds.add(world[v]);
   }
+  // Normals: the model's, or area-weighted over each whole object; turned with the positions.
+  std::vector<Vec3f> normals = model->normals;
+  if (!model->hasNormals()) {
+    normals.resize(model->vertexCount());
+    for (std::size_t o = 0; o < model->objectCount(); ++o) {
+      const ObjectRecord& object = model->objects[o];
+      computeVertexNormals(model->objectPositions(o), model->objectIndices(o),
+                           std::span(normals).subspan(object.vertexOffset, object.vertexCount));
+    }
+  }
+  if (options.transform) {
+    for (std::size_t v = 0; v < world.size(); ++v)
+      normals[v] = transformNormal(options, model->origin + toDouble(model->positions[v]), world[v],
+                                   normals[v]);
+  }
   double size = chunkSizeFor(options, input.bounds, input.inputTriangles);
   if (options.chunkSize == 0) size = fitChunkSize(*model, world, input.bounds, size, options);
   const ChunkGrid grid = ChunkGrid::over(input.bounds, size);
@@ -344,6 +433,7 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
         triangle[k].position = world[object.vertexOffset + v];
         triangle[k].color =
             input.colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
+        triangle[k].normal = normals[object.vertexOffset + v];
       }
       LODFORGE_TRY(input.chunks->addSegmentTriangle(segmentBounds[component[t / 3]], triangle));
     }

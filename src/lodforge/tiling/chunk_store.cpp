@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cassert>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -63,19 +64,28 @@ void weldExact(MeshPart& mesh) {
   }
   std::vector<Vec3d> positions(next);
   std::vector<Rgba8> colors(mesh.colors.empty() ? 0 : next);
+  std::vector<Vec3f> normals(mesh.normals.empty() ? 0 : next);
   for (std::uint32_t v = 0; v < count; ++v) {
-    if (remap[v] == ~0u) continue;
+    // Normals of a group are averaged (a part's hard edge, split in the input, meets here).
+    const std::uint32_t to = remap[representative[v]];
+    if (to != ~0u && !normals.empty()) normals[to] = normals[to] + mesh.normals[v];
+    if (remap[v] == ~0u) continue;  // not a representative, or unused
     positions[remap[v]] = mesh.positions[v];
     if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
   }
+  for (std::size_t v = 0; v < normals.size(); ++v)
+    normals[v] = normalizeOr(normals[v], Vec3f{0, 0, 1});
   mesh.positions = std::move(positions);
   mesh.colors = std::move(colors);
+  mesh.normals = std::move(normals);
 }
 
 MeshPart concatenate(std::span<const MeshPart> parts) {
   MeshPart out;
   const bool colors =
       std::any_of(parts.begin(), parts.end(), [](const MeshPart& p) { return !p.colors.empty(); });
+  const bool normals =
+      std::any_of(parts.begin(), parts.end(), [](const MeshPart& p) { return !p.normals.empty(); });
   for (const MeshPart& part : parts) {
     const std::uint32_t base = out.vertexCount();
     out.positions.insert(out.positions.end(), part.positions.begin(), part.positions.end());
@@ -86,6 +96,13 @@ MeshPart concatenate(std::span<const MeshPart> parts) {
         out.colors.insert(out.colors.end(), part.colors.begin(), part.colors.end());
       }
     }
+    if (normals) {
+      if (part.normals.empty()) {
+        out.normals.resize(out.positions.size(), Vec3f{0, 0, 1});
+      } else {
+        out.normals.insert(out.normals.end(), part.normals.begin(), part.normals.end());
+      }
+    }
     for (std::uint32_t i : part.indices) out.indices.push_back(base + i);
   }
   return out;
@@ -93,9 +110,38 @@ MeshPart concatenate(std::span<const MeshPart> parts) {
 
 namespace {
 
-constexpr char kMeshMagic[8] = {'L', 'F', 'M', 'E', 'S', 'H', '1', '\0'};
-constexpr std::size_t kCornerBytes = 3 * sizeof(double) + sizeof(Rgba8);
+constexpr char kMeshMagic[8] = {'L', 'F', 'M', 'E', 'S', 'H', '2', '\0'};
+// A chunk-file corner: position (3 doubles), colour, normal (octahedral, 2 x 16 bits).
+constexpr std::size_t kCornerBytes = 3 * sizeof(double) + sizeof(Rgba8) + sizeof(std::uint32_t);
 constexpr std::size_t kTriangleBytes = 3 * kCornerBytes;
+
+// Octahedral encoding of a unit normal (Cigolle et al. 2014): 0.005 degrees at 16 bits per
+// axis, a third of the bytes of three floats in every chunk-file corner.
+std::uint32_t encodeNormal(Vec3f n) {
+  const float sum = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
+  if (!(sum > 0)) return 0;  // unknown: decodes to +z
+  float u = n.x / sum, v = n.y / sum;
+  if (n.z < 0) {
+    const float fu = (1 - std::abs(v)) * (u >= 0 ? 1.0f : -1.0f);
+    const float fv = (1 - std::abs(u)) * (v >= 0 ? 1.0f : -1.0f);
+    u = fu, v = fv;
+  }
+  const auto snorm = [](float x) {
+    return static_cast<std::uint16_t>(static_cast<std::int16_t>(std::lround(x * 32767.0f)));
+  };
+  return static_cast<std::uint32_t>(snorm(u)) | static_cast<std::uint32_t>(snorm(v)) << 16;
+}
+
+Vec3f decodeNormal(std::uint32_t packed) {
+  const float u = static_cast<float>(static_cast<std::int16_t>(packed & 0xFFFF)) / 32767.0f;
+  const float v = static_cast<float>(static_cast<std::int16_t>(packed >> 16)) / 32767.0f;
+  Vec3f n{u, v, 1 - std::abs(u) - std::abs(v)};
+  if (n.z < 0) {
+    n.x = (1 - std::abs(v)) * (u >= 0 ? 1.0f : -1.0f);
+    n.y = (1 - std::abs(u)) * (v >= 0 ? 1.0f : -1.0f);
+  }
+  return normalizeOr(n, Vec3f{0, 0, 1});
+}
 
 Result<std::vector<std::byte>> readWhole(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
@@ -122,13 +168,16 @@ Status appendTo(const std::string& path, std::span<const std::byte> bytes) {
 Status saveMesh(const MeshPart& mesh, const std::string& path) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) return ioError(path, "cannot create");
-  const std::uint64_t header[3] = {mesh.positions.size(), mesh.colors.size(), mesh.indices.size()};
+  const std::uint64_t header[4] = {mesh.positions.size(), mesh.colors.size(), mesh.normals.size(),
+                                   mesh.indices.size()};
   out.write(kMeshMagic, sizeof kMeshMagic);
   out.write(reinterpret_cast<const char*>(header), sizeof header);
   out.write(reinterpret_cast<const char*>(mesh.positions.data()),
             static_cast<std::streamsize>(mesh.positions.size() * sizeof(Vec3d)));
   out.write(reinterpret_cast<const char*>(mesh.colors.data()),
             static_cast<std::streamsize>(mesh.colors.size() * sizeof(Rgba8)));
+  out.write(reinterpret_cast<const char*>(mesh.normals.data()),
+            static_cast<std::streamsize>(mesh.normals.size() * sizeof(Vec3f)));
   out.write(reinterpret_cast<const char*>(mesh.indices.data()),
             static_cast<std::streamsize>(mesh.indices.size() * sizeof(std::uint32_t)));
   if (!out.flush()) return ioError(path, "cannot write");
@@ -142,33 +191,43 @@ Result<MeshPart> loadMesh(const std::string& path) {
 }
 
 Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& name) {
-  std::uint64_t header[3];
+  std::uint64_t header[4];
   if (bytes.size() < sizeof kMeshMagic + sizeof header ||
       std::memcmp(bytes.data(), kMeshMagic, sizeof kMeshMagic) != 0)
     return badInputAtByte(name, 0, "not a lodforge mesh file (work file of `lodforge tiles`)");
   std::memcpy(header, bytes.data() + sizeof kMeshMagic, sizeof header);
   // Counts first, in a way that cannot overflow: each must fit the bytes that are there.
   const std::uint64_t body = bytes.size() - sizeof kMeshMagic - sizeof header;
-  if (header[0] > body / sizeof(Vec3d) || header[1] > body / sizeof(Rgba8) ||
-      header[2] > body / sizeof(std::uint32_t) ||
-      header[0] * sizeof(Vec3d) + header[1] * sizeof(Rgba8) + header[2] * sizeof(std::uint32_t) !=
-          body ||
-      (header[1] != 0 && header[1] != header[0]) || header[2] % 3 != 0)
+  const std::uint64_t sizes[4] = {sizeof(Vec3d), sizeof(Rgba8), sizeof(Vec3f),
+                                  sizeof(std::uint32_t)};
+  std::uint64_t total = 0;
+  for (int i = 0; i < 4; ++i) {
+    if (header[i] > body / sizes[i])
+      return badInputAtByte(name, sizeof kMeshMagic, "mesh file sizes do not match its counts");
+    total += header[i] * sizes[i];
+  }
+  if (total != body || (header[1] != 0 && header[1] != header[0]) ||
+      (header[2] != 0 && header[2] != header[0]) || header[3] % 3 != 0)
     return badInputAtByte(name, sizeof kMeshMagic, "mesh file sizes do not match its counts");
   MeshPart mesh;
   mesh.positions.resize(header[0]);
   mesh.colors.resize(header[1]);
-  mesh.indices.resize(header[2]);
+  mesh.normals.resize(header[2]);
+  mesh.indices.resize(header[3]);
   const std::byte* at = bytes.data() + sizeof kMeshMagic + sizeof header;
   // (memcpy of nothing from or to an empty vector's null data() is undefined, hence the guards)
-  if (header[0] > 0) std::memcpy(mesh.positions.data(), at, header[0] * sizeof(Vec3d));
-  at += header[0] * sizeof(Vec3d);
-  if (header[1] > 0) std::memcpy(mesh.colors.data(), at, header[1] * sizeof(Rgba8));
-  at += header[1] * sizeof(Rgba8);
-  if (header[2] > 0) std::memcpy(mesh.indices.data(), at, header[2] * sizeof(std::uint32_t));
+  const auto take = [&at](void* to, std::uint64_t count, std::uint64_t size) {
+    if (count > 0) std::memcpy(to, at, count * size);
+    at += count * size;
+  };
+  take(mesh.positions.data(), header[0], sizeof(Vec3d));
+  take(mesh.colors.data(), header[1], sizeof(Rgba8));
+  take(mesh.normals.data(), header[2], sizeof(Vec3f));
+  const std::byte* indicesAt = at;
+  take(mesh.indices.data(), header[3], sizeof(std::uint32_t));
   for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
     if (mesh.indices[i] >= header[0])
-      return badInputAtByte(name, static_cast<std::uint64_t>(at - bytes.data()) + 4 * i,
+      return badInputAtByte(name, static_cast<std::uint64_t>(indicesAt - bytes.data()) + 4 * i,
                             "mesh file index out of range");
   }
   return mesh;
@@ -208,8 +267,10 @@ Status ChunkWriter::add(const ChunkCell& cell, std::span<const CutCorner, 3> cor
   std::byte* out = buffer.data() + at;
   for (const CutCorner& corner : corners) {
     const double xyz[3] = {corner.position.x, corner.position.y, corner.position.z};
+    const std::uint32_t normal = encodeNormal(corner.normal);
     std::memcpy(out, xyz, sizeof xyz);
     std::memcpy(out + sizeof xyz, &corner.color, sizeof(Rgba8));
+    std::memcpy(out + sizeof xyz + sizeof(Rgba8), &normal, sizeof normal);
     out += kCornerBytes;
   }
   ++*lastCount_;
@@ -275,12 +336,17 @@ Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string&
   MeshPart mesh;
   mesh.positions.resize(corners);
   mesh.colors.resize(corners);
+  mesh.normals.resize(corners);
   mesh.indices.resize(corners);
   for (std::size_t i = 0; i < corners; ++i) {
+    const std::byte* at = bytes.data() + i * kCornerBytes;
     double xyz[3];
-    std::memcpy(xyz, bytes.data() + i * kCornerBytes, sizeof xyz);
+    std::uint32_t normal;
+    std::memcpy(xyz, at, sizeof xyz);
     mesh.positions[i] = {xyz[0], xyz[1], xyz[2]};
-    std::memcpy(&mesh.colors[i], bytes.data() + i * kCornerBytes + sizeof xyz, sizeof(Rgba8));
+    std::memcpy(&mesh.colors[i], at + sizeof xyz, sizeof(Rgba8));
+    std::memcpy(&normal, at + sizeof xyz + sizeof(Rgba8), sizeof normal);
+    mesh.normals[i] = decodeNormal(normal);
     mesh.indices[i] = static_cast<std::uint32_t>(i);
   }
   weldExact(mesh);

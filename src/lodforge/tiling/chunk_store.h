@@ -20,20 +20,21 @@ namespace lodforge {
 // An indexed mesh with exact (double) positions: what the octree passes between levels.
 struct MeshPart {
   std::vector<Vec3d> positions;
-  std::vector<Rgba8> colors;  // empty or one per vertex
+  std::vector<Rgba8> colors;   // empty or one per vertex
+  std::vector<Vec3f> normals;  // empty or one unit normal per vertex
   std::vector<std::uint32_t> indices;
 
   std::uint32_t vertexCount() const { return static_cast<std::uint32_t>(positions.size()); }
   std::uint64_t triangleCount() const { return indices.size() / 3; }
   std::uint64_t memoryBytes() const {
     return positions.size() * sizeof(Vec3d) + colors.size() * sizeof(Rgba8) +
-           indices.size() * sizeof(std::uint32_t);
+           normals.size() * sizeof(Vec3f) + indices.size() * sizeof(std::uint32_t);
   }
 };
 
 // Welds bit-identical positions (cut vertices are made identical on purpose), drops triangles
 // that repeat a corner and vertices no triangle uses. The first vertex of a group keeps its
-// colour. Deterministic.
+// colour; the group's normals are averaged. Deterministic.
 void weldExact(MeshPart& mesh);
 
 // Appends `parts`, renumbering their indices.

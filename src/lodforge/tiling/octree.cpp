@@ -115,6 +115,7 @@ Dropped dropSmallSegments(MeshPart& mesh, std::uint64_t target, const ChunkGrid&
         to = kept.vertexCount();
         kept.positions.push_back(mesh.positions[mesh.indices[t + k]]);
         if (!mesh.colors.empty()) kept.colors.push_back(mesh.colors[mesh.indices[t + k]]);
+        if (!mesh.normals.empty()) kept.normals.push_back(mesh.normals[mesh.indices[t + k]]);
       }
       kept.indices.push_back(to);
     }
@@ -282,9 +283,11 @@ struct Builder {
     MeshPart mesh;
     mesh.positions.resize(simplified.vertices.size());
     if (!merged.colors.empty()) mesh.colors.resize(simplified.vertices.size());
+    if (!merged.normals.empty()) mesh.normals.resize(simplified.vertices.size());
     for (std::size_t i = 0; i < simplified.vertices.size(); ++i) {
       mesh.positions[i] = merged.positions[simplified.vertices[i]];
       if (!mesh.colors.empty()) mesh.colors[i] = merged.colors[simplified.vertices[i]];
+      if (!mesh.normals.empty()) mesh.normals[i] = merged.normals[simplified.vertices[i]];
     }
     mesh.indices = simplified.indices;
     const Dropped dropped =

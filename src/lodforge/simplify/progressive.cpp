@@ -185,7 +185,7 @@ class Simplifier {
   std::vector<std::uint32_t> trianglesAfter_;    // triangle count after collapse k
   std::vector<float> errorAfter_;                // monotone error after collapse k
   double maxError_ = 0;
-  std::uint32_t borderVertices_ = 0;  // on a boundary or non-manifold edge
+  std::vector<std::uint8_t> border_;  // per vertex: on a boundary or non-manifold edge
 };
 
 void Simplifier::classifyBoundary() {
@@ -211,6 +211,7 @@ void Simplifier::classifyBoundary() {
   // Every edge is seen from both ends, so each end locks itself.
   buildIncidence();
   std::vector<std::uint32_t> edgeCount(vertexCount_, 0);
+  border_.assign(vertexCount_, 0);
   for (std::uint32_t u = 0; u < vertexCount_; ++u) {
     const auto fan = around(u);
     for (std::uint32_t t : fan) {
@@ -224,7 +225,7 @@ void Simplifier::classifyBoundary() {
       for (std::uint32_t w : otherCorners(t, u)) locked |= edgeCount[w] != 2;
     }
     vertex_[u].locked = locked || (!options_.locked.empty() && options_.locked[u] != 0);
-    borderVertices_ += locked ? 1 : 0;
+    border_[u] = locked ? 1 : 0;
   }
 }
 
@@ -655,7 +656,6 @@ void Simplifier::collapseAll() {
 ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
                                       std::span<const Rgba8> colors) const {
   ProgressiveMesh mesh;
-  mesh.borderVertices = borderVertices_;
   const auto collapses = static_cast<std::uint32_t>(collapsed_.size());
   mesh.q = vertexCount_ - collapses;
   // PermuteV: vertices that never collapse keep their order at the front; the k-th collapsed
@@ -719,12 +719,12 @@ SimplifiedMesh Simplifier::current() const {
       if (remap[v] == kNone) {
         remap[v] = static_cast<std::uint32_t>(out.vertices.size());
         out.vertices.push_back(v);
+        out.border.push_back(border_[v]);
       }
       out.indices.push_back(remap[v]);
     }
   }
   out.error = errorAfter_.empty() ? 0.0f : errorAfter_.back();
-  out.borderVertices = borderVertices_;
   return out;
 }
 

@@ -42,7 +42,6 @@ struct ProgressiveOptions {
 // boundary vertices Q of the paper, plus interior vertices no valid collapse could remove).
 struct ProgressiveMesh {
   std::uint32_t q = 0;
-  std::uint32_t borderVertices = 0;      // of Q, those on a boundary or non-manifold edge
   std::vector<Vec3f> positions;          // p, rearranged (Algorithm 1)
   std::vector<Vec3f> normals;            // p or empty
   std::vector<Rgba8> colors;             // p or empty
@@ -80,7 +79,7 @@ struct SimplifiedMesh {
   std::vector<std::uint32_t> vertices;  // input index of each kept vertex
   std::vector<std::uint32_t> indices;   // 3 per triangle, < vertices.size()
   float error = 0;                      // model units, as in ProgressiveMesh::error
-  std::uint32_t borderVertices = 0;     // input vertices on a boundary or non-manifold edge
+  std::vector<std::uint8_t> border;     // per kept vertex: on a boundary or non-manifold edge
 };
 
 // Collapses until at most `options.stopAtTriangles` triangles remain or nothing more may

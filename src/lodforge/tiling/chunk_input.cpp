@@ -133,28 +133,21 @@ Result<Model> readInputModel(const std::string& path) {
 
 // The surface estimate of ChunkGrid::sizeFor, halved while the chunk a triangle lands in holds
 // on average more than 1.5 x the target (parts clustered in a volume, as in a CAD assembly,
-// crowd into far fewer chunks than a surface would).
-double fitChunkSize(const Model& model, std::span<const Vec3d> world, const Aabbd& bounds,
-                    double size, const ChunkInputOptions& options) {
+// crowd into far fewer chunks than a surface would). `visit(add)` calls add(point, triangles)
+// for where the triangles are: each triangle's centroid, or each object's centre.
+template <class Visit>
+double fitChunkSize(const Aabbd& bounds, double size, const ChunkInputOptions& options,
+                    const Visit& visit) {
   const double smallest = bounds.longestSide() / 4096;
-  std::unordered_map<std::uint64_t, std::uint64_t> load;
+  std::unordered_map<std::uint64_t, double> load;
   while (size / 2 >= smallest) {
     const ChunkGrid grid = ChunkGrid::over(bounds, size);
     load.clear();
-    for (std::size_t o = 0; o < model.objectCount(); ++o) {
-      const std::uint64_t offset = model.objects[o].vertexOffset;
-      const auto indices = model.objectIndices(o);
-      for (std::size_t t = 0; t < indices.size(); t += 3) {
-        const Vec3d centroid = (world[offset + indices[t]] + world[offset + indices[t + 1]] +
-                                world[offset + indices[t + 2]]) *
-                               (1.0 / 3.0);
-        ++load[grid.cellIndex(grid.cellOf(centroid))];
-      }
-    }
+    visit([&](Vec3d p, double triangles) { load[grid.cellIndex(grid.cellOf(p))] += triangles; });
     double squares = 0, triangles = 0;
     for (const auto& [cell, count] : load) {
-      squares += static_cast<double>(count) * static_cast<double>(count);
-      triangles += static_cast<double>(count);
+      squares += count * count;
+      triangles += count;
     }
     if (squares / triangles <= 1.5 * static_cast<double>(options.trianglesPerChunk)) break;
     size /= 2;
@@ -247,7 +240,11 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   // normals, over the whole input, so that tiles agree along their borders) or has object ids
   // (the objects are the segments, §3.3: their bounds, memory per object, so that small ones
   // stay whole).
-  std::unordered_map<std::uint32_t, Aabbd> objectBounds;
+  struct ObjectExtent {
+    Aabbd bounds;
+    std::uint64_t triangles = 0;
+  };
+  std::unordered_map<std::uint32_t, ObjectExtent> objects;
   if (!header.hasNormals || header.hasObjectIds) {
     Result<PlyReader> faces = PlyReader::open(path, read);
     if (!faces) return faces.status();
@@ -261,8 +258,9 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
         std::array<CutCorner, 3> triangle;
         LODFORGE_TRY(fetch(batch, t, triangle));
         if (header.hasObjectIds) {
-          Aabbd& bounds = objectBounds[batch.triangleObjects[t / 3]];
-          for (const CutCorner& corner : triangle) bounds.add(corner.position);
+          ObjectExtent& object = objects[batch.triangleObjects[t / 3]];
+          for (const CutCorner& corner : triangle) object.bounds.add(corner.position);
+          ++object.triangles;
         }
         if (!header.hasNormals) {
           const Vec3f face = toFloat(cross(triangle[1].position - triangle[0].position,
@@ -280,8 +278,15 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   }
 
   // Pass 2: faces, corners from the cache, into the chunk files (cut, or whole by segment).
-  const ChunkGrid grid =
-      ChunkGrid::over(input.bounds, chunkSizeFor(options, input.bounds, header.faceCount));
+  double size = chunkSizeFor(options, input.bounds, header.faceCount);
+  if (options.chunkSize == 0 && header.hasObjectIds) {
+    // Where the triangles are, as far as the objects tell (small ones stay whole anyway).
+    size = fitChunkSize(input.bounds, size, options, [&](const auto& add) {
+      for (const auto& [id, object] : objects)
+        add(object.bounds.center(), static_cast<double>(object.triangles));
+    });
+  }
+  const ChunkGrid grid = ChunkGrid::over(input.bounds, size);
   input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
                                                options.chunkBufferBytes, options.keepInMemory);
   Result<PlyReader> faces = PlyReader::open(path, read);
@@ -326,8 +331,8 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
           return fail(std::move(status), &control), nullptr;
         std::copy(triangle.begin(), triangle.end(), next->corners.data() + t);
         if (header.hasObjectIds) {
-          const auto found = objectBounds.find(batch.triangleObjects[t / 3]);
-          next->segments.push_back(found == objectBounds.end() ? nullptr : &found->second);
+          const auto found = objects.find(batch.triangleObjects[t / 3]);
+          next->segments.push_back(found == objects.end() ? nullptr : &found->second.bounds);
         }
       }
       return next;
@@ -405,7 +410,19 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
                                    normals[v]);
   }
   double size = chunkSizeFor(options, input.bounds, input.inputTriangles);
-  if (options.chunkSize == 0) size = fitChunkSize(*model, world, input.bounds, size, options);
+  if (options.chunkSize == 0) {
+    size = fitChunkSize(input.bounds, size, options, [&](const auto& add) {
+      for (std::size_t o = 0; o < model->objectCount(); ++o) {
+        const std::uint64_t offset = model->objects[o].vertexOffset;
+        const auto indices = model->objectIndices(o);
+        for (std::size_t t = 0; t < indices.size(); t += 3)
+          add((world[offset + indices[t]] + world[offset + indices[t + 1]] +
+               world[offset + indices[t + 2]]) *
+                  (1.0 / 3.0),
+              1.0);
+      }
+    });
+  }
   const ChunkGrid grid = ChunkGrid::over(input.bounds, size);
   input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
                                                options.chunkBufferBytes, options.keepInMemory);

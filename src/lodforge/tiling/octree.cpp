@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <nanoflann.hpp>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/distance.h"
@@ -50,6 +51,22 @@ bool onGridPlane(const ChunkGrid& grid, Vec3d p) {
   return false;
 }
 
+// The kept vertices for nanoflann's k-d tree.
+struct KeptVertices {
+  const std::vector<Vec3f>& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  float kdtree_get_pt(std::size_t i, std::size_t axis) const {
+    return axis == 0 ? points[i].x : axis == 1 ? points[i].y : points[i].z;
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, KeptVertices>,
+                                        KeptVertices, 3, std::uint32_t>;
+
 struct Dropped {
   std::uint64_t segments = 0;
   double error = 0;  // bound on the distance from any dropped point to what remains
@@ -60,8 +77,9 @@ struct Dropped {
 // every parent above its target. When the simplified mesh is over its target, its connected
 // components that have no vertex on a grid plane — so no neighbouring tile meets them — go,
 // smallest first, until the target is met or one component is left.
-Dropped dropSmallSegments(MeshPart& mesh, std::uint64_t target, const ChunkGrid& grid,
-                          Vec3d center) {
+// `border` (a flag per vertex) is compacted with the mesh.
+Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border, std::uint64_t target,
+                          const ChunkGrid& grid, Vec3d center) {
   if (mesh.triangleCount() <= target) return {};
   std::vector<std::uint32_t> component(mesh.triangleCount());
   const std::uint32_t count = connectedComponents(mesh.vertexCount(), mesh.indices, component);
@@ -93,20 +111,15 @@ Dropped dropSmallSegments(MeshPart& mesh, std::uint64_t target, const ChunkGrid&
   }
   if (dropped.segments == 0) return {};
 
-  // Keep the rest; the dropped corners and longest dropped edge give the error bound (the
-  // distance to a surface is 1-Lipschitz: a point of a dropped triangle is within its longest
-  // edge of one of its corners).
+  // Keep the rest.
   std::vector<std::uint32_t> remap(mesh.vertexCount(), ~0u);
-  std::vector<std::uint8_t> droppedVertex(mesh.vertexCount(), 0);
+  std::vector<std::uint32_t> representative(count, ~0u);  // a vertex of each dropped component
   MeshPart kept;
-  double longestEdge = 0;
+  std::vector<std::uint8_t> keptBorder;
   for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
-    if (drop[component[t / 3]] != 0) {
-      for (std::size_t k = 0; k < 3; ++k) {
-        droppedVertex[mesh.indices[t + k]] = 1;
-        longestEdge = std::max(longestEdge, length(mesh.positions[mesh.indices[t + k]] -
-                                                   mesh.positions[mesh.indices[t + (k + 1) % 3]]));
-      }
+    const std::uint32_t c = component[t / 3];
+    if (drop[c] != 0) {
+      representative[c] = mesh.indices[t];
       continue;
     }
     for (std::size_t k = 0; k < 3; ++k) {
@@ -116,16 +129,29 @@ Dropped dropSmallSegments(MeshPart& mesh, std::uint64_t target, const ChunkGrid&
         kept.positions.push_back(mesh.positions[mesh.indices[t + k]]);
         if (!mesh.colors.empty()) kept.colors.push_back(mesh.colors[mesh.indices[t + k]]);
         if (!mesh.normals.empty()) kept.normals.push_back(mesh.normals[mesh.indices[t + k]]);
+        keptBorder.push_back(border[mesh.indices[t + k]]);
       }
       kept.indices.push_back(to);
     }
   }
-  std::vector<Vec3f> droppedPoints;
-  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v)
-    if (droppedVertex[v] != 0) droppedPoints.push_back(toFloat(mesh.positions[v] - center));
-  dropped.error =
-      farthestDistance(droppedPoints, relativeTo(kept, center), kept.indices) + longestEdge;
+  // The cost, bounded without searching far from the surface: every point of a dropped
+  // component is within its bounds' diagonal of its representative vertex, which is within the
+  // distance to the nearest kept vertex (a point of what remains) of the kept surface.
+  const std::vector<Vec3f> keptPositions = relativeTo(kept, center);
+  const KeptVertices cloud{keptPositions};
+  const KdTree tree(3, cloud);
+  for (std::uint32_t c = 0; c < count; ++c) {
+    if (drop[c] == 0) continue;
+    const Vec3f p = toFloat(mesh.positions[representative[c]] - center);
+    const float query[3] = {p.x, p.y, p.z};
+    std::uint32_t nearest = 0;
+    float squared = 0;
+    tree.knnSearch(query, 1, &nearest, &squared);
+    dropped.error =
+        std::max(dropped.error, std::sqrt(static_cast<double>(squared)) + length(bounds[c].size()));
+  }
   mesh = std::move(kept);
+  border = std::move(keptBorder);
   return dropped;
 }
 
@@ -278,8 +304,7 @@ struct Builder {
     simplify.minNormalCos = std::cos(options.maxNormalDeviationDegrees * std::numbers::pi / 180);
     simplify.stopAtTriangles = static_cast<std::uint32_t>(std::max<double>(
         1, std::floor(options.keep * static_cast<double>(merged.triangleCount()))));
-    const SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
-    node.lockedVertices = simplified.borderVertices;  // the price of locking
+    SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
     MeshPart mesh;
     mesh.positions.resize(simplified.vertices.size());
     if (!merged.colors.empty()) mesh.colors.resize(simplified.vertices.size());
@@ -290,17 +315,22 @@ struct Builder {
       if (!mesh.normals.empty()) mesh.normals[i] = merged.normals[simplified.vertices[i]];
     }
     mesh.indices = simplified.indices;
-    const Dropped dropped =
-        dropSmallSegments(mesh, simplify.stopAtTriangles, chunks.grid(), center);
-    node.droppedSegments = dropped.segments;
     // Geometric error: measured against the children's geometry, plus what they already
     // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
     // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
     // excursions, which area samples could miss, are bounded by the simplifier's own record.
+    // Measured before small segments are left out (whose cost is bounded apart: a sample near
+    // one would search far for the nearest remaining surface).
     const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);
     const SurfaceDistance distance =
         surfaceDistance(simplifiedPositions, mesh.indices, positions, merged.indices,
                         options.errorSamples, seedOf(node), /*corners=*/false);
+    const Dropped dropped =
+        dropSmallSegments(mesh, simplified.border, simplify.stopAtTriangles, chunks.grid(), center);
+    node.droppedSegments = dropped.segments;
+    // The price of locking: border vertices the tile had to keep.
+    node.lockedVertices = static_cast<std::uint64_t>(
+        std::count(simplified.border.begin(), simplified.border.end(), 1));
     node.geometricError = childError +
                           std::max(distance.hausdorff, static_cast<double>(simplified.error)) +
                           dropped.error;

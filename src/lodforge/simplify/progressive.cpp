@@ -86,6 +86,7 @@ struct alignas(64) VertexState {
   std::uint8_t removed = 0;                    // collapsed already
   std::uint8_t dirty = 1;                      // must be re-ranked next pass
   std::uint8_t gains = 0;                      // valid(): on a triangle around `from` without `to`
+  std::uint8_t boundary = 0;  // collapseBorders: on two boundary edges, may move along them
 };
 static_assert(sizeof(VertexState) == 64);
 
@@ -109,6 +110,7 @@ class Simplifier {
 
   void classifyBoundary();
   void computeQuadrics();
+  void addBoundaryPlanes();
   void collapseAll();
   ProgressiveMesh rearrange(std::span<const Vec3f> normals, std::span<const Rgba8> colors) const;
   SimplifiedMesh current() const;
@@ -221,11 +223,20 @@ void Simplifier::classifyBoundary() {
       for (std::uint32_t w : otherCorners(t, u)) ++edgeCount[w];
     }
     bool locked = false;
+    std::uint32_t boundaryEdges = 0, nonManifold = 0;
     for (std::uint32_t t : fan) {
-      for (std::uint32_t w : otherCorners(t, u)) locked |= edgeCount[w] != 2;
+      for (std::uint32_t w : otherCorners(t, u)) {
+        locked |= edgeCount[w] != 2;
+        boundaryEdges += edgeCount[w] == 1;
+        nonManifold += edgeCount[w] > 2;
+      }
+    }
+    border_[u] = locked ? 1 : 0;
+    if (options_.collapseBorders && locked && nonManifold == 0 && boundaryEdges == 2) {
+      locked = false;  // a plain rim vertex: it may slide along its rim
+      vertex_[u].boundary = 1;
     }
     vertex_[u].locked = locked || (!options_.locked.empty() && options_.locked[u] != 0);
-    border_[u] = locked ? 1 : 0;
   }
 }
 
@@ -241,8 +252,35 @@ void Simplifier::computeQuadrics() {
     const Quadric plane = Quadric::fromPlane(n / twiceArea, a, 0.5 * twiceArea);
     for (std::uint32_t v : c) quadrics_[v] += plane;
   }
+  if (options_.collapseBorders) addBoundaryPlanes();
   for (std::uint32_t v = 0; v < vertexCount_; ++v)
     vertex_[v].selfCost = quadrics_[v].evaluate(position(v));
+}
+
+void Simplifier::addBoundaryPlanes() {
+  // A plane through each boundary edge, perpendicular to its face, weighted by the edge's
+  // squared length (Garland & Heckbert's boundary constraint): moving a rim vertex off its rim
+  // costs as much as lifting a face.
+  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
+    const auto& c = corners_[t];
+    const Vec3d n = cross(position(c[1]) - position(c[0]), position(c[2]) - position(c[0]));
+    const double twiceArea = length(n);
+    if (twiceArea <= 0) continue;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = c[k], b = c[(k + 1) % 3];
+      if (border_[a] == 0 || border_[b] == 0) continue;
+      std::uint32_t onEdge = 0;
+      for (std::uint32_t s : around(a)) onEdge += contains(s, b) ? 1u : 0u;
+      if (onEdge != 1) continue;
+      const Vec3d edge = position(b) - position(a);
+      const Vec3d across = cross(edge, n / twiceArea);
+      const double span = length(across);
+      if (span <= 0) continue;
+      const Quadric plane = Quadric::fromPlane(across / span, position(a), dot(edge, edge));
+      quadrics_[a] += plane;
+      quadrics_[b] += plane;
+    }
+  }
 }
 
 bool Simplifier::allowed(std::uint32_t from, std::uint32_t to) const {
@@ -444,6 +482,8 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
   // Link condition: the common neighbours of the two ends are exactly the opposite corners of
   // the triangles on the edge; otherwise the collapse would create a non-manifold edge.
   if (common != shared) return false;
+  // A rim vertex moves only along its rim: over a boundary edge (one triangle), into the next.
+  if (vertex_[from].boundary != 0 && shared != 1) return false;
   const Vec3d target = position(to);
   const bool tetrahedron = fan == 3;
   for (std::uint32_t t : around(from)) {
@@ -725,6 +765,14 @@ SimplifiedMesh Simplifier::current() const {
     }
   }
   out.error = errorAfter_.empty() ? 0.0f : errorAfter_.back();
+  // Where each removed vertex went: follow its collapses to a live vertex (targets only ever
+  // point at vertices still live when they were chosen, so the chains end).
+  out.representative.assign(vertexCount_, kNone);
+  for (std::uint32_t v = 0; v < vertexCount_; ++v) {
+    std::uint32_t r = v;
+    while (vertex_[r].removed != 0) r = target_[r];
+    out.representative[v] = remap[r];
+  }
   return out;
 }
 

@@ -36,6 +36,11 @@ struct ProgressiveOptions {
   std::span<const std::uint8_t> locked{};
   // Stop once the mesh has at most this many triangles (0: collapse down to the minimum).
   std::uint32_t stopAtTriangles = 0;
+  // Let boundary vertices collapse along their boundary into a boundary neighbour (quadrics
+  // then hold planes along boundary edges, so a rim keeps its shape). Off, as the CAD paper
+  // has it: boundary vertices never move. Vertices where a boundary meets itself or a
+  // non-manifold edge, and `locked` ones, stay put either way.
+  bool collapseBorders = false;
 };
 
 // One object after preprocessing. p = vertexCount(), q = the vertices that never collapse (the
@@ -80,6 +85,9 @@ struct SimplifiedMesh {
   std::vector<std::uint32_t> indices;   // 3 per triangle, < vertices.size()
   float error = 0;                      // model units, as in ProgressiveMesh::error
   std::vector<std::uint8_t> border;     // per kept vertex: on a boundary or non-manifold edge
+  // Per input vertex: the kept vertex (index into `vertices`) it was collapsed into, through
+  // however many collapses; ~0u if that vertex is left in no triangle.
+  std::vector<std::uint32_t> representative;
 };
 
 // Collapses until at most `options.stopAtTriangles` triangles remain or nothing more may

@@ -1,9 +1,11 @@
 #include "lodforge/tiling/octree.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <numbers>
@@ -66,6 +68,60 @@ struct KeptVertices {
 using KdTree =
     nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, KeptVertices>,
                                         KeptVertices, 3, std::uint32_t>;
+
+// Flags the vertices on the outer faces of a node's cell: the planes of the leaf grid at its
+// cell's ends (a level-L cell spans 2^L leaf cells per axis), compared exactly, as cuts set them.
+std::vector<std::uint8_t> onOuterFaces(const MeshPart& mesh, const ChunkGrid& grid,
+                                       const OctreeNode& node) {
+  // Faces on the grid's own ends have no neighbour beyond them: NaN matches nothing.
+  std::array<double, 6> planes{};
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    const std::int32_t first = node.cell[a] * (1 << node.level);
+    const std::int32_t last = first + (1 << node.level);
+    planes[2 * a] = first > 0 ? grid.plane(axis, first) : std::nan("");
+    planes[2 * a + 1] = last < grid.dims[a] ? grid.plane(axis, last) : std::nan("");
+  }
+  std::vector<std::uint8_t> flags(mesh.positions.size(), 0);
+  for (std::size_t v = 0; v < flags.size(); ++v) {
+    const Vec3d& p = mesh.positions[v];
+    for (int axis = 0; axis < 3; ++axis) {
+      const auto a = static_cast<std::size_t>(axis);
+      if (p[axis] == planes[2 * a] || p[axis] == planes[2 * a + 1]) flags[v] = 1;
+    }
+  }
+  return flags;
+}
+
+// A bound on how far any input vertex is from the simplified surface, without a search: each is
+// at most its distance to the triangles around the vertex it was collapsed into (a part of that
+// surface). Every vertex is covered, where area samples could miss a rim or a spike.
+double removedVertexBound(std::span<const Vec3f> input, std::span<const Vec3f> positions,
+                          std::span<const std::uint32_t> indices,
+                          const SimplifiedMesh& simplified) {
+  // Triangles around each kept vertex (offsets into `fans`).
+  std::vector<std::uint32_t> start(positions.size() + 1, 0), fans(indices.size());
+  for (std::uint32_t v : indices) ++start[v + 1];
+  for (std::size_t v = 0; v < positions.size(); ++v) start[v + 1] += start[v];
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    fans[fill[indices[i]]++] = static_cast<std::uint32_t>(i / 3);
+  double worst = 0;
+  for (std::size_t v = 0; v < input.size(); ++v) {
+    const std::uint32_t r = simplified.representative[v];
+    if (r == ~0u || simplified.vertices[r] == v) continue;  // unused, or kept
+    double best = std::numeric_limits<double>::max();
+    for (std::uint32_t i = start[r]; i < start[r + 1]; ++i) {
+      const std::size_t t = 3 * std::size_t{fans[i]};
+      best = std::min(
+          best, pointTriangleDistanceSquared(toDouble(input[v]), toDouble(positions[indices[t]]),
+                                             toDouble(positions[indices[t + 1]]),
+                                             toDouble(positions[indices[t + 2]])));
+    }
+    if (best < std::numeric_limits<double>::max()) worst = std::max(worst, best);
+  }
+  return std::sqrt(worst);
+}
 
 struct Dropped {
   std::uint64_t segments = 0;
@@ -304,6 +360,11 @@ struct Builder {
     simplify.minNormalCos = std::cos(options.maxNormalDeviationDegrees * std::numbers::pi / 180);
     simplify.stopAtTriangles = static_cast<std::uint32_t>(std::max<double>(
         1, std::floor(options.keep * static_cast<double>(merged.triangleCount()))));
+    // Only the node's outer faces are shared with other tiles: vertices there never move. The
+    // input's own rims (and seams inside the node) may simplify, along themselves.
+    const std::vector<std::uint8_t> outer = onOuterFaces(merged, chunks.grid(), node);
+    simplify.locked = outer;
+    simplify.collapseBorders = true;
     SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
     MeshPart mesh;
     mesh.positions.resize(simplified.vertices.size());
@@ -325,15 +386,18 @@ struct Builder {
     const SurfaceDistance distance =
         surfaceDistance(simplifiedPositions, mesh.indices, positions, merged.indices,
                         options.errorSamples, seedOf(node), /*corners=*/false);
+    const double vertexError =
+        removedVertexBound(positions, simplifiedPositions, mesh.indices, simplified);
     const Dropped dropped =
         dropSmallSegments(mesh, simplified.border, simplify.stopAtTriangles, chunks.grid(), center);
     node.droppedSegments = dropped.segments;
     // The price of locking: border vertices the tile had to keep.
     node.lockedVertices = static_cast<std::uint64_t>(
         std::count(simplified.border.begin(), simplified.border.end(), 1));
-    node.geometricError = childError +
-                          std::max(distance.hausdorff, static_cast<double>(simplified.error)) +
-                          dropped.error;
+    node.geometricError =
+        childError +
+        std::max({distance.hausdorff, static_cast<double>(simplified.error), vertexError}) +
+        dropped.error;
     node.triangles = mesh.triangleCount();
     node.vertices = mesh.vertexCount();
     node.meshPath = meshPath(node);

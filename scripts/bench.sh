@@ -108,6 +108,21 @@ simplify_section() {
   fi
 }
 
+# One row of the tiles table: label, mode, then the command after `lodforge`.
+tiles_row() {
+  local label=$1 mode=$2 log=$work/time.log
+  shift 2
+  /usr/bin/time -v "$lodforge" "$@" > "$work/tiles.out" 2> "$log" || { cat "$log"; exit 1; }
+  local wall rss rate size
+  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
+  rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
+  rate=$(sed -n 's/.*(\([0-9,]*\) input triangles\/s).*/\1/p' "$work/tiles.out")
+  size=$(du -sh "$work/tiles-out" | cut -f1)
+  printf '| %-5s | %-22s | %9s | %5d MiB | %14s | %8s |\n' "$label" "$mode" "$wall" $((rss / 1024)) "$rate" "$size"
+  grep -o "left out [1-9][0-9,]* small segments" "$log" || true
+  rm -rf "$work/tiles-out"
+}
+
 tiles_section() {
   echo
   echo "== lodforge tiles: generated scans in each memory mode (the large-meshes paper's Table 2 / Fig. 10)"
@@ -115,37 +130,21 @@ tiles_section() {
   printf '|%s|%s|%s|%s|%s|%s|\n' ------- ------------------------ ----------- ----------- ---------------- ----------
   local sizes=(1M 10M)
   [[ ${BENCH_LARGE:-0} == 1 ]] && sizes+=(100M)
-  local log=$work/time.log
   for n in "${sizes[@]}"; do
     "$lodforge" -q generate scan --triangles "$n" -o "$work/tiles-scan.ply"
-    for mode in "minimal" "moderate" "moderate --threads 2" "unbounded"; do
-      local threads="" memory=$mode
-      if [[ $mode == "moderate --threads 2" ]]; then threads="--threads 2"; memory=moderate; fi
-      # shellcheck disable=SC2086
-      /usr/bin/time -v "$lodforge" $threads tiles "$work/tiles-scan.ply" -o "$work/tiles-out" \
-        --memory "$memory" > "$work/tiles.out" 2> "$log" || { cat "$log"; exit 1; }
-      local wall rss rate size
-      wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
-      rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
-      rate=$(sed -n 's/.*(\([0-9,]*\) input triangles\/s).*/\1/p' "$work/tiles.out")
-      size=$(du -sh "$work/tiles-out" | cut -f1)
-      printf '| %-5s | %-22s | %9s | %5d MiB | %14s | %8s |\n' "$n" "$mode" "$wall" $((rss / 1024)) "$rate" "$size"
-      rm -rf "$work/tiles-out"
+    for mode in minimal moderate unbounded; do
+      tiles_row "$n" "$mode" -v tiles "$work/tiles-scan.ply" -o "$work/tiles-out" --memory "$mode"
+      if [[ $mode == moderate ]]; then
+        tiles_row "$n" "moderate --threads 2" -v --threads 2 tiles "$work/tiles-scan.ply" \
+          -o "$work/tiles-out"
+      fi
     done
     rm -f "$work/tiles-scan.ply"
   done
   # An assembly: parts are segments (whole when small), parents leave the smallest out.
   "$lodforge" -q generate cad --objects 100K -o "$work/tiles-cad.ply"
-  /usr/bin/time -v "$lodforge" -v --threads 2 tiles "$work/tiles-cad.ply" -o "$work/tiles-out" \
-    > "$work/tiles.out" 2> "$log" || { cat "$log"; exit 1; }
-  local wall rss rate size
-  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
-  rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
-  rate=$(sed -n 's/.*(\([0-9,]*\) input triangles\/s).*/\1/p' "$work/tiles.out")
-  size=$(du -sh "$work/tiles-out" | cut -f1)
-  printf '| %-5s | %-22s | %9s | %5d MiB | %14s | %8s |\n' "cad" "moderate --threads 2" "$wall" $((rss / 1024)) "$rate" "$size"
-  grep -o "left out [0-9,]* small segments" "$log" || true
-  rm -rf "$work/tiles-out" "$work/tiles-cad.ply"
+  tiles_row cad "moderate --threads 2" -v --threads 2 tiles "$work/tiles-cad.ply" -o "$work/tiles-out"
+  rm -f "$work/tiles-cad.ply"
 }
 if [[ ${BENCH_ONLY:-} == tiles ]]; then tiles_section; exit 0; fi
 

@@ -20,21 +20,30 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Every chunk's welded mesh, as sorted position triples (order-free comparison).
-std::vector<std::array<double, 9>> contents(const ChunkWriter& chunks) {
-  std::vector<std::array<double, 9>> out;
+using Triangle = std::array<double, 9>;
+
+// Every chunk's welded mesh as position triples, each with the chunk it is in.
+std::vector<std::pair<Triangle, std::uint64_t>> chunkTriangles(const ChunkWriter& chunks) {
+  std::vector<std::pair<Triangle, std::uint64_t>> out;
   for (const auto& [index, count] : chunks.triangleCounts()) {
     Result<MeshPart> mesh = chunks.load(cellOfIndex(chunks.grid(), index));
     EXPECT_TRUE(mesh.ok());
     for (std::size_t t = 0; t < mesh->indices.size(); t += 3) {
-      std::array<double, 9> tri{};
+      Triangle tri{};
       for (std::size_t k = 0; k < 3; ++k) {
         const Vec3d p = mesh->positions[mesh->indices[t + k]];
         tri[3 * k] = p.x, tri[3 * k + 1] = p.y, tri[3 * k + 2] = p.z;
       }
-      out.push_back(tri);
+      out.emplace_back(tri, index);
     }
   }
+  return out;
+}
+
+// Sorted, without the chunks (order-free comparison).
+std::vector<Triangle> contents(const ChunkWriter& chunks) {
+  std::vector<Triangle> out;
+  for (const auto& [tri, index] : chunkTriangles(chunks)) out.push_back(tri);
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -143,24 +152,6 @@ TEST(ChunkInput, KeptInMemoryEqualsWrittenToDisk) {
   EXPECT_EQ(contents(*disk->chunks), contents(*memory->chunks));
 }
 
-// Every chunk's triangles as position triples, with the chunk each is in.
-std::map<std::array<double, 9>, std::uint64_t> chunkOfTriangle(const ChunkWriter& chunks) {
-  std::map<std::array<double, 9>, std::uint64_t> out;
-  for (const auto& [index, count] : chunks.triangleCounts()) {
-    Result<MeshPart> mesh = chunks.load(cellOfIndex(chunks.grid(), index));
-    EXPECT_TRUE(mesh.ok());
-    for (std::size_t t = 0; t < mesh->indices.size(); t += 3) {
-      std::array<double, 9> tri{};
-      for (std::size_t k = 0; k < 3; ++k) {
-        const Vec3d p = mesh->positions[mesh->indices[t + k]];
-        tri[3 * k] = p.x, tri[3 * k + 1] = p.y, tri[3 * k + 2] = p.z;
-      }
-      out[tri] = index;
-    }
-  }
-  return out;
-}
-
 TEST(ChunkInput, SmallSegmentsStayWholeAndLargeOnesAreCut) {
   // A generated assembly, loaded whole (GLB: segments are the parts' connected components) and
   // streamed (PLY with object ids: segments are the objects). Every part smaller than a chunk
@@ -179,7 +170,8 @@ TEST(ChunkInput, SmallSegmentsStayWholeAndLargeOnesAreCut) {
     Result<ChunkInput> input = chunkInput(dir.file(name), options);
     ASSERT_TRUE(input.ok()) << input.error().message;
     EXPECT_EQ(input->streamed, name == "cad.ply");
-    const auto chunkOf = chunkOfTriangle(*input->chunks);
+    std::map<Triangle, std::uint64_t> chunkOf;
+    for (const auto& [tri, index] : chunkTriangles(*input->chunks)) chunkOf[tri] = index;
     std::size_t small = 0, large = 0;
     for (std::size_t o = 0; o < model->objectCount(); ++o) {
       const Aabb bounds = computeBounds(model->objectPositions(o));
@@ -191,7 +183,7 @@ TEST(ChunkInput, SmallSegmentsStayWholeAndLargeOnesAreCut) {
       std::set<std::uint64_t> chunks;
       const auto indices = model->objectIndices(o);
       for (std::size_t t = 0; t < indices.size(); t += 3) {
-        std::array<double, 9> tri{};
+        Triangle tri{};
         for (std::size_t k = 0; k < 3; ++k) {
           const Vec3d p = model->origin + toDouble(model->objectPositions(o)[indices[t + k]]);
           tri[3 * k] = p.x, tri[3 * k + 1] = p.y, tri[3 * k + 2] = p.z;

@@ -182,6 +182,21 @@ std::set<Vec3d, bool (*)(const Vec3d&, const Vec3d&)> endsOf(
   return ends;
 }
 
+// 40 random mixes of levels, each assembled and checked for edges off the rim.
+void expectNoCracks(const Built& built,
+                    const std::set<Vec3d, bool (*)(const Vec3d&, const Vec3d&)>& rim,
+                    std::uint64_t seed, const std::string& what) {
+  Random random(seed);
+  for (int mix = 0; mix < 40; ++mix) {
+    std::vector<std::uint32_t> selected;
+    randomMix(built, built.tree.root, random, selected);
+    std::vector<MeshPart> parts;
+    for (std::uint32_t s : selected) parts.push_back(built.meshes.at(s));
+    EXPECT_EQ(edgesOffTheRim(boundaryEdges(concatenate(parts)), rim), 0u)
+        << what << ", mix " << mix << " of " << selected.size() << " tiles";
+  }
+}
+
 TEST(Octree, AnyMixOfLevelsHasNoBoundaryTheInputDidNotHave) {
   OctreeOptions options;
   options.errorSamples = 2000;
@@ -205,17 +220,7 @@ TEST(Octree, AnyMixOfLevelsHasNoBoundaryTheInputDidNotHave) {
         EXPECT_TRUE(p.x == 1000 || p.x == 1120 || p.y == 2000 || p.y == 2120) << p.x << " " << p.y;
       }
     }
-    const auto rim = endsOf(finest);
-    Random random(open ? 7 : 8);
-    for (int mix = 0; mix < 40; ++mix) {
-      std::vector<std::uint32_t> selected;
-      randomMix(built, built.tree.root, random, selected);
-      std::vector<MeshPart> parts;
-      for (std::uint32_t s : selected) parts.push_back(built.meshes.at(s));
-      EXPECT_EQ(edgesOffTheRim(boundaryEdges(concatenate(parts)), rim), 0u)
-          << (open ? "heightfield" : "horse") << ", mix " << mix << " of " << selected.size()
-          << " tiles";
-    }
+    expectNoCracks(built, endsOf(finest), open ? 7 : 8, open ? "heightfield" : "horse");
     // The rim simplifies too (only the tiles' outer faces are locked): the root keeps few of it.
     const std::size_t rootRim = boundaryEdges(built.meshes.at(built.tree.root)).size();
     if (open) {
@@ -311,16 +316,7 @@ TEST(Octree, SmallSegmentsLeaveCoarseTilesWithinTheErrorAndWithoutCracks) {
   std::vector<MeshPart> leaves;
   for (const auto& [index, mesh] : built.meshes)
     if (built.tree.nodes[index].level == 0) leaves.push_back(mesh);
-  const auto rim = endsOf(boundaryEdges(concatenate(leaves)));
-  Random random(11);
-  for (int mix = 0; mix < 40; ++mix) {
-    std::vector<std::uint32_t> selected;
-    randomMix(built, built.tree.root, random, selected);
-    std::vector<MeshPart> parts;
-    for (std::uint32_t s : selected) parts.push_back(built.meshes.at(s));
-    EXPECT_EQ(edgesOffTheRim(boundaryEdges(concatenate(parts)), rim), 0u)
-        << "mix " << mix << " of " << selected.size() << " tiles";
-  }
+  expectNoCracks(built, endsOf(boundaryEdges(concatenate(leaves))), 11, "cubes");
 }
 
 TEST(Octree, LevelsOptionStopsBelowTheRootWithAContentlessRoot) {

@@ -44,15 +44,6 @@ std::uint64_t seedOf(const OctreeNode& node) {
   return seed;
 }
 
-// Whether p lies on a grid plane: every cut vertex does (its coordinate is set to the plane's).
-bool onGridPlane(const ChunkGrid& grid, Vec3d p) {
-  for (int axis = 0; axis < 3; ++axis) {
-    const double k = std::round((p[axis] - grid.origin[axis]) / grid.size);
-    if (std::abs(k) < 1e9 && grid.plane(axis, static_cast<std::int32_t>(k)) == p[axis]) return true;
-  }
-  return false;
-}
-
 // The kept vertices for nanoflann's k-d tree.
 struct KeptVertices {
   const std::vector<Vec3f>& points;
@@ -129,13 +120,14 @@ struct Dropped {
 };
 
 // Whole segments too small to matter at this level: a CAD part that cannot simplify further (a
-// closed tube at the normal limit, a plate whose holes are locked borders) would otherwise keep
-// every parent above its target. When the simplified mesh is over its target, its connected
-// components that have no vertex on a grid plane — so no neighbouring tile meets them — go,
-// smallest first, until the target is met or one component is left.
-// `border` (a flag per vertex) is compacted with the mesh.
-Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border, std::uint64_t target,
-                          const ChunkGrid& grid, Vec3d center) {
+// closed tube at the normal limit, a sheet's corners) would otherwise keep every parent above
+// its target. When the simplified mesh is over its target, its connected components with no
+// vertex on the node's outer faces (`shared`) — so no neighbouring tile meets them — go,
+// smallest first, until the target is met or one component is left. `border` (a flag per
+// vertex) is compacted with the mesh.
+Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border,
+                          std::span<const std::uint8_t> shared, std::uint64_t target,
+                          Vec3d center) {
   if (mesh.triangleCount() <= target) return {};
   std::vector<std::uint32_t> component(mesh.triangleCount());
   const std::uint32_t count = connectedComponents(mesh.vertexCount(), mesh.indices, component);
@@ -147,7 +139,7 @@ Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border, std
     const std::uint32_t c = component[i / 3];
     const Vec3d& p = mesh.positions[mesh.indices[i]];
     bounds[c].add(p);
-    if (onGridPlane(grid, p)) touchesPlane[c] = 1;
+    if (shared[mesh.indices[i]] != 0) touchesPlane[c] = 1;
     if (i % 3 == 0) ++triangles[c];
   }
   std::vector<std::uint32_t> order;
@@ -388,8 +380,10 @@ struct Builder {
                         options.errorSamples, seedOf(node), /*corners=*/false);
     const double vertexError =
         removedVertexBound(positions, simplifiedPositions, mesh.indices, simplified);
+    std::vector<std::uint8_t> shared(mesh.vertexCount());
+    for (std::size_t i = 0; i < shared.size(); ++i) shared[i] = outer[simplified.vertices[i]];
     const Dropped dropped =
-        dropSmallSegments(mesh, simplified.border, simplify.stopAtTriangles, chunks.grid(), center);
+        dropSmallSegments(mesh, simplified.border, shared, simplify.stopAtTriangles, center);
     node.droppedSegments = dropped.segments;
     // The price of locking: border vertices the tile had to keep.
     node.lockedVertices = static_cast<std::uint64_t>(

@@ -77,31 +77,23 @@ struct GlbWriter::State {
     return {};
   }
 
-  // Writes one view + accessor; returns the accessor index. `stride` is one element's size;
-  // `vertices` bounds the index codec.
+  // Writes one view + accessor; returns the accessor index. `stride` is one element's size.
+  // Indices (`target` kElementArrayBuffer) come as `wideIndices`, the 32-bit values the index
+  // codec reads whatever size they decode to, with `vertices` bounding them; `data` then holds
+  // them at `stride` bytes each for the uncompressed layout (unused when compressing).
   Result<std::uint32_t> addAccessor(const void* data, std::size_t bytes, std::size_t count,
                                     int componentType, const char* type, int target,
                                     bool normalized, const nlohmann::json* min,
                                     const nlohmann::json* max, std::size_t stride,
-                                    std::size_t vertices) {
+                                    std::span<const std::uint32_t> wideIndices = {},
+                                    std::size_t vertices = 0) {
     nlohmann::json view;
     if (options.meshoptCompression) {
       const bool triangles = target == kElementArrayBuffer;
       if (triangles) {
-        // The codec reads 32-bit indices whatever size they decode to.
-        std::vector<std::uint32_t> wide(count);
-        for (std::size_t i = 0; i < count; ++i) {
-          if (stride == 2) {
-            std::uint16_t v;
-            std::memcpy(&v, static_cast<const std::byte*>(data) + 2 * i, 2);
-            wide[i] = v;
-          } else {
-            std::memcpy(&wide[i], static_cast<const std::byte*>(data) + 4 * i, 4);
-          }
-        }
         encoded.resize(meshopt_encodeIndexBufferBound(count, vertices));
         encoded.resize(meshopt_encodeIndexBuffer(reinterpret_cast<unsigned char*>(encoded.data()),
-                                                 encoded.size(), wide.data(), count));
+                                                 encoded.size(), wideIndices.data(), count));
       } else {
         encoded.resize(meshopt_encodeVertexBufferBound(count, stride));
         encoded.resize(meshopt_encodeVertexBuffer(reinterpret_cast<unsigned char*>(encoded.data()),
@@ -205,7 +197,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
     const nlohmann::json min = lo, max = hi;
     Result<std::uint32_t> position =
         s.addAccessor(grid.data(), grid.size() * 2, vertexCount, kUnsignedShort, "VEC3",
-                      kArrayBuffer, false, &min, &max, 8, vertexCount);
+                      kArrayBuffer, false, &min, &max, 8);
     if (!position) return position.status();
     attributes["POSITION"] = *position;
     s.dequantize.emplace_back(std::pair{box.min, step});
@@ -217,9 +209,8 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
         for (std::size_t a = 0; a < 3; ++a)
           packed[4 * v + a] = static_cast<std::int8_t>(std::lround(axes[a] * 127.0f));
       }
-      Result<std::uint32_t> normal =
-          s.addAccessor(packed.data(), packed.size(), vertexCount, kByte, "VEC3", kArrayBuffer,
-                        true, nullptr, nullptr, 4, vertexCount);
+      Result<std::uint32_t> normal = s.addAccessor(packed.data(), packed.size(), vertexCount, kByte,
+                                                   "VEC3", kArrayBuffer, true, nullptr, nullptr, 4);
       if (!normal) return normal.status();
       attributes["NORMAL"] = *normal;
     }
@@ -228,7 +219,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
     const nlohmann::json max = {bounds.max.x, bounds.max.y, bounds.max.z};
     Result<std::uint32_t> position =
         s.addAccessor(mesh.positions.data(), mesh.positions.size_bytes(), vertexCount, kFloat,
-                      "VEC3", kArrayBuffer, false, &min, &max, sizeof(Vec3f), vertexCount);
+                      "VEC3", kArrayBuffer, false, &min, &max, sizeof(Vec3f));
     if (!position) return position.status();
     attributes["POSITION"] = *position;
     s.dequantize.emplace_back(std::nullopt);
@@ -238,7 +229,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
       for (Vec3f& n : unit) n = normalizeOr(n, Vec3f{0, 0, 1});
       Result<std::uint32_t> normal =
           s.addAccessor(unit.data(), unit.size() * sizeof(Vec3f), vertexCount, kFloat, "VEC3",
-                        kArrayBuffer, false, nullptr, nullptr, sizeof(Vec3f), vertexCount);
+                        kArrayBuffer, false, nullptr, nullptr, sizeof(Vec3f));
       if (!normal) return normal.status();
       attributes["NORMAL"] = *normal;
     }
@@ -246,24 +237,26 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
   if (!mesh.colors.empty()) {
     Result<std::uint32_t> color =
         s.addAccessor(mesh.colors.data(), mesh.colors.size_bytes(), vertexCount, kUnsignedByte,
-                      "VEC4", kArrayBuffer, true, nullptr, nullptr, sizeof(Rgba8), vertexCount);
+                      "VEC4", kArrayBuffer, true, nullptr, nullptr, sizeof(Rgba8));
     if (!color) return color.status();
     attributes["COLOR_0"] = *color;
   }
   // 16-bit indices when they fit; 65535 itself is the primitive-restart value glTF forbids.
   Result<std::uint32_t> indices = [&]() -> Result<std::uint32_t> {
     if (vertexCount < 65535) {
-      s.scratch.resize(mesh.indices.size() * 2);
-      for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
+      // Narrowed only for the uncompressed layout (the meshopt codec takes the 32-bit ones).
+      s.scratch.resize(s.options.meshoptCompression ? 0 : mesh.indices.size() * 2);
+      for (std::size_t i = 0; i < s.scratch.size() / 2; ++i) {
         const auto v = static_cast<std::uint16_t>(mesh.indices[i]);
         std::memcpy(s.scratch.data() + 2 * i, &v, 2);
       }
-      return s.addAccessor(s.scratch.data(), s.scratch.size(), mesh.indices.size(), kUnsignedShort,
-                           "SCALAR", kElementArrayBuffer, false, nullptr, nullptr, 2, vertexCount);
+      return s.addAccessor(s.scratch.data(), mesh.indices.size() * 2, mesh.indices.size(),
+                           kUnsignedShort, "SCALAR", kElementArrayBuffer, false, nullptr, nullptr,
+                           2, mesh.indices, vertexCount);
     }
     return s.addAccessor(mesh.indices.data(), mesh.indices.size_bytes(), mesh.indices.size(),
                          kUnsignedInt, "SCALAR", kElementArrayBuffer, false, nullptr, nullptr, 4,
-                         vertexCount);
+                         mesh.indices, vertexCount);
   }();
   if (!indices) return indices.status();
 

@@ -260,9 +260,10 @@ void Simplifier::computeQuadrics() {
 void Simplifier::addBoundaryPlanes() {
   // A plane through each boundary edge, perpendicular to its face, weighted by the edge's
   // squared length (Garland & Heckbert's boundary constraint): moving a rim vertex off its rim
-  // costs as much as lifting a face.
+  // costs as much as lifting a face. Only faces with a corner on the boundary are looked at.
   for (std::uint32_t t = 0; t < triangleCount_; ++t) {
     const auto& c = corners_[t];
+    if (border_[c[0]] + border_[c[1]] + border_[c[2]] < 2) continue;
     const Vec3d n = cross(position(c[1]) - position(c[0]), position(c[2]) - position(c[0]));
     const double twiceArea = length(n);
     if (twiceArea <= 0) continue;
@@ -765,14 +766,11 @@ SimplifiedMesh Simplifier::current() const {
     }
   }
   out.error = errorAfter_.empty() ? 0.0f : errorAfter_.back();
-  // Where each removed vertex went: follow its collapses to a live vertex (targets only ever
-  // point at vertices still live when they were chosen, so the chains end).
-  out.representative.assign(vertexCount_, kNone);
-  for (std::uint32_t v = 0; v < vertexCount_; ++v) {
-    std::uint32_t r = v;
-    while (vertex_[r].removed != 0) r = target_[r];
-    out.representative[v] = remap[r];
-  }
+  // Where each removed vertex went: a collapse's target was live then, so it went later or not
+  // at all; taking the collapses last first, each removed vertex inherits its target's place.
+  out.representative = remap;
+  for (auto k = collapsed_.size(); k-- > 0;)
+    out.representative[collapsed_[k]] = out.representative[target_[collapsed_[k]]];
   return out;
 }
 

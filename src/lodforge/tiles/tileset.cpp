@@ -108,6 +108,50 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
   }
 }
 
+// The memory mode and limit (§3.4) decide threads, buffers and the leaf size.
+Status planMemory(const TilesOptions& options, ChunkInputOptions& input, OctreeOptions& octree) {
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  switch (options.memory) {
+    case TilesMemory::kMinimal:
+      octree.threads = 1;
+      input.chunkBufferBytes = std::min<std::uint64_t>(input.chunkBufferBytes, 32 << 20);
+      input.vertexCacheBytes = std::min<std::uint64_t>(input.vertexCacheBytes, 32 << 20);
+      break;
+    case TilesMemory::kModerate:
+      octree.threads = options.threads > 0 ? options.threads : std::max(1, cores / 4);
+      break;
+    case TilesMemory::kUnbounded:
+      octree.threads = options.threads > 0 ? options.threads : cores;
+      input.keepInMemory = true;
+      octree.keepInMemory = true;
+      break;
+  }
+  if (options.memoryLimit > 0) {
+    // The program itself (code, libraries, thread stacks, I/O buffers) takes about 32 MiB; of
+    // the rest a quarter goes to the chunk buffer, an eighth to the vertex cache and half to the
+    // nodes in flight (the octree lowers its parallelism to fit).
+    constexpr std::uint64_t kProgram = std::uint64_t{32} << 20;
+    if (options.memoryLimit < kProgram + (std::uint64_t{16} << 20))
+      return Error{ErrorKind::kLimit,
+                   fmt::format("--memory-limit {} MiB is too small for tiles: at least 48 MiB",
+                               options.memoryLimit >> 20)};
+    const std::uint64_t usable = options.memoryLimit - kProgram;
+    input.chunkBufferBytes = std::min(input.chunkBufferBytes, usable / 4);
+    input.vertexCacheBytes = std::min(input.vertexCacheBytes, usable / 8);
+    octree.memoryBudget = usable / 2;
+    // A parent holds about four children (eight in a volume) while it is simplified, at ~200
+    // bytes per triangle: smaller leaves when the budget cannot hold that for the default size.
+    if (input.chunkSize == 0) {
+      input.trianglesPerChunk =
+          std::clamp<std::uint64_t>(octree.memoryBudget / (4 * 200), 4096, input.trianglesPerChunk);
+    }
+    input.keepInMemory = false;
+    octree.keepInMemory = false;
+  }
+  input.threads = octree.threads;
+  return {};
+}
+
 }  // namespace
 
 std::string tileContentUri(const OctreeNode& node) {
@@ -233,49 +277,10 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
     }
   } keep{staging, work};
 
-  // The memory mode and limit decide threads and buffers.
-  const int cores = static_cast<int>(std::thread::hardware_concurrency());
   ChunkInputOptions input = options.input;
   OctreeOptions octree = options.octree;
-  switch (options.memory) {
-    case TilesMemory::kMinimal:
-      octree.threads = 1;
-      input.chunkBufferBytes = std::min<std::uint64_t>(input.chunkBufferBytes, 32 << 20);
-      input.vertexCacheBytes = std::min<std::uint64_t>(input.vertexCacheBytes, 32 << 20);
-      break;
-    case TilesMemory::kModerate:
-      octree.threads = options.threads > 0 ? options.threads : std::max(1, cores / 4);
-      break;
-    case TilesMemory::kUnbounded:
-      octree.threads = options.threads > 0 ? options.threads : cores;
-      input.keepInMemory = true;
-      octree.keepInMemory = true;
-      break;
-  }
-  if (options.memoryLimit > 0) {
-    // The program itself (code, libraries, thread stacks, I/O buffers) takes about 32 MiB; of
-    // the rest a quarter goes to the chunk buffer, an eighth to the vertex cache and half to the
-    // nodes in flight (the octree lowers its parallelism to fit).
-    constexpr std::uint64_t kProgram = std::uint64_t{32} << 20;
-    if (options.memoryLimit < kProgram + (std::uint64_t{16} << 20))
-      return Error{ErrorKind::kLimit,
-                   fmt::format("--memory-limit {} MiB is too small for tiles: at least 48 MiB",
-                               options.memoryLimit >> 20)};
-    const std::uint64_t usable = options.memoryLimit - kProgram;
-    input.chunkBufferBytes = std::min(input.chunkBufferBytes, usable / 4);
-    input.vertexCacheBytes = std::min(input.vertexCacheBytes, usable / 8);
-    octree.memoryBudget = usable / 2;
-    // A parent holds about four children (eight in a volume) while it is simplified, at ~200
-    // bytes per triangle: smaller leaves when the budget cannot hold that for the default size.
-    if (input.chunkSize == 0) {
-      input.trianglesPerChunk =
-          std::clamp<std::uint64_t>(octree.memoryBudget / (4 * 200), 4096, input.trianglesPerChunk);
-    }
-    input.keepInMemory = false;
-    octree.keepInMemory = false;
-  }
+  LODFORGE_TRY(planMemory(options, input, octree));
   stats.threads = octree.threads;
-  input.threads = octree.threads;
 
   // Georeferencing: a CRS is set up on the first input point (the local frame's origin).
   struct LazyCrs {

@@ -371,9 +371,10 @@ struct Builder {
     // Geometric error: measured against the children's geometry, plus what they already
     // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
     // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
-    // excursions, which area samples could miss, are bounded by the simplifier's own record.
-    // Measured before small segments are left out (whose cost is bounded apart: a sample near
-    // one would search far for the nearest remaining surface).
+    // excursions, which area samples could miss, are bounded by the simplifier's own record and
+    // by each one's distance to the fan it went into (removedVertexBound). Measured before small
+    // segments are left out (whose cost is bounded apart: a sample near one would search far for
+    // the nearest remaining surface).
     const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);
     const SurfaceDistance distance =
         surfaceDistance(simplifiedPositions, mesh.indices, positions, merged.indices,

@@ -133,6 +133,32 @@ TEST(FarthestDistance, EqualsTheBruteForceFarthestOfRandomPoints) {
   EXPECT_TRUE(std::isinf(farthestDistance(points, positions, {})));
 }
 
+TEST(SampledHausdorff, EqualsTheFullMeasureOnRandomSurfaces) {
+  // The early-ending searches must give exactly the maximum the full measure finds, on rough
+  // surfaces partly beside each other, with and without corner samples.
+  Random random(21);
+  for (int round = 0; round < 12; ++round) {
+    std::vector<Vec3f> pa, pb;
+    std::vector<std::uint32_t> ia, ib;
+    plane(5 + round, 4, 0, pa, ia);
+    for (Vec3f& p : pa) p.z = float(random.uniform(-0.5, 0.5));
+    plane(3 + 2 * round, 4, 0, pb, ib);
+    const double shift = random.uniform(-1, 1);
+    for (Vec3f& p : pb) {
+      p.z = float(0.3 * std::sin(3 * p.x) + random.uniform(-0.1, 0.1));
+      p.x += float(shift);
+    }
+    const bool corners = round % 2 == 0;
+    const std::uint64_t seed = 100 + static_cast<std::uint64_t>(round);
+    const SurfaceDistance full = surfaceDistance(pa, ia, pb, ib, 3000, seed, corners);
+    EXPECT_DOUBLE_EQ(sampledHausdorff(pa, ia, pb, ib, 3000, seed, corners), full.hausdorff);
+  }
+  std::vector<Vec3f> pa;
+  std::vector<std::uint32_t> ia;
+  plane(3, 1, 0, pa, ia);
+  EXPECT_TRUE(std::isinf(sampledHausdorff(pa, ia, pa, {}, 10)));
+}
+
 TEST(SurfaceDistance, CornerSamplesCatchASpikeThatAreaSamplesMiss) {
   std::vector<Vec3f> pa, pb;
   std::vector<std::uint32_t> ia, ib;

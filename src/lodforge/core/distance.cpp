@@ -85,7 +85,9 @@ class TriangleGrid {
     forEachCell([&](std::size_t cell, std::uint32_t t) { items_[counts[cell]++] = t; });
   }
 
-  double nearestSquared(Vec3d p) const {
+  // The squared distance from p to the nearest triangle, or any value not above `enough` as soon
+  // as one is found (a maximum over many queries needs nothing more from a query below it).
+  double nearestSquared(Vec3d p, double enough = -1) const {
     const int cx = clampCell(0, p.x), cy = clampCell(1, p.y), cz = clampCell(2, p.z);
     double best = std::numeric_limits<double>::max();
     const int maxRing = std::max({dims_[0], dims_[1], dims_[2]});
@@ -95,20 +97,25 @@ class TriangleGrid {
       const int y0 = std::max(cy - ring, 0), y1 = std::min(cy + ring, dims_[1] - 1);
       const int x0 = std::max(cx - ring, 0), x1 = std::min(cx + ring, dims_[0] - 1);
       const auto visit = [&](int x, int y, int z) {
+        // A cell whose box is already farther than the best triangle holds nothing closer.
+        if (boxDistanceSquared(p, x, y, z) >= best) return false;
         const std::size_t cell = index(x, y, z);
         for (std::uint32_t i = start_[cell]; i < start_[cell + 1]; ++i) {
           const std::uint32_t t = items_[i];
           best = std::min(
               best, pointTriangleDistanceSquared(p, corner(t, 0), corner(t, 1), corner(t, 2)));
+          if (best <= enough) return true;
         }
+        return false;
       };
       for (int z = z0; z <= z1; ++z) {
         for (int y = y0; y <= y1; ++y) {
           if (std::abs(z - cz) == ring || std::abs(y - cy) == ring) {
-            for (int x = x0; x <= x1; ++x) visit(x, y, z);
+            for (int x = x0; x <= x1; ++x)
+              if (visit(x, y, z)) return best;
           } else {
-            if (cx - ring >= 0) visit(cx - ring, y, z);
-            if (ring > 0 && cx + ring < dims_[0]) visit(cx + ring, y, z);
+            if (cx - ring >= 0 && visit(cx - ring, y, z)) return best;
+            if (ring > 0 && cx + ring < dims_[0] && visit(cx + ring, y, z)) return best;
           }
         }
       }
@@ -130,6 +137,19 @@ class TriangleGrid {
   }
 
  private:
+  double boxDistanceSquared(Vec3d p, int x, int y, int z) const {
+    const int c[3] = {x, y, z};
+    double sum = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      // Edge cells reach out without end: they hold whatever clamping put there.
+      const double low = origin_[axis] + c[axis] * cell_;
+      const double below = c[axis] > 0 ? low - p[axis] : 0.0;
+      const double above = c[axis] < dims_[axis] - 1 ? p[axis] - (low + cell_) : 0.0;
+      const double d = std::max({below, 0.0, above});
+      sum += d * d;
+    }
+    return sum;
+  }
   Vec3d corner(std::uint32_t t, int k) const {
     return toDouble(positions_[indices_[3 * t + static_cast<std::size_t>(k)]]);
   }
@@ -209,6 +229,19 @@ struct OneSided {
   std::size_t count = 0;
 };
 
+// The largest of the points' distances to the grid's triangles (exact: a query stops early only
+// when it can no longer exceed the largest found so far).
+double farthest(const std::vector<Vec3d>& points, const TriangleGrid& grid) {
+  return std::sqrt(tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, points.size(), 1024), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double worst) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i)
+          worst = std::max(worst, grid.nearestSquared(points[i], worst));
+        return worst;
+      },
+      [](double a, double b) { return std::max(a, b); }));
+}
+
 OneSided measure(const std::vector<Vec3d>& points, const TriangleGrid& grid) {
   return tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, points.size(), 1024), OneSided{},
@@ -255,6 +288,17 @@ SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
   result.meanAB = ab.sum / static_cast<double>(std::max<std::size_t>(1, ab.count));
   result.meanBA = ba.sum / static_cast<double>(std::max<std::size_t>(1, ba.count));
   return result;
+}
+
+double sampledHausdorff(std::span<const Vec3f> positionsA, std::span<const std::uint32_t> indicesA,
+                        std::span<const Vec3f> positionsB, std::span<const std::uint32_t> indicesB,
+                        std::uint32_t samplesPerMesh, std::uint64_t seed, bool corners) {
+  if (indicesA.empty() || indicesB.empty()) return std::numeric_limits<double>::infinity();
+  const double ab = farthest(samplePoints(positionsA, indicesA, samplesPerMesh, seed, corners),
+                             TriangleGrid(positionsB, indicesB));
+  const double ba = farthest(samplePoints(positionsB, indicesB, samplesPerMesh, seed + 1, corners),
+                             TriangleGrid(positionsA, indicesA));
+  return std::max(ab, ba);
 }
 
 double farthestDistance(std::span<const Vec3f> points, std::span<const Vec3f> positions,

@@ -29,6 +29,13 @@ SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
                                 std::uint32_t samplesPerMesh = 100'000, std::uint64_t seed = 1,
                                 bool corners = true);
 
+// surfaceDistance's Hausdorff distance alone (the same samples and value), faster: a sample's
+// search ends as soon as it cannot exceed the largest distance found so far.
+double sampledHausdorff(std::span<const Vec3f> positionsA, std::span<const std::uint32_t> indicesA,
+                        std::span<const Vec3f> positionsB, std::span<const std::uint32_t> indicesB,
+                        std::uint32_t samplesPerMesh = 100'000, std::uint64_t seed = 1,
+                        bool corners = true);
+
 // The largest exact distance from any of `points` to the surface (one-sided; infinity when the
 // surface has no triangles).
 double farthestDistance(std::span<const Vec3f> points, std::span<const Vec3f> positions,

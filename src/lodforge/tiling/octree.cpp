@@ -102,7 +102,8 @@ double removedVertexBound(std::span<const Vec3f> input, std::span<const Vec3f> p
     const std::uint32_t r = simplified.representative[v];
     if (r == ~0u || simplified.vertices[r] == v) continue;  // unused, or kept
     double best = std::numeric_limits<double>::max();
-    for (std::uint32_t i = start[r]; i < start[r + 1]; ++i) {
+    for (std::uint32_t i = start[r]; i < start[r + 1] && best > worst; ++i) {
+      // (A vertex already within `worst` of the fan cannot raise it: its search ends there.)
       const std::size_t t = 3 * std::size_t{fans[i]};
       best = std::min(
           best, pointTriangleDistanceSquared(toDouble(input[v]), toDouble(positions[indices[t]]),
@@ -376,9 +377,9 @@ struct Builder {
     // segments are left out (whose cost is bounded apart: a sample near one would search far for
     // the nearest remaining surface).
     const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);
-    const SurfaceDistance distance =
-        surfaceDistance(simplifiedPositions, mesh.indices, positions, merged.indices,
-                        options.errorSamples, seedOf(node), /*corners=*/false);
+    const double sampled =
+        sampledHausdorff(simplifiedPositions, mesh.indices, positions, merged.indices,
+                         options.errorSamples, seedOf(node), /*corners=*/false);
     const double vertexError =
         removedVertexBound(positions, simplifiedPositions, mesh.indices, simplified);
     std::vector<std::uint8_t> shared(mesh.vertexCount());
@@ -389,10 +390,9 @@ struct Builder {
     // The price of locking: border vertices the tile had to keep.
     node.lockedVertices = static_cast<std::uint64_t>(
         std::count(simplified.border.begin(), simplified.border.end(), 1));
-    node.geometricError =
-        childError +
-        std::max({distance.hausdorff, static_cast<double>(simplified.error), vertexError}) +
-        dropped.error;
+    node.geometricError = childError +
+                          std::max({sampled, static_cast<double>(simplified.error), vertexError}) +
+                          dropped.error;
     node.triangles = mesh.triangleCount();
     node.vertices = mesh.vertexCount();
     node.meshPath = meshPath(node);

@@ -42,5 +42,6 @@ void addCompare(CLI::App& app, const Global& global, Run& run);
 void addRender(CLI::App& app, const Global& global, Run& run);
 void addView(CLI::App& app, const Global& global, Run& run);
 void addTiles(CLI::App& app, const Global& global, Run& run);
+void addPoints(CLI::App& app, const Global& global, Run& run);
 
 }  // namespace lodforge::cli

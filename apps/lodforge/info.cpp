@@ -10,8 +10,11 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
+#include "lodforge/io/las_reader.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
+#include "lodforge/io/point_reader.h"
+#include "lodforge/points/cloud_file.h"
 #include "lodforge/simplify/package.h"
 
 namespace lodforge::cli {
@@ -179,6 +182,126 @@ Status describePackage(const std::string& path, bool json) {
   return {};
 }
 
+// A point file: a LAS header as it stands (nothing else is read); text files are streamed to
+// count their points and find their bounds.
+Status describePointFile(const std::string& path, bool json) {
+  Result<std::uint64_t> bytes = fileSize(path);
+  if (!bytes) return bytes.status();
+  nlohmann::json j = {{"file", path}, {"fileBytes", *bytes}};
+  Aabbd bounds;
+  std::uint64_t count = 0;
+  if (fileExtension(path) == "las" || fileExtension(path) == "laz") {
+    Result<LasReader> las = LasReader::open(path);
+    if (!las) return las.status();
+    const LasHeader& h = las->header();
+    j["format"] = "LAS";
+    j["version"] = fmt::format("{}.{}", h.versionMajor, h.versionMinor);
+    j["pointFormat"] = h.pointFormat;
+    j["recordLength"] = h.recordLength;
+    j["scale"] = {h.scale.x, h.scale.y, h.scale.z};
+    j["offset"] = {h.offset.x, h.offset.y, h.offset.z};
+    j["colors"] = h.hasColors;
+    if (h.hasColors) j["colorBits"] = h.eightBitColors ? 8 : 16;
+    j["crs"] = h.crs;
+    j["software"] = h.generatingSoftware;
+    count = h.pointCount;
+    bounds = h.bounds;
+  } else {
+    Result<PointReader> reader = PointReader::open(path);
+    if (!reader) return reader.status();
+    j["format"] = reader->info().format;
+    j["normals"] = reader->info().hasNormals;
+    j["colors"] = reader->info().hasColors;
+    PointBatch batch;
+    Progress progress("reading", *bytes, Progress::Unit::kBytes);
+    while (true) {
+      LODFORGE_TRY(checkCancelled());
+      Result<bool> more = reader->next(batch);
+      if (!more) return more.status();
+      if (!*more) break;
+      for (const Vec3d& p : batch.positions) bounds.add(p);
+      count += batch.size();
+    }
+  }
+  j["points"] = count;
+  if (!bounds.empty())
+    j["bounds"] = {{"min", {bounds.min.x, bounds.min.y, bounds.min.z}},
+                   {"max", {bounds.max.x, bounds.max.y, bounds.max.z}}};
+  if (json) {
+    fmt::print("{}\n", j.dump(2));
+    return {};
+  }
+  fmt::print("file       {}\n", path);
+  if (j.contains("version")) {
+    fmt::print("format     LAS {}, point format {} ({}-byte records{}) ({})\n",
+               j["version"].get<std::string>(), j["pointFormat"].get<int>(),
+               j["recordLength"].get<int>(),
+               j["colors"].get<bool>() ? fmt::format(", {}-bit colours", j["colorBits"].get<int>())
+                                       : std::string(),
+               formatBytes(*bytes));
+    fmt::print("scale      {:.6g} {:.6g} {:.6g}, offset {:.10g} {:.10g} {:.10g}\n",
+               j["scale"][0].get<double>(), j["scale"][1].get<double>(),
+               j["scale"][2].get<double>(), j["offset"][0].get<double>(),
+               j["offset"][1].get<double>(), j["offset"][2].get<double>());
+  } else {
+    fmt::print("format     {} ({})\n", j["format"].get<std::string>(), formatBytes(*bytes));
+  }
+  fmt::print("points     {}\n", formatCount(count));
+  if (!bounds.empty())
+    fmt::print("bounds     min ({:.10g}, {:.10g}, {:.10g})  max ({:.10g}, {:.10g}, {:.10g})\n",
+               bounds.min.x, bounds.min.y, bounds.min.z, bounds.max.x, bounds.max.y, bounds.max.z);
+  const std::string crs = j.value("crs", std::string());
+  if (j.contains("crs"))
+    fmt::print("crs        {}\n", crs.empty()        ? std::string("none stated")
+                                  : crs.size() > 100 ? crs.substr(0, 97) + "..."
+                                                     : crs);
+  return {};
+}
+
+// A point package (.lfc): blocks, LOD parts and the tolerance that cut them.
+Status describeCloud(const std::string& path, bool json) {
+  Result<CloudFile> cloud = CloudFile::open(path);
+  if (!cloud) return cloud.status();
+  const CloudHeader& h = cloud->header();
+  std::uint64_t smallest = h.pointCount, largest = 0;
+  for (const CloudBlock& b : cloud->blocks()) {
+    smallest = std::min(smallest, b.pointCount);
+    largest = std::max(largest, b.pointCount);
+  }
+  if (json) {
+    nlohmann::json j = {{"file", path},
+                        {"format", "lodforge point package"},
+                        {"version", h.version},
+                        {"points", h.pointCount},
+                        {"blocks", h.blockCount},
+                        {"blockPoints", {smallest, largest}},
+                        {"partI", h.droppedCount},
+                        {"partII", h.residentCount},
+                        {"partIII", h.segmentCount},
+                        {"tolerance", h.tolerance},
+                        {"crs", cloud->crs()},
+                        {"bounds",
+                         {{"min", {h.bounds.min.x, h.bounds.min.y, h.bounds.min.z}},
+                          {"max", {h.bounds.max.x, h.bounds.max.y, h.bounds.max.z}}}}};
+    fmt::print("{}\n", j.dump(2));
+    return {};
+  }
+  fmt::print("file       {}\n", path);
+  fmt::print("format     lodforge point package v{}\n", h.version);
+  fmt::print("points     {}\n", formatCount(h.pointCount));
+  fmt::print("blocks     {} ({} to {} points)\n", formatCount(h.blockCount), formatCount(smallest),
+             formatCount(largest));
+  fmt::print(
+      "LOD        tolerance {:.6g}: Part II {} nodes in memory, Part III {} in segment "
+      "files, Part I {} dropped\n",
+      h.tolerance, formatCount(h.residentCount), formatCount(h.segmentCount),
+      formatCount(h.droppedCount));
+  fmt::print("bounds     min ({:.10g}, {:.10g}, {:.10g})  max ({:.10g}, {:.10g}, {:.10g})\n",
+             h.bounds.min.x, h.bounds.min.y, h.bounds.min.z, h.bounds.max.x, h.bounds.max.y,
+             h.bounds.max.z);
+  return {};
+}
+
 }  // namespace
 
 void addInfo(CLI::App& app, const Global& global, Run& run) {
@@ -189,7 +312,10 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("info", "Print a file's format, counts, bounds and load cost");
-  sub->add_option("FILE", options->path, "A .ply .obj .stl .gltf .glb model or a .lfp package")
+  sub->add_option(
+         "FILE", options->path,
+         "A .ply .obj .stl .gltf .glb model, a .las .xyz .txt .csv .pts point file, or a .lfp "
+         "or .lfc package")
       ->required();
   sub->add_flag("--json", options->json, "Print JSON instead of text");
   sub->add_flag("--salvage", options->salvage,
@@ -198,6 +324,8 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
     run = [&global, options]() -> Status {
       if (fileExtension(options->path) == "lfp")
         return describePackage(options->path, options->json);
+      if (fileExtension(options->path) == "lfc") return describeCloud(options->path, options->json);
+      if (isPointCloudPath(options->path)) return describePointFile(options->path, options->json);
       const FileFormat format = formatFromPath(options->path);
       if (format == FileFormat::kUnknown)
         return Error{ErrorKind::kUsage,

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   cli::addBuild(app, global, run);
   cli::addExtract(app, global, run);
   cli::addTiles(app, global, run);
+  cli::addPoints(app, global, run);
   cli::addGenerate(app, global, run);
   cli::addBench(app, global, run);
   cli::addCompare(app, global, run);

@@ -1,0 +1,327 @@
+#include "lodforge/io/las_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <optional>
+
+namespace lodforge {
+
+namespace {
+
+// Public header block: where each field sits (LAS 1.4 R15, Table 3; earlier versions are
+// prefixes of it).
+constexpr std::size_t kHeader12 = 227, kHeader13 = 235, kHeader14 = 375;
+constexpr std::size_t kVlrHeader = 54, kEvlrHeader = 60;
+constexpr std::uint16_t kWktRecord = 2112, kGeoKeyRecord = 34735;
+constexpr std::uint16_t kProjectedCsKey = 3072, kGeographicKey = 2048, kUserDefined = 32767;
+constexpr std::size_t kColorProbe = 1 << 16;  // points looked at to tell 8- from 16-bit colours
+
+template <class T>
+T load(const std::byte* at) {
+  T value;
+  std::memcpy(&value, at, sizeof value);
+  return value;
+}
+
+std::string fixedString(const std::byte* at, std::size_t size) {
+  std::string s(reinterpret_cast<const char*>(at), size);
+  s.erase(std::find(s.begin(), s.end(), '\0'), s.end());
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+// Where a format keeps red, green, blue (three uint16), 0 when it has no colour.
+std::size_t colorOffset(int format) {
+  switch (format) {
+    case 2:
+      return 20;
+    case 3:
+    case 5:
+      return 28;
+    case 7:
+    case 8:
+    case 10:
+      return 30;
+    default:
+      return 0;
+  }
+}
+
+// "EPSG:N" from a GeoKeyDirectoryTag: the projected system, else the geographic one.
+std::string epsgFromGeoKeys(std::span<const std::uint16_t> keys) {
+  if (keys.size() < 4) return {};
+  const std::size_t count = std::min<std::size_t>(keys[3], (keys.size() - 4) / 4);
+  std::uint16_t projected = 0, geographic = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::uint16_t id = keys[4 + 4 * k], location = keys[5 + 4 * k], value = keys[7 + 4 * k];
+    if (location != 0 || value == 0 || value == kUserDefined) continue;  // not a plain code
+    if (id == kProjectedCsKey) projected = value;
+    if (id == kGeographicKey) geographic = value;
+  }
+  const std::uint16_t code = projected != 0 ? projected : geographic;
+  return code != 0 ? fmt::format("EPSG:{}", code) : std::string{};
+}
+
+}  // namespace
+
+std::uint16_t lasRecordSize(int pointFormat) {
+  static constexpr std::uint16_t kSizes[] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+  return pointFormat >= 0 && pointFormat <= 10 ? kSizes[pointFormat] : 0;
+}
+
+struct LasReader::State {
+  std::string path;                   // to open a second reader for the EVLRs and the probe
+  std::span<const std::byte> memory;  // or the bytes of an in-memory file
+  std::optional<ByteSource> source;
+  LasHeader header;
+  std::size_t batchSize = 1 << 16;
+  std::uint64_t nextPoint = 0;
+  std::size_t rgb = 0;
+  std::vector<std::byte> records;
+
+  Result<ByteSource> reopen() const {
+    if (!path.empty()) return ByteSource::openFile(path);
+    return ByteSource::fromMemory(memory, source->name());
+  }
+  Error fail(std::uint64_t at, std::string_view what) const {
+    return badInputAtByte(source->name(), at, what);
+  }
+};
+
+LasReader::LasReader(std::unique_ptr<State> state) : state_(std::move(state)) {}
+LasReader::LasReader(LasReader&&) noexcept = default;
+LasReader& LasReader::operator=(LasReader&&) noexcept = default;
+LasReader::~LasReader() = default;
+
+const LasHeader& LasReader::header() const {
+  return state_->header;
+}
+
+Result<LasReader> LasReader::open(const std::string& path, std::size_t batchSize) {
+  Result<ByteSource> source = ByteSource::openFile(path);
+  if (!source) return source.status();
+  auto state = std::make_unique<State>();
+  state->path = path;
+  state->source.emplace(std::move(*source));
+  state->batchSize = std::max<std::size_t>(1, batchSize);
+  return start(std::move(state));
+}
+
+Result<LasReader> LasReader::fromMemory(std::span<const std::byte> bytes, std::string name,
+                                        std::size_t batchSize) {
+  auto state = std::make_unique<State>();
+  state->memory = bytes;
+  state->source.emplace(ByteSource::fromMemory(bytes, std::move(name)));
+  state->batchSize = std::max<std::size_t>(1, batchSize);
+  return start(std::move(state));
+}
+
+Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
+  ByteSource& source = *state->source;
+  LasHeader& h = state->header;
+  const std::uint64_t fileSize = source.size();
+  std::vector<std::byte> bytes(kHeader12);
+  if (!source.read(bytes.data(), kHeader12))
+    return state->fail(
+        0, fmt::format("{} bytes are too few for a LAS header ({} bytes)", fileSize, kHeader12));
+  if (std::memcmp(bytes.data(), "LASF", 4) != 0)
+    return state->fail(0, "not a LAS file: it does not start with \"LASF\"");
+  h.versionMajor = static_cast<int>(bytes[24]);
+  h.versionMinor = static_cast<int>(bytes[25]);
+  if (h.versionMajor != 1 || h.versionMinor > 4)
+    return state->fail(24, fmt::format("LAS version {}.{} is not supported (1.0 to 1.4 are)",
+                                       h.versionMajor, h.versionMinor));
+  h.systemIdentifier = fixedString(bytes.data() + 26, 32);
+  h.generatingSoftware = fixedString(bytes.data() + 58, 32);
+  h.headerSize = load<std::uint16_t>(bytes.data() + 94);
+  h.pointOffset = load<std::uint32_t>(bytes.data() + 96);
+  h.vlrCount = load<std::uint32_t>(bytes.data() + 100);
+  const auto formatByte = static_cast<std::uint8_t>(bytes[104]);
+  h.recordLength = load<std::uint16_t>(bytes.data() + 105);
+  h.pointCount = load<std::uint32_t>(bytes.data() + 107);
+  const std::size_t wanted = h.versionMinor >= 4   ? kHeader14
+                             : h.versionMinor == 3 ? kHeader13
+                                                   : kHeader12;
+  if (h.headerSize < wanted)
+    return state->fail(94, fmt::format("header size {} is smaller than LAS {}.{}'s {} bytes",
+                                       h.headerSize, h.versionMajor, h.versionMinor, wanted));
+  if (h.headerSize > fileSize)
+    return state->fail(94, fmt::format("header size {} runs past the end of the file ({} bytes)",
+                                       h.headerSize, fileSize));
+  bytes.resize(h.headerSize);
+  if (!source.read(bytes.data() + kHeader12, h.headerSize - kHeader12))
+    return state->fail(kHeader12, "the file ends inside the header");
+  // LASzip marks compressed files by setting the format's top bits.
+  if ((formatByte & 0xC0) != 0)
+    return state->fail(
+        104, fmt::format("LAZ (compressed) point data (point format byte {:#x}) is not "
+                         "supported; decompress it first, e.g. `pdal translate in.laz "
+                         "out.las` (Debian package pdal) or `laszip -i in.laz -o out.las`",
+                         formatByte));
+  h.pointFormat = formatByte;
+  if (lasRecordSize(h.pointFormat) == 0)
+    return state->fail(
+        104, fmt::format("point format {} is not a LAS format (0 to 10 are)", h.pointFormat));
+  if (h.recordLength < lasRecordSize(h.pointFormat))
+    return state->fail(105,
+                       fmt::format("point records of {} bytes are shorter than format {}'s {}",
+                                   h.recordLength, h.pointFormat, lasRecordSize(h.pointFormat)));
+  std::uint64_t evlrOffset = 0;
+  std::uint32_t evlrCount = 0;
+  if (h.versionMinor >= 4) {
+    evlrOffset = load<std::uint64_t>(bytes.data() + 235);
+    evlrCount = load<std::uint32_t>(bytes.data() + 243);
+    const auto count64 = load<std::uint64_t>(bytes.data() + 247);
+    if (count64 != 0) h.pointCount = count64;
+  }
+  for (int k = 0; k < 3; ++k) {
+    h.scale[k] = load<double>(bytes.data() + 131 + 8 * static_cast<std::size_t>(k));
+    h.offset[k] = load<double>(bytes.data() + 155 + 8 * static_cast<std::size_t>(k));
+    h.bounds.max[k] = load<double>(bytes.data() + 179 + 16 * static_cast<std::size_t>(k));
+    h.bounds.min[k] = load<double>(bytes.data() + 187 + 16 * static_cast<std::size_t>(k));
+    if (!std::isfinite(h.scale[k]) || h.scale[k] == 0)
+      return state->fail(
+          131 + 8 * static_cast<std::uint64_t>(k),
+          fmt::format("scale factor {} is not a finite non-zero number", h.scale[k]));
+    if (!std::isfinite(h.offset[k]))
+      return state->fail(155 + 8 * static_cast<std::uint64_t>(k), "offset is not finite");
+    if (!std::isfinite(h.bounds.min[k]) || !std::isfinite(h.bounds.max[k]))
+      return state->fail(179 + 16 * static_cast<std::uint64_t>(k), "bounds are not finite");
+  }
+  if (h.pointOffset < h.headerSize)
+    return state->fail(96, fmt::format("point data offset {} lies inside the {}-byte header",
+                                       h.pointOffset, h.headerSize));
+  const std::uint64_t pointBytes = h.pointCount * h.recordLength;
+  if (h.pointCount > (fileSize / h.recordLength) || h.pointOffset + pointBytes > fileSize)
+    return state->fail(107, fmt::format("{} points of {} bytes from byte {} run past the end of "
+                                        "the file ({} bytes)",
+                                        h.pointCount, h.recordLength, h.pointOffset, fileSize));
+
+  // Variable length records, between the header and the points.
+  std::string wkt, epsg;
+  const auto takeRecord = [&](std::uint16_t id, std::string_view user,
+                              std::span<const std::byte> data) {
+    if (user != "LASF_Projection") return;
+    if (id == kWktRecord) {
+      wkt = fixedString(data.data(), data.size());
+    } else if (id == kGeoKeyRecord) {
+      std::vector<std::uint16_t> keys(data.size() / 2);
+      std::memcpy(keys.data(), data.data(), 2 * keys.size());
+      epsg = epsgFromGeoKeys(keys);
+    }
+  };
+  std::vector<std::byte> record;
+  for (std::uint32_t v = 0; v < h.vlrCount; ++v) {
+    const std::uint64_t at = source.offset();
+    std::byte head[kVlrHeader];
+    if (at + kVlrHeader > h.pointOffset || !source.read(head, kVlrHeader))
+      return state->fail(at, fmt::format("variable length record {} of {} runs past the point "
+                                         "data at byte {}",
+                                         v + 1, h.vlrCount, h.pointOffset));
+    const auto id = load<std::uint16_t>(head + 18);
+    const auto length = load<std::uint16_t>(head + 20);
+    if (at + kVlrHeader + length > h.pointOffset)
+      return state->fail(at + 20, fmt::format("variable length record {} ({} bytes) runs past "
+                                              "the point data at byte {}",
+                                              v + 1, length, h.pointOffset));
+    record.resize(length);
+    if (!source.read(record.data(), length)) return state->fail(at, "the file ends in a record");
+    takeRecord(id, fixedString(head + 2, 16), record);
+  }
+  if (evlrCount > 0) {
+    // Extended records (LAS 1.4) follow the points; a second reader fetches them.
+    Result<ByteSource> extra = state->reopen();
+    if (!extra) return extra.status();
+    if (evlrOffset < h.pointOffset + pointBytes || !extra->skip(evlrOffset))
+      return state->fail(235, fmt::format("extended records at byte {} are not after the points "
+                                          "within the file",
+                                          evlrOffset));
+    for (std::uint32_t v = 0; v < evlrCount; ++v) {
+      const std::uint64_t at = extra->offset();
+      std::byte head[kEvlrHeader];
+      if (!extra->read(head, kEvlrHeader))
+        return state->fail(at, fmt::format("extended record {} of {} runs past the end of the "
+                                           "file",
+                                           v + 1, evlrCount));
+      const auto id = load<std::uint16_t>(head + 18);
+      const auto length = load<std::uint64_t>(head + 20);
+      if (length > extra->remaining())
+        return state->fail(at + 20, fmt::format("extended record {} ({} bytes) runs past the "
+                                                "end of the file",
+                                                v + 1, length));
+      const std::string user = fixedString(head + 2, 16);
+      if (user == "LASF_Projection" && (id == kWktRecord || id == kGeoKeyRecord) &&
+          length < (std::uint64_t{1} << 24)) {
+        record.resize(length);
+        extra->read(record.data(), record.size());
+        takeRecord(id, user, record);
+      } else {
+        extra->skip(length);
+      }
+    }
+  }
+  h.crs = !wkt.empty() ? wkt : epsg;
+  if (!source.skip(h.pointOffset - source.offset()))
+    return state->fail(source.offset(), "the file ends before the point data");
+
+  state->rgb = colorOffset(h.pointFormat);
+  h.hasColors = state->rgb != 0;
+  if (h.hasColors) {
+    // 8- or 16-bit colours: the first points tell.
+    Result<ByteSource> probe = state->reopen();
+    if (!probe) return probe.status();
+    probe->skip(h.pointOffset);
+    const std::uint64_t count = std::min<std::uint64_t>(h.pointCount, kColorProbe);
+    std::uint16_t largest = 0;
+    std::vector<std::byte> buffer(h.recordLength);
+    for (std::uint64_t i = 0; i < count && probe->read(buffer.data(), buffer.size()); ++i) {
+      for (std::size_t c = 0; c < 3; ++c)
+        largest = std::max(largest, load<std::uint16_t>(buffer.data() + state->rgb + 2 * c));
+    }
+    h.eightBitColors = largest <= 255;
+  }
+  return LasReader(std::move(state));
+} catch (const ErrorException& e) {
+  return e.error;
+}
+
+Result<bool> LasReader::next(PointBatch& batch) try {
+  State& s = *state_;
+  const LasHeader& h = s.header;
+  batch.clear();
+  batch.first = s.nextPoint;
+  if (s.nextPoint >= h.pointCount) return false;
+  const std::size_t count =
+      static_cast<std::size_t>(std::min<std::uint64_t>(s.batchSize, h.pointCount - s.nextPoint));
+  s.records.resize(count * h.recordLength);
+  const std::uint64_t at = s.source->offset();
+  if (!s.source->read(s.records.data(), s.records.size()))
+    return s.fail(at, fmt::format("the file ends inside point {}", s.nextPoint));
+  batch.positions.resize(count);
+  if (h.hasColors) batch.colors.resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::byte* r = s.records.data() + i * h.recordLength;
+    Vec3d& p = batch.positions[i];
+    for (int k = 0; k < 3; ++k) {
+      // Double precision: scale 0.01 at offset 6e5 keeps the centimetres exactly as written.
+      p[k] = static_cast<double>(load<std::int32_t>(r + 4 * static_cast<std::size_t>(k))) *
+                 h.scale[k] +
+             h.offset[k];
+    }
+    if (h.hasColors) {
+      std::uint16_t rgb[3];
+      std::memcpy(rgb, r + s.rgb, sizeof rgb);
+      const int shift = h.eightBitColors ? 0 : 8;
+      batch.colors[i] = {static_cast<std::uint8_t>(std::min(255, rgb[0] >> shift)),
+                         static_cast<std::uint8_t>(std::min(255, rgb[1] >> shift)),
+                         static_cast<std::uint8_t>(std::min(255, rgb[2] >> shift)), 255};
+    }
+  }
+  s.nextPoint += count;
+  return true;
+} catch (const ErrorException& e) {
+  return e.error;
+}
+
+}  // namespace lodforge

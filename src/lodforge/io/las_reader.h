@@ -1,0 +1,62 @@
+// LAS reader (ASPRS LAS 1.0–1.4, point formats 0–10, uncompressed): the header, the variable
+// length records that carry the coordinate system (OGC WKT, or GeoTIFF keys naming an EPSG
+// code), and the points streamed in batches with scale and offset applied in double precision.
+// LAZ (compressed) files are refused with a message that says how to decompress them.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/status.h"
+#include "lodforge/io/point_batch.h"
+
+namespace lodforge {
+
+struct LasHeader {
+  int versionMajor = 1, versionMinor = 2;
+  int pointFormat = 0;
+  std::uint16_t headerSize = 0;
+  std::uint16_t recordLength = 0;  // bytes per point record (the format's size plus extra bytes)
+  std::uint32_t pointOffset = 0;   // byte where the point records start
+  std::uint32_t vlrCount = 0;
+  std::uint64_t pointCount = 0;  // the 64-bit count of LAS 1.4 where it is set
+  Vec3d scale{1, 1, 1}, offset;
+  Aabbd bounds;  // as the header states it
+  std::string systemIdentifier, generatingSoftware;
+  // Coordinate system: WKT (record 2112) when present, else "EPSG:N" from the GeoTIFF keys
+  // (projected, else geographic); empty when the file names none.
+  std::string crs;
+  bool hasColors = false;
+  // Colours are 16-bit in the spec, but many writers store 0–255: true when the first points'
+  // colours all fit in 8 bits, and then they are taken as they are.
+  bool eightBitColors = false;
+};
+
+// The smallest record of a point format (0–10), 0 for an unknown format.
+std::uint16_t lasRecordSize(int pointFormat);
+
+class LasReader {
+ public:
+  static Result<LasReader> open(const std::string& path, std::size_t batchSize = 1 << 16);
+  static Result<LasReader> fromMemory(std::span<const std::byte> bytes, std::string name,
+                                      std::size_t batchSize = 1 << 16);
+  LasReader(LasReader&&) noexcept;
+  LasReader& operator=(LasReader&&) noexcept;
+  ~LasReader();
+
+  const LasHeader& header() const;
+  // The next batch of points (positions, and colours when the format has them); false at the
+  // end of the point records.
+  Result<bool> next(PointBatch& batch);
+
+ private:
+  struct State;
+  explicit LasReader(std::unique_ptr<State> state);
+  static Result<LasReader> start(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace lodforge

@@ -1,0 +1,105 @@
+#include "lodforge/io/point_reader.h"
+
+#include <variant>
+
+#include "lodforge/core/file.h"
+#include "lodforge/io/las_reader.h"
+#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/xyz_reader.h"
+
+namespace lodforge {
+
+bool isPointCloudPath(const std::string& path) {
+  const std::string ext = fileExtension(path);
+  return ext == "las" || ext == "laz" || ext == "xyz" || ext == "txt" || ext == "csv" ||
+         ext == "pts";
+}
+
+struct PointReader::State {
+  std::variant<LasReader, PlyReader, XyzReader> reader;
+  PointCloudInfo info;
+  PlyBatch plyBatch;
+};
+
+PointReader::PointReader(std::unique_ptr<State> state) : state_(std::move(state)) {}
+PointReader::PointReader(PointReader&&) noexcept = default;
+PointReader& PointReader::operator=(PointReader&&) noexcept = default;
+PointReader::~PointReader() = default;
+
+const PointCloudInfo& PointReader::info() const {
+  return state_->info;
+}
+
+Result<PointReader> PointReader::open(const std::string& path, std::size_t batchSize) {
+  const std::string ext = fileExtension(path);
+  if (ext == "las" || ext == "laz") {
+    Result<LasReader> las = LasReader::open(path, batchSize);
+    if (!las) return las.status();
+    const LasHeader& h = las->header();
+    PointCloudInfo info;
+    info.format =
+        fmt::format("LAS {}.{}, point format {}", h.versionMajor, h.versionMinor, h.pointFormat);
+    info.count = h.pointCount;
+    info.bounds = h.bounds;
+    info.crs = h.crs;
+    info.hasColors = h.hasColors;
+    return PointReader(std::make_unique<State>(State{std::move(*las), std::move(info), {}}));
+  }
+  if (ext == "ply") {
+    PlyReadOptions options;
+    options.batchSize = batchSize;
+    options.readFaces = false;
+    Result<PlyReader> ply = PlyReader::open(path, options);
+    if (!ply) return ply.status();
+    const PlyHeader& h = ply->header();
+    PointCloudInfo info;
+    info.format = fmt::format("PLY {}", plyFormatName(h.format));
+    info.count = h.vertexCount;
+    info.hasNormals = h.hasNormals;
+    info.hasColors = h.hasColors;
+    return PointReader(std::make_unique<State>(State{std::move(*ply), std::move(info), {}}));
+  }
+  if (isPointCloudPath(path)) {
+    Result<XyzReader> xyz = XyzReader::open(path, batchSize);
+    if (!xyz) return xyz.status();
+    const XyzLayout& layout = xyz->layout();
+    PointCloudInfo info;
+    info.format = fmt::format(
+        "text, {} columns separated by {}", layout.columns,
+        layout.separator == ' ' ? std::string("spaces") : fmt::format("'{}'", layout.separator));
+    info.hasNormals = layout.normal >= 0;
+    info.hasColors = layout.red >= 0;
+    return PointReader(std::make_unique<State>(State{std::move(*xyz), std::move(info), {}}));
+  }
+  return Error{
+      ErrorKind::kUsage,
+      fmt::format("{}: not a point file (expected .las, .ply, .xyz, .txt, .csv or .pts)", path)};
+}
+
+Result<bool> PointReader::next(PointBatch& batch) {
+  State& s = *state_;
+  if (auto* ply = std::get_if<PlyReader>(&s.reader)) {
+    batch.clear();
+    while (true) {
+      Result<bool> more = ply->next(s.plyBatch);
+      if (!more || !*more) return more;
+      if (s.plyBatch.kind != PlyBatch::Kind::kVertices) continue;
+      batch.first = s.plyBatch.first;
+      batch.positions = std::move(s.plyBatch.positions);
+      batch.normals = std::move(s.plyBatch.normals);
+      batch.colors = std::move(s.plyBatch.colors);
+      return true;
+    }
+  }
+  return std::visit(
+      [&](auto& reader) -> Result<bool> {
+        if constexpr (std::is_same_v<std::decay_t<decltype(reader)>, PlyReader>) {
+          return false;  // handled above
+        } else {
+          return reader.next(batch);
+        }
+      },
+      s.reader);
+}
+
+}  // namespace lodforge

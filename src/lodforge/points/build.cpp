@@ -1,0 +1,197 @@
+#include "lodforge/points/build.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <mutex>
+#include <random>
+
+#include <tbb/parallel_for.h>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/points/cloud_file.h"
+#include "lodforge/points/partition.h"
+
+namespace lodforge {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ScopedDirectory {
+  std::string path;
+  ~ScopedDirectory() {
+    std::error_code ignored;
+    if (!path.empty()) fs::remove_all(path, ignored);
+  }
+};
+
+Result<std::vector<CloudPoint>> loadBlock(const PointBlock& block) {
+  Result<ByteSource> in = ByteSource::openFile(block.path);
+  if (!in) return in.status();
+  std::vector<CloudPoint> points(block.count);
+  if (!in->read(points.data(), points.size() * sizeof(CloudPoint)))
+    return ioError(block.path, "work file is shorter than expected");
+  return points;
+}
+
+// The automatic tolerance: the median over sample blocks of the one that keeps `share` of a
+// block's points as Part II.
+Result<double> pickTolerance(const Partition& partition, const PointsBuildOptions& options,
+                             bool hasNormals) {
+  const std::size_t samples = std::min<std::size_t>(8, partition.blocks.size());
+  std::vector<double> tolerances(samples);
+  std::vector<Status> failures(samples);
+  tbb::parallel_for(std::size_t{0}, samples, [&](std::size_t s) {
+    const PointBlock& block = partition.blocks[s * partition.blocks.size() / samples];
+    Result<std::vector<CloudPoint>> points = loadBlock(block);
+    if (!points) {
+      failures[s] = points.status();
+      return;
+    }
+    const std::vector<ClusterNode> tree =
+        clusterBlock(*points, block.centroid, hasNormals, options.cluster);
+    const auto resident = static_cast<std::size_t>(
+        std::max(1.0, options.residentShare * static_cast<double>(block.count)));
+    tolerances[s] = toleranceForResident(tree, resident);
+  });
+  for (const Status& f : failures) LODFORGE_TRY(f);
+  std::nth_element(tolerances.begin(),
+                   tolerances.begin() + static_cast<std::ptrdiff_t>(samples / 2), tolerances.end());
+  return tolerances[samples / 2];
+}
+
+}  // namespace
+
+Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::string& output,
+                                         const PointsBuildOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  PointsBuildStats stats;
+  ScopedDirectory work{options.workDirectory.empty() ? output + ".work" : options.workDirectory};
+  std::error_code error;
+  fs::remove_all(work.path, error);
+  fs::create_directories(work.path, error);
+  if (error) return ioError(work.path, error.message());
+
+  PartitionOptions partitionOptions;
+  partitionOptions.blockSize = options.blockSize;
+  partitionOptions.workDirectory = work.path;
+  if (options.memoryLimit > 0) partitionOptions.memoryBytes = options.memoryLimit / 2;
+  Result<Partition> partition = partitionPoints(input, partitionOptions);
+  if (!partition) return partition.status();
+  stats.partitionSeconds = elapsed();
+  stats.points = partition->pointCount;
+  stats.blocks = partition->blocks.size();
+  stats.streamedPasses = partition->streamedPasses;
+  stats.minBlock = stats.points;
+  for (const PointBlock& b : partition->blocks) {
+    stats.minBlock = std::min(stats.minBlock, b.count);
+    stats.maxBlock = std::max(stats.maxBlock, b.count);
+  }
+  const bool hasNormals = partition->info.hasNormals;
+  stats.estimatedNormals = !hasNormals;
+  stats.tolerance = options.tolerance;
+  if (stats.tolerance <= 0) {
+    Result<double> picked = pickTolerance(*partition, options, hasNormals);
+    if (!picked) return picked.status();
+    stats.tolerance = *picked;
+  }
+
+  // Segment files go straight into a staging directory renamed when the package is complete.
+  const std::string segments = segmentDirectoryFor(output);
+  ScopedDirectory staging{temporaryPathFor(segments)};
+  fs::create_directories(staging.path, error);
+  if (error) return ioError(staging.path, error.message());
+  const std::uint64_t buildId =
+      std::random_device{}() ^ (std::uint64_t{std::random_device{}()} << 32);
+
+  // Blocks in parallel; Part II goes to a work file in completion order, placed at the end.
+  std::vector<CloudBlock> table(partition->blocks.size());
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> residentAt(table.size());
+  Result<OutputFile> residentFile = OutputFile::create(work.path + "/resident");
+  if (!residentFile) return residentFile.status();
+  std::mutex mutex;
+  std::uint64_t residentWritten = 0;
+  Status failure;
+  Progress progress("points: blocks", stats.points);
+  tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t b) {
+    if (cancelRequested()) return;
+    const PointBlock& block = partition->blocks[b];
+    Result<std::vector<CloudPoint>> points = loadBlock(block);
+    Status status = points.status();
+    LodCut cut;
+    if (status.ok()) {
+      const std::vector<ClusterNode> tree =
+          clusterBlock(*points, block.centroid, hasNormals, options.cluster);
+      cut = cutTree(tree, static_cast<float>(stats.tolerance));
+      CloudBlock& entry = table[b];
+      entry.bounds = block.bounds;
+      entry.origin = block.centroid;
+      entry.pointCount = block.count;
+      entry.residentCount = static_cast<std::uint32_t>(cut.resident.size());
+      entry.segmentCount = static_cast<std::uint32_t>(cut.segment.size());
+      entry.maxError = tree.front().error;
+      for (const ClusterNode& n : cut.resident)
+        entry.residentError = std::max(entry.residentError, n.error);
+      status = writeSegmentFile(staging.path + "/" + segmentFileName(b), buildId, b, cut.segment);
+    }
+    std::lock_guard lock(mutex);
+    if (status.ok()) status = residentFile->writeSpan(std::span<const ClusterNode>(cut.resident));
+    if (!status.ok()) {
+      if (failure.ok()) failure = status;
+      return;
+    }
+    residentAt[b] = {residentWritten, static_cast<std::uint32_t>(cut.resident.size())};
+    residentWritten += cut.resident.size();
+    stats.residentNodes += cut.resident.size();
+    stats.segmentNodes += cut.segment.size();
+    stats.droppedNodes += cut.dropped;
+    std::error_code ignored;
+    fs::remove(block.path, ignored);
+    progress.advance(block.count);
+  });
+  LODFORGE_TRY(failure);
+  LODFORGE_TRY(checkCancelled());
+  progress.finish();
+  LODFORGE_TRY(residentFile->commit());
+
+  // Part II in block order.
+  std::vector<ClusterNode> resident;
+  resident.reserve(stats.residentNodes);
+  {
+    Result<MappedFile> mapped = MappedFile::open(work.path + "/resident");
+    if (!mapped) return mapped.status();
+    const auto* all = reinterpret_cast<const ClusterNode*>(mapped->bytes().data());
+    for (std::size_t b = 0; b < table.size(); ++b) {
+      table[b].residentFirst = resident.size();
+      resident.insert(resident.end(), all + residentAt[b].first,
+                      all + residentAt[b].first + residentAt[b].second);
+    }
+  }
+  CloudHeader header{};
+  header.flags =
+      (hasNormals ? kCloudInputNormals : 0u) | (partition->info.hasColors ? kCloudInputColors : 0u);
+  header.buildId = buildId;
+  header.pointCount = stats.points;
+  header.segmentCount = stats.segmentNodes;
+  header.droppedCount = stats.droppedNodes;
+  header.tolerance = stats.tolerance;
+  header.bounds = partition->bounds;
+  // The segment directory first, then the package that names its build: a crash between the
+  // two leaves a package that refuses the new segments (other build id), never a mix.
+  fs::remove_all(segments, error);
+  fs::rename(staging.path, segments, error);
+  if (error) return ioError(segments, error.message());
+  staging.path.clear();
+  LODFORGE_TRY(writeCloudFile(output, header, partition->info.crs, table, resident));
+  for (const auto& entry : fs::directory_iterator(segments)) stats.outputBytes += entry.file_size();
+  stats.outputBytes += fs::file_size(output);
+  stats.seconds = elapsed();
+  return stats;
+}
+
+}  // namespace lodforge

@@ -1,0 +1,39 @@
+// `lodforge points INPUT -o cloud.lfc` (points paper §4.1): partition into blocks, then per block
+// (in parallel) normals, clustering tree, LOD cut; Part II into the package, Part III into the
+// block's segment file.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "lodforge/core/status.h"
+#include "lodforge/points/cluster.h"
+
+namespace lodforge {
+
+struct PointsBuildOptions {
+  std::uint64_t blockSize = 50'000;
+  // The cut's error tolerance in metres; 0 picks the one that keeps about `residentShare` of
+  // the points as Part II nodes (the median over up to 8 sample blocks).
+  double tolerance = 0;
+  double residentShare = 1.0 / 32;
+  ClusterOptions cluster;
+  std::uint64_t memoryLimit = 0;  // bytes for the whole build, 0: 1 GiB of points when splitting
+  std::string workDirectory;      // default: beside the output
+};
+
+struct PointsBuildStats {
+  std::uint64_t points = 0, blocks = 0;
+  std::uint64_t residentNodes = 0, segmentNodes = 0, droppedNodes = 0;
+  std::uint64_t minBlock = 0, maxBlock = 0;  // points per block
+  double tolerance = 0;
+  bool estimatedNormals = false;
+  int streamedPasses = 0;
+  double seconds = 0, partitionSeconds = 0;
+  std::uint64_t outputBytes = 0;  // package and segment files
+};
+
+Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::string& output,
+                                         const PointsBuildOptions& options);
+
+}  // namespace lodforge

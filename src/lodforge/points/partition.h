@@ -1,0 +1,65 @@
+// Block partition of a point cloud (points paper §4.1, "Data partition"): split at the centroid
+// along the longest axis until every block holds at most `blockSize` points. Out-of-core: the
+// input is streamed once into a work file, nodes larger than the memory allowance are split by
+// streamed passes (each writes two files), smaller ones are split in memory; every block ends as
+// a file of CloudPoint records in the work directory.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lodforge/core/math.h"
+#include "lodforge/core/status.h"
+#include "lodforge/io/point_reader.h"
+
+namespace lodforge {
+
+// One point in the work files (40 bytes): double position, normal (zero when the input has
+// none), colour (white when it has none).
+struct CloudPoint {
+  Vec3d position;
+  Vec3f normal;
+  Rgba8 color;
+};
+static_assert(sizeof(CloudPoint) == 40);
+
+struct PartitionOptions {
+  std::uint64_t blockSize = 50'000;  // at most this many points per block
+  // Points held in memory at once while splitting (bytes); nodes above it are split by streamed
+  // passes over their files.
+  std::uint64_t memoryBytes = std::uint64_t{1} << 30;
+  std::string workDirectory;  // must exist
+};
+
+struct PointBlock {
+  std::string path;  // CloudPoint records
+  std::uint64_t count = 0;
+  Aabbd bounds;
+  Vec3d centroid;
+};
+
+struct Partition {
+  PointCloudInfo info;
+  std::vector<PointBlock> blocks;  // depth-first, lower side first
+  std::uint64_t pointCount = 0;
+  Aabbd bounds;
+  int streamedPasses = 0;  // splits done by streaming a node's file
+};
+
+// The position where a node splits and the axis (the longest of its bounds).
+struct SplitPlane {
+  int axis = 0;
+  double value = 0;
+};
+SplitPlane centroidSplit(const Aabbd& bounds, Vec3d centroid);
+
+// Reorders `points` so that those below the plane come first and returns how many they are. When
+// every point falls on one side (coincident coordinates), splits at the median along the axis
+// instead, so both sides are non-empty whenever there are two points or more.
+std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane);
+
+Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options);
+
+}  // namespace lodforge

@@ -1,0 +1,325 @@
+#include "lodforge/io/las_reader.h"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "lodforge/io/point_reader.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+using test::bytesOf;
+
+struct LasPoint {
+  std::int32_t x = 0, y = 0, z = 0;
+  std::uint16_t r = 0, g = 0, b = 0;
+};
+
+struct Record {
+  std::string user = "LASF_Projection";
+  std::uint16_t id = 0;
+  std::string data;
+};
+
+template <class T>
+void put(std::string& s, std::size_t at, T value) {
+  if (s.size() < at + sizeof value) s.resize(at + sizeof value, '\0');
+  std::memcpy(s.data() + at, &value, sizeof value);
+}
+
+// A LAS file built field by field (the layout of LAS 1.4 R15, Tables 3, 4 and 7–17).
+std::string makeLas(int minor, int format, const std::vector<LasPoint>& points,
+                    const std::vector<Record>& vlrs = {}, const std::vector<Record>& evlrs = {},
+                    Vec3d scale = {0.01, 0.01, 0.01}, Vec3d offset = {1000, 2000, 0}) {
+  const std::size_t headerSize = minor >= 4 ? 375 : minor == 3 ? 235 : 227;
+  std::string s(headerSize, '\0');
+  std::memcpy(s.data(), "LASF", 4);
+  s[24] = 1;
+  s[25] = static_cast<char>(minor);
+  std::memcpy(s.data() + 58, "lodforge test", 13);
+  put<std::uint16_t>(s, 94, static_cast<std::uint16_t>(headerSize));
+  std::size_t vlrBytes = 0;
+  for (const Record& v : vlrs) vlrBytes += 54 + v.data.size();
+  put<std::uint32_t>(s, 96, static_cast<std::uint32_t>(headerSize + vlrBytes));
+  put<std::uint32_t>(s, 100, static_cast<std::uint32_t>(vlrs.size()));
+  s[104] = static_cast<char>(format);
+  const std::uint16_t length = lasRecordSize(format);
+  put<std::uint16_t>(s, 105, length);
+  put<std::uint32_t>(s, 107, minor >= 4 ? 0u : static_cast<std::uint32_t>(points.size()));
+  for (int k = 0; k < 3; ++k) {
+    put<double>(s, 131 + 8 * static_cast<std::size_t>(k), scale[k]);
+    put<double>(s, 155 + 8 * static_cast<std::size_t>(k), offset[k]);
+    put<double>(s, 179 + 16 * static_cast<std::size_t>(k), 1e9);   // max
+    put<double>(s, 187 + 16 * static_cast<std::size_t>(k), -1e9);  // min
+  }
+  for (const Record& v : vlrs) {
+    std::string head(54, '\0');
+    std::memcpy(head.data() + 2, v.user.data(), std::min<std::size_t>(16, v.user.size()));
+    put<std::uint16_t>(head, 18, v.id);
+    put<std::uint16_t>(head, 20, static_cast<std::uint16_t>(v.data.size()));
+    s += head + v.data;
+  }
+  const std::size_t colorAt = format == 2 ? 20 : format == 3 || format == 5 ? 28 : 30;
+  const bool colors =
+      format == 2 || format == 3 || format == 5 || format == 7 || format == 8 || format == 10;
+  for (const LasPoint& p : points) {
+    std::string r(length, '\0');
+    put(r, 0, p.x);
+    put(r, 4, p.y);
+    put(r, 8, p.z);
+    if (colors) {
+      put(r, colorAt, p.r);
+      put(r, colorAt + 2, p.g);
+      put(r, colorAt + 4, p.b);
+    }
+    s += r;
+  }
+  if (minor >= 4) {
+    put<std::uint64_t>(s, 235, evlrs.empty() ? 0 : s.size());
+    put<std::uint32_t>(s, 243, static_cast<std::uint32_t>(evlrs.size()));
+    put<std::uint64_t>(s, 247, points.size());
+    for (const Record& v : evlrs) {
+      std::string head(60, '\0');
+      std::memcpy(head.data() + 2, v.user.data(), std::min<std::size_t>(16, v.user.size()));
+      put<std::uint16_t>(head, 18, v.id);
+      put<std::uint64_t>(head, 20, v.data.size());
+      s += head + v.data;
+    }
+  }
+  return s;
+}
+
+std::vector<LasPoint> somePoints(std::size_t n, std::uint16_t colorScale) {
+  std::vector<LasPoint> points(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto v = static_cast<std::int32_t>(i);
+    points[i] = {v * 100 - 5000,
+                 -v * 7,
+                 v * 3 + 1,
+                 static_cast<std::uint16_t>((i % 256) * colorScale),
+                 static_cast<std::uint16_t>(((i * 7) % 256) * colorScale),
+                 static_cast<std::uint16_t>(255 * colorScale)};
+  }
+  return points;
+}
+
+std::vector<Vec3d> readAll(LasReader& reader, std::vector<Rgba8>* colors = nullptr) {
+  std::vector<Vec3d> positions;
+  PointBatch batch;
+  while (true) {
+    Result<bool> more = reader.next(batch);
+    EXPECT_TRUE(more.ok()) << (more.ok() ? "" : more.error().message);
+    if (!more.ok() || !*more) break;
+    positions.insert(positions.end(), batch.positions.begin(), batch.positions.end());
+    if (colors) colors->insert(colors->end(), batch.colors.begin(), batch.colors.end());
+  }
+  return positions;
+}
+
+TEST(LasReader, ReadsEveryVersionAndPointFormatWithScaleAndOffset) {
+  // Formats 0–10 (6–10 only in 1.4), records of each format's size, read in small batches so
+  // several batch boundaries are crossed.
+  for (int format = 0; format <= 10; ++format) {
+    for (int minor : {0, 2, 3, 4}) {
+      if (format >= 6 && minor < 4) continue;
+      if ((format == 4 || format == 5) && minor < 3) continue;
+      SCOPED_TRACE(::testing::Message() << "LAS 1." << minor << " format " << format);
+      const std::vector<LasPoint> points = somePoints(300, 257);
+      const std::string file = makeLas(minor, format, points);
+      Result<LasReader> reader = LasReader::fromMemory(bytesOf(file), "t.las", 64);
+      ASSERT_TRUE(reader.ok()) << reader.error().message;
+      EXPECT_EQ(reader->header().pointFormat, format);
+      EXPECT_EQ(reader->header().pointCount, points.size());
+      std::vector<Rgba8> colors;
+      const std::vector<Vec3d> read = readAll(*reader, &colors);
+      ASSERT_EQ(read.size(), points.size());
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        EXPECT_DOUBLE_EQ(read[i].x, points[i].x * 0.01 + 1000);
+        EXPECT_DOUBLE_EQ(read[i].y, points[i].y * 0.01 + 2000);
+        EXPECT_DOUBLE_EQ(read[i].z, points[i].z * 0.01);
+      }
+      const bool hasColors = reader->header().hasColors;
+      EXPECT_EQ(hasColors, format == 2 || format == 3 || format == 5 || format == 7 ||
+                               format == 8 || format == 10);
+      if (hasColors) {
+        ASSERT_EQ(colors.size(), points.size());
+        EXPECT_FALSE(reader->header().eightBitColors);
+        for (std::size_t i = 0; i < points.size(); ++i)
+          EXPECT_EQ(colors[i].r, points[i].r >> 8) << i;
+      }
+    }
+  }
+}
+
+TEST(LasReader, TellsEightBitColoursFromSixteen) {
+  const std::string file = makeLas(2, 3, somePoints(100, 1));
+  Result<LasReader> reader = LasReader::fromMemory(bytesOf(file), "t.las");
+  ASSERT_TRUE(reader.ok());
+  EXPECT_TRUE(reader->header().eightBitColors);
+  std::vector<Rgba8> colors;
+  readAll(*reader, &colors);
+  ASSERT_EQ(colors.size(), 100u);
+  EXPECT_EQ(colors[77].r, 77);
+  EXPECT_EQ(colors[77].g, (77 * 7) % 256);
+}
+
+TEST(LasReader, KeepsGeoScaleCoordinatesExact) {
+  // Millimetres at a UTM easting of 600 km: exact in double, as written.
+  std::vector<LasPoint> points{{123456789, 987654321, -12345}};
+  const std::string file = makeLas(2, 0, points, {}, {}, {0.001, 0.001, 0.001}, {500000, 4e6, 0});
+  Result<LasReader> reader = LasReader::fromMemory(bytesOf(file), "t.las");
+  ASSERT_TRUE(reader.ok());
+  const std::vector<Vec3d> read = readAll(*reader);
+  ASSERT_EQ(read.size(), 1u);
+  EXPECT_DOUBLE_EQ(read[0].x, 123456789 * 0.001 + 500000);
+  EXPECT_NEAR(read[0].x, 623456.789, 1e-9);
+  EXPECT_NEAR(read[0].y, 4987654.321, 1e-8);
+}
+
+TEST(LasReader, ReadsTheCoordinateSystemFromWktGeoKeysAndExtendedRecords) {
+  const std::string wkt = "PROJCS[\"WGS 84 / UTM zone 33N\"]";
+  {
+    const std::string file =
+        makeLas(2, 0, somePoints(3, 1), {{"LASF_Projection", 2112, wkt + '\0'}});
+    Result<LasReader> reader = LasReader::fromMemory(bytesOf(file), "t.las");
+    ASSERT_TRUE(reader.ok()) << reader.error().message;
+    EXPECT_EQ(reader->header().crs, wkt);
+  }
+  {
+    // GeoKeyDirectory: version 1.1.0, 2 keys: GTModelType = 1, ProjectedCSType = 32633.
+    std::string keys;
+    for (std::uint16_t v : {1, 1, 0, 2, 1024, 0, 1, 1, 3072, 0, 1, 32633}) {
+      keys.append(reinterpret_cast<const char*>(&v), 2);
+    }
+    const std::string file = makeLas(2, 1, somePoints(3, 1), {{"LASF_Projection", 34735, keys}});
+    Result<LasReader> reader = LasReader::fromMemory(bytesOf(file), "t.las");
+    ASSERT_TRUE(reader.ok()) << reader.error().message;
+    EXPECT_EQ(reader->header().crs, "EPSG:32633");
+  }
+  {
+    // LAS 1.4 keeps its WKT in an extended record after the points.
+    const std::string file = makeLas(4, 6, somePoints(5, 1), {}, {{"LASF_Projection", 2112, wkt}});
+    Result<LasReader> reader = LasReader::fromMemory(bytesOf(file), "t.las");
+    ASSERT_TRUE(reader.ok()) << reader.error().message;
+    EXPECT_EQ(reader->header().crs, wkt);
+    EXPECT_EQ(readAll(*reader).size(), 5u);
+  }
+}
+
+TEST(LasReader, ReadsTheRealAutzenAndLibLasSamples) {
+  // The header's bounds must hold every point, and the first point is as PDAL reads it.
+  Result<LasReader> autzen = LasReader::open(test::dataPath("points/autzen_trim.las"));
+  ASSERT_TRUE(autzen.ok()) << autzen.error().message;
+  const LasHeader& h = autzen->header();
+  EXPECT_EQ(h.versionMinor, 2);
+  EXPECT_EQ(h.pointFormat, 3);
+  EXPECT_EQ(h.pointCount, 110'000u);
+  EXPECT_NE(h.crs.find("Lambert_Conformal_Conic"), std::string::npos);
+  EXPECT_TRUE(h.eightBitColors);
+  std::vector<Rgba8> colors;
+  const std::vector<Vec3d> points = readAll(*autzen, &colors);
+  ASSERT_EQ(points.size(), 110'000u);
+  Aabbd bounds;
+  for (const Vec3d& p : points) bounds.add(p);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(bounds.min[k], h.bounds.min[k], 1e-6);
+    EXPECT_NEAR(bounds.max[k], h.bounds.max[k], 1e-6);
+  }
+  EXPECT_EQ(colors[0].r, 84);  // 8-bit colours taken as they are
+  Result<LasReader> sample = LasReader::open(test::dataPath("points/sample_c.las"));
+  ASSERT_TRUE(sample.ok());
+  EXPECT_FALSE(sample->header().eightBitColors);
+  std::vector<Rgba8> sampleColors;
+  EXPECT_EQ(readAll(*sample, &sampleColors).size(), 14'408u);
+  EXPECT_EQ(sampleColors[0].r, 48896 >> 8);
+}
+
+void expectBad(const std::string& file, const std::string& fragment) {
+  Result<LasReader> reader = LasReader::fromMemory(bytesOf(file), "bad.las");
+  Status status = reader.status();
+  if (reader.ok()) {
+    PointBatch batch;
+    while (status.ok()) {
+      Result<bool> more = reader->next(batch);
+      status = more.status();
+      if (more.ok() && !*more) break;
+    }
+  }
+  ASSERT_FALSE(status.ok()) << "accepted a file that should fail with: " << fragment;
+  EXPECT_EQ(status.kind(), ErrorKind::kBadInput);
+  EXPECT_NE(status.message().find("bad.las: byte "), std::string::npos) << status.message();
+  EXPECT_NE(status.message().find(fragment), std::string::npos) << status.message();
+}
+
+TEST(LasReader, RefusesBadFilesWithTheirPosition) {
+  const std::string good = makeLas(2, 3, somePoints(10, 1));
+  expectBad(good.substr(0, 100), "too few for a LAS header");
+  std::string wrong = good;
+  wrong[0] = 'X';
+  expectBad(wrong, "LASF");
+  wrong = good;
+  put<std::uint16_t>(wrong, 94, 200);
+  expectBad(wrong, "header size 200");
+  wrong = good;
+  put<std::uint32_t>(wrong, 107, 1000);
+  expectBad(wrong, "run past the end of the file");
+  expectBad(good.substr(0, good.size() - 5), "run past the end of the file");
+  wrong = good;
+  wrong[104] = 11;
+  expectBad(wrong, "point format 11");
+  wrong = good;
+  put<std::uint16_t>(wrong, 105, 20);
+  expectBad(wrong, "shorter than format 3's 34");
+  wrong = good;
+  put<double>(wrong, 139, std::nan(""));
+  expectBad(wrong, "scale factor");
+  wrong = good;
+  wrong[25] = 9;
+  expectBad(wrong, "version 1.9");
+  // A VLR longer than the space before the points.
+  std::string vlr = makeLas(2, 0, somePoints(4, 1), {{"LASF_Projection", 2112, "WKT"}});
+  put<std::uint16_t>(vlr, 227 + 20, 500);
+  expectBad(vlr, "runs past the point data");
+  vlr = makeLas(2, 0, somePoints(4, 1), {{"LASF_Projection", 2112, "WKT"}});
+  put<std::uint32_t>(vlr, 100, 3);
+  expectBad(vlr, "variable length record 2 of 3");
+  // Extended records that point beyond the file.
+  std::string evlr = makeLas(4, 6, somePoints(4, 1), {}, {{"LASF_Projection", 2112, "WKT"}});
+  put<std::uint64_t>(evlr, 235, evlr.size() + 10);
+  expectBad(evlr, "extended records");
+}
+
+TEST(LasReader, RefusesLazWithAdviceOnDecompressing) {
+  Result<LasReader> reader = LasReader::open(test::dataPath("points/autzen_trim.laz"));
+  ASSERT_FALSE(reader.ok());
+  EXPECT_EQ(reader.status().kind(), ErrorKind::kBadInput);
+  EXPECT_NE(reader.error().message.find("autzen_trim.laz: byte 104: LAZ"), std::string::npos)
+      << reader.error().message;
+  EXPECT_NE(reader.error().message.find("pdal translate"), std::string::npos);
+}
+
+TEST(PointReader, ReadsLasThroughTheCommonReader) {
+  Result<PointReader> reader = PointReader::open(test::dataPath("points/sample_c.las"));
+  ASSERT_TRUE(reader.ok());
+  EXPECT_EQ(reader->info().format, "LAS 1.2, point format 3");
+  EXPECT_EQ(reader->info().count, 14'408u);
+  EXPECT_TRUE(reader->info().hasColors);
+  EXPECT_TRUE(reader->info().crs.empty());
+  std::uint64_t count = 0;
+  PointBatch batch;
+  while (true) {
+    Result<bool> more = reader->next(batch);
+    ASSERT_TRUE(more.ok());
+    if (!*more) break;
+    count += batch.size();
+  }
+  EXPECT_EQ(count, 14'408u);
+  EXPECT_FALSE(PointReader::open("cloud.e57").ok());
+}
+
+}  // namespace
+}  // namespace lodforge

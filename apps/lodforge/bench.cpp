@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "cloud.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/threads.h"
@@ -348,7 +349,7 @@ void addBench(CLI::App& app, const Global& global, Run& run) {
   auto o = std::make_shared<BenchOptions>();
   CLI::App* sub =
       app.add_subcommand("bench", "Time LOD selection and coherent streaming along a camera path");
-  sub->add_option("PACKAGE", o->input, "A .lfp package")->required();
+  sub->add_option("PACKAGE", o->input, "A .lfp package or a .lfc point package")->required();
   sub->add_option("--path", o->path, "orbit, fly, or a camera path JSON file (docs/formats.md)")
       ->capture_default_str();
   sub->add_option("--frames", o->frames, "Frames along the path (a file's path is cut to this)")
@@ -388,8 +389,34 @@ void addBench(CLI::App& app, const Global& global, Run& run) {
                 "With --render: stream on the GPU as the paper does (only the Δ is uploaded; "
                 "reassembly and reformation in compute shaders)")
       ->needs("--render");
-  sub->callback([&global, &run, o, sub] {
+  // Point packages (.lfc): the points paper's runtime instead.
+  auto cloud = std::make_shared<CloudRunOptions>();
+  sub->add_option("--fovea", cloud->foveaRadii,
+                  "Point packages: fovea radii in pixels, one run each (default 200)")
+      ->delimiter(',');
+  sub->add_option("--foveal-splat", cloud->fovealSplat,
+                  "Point packages: largest splat in the fovea, pixels (default 2)")
+      ->check(CLI::Range(0.1, 100.0));
+  sub->add_option("--resident-blocks", cloud->residentBlocks,
+                  "Point packages: blocks kept in memory (default 8, as in the paper)")
+      ->check(CLI::Range(1, 1'000'000));
+  sub->add_option("--loads-per-frame", cloud->loadsPerFrame,
+                  "Point packages: segment files read per frame at most (default 2)")
+      ->check(CLI::Range(1, 1'000'000));
+  sub->callback([&global, &run, o, sub, cloud] {
     o->sizeGiven = sub->count("--size") > 0;
+    if (fileExtension(o->input) == "lfc") {
+      cloud->input = o->input;
+      cloud->path = o->path;
+      cloud->frames = o->frames;
+      cloud->size = o->size;
+      cloud->fovY = o->fovY;
+      cloud->render = o->render;
+      cloud->json = o->json;
+      if (cloud->foveaRadii.empty()) cloud->foveaRadii = {200};
+      run = [&global, cloud] { return runCloudBench(global, *cloud); };
+      return;
+    }
     run = [&global, o] { return runBench(global, *o); };
   });
 }

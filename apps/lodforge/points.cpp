@@ -19,6 +19,7 @@ void addPoints(CLI::App& app, const Global& global, Run& run) {
     double tolerance = 0;
     double residentShare = 1.0 / 32;
     int neighbours = 12;
+    bool salvage = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -40,6 +41,8 @@ void addPoints(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("--neighbours", options->neighbours,
                   "Neighbours for normals where the input has none (default 12)")
       ->check(CLI::Range(3, 64));
+  sub->add_flag("--salvage", options->salvage,
+                "Read a PLY cut short up to its last whole point (with a warning)");
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
       if (fileExtension(options->output) != "lfc")
@@ -51,8 +54,12 @@ void addPoints(CLI::App& app, const Global& global, Run& run) {
       build.residentShare = options->residentShare;
       build.cluster.neighbours = options->neighbours;
       build.memoryLimit = global.memoryLimit;
+      build.salvageTruncated = options->salvage;
       Result<PointsBuildStats> stats = buildPointCloud(options->input, options->output, build);
       if (!stats) return stats.status();
+      if (stats->truncation)
+        fmt::print(stderr, "lodforge: warning: {}; built from what came before\n",
+                   *stats->truncation);
       say(global,
           fmt::format("wrote {}: {} points in {} blocks, Part II {} nodes, Part III {}, {} in "
                       "{:.1f} s ({} points/s)",
@@ -63,13 +70,14 @@ void addPoints(CLI::App& app, const Global& global, Run& run) {
                                                              std::max(stats->seconds, 1e-9)))));
       detail(
           global,
-          fmt::format("tolerance {:.6g}; blocks of {} to {} points; {} streamed split passes; "
-                      "{:.1f} s to partition; normals {}; Part I {} nodes dropped; peak "
-                      "memory {}",
-                      stats->tolerance, formatCount(stats->minBlock), formatCount(stats->maxBlock),
-                      stats->streamedPasses, stats->partitionSeconds,
-                      stats->estimatedNormals ? "estimated" : "from the input",
-                      formatCount(stats->droppedNodes), formatBytes(peakRssBytes())));
+          fmt::format(
+              "tolerance {:.6g}; {} threads; blocks of {} to {} points; {} streamed split passes; "
+              "{:.1f} s to partition; normals {}; Part I {} nodes dropped; peak "
+              "memory {}",
+              stats->tolerance, stats->threads, formatCount(stats->minBlock),
+              formatCount(stats->maxBlock), stats->streamedPasses, stats->partitionSeconds,
+              stats->estimatedNormals ? "estimated" : "from the input",
+              formatCount(stats->droppedNodes), formatBytes(peakRssBytes())));
       return {};
     };
   });

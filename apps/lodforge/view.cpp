@@ -15,6 +15,8 @@
 #include <imgui.h>
 
 #include "cli.h"
+#include "cloud.h"
+#include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
@@ -313,7 +315,7 @@ Status runView(const Global& global, const ViewOptions& o) {
 void addView(CLI::App& app, const Global& global, Run& run) {
   auto o = std::make_shared<ViewOptions>();
   CLI::App* sub = app.add_subcommand("view", "Interactive viewer (needs a display; see render)");
-  sub->add_option("PACKAGE", o->input, "A .lfp package")->required();
+  sub->add_option("PACKAGE", o->input, "A .lfp package or a .lfc point package")->required();
   sub->add_option("--budget", o->budget, "Starting vertex budget: a count (3M) or a share (10%)")
       ->capture_default_str();
   sub->add_option("--size", o->size, "Window WIDTHxHEIGHT")->capture_default_str();
@@ -334,7 +336,34 @@ void addView(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("--min-t", o->minT, "Eq. 3's MinT")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  sub->callback([&global, &run, o] { run = [&global, o] { return runView(global, *o); }; });
+  auto cloud = std::make_shared<CloudRunOptions>();
+  sub->add_option("--fovea", cloud->foveaRadii, "Point packages: fovea radius in pixels")
+      ->expected(1);
+  sub->add_option("--foveal-splat", cloud->fovealSplat,
+                  "Point packages: largest splat in the fovea, pixels (default 2)")
+      ->check(CLI::Range(0.1, 100.0));
+  sub->add_option("--resident-blocks", cloud->residentBlocks,
+                  "Point packages: blocks kept in memory (default 8, as in the paper)")
+      ->check(CLI::Range(1, 1'000'000));
+  sub->add_option("--loads-per-frame", cloud->loadsPerFrame,
+                  "Point packages: segment files read per frame at most (default 2)")
+      ->check(CLI::Range(1, 1'000'000));
+  sub->callback([&global, &run, o, cloud] {
+    if (fileExtension(o->input) == "lfc") {
+      cloud->input = o->input;
+      cloud->size = o->size;
+      cloud->fovY = o->fovY;
+      cloud->play = !o->play.empty();
+      cloud->path = o->play.empty() ? "orbit" : o->play;
+      cloud->frames = o->frames;
+      cloud->stopAfter = o->stopAfter;
+      cloud->screenshot = o->screenshot;
+      if (cloud->foveaRadii.empty()) cloud->foveaRadii = {200};
+      run = [&global, cloud] { return runCloudView(global, *cloud); };
+      return;
+    }
+    run = [&global, o] { return runView(global, *o); };
+  });
 }
 
 }  // namespace lodforge::cli

@@ -334,6 +334,125 @@ TEST(CliPackage, BuildStaysUnderItsMemoryLimit) {
   EXPECT_EQ(info(dir.file("big.lfp"), dir)["objects"], 20'000u);
 }
 
+std::string glSubprocess();  // below, with the render tests
+
+TEST(CliPoints, BuildsAPackageFromLasAndInfoReportsBoth) {
+  test::TempDir dir;
+  const std::string las = test::dataPath("points/autzen_trim.las");
+  const nlohmann::json header = info(las, dir);
+  EXPECT_EQ(header["format"], "LAS");
+  EXPECT_EQ(header["version"], "1.2");
+  EXPECT_EQ(header["pointFormat"], 3);
+  EXPECT_EQ(header["points"], 110'000);
+  EXPECT_EQ(header["colorBits"], 8);
+  EXPECT_NE(header["crs"].get<std::string>().find("Lambert_Conformal_Conic"), std::string::npos);
+  EXPECT_DOUBLE_EQ(header["bounds"]["min"][0].get<double>(), 636001.76);
+  const Outcome o =
+      lodforge("-v points " + las + " -o " + dir.file("autzen.lfc") + " --block-size 20K", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("110,000 points"), std::string::npos) << o.out;
+  EXPECT_NE(o.err.find("normals estimated"), std::string::npos) << o.err;
+  const nlohmann::json cloud = info(dir.file("autzen.lfc"), dir);
+  EXPECT_EQ(cloud["points"], 110'000);
+  EXPECT_GE(cloud["blocks"].get<int>(), 110'000 / 20'000);
+  EXPECT_LE(cloud["blockPoints"][1].get<int>(), 20'000);
+  EXPECT_EQ(cloud["crs"], header["crs"]);
+  EXPECT_EQ(cloud["partI"].get<std::uint64_t>() + cloud["partII"].get<std::uint64_t>() +
+                cloud["partIII"].get<std::uint64_t>(),
+            2 * 110'000 - cloud["blocks"].get<std::uint64_t>());
+  // Text and PLY points too.
+  EXPECT_EQ(
+      lodforge("points " + test::dataPath("points/kitten.xyz") + " -o " + dir.file("k.lfc"), dir)
+          .code,
+      0);
+  EXPECT_EQ(info(dir.file("k.lfc"), dir)["points"], 5'210);
+  ASSERT_EQ(lodforge("-q generate points --points 20K -o " + dir.file("p.ply"), dir).code, 0);
+  EXPECT_EQ(lodforge("points " + dir.file("p.ply") + " -o " + dir.file("p.lfc"), dir).code, 0);
+  EXPECT_EQ(info(dir.file("p.lfc"), dir)["points"], 20'000);
+}
+
+TEST(CliPoints, BadInputIsExitCode2AndLeavesNothing) {
+  test::TempDir dir;
+  Outcome o = lodforge(
+      "points " + test::dataPath("points/autzen_trim.laz") + " -o " + dir.file("a.lfc"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("pdal translate"), std::string::npos) << o.err;
+  o = lodforge("info " + test::dataPath("points/autzen_trim.laz"), dir);
+  EXPECT_EQ(o.code, 2);
+  // A LAS cut short: its point count runs past the end.
+  std::string las = test::readFile(test::dataPath("points/sample_c.las"));
+  test::writeFile(dir.file("cut.las"), las.substr(0, 5'000));
+  o = lodforge("points " + dir.file("cut.las") + " -o " + dir.file("b.lfc"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("cut.las: byte 107"), std::string::npos) << o.err;
+  // A real PLY point set, cut short, and (read with --salvage) with a NaN normal.
+  o = lodforge("points " + test::dataPath("points/pond.0.ply") + " -o " + dir.file("c.lfc"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("pond.0.ply: byte 276"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("truncated"), std::string::npos) << o.err;
+  o = lodforge(
+      "points --salvage " + test::dataPath("points/pond.0.ply") + " -o " + dir.file("c.lfc"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("vertex 692: normal is not finite"), std::string::npos) << o.err;
+  test::writeFile(dir.file("bad.xyz"), "1 2 3\n4 5 x\n");
+  o = lodforge("points " + dir.file("bad.xyz") + " -o " + dir.file("d.lfc"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("bad.xyz:2:"), std::string::npos) << o.err;
+  EXPECT_EQ(lodforge("points " + dir.file("bad.xyz") + " -o " + dir.file("d.ply"), dir).code, 2);
+  test::writeFile(dir.file("bad.lfc"), "LFCLOUD");
+  o = lodforge("info " + dir.file("bad.lfc"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("bad.lfc"), std::string::npos) << o.err;
+  // Nothing half written.
+  for (const auto& name : test::listFolder(dir.path())) {
+    EXPECT_TRUE(name == "cut.las" || name == "bad.xyz" || name == "bad.lfc") << name;
+  }
+}
+
+TEST(CliPoints, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {
+#ifdef LODFORGE_SANITIZED
+  GTEST_SKIP() << "peak RSS means nothing under ASan; the release build checks it";
+#endif
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate points --points 3M -o " + dir.file("p.ply"), dir).code, 0);
+  constexpr std::uint64_t kLimit = 64ull << 20;
+  ASSERT_GT(std::filesystem::file_size(dir.file("p.ply")), kLimit);
+  const Finished run = waitFor(spawnLodforge(
+      {"-q", "--memory-limit", "64M", "points", dir.file("p.ply"), "-o", dir.file("p.lfc")}));
+  ASSERT_EQ(run.code, 0);
+  EXPECT_LT(run.peak, kLimit) << "peak RSS " << run.peak / (1 << 20) << " MiB";
+  EXPECT_EQ(info(dir.file("p.lfc"), dir)["points"], 3'000'000);
+}
+
+TEST(CliPoints, BenchAndViewRunTheGazeDrivenRuntime) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("points " + test::dataPath("points/autzen_trim.las") + " -o " +
+                         dir.file("a.lfc") + " --block-size 10K",
+                     dir)
+                .code,
+            0);
+  Outcome o = lodforge("bench " + dir.file("a.lfc") +
+                           " --frames 8 --size 320x240 --fovea 50,400 --resident-blocks 3 --json " +
+                           dir.file("b.json"),
+                       dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("frame time by splats drawn"), std::string::npos) << o.out;
+  const auto j = nlohmann::json::parse(test::readFile(dir.file("b.json")));
+  ASSERT_EQ(j["runs"].size(), 2u);
+  std::uint64_t small = 0, large = 0;
+  for (const auto& f : j["runs"][0]["frames"]) small += f["splats"].get<std::uint64_t>();
+  for (const auto& f : j["runs"][1]["frames"]) large += f["splats"].get<std::uint64_t>();
+  EXPECT_GT(large, small) << "a wider fovea draws more";
+  // In a window (virtual display): the screenshot shows the cloud.
+  o = lodforge("view " + dir.file("a.lfc") + " --size 320x240 --stop-after 6 --screenshot " +
+                   dir.file("v.png"),
+               dir, "xvfb-run -a -s '-screen 0 1280x1024x24' " + glSubprocess());
+  ASSERT_EQ(o.code, 0) << o.err;
+  const auto shot = readPng(dir.file("v.png"));
+  ASSERT_TRUE(shot.ok());
+  EXPECT_GT(compareImages(*shot, Image(320, 240)).shareAbove, 0.02);
+}
+
 TEST(CliTiles, WritesATilesetAndReplacesOnlyATileset) {
   test::TempDir dir;
   const std::string out = dir.file("horse-tiles");

@@ -30,7 +30,13 @@ const PointCloudInfo& PointReader::info() const {
   return state_->info;
 }
 
-Result<PointReader> PointReader::open(const std::string& path, std::size_t batchSize) {
+std::optional<std::string> PointReader::truncation() const {
+  if (const auto* ply = std::get_if<PlyReader>(&state_->reader)) return ply->truncation();
+  return std::nullopt;
+}
+
+Result<PointReader> PointReader::open(const std::string& path, std::size_t batchSize,
+                                      bool salvageTruncated) {
   const std::string ext = fileExtension(path);
   if (ext == "las" || ext == "laz") {
     Result<LasReader> las = LasReader::open(path, batchSize);
@@ -49,6 +55,7 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
     PlyReadOptions options;
     options.batchSize = batchSize;
     options.readFaces = false;
+    options.salvageTruncated = salvageTruncated;
     Result<PlyReader> ply = PlyReader::open(path, options);
     if (!ply) return ply.status();
     const PlyHeader& h = ply->header();

@@ -26,12 +26,17 @@ bool isPointCloudPath(const std::string& path);
 
 class PointReader {
  public:
-  static Result<PointReader> open(const std::string& path, std::size_t batchSize = 1 << 16);
+  // With `salvageTruncated`, a PLY cut short is read up to its last whole point (truncation()
+  // then says where it was cut); otherwise it is bad input.
+  static Result<PointReader> open(const std::string& path, std::size_t batchSize = 1 << 16,
+                                  bool salvageTruncated = false);
   PointReader(PointReader&&) noexcept;
   PointReader& operator=(PointReader&&) noexcept;
   ~PointReader();
 
   const PointCloudInfo& info() const;
+  // Where a salvaged file was cut short (after the last batch); empty if it was whole.
+  std::optional<std::string> truncation() const;
   // The next batch; false when the file is done.
   Result<bool> next(PointBatch& batch);
 

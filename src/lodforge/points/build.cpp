@@ -7,9 +7,12 @@
 #include <random>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "lodforge/core/file.h"
+#include "lodforge/core/memory.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/core/units.h"
 #include "lodforge/points/cloud_file.h"
 #include "lodforge/points/partition.h"
 
@@ -62,6 +65,40 @@ Result<double> pickTolerance(const Partition& partition, const PointsBuildOption
   return tolerances[samples / 2];
 }
 
+// What a block costs while it is built, per point: its records, the tree (two nodes per point)
+// and its ranges, the k-d tree and local copies, and the cut's copy of the tree (measured
+// ≈ 280 bytes; rounded up).
+constexpr std::uint64_t kBlockBytesPerPoint = 320;
+// Buffers of the streamed passes and the package writer.
+constexpr std::uint64_t kBufferBytes = std::uint64_t{12} << 20;
+
+struct MemoryPlan {
+  int threads = 1;
+  std::uint64_t partitionBytes = 0;  // points held in memory while splitting
+};
+
+// Under --memory-limit: what the process already holds, then the blocks in flight (as many
+// threads as fit in half of what is left), and the rest for splitting in memory.
+Result<MemoryPlan> planMemory(const PointsBuildOptions& options) {
+  MemoryPlan plan;
+  plan.threads = tbb::this_task_arena::max_concurrency();
+  plan.partitionBytes = PartitionOptions{}.memoryBytes;
+  if (options.memoryLimit == 0) return plan;
+  const std::uint64_t base = currentRssBytes() + kBufferBytes;
+  const std::uint64_t block = options.blockSize * kBlockBytesPerPoint;
+  const std::uint64_t least = base + block + 2 * options.blockSize * sizeof(CloudPoint);
+  if (options.memoryLimit < least)
+    return Error{
+        ErrorKind::kLimit,
+        fmt::format("--memory-limit {} is too small for blocks of {} points: at least {}",
+                    formatBytes(options.memoryLimit), options.blockSize, formatBytes(least))};
+  const std::uint64_t available = options.memoryLimit - base;
+  plan.threads = static_cast<int>(std::clamp<std::uint64_t>(
+      available / 2 / block, 1, static_cast<std::uint64_t>(plan.threads)));
+  plan.partitionBytes = available - static_cast<std::uint64_t>(plan.threads) * block;
+  return plan;
+}
+
 }  // namespace
 
 Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::string& output,
@@ -80,13 +117,18 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   PartitionOptions partitionOptions;
   partitionOptions.blockSize = options.blockSize;
   partitionOptions.workDirectory = work.path;
-  if (options.memoryLimit > 0) partitionOptions.memoryBytes = options.memoryLimit / 2;
+  partitionOptions.salvageTruncated = options.salvageTruncated;
+  Result<MemoryPlan> plan = planMemory(options);
+  if (!plan) return plan.status();
+  partitionOptions.memoryBytes = plan->partitionBytes;
+  stats.threads = plan->threads;
   Result<Partition> partition = partitionPoints(input, partitionOptions);
   if (!partition) return partition.status();
   stats.partitionSeconds = elapsed();
   stats.points = partition->pointCount;
   stats.blocks = partition->blocks.size();
   stats.streamedPasses = partition->streamedPasses;
+  stats.truncation = partition->truncation;
   stats.minBlock = stats.points;
   for (const PointBlock& b : partition->blocks) {
     stats.minBlock = std::min(stats.minBlock, b.count);
@@ -118,41 +160,44 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   std::uint64_t residentWritten = 0;
   Status failure;
   Progress progress("points: blocks", stats.points);
-  tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t b) {
-    if (cancelRequested()) return;
-    const PointBlock& block = partition->blocks[b];
-    Result<std::vector<CloudPoint>> points = loadBlock(block);
-    Status status = points.status();
-    LodCut cut;
-    if (status.ok()) {
-      const std::vector<ClusterNode> tree =
-          clusterBlock(*points, block.centroid, hasNormals, options.cluster);
-      cut = cutTree(tree, static_cast<float>(stats.tolerance));
-      CloudBlock& entry = table[b];
-      entry.bounds = block.bounds;
-      entry.origin = block.centroid;
-      entry.pointCount = block.count;
-      entry.residentCount = static_cast<std::uint32_t>(cut.resident.size());
-      entry.segmentCount = static_cast<std::uint32_t>(cut.segment.size());
-      entry.maxError = tree.front().error;
-      for (const ClusterNode& n : cut.resident)
-        entry.residentError = std::max(entry.residentError, n.error);
-      status = writeSegmentFile(staging.path + "/" + segmentFileName(b), buildId, b, cut.segment);
-    }
-    std::lock_guard lock(mutex);
-    if (status.ok()) status = residentFile->writeSpan(std::span<const ClusterNode>(cut.resident));
-    if (!status.ok()) {
-      if (failure.ok()) failure = status;
-      return;
-    }
-    residentAt[b] = {residentWritten, static_cast<std::uint32_t>(cut.resident.size())};
-    residentWritten += cut.resident.size();
-    stats.residentNodes += cut.resident.size();
-    stats.segmentNodes += cut.segment.size();
-    stats.droppedNodes += cut.dropped;
-    std::error_code ignored;
-    fs::remove(block.path, ignored);
-    progress.advance(block.count);
+  tbb::task_arena arena(plan->threads);
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t b) {
+      if (cancelRequested()) return;
+      const PointBlock& block = partition->blocks[b];
+      Result<std::vector<CloudPoint>> points = loadBlock(block);
+      Status status = points.status();
+      LodCut cut;
+      if (status.ok()) {
+        const std::vector<ClusterNode> tree =
+            clusterBlock(*points, block.centroid, hasNormals, options.cluster);
+        cut = cutTree(tree, static_cast<float>(stats.tolerance));
+        CloudBlock& entry = table[b];
+        entry.bounds = block.bounds;
+        entry.origin = block.centroid;
+        entry.pointCount = block.count;
+        entry.residentCount = static_cast<std::uint32_t>(cut.resident.size());
+        entry.segmentCount = static_cast<std::uint32_t>(cut.segment.size());
+        entry.maxError = tree.front().error;
+        for (const ClusterNode& n : cut.resident)
+          entry.residentError = std::max(entry.residentError, n.error);
+        status = writeSegmentFile(staging.path + "/" + segmentFileName(b), buildId, b, cut.segment);
+      }
+      std::lock_guard lock(mutex);
+      if (status.ok()) status = residentFile->writeSpan(std::span<const ClusterNode>(cut.resident));
+      if (!status.ok()) {
+        if (failure.ok()) failure = status;
+        return;
+      }
+      residentAt[b] = {residentWritten, static_cast<std::uint32_t>(cut.resident.size())};
+      residentWritten += cut.resident.size();
+      stats.residentNodes += cut.resident.size();
+      stats.segmentNodes += cut.segment.size();
+      stats.droppedNodes += cut.dropped;
+      std::error_code ignored;
+      fs::remove(block.path, ignored);
+      progress.advance(block.count);
+    });
   });
   LODFORGE_TRY(failure);
   LODFORGE_TRY(checkCancelled());

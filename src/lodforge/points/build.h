@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "lodforge/core/status.h"
@@ -18,8 +19,9 @@ struct PointsBuildOptions {
   double tolerance = 0;
   double residentShare = 1.0 / 32;
   ClusterOptions cluster;
-  std::uint64_t memoryLimit = 0;  // bytes for the whole build, 0: 1 GiB of points when splitting
+  std::uint64_t memoryLimit = 0;  // bytes for the whole build, 0: 256 MiB of points when splitting
   std::string workDirectory;      // default: beside the output
+  bool salvageTruncated = false;  // a PLY cut short: read up to its last whole point
 };
 
 struct PointsBuildStats {
@@ -28,9 +30,11 @@ struct PointsBuildStats {
   std::uint64_t minBlock = 0, maxBlock = 0;  // points per block
   double tolerance = 0;
   bool estimatedNormals = false;
+  int threads = 0;  // blocks built at once (fewer than asked when the memory limit is tight)
   int streamedPasses = 0;
   double seconds = 0, partitionSeconds = 0;
-  std::uint64_t outputBytes = 0;  // package and segment files
+  std::uint64_t outputBytes = 0;          // package and segment files
+  std::optional<std::string> truncation;  // where a salvaged input was cut short
 };
 
 Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::string& output,

@@ -55,12 +55,13 @@ Result<std::vector<CloudPoint>> readPoints(const std::string& path, std::uint64_
 }
 
 // Pass 0: the input into one work file, with its bounds and centroid.
-Result<PartNode> readInput(const std::string& input, const std::string& path,
-                           PointCloudInfo& info) {
-  Result<PointReader> reader = PointReader::open(input);
+Result<PartNode> readInput(const std::string& input, const std::string& path, bool salvage,
+                           Partition& partition) {
+  PointCloudInfo& info = partition.info;
+  Result<PointReader> reader = PointReader::open(input, 1 << 16, salvage);
   if (!reader) return reader.status();
   info = reader->info();
-  Result<OutputFile> out = OutputFile::create(path);
+  Result<OutputFile> out = OutputFile::create(path, std::size_t{1} << 20);
   if (!out) return out.status();
   Progress progress("points: reading", info.count.value_or(0));
   PointBatch batch;
@@ -85,6 +86,7 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
     LODFORGE_TRY(checkCancelled());
   }
   progress.finish();
+  partition.truncation = reader->truncation();
   LODFORGE_TRY(out->commit());
   if (stats.count == 0) return badInput(input, "the file has no points");
   return PartNode{"b", path, stats.count, stats.bounds, stats.sum};
@@ -99,13 +101,13 @@ Result<std::array<PartNode, 2>> splitStreamed(const PartNode& node, const std::s
   for (std::size_t side = 0; side < 2; ++side) {
     children[side].name = node.name + static_cast<char>('0' + side);
     children[side].path = work + "/" + children[side].name + ".points";
-    Result<OutputFile> out = OutputFile::create(children[side].path);
+    Result<OutputFile> out = OutputFile::create(children[side].path, std::size_t{1} << 20);
     if (!out) return out.status();
     outs[side].emplace(std::move(*out));
   }
   Result<ByteSource> in = ByteSource::openFile(node.path);
   if (!in) return in.status();
-  std::vector<CloudPoint> batch(1 << 16);
+  std::vector<CloudPoint> batch(1 << 14);
   std::array<std::vector<CloudPoint>, 2> sides;
   for (std::uint64_t done = 0; done < node.count;) {
     const std::size_t n =
@@ -198,7 +200,8 @@ std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane) {
 Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options) {
   assert(options.blockSize > 0 && !options.workDirectory.empty());
   Partition partition;
-  Result<PartNode> root = readInput(input, options.workDirectory + "/b.points", partition.info);
+  Result<PartNode> root =
+      readInput(input, options.workDirectory + "/b.points", options.salvageTruncated, partition);
   if (!root) return root.status();
   partition.pointCount = root->count;
   partition.bounds = root->bounds;

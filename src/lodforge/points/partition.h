@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -29,8 +30,9 @@ struct PartitionOptions {
   std::uint64_t blockSize = 50'000;  // at most this many points per block
   // Points held in memory at once while splitting (bytes); nodes above it are split by streamed
   // passes over their files.
-  std::uint64_t memoryBytes = std::uint64_t{1} << 30;
-  std::string workDirectory;  // must exist
+  std::uint64_t memoryBytes = std::uint64_t{256} << 20;
+  std::string workDirectory;      // must exist
+  bool salvageTruncated = false;  // read a PLY cut short up to its last whole point
 };
 
 struct PointBlock {
@@ -45,7 +47,8 @@ struct Partition {
   std::vector<PointBlock> blocks;  // depth-first, lower side first
   std::uint64_t pointCount = 0;
   Aabbd bounds;
-  int streamedPasses = 0;  // splits done by streaming a node's file
+  int streamedPasses = 0;                 // splits done by streaming a node's file
+  std::optional<std::string> truncation;  // where a salvaged input was cut short
 };
 
 // The position where a node splits and the axis (the longest of its bounds).

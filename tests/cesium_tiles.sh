@@ -2,7 +2,8 @@
 # Tilesets lodforge writes, loaded by CesiumJS in Debian's headless chromium from a local HTTP
 # server (tests/js/cesium-tiles.mjs): the horse georeferenced with --origin, and a generated scan
 # with meshopt-compressed contents, both with KHR_mesh_quantization (the default), and a
-# generated 2,000-part assembly (tiled by part, colours per part). Fails on any tile failure, failed request or console error,
+# generated 2,000-part assembly (tiled by part, colours per part), and a LAS point cloud placed from
+# its own coordinate system. Fails on any tile failure, failed request or console error,
 # or if the screenshot does not show the model.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
@@ -23,3 +24,6 @@ node "$here/js/cesium-tiles.mjs" "$out/scan" "$out/scan.png" --min-coverage 0.2
 "$lodforge" -q generate cad --objects 2000 --seed 5 -o "$out/cad.glb"
 "$lodforge" -q tiles "$out/cad.glb" -o "$out/cad" --origin 2.35,48.85,35
 node "$here/js/cesium-tiles.mjs" "$out/cad" "$out/cad.png" --min-coverage 0.05
+# A point cloud (refine ADD, glTF POINTS), placed on Earth from its LAS coordinate system.
+"$lodforge" -q tiles "$data/points/autzen_trim.las" -o "$out/autzen" --block-size 20K --tile-points 10K
+node "$here/js/cesium-tiles.mjs" "$out/autzen" "$out/autzen.png" --min-coverage 0.05

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every kind of GLB lodforge writes, checked by the Khronos glTF validator: conversions of the
 # real models in ../shared/data, the generated CAD assembly, a generated scan, levels extracted
-# from a progressive package, 3D Tiles contents (the horse, a scan, an assembly's package).
+# from a progressive package, 3D Tiles contents (the horse, a scan, an assembly's package, point
+# clouds from a LAS and a PLY).
 # Fails on any error.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
@@ -28,7 +29,11 @@ want=$(( $(ls "$data"/meshes | wc -l) + 6 ))
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse-tiles" --chunk-size 0.05 --no-quantization
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan-tiles" --chunk-size 60 --compress meshopt
 "$lodforge" -q tiles "$out/cad.lfp" -o "$out/cad-tiles"
+# Point tiles: a real LAS (quantised, georeferenced) and generated points, float and meshopt.
+"$lodforge" -q tiles "$data/points/autzen_trim.las" -o "$out/autzen-tiles" --block-size 20K --tile-points 10K
+"$lodforge" -q generate points --points 60K -o "$out/points.ply"
+"$lodforge" -q tiles "$out/points.ply" -o "$out/points-tiles" --block-size 10K --no-quantization --compress meshopt
 tiles=$(ls "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb | wc -l)
 [[ $tiles -ge 20 ]] || { echo "expected at least 20 tile GLBs, found $tiles" >&2; exit 1; }
 node "$here/js/validate-gltf.mjs" "$out"/*.glb "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb \
-  "$out"/cad-tiles/tiles/*.glb
+  "$out"/cad-tiles/tiles/*.glb "$out"/autzen-tiles/tiles/*.glb "$out"/points-tiles/tiles/*.glb

@@ -5,11 +5,27 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
 #include "lodforge/core/units.h"
+#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/point_reader.h"
+#include "lodforge/tiles/point_tiles.h"
 #include "lodforge/tiles/tileset.h"
 
 namespace lodforge::cli {
+
+namespace {
+
+// A point cloud: a point file by its extension, or a PLY without faces.
+bool isPointInput(const std::string& path) {
+  if (isPointCloudPath(path)) return true;
+  if (fileExtension(path) != "ply") return false;
+  Result<PlyReader> ply = PlyReader::open(path, {.salvageTruncated = true});
+  return ply.ok() && ply->header().faceCount == 0 && ply->header().vertexCount > 0;
+}
+
+}  // namespace
 
 void addTiles(CLI::App& app, const Global& global, Run& run) {
   struct Options {
@@ -23,12 +39,17 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
     std::string origin, crs;
     std::string compress = "none";
     bool noQuantization = false;
+    std::uint64_t blockSize = 50'000;
+    std::uint64_t tilePoints = 50'000;
+    bool salvage = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub =
       app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh or an assembly");
-  sub->add_option("INPUT", options->input,
-                  "A .ply .obj .stl .gltf or .glb mesh or assembly, or an .lfp package")
+  sub->add_option(
+         "INPUT", options->input,
+         "A .ply .obj .stl .gltf or .glb mesh or assembly, an .lfp package, or a point cloud "
+         "(.las .xyz .txt .csv .pts, or a PLY without faces)")
       ->required();
   sub->add_option("-o,--output", options->output, "The tileset directory to write")->required();
   sub->add_option("--chunk-size", options->chunkSize,
@@ -59,6 +80,12 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
   sub->add_flag("--no-quantization", options->noQuantization,
                 "Float positions and normals everywhere instead of KHR_mesh_quantization (16-bit "
                 "positions, 8-bit normals) in the tiles where it is invisible");
+  addCountOption(*sub, "--block-size", options->blockSize,
+                 "Point clouds: most points per leaf tile (a block of the partition; default 50K)");
+  addCountOption(*sub, "--tile-points", options->tilePoints,
+                 "Point clouds: about this many points in a tile above the blocks (default 50K)");
+  sub->add_flag("--salvage", options->salvage,
+                "Point clouds: read a PLY cut short up to its last whole point");
   sub->add_flag("--resume", options->resume,
                 "Continue an interrupted run from OUTPUT.work and OUTPUT.partial (same input and "
                 "options)");
@@ -85,6 +112,29 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
         Result<Geodetic> origin = parseOrigin(options->origin);
         if (!origin) return origin.status();
         tiles.origin = *origin;
+      }
+      if (isPointInput(options->input)) {
+        PointTilesOptions points;
+        points.blockSize = std::max<std::uint64_t>(1, options->blockSize);
+        points.tilePoints = std::max<std::uint64_t>(1, options->tilePoints);
+        points.memoryLimit = global.memoryLimit;
+        points.crs = options->crs;
+        points.origin = tiles.origin;
+        points.quantize = !options->noQuantization;
+        points.meshoptCompression = tiles.meshoptCompression;
+        points.salvageTruncated = options->salvage;
+        Result<PointTilesStats> stats = writePointTiles(options->input, options->output, points);
+        if (!stats) return stats.status();
+        say(global,
+            fmt::format("wrote {}: a point tileset of {} points in {} tiles ({} blocks, depth {}), "
+                        "{} in {:.1f} s ({} points/s){}",
+                        options->output, formatCount(stats->points), formatCount(stats->tiles),
+                        formatCount(stats->blocks), stats->depth, formatBytes(stats->outputBytes),
+                        stats->seconds,
+                        formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->points) /
+                                                               std::max(stats->seconds, 1e-9))),
+                        stats->crs.empty() ? "" : "; placed on Earth from its coordinate system"));
+        return {};
       }
       Result<TilesStats> stats = writeTiles(options->input, options->output, tiles);
       if (!stats) {

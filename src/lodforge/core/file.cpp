@@ -98,6 +98,7 @@ std::size_t ByteSource::ensure(std::size_t n) {
 }
 
 bool ByteSource::read(void* out, std::size_t n) {
+  if (n == 0) return true;  // `out` may be null (an empty vector's data)
   if (ensure(n) < n) return false;
   std::memcpy(out, data(), n);
   position_ += n;

@@ -166,7 +166,9 @@ std::uint32_t GlbWriter::addMaterial(const std::array<float, 4>& baseColor, std:
 Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_view name,
                                          std::optional<std::uint32_t> material) {
   State& s = *state_;
-  assert(!mesh.positions.empty() && !mesh.indices.empty() && mesh.indices.size() % 3 == 0);
+  assert(!mesh.positions.empty());
+  assert(mesh.points ? mesh.indices.empty()
+                     : (!mesh.indices.empty() && mesh.indices.size() % 3 == 0));
   assert(mesh.normals.empty() || mesh.normals.size() == mesh.positions.size());
   assert(mesh.colors.empty() || mesh.colors.size() == mesh.positions.size());
   const std::size_t vertexCount = mesh.positions.size();
@@ -243,6 +245,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
   }
   // 16-bit indices when they fit; 65535 itself is the primitive-restart value glTF forbids.
   Result<std::uint32_t> indices = [&]() -> Result<std::uint32_t> {
+    if (mesh.points) return 0u;  // unused
     if (vertexCount < 65535) {
       // Narrowed only for the uncompressed layout (the meshopt codec takes the 32-bit ones).
       s.scratch.resize(s.options.meshoptCompression ? 0 : mesh.indices.size() * 2);
@@ -264,8 +267,12 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
     if (!s.defaultMaterial) s.defaultMaterial = addMaterial({1, 1, 1, 1}, "default");
     material = s.defaultMaterial;
   }
-  nlohmann::json primitive = {
-      {"attributes", attributes}, {"indices", *indices}, {"mode", 4}, {"material", *material}};
+  nlohmann::json primitive = {{"attributes", attributes}, {"mode", 4}, {"material", *material}};
+  if (mesh.points) {
+    primitive["mode"] = 0;
+  } else {
+    primitive["indices"] = *indices;
+  }
   nlohmann::json entry = {{"primitives", nlohmann::json::array({primitive})}};
   if (!name.empty()) entry["name"] = std::string(name);
   s.meshes.push_back(std::move(entry));

@@ -22,11 +22,13 @@ struct GlbMeshData {
   std::span<const Vec3f> positions;
   std::span<const Vec3f> normals;          // empty or one per vertex (normalised on write)
   std::span<const Rgba8> colors;           // empty or one per vertex
-  std::span<const std::uint32_t> indices;  // 3 per triangle, < positions.size()
+  std::span<const std::uint32_t> indices;  // 3 per triangle, < positions.size(); none for points
   // KHR_mesh_quantization: positions as 16-bit integers on a grid over the mesh's box (the node
   // drawing it scales them back; error at most half a step, glbQuantizationStep), normals as
   // normalised 8-bit integers. A required extension.
   bool quantized = false;
+  // A point cloud: one POINTS primitive over the vertices (glTF mode 0), no indices.
+  bool points = false;
 };
 
 // The grid step of a quantised mesh inside `bounds`: its longest side over 65535.

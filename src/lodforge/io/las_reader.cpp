@@ -186,6 +186,11 @@ Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
           fmt::format("scale factor {} is not a finite non-zero number", h.scale[k]));
     if (!std::isfinite(h.offset[k]))
       return state->fail(155 + 8 * static_cast<std::uint64_t>(k), "offset is not finite");
+    // Every stored integer must give a finite coordinate.
+    if (!std::isfinite(std::abs(h.scale[k]) * 2147483648.0 + std::abs(h.offset[k])))
+      return state->fail(131 + 8 * static_cast<std::uint64_t>(k),
+                         fmt::format("scale factor {} and offset {} overflow a coordinate",
+                                     h.scale[k], h.offset[k]));
     if (!std::isfinite(h.bounds.min[k]) || !std::isfinite(h.bounds.max[k]))
       return state->fail(179 + 16 * static_cast<std::uint64_t>(k), "bounds are not finite");
   }
@@ -207,7 +212,7 @@ Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
       wkt = fixedString(data.data(), data.size());
     } else if (id == kGeoKeyRecord) {
       std::vector<std::uint16_t> keys(data.size() / 2);
-      std::memcpy(keys.data(), data.data(), 2 * keys.size());
+      if (!keys.empty()) std::memcpy(keys.data(), data.data(), 2 * keys.size());
       epsg = epsgFromGeoKeys(keys);
     }
   };

@@ -89,8 +89,23 @@ Status writeCloudFile(const std::string& path, CloudHeader header, const std::st
 Result<CloudFile> CloudFile::open(const std::string& path) {
   Result<MappedFile> mapped = MappedFile::open(path);
   if (!mapped) return mapped.status();
-  CloudFile cloud(std::move(*mapped));
-  const std::span<const std::byte> bytes = cloud.file_.bytes();
+  CloudFile cloud;
+  cloud.file_.emplace(std::move(*mapped));
+  cloud.bytes_ = cloud.file_->bytes();
+  cloud.path_ = path;
+  return parse(std::move(cloud));
+}
+
+Result<CloudFile> CloudFile::fromBytes(std::span<const std::byte> bytes, const std::string& name) {
+  CloudFile cloud;
+  cloud.bytes_ = bytes;
+  cloud.path_ = name;
+  return parse(std::move(cloud));
+}
+
+Result<CloudFile> CloudFile::parse(CloudFile cloud) {
+  const std::span<const std::byte> bytes = cloud.bytes_;
+  const std::string& path = cloud.path_;
   if (bytes.size() < sizeof(CloudHeader) + 8)
     return badInputAtByte(path, 0, "too short for a point package");
   std::memcpy(&cloud.header_, bytes.data(), sizeof(CloudHeader));
@@ -130,7 +145,7 @@ Result<CloudFile> CloudFile::open(const std::string& path) {
 }
 
 Result<std::vector<ClusterNode>> CloudFile::loadSegment(std::size_t block) const {
-  const std::string path = segmentDirectoryFor(file_.path()) + "/" + segmentFileName(block);
+  const std::string path = segmentDirectoryFor(path_) + "/" + segmentFileName(block);
   Result<std::string> text = readFileToString(path, std::uint64_t{1} << 34);
   if (!text) return text.status();
   const std::string& bytes = *text;
@@ -143,7 +158,7 @@ Result<std::vector<ClusterNode>> CloudFile::loadSegment(std::size_t block) const
   if (header.version != kCloudVersion) return badInputAtByte(path, 8, "unsupported version");
   if (header.buildId != header_.buildId || header.block != block)
     return badInputAtByte(path, 16,
-                          fmt::format("belongs to another build or block than {}", file_.path()));
+                          fmt::format("belongs to another build or block than {}", path_));
   const CloudBlock& entry = blocks_[block];
   if (header.count != entry.segmentCount ||
       bytes.size() != sizeof header + header.count * sizeof(ClusterNode) + 8)
@@ -153,7 +168,8 @@ Result<std::vector<ClusterNode>> CloudFile::loadSegment(std::size_t block) const
   if (checksum64({reinterpret_cast<const std::byte*>(bytes.data()), bytes.size() - 8}) != digest)
     return badInputAtByte(path, bytes.size() - 8, "checksum mismatch: the segment is corrupted");
   std::vector<ClusterNode> nodes(header.count);
-  std::memcpy(nodes.data(), bytes.data() + sizeof header, nodes.size() * sizeof(ClusterNode));
+  if (!nodes.empty())
+    std::memcpy(nodes.data(), bytes.data() + sizeof header, nodes.size() * sizeof(ClusterNode));
   bool forward = true;  // children after their parent: a walk down always ends
   for (std::size_t i = 0; i < nodes.size(); ++i)
     forward = forward && (nodes[i].leaf() || nodes[i].firstChild > i);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -63,6 +64,9 @@ std::string segmentFileName(std::uint64_t block);
 class CloudFile {
  public:
   static Result<CloudFile> open(const std::string& path);
+  // The same checks over bytes the caller keeps alive (8-byte aligned), named `name`; segment
+  // files are then looked for beside `name`.
+  static Result<CloudFile> fromBytes(std::span<const std::byte> bytes, const std::string& name);
   const CloudHeader& header() const { return header_; }
   const std::string& crs() const { return crs_; }
   std::span<const CloudBlock> blocks() const { return blocks_; }
@@ -72,11 +76,14 @@ class CloudFile {
   }
   // A block's Part III, read from its segment file and checked.
   Result<std::vector<ClusterNode>> loadSegment(std::size_t block) const;
-  const std::string& path() const { return file_.path(); }
+  const std::string& path() const { return path_; }
 
  private:
-  CloudFile(MappedFile file) : file_(std::move(file)) {}
-  MappedFile file_;
+  CloudFile() = default;
+  static Result<CloudFile> parse(CloudFile cloud);
+  std::optional<MappedFile> file_;
+  std::span<const std::byte> bytes_;
+  std::string path_;
   CloudHeader header_{};
   std::string crs_;
   std::span<const CloudBlock> blocks_;

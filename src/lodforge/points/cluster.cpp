@@ -99,7 +99,8 @@ void estimateNormals(std::span<CloudPoint> points, int neighbours) {
 }
 
 std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin, bool hasNormals,
-                                      const ClusterOptions& options) {
+                                      const ClusterOptions& options,
+                                      std::vector<std::uint32_t>* firstPoint) {
   std::vector<ClusterNode> nodes;
   if (points.empty()) return nodes;
   if (!hasNormals) estimateNormals(points, options.neighbours);
@@ -180,6 +181,10 @@ std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin
     if (!node.leaf())
       node.error =
           std::max({node.error, nodes[node.firstChild].error, nodes[node.firstChild + 1].error});
+  }
+  if (firstPoint) {
+    firstPoint->resize(nodes.size());
+    for (std::size_t i = 0; i < nodes.size(); ++i) (*firstPoint)[i] = ranges[i].begin;
   }
   return nodes;
 }

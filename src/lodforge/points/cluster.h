@@ -43,8 +43,11 @@ void estimateNormals(std::span<CloudPoint> points, int neighbours);
 // Node error E = α1·mean|(p_i − c)·n| + α2·r·mean(1 − n_i·n): the paper's distance and normal
 // terms, the second scaled by the square's radius so that E is a length (see docs/points.md).
 // Leaves are single points whose radius is half the distance to their nearest neighbour.
+// With `firstPoint`, each node's first point (its range in the reordered `points` starts
+// there; a leaf's is its point).
 std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin, bool hasNormals,
-                                      const ClusterOptions& options = {});
+                                      const ClusterOptions& options = {},
+                                      std::vector<std::uint32_t>* firstPoint = nullptr);
 
 // The cut of a tree at `tolerance` (Fig. 4): Part II is every node with error ≤ tolerance whose
 // parent's error is above it (or the root); Part I, their ancestors, is dropped; Part III, their

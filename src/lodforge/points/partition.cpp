@@ -55,10 +55,10 @@ Result<std::vector<CloudPoint>> readPoints(const std::string& path, std::uint64_
 }
 
 // Pass 0: the input into one work file, with its bounds and centroid.
-Result<PartNode> readInput(const std::string& input, const std::string& path, bool salvage,
-                           Partition& partition) {
+Result<PartNode> readInput(const std::string& input, const std::string& path,
+                           const PartitionOptions& options, Partition& partition) {
   PointCloudInfo& info = partition.info;
-  Result<PointReader> reader = PointReader::open(input, 1 << 16, salvage);
+  Result<PointReader> reader = PointReader::open(input, 1 << 16, options.salvageTruncated);
   if (!reader) return reader.status();
   info = reader->info();
   Result<OutputFile> out = OutputFile::create(path, std::size_t{1} << 20);
@@ -77,6 +77,11 @@ Result<PartNode> readInput(const std::string& input, const std::string& path, bo
       p.position = batch.positions[i];
       if (!isFinite(p.position))
         return badInput(input, fmt::format("point {}: coordinate is not finite", batch.first + i));
+      if (options.transform && !options.transform(batch.positions[i], p.position))
+        return badInput(input, fmt::format("point {} ({:.10g}, {:.10g}, {:.10g}) cannot be placed "
+                                           "on Earth from the coordinate system",
+                                           batch.first + i, batch.positions[i].x,
+                                           batch.positions[i].y, batch.positions[i].z));
       p.normal = batch.normals.empty() ? Vec3f{} : batch.normals[i];
       p.color = batch.colors.empty() ? Rgba8{} : batch.colors[i];
       stats.add(p);
@@ -200,8 +205,7 @@ std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane) {
 Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options) {
   assert(options.blockSize > 0 && !options.workDirectory.empty());
   Partition partition;
-  Result<PartNode> root =
-      readInput(input, options.workDirectory + "/b.points", options.salvageTruncated, partition);
+  Result<PartNode> root = readInput(input, options.workDirectory + "/b.points", options, partition);
   if (!root) return root.status();
   partition.pointCount = root->count;
   partition.bounds = root->bounds;
@@ -235,7 +239,10 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
   progress.finish();
   std::sort(blocks.named.begin(), blocks.named.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (auto& [name, block] : blocks.named) partition.blocks.push_back(std::move(block));
+  for (auto& [name, block] : blocks.named) {
+    block.name = name;
+    partition.blocks.push_back(std::move(block));
+  }
   return partition;
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -33,9 +34,13 @@ struct PartitionOptions {
   std::uint64_t memoryBytes = std::uint64_t{256} << 20;
   std::string workDirectory;      // must exist
   bool salvageTruncated = false;  // read a PLY cut short up to its last whole point
+  // Applied to every point as it is read (one thread): e.g. a CRS to a local frame. False
+  // refuses the point.
+  std::function<bool(Vec3d, Vec3d&)> transform;
 };
 
 struct PointBlock {
+  std::string name;  // its path in the split tree: "b", then "0" (lower side) or "1" per split
   std::string path;  // CloudPoint records
   std::uint64_t count = 0;
   Aabbd bounds;

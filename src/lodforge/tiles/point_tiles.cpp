@@ -1,0 +1,383 @@
+#include "lodforge/tiles/point_tiles.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <mutex>
+
+#include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/io/glb_writer.h"
+#include "lodforge/points/partition.h"
+
+namespace lodforge {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ScopedDirectory {
+  std::string path;
+  ~ScopedDirectory() {
+    std::error_code ignored;
+    if (!path.empty()) fs::remove_all(path, ignored);
+  }
+};
+
+// glTF is y-up, 3D Tiles z-up (as for mesh tiles).
+Vec3f toYUp(Vec3f p) {
+  return {p.x, p.z, -p.y};
+}
+Vec3d toYUp(Vec3d p) {
+  return {p.x, p.z, -p.y};
+}
+
+nlohmann::json boxOf(const Aabbd& bounds) {
+  const Vec3d c = bounds.center(), h = bounds.size() * 0.5;
+  return {{"box", {c.x, c.y, c.z, h.x, 0, 0, 0, h.y, 0, 0, 0, h.z}}};
+}
+
+Result<std::vector<CloudPoint>> loadPoints(const std::string& path, std::uint64_t first,
+                                           std::uint64_t count) {
+  Result<ByteSource> in = ByteSource::openFile(path);
+  if (!in) return in.status();
+  std::vector<CloudPoint> points(count);
+  if (!in->skip(first * sizeof(CloudPoint)) ||
+      !in->read(points.data(), points.size() * sizeof(CloudPoint)))
+    return ioError(path, "work file is shorter than expected");
+  return points;
+}
+
+int depthOf(const PointBlock& block) {
+  return static_cast<int>(block.name.size()) - 1;
+}
+
+// The clustering tree with each node's error replaced by its tile error (still monotone: both
+// the error and the radius are).
+std::vector<ClusterNode> tileErrorTree(std::vector<ClusterNode> tree) {
+  for (ClusterNode& n : tree) n.error = pointTileError(n);
+  return tree;
+}
+
+// τ_d per depth of the partition tree: a tile at depth d should hold about `tilePoints`, so the
+// cut at τ_d keeps 2^d · tilePoints of the N points (the median over up to 8 sample blocks),
+// and τ never grows with depth.
+std::vector<float> toleranceSchedule(const Partition& partition, const PointTilesOptions& options,
+                                     int maxDepth) {
+  std::vector<float> taus(static_cast<std::size_t>(maxDepth), 0);
+  if (maxDepth == 0) return taus;
+  const std::size_t samples = std::min<std::size_t>(8, partition.blocks.size());
+  std::vector<std::vector<float>> perSample(samples);
+  tbb::parallel_for(std::size_t{0}, samples, [&](std::size_t s) {
+    const PointBlock& block = partition.blocks[s * partition.blocks.size() / samples];
+    Result<std::vector<CloudPoint>> points = loadPoints(block.path, 0, block.count);
+    if (!points) return;  // the block pass reports it
+    const std::vector<ClusterNode> tree = tileErrorTree(
+        clusterBlock(*points, block.centroid, partition.info.hasNormals, options.cluster));
+    for (int d = 0; d < maxDepth; ++d) {
+      const double share = std::min(1.0, std::ldexp(static_cast<double>(options.tilePoints), d) /
+                                             static_cast<double>(partition.pointCount));
+      perSample[s].push_back(toleranceForResident(
+          tree, static_cast<std::size_t>(std::max(1.0, share * static_cast<double>(block.count)))));
+    }
+  });
+  for (int d = 0; d < maxDepth; ++d) {
+    std::vector<float> values;
+    for (const auto& v : perSample)
+      if (static_cast<int>(v.size()) > d) values.push_back(v[static_cast<std::size_t>(d)]);
+    if (values.empty()) continue;
+    std::nth_element(values.begin(),
+                     values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+    taus[static_cast<std::size_t>(d)] = values[values.size() / 2];
+    if (d > 0)
+      taus[static_cast<std::size_t>(d)] =
+          std::min(taus[static_cast<std::size_t>(d)], taus[static_cast<std::size_t>(d - 1)]);
+  }
+  return taus;
+}
+
+// One block: its points sorted by the depth of the tile that holds them (0 = the root), with
+// the count per depth.
+struct BlockTiles {
+  std::string path;
+  std::vector<std::uint64_t> counts;  // per depth 0..depthOf(block)
+  Aabbd bounds;
+  float rootError = 0;
+};
+
+Status levelBlock(const PointBlock& block, const Partition& partition,
+                  const PointTilesOptions& options, std::span<const float> taus,
+                  const std::string& path, BlockTiles& out) {
+  Result<std::vector<CloudPoint>> loaded = loadPoints(block.path, 0, block.count);
+  if (!loaded) return loaded.status();
+  std::vector<CloudPoint>& points = *loaded;
+  std::vector<std::uint32_t> firstPoint;
+  const std::vector<ClusterNode> tree = tileErrorTree(clusterBlock(
+      points, block.centroid, partition.info.hasNormals, options.cluster, &firstPoint));
+  const std::vector<std::uint32_t> reps =
+      clusterRepresentatives(tree, points, firstPoint, block.centroid);
+  const int depth = depthOf(block);
+  // The shallowest depth whose cut holds each point's node as a representative.
+  std::vector<std::uint8_t> level(points.size(), static_cast<std::uint8_t>(depth));
+  for (int d = depth - 1; d >= 0; --d) {
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+      const std::uint32_t t = stack.back();
+      stack.pop_back();
+      if (tree[t].error <= taus[static_cast<std::size_t>(d)] || tree[t].leaf()) {
+        level[reps[t]] = static_cast<std::uint8_t>(d);
+      } else {
+        stack.push_back(tree[t].firstChild);
+        stack.push_back(tree[t].firstChild + 1);
+      }
+    }
+  }
+  std::vector<std::uint32_t> order(points.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return level[a] < level[b]; });
+  std::vector<CloudPoint> sorted(points.size());
+  out.counts.assign(static_cast<std::size_t>(depth) + 1, 0);
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    sorted[i] = points[order[i]];
+    ++out.counts[level[order[i]]];
+    out.bounds.add(sorted[i].position);
+  }
+  out.path = path;
+  out.rootError = tree.front().error;
+  Result<OutputFile> file = OutputFile::create(path, std::size_t{1} << 20);
+  if (!file) return file.status();
+  LODFORGE_TRY(file->writeSpan(std::span<const CloudPoint>(sorted)));
+  return file->commit();
+}
+
+struct TileNode {
+  std::string name;
+  int depth = 0;
+  std::vector<std::size_t> blocks;    // under it
+  std::vector<std::string> children;  // names
+  Aabbd bounds;
+  std::uint64_t points = 0;  // in its own content
+  std::string uri;           // empty when it has no content
+};
+
+Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
+                    const PointTilesOptions& options, bool colors, const std::string& path) {
+  std::vector<CloudPoint> points;
+  points.reserve(node.points);
+  for (std::size_t b : node.blocks) {
+    const BlockTiles& block = blocks[b];
+    const auto d = static_cast<std::size_t>(node.depth);
+    std::uint64_t first = 0;
+    for (std::size_t k = 0; k < d; ++k) first += block.counts[k];
+    Result<std::vector<CloudPoint>> section = loadPoints(block.path, first, block.counts[d]);
+    if (!section) return section.status();
+    points.insert(points.end(), section->begin(), section->end());
+  }
+  Aabbd content;
+  for (const CloudPoint& p : points) content.add(p.position);
+  const Vec3d center = content.center();
+  std::vector<Vec3f> positions(points.size()), normals(points.size());
+  std::vector<Rgba8> rgba(colors ? points.size() : 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    positions[i] = toYUp(toFloat(points[i].position - center));
+    normals[i] = toYUp(normalizeOr(points[i].normal, Vec3f{0, 0, 1}));
+    if (colors) rgba[i] = points[i].color;
+  }
+  Result<GlbWriter> writer = GlbWriter::create(
+      path, {.doubleSided = false, .meshoptCompression = options.meshoptCompression});
+  if (!writer) return writer.status();
+  Result<std::uint32_t> mesh = writer->addMesh({.positions = positions,
+                                                .normals = normals,
+                                                .colors = rgba,
+                                                .indices = {},
+                                                .quantized = options.quantize,
+                                                .points = true},
+                                               "points");
+  if (!mesh) return mesh.status();
+  writer->addNode("points", *mesh);
+  writer->setRootTranslation(toYUp(center));
+  return writer->finish();
+}
+
+}  // namespace
+
+float pointTileError(const ClusterNode& node) {
+  return std::max(node.error, node.radius);
+}
+
+std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> tree,
+                                                  std::span<const CloudPoint> points,
+                                                  std::span<const std::uint32_t> firstPoint,
+                                                  Vec3d origin) {
+  std::vector<std::uint32_t> reps(tree.size());
+  for (std::size_t i = tree.size(); i-- > 0;) {
+    const ClusterNode& node = tree[i];
+    if (node.leaf()) {
+      reps[i] = firstPoint[i];
+      continue;
+    }
+    const Vec3d c = origin + toDouble(node.position);
+    const std::uint32_t a = reps[node.firstChild], b = reps[node.firstChild + 1];
+    reps[i] = length(points[a].position - c) <= length(points[b].position - c) ? a : b;
+  }
+  return reps;
+}
+
+Result<PointTilesStats> writePointTiles(const std::string& input,
+                                        const std::string& outputDirectory,
+                                        const PointTilesOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PointTilesStats stats;
+  std::error_code error;
+  ScopedDirectory staging{outputDirectory + ".partial"};
+  ScopedDirectory work{outputDirectory + ".work"};
+  fs::remove_all(staging.path, error);
+  fs::remove_all(work.path, error);
+  fs::create_directories(fs::path(staging.path) / "tiles", error);
+  fs::create_directories(work.path, error);
+  if (error) return ioError(staging.path, error.message());
+
+  // Georeferencing: the CRS goes through PROJ while the input is read (one thread), so the
+  // blocks are in the local east-north-up frame already.
+  Result<PointReader> probe = PointReader::open(input, 1, options.salvageTruncated);
+  if (!probe) return probe.status();
+  stats.crs = !options.crs.empty() || options.origin ? options.crs : probe->info().crs;
+  std::optional<CrsToLocal> frame;
+  PartitionOptions partitionOptions;
+  partitionOptions.blockSize = options.blockSize;
+  partitionOptions.workDirectory = work.path;
+  partitionOptions.salvageTruncated = options.salvageTruncated;
+  if (options.memoryLimit > 0) partitionOptions.memoryBytes = options.memoryLimit / 2;
+  if (!stats.crs.empty()) {
+    PointBatch first;
+    Result<bool> some = probe->next(first);
+    if (!some) return some.status();
+    if (!*some) return badInput(input, "the file has no points");
+    Result<CrsToLocal> created = CrsToLocal::create(stats.crs, first.positions.front());
+    if (!created) return created.status();
+    frame.emplace(std::move(*created));
+    partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) { return frame->apply(in, out); };
+  }
+  Result<Partition> partition = partitionPoints(input, partitionOptions);
+  if (!partition) return partition.status();
+  stats.points = partition->pointCount;
+  stats.blocks = partition->blocks.size();
+  for (const PointBlock& b : partition->blocks) stats.depth = std::max(stats.depth, depthOf(b));
+  const std::vector<float> taus = toleranceSchedule(*partition, options, stats.depth);
+
+  // Every block's points sorted by the tile that holds them.
+  std::vector<BlockTiles> blocks(partition->blocks.size());
+  std::vector<Status> failures(blocks.size());
+  Progress progress("tiles: blocks", stats.points);
+  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+    if (cancelRequested()) return;
+    const PointBlock& block = partition->blocks[b];
+    failures[b] = levelBlock(block, *partition, options, taus,
+                             work.path + "/" + block.name + ".tiles", blocks[b]);
+    std::error_code ignored;
+    fs::remove(block.path, ignored);
+    progress.advance(block.count);
+  });
+  for (const Status& f : failures) LODFORGE_TRY(f);
+  LODFORGE_TRY(checkCancelled());
+  progress.finish();
+
+  // The tile tree: every prefix of a block's name.
+  std::map<std::string, TileNode> nodes;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const std::string& name = partition->blocks[b].name;
+    for (std::size_t length = 1; length <= name.size(); ++length) {
+      TileNode& node = nodes[name.substr(0, length)];
+      node.name = name.substr(0, length);
+      node.depth = static_cast<int>(length) - 1;
+      node.blocks.push_back(b);
+      node.bounds.add(blocks[b].bounds);
+      node.points += blocks[b].counts[static_cast<std::size_t>(node.depth)];
+      if (length < name.size()) {
+        const std::string child = name.substr(0, length + 1);
+        if (std::find(node.children.begin(), node.children.end(), child) == node.children.end())
+          node.children.push_back(child);
+      }
+    }
+  }
+  std::vector<TileNode*> withContent;
+  for (auto& [name, node] : nodes) {
+    std::sort(node.children.begin(), node.children.end());
+    if (node.points == 0) continue;
+    node.uri = "tiles/" + name + ".glb";
+    withContent.push_back(&node);
+  }
+  const bool colors = partition->info.hasColors;
+  std::vector<Status> written(withContent.size());
+  Progress writing("tiles: contents", withContent.size());
+  tbb::parallel_for(std::size_t{0}, withContent.size(), [&](std::size_t i) {
+    if (cancelRequested()) return;
+    written[i] = writeContent(*withContent[i], blocks, options, colors,
+                              staging.path + "/" + withContent[i]->uri);
+    writing.advance(1);
+  });
+  for (const Status& f : written) LODFORGE_TRY(f);
+  LODFORGE_TRY(checkCancelled());
+  writing.finish();
+  stats.tiles = withContent.size();
+
+  // tileset.json: ADD refinement; a tile at depth d stands for the cut at τ_d, a block's tile
+  // for every point (error 0).
+  float rootError = 0;
+  for (const BlockTiles& b : blocks) rootError = std::max(rootError, b.rootError);
+  const std::function<nlohmann::json(const TileNode&)> tile = [&](const TileNode& node) {
+    const bool leaf = node.children.empty();
+    nlohmann::json t = {
+        {"boundingVolume", boxOf(node.bounds)},
+        {"geometricError",
+         leaf ? 0.0 : static_cast<double>(taus[static_cast<std::size_t>(node.depth)])}};
+    if (!node.uri.empty()) t["content"] = {{"uri", node.uri}};
+    if (!leaf) {
+      t["children"] = nlohmann::json::array();
+      for (const std::string& child : node.children) t["children"].push_back(tile(nodes.at(child)));
+    }
+    return t;
+  };
+  nlohmann::json root = tile(nodes.at("b"));
+  root["refine"] = "ADD";
+  if (frame) {
+    root["transform"] = frame->localToEcef().m;
+  } else if (options.origin) {
+    root["transform"] = eastNorthUpToEcef(*options.origin).m;
+  }
+  const nlohmann::json tileset = {
+      {"asset", {{"version", "1.1"}, {"generator", "lodforge " LODFORGE_VERSION}}},
+      {"geometricError", std::max(static_cast<double>(rootError),
+                                  taus.empty() ? 0.0 : 2.0 * static_cast<double>(taus.front()))},
+      {"root", root}};
+  {
+    Result<OutputFile> out = OutputFile::create(staging.path + "/tileset.json");
+    if (!out) return out.status();
+    const std::string text = tileset.dump(1);
+    LODFORGE_TRY(out->write(text.data(), text.size()));
+    LODFORGE_TRY(out->commit());
+  }
+  for (const auto& entry : fs::recursive_directory_iterator(staging.path))
+    if (entry.is_regular_file()) stats.outputBytes += entry.file_size();
+
+  // Complete: replace the previous tileset, if any, by the new one.
+  if (fs::exists(outputDirectory)) {
+    const std::string old = outputDirectory + ".old";
+    fs::rename(outputDirectory, old, error);
+    if (error) return ioError(outputDirectory, error.message());
+    ScopedDirectory removeOld{old};
+  }
+  fs::rename(staging.path, outputDirectory, error);
+  if (error) return ioError(outputDirectory, error.message());
+  staging.path.clear();
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+}  // namespace lodforge

@@ -1,0 +1,60 @@
+// Point clouds as 3D Tiles 1.1 (refine ADD): the block partition of the points paper (§4.1) is
+// the tile tree, and each block's clustering tree decides which points go up. Every cluster node
+// is represented by one of its own points, chosen so that a parent's representative is one of
+// its children's (so coarser cuts are subsets of finer ones). A tile at depth d holds the
+// representatives of its blocks' cut at tolerance τ_d that no shallower tile holds; a block's
+// own tile holds the rest: every input point appears in exactly one tile. Contents are glTF
+// POINTS with COLOR_0 and NORMAL.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "lodforge/core/status.h"
+#include "lodforge/points/cluster.h"
+#include "lodforge/tiles/georeference.h"
+
+namespace lodforge {
+
+struct PointTilesOptions {
+  std::uint64_t blockSize = 50'000;   // points per leaf tile at most
+  std::uint64_t tilePoints = 50'000;  // about this many points in a tile above the blocks
+  ClusterOptions cluster;
+  std::uint64_t memoryLimit = 0;  // bytes, 0: the partition's default
+  // Georeferencing: the input's CRS (default: the one its LAS file names) through PROJ, or its
+  // (0, 0, 0) placed at `origin` with x east, y north, z up.
+  std::string crs;
+  std::optional<Geodetic> origin;
+  bool quantize = true;  // KHR_mesh_quantization positions (16-bit over the tile's box)
+  bool meshoptCompression = false;
+  bool salvageTruncated = false;
+};
+
+struct PointTilesStats {
+  std::uint64_t points = 0, blocks = 0, tiles = 0;
+  int depth = 0;  // of the deepest block tile
+  std::string crs;
+  std::uint64_t outputBytes = 0;
+  double seconds = 0;
+};
+
+// A node's "tile error" for point tiles: the clustering error E and the square's radius, the
+// larger (a flat cluster is fitted well but still stands for a patch that wide).
+float pointTileError(const ClusterNode& node);
+
+// One representative input point per cluster node (indices into the block's points, as
+// clusterBlock left them): a leaf's own point; a parent's, the child representative nearest
+// its centroid.
+std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> tree,
+                                                  std::span<const CloudPoint> points,
+                                                  std::span<const std::uint32_t> firstPoint,
+                                                  Vec3d origin);
+
+// `lodforge tiles cloud.las`: the whole pipeline into `outputDirectory` (written under a
+// temporary name and renamed when complete).
+Result<PointTilesStats> writePointTiles(const std::string& input,
+                                        const std::string& outputDirectory,
+                                        const PointTilesOptions& options);
+
+}  // namespace lodforge

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render or tiles runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles or points runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -148,6 +148,68 @@ tiles_section() {
 }
 if [[ ${BENCH_ONLY:-} == tiles ]]; then tiles_section; exit 0; fi
 
+# Point clouds (issue 7): lodforge points on generated clouds (streamed binary PLY with normals
+# and colours, and the same cloud without normals, so they are estimated), peak RSS flat as the
+# input grows; then the gaze-driven runtime along an orbit and the point tileset.
+points_row() {
+  local label=$1 mode=$2 log=$work/time.log
+  shift 2
+  /usr/bin/time -v "$lodforge" "$@" > "$work/points.out" 2> "$log" || { cat "$log"; exit 1; }
+  local wall rss rate
+  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
+  rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
+  rate=$(sed -n 's/.*(\([0-9,]*\) points\/s).*/\1/p' "$work/points.out")
+  printf '| %-5s | %-28s | %9s | %6d MiB | %12s | %s\n' "$label" "$mode" "$wall" $((rss / 1024)) "$rate" \
+    "$(grep -o "streamed split passes\|[0-9]* streamed split passes" "$log" | head -1)"
+}
+
+points_section() {
+  echo
+  echo "== lodforge points: generated clouds (the points paper §4.1; PotreeConverter 2 publishes ~6 M points/s on 8 cores)"
+  printf '| %-5s | %-28s | %9s | %10s | %12s | %s\n' cloud build wall "peak RSS" "points/s" passes
+  printf '|%s|%s|%s|%s|%s|%s\n' ------- ------------------------------ ----------- ------------ -------------- ------
+  local sizes=(1M 10M)
+  [[ ${BENCH_LARGE:-0} == 1 ]] && sizes+=(100M)
+  for n in "${sizes[@]}"; do
+    "$lodforge" -q generate points --points "$n" -o "$work/points.ply"
+    points_row "$n" "normals from the input" -v points "$work/points.ply" -o "$work/cloud.lfc"
+    points_row "$n" "--memory-limit 256M" -v --memory-limit 256M points "$work/points.ply" -o "$work/cloud.lfc"
+    if [[ $n != 100M ]]; then
+      # Positions only (x y z text): normals are estimated.
+      python3 - "$work/points.ply" "$work/points.xyz" <<'PY'
+import struct, sys
+src, dst = sys.argv[1], sys.argv[2]
+with open(src, 'rb') as f:
+    header = b''
+    while not header.endswith(b'end_header\n'):
+        header += f.readline()
+    count = int([l for l in header.split(b'\n') if l.startswith(b'element vertex')][0].split()[2])
+    props = [l.split()[-1] for l in header.split(b'\n') if l.startswith(b'property')]
+    size = 28 if b'red' in props else 24
+    with open(dst, 'w') as out:
+        for _ in range(count):
+            x, y, z = struct.unpack_from('<3f', f.read(size))
+            out.write(f'{x:.4f} {y:.4f} {z:.4f}\n')
+PY
+      points_row "$n" "text x y z, normals estimated" -v points "$work/points.xyz" -o "$work/cloud2.lfc"
+      rm -f "$work/points.xyz" "$work/cloud2.lfc"
+      rm -rf "$work/cloud2.lfs"
+    fi
+    if [[ $n == 10M ]]; then
+      echo
+      "$lodforge" info "$work/cloud.lfc" | sed 's/^/    /'
+      echo
+      "$lodforge" bench "$work/cloud.lfc" --frames 120 --size 1280x720 --fovea 100,200,400 --render
+      echo
+      points_row "$n" "tiles (point tileset)" -v tiles "$work/points.ply" -o "$work/points-tiles"
+      du -sh "$work/points-tiles" | sed 's/^/    tileset size: /'
+      rm -rf "$work/points-tiles"
+    fi
+    rm -rf "$work/points.ply" "$work/cloud.lfc" "$work/cloud.lfs"
+  done
+}
+if [[ ${BENCH_ONLY:-} == points ]]; then points_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -167,5 +229,6 @@ done
 measure "generate points --points 10M" "$lodforge" -q generate points --points 10M -o "$work/points.ply"
 simplify_section
 tiles_section
+points_section
 render_section
 runtime_section

@@ -109,7 +109,7 @@ TEST(CloudFile, StreamedAndInMemoryBuildsAgree) {
   options.blockSize = 3'000;
   options.tolerance = 0.05;
   ASSERT_TRUE(buildPointCloud(dir.file("sheet.csv"), dir.file("a.lfc"), options).ok());
-  options.memoryLimit = 2 * 5'000 * sizeof(CloudPoint);  // 5,000 points split in memory
+  options.splitBytes = 5'000 * sizeof(CloudPoint);  // 5,000 points split in memory
   Result<PointsBuildStats> streamed =
       buildPointCloud(dir.file("sheet.csv"), dir.file("b.lfc"), options);
   ASSERT_TRUE(streamed.ok());

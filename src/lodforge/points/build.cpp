@@ -120,7 +120,7 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   partitionOptions.salvageTruncated = options.salvageTruncated;
   Result<MemoryPlan> plan = planMemory(options);
   if (!plan) return plan.status();
-  partitionOptions.memoryBytes = plan->partitionBytes;
+  partitionOptions.memoryBytes = options.splitBytes > 0 ? options.splitBytes : plan->partitionBytes;
   stats.threads = plan->threads;
   Result<Partition> partition = partitionPoints(input, partitionOptions);
   if (!partition) return partition.status();

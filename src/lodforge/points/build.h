@@ -20,6 +20,7 @@ struct PointsBuildOptions {
   double residentShare = 1.0 / 32;
   ClusterOptions cluster;
   std::uint64_t memoryLimit = 0;  // bytes for the whole build, 0: 256 MiB of points when splitting
+  std::uint64_t splitBytes = 0;   // points split in memory (bytes); 0: planned from the limit
   std::string workDirectory;      // default: beside the output
   bool salvageTruncated = false;  // a PLY cut short: read up to its last whole point
 };

@@ -57,6 +57,29 @@ TEST(ByteSource, ReadSkipAndOffsets) {
   EXPECT_EQ(source->remaining(), 5u);
 }
 
+TEST(ByteSource, ReadsLargerThanItsBufferWithoutHoldingThemTwice) {
+  test::TempDir dir;
+  std::string data(5 << 20, '\0');
+  for (std::size_t i = 0; i < data.size(); ++i) data[i] = char((i * 7) % 253);
+  test::writeFile(dir.file("data.bin"), data);
+  Result<ByteSource> source = ByteSource::openFile(dir.file("data.bin"));
+  ASSERT_TRUE(source.ok());
+  std::string small(100, '\0'), big(3 << 20, '\0');
+  ASSERT_TRUE(source->read(small.data(), small.size()));  // fills the buffer
+  ASSERT_TRUE(source->read(big.data(), big.size()));      // the buffered rest, then direct
+  EXPECT_EQ(big, data.substr(100, big.size()));
+  EXPECT_EQ(source->offset(), 100u + big.size());
+  ASSERT_TRUE(source->read(small.data(), small.size()));  // buffered reads go on from there
+  EXPECT_EQ(small, data.substr(100 + big.size(), 100));
+  std::string rest(source->remaining() + 1, '\0');
+  EXPECT_FALSE(source->read(rest.data(), rest.size()));  // past the end: nothing consumed
+  EXPECT_EQ(source->offset(), 200u + big.size());
+  rest.pop_back();
+  ASSERT_TRUE(source->read(rest.data(), rest.size()));
+  EXPECT_EQ(rest, data.substr(200 + big.size()));
+  EXPECT_EQ(source->remaining(), 0u);
+}
+
 TEST(ByteSource, RefusesOverlongLinesAndMissingFiles) {
   const std::string text(5000, 'x');
   ByteSource memory = ByteSource::fromMemory(test::bytesOf(text), "long.txt");

@@ -99,6 +99,26 @@ std::size_t ByteSource::ensure(std::size_t n) {
 
 bool ByteSource::read(void* out, std::size_t n) {
   if (n == 0) return true;  // `out` may be null (an empty vector's data)
+  if (fd_ >= 0 && n > buffer_.size()) {
+    // Bigger than the buffer: straight into `out` (growing the buffer would hold it twice).
+    if (n > remaining()) return false;
+    const std::size_t buffered = available_ - position_;
+    std::memcpy(out, data(), buffered);
+    auto* target = static_cast<std::byte*>(out);
+    std::size_t done = buffered;
+    while (done < n) {
+      const ssize_t got = ::read(fd_, target + done, n - done);
+      if (got < 0) {
+        if (errno == EINTR) continue;
+        throw ErrorException{ioErrorFromErrno(name_, "read")};
+      }
+      if (got == 0) throw ErrorException{ioError(name_, "the file shrank while being read")};
+      done += static_cast<std::size_t>(got);
+    }
+    bufferOffset_ += available_ + (n - buffered);
+    available_ = position_ = 0;
+    return true;
+  }
   if (ensure(n) < n) return false;
   std::memcpy(out, data(), n);
   position_ += n;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <random>
 
@@ -204,19 +205,23 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   progress.finish();
   LODFORGE_TRY(residentFile->commit());
 
-  // Part II in block order.
-  std::vector<ClusterNode> resident;
-  resident.reserve(stats.residentNodes);
-  {
-    Result<MappedFile> mapped = MappedFile::open(work.path + "/resident");
-    if (!mapped) return mapped.status();
-    const auto* all = reinterpret_cast<const ClusterNode*>(mapped->bytes().data());
-    for (std::size_t b = 0; b < table.size(); ++b) {
-      table[b].residentFirst = resident.size();
-      resident.insert(resident.end(), all + residentAt[b].first,
-                      all + residentAt[b].first + residentAt[b].second);
-    }
+  // Part II in block order, each block's records read back from the work file as the package
+  // is written (holding all of Part II would grow with the input).
+  std::uint64_t first = 0;
+  for (CloudBlock& entry : table) {
+    entry.residentFirst = first;
+    first += entry.residentCount;
   }
+  const std::string residentPath = work.path + "/resident";
+  const ResidentSource residentOf = [&](std::size_t b) -> Result<std::vector<ClusterNode>> {
+    std::ifstream in(residentPath, std::ios::binary);
+    std::vector<ClusterNode> part(residentAt[b].second);
+    in.seekg(static_cast<std::streamoff>(residentAt[b].first * sizeof(ClusterNode)));
+    in.read(reinterpret_cast<char*>(part.data()),
+            static_cast<std::streamsize>(part.size() * sizeof(ClusterNode)));
+    if (!in && !part.empty()) return ioError(residentPath, "work file is shorter than expected");
+    return part;
+  };
   CloudHeader header{};
   header.flags =
       (hasNormals ? kCloudInputNormals : 0u) | (partition->info.hasColors ? kCloudInputColors : 0u);
@@ -232,7 +237,7 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   fs::rename(staging.path, segments, error);
   if (error) return ioError(segments, error.message());
   staging.path.clear();
-  LODFORGE_TRY(writeCloudFile(output, header, partition->info.crs, table, resident));
+  LODFORGE_TRY(writeCloudFile(output, header, partition->info.crs, table, residentOf));
   for (const auto& entry : fs::directory_iterator(segments)) stats.outputBytes += entry.file_size();
   stats.outputBytes += fs::file_size(output);
   stats.seconds = elapsed();

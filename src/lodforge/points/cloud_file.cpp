@@ -63,10 +63,20 @@ Status writeSegmentFile(const std::string& path, std::uint64_t buildId, std::uin
 
 Status writeCloudFile(const std::string& path, CloudHeader header, const std::string& crs,
                       std::span<const CloudBlock> blocks, std::span<const ClusterNode> resident) {
+  return writeCloudFile(
+      path, header, crs, blocks, [&](std::size_t b) -> Result<std::vector<ClusterNode>> {
+        const auto first = resident.begin() + static_cast<std::ptrdiff_t>(blocks[b].residentFirst);
+        return std::vector<ClusterNode>(first, first + blocks[b].residentCount);
+      });
+}
+
+Status writeCloudFile(const std::string& path, CloudHeader header, const std::string& crs,
+                      std::span<const CloudBlock> blocks, const ResidentSource& residentOf) {
   std::memcpy(header.magic, kCloudMagic, 8);
   header.version = kCloudVersion;
   header.blockCount = blocks.size();
-  header.residentCount = resident.size();
+  header.residentCount = 0;
+  for (const CloudBlock& b : blocks) header.residentCount += b.residentCount;
   header.crsBytes = static_cast<std::uint32_t>(crs.size());
   Result<OutputFile> out = OutputFile::create(path);
   if (!out) return out.status();
@@ -80,7 +90,12 @@ Status writeCloudFile(const std::string& path, CloudHeader header, const std::st
   LODFORGE_TRY(put(&header, sizeof header));
   LODFORGE_TRY(put(crsPadded.data(), crsPadded.size()));
   LODFORGE_TRY(put(blocks.data(), blocks.size_bytes()));
-  LODFORGE_TRY(put(resident.data(), resident.size_bytes()));
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    Result<std::vector<ClusterNode>> part = residentOf(b);
+    if (!part) return part.status();
+    assert(part->size() == blocks[b].residentCount);
+    LODFORGE_TRY(put(part->data(), part->size() * sizeof(ClusterNode)));
+  }
   const std::uint64_t digest = sum.digest();
   LODFORGE_TRY(out->write(&digest, sizeof digest));
   return out->commit();

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -100,5 +101,10 @@ Status writeSegmentFile(const std::string& path, std::uint64_t buildId, std::uin
 // Writes the .lfc: header (counts filled from the table), CRS, table and resident records.
 Status writeCloudFile(const std::string& path, CloudHeader header, const std::string& crs,
                       std::span<const CloudBlock> blocks, std::span<const ClusterNode> resident);
+// The same with each block's Part II fetched when it is written (blocks[b].residentCount
+// records), so the package is written without holding all of Part II.
+using ResidentSource = std::function<Result<std::vector<ClusterNode>>(std::size_t block)>;
+Status writeCloudFile(const std::string& path, CloudHeader header, const std::string& crs,
+                      std::span<const CloudBlock> blocks, const ResidentSource& residentOf);
 
 }  // namespace lodforge

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles or points runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -210,6 +210,32 @@ PY
 }
 if [[ ${BENCH_ONLY:-} == points ]]; then points_section; exit 0; fi
 
+# lodforge serve under load (issue 8): wrk on loopback, 100 connections for 10 s, each request
+# the next tile of a 1 M-triangle scan's tileset; then the same for tileset.json with gzip.
+serve_section() {
+  echo
+  echo "== lodforge serve under wrk (loopback, 2 wrk threads, 100 connections, 10 s)"
+  "$lodforge" -q generate scan --triangles 1M -o "$work/serve-scan.ply"
+  rm -rf "$work/serve-tiles"
+  "$lodforge" -q tiles "$work/serve-scan.ply" -o "$work/serve-tiles"
+  (cd "$work/serve-tiles" && ls tiles/*.glb | sed 's|^|/tiles/|') > "$work/tiles.txt"
+  local sizes
+  sizes=$(du -b "$work"/serve-tiles/tiles/*.glb | awk '{s += $1} END {printf "%.0f KiB mean over %d tiles", s / NR / 1024, NR}')
+  "$lodforge" serve "$work/serve-tiles" --port 18731 > "$work/serve.out" 2> "$work/serve.log" &
+  local server=$!
+  sleep 1
+  echo "tile contents: $sizes"
+  TILES_LIST="$work/tiles.txt" wrk -t2 -c100 -d10s --latency -s bench/wrk-tiles.lua \
+    http://127.0.0.1:18731 | grep -E "Requests/sec|Transfer/sec|99%|50%|errors|requests in"
+  echo "tileset.json, gzip:"
+  wrk -t2 -c100 -d10s --latency -H "Accept-Encoding: gzip" http://127.0.0.1:18731/tiles/tileset.json |
+    grep -E "Requests/sec|Transfer/sec|99%|50%|requests in|Non-2xx|Socket errors"
+  kill -INT $server
+  wait $server
+  rm -rf "$work/serve-tiles" "$work/serve-scan.ply" "$work/tiles.txt"
+}
+if [[ ${BENCH_ONLY:-} == serve ]]; then serve_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -230,5 +256,6 @@ measure "generate points --points 10M" "$lodforge" -q generate points --points 1
 simplify_section
 tiles_section
 points_section
+serve_section
 render_section
 runtime_section

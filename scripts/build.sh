@@ -20,3 +20,5 @@ mkdir -p build
 log=build/configure-$name.log
 cmake -S . -B "build/$name" -G Ninja "${args[@]}" > "$log" 2>&1 || { cat "$log"; exit 1; }
 cmake --build "build/$name" -j"$jobs"
+# The browser viewers `lodforge serve` hands out (web/dist).
+if [[ $name == release ]]; then scripts/build-web.sh; fi

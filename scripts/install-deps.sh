@@ -13,7 +13,7 @@ packages=(
   # libraries
   libtbb-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev libtinygltf-dev
   libtinyobjloader-dev libmeshoptimizer-dev libdraco-dev libnanoflann-dev libeigen3-dev libproj-dev
-  libstb-dev libcpp-httplib-dev libxxhash-dev
+  libstb-dev libcpp-httplib-dev zlib1g-dev libxxhash-dev
   # rendering (headless EGL on Mesa's llvmpipe, GLFW window, Dear ImGui)
   libepoxy-dev libegl-dev libgl1-mesa-dri libglfw3-dev libimgui-dev xvfb
   # tests and benchmarks
@@ -40,13 +40,15 @@ if ((${#missing[@]})); then
   $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# npm packages of the test tools (glTF validator, playwright-core), pinned by package-lock.json.
-# `npm ci` only when node_modules is missing or older than the lock file.
-js="$here/tests/js"
-if [[ -f "$js/package-lock.json" ]]; then
-  stamp="$js/node_modules/.package-lock.json"
-  if [[ ! -f "$stamp" || "$js/package-lock.json" -nt "$stamp" ]]; then
-    echo "install-deps: npm ci in tests/js"
-    (cd "$js" && npm ci --no-audit --no-fund --loglevel=error)
+# npm packages, pinned by package-lock.json: the test tools (glTF validator, playwright-core) and
+# the browser viewers (web/: cesium, three, 3d-tiles-renderer, vite). `npm ci` only when
+# node_modules is missing or older than the lock file.
+for js in "$here/tests/js" "$here/web"; do
+  if [[ -f "$js/package-lock.json" ]]; then
+    stamp="$js/node_modules/.package-lock.json"
+    if [[ ! -f "$stamp" || "$js/package-lock.json" -nt "$stamp" ]]; then
+      echo "install-deps: npm ci in ${js#"$here"/}"
+      (cd "$js" && npm ci --no-audit --no-fund --loglevel=error)
+    fi
   fi
-fi
+done

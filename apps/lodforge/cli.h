@@ -43,5 +43,6 @@ void addRender(CLI::App& app, const Global& global, Run& run);
 void addView(CLI::App& app, const Global& global, Run& run);
 void addTiles(CLI::App& app, const Global& global, Run& run);
 void addPoints(CLI::App& app, const Global& global, Run& run);
+void addServe(CLI::App& app, const Global& global, Run& run);
 
 }  // namespace lodforge::cli

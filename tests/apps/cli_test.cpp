@@ -15,6 +15,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <httplib.h>
+
 #include "lodforge/render/image.h"
 #include "test_support.h"
 
@@ -57,7 +59,8 @@ nlohmann::json info(const std::string& path, const test::TempDir& dir) {
 }
 
 // Starts `lodforge ARGS` without a shell (so signals reach it), stderr to `errPath` if given.
-pid_t spawnLodforge(std::vector<std::string> args, const std::string& errPath = "") {
+pid_t spawnLodforge(std::vector<std::string> args, const std::string& errPath = "",
+                    const std::string& outPath = "") {
   const std::string binary = LODFORGE_BINARY;
   args.insert(args.begin(), binary);
   std::vector<char*> argv;
@@ -67,6 +70,9 @@ pid_t spawnLodforge(std::vector<std::string> args, const std::string& errPath = 
   posix_spawn_file_actions_init(&actions);
   if (!errPath.empty())
     posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+  if (!outPath.empty())
+    posix_spawn_file_actions_addopen(&actions, 1, outPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
                                      0644);
   pid_t pid = 0;
   const int started = posix_spawn(&pid, binary.c_str(), &actions, nullptr, argv.data(), environ);
@@ -451,6 +457,158 @@ TEST(CliPoints, BenchAndViewRunTheGazeDrivenRuntime) {
   const auto shot = readPng(dir.file("v.png"));
   ASSERT_TRUE(shot.ok());
   EXPECT_GT(compareImages(*shot, Image(320, 240)).shareAbove, 0.02);
+}
+
+// `lodforge serve` on a free port (it prints which); stops it with Ctrl-C on destruction.
+class Served {
+ public:
+  Served(const test::TempDir& dir, std::vector<std::string> args) : dir_(dir) {
+    args.insert(args.begin(), {"serve", "--port", "0"});
+    pid_ = spawnLodforge(args, dir.file(".serve-err"), dir.file(".serve-out"));
+    for (int i = 0; i < 200 && port_ == 0; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(25));
+      const std::string out = test::readFile(dir.file(".serve-out"));
+      const std::size_t at = out.find("http://127.0.0.1:");
+      if (at != std::string::npos) port_ = std::atoi(out.c_str() + at + 17);
+    }
+    EXPECT_GT(port_, 0) << test::readFile(dir.file(".serve-err"));
+  }
+  ~Served() {
+    if (pid_ > 0 && !stopped_) stop();
+  }
+  // Ctrl-C: the exit code, and what it printed.
+  Finished stop() {
+    stopped_ = true;
+    ::kill(pid_, SIGINT);
+    return waitFor(pid_);
+  }
+  int port() const { return port_; }
+  httplib::Client client() const {
+    httplib::Client c("127.0.0.1", port_);
+    c.set_decompress(false);
+    c.set_url_encode(false);  // paths go out exactly as written
+    return c;
+  }
+  std::string log() const { return test::readFile(dir_.file(".serve-err")); }
+
+ private:
+  const test::TempDir& dir_;
+  pid_t pid_ = -1;
+  int port_ = 0;
+  bool stopped_ = false;
+};
+
+TEST(CliServe, ServesATilesetWithTypesRangesAndCompression) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q tiles " + test::dataPath("meshes/horse.ply") + " -o " + dir.file("t") +
+                         " --chunk-size 0.05",
+                     dir)
+                .code,
+            0);
+  Served served(dir, {dir.file("t")});
+  httplib::Client http = served.client();
+  const std::string tileset = test::readFile(dir.file("t/tileset.json"));
+  auto r = http.Get("/tiles/tileset.json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_EQ(r->get_header_value("Content-Type"), "application/json; charset=utf-8");
+  EXPECT_EQ(r->body, tileset);
+  EXPECT_FALSE(r->has_header("Access-Control-Allow-Origin"));  // opt-in only
+  // Compressed JSON when the client takes gzip.
+  r = http.Get("/tiles/tileset.json", {{"Accept-Encoding", "gzip"}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->get_header_value("Content-Encoding"), "gzip");
+  EXPECT_LT(r->body.size(), tileset.size() / 2);
+  {
+    // It is one gzip stream of the file (not compressed twice).
+    httplib::Client plain("127.0.0.1", served.port());
+    plain.set_decompress(true);
+    auto decoded = plain.Get("/tiles/tileset.json", {{"Accept-Encoding", "gzip"}});
+    ASSERT_TRUE(decoded);
+    EXPECT_EQ(decoded->body, tileset);
+  }
+  // A tile: its type, a range of it, and HEAD.
+  const auto tiles = test::listFolder(dir.file("t/tiles"));
+  ASSERT_FALSE(tiles.empty());
+  const std::string glb = test::readFile(dir.file("t/tiles/" + tiles[0]));
+  r = http.Get("/tiles/tiles/" + tiles[0]);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->get_header_value("Content-Type"), "model/gltf-binary");
+  EXPECT_EQ(r->body, glb);
+  r = http.Get("/tiles/tiles/" + tiles[0], {{"Range", "bytes=12-111"}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 206);
+  EXPECT_EQ(r->body, glb.substr(12, 100));
+  r = http.Head("/tiles/tiles/" + tiles[0]);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_TRUE(r->body.empty());
+  EXPECT_EQ(r->get_header_value("Content-Length"), std::to_string(glb.size()));
+  // Only GET and HEAD.
+  r = http.Post("/tiles/tileset.json", "x", "text/plain");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 405);
+  EXPECT_EQ(r->get_header_value("Allow"), "GET, HEAD");
+  r = http.Delete("/tiles/tileset.json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 405);
+  // The viewers, from this build's web/dist, whatever the working directory.
+  r = http.Get("/");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 302);
+  for (const char* page : {"/cesium/", "/three/"}) {
+    r = http.Get(page);
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->status, 200) << page;
+    EXPECT_EQ(r->get_header_value("Content-Type"), "text/html; charset=utf-8");
+  }
+  // A request log line each, and a clean stop on Ctrl-C.
+  const Finished end = served.stop();
+  EXPECT_EQ(end.code, 0);
+  EXPECT_NE(served.log().find("GET /tiles/tileset.json 200"), std::string::npos) << served.log();
+}
+
+TEST(CliServe, RefusesEveryWayOutOfTheDirectory) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("t/tiles"));
+  test::writeFile(dir.file("t/tileset.json"), "{}");
+  test::writeFile(dir.file("secret.txt"), "secret");
+  std::filesystem::create_symlink(dir.file("secret.txt"), dir.file("t/link.txt"));
+  std::filesystem::create_directory_symlink(dir.path(), dir.file("t/up"));
+  std::filesystem::create_symlink("tileset.json", dir.file("t/inside.json"));
+  Served served(dir, {dir.file("t"), "--cors"});
+  httplib::Client http = served.client();
+  const auto status = [&](const std::string& path) {
+    auto r = http.Get(path);
+    return r ? r->status : -1;
+  };
+  for (const std::string& path :
+       {std::string("/tiles/../secret.txt"), std::string("/tiles/tiles/../../secret.txt"),
+        std::string("/tiles/%2e%2e/secret.txt"), std::string("/tiles/%2E%2E%2Fsecret.txt"),
+        std::string("/tiles/..%2fsecret.txt"), std::string("/tiles/.%2e/secret.txt"),
+        std::string("/tiles/%2fetc%2fpasswd"), std::string("/tiles//etc/passwd"),
+        std::string("/tiles/link.txt"), std::string("/tiles/up/secret.txt"),
+        std::string("/tiles/..\\secret.txt")}) {
+    const int s = status(path);
+    EXPECT_TRUE(s == 403 || s == 404) << path << " -> " << s;
+    auto r = http.Get(path);
+    if (r) {
+      EXPECT_EQ(r->body.find("secret"), std::string::npos) << path;
+    }
+  }
+  // Double-encoded: one decoding leaves "%2e%2e", a name that does not exist.
+  EXPECT_EQ(status("/tiles/%252e%252e/secret.txt"), 404);
+  EXPECT_EQ(status("/tiles/missing.json"), 404);
+  EXPECT_EQ(status("/tiles/tiles"), 404);  // no directory listings
+  // A symlink that stays inside is fine, and --cors adds its header.
+  auto r = http.Get("/tiles/inside.json");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_EQ(r->body, "{}");
+  EXPECT_EQ(r->get_header_value("Access-Control-Allow-Origin"), "*");
+  EXPECT_EQ(served.stop().code, 0);
+  // Not a directory: a usage error.
+  EXPECT_EQ(lodforge("serve " + dir.file("secret.txt"), dir).code, 2);
 }
 
 TEST(CliTiles, WritesATilesetAndReplacesOnlyATileset) {

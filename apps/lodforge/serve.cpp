@@ -1,0 +1,262 @@
+// `lodforge serve DIR`: a tileset directory and the browser viewers over HTTP (cpp-httplib).
+// GET and HEAD only, content types for what tilesets and the viewers hold, Range requests and
+// gzip for text (both from cpp-httplib), an opt-in CORS header, loopback unless told otherwise,
+// one log line per request, a clean stop on Ctrl-C. Paths are resolved inside their root:
+// "..", absolute paths and symlinks that lead out are refused.
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include <fmt/format.h>
+#include <httplib.h>
+#include <sys/socket.h>
+#include <zlib.h>
+
+#include "cli.h"
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+#include "serve_paths.h"
+
+namespace lodforge::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::size_t kWorkers = 128;
+
+struct ServeOptions {
+  std::string directory;
+  std::string host = "127.0.0.1";
+  int port = 8080;
+  bool cors = false;
+  std::string web;  // the viewers' folder; default: found beside the binary
+};
+
+// tileset.json gzipped once per version of the file (cpp-httplib would deflate it on every
+// request: at 100 connections on 2 cores that costs a third of the throughput and some requests
+// time out). Keyed by path, size and modification time.
+class GzipCache {
+ public:
+  std::shared_ptr<const std::string> get(const fs::path& path, const std::string& body) {
+    std::error_code error;
+    const auto stamp = fs::last_write_time(path, error).time_since_epoch().count();
+    std::lock_guard lock(mutex_);
+    Entry& entry = entries_[path.string()];
+    if (!entry.gzip || entry.stamp != stamp || entry.size != body.size()) {
+      entry.gzip = std::make_shared<const std::string>(gzip(body));
+      entry.stamp = stamp;
+      entry.size = body.size();
+    }
+    return entry.gzip;
+  }
+
+ private:
+  static std::string gzip(const std::string& data) {
+    z_stream z{};
+    deflateInit2(&z, Z_BEST_COMPRESSION, Z_DEFLATED, 15 + 16, 9, Z_DEFAULT_STRATEGY);
+    std::string out(deflateBound(&z, static_cast<uLong>(data.size())) + 32, '\0');
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+    z.avail_in = static_cast<uInt>(data.size());
+    z.next_out = reinterpret_cast<Bytef*>(out.data());
+    z.avail_out = static_cast<uInt>(out.size());
+    deflate(&z, Z_FINISH);
+    out.resize(z.total_out);
+    deflateEnd(&z);
+    return out;
+  }
+  struct Entry {
+    std::shared_ptr<const std::string> gzip;
+    std::int64_t stamp = 0;
+    std::size_t size = 0;
+  };
+  std::mutex mutex_;
+  std::map<std::string, Entry> entries_;
+};
+
+// Files mapped once per version and handed to the socket from the mapping (no read and no copy
+// per request; tiles are read far more often than they change).
+class FileCache {
+ public:
+  std::shared_ptr<const MappedFile> get(const fs::path& path) {
+    std::error_code error;
+    const auto stamp = fs::last_write_time(path, error).time_since_epoch().count();
+    const auto size = fs::file_size(path, error);
+    if (error) return nullptr;
+    std::lock_guard lock(mutex_);
+    Entry& entry = entries_[path.string()];
+    if (!entry.file || entry.stamp != stamp || entry.size != size) {
+      Result<MappedFile> mapped = MappedFile::open(path.string());
+      if (!mapped) return nullptr;
+      entry.file = std::make_shared<const MappedFile>(std::move(*mapped));
+      entry.stamp = stamp;
+      entry.size = size;
+    }
+    return entry.file;
+  }
+
+ private:
+  struct Entry {
+    std::shared_ptr<const MappedFile> file;
+    std::int64_t stamp = 0;
+    std::uintmax_t size = 0;
+  };
+  std::mutex mutex_;
+  std::map<std::string, Entry> entries_;
+};
+
+struct Caches {
+  FileCache files;
+  GzipCache gzip;
+};
+
+void serveFile(const fs::path& root, const std::string& relative, const httplib::Request& request,
+               httplib::Response& response, Caches& caches) {
+  const ResolvedPath resolved = resolveInside(root, relative);
+  if (resolved.status != 200) {
+    response.status = resolved.status;
+    response.set_content(resolved.status == 403 ? "forbidden\n" : "not found\n", "text/plain");
+    return;
+  }
+  const std::shared_ptr<const MappedFile> file = caches.files.get(resolved.path);
+  if (!file) {
+    response.status = 500;
+    response.set_content("cannot read the file\n", "text/plain");
+    return;
+  }
+  const auto bytes = file->bytes();
+  // cpp-httplib answers Range requests (206) and gzips text types on its own; HEAD drops the
+  // body but keeps its length. JSON is compressed here, once ("; charset" keeps cpp-httplib from
+  // compressing it again).
+  const std::string type = contentTypeFor(resolved.path.string());
+  const std::string text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  if (type == "application/json") {
+    response.set_header("Vary", "Accept-Encoding");
+    if (request.get_header_value("Accept-Encoding").find("gzip") != std::string::npos) {
+      response.set_header("Content-Encoding", "gzip");
+      response.set_content(*caches.gzip.get(resolved.path, text),
+                           "application/json; charset=utf-8");
+      return;
+    }
+    response.set_content(text, "application/json; charset=utf-8");
+    return;
+  }
+  if (type.starts_with("text/") || type == "image/svg+xml" || type == "application/xml") {
+    response.set_content(text, type);  // cpp-httplib gzips these when asked
+    return;
+  }
+  // Binary contents straight from the mapping (cpp-httplib cuts Range requests from it).
+  response.set_content_provider(
+      bytes.size(), type, [file](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
+        const auto data = file->bytes();
+        return sink.write(reinterpret_cast<const char*>(data.data()) + offset, length);
+      });
+}
+
+Status runServe(const Global& global, const ServeOptions& o) {
+  const fs::path root = fs::weakly_canonical(o.directory);
+  if (!fs::is_directory(root))
+    return Error{ErrorKind::kUsage, fmt::format("{}: not a directory", o.directory)};
+  const fs::path web = o.web.empty() ? findWebDirectory() : fs::path(o.web);
+  httplib::Server server;
+  Caches caches;
+  if (!server.is_valid()) return Error{ErrorKind::kIo, "cannot start the HTTP server"};
+  // A viewer keeps several connections alive; each holds a worker while it waits for its next
+  // request, so the pool is sized for many of them (the work per request is a file read).
+  server.new_task_queue = [] { return new httplib::ThreadPool(kWorkers); };
+  server.set_keep_alive_max_count(1000);
+  server.set_tcp_nodelay(true);  // headers and body go out as two writes: no Nagle wait
+  // cpp-httplib listens with a backlog of 5 (compiled in): 100 clients connecting at once see
+  // their SYNs dropped and retried a second or three later. Remember the socket, listen again
+  // with the system's maximum once it is bound (Linux takes a new backlog that way).
+  int listening = -1;
+  server.set_socket_options([&listening](socket_t socket) {
+    int yes = 1;
+    ::setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    listening = socket;
+  });
+  server.set_pre_routing_handler([&](const httplib::Request& request, httplib::Response& response) {
+    if (request.method != "GET" && request.method != "HEAD") {
+      response.status = 405;
+      response.set_header("Allow", "GET, HEAD");
+      response.set_content("only GET and HEAD\n", "text/plain");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (o.cors) response.set_header("Access-Control-Allow-Origin", "*");
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  // The viewers at /cesium/ and /three/ (built by `make` into web/dist), the tileset at /tiles/.
+  server.Get("/", [](const httplib::Request&, httplib::Response& response) {
+    response.set_redirect("/cesium/");
+  });
+  server.Get(R"(/tiles/(.*))", [&](const httplib::Request& request, httplib::Response& response) {
+    serveFile(root, request.matches[1].str(), request, response, caches);
+  });
+  server.Get(R"(/((cesium|three|assets)/.*))",
+             [&](const httplib::Request& request, httplib::Response& response) {
+               std::string relative = request.matches[1].str();
+               if (relative.ends_with('/')) relative += "index.html";
+               if (web.empty()) {
+                 response.status = 404;
+                 response.set_content("the viewers are not built: run make\n", "text/plain");
+                 return;
+               }
+               serveFile(web, relative, request, response, caches);
+             });
+  server.Get(R"(/(cesium|three))",
+             [](const httplib::Request& request, httplib::Response& response) {
+               response.set_redirect(request.path + "/");
+             });
+  server.set_logger([&global](const httplib::Request& request, const httplib::Response& response) {
+    if (global.verbosity >= 0)
+      fmt::print(stderr, "{} {} {} {} {}\n", request.remote_addr, request.method, request.path,
+                 response.status, response.body.size());
+  });
+  const int port = o.port == 0 ? server.bind_to_any_port(o.host) : o.port;
+  if (o.port != 0 && !server.bind_to_port(o.host, o.port))
+    return Error{ErrorKind::kIo, fmt::format("cannot listen on {}:{} (in use?)", o.host, o.port)};
+  if (port < 0) return Error{ErrorKind::kIo, fmt::format("cannot listen on {}", o.host)};
+  if (listening >= 0) ::listen(listening, SOMAXCONN);
+  say(global, fmt::format("serving {} on http://{}:{}/ (viewers: /cesium/ and /three/{}); Ctrl-C "
+                          "stops",
+                          root.string(), o.host, port, web.empty() ? ", not built: run make" : ""));
+  std::fflush(stdout);  // a script waiting for the port reads it now, not at exit
+  if (o.host != "127.0.0.1" && o.host != "localhost" && o.host != "::1")
+    fmt::print(stderr, "lodforge: warning: listening on {}, reachable from other machines\n",
+               o.host);
+  // Ctrl-C sets the cancel flag; this thread turns it into a clean stop.
+  std::atomic<bool> done{false};
+  std::thread watcher([&] {
+    while (!done.load()) {
+      if (cancelRequested()) {
+        server.stop();
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+  server.listen_after_bind();
+  done = true;
+  watcher.join();
+  say(global, "stopped");
+  return {};
+}
+
+}  // namespace
+
+void addServe(CLI::App& app, const Global& global, Run& run) {
+  auto o = std::make_shared<ServeOptions>();
+  CLI::App* sub = app.add_subcommand("serve", "Serve a tileset and the browser viewers over HTTP");
+  sub->add_option("DIR", o->directory, "The tileset directory (lodforge tiles -o DIR)")->required();
+  sub->add_option("--port", o->port, "Port (default 8080; 0 picks a free one)")
+      ->check(CLI::Range(0, 65535));
+  sub->add_option("--host", o->host,
+                  "Address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 for all)");
+  sub->add_flag("--cors", o->cors, "Add Access-Control-Allow-Origin: * (for viewers elsewhere)");
+  sub->add_option("--web", o->web, "The viewers' folder (default: beside the binary)");
+  sub->callback([&global, &run, o] { run = [&global, o] { return runServe(global, *o); }; });
+}
+
+}  // namespace lodforge::cli

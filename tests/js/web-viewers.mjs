@@ -1,0 +1,113 @@
+// The browser viewers end to end: `lodforge serve TILESET` on a free loopback port, each page
+// (/cesium/, /three/) in Debian's headless chromium (playwright-core) until all tiles are
+// loaded; fails on a console error, a failed or outside request, a tile failure, or a
+// screenshot in which the model covers too little.
+//   node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage 0.02]
+import { spawn } from 'node:child_process';
+import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { chromium } from 'playwright-core';
+
+const [lodforge, tilesetDir, outDir] = process.argv.slice(2);
+const coverageArg = process.argv.indexOf('--min-coverage');
+const minCoverage = coverageArg > 0 ? Number(process.argv[coverageArg + 1]) : 0.02;
+if (!lodforge || !tilesetDir || !outDir) {
+  console.error('usage: node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage F]');
+  process.exit(2);
+}
+
+// The server picks a free port and says which.
+const server = spawn(lodforge, ['serve', tilesetDir, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+let serverLog = '';
+server.stderr.on('data', (d) => { serverLog += d; });
+const port = await new Promise((resolve, reject) => {
+  let out = '';
+  server.stdout.on('data', (d) => {
+    out += d;
+    const m = out.match(/http:\/\/127\.0\.0\.1:(\d+)\//);
+    if (m) resolve(Number(m[1]));
+  });
+  server.on('exit', (code) => reject(new Error(`lodforge serve exited with ${code}: ${serverLog}`)));
+  setTimeout(() => reject(new Error('lodforge serve did not start')), 20000);
+});
+
+const profile = mkdtempSync(path.join(tmpdir(), 'lodforge-chromium-'));
+const context = await chromium.launchPersistentContext(profile, {
+  executablePath: '/usr/bin/chromium',
+  headless: true,
+  viewport: { width: 800, height: 600 },
+  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+         '--disable-background-networking', '--disable-component-update', '--disable-sync',
+         '--no-first-run', '--disable-quic'],
+});
+const problems = [];
+try {
+  for (const viewer of ['cesium', 'three']) {
+    const tab = await context.newPage();
+    const mine = (p) => problems.push(`${viewer}: ${p}`);
+    // Nothing may leave this machine.
+    await tab.route('**/*', (route) => {
+      const host = new URL(route.request().url()).hostname;
+      if (host === '127.0.0.1' || host === 'localhost') return route.continue();
+      mine(`request to ${route.request().url()}`);
+      return route.abort();
+    });
+    tab.on('console', (m) => { if (m.type() === 'error') mine(`console: ${m.text()}`); });
+    tab.on('pageerror', (e) => mine(`page error: ${e.message}`));
+    tab.on('requestfailed', (r) => mine(`request failed: ${r.url()}`));
+    tab.on('response', (r) => { if (r.status() >= 400) mine(`HTTP ${r.status()}: ${r.url()}`); });
+    await tab.goto(`http://127.0.0.1:${port}/${viewer}/`);
+    await tab.waitForFunction(() => window.lodforge && (window.lodforge.loaded || window.lodforge.error ||
+                                                        window.lodforge.failed.length > 0),
+                              null, { timeout: 240000 });
+    const report = await tab.evaluate(() => window.lodforge);
+    if (report.error) mine(`viewer: ${report.error}`);
+    for (const f of report.failed) mine(`tile failed: ${f}`);
+    if (report.tilesLoaded < 1) mine('no tile loaded');
+    await tab.waitForTimeout(1000);
+    const stats = await tab.evaluate(() => document.getElementById('stats').textContent);
+    const png = await tab.screenshot();
+    const shot = path.join(outDir, `${viewer}.png`);
+    writeFileSync(shot, png);
+    // Share of pixels that differ from the page's background (#12151a) and the panel.
+    const coverage = await tab.evaluate(async (data) => {
+      const image = new Image();
+      image.src = 'data:image/png;base64,' + data;
+      await image.decode();
+      const canvas = document.createElement('canvas');
+      canvas.width = image.width;
+      canvas.height = image.height;
+      const g = canvas.getContext('2d');
+      g.drawImage(image, 0, 0);
+      const panel = document.getElementById('panel').getBoundingClientRect();
+      const pixels = g.getImageData(0, 0, image.width, image.height).data;
+      let lit = 0, counted = 0;
+      for (let y = 0; y < image.height; y++) {
+        for (let x = 0; x < image.width; x++) {
+          if (x <= panel.right && y <= panel.bottom) continue;
+          const i = 4 * (y * image.width + x);
+          counted++;
+          if (Math.abs(pixels[i] - 0x12) + Math.abs(pixels[i + 1] - 0x15) + Math.abs(pixels[i + 2] - 0x1a) > 30) lit++;
+        }
+      }
+      return lit / counted;
+    }, png.toString('base64'));
+    console.log(`${viewer}: ${report.tilesLoaded} tiles loaded, "${stats}", model covers ${(100 * coverage).toFixed(1)} % (${shot})`);
+    if (coverage < minCoverage) mine(`the model covers ${(100 * coverage).toFixed(2)} % of the view`);
+    await tab.close();
+  }
+} catch (e) {
+  problems.push(String(e));
+} finally {
+  await context.close();
+  server.kill('SIGINT');
+  rmSync(profile, { recursive: true, force: true });
+}
+const exitCode = await new Promise((resolve) => server.on('exit', (code) => resolve(code)));
+if (exitCode !== 0) problems.push(`lodforge serve exited with ${exitCode} after Ctrl-C`);
+if (problems.length > 0) {
+  for (const p of problems) console.error(p);
+  process.exit(1);
+}
+console.log('both viewers loaded every tile without errors; serve stopped cleanly');

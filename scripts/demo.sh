@@ -2,7 +2,8 @@
 # `make demo`: generates a CAD assembly and a scanned surface, reads them and the real models in
 # ../shared/data, prints `lodforge info` for each, builds progressive packages, times budgeted
 # selection and streaming along an orbit, renders frames headless at three budgets and full
-# detail with their image difference, and writes GLBs, PNGs and JSON under out/demo/.
+# detail with their image difference, writes 3D Tiles of the scan and of a real LAS point cloud,
+# and writes GLBs, PNGs and JSON under out/demo/; it ends with the `lodforge serve` command.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 lodforge=build/release/lodforge
@@ -58,9 +59,23 @@ else
   echo "(no real models: $data/meshes not found)"
 fi
 
+section "3D Tiles: the scan (mesh) and a real LAS point cloud (placed on Earth from its CRS)"
+"$lodforge" tiles "$out/scan.ply" -o "$out/tiles/scan" --origin 8.5417,47.3769,408 --compress meshopt
+if [[ -f $data/points/autzen_trim.las ]]; then
+  "$lodforge" info "$data/points/autzen_trim.las"
+  "$lodforge" points "$data/points/autzen_trim.las" -o "$out/autzen.lfc"
+  "$lodforge" tiles "$data/points/autzen_trim.las" -o "$out/tiles/autzen" --tile-points 20K
+fi
+
 section "results"
 ls -l "$out"
 echo
 echo "The GLBs in $(pwd)/$out open in any glTF 2.0 viewer (Blender, the three.js editor, ...)."
 echo "Frames: $(pwd)/$out/render/ (reference, budget-1/5/20, difference heat maps)."
 echo "Interactive: $lodforge view $out/cad-assembly.lfp   (needs a display)"
+echo "Point package: $lodforge view $out/autzen.lfc   (needs a display; the fovea follows the mouse)"
+echo
+echo "In a browser (CesiumJS and three.js viewers, nothing fetched from the internet):"
+echo "  $lodforge serve $out/tiles/scan --port 8080"
+echo "  then open http://127.0.0.1:8080/cesium/  or  http://127.0.0.1:8080/three/"
+echo "  (the point cloud: $lodforge serve $out/tiles/autzen --port 8080)"

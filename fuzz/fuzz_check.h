@@ -12,6 +12,15 @@
 
 namespace lodforge::fuzz {
 
+// A reader's error must be bad input whose message starts with `prefix` (the file's name).
+inline void checkError(const Error& error, const std::string& prefix) {
+  if (error.kind != ErrorKind::kBadInput || error.message.rfind(prefix, 0) != 0) {
+    std::fprintf(stderr, "unexpected error (kind %d): %s\n", static_cast<int>(error.kind),
+                 error.message.c_str());
+    std::abort();
+  }
+}
+
 inline void check(const Result<Model>& result, const std::string& name) {
   if (result.ok()) {
     std::string why;

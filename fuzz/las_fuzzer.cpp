@@ -6,18 +6,14 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "fuzz_check.h"
 #include "lodforge/io/las_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace lodforge;
   const std::span<const std::byte> bytes(reinterpret_cast<const std::byte*>(data), size);
-  const auto fail = [](const Error& e) {
-    if (e.kind != ErrorKind::kBadInput || e.message.rfind("fuzz.las", 0) != 0) {
-      std::fprintf(stderr, "unexpected error (kind %d): %s\n", static_cast<int>(e.kind),
-                   e.message.c_str());
-      std::abort();
-    }
-  };
+  const auto fail = [](const Error& e) { fuzz::checkError(e, "fuzz.las"); };
+
   for (std::size_t batch : {std::size_t{1}, std::size_t{7}, std::size_t{1} << 16}) {
     Result<LasReader> reader = LasReader::fromMemory(bytes, "fuzz.las", batch);
     if (!reader) {

@@ -391,18 +391,7 @@ void addBench(CLI::App& app, const Global& global, Run& run) {
       ->needs("--render");
   // Point packages (.lfc): the points paper's runtime instead.
   auto cloud = std::make_shared<CloudRunOptions>();
-  sub->add_option("--fovea", cloud->foveaRadii,
-                  "Point packages: fovea radii in pixels, one run each (default 200)")
-      ->delimiter(',');
-  sub->add_option("--foveal-splat", cloud->fovealSplat,
-                  "Point packages: largest splat in the fovea, pixels (default 2)")
-      ->check(CLI::Range(0.1, 100.0));
-  sub->add_option("--resident-blocks", cloud->residentBlocks,
-                  "Point packages: blocks kept in memory (default 8, as in the paper)")
-      ->check(CLI::Range(1, 1'000'000));
-  sub->add_option("--loads-per-frame", cloud->loadsPerFrame,
-                  "Point packages: segment files read per frame at most (default 2)")
-      ->check(CLI::Range(1, 1'000'000));
+  addCloudOptions(*sub, *cloud, /*severalRadii=*/true);
   sub->callback([&global, &run, o, sub, cloud] {
     o->sizeGiven = sub->count("--size") > 0;
     if (fileExtension(o->input) == "lfc") {

@@ -52,6 +52,27 @@ Result<std::vector<Camera>> cloudPath(const CloudRunOptions& o, const Aabbd& bou
 
 }  // namespace
 
+void addCloudOptions(CLI::App& sub, CloudRunOptions& options, bool severalRadii) {
+  auto* fovea = sub.add_option(
+      "--fovea", options.foveaRadii,
+      severalRadii ? "Point packages: fovea radii in pixels, one run each (default 200)"
+                   : "Point packages: fovea radius in pixels (default 200)");
+  if (severalRadii) {
+    fovea->delimiter(',');
+  } else {
+    fovea->expected(1);
+  }
+  sub.add_option("--foveal-splat", options.fovealSplat,
+                 "Point packages: largest splat in the fovea, pixels (default 2)")
+      ->check(CLI::Range(0.1, 100.0));
+  sub.add_option("--resident-blocks", options.residentBlocks,
+                 "Point packages: blocks kept in memory (default 8, as in the paper)")
+      ->check(CLI::Range(1, 1'000'000));
+  sub.add_option("--loads-per-frame", options.loadsPerFrame,
+                 "Point packages: segment files read per frame at most (default 2)")
+      ->check(CLI::Range(1, 1'000'000));
+}
+
 Status runCloudBench(const Global& global, const CloudRunOptions& o) {
   Result<CloudFile> cloud = CloudFile::open(o.input);
   if (!cloud) return cloud.status();

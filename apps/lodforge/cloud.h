@@ -26,6 +26,9 @@ struct CloudRunOptions {
   std::string screenshot;
 };
 
+// --fovea, --foveal-splat, --resident-blocks and --loads-per-frame, for view and bench.
+void addCloudOptions(CLI::App& sub, CloudRunOptions& options, bool severalRadii);
+
 Status runCloudBench(const Global& global, const CloudRunOptions& options);
 Status runCloudView(const Global& global, const CloudRunOptions& options);
 

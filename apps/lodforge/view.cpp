@@ -337,17 +337,7 @@ void addView(CLI::App& app, const Global& global, Run& run) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
   auto cloud = std::make_shared<CloudRunOptions>();
-  sub->add_option("--fovea", cloud->foveaRadii, "Point packages: fovea radius in pixels")
-      ->expected(1);
-  sub->add_option("--foveal-splat", cloud->fovealSplat,
-                  "Point packages: largest splat in the fovea, pixels (default 2)")
-      ->check(CLI::Range(0.1, 100.0));
-  sub->add_option("--resident-blocks", cloud->residentBlocks,
-                  "Point packages: blocks kept in memory (default 8, as in the paper)")
-      ->check(CLI::Range(1, 1'000'000));
-  sub->add_option("--loads-per-frame", cloud->loadsPerFrame,
-                  "Point packages: segment files read per frame at most (default 2)")
-      ->check(CLI::Range(1, 1'000'000));
+  addCloudOptions(*sub, *cloud, /*severalRadii=*/false);
   sub->callback([&global, &run, o, cloud] {
     if (fileExtension(o->input) == "lfc") {
       cloud->input = o->input;

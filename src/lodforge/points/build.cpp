@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
 #include "lodforge/core/progress.h"
@@ -22,14 +23,6 @@ namespace lodforge {
 namespace fs = std::filesystem;
 
 namespace {
-
-struct ScopedDirectory {
-  std::string path;
-  ~ScopedDirectory() {
-    std::error_code ignored;
-    if (!path.empty()) fs::remove_all(path, ignored);
-  }
-};
 
 Result<std::vector<CloudPoint>> loadBlock(const PointBlock& block) {
   Result<ByteSource> in = ByteSource::openFile(block.path);
@@ -109,7 +102,7 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   PointsBuildStats stats;
-  ScopedDirectory work{options.workDirectory.empty() ? output + ".work" : options.workDirectory};
+  ScopedDirectory work(options.workDirectory.empty() ? output + ".work" : options.workDirectory);
   std::error_code error;
   fs::remove_all(work.path, error);
   fs::create_directories(work.path, error);
@@ -146,7 +139,7 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
 
   // Segment files go straight into a staging directory renamed when the package is complete.
   const std::string segments = segmentDirectoryFor(output);
-  ScopedDirectory staging{temporaryPathFor(segments)};
+  ScopedDirectory staging(temporaryPathFor(segments));
   fs::create_directories(staging.path, error);
   if (error) return ioError(staging.path, error.message());
   const std::uint64_t buildId =
@@ -233,10 +226,7 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   header.bounds = partition->bounds;
   // The segment directory first, then the package that names its build: a crash between the
   // two leaves a package that refuses the new segments (other build id), never a mix.
-  fs::remove_all(segments, error);
-  fs::rename(staging.path, segments, error);
-  if (error) return ioError(segments, error.message());
-  staging.path.clear();
+  LODFORGE_TRY(replaceDirectory(staging, segments));
   LODFORGE_TRY(writeCloudFile(output, header, partition->info.crs, table, residentOf));
   for (const auto& entry : fs::directory_iterator(segments)) stats.outputBytes += entry.file_size();
   stats.outputBytes += fs::file_size(output);

@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/glb_writer.h"
@@ -20,14 +21,6 @@ namespace lodforge {
 namespace fs = std::filesystem;
 
 namespace {
-
-struct ScopedDirectory {
-  std::string path;
-  ~ScopedDirectory() {
-    std::error_code ignored;
-    if (!path.empty()) fs::remove_all(path, ignored);
-  }
-};
 
 // glTF is y-up, 3D Tiles z-up (as for mesh tiles).
 Vec3f toYUp(Vec3f p) {
@@ -235,8 +228,8 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   const auto start = std::chrono::steady_clock::now();
   PointTilesStats stats;
   std::error_code error;
-  ScopedDirectory staging{outputDirectory + ".partial"};
-  ScopedDirectory work{outputDirectory + ".work"};
+  ScopedDirectory staging(outputDirectory + ".partial");
+  ScopedDirectory work(outputDirectory + ".work");
   fs::remove_all(staging.path, error);
   fs::remove_all(work.path, error);
   fs::create_directories(fs::path(staging.path) / "tiles", error);
@@ -367,15 +360,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
     if (entry.is_regular_file()) stats.outputBytes += entry.file_size();
 
   // Complete: replace the previous tileset, if any, by the new one.
-  if (fs::exists(outputDirectory)) {
-    const std::string old = outputDirectory + ".old";
-    fs::rename(outputDirectory, old, error);
-    if (error) return ioError(outputDirectory, error.message());
-    ScopedDirectory removeOld{old};
-  }
-  fs::rename(staging.path, outputDirectory, error);
-  if (error) return ioError(outputDirectory, error.message());
-  staging.path.clear();
+  LODFORGE_TRY(replaceDirectory(staging, outputDirectory));
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }

@@ -10,6 +10,7 @@
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/core/directory.h"
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/glb_writer.h"
@@ -32,15 +33,6 @@ nlohmann::json boxOf(const Aabbd& bounds) {
   const Vec3d c = bounds.center(), h = bounds.size() * 0.5;
   return {{"box", {c.x, c.y, c.z, h.x, 0, 0, 0, h.y, 0, 0, 0, h.z}}};
 }
-
-// A directory removed when this goes out of scope (work files, an unfinished output).
-struct ScopedDirectory {
-  std::string path;
-  ~ScopedDirectory() {
-    std::error_code ignored;
-    if (!path.empty()) fs::remove_all(path, ignored);
-  }
-};
 
 // After chunking: what the chunks were made from and of, so that --resume can trust them.
 Status saveChunkState(const std::string& path, const nlohmann::json& identity,
@@ -376,15 +368,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
 
   // Complete: replace the previous tileset, if any, by the new one.
   keep.done = true;
-  if (fs::exists(outputDirectory)) {
-    const std::string old = outputDirectory + ".old";
-    fs::rename(outputDirectory, old, error);
-    if (error) return ioError(outputDirectory, error.message());
-    ScopedDirectory removeOld{old};
-  }
-  fs::rename(staging.path, outputDirectory, error);
-  if (error) return ioError(outputDirectory, error.message());
-  staging.path.clear();
+  LODFORGE_TRY(replaceDirectory(staging, outputDirectory));
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }

@@ -1,0 +1,25 @@
+// Output directories that appear whole or not at all: work and staging folders removed when they
+// go out of scope, and a finished staging folder put in place of the previous output.
+#pragma once
+
+#include <string>
+
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+// Removes `path` (recursively) on destruction unless `path` was cleared.
+struct ScopedDirectory {
+  std::string path;
+  ScopedDirectory() = default;
+  explicit ScopedDirectory(std::string p) : path(std::move(p)) {}
+  ScopedDirectory(const ScopedDirectory&) = delete;
+  ScopedDirectory& operator=(const ScopedDirectory&) = delete;
+  ~ScopedDirectory();
+};
+
+// Renames the complete `staging` directory to `output`, replacing what was there (moved aside
+// first, removed after), and clears `staging.path` so it is kept.
+Status replaceDirectory(ScopedDirectory& staging, const std::string& output);
+
+}  // namespace lodforge

@@ -452,7 +452,7 @@ TEST(CliPoints, BenchAndViewRunTheGazeDrivenRuntime) {
   // In a window (virtual display): the screenshot shows the cloud.
   o = lodforge("view " + dir.file("a.lfc") + " --size 320x240 --stop-after 6 --screenshot " +
                    dir.file("v.png"),
-               dir, "xvfb-run -a -s '-screen 0 1280x1024x24' " + glSubprocess());
+               dir, glSubprocess() + "xvfb-run -a -s '-screen 0 1280x1024x24' ");
   ASSERT_EQ(o.code, 0) << o.err;
   const auto shot = readPng(dir.file("v.png"));
   ASSERT_TRUE(shot.ok());

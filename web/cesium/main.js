@@ -18,6 +18,9 @@ async function main() {
   viewer.scene.backgroundColor = Cesium.Color.fromCssColorString('#12151a');
   const tileset = await Cesium.Cesium3DTileset.fromUrl('/tiles/tileset.json', {
     maximumScreenSpaceError: 16,
+    // Point tilesets: points grow with their tile's geometric error, so a coarse tile is not a
+    // sprinkle of single pixels (meshes are not affected).
+    pointCloudShading: { attenuation: true, maximumAttenuation: 6 },
   });
   viewer.scene.primitives.add(tileset);
   tileset.tileFailed.addEventListener((e) => report.failed.push(`${e.url}: ${e.message}`));

@@ -40,7 +40,7 @@ struct ServeOptions {
 // time out). Keyed by path, size and modification time.
 class GzipCache {
  public:
-  std::shared_ptr<const std::string> get(const fs::path& path, const std::string& body) {
+  std::shared_ptr<const std::string> get(const fs::path& path, std::span<const std::byte> body) {
     std::error_code error;
     const auto stamp = fs::last_write_time(path, error).time_since_epoch().count();
     std::lock_guard lock(mutex_);
@@ -54,11 +54,11 @@ class GzipCache {
   }
 
  private:
-  static std::string gzip(const std::string& data) {
+  static std::string gzip(std::span<const std::byte> data) {
     z_stream z{};
     deflateInit2(&z, Z_BEST_COMPRESSION, Z_DEFLATED, 15 + 16, 9, Z_DEFAULT_STRATEGY);
     std::string out(deflateBound(&z, static_cast<uLong>(data.size())) + 32, '\0');
-    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(data.data()));
     z.avail_in = static_cast<uInt>(data.size());
     z.next_out = reinterpret_cast<Bytef*>(out.data());
     z.avail_out = static_cast<uInt>(out.size());
@@ -131,20 +131,23 @@ void serveFile(const fs::path& root, const std::string& relative, const httplib:
   // body but keeps its length. JSON is compressed here, once ("; charset" keeps cpp-httplib from
   // compressing it again).
   const std::string type = contentTypeFor(resolved.path.string());
-  const std::string text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  // Text is copied into the response (cpp-httplib compresses bodies only); binary is not.
+  const auto text = [&] {
+    return std::string(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  };
   if (type == "application/json") {
     response.set_header("Vary", "Accept-Encoding");
     if (request.get_header_value("Accept-Encoding").find("gzip") != std::string::npos) {
       response.set_header("Content-Encoding", "gzip");
-      response.set_content(*caches.gzip.get(resolved.path, text),
+      response.set_content(*caches.gzip.get(resolved.path, bytes),
                            "application/json; charset=utf-8");
       return;
     }
-    response.set_content(text, "application/json; charset=utf-8");
+    response.set_content(text(), "application/json; charset=utf-8");
     return;
   }
   if (type.starts_with("text/") || type == "image/svg+xml" || type == "application/xml") {
-    response.set_content(text, type);  // cpp-httplib gzips these when asked
+    response.set_content(text(), type);  // cpp-httplib gzips these when asked
     return;
   }
   // Binary contents straight from the mapping (cpp-httplib cuts Range requests from it).

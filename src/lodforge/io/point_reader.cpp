@@ -85,28 +85,21 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
 
 Result<bool> PointReader::next(PointBatch& batch) {
   State& s = *state_;
-  if (auto* ply = std::get_if<PlyReader>(&s.reader)) {
-    batch.clear();
-    while (true) {
-      Result<bool> more = ply->next(s.plyBatch);
-      if (!more || !*more) return more;
-      if (s.plyBatch.kind != PlyBatch::Kind::kVertices) continue;
-      batch.first = s.plyBatch.first;
-      batch.positions = std::move(s.plyBatch.positions);
-      batch.normals = std::move(s.plyBatch.normals);
-      batch.colors = std::move(s.plyBatch.colors);
-      return true;
-    }
+  if (auto* las = std::get_if<LasReader>(&s.reader)) return las->next(batch);
+  if (auto* xyz = std::get_if<XyzReader>(&s.reader)) return xyz->next(batch);
+  // PLY: vertex batches only (faces are skipped by the reader's options).
+  PlyReader& ply = std::get<PlyReader>(s.reader);
+  batch.clear();
+  while (true) {
+    Result<bool> more = ply.next(s.plyBatch);
+    if (!more || !*more) return more;
+    if (s.plyBatch.kind != PlyBatch::Kind::kVertices) continue;
+    batch.first = s.plyBatch.first;
+    batch.positions = std::move(s.plyBatch.positions);
+    batch.normals = std::move(s.plyBatch.normals);
+    batch.colors = std::move(s.plyBatch.colors);
+    return true;
   }
-  return std::visit(
-      [&](auto& reader) -> Result<bool> {
-        if constexpr (std::is_same_v<std::decay_t<decltype(reader)>, PlyReader>) {
-          return false;  // handled above
-        } else {
-          return reader.next(batch);
-        }
-      },
-      s.reader);
 }
 
 }  // namespace lodforge

@@ -131,8 +131,11 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   const bool hasNormals = partition->info.hasNormals;
   stats.estimatedNormals = !hasNormals;
   stats.tolerance = options.tolerance;
+  // Blocks (the sampled ones too) are built by as many threads as the memory plan allows.
+  tbb::task_arena arena(plan->threads);
   if (stats.tolerance <= 0) {
-    Result<double> picked = pickTolerance(*partition, options, hasNormals);
+    Result<double> picked =
+        arena.execute([&] { return pickTolerance(*partition, options, hasNormals); });
     if (!picked) return picked.status();
     stats.tolerance = *picked;
   }
@@ -154,7 +157,6 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   std::uint64_t residentWritten = 0;
   Status failure;
   Progress progress("points: blocks", stats.points);
-  tbb::task_arena arena(plan->threads);
   arena.execute([&] {
     tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t b) {
       if (cancelRequested()) return;

@@ -15,25 +15,13 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/points/partition.h"
+#include "lodforge/tiles/tileset.h"
 
 namespace lodforge {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-// glTF is y-up, 3D Tiles z-up (as for mesh tiles).
-Vec3f toYUp(Vec3f p) {
-  return {p.x, p.z, -p.y};
-}
-Vec3d toYUp(Vec3d p) {
-  return {p.x, p.z, -p.y};
-}
-
-nlohmann::json boxOf(const Aabbd& bounds) {
-  const Vec3d c = bounds.center(), h = bounds.size() * 0.5;
-  return {{"box", {c.x, c.y, c.z, h.x, 0, 0, 0, h.y, 0, 0, 0, h.z}}};
-}
 
 Result<std::vector<CloudPoint>> loadPoints(const std::string& path, std::uint64_t first,
                                            std::uint64_t count) {
@@ -327,7 +315,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   const std::function<nlohmann::json(const TileNode&)> tile = [&](const TileNode& node) {
     const bool leaf = node.children.empty();
     nlohmann::json t = {
-        {"boundingVolume", boxOf(node.bounds)},
+        {"boundingVolume", {{"box", tileBox(node.bounds)}}},
         {"geometricError",
          leaf ? 0.0 : static_cast<double>(taus[static_cast<std::size_t>(node.depth)])}};
     if (!node.uri.empty()) t["content"] = {{"uri", node.uri}};

@@ -21,17 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// glTF is y-up, 3D Tiles z-up: a viewer turns content (x, y, z) into (x, -z, y).
-Vec3f toYUp(Vec3f p) {
-  return {p.x, p.z, -p.y};
-}
-Vec3d toYUp(Vec3d p) {
-  return {p.x, p.z, -p.y};
-}
-
 nlohmann::json boxOf(const Aabbd& bounds) {
-  const Vec3d c = bounds.center(), h = bounds.size() * 0.5;
-  return {{"box", {c.x, c.y, c.z, h.x, 0, 0, 0, h.y, 0, 0, 0, h.z}}};
+  return {{"box", tileBox(bounds)}};
 }
 
 // After chunking: what the chunks were made from and of, so that --resume can trust them.
@@ -145,6 +136,11 @@ Status planMemory(const TilesOptions& options, ChunkInputOptions& input, OctreeO
 }
 
 }  // namespace
+
+std::array<double, 12> tileBox(const Aabbd& bounds) {
+  const Vec3d c = bounds.center(), h = bounds.size() * 0.5;
+  return {c.x, c.y, c.z, h.x, 0, 0, 0, h.y, 0, 0, 0, h.z};
+}
 
 std::string tileContentUri(const OctreeNode& node) {
   return fmt::format("tiles/{}-{}-{}-{}.glb", node.level, node.cell[0], node.cell[1], node.cell[2]);

@@ -3,6 +3,7 @@
 // asks; bounding volumes stay in the tileset's z-up frame.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -80,6 +81,18 @@ double tileQuantizationError(const OctreeNode& node, bool quantize);
 Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
                         const std::optional<Mat4d>& rootTransform = std::nullopt,
                         bool quantized = false);
+
+// glTF is y-up, 3D Tiles z-up: a viewer turns content (x, y, z) into (x, -z, y), so contents
+// are written as (x, z, -y).
+inline Vec3f toYUp(Vec3f p) {
+  return {p.x, p.z, -p.y};
+}
+inline Vec3d toYUp(Vec3d p) {
+  return {p.x, p.z, -p.y};
+}
+
+// A tile's "box" bounding volume for axis-aligned bounds: centre, then three half-axes.
+std::array<double, 12> tileBox(const Aabbd& bounds);
 
 // The relative URI of a node's content.
 std::string tileContentUri(const OctreeNode& node);

@@ -25,12 +25,7 @@ namespace fs = std::filesystem;
 namespace {
 
 Result<std::vector<CloudPoint>> loadBlock(const PointBlock& block) {
-  Result<ByteSource> in = ByteSource::openFile(block.path);
-  if (!in) return in.status();
-  std::vector<CloudPoint> points(block.count);
-  if (!in->read(points.data(), points.size() * sizeof(CloudPoint)))
-    return ioError(block.path, "work file is shorter than expected");
-  return points;
+  return readPointRecords(block.path, 0, block.count);
 }
 
 // The automatic tolerance: the median over sample blocks of the one that keeps `share` of a

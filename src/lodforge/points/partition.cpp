@@ -45,15 +45,6 @@ Status writePoints(const std::string& path, std::span<const CloudPoint> points) 
   return out->commit();
 }
 
-Result<std::vector<CloudPoint>> readPoints(const std::string& path, std::uint64_t count) {
-  Result<ByteSource> in = ByteSource::openFile(path);
-  if (!in) return in.status();
-  std::vector<CloudPoint> points(count);
-  if (!in->read(points.data(), points.size() * sizeof(CloudPoint)))
-    return ioError(path, "work file is shorter than expected");
-  return points;
-}
-
 // Pass 0: the input into one work file, with its bounds and centroid.
 Result<PartNode> readInput(const std::string& input, const std::string& path,
                            const PartitionOptions& options, Partition& partition) {
@@ -202,6 +193,17 @@ std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane) {
   return below;
 }
 
+Result<std::vector<CloudPoint>> readPointRecords(const std::string& path, std::uint64_t first,
+                                                 std::uint64_t count) {
+  Result<ByteSource> in = ByteSource::openFile(path);
+  if (!in) return in.status();
+  std::vector<CloudPoint> points(count);
+  if (!in->skip(first * sizeof(CloudPoint)) ||
+      !in->read(points.data(), points.size() * sizeof(CloudPoint)))
+    return ioError(path, "work file is shorter than expected");
+  return points;
+}
+
 Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options) {
   assert(options.blockSize > 0 && !options.workDirectory.empty());
   Partition partition;
@@ -228,7 +230,7 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
       }
       if (children.error().kind != ErrorKind::kUnsupported) return children.status();
     }
-    Result<std::vector<CloudPoint>> points = readPoints(node.path, node.count);
+    Result<std::vector<CloudPoint>> points = readPointRecords(node.path, 0, node.count);
     if (!points) return points.status();
     std::filesystem::remove(node.path);
     splitInMemory(*points, node.name, options.blockSize, options.workDirectory, blocks);

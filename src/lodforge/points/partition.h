@@ -68,6 +68,10 @@ SplitPlane centroidSplit(const Aabbd& bounds, Vec3d centroid);
 // instead, so both sides are non-empty whenever there are two points or more.
 std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane);
 
+// Records [first, first + count) of a work file of CloudPoints (a block's, say).
+Result<std::vector<CloudPoint>> readPointRecords(const std::string& path, std::uint64_t first,
+                                                 std::uint64_t count);
+
 Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options);
 
 }  // namespace lodforge

@@ -23,17 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Result<std::vector<CloudPoint>> loadPoints(const std::string& path, std::uint64_t first,
-                                           std::uint64_t count) {
-  Result<ByteSource> in = ByteSource::openFile(path);
-  if (!in) return in.status();
-  std::vector<CloudPoint> points(count);
-  if (!in->skip(first * sizeof(CloudPoint)) ||
-      !in->read(points.data(), points.size() * sizeof(CloudPoint)))
-    return ioError(path, "work file is shorter than expected");
-  return points;
-}
-
 int depthOf(const PointBlock& block) {
   return static_cast<int>(block.name.size()) - 1;
 }
@@ -56,7 +45,7 @@ std::vector<float> toleranceSchedule(const Partition& partition, const PointTile
   std::vector<std::vector<float>> perSample(samples);
   tbb::parallel_for(std::size_t{0}, samples, [&](std::size_t s) {
     const PointBlock& block = partition.blocks[s * partition.blocks.size() / samples];
-    Result<std::vector<CloudPoint>> points = loadPoints(block.path, 0, block.count);
+    Result<std::vector<CloudPoint>> points = readPointRecords(block.path, 0, block.count);
     if (!points) return;  // the block pass reports it
     const std::vector<ClusterNode> tree = tileErrorTree(
         clusterBlock(*points, block.centroid, partition.info.hasNormals, options.cluster));
@@ -94,7 +83,7 @@ struct BlockTiles {
 Status levelBlock(const PointBlock& block, const Partition& partition,
                   const PointTilesOptions& options, std::span<const float> taus,
                   const std::string& path, BlockTiles& out) {
-  Result<std::vector<CloudPoint>> loaded = loadPoints(block.path, 0, block.count);
+  Result<std::vector<CloudPoint>> loaded = readPointRecords(block.path, 0, block.count);
   if (!loaded) return loaded.status();
   std::vector<CloudPoint>& points = *loaded;
   std::vector<std::uint32_t> firstPoint;
@@ -156,7 +145,7 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
     const auto d = static_cast<std::size_t>(node.depth);
     std::uint64_t first = 0;
     for (std::size_t k = 0; k < d; ++k) first += block.counts[k];
-    Result<std::vector<CloudPoint>> section = loadPoints(block.path, first, block.counts[d]);
+    Result<std::vector<CloudPoint>> section = readPointRecords(block.path, first, block.counts[d]);
     if (!section) return section.status();
     points.insert(points.end(), section->begin(), section->end());
   }

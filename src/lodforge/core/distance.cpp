@@ -55,11 +55,17 @@ class TriangleGrid {
     // Cells about twice the typical triangle's size: a few triangles per non-empty cell whether
     // the mesh fills a volume or lies on a surface (a volume-based size puts dozens of a flat
     // scan's triangles in every cell, or spreads a flat mesh's few big triangles over a million).
+    // The typical size from at most ~8K evenly spread triangles: the grid only has to be about
+    // right (queries are exact whatever its size), and building it is most of a query batch.
+    const std::size_t stride = std::max<std::size_t>(1, triangles / 8192);
     double area = 0;
-    for (std::uint32_t t = 0; t < triangles; ++t)
+    std::size_t measured = 0;
+    for (std::size_t i = 0; i < triangles; i += stride, ++measured) {
+      const auto t = static_cast<std::uint32_t>(i);
       area += 0.5 * length(cross(corner(t, 1) - corner(t, 0), corner(t, 2) - corner(t, 0)));
+    }
     if (triangles > 0 && area > 0) {
-      cell_ = 2 * std::sqrt(area / static_cast<double>(triangles));
+      cell_ = 2 * std::sqrt(area / static_cast<double>(measured));
     } else {
       const double volume =
           std::max(size.x, 1e-12) * std::max(size.y, 1e-12) * std::max(size.z, 1e-12);
@@ -77,12 +83,34 @@ class TriangleGrid {
     const std::size_t cells = static_cast<std::size_t>(dims_[0]) *
                               static_cast<std::size_t>(dims_[1]) *
                               static_cast<std::size_t>(dims_[2]);
-    std::vector<std::uint32_t> counts(cells + 1, 0);
-    forEachCell([&](std::size_t cell, std::uint32_t) { ++counts[cell + 1]; });
-    for (std::size_t i = 1; i <= cells; ++i) counts[i] += counts[i - 1];
-    start_ = counts;
-    items_.resize(counts[cells]);
-    forEachCell([&](std::size_t cell, std::uint32_t t) { items_[counts[cell]++] = t; });
+    // Counting sort of (cell, triangle) pairs. Most triangles lie in one cell: that cell is kept
+    // from the counting pass, the few that span more are visited again.
+    constexpr std::uint32_t kSpans = ~0u;
+    std::vector<std::uint32_t> single(triangles);
+    start_.assign(cells + 1, 0);
+    for (std::uint32_t t = 0; t < triangles; ++t) {
+      const CellRange r = cellRange(t);
+      if (r.x0 == r.x1 && r.y0 == r.y1 && r.z0 == r.z1) {
+        const auto cell = static_cast<std::uint32_t>(index(r.x0, r.y0, r.z0));
+        single[t] = cell;
+        ++start_[cell];
+      } else {
+        single[t] = kSpans;
+        forEachCell(r, [&](std::size_t cell) { ++start_[cell]; });
+      }
+    }
+    // Inclusive sums: start_[c] is where cell c ends; filling backwards (last triangle first)
+    // moves it to where c starts, with each cell's triangles in increasing order.
+    for (std::size_t i = 1; i < cells; ++i) start_[i] += start_[i - 1];
+    start_[cells] = cells > 0 ? start_[cells - 1] : 0;
+    items_.resize(start_[cells]);
+    for (std::uint32_t t = static_cast<std::uint32_t>(triangles); t-- > 0;) {
+      if (single[t] != kSpans) {
+        items_[--start_[single[t]]] = t;
+      } else {
+        forEachCell(cellRange(t), [&](std::size_t cell) { items_[--start_[cell]] = t; });
+      }
+    }
   }
 
   // The squared distance from p to the nearest triangle, or any value not above `enough` as soon
@@ -163,19 +191,21 @@ class TriangleGrid {
                static_cast<std::size_t>(dims_[0]) +
            static_cast<std::size_t>(x);
   }
+  struct CellRange {
+    int x0, x1, y0, y1, z0, z1;
+  };
+  // The cells triangle t's bounding box touches.
+  CellRange cellRange(std::uint32_t t) const {
+    Aabb box;
+    for (int k = 0; k < 3; ++k) box.add(positions_[indices_[3 * t + static_cast<std::size_t>(k)]]);
+    return {clampCell(0, box.min.x), clampCell(0, box.max.x), clampCell(1, box.min.y),
+            clampCell(1, box.max.y), clampCell(2, box.min.z), clampCell(2, box.max.z)};
+  }
   template <class Fn>
-  void forEachCell(Fn&& fn) const {
-    for (std::uint32_t t = 0; t < indices_.size() / 3; ++t) {
-      Aabb box;
-      for (int k = 0; k < 3; ++k)
-        box.add(positions_[indices_[3 * t + static_cast<std::size_t>(k)]]);
-      const int x0 = clampCell(0, box.min.x), x1 = clampCell(0, box.max.x);
-      const int y0 = clampCell(1, box.min.y), y1 = clampCell(1, box.max.y);
-      const int z0 = clampCell(2, box.min.z), z1 = clampCell(2, box.max.z);
-      for (int z = z0; z <= z1; ++z)
-        for (int y = y0; y <= y1; ++y)
-          for (int x = x0; x <= x1; ++x) fn(index(x, y, z), t);
-    }
+  void forEachCell(const CellRange& r, Fn&& fn) const {
+    for (int z = r.z0; z <= r.z1; ++z)
+      for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) fn(index(x, y, z));
   }
 
   std::span<const Vec3f> positions_;

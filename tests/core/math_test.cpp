@@ -1,6 +1,7 @@
 #include "lodforge/core/math.h"
 
 #include <bit>
+#include <cmath>
 
 #include <gtest/gtest.h>
 
@@ -108,6 +109,24 @@ TEST(Box3, EmptyAbsorbsPoints) {
   Aabb other;
   box.add(other);  // adding an empty box changes nothing
   EXPECT_EQ(box.min, (Vec3f{-1, 2, 3}));
+}
+
+TEST(RoundToLong, EqualsLroundOnEveryFloatNearHalvesAndOnRandomFloats) {
+  // The hard cases are the floats next to n + 0.5, where adding 0.5 in float would round.
+  for (int n = -40000; n <= 40000; ++n) {
+    const float half = static_cast<float>(n) + 0.5f;
+    float x = half;
+    for (int step = 0; step < 4; ++step) x = std::nextafter(x, -1e9f);
+    for (int step = 0; step < 9; ++step, x = std::nextafter(x, 1e9f))
+      ASSERT_EQ(roundToLong(x), std::lround(x)) << x;
+  }
+  Random random(7);
+  for (int i = 0; i < 1'000'000; ++i) {
+    const auto x = static_cast<float>(random.uniform(-1, 1) * 40000);
+    ASSERT_EQ(roundToLong(x), std::lround(x)) << x;
+  }
+  for (float x : {0.0f, -0.0f, 0.49999997f, -0.49999997f, 1e-30f, -1e-30f, 32767.0f})
+    EXPECT_EQ(roundToLong(x), std::lround(x)) << x;
 }
 
 TEST(Random, IsDeterministicAndIndependentPerItem) {

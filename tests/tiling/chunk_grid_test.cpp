@@ -82,6 +82,56 @@ TEST(CutTriangle, PiecesKeepTheAreaAndLieInTheirCells) {
   }
 }
 
+TEST(CutTriangle, TrianglesInsideACellStayWholeAndDegenerateOnesVanish) {
+  // Most of a mesh: a triangle within one cell (or touching its faces) is one piece, itself, in
+  // the cell of its centroid; repeated corners or no area give nothing, inside a cell or across.
+  Random random(11);
+  Aabbd box;
+  box.add(Vec3d{0, 0, 0});
+  box.add(Vec3d{10, 10, 10});
+  const ChunkGrid grid = ChunkGrid::over(box, 2.5);
+  std::vector<ChunkCell> cells;
+  std::vector<CutCorner> corners;
+  for (int i = 0; i < 3000; ++i) {
+    const ChunkCell cell{static_cast<std::int32_t>(random.uniform(0, 4)),
+                         static_cast<std::int32_t>(random.uniform(0, 4)),
+                         static_cast<std::int32_t>(random.uniform(0, 4))};
+    const Aabbd bounds = grid.cellBounds(cell);
+    std::array<CutCorner, 3> t;
+    for (auto& c : t) {
+      for (int axis = 0; axis < 3; ++axis) {
+        // A third of the corners on a face of the cell.
+        const double u =
+            random.uniform(0, 3) < 1 ? std::round(random.uniform(0, 1)) : random.uniform(0, 1);
+        c.position[axis] = bounds.min[axis] + u * (bounds.max[axis] - bounds.min[axis]);
+      }
+      c.normal = {0, 0, 1};
+    }
+    const int kind = i % 3;  // 0: a plain triangle, 1: a repeated corner, 2: collinear corners
+    if (kind == 1) t[2].position = t[i % 2].position;
+    if (kind == 2) t[2].position = t[0].position + (t[1].position - t[0].position) * 0.5;
+    cells.clear();
+    corners.clear();
+    cutTriangle(grid, t, cells, corners);
+    const bool flat =
+        length(cross(t[1].position - t[0].position, t[2].position - t[0].position)) == 0;
+    if (kind != 0 || flat) {
+      if (kind == 1) {
+        EXPECT_TRUE(cells.empty()) << i;
+      }
+      double sum = 0;
+      for (std::size_t p = 0; p < cells.size(); ++p)
+        sum +=
+            area(corners[3 * p].position, corners[3 * p + 1].position, corners[3 * p + 2].position);
+      EXPECT_NEAR(sum, 0, 1e-12) << i;
+      continue;
+    }
+    ASSERT_EQ(cells.size(), 1u) << i;
+    EXPECT_EQ(cells[0], grid.cellOf((t[0].position + t[1].position + t[2].position) / 3.0));
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(corners[k].position, t[k].position) << i;
+  }
+}
+
 TEST(CutTriangle, TrianglesSharingAnEdgeGetBitIdenticalCutVertices) {
   // A closed surface cut into chunks and welded exactly is still closed: every cut vertex on a
   // shared edge came out the same from both triangles, and no T-junction appeared.

@@ -67,6 +67,12 @@ inline Vec3d toDouble(Vec3f a) {
 inline Vec3f toFloat(Vec3d a) {
   return {static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(a.z)};
 }
+// std::lround of a float (halves away from zero) without its library call, for per-vertex
+// loops: exact, because a float plus or minus 0.5 is exact in double.
+inline long roundToLong(float x) {
+  const double d = x;
+  return static_cast<long>(d + (d >= 0 ? 0.5 : -0.5));
+}
 
 struct Rgba8 {
   std::uint8_t r = 255, g = 255, b = 255, a = 255;

@@ -209,7 +209,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
         const Vec3f n = normalizeOr(mesh.normals[v], Vec3f{0, 0, 1});
         const float axes[3] = {n.x, n.y, n.z};
         for (std::size_t a = 0; a < 3; ++a)
-          packed[4 * v + a] = static_cast<std::int8_t>(std::lround(axes[a] * 127.0f));
+          packed[4 * v + a] = static_cast<std::int8_t>(roundToLong(axes[a] * 127.0f));
       }
       Result<std::uint32_t> normal = s.addAccessor(packed.data(), packed.size(), vertexCount, kByte,
                                                    "VEC3", kArrayBuffer, true, nullptr, nullptr, 4);

@@ -177,12 +177,45 @@ struct Emitter {
   }
 };
 
+// True when no grid plane passes strictly between the triangle's corners on any axis, which
+// is when Emitter::cut splits nothing (the same test, plane by plane).
+bool insideOneCell(const ChunkGrid& grid, const std::array<CutCorner, 3>& triangle) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    const double low = std::min(
+        {triangle[0].position[axis], triangle[1].position[axis], triangle[2].position[axis]});
+    const double high = std::max(
+        {triangle[0].position[axis], triangle[1].position[axis], triangle[2].position[axis]});
+    const auto first =
+        static_cast<std::int32_t>(std::max(1.0, std::floor((low - grid.origin[axis]) / grid.size)));
+    const auto last =
+        static_cast<std::int32_t>(std::min(static_cast<double>(grid.dims[a] - 1),
+                                           std::floor((high - grid.origin[axis]) / grid.size) + 1));
+    for (std::int32_t k = first; k <= last; ++k) {
+      const double coordinate = grid.plane(axis, k);
+      if (coordinate > low && coordinate < high) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 void cutTriangle(const ChunkGrid& grid, const std::array<CutCorner, 3>& triangle,
                  std::vector<ChunkCell>& cells, std::vector<CutCorner>& corners) {
-  Emitter emitter{grid, cells, corners};
-  emitter.cut(Polygon(triangle.begin(), triangle.end()), 0);
+  if (!insideOneCell(grid, triangle)) {
+    Emitter emitter{grid, cells, corners};
+    emitter.cut(Polygon(triangle.begin(), triangle.end()), 0);
+    return;
+  }
+  // Most triangles: what Emitter::emit does with an uncut triangle, without its polygons.
+  const Vec3d &a = triangle[0].position, &b = triangle[1].position, &c = triangle[2].position;
+  if (a == b || b == c || a == c) return;  // a repeated corner: no piece
+  const Vec3d normal = cross(b - a, c - a);
+  if (normal.x == 0 && normal.y == 0 && normal.z == 0) return;  // no area
+  // The centroid summed as emit sums it, so the cell is the same bit for bit.
+  cells.push_back(grid.cellOf((((Vec3d{} + a) + b) + c) / 3.0));
+  corners.insert(corners.end(), triangle.begin(), triangle.end());
 }
 
 }  // namespace lodforge

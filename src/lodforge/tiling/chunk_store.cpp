@@ -127,7 +127,7 @@ std::uint32_t encodeNormal(Vec3f n) {
     u = fu, v = fv;
   }
   const auto snorm = [](float x) {
-    return static_cast<std::uint16_t>(static_cast<std::int16_t>(std::lround(x * 32767.0f)));
+    return static_cast<std::uint16_t>(static_cast<std::int16_t>(roundToLong(x * 32767.0f)));
   };
   return static_cast<std::uint32_t>(snorm(u)) | static_cast<std::uint32_t>(snorm(v)) << 16;
 }

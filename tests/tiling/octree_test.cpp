@@ -1,11 +1,14 @@
 #include "lodforge/tiling/octree.h"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -330,6 +333,76 @@ TEST(Octree, LevelsOptionStopsBelowTheRootWithAContentlessRoot) {
   EXPECT_TRUE(root.meshPath.empty());
   for (std::uint32_t c : root.children)
     EXPECT_GE(root.geometricError, built.tree.nodes[c].geometricError);
+}
+
+TEST(Octree, NodesFollowTheirChildrenWithinTheBudgetAndTheTreeIsTheSameForAnySchedule) {
+  // Nodes start as soon as their children are done, across levels; a budget that fits one
+  // node at a time keeps them one at a time; and whatever the schedule, the same tree.
+  const MeshPart input = heightfield(120);
+  Aabbd box;
+  for (const Vec3d& p : input.positions) box.add(p);
+  struct Run {
+    std::vector<OctreeNode> nodes;
+    std::map<std::string, MeshPart> meshes;
+    int mostAtOnce = 0;
+  };
+  const auto run = [&](int threads, std::uint64_t budget, const std::string& name) {
+    const std::string work = ::testing::TempDir() + "/octree-schedule-" + name;
+    fs::remove_all(work);
+    ChunkWriter chunks(ChunkGrid::over(box, 10), work + "/chunks", 1 << 20);
+    for (std::size_t t = 0; t < input.indices.size(); t += 3) {
+      std::array<CutCorner, 3> triangle;
+      for (std::size_t k = 0; k < 3; ++k)
+        triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}, {0, 0, 1}};
+      EXPECT_TRUE(chunks.addTriangle(triangle).ok());
+    }
+    EXPECT_TRUE(chunks.flush().ok());
+    OctreeOptions options;
+    options.errorSamples = 500;
+    options.threads = threads;
+    options.memoryBudget = budget;
+    options.workDirectory = work + "/nodes";
+    fs::create_directories(options.workDirectory);
+    Run out;
+    std::mutex mutex;
+    std::atomic<int> atOnce = 0;
+    std::set<std::string> done;
+    Result<OctreeResult> tree =
+        buildOctree(chunks, options, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
+          const int now = ++atOnce;
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));  // let others overlap
+          std::lock_guard lock(mutex);
+          out.mostAtOnce = std::max(out.mostAtOnce, now);
+          out.meshes[node.meshPath.substr(node.meshPath.rfind('/'))] = mesh;
+          done.insert(node.meshPath);
+          --atOnce;
+          return {};
+        });
+    EXPECT_TRUE(tree.ok());
+    if (!tree.ok()) return out;
+    for (const OctreeNode& node : tree->nodes) {
+      for (std::uint32_t c : node.children) EXPECT_EQ(done.count(tree->nodes[c].meshPath), 1u);
+    }
+    out.nodes = std::move(tree->nodes);
+    return out;
+  };
+  const Run one = run(1, 0, "one"), two = run(2, 0, "two"), tight = run(2, 1, "tight");
+  EXPECT_EQ(one.mostAtOnce, 1);
+  EXPECT_LE(two.mostAtOnce, 2);
+  EXPECT_EQ(tight.mostAtOnce, 1);  // the budget holds one node, so one runs at a time
+  ASSERT_GT(one.nodes.size(), 20u);
+  for (const Run* other : {&two, &tight}) {
+    ASSERT_EQ(other->nodes.size(), one.nodes.size());
+    for (std::size_t i = 0; i < one.nodes.size(); ++i) {
+      EXPECT_EQ(other->nodes[i].geometricError, one.nodes[i].geometricError) << i;
+      EXPECT_EQ(other->nodes[i].triangles, one.nodes[i].triangles) << i;
+    }
+    ASSERT_EQ(other->meshes.size(), one.meshes.size());
+    for (const auto& [name, mesh] : one.meshes) {
+      EXPECT_EQ(other->meshes.at(name).indices, mesh.indices) << name;
+      EXPECT_EQ(other->meshes.at(name).positions, mesh.positions) << name;
+    }
+  }
 }
 
 }  // namespace

@@ -9,10 +9,12 @@
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <queue>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 #include <nanoflann.hpp>
 #include <nlohmann/json.hpp>
 
@@ -237,40 +239,6 @@ struct Builder {
                        node.cell[1], node.cell[2]);
   }
 
-  // Runs `work` for every node in `indices`, in parallel; the first failure wins.
-  Status forEach(const std::vector<std::uint32_t>& indices, const std::string& label,
-                 std::uint64_t largestTriangles, const std::function<Status(OctreeNode&)>& work) {
-    Progress progress(label, indices.size());
-    std::mutex mutex;
-    Status failure;
-    // As many at once as the memory budget allows for the largest node of the level.
-    int concurrency =
-        options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
-    if (options.memoryBudget > 0) {
-      const std::uint64_t fit = options.memoryBudget / estimateBytes(largestTriangles);
-      concurrency = static_cast<int>(
-          std::clamp<std::uint64_t>(fit, 1, static_cast<std::uint64_t>(concurrency)));
-    }
-    tbb::task_arena arena(concurrency);
-    arena.execute([&] {
-      tbb::parallel_for(std::size_t{0}, indices.size(), [&](std::size_t i) {
-        {
-          std::lock_guard lock(mutex);
-          if (!failure.ok()) return;
-        }
-        Status status = checkCancelled();
-        if (status.ok()) status = work(result.nodes[indices[i]]);
-        progress.advance(1);
-        if (!status.ok()) {
-          std::lock_guard lock(mutex);
-          if (failure.ok()) failure = std::move(status);
-        }
-      });
-    });
-    progress.finish();
-    return failure;
-  }
-
   // A finished node's summary beside its mesh file: written last, so its presence means done.
   static std::string summaryPath(const std::string& mesh) { return mesh + ".json"; }
 
@@ -401,19 +369,26 @@ struct Builder {
     return writeSummary(node);
   }
 
+  // The whole tree from the leaf cells alone (nodes: leaves first, then level by level), then
+  // every node built as soon as its children are.
   Status run() {
+    if (chunks.triangleCounts().empty())
+      return Error{ErrorKind::kBadInput, "the input has no triangles"};
+    planTree();
+    LODFORGE_TRY(buildAll());
+    finishRoot();
+    return {};
+  }
+
+  void planTree() {
     std::vector<std::uint32_t> level;
     for (const auto& [index, count] : chunks.triangleCounts()) {
       OctreeNode node;
       node.cell = cellOfIndex(chunks.grid(), index);
       level.push_back(static_cast<std::uint32_t>(result.nodes.size()));
       result.nodes.push_back(std::move(node));
+      inputTriangles.push_back(count);
     }
-    if (level.empty()) return Error{ErrorKind::kBadInput, "the input has no triangles"};
-    std::uint64_t largest = 0;
-    for (const auto& [index, count] : chunks.triangleCounts()) largest = std::max(largest, count);
-    LODFORGE_TRY(
-        forEach(level, "tiles: leaves", largest, [&](OctreeNode& n) { return buildLeaf(n); }));
     int depth = 0;
     while (level.size() > 1 && (options.levels == 0 || depth < options.levels)) {
       ++depth;
@@ -431,42 +406,126 @@ struct Builder {
         node.children = std::move(children);
         parents.push_back(static_cast<std::uint32_t>(result.nodes.size()));
         result.nodes.push_back(std::move(node));
+        inputTriangles.push_back(0);  // known once its children are built
       }
-      largest = 0;
-      for (std::uint32_t p : parents) {
-        std::uint64_t sum = 0;
-        for (std::uint32_t c : result.nodes[p].children) sum += result.nodes[c].triangles;
-        largest = std::max(largest, sum);
-      }
-      LODFORGE_TRY(forEach(parents, fmt::format("tiles: level {}", depth), largest,
-                           [&](OctreeNode& n) { return buildParent(n); }));
       level = std::move(parents);
     }
     result.levels = depth;
-    if (level.size() == 1) {
-      result.root = level[0];
-      return {};
+    topLevel = std::move(level);
+  }
+
+  // Priority among ready nodes: parents before leaves (their children's meshes are freshest in
+  // the page cache, or held in memory), then Morton order of the cell, so that siblings finish
+  // close together and their parent becomes ready early.
+  std::uint64_t priority(std::uint32_t index) const {
+    const OctreeNode& node = result.nodes[index];
+    std::uint64_t morton = 0;
+    for (int bit = 0; bit < 20; ++bit) {
+      for (std::size_t axis = 0; axis < 3; ++axis) {
+        const auto c = static_cast<std::uint64_t>(static_cast<std::uint32_t>(node.cell[axis]));
+        morton |= ((c >> bit) & 1) << (3 * bit + static_cast<int>(axis));
+      }
     }
-    // Stopped below a single root (--levels): a root without content over the top level.
+    return (static_cast<std::uint64_t>(63 - std::min(node.level, 63)) << 58) | (morton >> 6);
+  }
+
+  // Builds every node on `threads` workers, each as soon as its children are done. With a
+  // memory budget, a node starts only while the nodes in progress and it fit in the budget (or
+  // nothing else is in progress). Each node's work is isolated: a worker waiting inside it (in
+  // the simplifier's parallel loops) never picks up another node, which would hold two nodes'
+  // memory on one stack. The first failure wins; nothing new starts after it.
+  Status buildAll() {
+    const auto count = static_cast<std::uint32_t>(result.nodes.size());
+    std::vector<std::uint32_t> parent(count, ~0u), pending(count, 0);
+    for (std::uint32_t i = 0; i < count; ++i) {
+      for (std::uint32_t c : result.nodes[i].children) parent[c] = i;
+      pending[i] = static_cast<std::uint32_t>(result.nodes[i].children.size());
+    }
+    const auto later = [&](std::uint32_t a, std::uint32_t b) { return priority(a) > priority(b); };
+    std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, decltype(later)> ready(later);
+    for (std::uint32_t i = 0; i < count; ++i)
+      if (pending[i] == 0) ready.push(i);
+    Progress progress("tiles: octree", count);
+    std::mutex mutex;  // guards ready, pending, inFlight and failure
+    Status failure;
+    std::uint64_t inFlightBytes = 0;
+    std::uint32_t inFlight = 0;
+    const int threads =
+        options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
+    tbb::task_arena arena(threads);
+    tbb::task_group group;
+    std::function<void()> admit;  // called with the mutex held
+    const auto process = [&](std::uint32_t index, std::uint64_t bytes) {
+      Status status = checkCancelled();
+      if (status.ok()) {
+        tbb::this_task_arena::isolate([&] {
+          OctreeNode& node = result.nodes[index];
+          status = node.level == 0 ? buildLeaf(node) : buildParent(node);
+        });
+      }
+      progress.advance(1);
+      std::lock_guard lock(mutex);
+      inFlightBytes -= bytes;
+      --inFlight;
+      if (!status.ok() && failure.ok()) failure = std::move(status);
+      const std::uint32_t up = parent[index];
+      if (up != ~0u) {
+        inputTriangles[up] += result.nodes[index].triangles;
+        if (--pending[up] == 0) ready.push(up);
+      }
+      admit();
+    };
+    admit = [&] {
+      while (failure.ok() && !ready.empty() && inFlight < static_cast<std::uint32_t>(threads)) {
+        const std::uint32_t next = ready.top();
+        const std::uint64_t bytes = estimateBytes(inputTriangles[next]);
+        if (options.memoryBudget > 0 && inFlight > 0 &&
+            inFlightBytes + bytes > options.memoryBudget)
+          return;  // waits for a node in progress to finish
+        ready.pop();
+        inFlightBytes += bytes;
+        ++inFlight;
+        group.run([&process, next, bytes] { process(next, bytes); });
+      }
+    };
+    arena.execute([&] {
+      {
+        std::lock_guard lock(mutex);
+        admit();
+      }
+      group.wait();
+    });
+    progress.finish();
+    return failure;
+  }
+
+  // Stopped below a single root (--levels): a root without content over the top level.
+  void finishRoot() {
+    if (topLevel.size() == 1) {
+      result.root = topLevel[0];
+      return;
+    }
     OctreeNode root;
-    root.level = depth + 1;
-    root.children = level;
-    for (std::uint32_t c : level) {
+    root.level = result.levels + 1;
+    root.children = topLevel;
+    for (std::uint32_t c : topLevel) {
       root.bounds.add(result.nodes[c].bounds);
       root.geometricError = std::max(root.geometricError, result.nodes[c].geometricError);
     }
     root.geometricError = std::max(root.geometricError * 2, root.bounds.longestSide() / 100);
     result.root = static_cast<std::uint32_t>(result.nodes.size());
     result.nodes.push_back(std::move(root));
-    return {};
   }
+
+  std::vector<std::uint64_t> inputTriangles;  // per node: what it is built from
+  std::vector<std::uint32_t> topLevel;
 };
 
 }  // namespace
 
 Result<OctreeResult> buildOctree(const ChunkWriter& chunks, const OctreeOptions& options,
                                  const NodeSink& sink) {
-  Builder builder{chunks, options, sink, {}, {}, {}};
+  Builder builder{chunks, options, sink, {}, {}, {}, {}, {}};
   if (!options.keepInMemory) std::filesystem::create_directories(options.workDirectory);
   LODFORGE_TRY(builder.run());
   return std::move(builder.result);

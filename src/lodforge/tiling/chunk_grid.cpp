@@ -129,7 +129,8 @@ struct Emitter {
                               static_cast<std::uint8_t>(std::lround(colorSum[1] / n)),
                               static_cast<std::uint8_t>(std::lround(colorSum[2] / n)),
                               static_cast<std::uint8_t>(std::lround(colorSum[3] / n))},
-                             normalizeOr(normalSum, unique[0].normal)};
+                             normalizeOr(normalSum, unique[0].normal),
+                             CutCorner::kNoSource};
     const ChunkCell cell = grid.cellOf(centroid.position);
     if (unique.size() == 3) {
       const Vec3d normal =

@@ -56,6 +56,7 @@ class VertexCache {
     std::memcpy(normal, at + kNormalOffset, sizeof normal);
     out.position = {xyz[0], xyz[1], xyz[2]};
     out.normal = normalizeOr(Vec3f{normal[0], normal[1], normal[2]}, Vec3f{0, 0, 1});
+    out.source = vertex;
     return true;
   }
 
@@ -451,6 +452,7 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
         triangle[k].color =
             input.colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
         triangle[k].normal = normals[object.vertexOffset + v];
+        triangle[k].source = object.vertexOffset + v;
       }
       LODFORGE_TRY(input.chunks->addSegmentTriangle(segmentBounds[component[t / 3]], triangle));
     }

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -65,10 +67,23 @@ void weldExact(MeshPart& mesh) {
   std::vector<Vec3d> positions(next);
   std::vector<Rgba8> colors(mesh.colors.empty() ? 0 : next);
   std::vector<Vec3f> normals(mesh.normals.empty() ? 0 : next);
+  // The members of each group whose normals were summed, as a list through `summedNext`.
+  std::vector<std::uint32_t> summedHead(normals.empty() ? 0 : next, ~0u);
+  std::vector<std::uint32_t> summedNext(normals.empty() ? 0 : count, ~0u);
   for (std::uint32_t v = 0; v < count; ++v) {
-    // Normals of a group are averaged (a part's hard edge, split in the input, meets here).
+    // Distinct normals of a group are averaged (a part's hard edge, split in the input, meets
+    // here); a normal seen already in the group is the same vertex stored again.
     const std::uint32_t to = remap[representative[v]];
-    if (to != ~0u && !normals.empty()) normals[to] = normals[to] + mesh.normals[v];
+    if (to != ~0u && !normals.empty()) {
+      bool seen = false;
+      for (std::uint32_t m = summedHead[to]; m != ~0u && !seen; m = summedNext[m])
+        seen = mesh.normals[m] == mesh.normals[v];
+      if (!seen) {
+        normals[to] = normals[to] + mesh.normals[v];
+        summedNext[v] = summedHead[to];
+        summedHead[to] = v;
+      }
+    }
     if (remap[v] == ~0u) continue;  // not a representative, or unused
     positions[remap[v]] = mesh.positions[v];
     if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
@@ -111,9 +126,12 @@ MeshPart concatenate(std::span<const MeshPart> parts) {
 namespace {
 
 constexpr char kMeshMagic[8] = {'L', 'F', 'M', 'E', 'S', 'H', '2', '\0'};
-// A chunk-file corner: position (3 doubles), colour, normal (octahedral, 2 x 16 bits).
+// A chunk file is a run of blocks, one per append: magic, vertex count, triangle count (u32
+// each), the vertex records, then three u32 indices per triangle into the block's records.
+constexpr char kBlockMagic[4] = {'L', 'F', 'C', 'K'};
+constexpr std::size_t kBlockHeaderBytes = sizeof kBlockMagic + 2 * sizeof(std::uint32_t);
+// A vertex record: position (3 doubles), colour, normal (octahedral, 2 x 16 bits).
 constexpr std::size_t kCornerBytes = 3 * sizeof(double) + sizeof(Rgba8) + sizeof(std::uint32_t);
-constexpr std::size_t kTriangleBytes = 3 * kCornerBytes;
 
 // Octahedral encoding of a unit normal (Cigolle et al. 2014): 0.005 degrees at 16 bits per
 // axis, a third of the bytes of three floats in every chunk-file corner.
@@ -143,6 +161,38 @@ Vec3f decodeNormal(std::uint32_t packed) {
   return normalizeOr(n, Vec3f{0, 0, 1});
 }
 
+void writeRecord(std::byte* out, const CutCorner& corner) {
+  const double xyz[3] = {corner.position.x, corner.position.y, corner.position.z};
+  const std::uint32_t normal = encodeNormal(corner.normal);
+  std::memcpy(out, xyz, sizeof xyz);
+  std::memcpy(out + sizeof xyz, &corner.color, sizeof(Rgba8));
+  std::memcpy(out + sizeof xyz + sizeof(Rgba8), &normal, sizeof normal);
+}
+
+// Appends the vertex records in `bytes` (a whole number of them) to the mesh.
+void appendRecords(std::span<const std::byte> bytes, MeshPart& mesh) {
+  const std::size_t first = mesh.positions.size(), count = bytes.size() / kCornerBytes;
+  mesh.positions.resize(first + count);
+  mesh.colors.resize(first + count);
+  mesh.normals.resize(first + count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::byte* at = bytes.data() + i * kCornerBytes;
+    double xyz[3];
+    std::uint32_t normal;
+    std::memcpy(xyz, at, sizeof xyz);
+    mesh.positions[first + i] = {xyz[0], xyz[1], xyz[2]};
+    std::memcpy(&mesh.colors[first + i], at + sizeof xyz, sizeof(Rgba8));
+    std::memcpy(&normal, at + sizeof xyz + sizeof(Rgba8), sizeof normal);
+    mesh.normals[first + i] = decodeNormal(normal);
+  }
+}
+
+std::uint64_t hashSource(std::uint64_t key) {
+  key ^= key >> 33;
+  key *= 0xFF51AFD7ED558CCDull;
+  return key ^ (key >> 33);
+}
+
 Result<std::vector<std::byte>> readWhole(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return ioError(path, "cannot open");
@@ -154,10 +204,12 @@ Result<std::vector<std::byte>> readWhole(const std::string& path) {
   return bytes;
 }
 
-Status appendTo(const std::string& path, std::span<const std::byte> bytes) {
+Status appendTo(const std::string& path, std::initializer_list<std::span<const std::byte>> parts) {
   std::FILE* file = std::fopen(path.c_str(), "ab");
   if (file == nullptr) return ioErrorFromErrno(path, "open for appending");
-  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
+  bool ok = true;
+  for (std::span<const std::byte> bytes : parts)
+    ok = ok && std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
   const bool closed = std::fclose(file) == 0;
   if (!ok || !closed) return ioErrorFromErrno(path, "append");
   return {};
@@ -261,23 +313,51 @@ Status ChunkWriter::add(const ChunkCell& cell, std::span<const CutCorner, 3> cor
     lastBuffer_ = &buffers_[index];
     lastCount_ = &counts_[index];
   }
-  std::vector<std::byte>& buffer = *lastBuffer_;
-  const std::size_t at = buffer.size();
-  buffer.resize(at + kTriangleBytes);
-  std::byte* out = buffer.data() + at;
-  for (const CutCorner& corner : corners) {
-    const double xyz[3] = {corner.position.x, corner.position.y, corner.position.z};
-    const std::uint32_t normal = encodeNormal(corner.normal);
-    std::memcpy(out, xyz, sizeof xyz);
-    std::memcpy(out + sizeof xyz, &corner.color, sizeof(Rgba8));
-    std::memcpy(out + sizeof xyz + sizeof(Rgba8), &normal, sizeof normal);
-    out += kCornerBytes;
-  }
+  Buffer& buffer = *lastBuffer_;
+  for (const CutCorner& corner : corners) buffer.indices.push_back(vertexOf(buffer, corner));
   ++*lastCount_;
   ++triangles_;
-  buffered_ += kTriangleBytes;
+  buffered_ += 3 * sizeof(std::uint32_t);
   if (buffered_ >= bufferBytes_ && !keepInMemory_) return flush();
   return {};
+}
+
+std::uint32_t ChunkWriter::vertexOf(Buffer& buffer, const CutCorner& corner) {
+  const auto addRecord = [&] {
+    const std::size_t at = buffer.vertices.size();
+    buffer.vertices.resize(at + kCornerBytes);
+    writeRecord(buffer.vertices.data() + at, corner);
+    buffered_ += kCornerBytes;
+    return static_cast<std::uint32_t>(at / kCornerBytes);
+  };
+  if (corner.source == CutCorner::kNoSource) return addRecord();  // made by a cut: weld later
+  if (2 * (std::size_t{buffer.keyCount} + 1) > buffer.keys.size()) {
+    // Grow (a power of two, at most half full) and re-insert.
+    const std::size_t capacity = std::max<std::size_t>(64, 2 * buffer.keys.size());
+    std::vector<std::uint64_t> keys(capacity, 0);
+    std::vector<std::uint32_t> records(capacity);
+    for (std::size_t i = 0; i < buffer.keys.size(); ++i) {
+      if (buffer.keys[i] == 0) continue;
+      std::size_t slot = hashSource(buffer.keys[i]) & (capacity - 1);
+      while (keys[slot] != 0) slot = (slot + 1) & (capacity - 1);
+      keys[slot] = buffer.keys[i];
+      records[slot] = buffer.records[i];
+    }
+    buffered_ += (capacity - buffer.keys.size()) * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+    buffer.keys = std::move(keys);
+    buffer.records = std::move(records);
+  }
+  const std::uint64_t key = corner.source + 1;
+  const std::size_t mask = buffer.keys.size() - 1;
+  std::size_t slot = hashSource(key) & mask;
+  while (buffer.keys[slot] != 0) {
+    if (buffer.keys[slot] == key) return buffer.records[slot];
+    slot = (slot + 1) & mask;
+  }
+  buffer.keys[slot] = key;
+  buffer.records[slot] = addRecord();
+  ++buffer.keyCount;
+  return buffer.records[slot];
 }
 
 Status ChunkWriter::addTriangle(const std::array<CutCorner, 3>& triangle) {
@@ -317,10 +397,16 @@ void cutSegmentTriangle(const ChunkGrid& grid, const Aabbd* segment,
 Status ChunkWriter::flush() {
   if (keepInMemory_) return {};
   for (auto& [index, buffer] : buffers_) {
-    if (buffer.empty()) continue;
-    LODFORGE_TRY(appendTo(chunkPath(cellOfIndex(grid_, index)), buffer));
-    buffer.clear();
-    buffer.shrink_to_fit();
+    if (buffer.indices.empty()) continue;
+    std::byte header[kBlockHeaderBytes];
+    const std::uint32_t counts[2] = {
+        static_cast<std::uint32_t>(buffer.vertices.size() / kCornerBytes),
+        static_cast<std::uint32_t>(buffer.indices.size() / 3)};
+    std::memcpy(header, kBlockMagic, sizeof kBlockMagic);
+    std::memcpy(header + sizeof kBlockMagic, counts, sizeof counts);
+    LODFORGE_TRY(appendTo(chunkPath(cellOfIndex(grid_, index)),
+                          {std::span<const std::byte>(header), buffer.vertices,
+                           std::as_bytes(std::span(buffer.indices))}));
   }
   buffers_.clear();
   lastBuffer_ = nullptr;
@@ -329,25 +415,35 @@ Status ChunkWriter::flush() {
 }
 
 Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string& name) {
-  if (bytes.size() % kTriangleBytes != 0)
-    return badInputAtByte(name, bytes.size() / kTriangleBytes * kTriangleBytes,
-                          "chunk file ends inside a triangle");
-  const std::size_t corners = bytes.size() / kCornerBytes;
   MeshPart mesh;
-  mesh.positions.resize(corners);
-  mesh.colors.resize(corners);
-  mesh.normals.resize(corners);
-  mesh.indices.resize(corners);
-  for (std::size_t i = 0; i < corners; ++i) {
-    const std::byte* at = bytes.data() + i * kCornerBytes;
-    double xyz[3];
-    std::uint32_t normal;
-    std::memcpy(xyz, at, sizeof xyz);
-    mesh.positions[i] = {xyz[0], xyz[1], xyz[2]};
-    std::memcpy(&mesh.colors[i], at + sizeof xyz, sizeof(Rgba8));
-    std::memcpy(&normal, at + sizeof xyz + sizeof(Rgba8), sizeof normal);
-    mesh.normals[i] = decodeNormal(normal);
-    mesh.indices[i] = static_cast<std::uint32_t>(i);
+  std::size_t at = 0;
+  while (at < bytes.size()) {
+    if (bytes.size() - at < kBlockHeaderBytes)
+      return badInputAtByte(name, at, "chunk file ends inside a block header");
+    if (std::memcmp(bytes.data() + at, kBlockMagic, sizeof kBlockMagic) != 0)
+      return badInputAtByte(name, at, "not a chunk block (work file of `lodforge tiles`)");
+    std::uint32_t counts[2];
+    std::memcpy(counts, bytes.data() + at + sizeof kBlockMagic, sizeof counts);
+    const std::uint64_t recordBytes = std::uint64_t{counts[0]} * kCornerBytes;
+    const std::uint64_t indexCount = 3 * std::uint64_t{counts[1]};
+    const std::uint64_t rest = bytes.size() - at - kBlockHeaderBytes;
+    if (recordBytes > rest || indexCount > (rest - recordBytes) / sizeof(std::uint32_t))
+      return badInputAtByte(name, at, "chunk block runs past the end of the file");
+    if (mesh.positions.size() + counts[0] > std::numeric_limits<std::uint32_t>::max())
+      return badInputAtByte(name, at, "chunk file holds more than 2^32 vertices");
+    const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+    const std::byte* records = bytes.data() + at + kBlockHeaderBytes;
+    appendRecords(std::span(records, static_cast<std::size_t>(recordBytes)), mesh);
+    const std::byte* indices = records + recordBytes;
+    for (std::uint64_t i = 0; i < indexCount; ++i) {
+      std::uint32_t v;
+      std::memcpy(&v, indices + 4 * i, sizeof v);
+      if (v >= counts[0])
+        return badInputAtByte(name, static_cast<std::uint64_t>(indices - bytes.data()) + 4 * i,
+                              "chunk file index out of range");
+      mesh.indices.push_back(base + v);
+    }
+    at += kBlockHeaderBytes + static_cast<std::size_t>(recordBytes + 4 * indexCount);
   }
   weldExact(mesh);
   return mesh;
@@ -361,8 +457,12 @@ Result<MeshPart> loadChunk(const std::string& path) {
 
 Result<MeshPart> ChunkWriter::load(const ChunkCell& cell) const {
   const auto it = buffers_.find(grid_.cellIndex(cell));
-  if (it != buffers_.end()) return parseChunk(it->second, chunkPath(cell));
-  return loadChunk(chunkPath(cell));
+  if (it == buffers_.end()) return loadChunk(chunkPath(cell));
+  MeshPart mesh;
+  appendRecords(it->second.vertices, mesh);
+  mesh.indices = it->second.indices;
+  weldExact(mesh);
+  return mesh;
 }
 
 ChunkCell cellOfIndex(const ChunkGrid& grid, std::uint64_t index) {

@@ -1,6 +1,7 @@
-// Chunks on disk (large-meshes paper §3.3–3.4): the input streamed into the chunk grid as
-// triangle soups, one file per non-empty chunk, buffered in memory up to a budget and appended
-// to disk when it is reached; and meshes (a chunk once welded, an octree node once simplified)
+// Chunks on disk (large-meshes paper §3.3–3.4): the input streamed into the chunk grid, one
+// file per non-empty chunk, buffered in memory up to a budget and appended to disk when it is
+// reached (a block per append: the vertices since the last one, an input vertex once, and
+// triangles over them); and meshes (a chunk once welded, an octree node once simplified)
 // saved and reloaded on demand, so only the nodes being built are ever in memory.
 #pragma once
 
@@ -34,7 +35,8 @@ struct MeshPart {
 
 // Welds bit-identical positions (cut vertices are made identical on purpose), drops triangles
 // that repeat a corner and vertices no triangle uses. The first vertex of a group keeps its
-// colour; the group's normals are averaged. Deterministic.
+// colour; the group's distinct normals are averaged (each once, so the result does not depend
+// on how often a vertex was stored). Deterministic.
 void weldExact(MeshPart& mesh);
 
 // Appends `parts`, renumbering their indices.
@@ -82,12 +84,23 @@ class ChunkWriter {
   std::string directory_;
   std::uint64_t bufferBytes_ = 0, buffered_ = 0, triangles_ = 0;
   bool keepInMemory_ = false;
-  std::map<std::uint64_t, std::vector<std::byte>> buffers_;  // by cell index
+  // A chunk's pieces since the last flush: vertex records and triangles over them, with an
+  // open-addressing table from input vertex (source + 1; 0 is empty) to its record.
+  struct Buffer {
+    std::vector<std::byte> vertices;
+    std::vector<std::uint32_t> indices;
+    std::vector<std::uint64_t> keys;
+    std::vector<std::uint32_t> records;
+    std::uint32_t keyCount = 0;
+  };
+  // The record of `corner` in `buffer` (added if new); the bytes it took go to buffered_.
+  std::uint32_t vertexOf(Buffer& buffer, const CutCorner& corner);
+  std::map<std::uint64_t, Buffer> buffers_;  // by cell index
   std::map<std::uint64_t, std::uint64_t> counts_;
   // The chunk the last piece went to: neighbouring triangles mostly share it, so the two map
   // lookups are skipped (map nodes do not move; flush() forgets the buffer).
   std::uint64_t lastIndex_ = ~std::uint64_t{0};
-  std::vector<std::byte>* lastBuffer_ = nullptr;
+  Buffer* lastBuffer_ = nullptr;
   std::uint64_t* lastCount_ = nullptr;
   std::vector<ChunkCell> pieceCells_;  // addTriangle's scratch
   std::vector<CutCorner> pieceCorners_;

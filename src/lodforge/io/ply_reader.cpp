@@ -255,6 +255,47 @@ struct PlyReader::State {
     }
   }
 
+  // A binary element of scalar properties only has a fixed size: read whole, then decoded from
+  // memory (one read per vertex instead of one per property). Empty: not fixed.
+  std::vector<std::size_t> recordOffsets;  // per property; back() is the record size
+  int recordElement = -1;
+  std::vector<std::byte> record;
+  void planRecord(const PlyElement& e);
+  template <class T>
+  double decode(const std::byte* at) const {
+    T value;
+    std::memcpy(&value, at, sizeof value);
+    if constexpr (sizeof(T) == 2) {
+      if (swap) value = std::bit_cast<T>(__builtin_bswap16(std::bit_cast<std::uint16_t>(value)));
+    } else if constexpr (sizeof(T) == 4) {
+      if (swap) value = std::bit_cast<T>(__builtin_bswap32(std::bit_cast<std::uint32_t>(value)));
+    } else if constexpr (sizeof(T) == 8) {
+      if (swap) value = std::bit_cast<T>(__builtin_bswap64(std::bit_cast<std::uint64_t>(value)));
+    }
+    return static_cast<double>(value);
+  }
+  double decodeNumber(const std::byte* at, PlyType type) const {
+    switch (type) {
+      case PlyType::kInt8:
+        return decode<std::int8_t>(at);
+      case PlyType::kUint8:
+        return decode<std::uint8_t>(at);
+      case PlyType::kInt16:
+        return decode<std::int16_t>(at);
+      case PlyType::kUint16:
+        return decode<std::uint16_t>(at);
+      case PlyType::kInt32:
+        return decode<std::int32_t>(at);
+      case PlyType::kUint32:
+        return decode<std::uint32_t>(at);
+      case PlyType::kFloat32:
+        return decode<float>(at);
+      case PlyType::kFloat64:
+        return decode<double>(at);
+    }
+    return 0;
+  }
+
   void readVertex(PlyBatch& batch);
   void readFace(PlyBatch& batch);
   void skipElement(const PlyElement& e);
@@ -433,17 +474,43 @@ void PlyReader::State::checkCountsFitFile() {
   }
 }
 
+void PlyReader::State::planRecord(const PlyElement& e) {
+  recordElement = static_cast<int>(element);
+  recordOffsets.clear();
+  if (header.format == PlyFormat::kAscii) return;
+  std::size_t offset = 0;
+  for (const PlyProperty& p : e.properties) {
+    if (p.isList) {
+      recordOffsets.clear();
+      return;
+    }
+    recordOffsets.push_back(offset);
+    offset += plyTypeSize(p.type);
+  }
+  recordOffsets.push_back(offset);
+  record.resize(offset);
+}
+
 void PlyReader::State::readVertex(PlyBatch& batch) {
   const PlyElement& e = header.elements[element];
   values.resize(e.properties.size());
   beginElement();
-  for (std::size_t i = 0; i < e.properties.size(); ++i) {
-    const PlyProperty& p = e.properties[i];
-    if (p.isList) {
-      skipProperty(e, p);
-      values[i] = 0;
-    } else {
-      values[i] = readNumber(e, p, p.type);
+  if (recordElement != static_cast<int>(element)) planRecord(e);
+  // Whole records while one fits in what is left (otherwise property by property, which says
+  // where the file ends).
+  if (!recordOffsets.empty() && source.remaining() >= record.size()) {
+    if (!source.read(record.data(), record.size())) fail("cannot read a vertex record");
+    for (std::size_t i = 0; i < e.properties.size(); ++i)
+      values[i] = decodeNumber(record.data() + recordOffsets[i], e.properties[i].type);
+  } else {
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const PlyProperty& p = e.properties[i];
+      if (p.isList) {
+        skipProperty(e, p);
+        values[i] = 0;
+      } else {
+        values[i] = readNumber(e, p, p.type);
+      }
     }
   }
   auto value = [&](int role) { return values[static_cast<std::size_t>(role)]; };

@@ -260,6 +260,7 @@ struct PlyReader::State {
   std::vector<std::size_t> recordOffsets;  // per property; back() is the record size
   int recordElement = -1;
   std::vector<std::byte> record;
+  std::vector<std::byte> cornerBytes;  // a binary face's corners
   void planRecord(const PlyElement& e);
   template <class T>
   double decode(const std::byte* at) const {
@@ -563,8 +564,17 @@ void PlyReader::State::readFace(PlyBatch& batch) {
     if (static_cast<int>(i) == roles.faceIndices) {
       corners = readListCount(e, p);
       if (corners > kMaxPolygon) fail(fmt::format("face {}: {} corners", elementDone, corners));
+      // Binary corners in one read (readListCount made sure the file holds them).
+      const bool whole = header.format != PlyFormat::kAscii;
+      const std::size_t size = plyTypeSize(p.type);
+      if (whole) {
+        cornerBytes.resize(corners * size);
+        if (!source.read(cornerBytes.data(), cornerBytes.size()))
+          fail("cannot read a face's corners");
+      }
       for (std::uint64_t k = 0; k < corners; ++k) {
-        const double raw = readNumber(e, p, p.type);
+        const double raw =
+            whole ? decodeNumber(cornerBytes.data() + k * size, p.type) : readNumber(e, p, p.type);
         if (raw < 0 || raw >= static_cast<double>(header.vertexCount)) {
           fail(fmt::format("face {}: vertex index {} out of range (the file has {} vertices)",
                            elementDone, raw, header.vertexCount));

@@ -331,33 +331,38 @@ std::uint32_t ChunkWriter::vertexOf(Buffer& buffer, const CutCorner& corner) {
     return static_cast<std::uint32_t>(at / kCornerBytes);
   };
   if (corner.source == CutCorner::kNoSource) return addRecord();  // made by a cut: weld later
-  if (2 * (std::size_t{buffer.keyCount} + 1) > buffer.keys.size()) {
+  constexpr std::uint32_t kRun = 64, kNoRecord = ~0u;
+  if (2 * (std::size_t{buffer.runCount} + 1) > buffer.runs.size()) {
     // Grow (a power of two, at most half full) and re-insert.
-    const std::size_t capacity = std::max<std::size_t>(64, 2 * buffer.keys.size());
-    std::vector<std::uint64_t> keys(capacity, 0);
-    std::vector<std::uint32_t> records(capacity);
-    for (std::size_t i = 0; i < buffer.keys.size(); ++i) {
-      if (buffer.keys[i] == 0) continue;
-      std::size_t slot = hashSource(buffer.keys[i]) & (capacity - 1);
-      while (keys[slot] != 0) slot = (slot + 1) & (capacity - 1);
-      keys[slot] = buffer.keys[i];
-      records[slot] = buffer.records[i];
+    const std::size_t capacity = std::max<std::size_t>(16, 2 * buffer.runs.size());
+    std::vector<std::uint64_t> runs(capacity, 0);
+    std::vector<std::uint32_t> runBlock(capacity);
+    for (std::size_t i = 0; i < buffer.runs.size(); ++i) {
+      if (buffer.runs[i] == 0) continue;
+      std::size_t slot = hashSource(buffer.runs[i]) & (capacity - 1);
+      while (runs[slot] != 0) slot = (slot + 1) & (capacity - 1);
+      runs[slot] = buffer.runs[i];
+      runBlock[slot] = buffer.runBlock[i];
     }
-    buffered_ += (capacity - buffer.keys.size()) * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
-    buffer.keys = std::move(keys);
-    buffer.records = std::move(records);
+    buffered_ += (capacity - buffer.runs.size()) * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+    buffer.runs = std::move(runs);
+    buffer.runBlock = std::move(runBlock);
   }
-  const std::uint64_t key = corner.source + 1;
-  const std::size_t mask = buffer.keys.size() - 1;
+  const std::uint64_t key = corner.source / kRun + 1;
+  const std::size_t mask = buffer.runs.size() - 1;
   std::size_t slot = hashSource(key) & mask;
-  while (buffer.keys[slot] != 0) {
-    if (buffer.keys[slot] == key) return buffer.records[slot];
-    slot = (slot + 1) & mask;
+  while (buffer.runs[slot] != 0 && buffer.runs[slot] != key) slot = (slot + 1) & mask;
+  if (buffer.runs[slot] == 0) {
+    buffer.runs[slot] = key;
+    buffer.runBlock[slot] = static_cast<std::uint32_t>(buffer.blocks.size() / kRun);
+    buffer.blocks.resize(buffer.blocks.size() + kRun, kNoRecord);
+    buffered_ += kRun * sizeof(std::uint32_t);
+    ++buffer.runCount;
   }
-  buffer.keys[slot] = key;
-  buffer.records[slot] = addRecord();
-  ++buffer.keyCount;
-  return buffer.records[slot];
+  std::uint32_t& record =
+      buffer.blocks[std::size_t{buffer.runBlock[slot]} * kRun + corner.source % kRun];
+  if (record == kNoRecord) record = addRecord();
+  return record;
 }
 
 Status ChunkWriter::addTriangle(const std::array<CutCorner, 3>& triangle) {

@@ -84,14 +84,18 @@ class ChunkWriter {
   std::string directory_;
   std::uint64_t bufferBytes_ = 0, buffered_ = 0, triangles_ = 0;
   bool keepInMemory_ = false;
-  // A chunk's pieces since the last flush: vertex records and triangles over them, with an
-  // open-addressing table from input vertex (source + 1; 0 is empty) to its record.
+  // A chunk's pieces since the last flush: vertex records and triangles over them, and where
+  // each input vertex's record is. Input vertices arrive in runs of nearby numbers (a scan's
+  // rows, looked up again a row later), so the lookup is by runs of 64 numbers: an
+  // open-addressing table from run (+ 1; 0 is empty) to a block of 64 records (~0: none yet).
+  // Consecutive vertices then share a block instead of each taking a random table slot.
   struct Buffer {
     std::vector<std::byte> vertices;
     std::vector<std::uint32_t> indices;
-    std::vector<std::uint64_t> keys;
-    std::vector<std::uint32_t> records;
-    std::uint32_t keyCount = 0;
+    std::vector<std::uint64_t> runs;
+    std::vector<std::uint32_t> runBlock;
+    std::vector<std::uint32_t> blocks;
+    std::uint32_t runCount = 0;
   };
   // The record of `corner` in `buffer` (added if new); the bytes it took go to buffered_.
   std::uint32_t vertexOf(Buffer& buffer, const CutCorner& corner);

@@ -380,6 +380,16 @@ TEST(Octree, NodesFollowTheirChildrenWithinTheBudgetAndTheTreeIsTheSameForAnySch
         });
     EXPECT_TRUE(tree.ok());
     if (!tree.ok()) return out;
+    // Work files go as soon as nothing needs them: every chunk, every mesh but the root's; the
+    // summaries stay (a resumed run reads them).
+    std::size_t meshes = 0, summaries = 0;
+    for (const auto& entry : fs::directory_iterator(options.workDirectory)) {
+      meshes += entry.path().extension() == ".mesh" ? 1 : 0;
+      summaries += entry.path().extension() == ".json" ? 1 : 0;
+    }
+    EXPECT_EQ(meshes, 1u);
+    EXPECT_EQ(summaries, tree->nodes.size());
+    EXPECT_TRUE(fs::is_empty(work + "/chunks"));
     for (const OctreeNode& node : tree->nodes) {
       for (std::uint32_t c : node.children) EXPECT_EQ(done.count(tree->nodes[c].meshPath), 1u);
     }
@@ -403,6 +413,56 @@ TEST(Octree, NodesFollowTheirChildrenWithinTheBudgetAndTheTreeIsTheSameForAnySch
       EXPECT_EQ(other->meshes.at(name).positions, mesh.positions) << name;
     }
   }
+}
+
+TEST(Octree, AResumedBuildSkipsFinishedNodesWhoseWorkFilesAreGone) {
+  // A run stopped at its root (the sink fails there): every other node is finished and the
+  // meshes below level 1 are already removed. Resumed, only the root is built, the same as
+  // in an uninterrupted run.
+  const MeshPart input = heightfield(100);
+  Aabbd box;
+  for (const Vec3d& p : input.positions) box.add(p);
+  const std::string work = ::testing::TempDir() + "/octree-resume";
+  fs::remove_all(work);
+  ChunkWriter chunks(ChunkGrid::over(box, 10), work + "/chunks", 1 << 20);
+  for (std::size_t t = 0; t < input.indices.size(); t += 3) {
+    std::array<CutCorner, 3> triangle;
+    for (std::size_t k = 0; k < 3; ++k)
+      triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}, {0, 0, 1}};
+    ASSERT_TRUE(chunks.addTriangle(triangle).ok());
+  }
+  ASSERT_TRUE(chunks.flush().ok());
+  OctreeOptions options;
+  options.errorSamples = 500;
+  const Built whole = build(input, 10, options, work + "-whole");
+  const int rootLevel = whole.tree.nodes[whole.tree.root].level;
+  ASSERT_GE(rootLevel, 2);
+  options.threads = 2;
+  options.workDirectory = work + "/nodes";
+  fs::create_directories(options.workDirectory);
+  Result<OctreeResult> stopped =
+      buildOctree(chunks, options, [&](const OctreeNode& node, const MeshPart&) -> Status {
+        if (node.level == rootLevel) return Error{ErrorKind::kCancelled, "stopped"};
+        return {};
+      });
+  ASSERT_FALSE(stopped.ok());
+  options.resume = true;
+  std::vector<int> built;
+  MeshPart root;
+  Result<OctreeResult> resumed =
+      buildOctree(chunks, options, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
+        built.push_back(node.level);
+        root = mesh;
+        return {};
+      });
+  ASSERT_TRUE(resumed.ok()) << resumed.error().message;
+  ASSERT_EQ(built.size(), 1u);  // the root alone
+  EXPECT_EQ(built[0], resumed->nodes[resumed->root].level);
+  // The same root as an uninterrupted build.
+  EXPECT_EQ(root.indices, whole.meshes.at(whole.tree.root).indices);
+  EXPECT_EQ(root.positions, whole.meshes.at(whole.tree.root).positions);
+  EXPECT_EQ(resumed->nodes[resumed->root].geometricError,
+            whole.tree.nodes[whole.tree.root].geometricError);
 }
 
 }  // namespace

@@ -264,11 +264,16 @@ struct Builder {
     return {};
   }
 
+  // A node is done when its summary is there and its mesh too, unless its parent is done as
+  // well (which removed the mesh: nothing needs it any more).
   bool readSummary(OctreeNode& node) const {
     if (!options.resume || options.keepInMemory) return false;
     const std::string mesh = meshPath(node);
     std::ifstream in(summaryPath(mesh));
-    if (!in || !std::filesystem::exists(mesh)) return false;
+    const auto up = parentOf[static_cast<std::size_t>(&node - result.nodes.data())];
+    const bool parentDone =
+        up != kNoParent && std::filesystem::exists(summaryPath(meshPath(result.nodes[up])));
+    if (!in || (!parentDone && !std::filesystem::exists(mesh))) return false;
     try {
       const nlohmann::json summary = nlohmann::json::parse(in);
       const auto& b = summary.at("bounds");
@@ -296,7 +301,11 @@ struct Builder {
     node.meshPath = meshPath(node);
     LODFORGE_TRY(sink(node, *mesh));
     LODFORGE_TRY(save(std::move(*mesh), node.meshPath));
-    return writeSummary(node);
+    LODFORGE_TRY(writeSummary(node));
+    // The chunk is no longer needed, even to resume: its work file goes now, while its pages
+    // may still be unwritten, rather than in one long removal at the end.
+    if (!options.keepInMemory) removeWorkFile(chunks.chunkPath(node.cell));
+    return {};
   }
 
   Status buildParent(OctreeNode& node) {
@@ -366,7 +375,17 @@ struct Builder {
     node.meshPath = meshPath(node);
     LODFORGE_TRY(sink(node, mesh));
     LODFORGE_TRY(save(std::move(mesh), node.meshPath));
-    return writeSummary(node);
+    LODFORGE_TRY(writeSummary(node));
+    // The children's meshes are no longer needed, even to resume (their summaries stay).
+    if (!options.keepInMemory) {
+      for (std::uint32_t c : node.children) removeWorkFile(result.nodes[c].meshPath);
+    }
+    return {};
+  }
+
+  static void removeWorkFile(const std::string& path) {
+    std::error_code ignored;  // what is left goes with the work directory
+    std::filesystem::remove(path, ignored);
   }
 
   // The whole tree from the leaf cells alone (nodes: leaves first, then level by level), then
@@ -412,6 +431,9 @@ struct Builder {
     }
     result.levels = depth;
     topLevel = std::move(level);
+    parentOf.assign(result.nodes.size(), kNoParent);
+    for (std::uint32_t i = 0; i < result.nodes.size(); ++i)
+      for (std::uint32_t c : result.nodes[i].children) parentOf[c] = i;
   }
 
   // Priority among ready nodes: parents before leaves (their children's meshes are freshest in
@@ -436,11 +458,9 @@ struct Builder {
   // memory on one stack. The first failure wins; nothing new starts after it.
   Status buildAll() {
     const auto count = static_cast<std::uint32_t>(result.nodes.size());
-    std::vector<std::uint32_t> parent(count, ~0u), pending(count, 0);
-    for (std::uint32_t i = 0; i < count; ++i) {
-      for (std::uint32_t c : result.nodes[i].children) parent[c] = i;
+    std::vector<std::uint32_t> pending(count, 0);
+    for (std::uint32_t i = 0; i < count; ++i)
       pending[i] = static_cast<std::uint32_t>(result.nodes[i].children.size());
-    }
     const auto later = [&](std::uint32_t a, std::uint32_t b) { return priority(a) > priority(b); };
     std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, decltype(later)> ready(later);
     for (std::uint32_t i = 0; i < count; ++i)
@@ -468,8 +488,8 @@ struct Builder {
       inFlightBytes -= bytes;
       --inFlight;
       if (!status.ok() && failure.ok()) failure = std::move(status);
-      const std::uint32_t up = parent[index];
-      if (up != ~0u) {
+      const std::uint32_t up = parentOf[index];
+      if (up != kNoParent) {
         inputTriangles[up] += result.nodes[index].triangles;
         if (--pending[up] == 0) ready.push(up);
       }
@@ -517,7 +537,9 @@ struct Builder {
     result.nodes.push_back(std::move(root));
   }
 
+  static constexpr std::uint32_t kNoParent = ~0u;
   std::vector<std::uint64_t> inputTriangles;  // per node: what it is built from
+  std::vector<std::uint32_t> parentOf;        // per node (kNoParent for the top level)
   std::vector<std::uint32_t> topLevel;
 };
 
@@ -525,7 +547,7 @@ struct Builder {
 
 Result<OctreeResult> buildOctree(const ChunkWriter& chunks, const OctreeOptions& options,
                                  const NodeSink& sink) {
-  Builder builder{chunks, options, sink, {}, {}, {}, {}, {}};
+  Builder builder{chunks, options, sink, {}, {}, {}, {}, {}, {}};
   if (!options.keepInMemory) std::filesystem::create_directories(options.workDirectory);
   LODFORGE_TRY(builder.run());
   return std::move(builder.result);

@@ -184,39 +184,77 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
     ~Closer() { ::close(fd); }
   } closer{fd};
   {
+    // Two stages over batches, so that parsing the next batch overlaps writing this one (the
+    // copy into the page cache is a large part of the pass): read (the reader is sequential),
+    // then transform, bound and write in file order.
     Progress progress("tiles: vertices", header.vertexCount);
-    PlyBatch batch;
+    // Each stage keeps its own failure; `failed` tells the other one to stop.
+    Status readFailure, writeFailure;
+    std::atomic<bool> failed = false;
     std::vector<std::byte> buffer;
-    while (true) {
-      Result<bool> more = vertices->next(batch);
-      if (!more) return more.status();
-      if (!*more) break;
-      if (batch.kind != PlyBatch::Kind::kVertices) continue;
-      buffer.resize(batch.positions.size() * kVertexBytes);
-      for (std::size_t i = 0; i < batch.positions.size(); ++i) {
-        Vec3d p = batch.positions[i];
-        if (options.transform && !options.transform(batch.positions[i], p))
-          return badInput(path, fmt::format("vertex {}: cannot be transformed to the tileset's "
-                                            "frame (outside the coordinate system?)",
-                                            batch.first + i));
+    const auto readBatch = [&](tbb::flow_control& control) -> std::shared_ptr<PlyBatch> {
+      auto batch = std::make_shared<PlyBatch>();
+      while (!failed) {
+        Status status = checkCancelled();
+        Result<bool> more = status.ok() ? vertices->next(*batch) : Result<bool>(status);
+        if (!more) {
+          readFailure = more.status();
+          failed = true;
+          break;
+        }
+        if (!*more) break;
+        if (batch->kind == PlyBatch::Kind::kVertices) return batch;
+      }
+      control.stop();
+      return nullptr;
+    };
+    const auto writeBatch = [&](std::shared_ptr<PlyBatch> batch) {
+      if (failed) return;
+      buffer.resize(batch->positions.size() * kVertexBytes);
+      for (std::size_t i = 0; i < batch->positions.size(); ++i) {
+        Vec3d p = batch->positions[i];
+        if (options.transform && !options.transform(batch->positions[i], p)) {
+          failed = true;
+          writeFailure =
+              badInput(path, fmt::format("vertex {}: cannot be transformed to the tileset's "
+                                         "frame (outside the coordinate system?)",
+                                         batch->first + i));
+          return;
+        }
         input.bounds.add(p);
         const double xyz[3] = {p.x, p.y, p.z};
-        const Rgba8 color = batch.colors.empty() ? Rgba8{255, 255, 255, 255} : batch.colors[i];
+        const Rgba8 color = batch->colors.empty() ? Rgba8{255, 255, 255, 255} : batch->colors[i];
         // The file's normals (turned with the positions), or zero for the normals pass to fill.
-        const Vec3f n = batch.normals.empty()
+        const Vec3f n = batch->normals.empty()
                             ? Vec3f{}
-                            : transformNormal(options, batch.positions[i], p, batch.normals[i]);
+                            : transformNormal(options, batch->positions[i], p, batch->normals[i]);
         const float normal[3] = {n.x, n.y, n.z};
         std::byte* record = buffer.data() + i * kVertexBytes;
         std::memcpy(record, xyz, sizeof xyz);
         std::memcpy(record + sizeof xyz, &color, sizeof color);
         std::memcpy(record + kNormalOffset, normal, sizeof normal);
       }
-      if (::write(fd, buffer.data(), buffer.size()) != static_cast<ssize_t>(buffer.size()))
-        return ioErrorFromErrno(vertexPath, "write");
-      progress.advance(batch.positions.size());
-      LODFORGE_TRY(checkCancelled());
+      if (::write(fd, buffer.data(), buffer.size()) != static_cast<ssize_t>(buffer.size())) {
+        failed = true;
+        writeFailure = ioErrorFromErrno(vertexPath, "write");
+        return;
+      }
+      progress.advance(batch->positions.size());
+    };
+    const auto pipeline = [&] {
+      using Work = std::shared_ptr<PlyBatch>;
+      tbb::parallel_pipeline(
+          3, tbb::make_filter<void, Work>(tbb::filter_mode::serial_in_order, readBatch) &
+                 tbb::make_filter<Work, void>(tbb::filter_mode::serial_in_order, writeBatch));
+    };
+    if (options.threads > 0) {
+      tbb::task_arena arena(options.threads);
+      arena.execute(pipeline);
+    } else {
+      pipeline();
     }
+    LODFORGE_TRY(writeFailure);  // the earlier batch's, if both failed
+    LODFORGE_TRY(readFailure);
     progress.finish();
   }
   if (input.bounds.empty()) return badInput(path, "no vertices");

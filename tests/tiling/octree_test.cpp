@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -110,6 +111,22 @@ MeshPart heightfieldWithCubes(int n, int cubes, std::uint64_t seed) {
     }
   }
   return mesh;
+}
+
+// `input` cut into a grid of `chunkSize` cubes, in chunk files under `directory`.
+std::unique_ptr<ChunkWriter> chunksOf(const MeshPart& input, double chunkSize,
+                                      const std::string& directory) {
+  Aabbd box;
+  for (const Vec3d& p : input.positions) box.add(p);
+  auto chunks = std::make_unique<ChunkWriter>(ChunkGrid::over(box, chunkSize), directory, 1 << 20);
+  for (std::size_t t = 0; t < input.indices.size(); t += 3) {
+    std::array<CutCorner, 3> triangle;
+    for (std::size_t k = 0; k < 3; ++k)
+      triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}, {0, 0, 1}};
+    EXPECT_TRUE(chunks->addTriangle(triangle).ok());
+  }
+  EXPECT_TRUE(chunks->flush().ok());
+  return chunks;
 }
 
 // Cuts `input` into a grid and builds the octree, keeping every node's mesh. With `segments`,
@@ -339,8 +356,6 @@ TEST(Octree, NodesFollowTheirChildrenWithinTheBudgetAndTheTreeIsTheSameForAnySch
   // Nodes start as soon as their children are done, across levels; a budget that fits one
   // node at a time keeps them one at a time; and whatever the schedule, the same tree.
   const MeshPart input = heightfield(120);
-  Aabbd box;
-  for (const Vec3d& p : input.positions) box.add(p);
   struct Run {
     std::vector<OctreeNode> nodes;
     std::map<std::string, MeshPart> meshes;
@@ -349,14 +364,7 @@ TEST(Octree, NodesFollowTheirChildrenWithinTheBudgetAndTheTreeIsTheSameForAnySch
   const auto run = [&](int threads, std::uint64_t budget, const std::string& name) {
     const std::string work = ::testing::TempDir() + "/octree-schedule-" + name;
     fs::remove_all(work);
-    ChunkWriter chunks(ChunkGrid::over(box, 10), work + "/chunks", 1 << 20);
-    for (std::size_t t = 0; t < input.indices.size(); t += 3) {
-      std::array<CutCorner, 3> triangle;
-      for (std::size_t k = 0; k < 3; ++k)
-        triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}, {0, 0, 1}};
-      EXPECT_TRUE(chunks.addTriangle(triangle).ok());
-    }
-    EXPECT_TRUE(chunks.flush().ok());
+    const std::unique_ptr<ChunkWriter> chunks = chunksOf(input, 10, work + "/chunks");
     OctreeOptions options;
     options.errorSamples = 500;
     options.threads = threads;
@@ -368,7 +376,7 @@ TEST(Octree, NodesFollowTheirChildrenWithinTheBudgetAndTheTreeIsTheSameForAnySch
     std::atomic<int> atOnce = 0;
     std::set<std::string> done;
     Result<OctreeResult> tree =
-        buildOctree(chunks, options, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
+        buildOctree(*chunks, options, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
           const int now = ++atOnce;
           std::this_thread::sleep_for(std::chrono::milliseconds(5));  // let others overlap
           std::lock_guard lock(mutex);
@@ -420,18 +428,9 @@ TEST(Octree, AResumedBuildSkipsFinishedNodesWhoseWorkFilesAreGone) {
   // meshes below level 1 are already removed. Resumed, only the root is built, the same as
   // in an uninterrupted run.
   const MeshPart input = heightfield(100);
-  Aabbd box;
-  for (const Vec3d& p : input.positions) box.add(p);
   const std::string work = ::testing::TempDir() + "/octree-resume";
   fs::remove_all(work);
-  ChunkWriter chunks(ChunkGrid::over(box, 10), work + "/chunks", 1 << 20);
-  for (std::size_t t = 0; t < input.indices.size(); t += 3) {
-    std::array<CutCorner, 3> triangle;
-    for (std::size_t k = 0; k < 3; ++k)
-      triangle[k] = {input.positions[input.indices[t + k]], {255, 255, 255, 255}, {0, 0, 1}};
-    ASSERT_TRUE(chunks.addTriangle(triangle).ok());
-  }
-  ASSERT_TRUE(chunks.flush().ok());
+  const std::unique_ptr<ChunkWriter> chunks = chunksOf(input, 10, work + "/chunks");
   OctreeOptions options;
   options.errorSamples = 500;
   const Built whole = build(input, 10, options, work + "-whole");
@@ -441,7 +440,7 @@ TEST(Octree, AResumedBuildSkipsFinishedNodesWhoseWorkFilesAreGone) {
   options.workDirectory = work + "/nodes";
   fs::create_directories(options.workDirectory);
   Result<OctreeResult> stopped =
-      buildOctree(chunks, options, [&](const OctreeNode& node, const MeshPart&) -> Status {
+      buildOctree(*chunks, options, [&](const OctreeNode& node, const MeshPart&) -> Status {
         if (node.level == rootLevel) return Error{ErrorKind::kCancelled, "stopped"};
         return {};
       });
@@ -450,7 +449,7 @@ TEST(Octree, AResumedBuildSkipsFinishedNodesWhoseWorkFilesAreGone) {
   std::vector<int> built;
   MeshPart root;
   Result<OctreeResult> resumed =
-      buildOctree(chunks, options, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
+      buildOctree(*chunks, options, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
         built.push_back(node.level);
         root = mesh;
         return {};

@@ -153,28 +153,6 @@ struct PlyReader::State {
     return std::string_view(line).substr(start, linePos - start);
   }
 
-  template <class T>
-  T loadBinary(const PlyElement& e, const PlyProperty& p) {
-    T value;
-    if (!source.read(&value, sizeof value)) {
-      fileEnds(
-          fmt::format("{} {}: file ends inside property '{}' ({} of {} '{}' elements complete)",
-                      e.name, elementDone, p.name, elementDone, e.count, e.name));
-    }
-    if (swap) {
-      if constexpr (sizeof(T) > 1) {
-        if constexpr (sizeof(T) == 2) {
-          value = std::bit_cast<T>(__builtin_bswap16(std::bit_cast<std::uint16_t>(value)));
-        } else if constexpr (sizeof(T) == 4) {
-          value = std::bit_cast<T>(__builtin_bswap32(std::bit_cast<std::uint32_t>(value)));
-        } else {
-          value = std::bit_cast<T>(__builtin_bswap64(std::bit_cast<std::uint64_t>(value)));
-        }
-      }
-    }
-    return value;
-  }
-
   double readNumber(const PlyElement& e, const PlyProperty& p, PlyType type) {
     if (header.format == PlyFormat::kAscii) {
       const std::string_view token = nextToken(e);
@@ -190,25 +168,13 @@ struct PlyReader::State {
       }
       return value;
     }
-    switch (type) {
-      case PlyType::kInt8:
-        return loadBinary<std::int8_t>(e, p);
-      case PlyType::kUint8:
-        return loadBinary<std::uint8_t>(e, p);
-      case PlyType::kInt16:
-        return loadBinary<std::int16_t>(e, p);
-      case PlyType::kUint16:
-        return loadBinary<std::uint16_t>(e, p);
-      case PlyType::kInt32:
-        return loadBinary<std::int32_t>(e, p);
-      case PlyType::kUint32:
-        return loadBinary<std::uint32_t>(e, p);
-      case PlyType::kFloat32:
-        return static_cast<double>(loadBinary<float>(e, p));
-      case PlyType::kFloat64:
-        return loadBinary<double>(e, p);
+    std::byte bytes[8];
+    if (!source.read(bytes, plyTypeSize(type))) {
+      fileEnds(
+          fmt::format("{} {}: file ends inside property '{}' ({} of {} '{}' elements complete)",
+                      e.name, elementDone, p.name, elementDone, e.count, e.name));
     }
-    return 0;
+    return decodeNumber(bytes, type);
   }
 
   // A list's length, checked against what the rest of the file can hold.

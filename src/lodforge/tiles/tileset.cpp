@@ -298,6 +298,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   input.workDirectory = work.path;
   const std::string statePath = work.path + "/state.json";
   const nlohmann::json identity = {
+      {"workFormat", 2},  // 2: indexed chunk blocks; work files of another format start over
       {"input", fs::absolute(path).string()},
       {"bytes", fs::exists(path) ? fs::file_size(path) : 0},
       {"modified", fs::exists(path) ? fs::last_write_time(path).time_since_epoch().count() : 0},

@@ -117,6 +117,14 @@ class VertexCache {
   std::vector<std::uint8_t> dirty_;
 };
 
+// Runs `work` on `threads` threads (0: as many as the process allows).
+template <class Work>
+void runOn(int threads, const Work& work) {
+  if (threads <= 0) return work();
+  tbb::task_arena arena(threads);
+  arena.execute(work);
+}
+
 double chunkSizeFor(const ChunkInputOptions& options, const Aabbd& bounds,
                     std::uint64_t triangles) {
   return options.chunkSize > 0 ? options.chunkSize
@@ -247,12 +255,7 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
           3, tbb::make_filter<void, Work>(tbb::filter_mode::serial_in_order, readBatch) &
                  tbb::make_filter<Work, void>(tbb::filter_mode::serial_in_order, writeBatch));
     };
-    if (options.threads > 0) {
-      tbb::task_arena arena(options.threads);
-      arena.execute(pipeline);
-    } else {
-      pipeline();
-    }
+    runOn(options.threads, pipeline);
     LODFORGE_TRY(writeFailure);  // the earlier batch's, if both failed
     LODFORGE_TRY(readFailure);
     progress.finish();
@@ -403,12 +406,7 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
                     tbb::make_filter<Work, Work>(tbb::filter_mode::parallel, cutBatch) &
                     tbb::make_filter<Work, void>(tbb::filter_mode::serial_in_order, addBatch));
   };
-  if (options.threads > 0) {
-    tbb::task_arena arena(options.threads);
-    arena.execute(pipeline);
-  } else {
-    pipeline();
-  }
+  runOn(options.threads, pipeline);
   LODFORGE_TRY(failure);
   LODFORGE_TRY(input.chunks->flush());
   progress.finish();

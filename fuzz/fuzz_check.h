@@ -3,12 +3,14 @@
 // an inconsistent model) is a finding.
 #pragma once
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
 
 #include "lodforge/core/model.h"
 #include "lodforge/core/status.h"
+#include "lodforge/io/point_batch.h"
 
 namespace lodforge::fuzz {
 
@@ -30,11 +32,26 @@ inline void check(const Result<Model>& result, const std::string& name) {
     }
     return;
   }
-  const Error& error = result.error();
-  if (error.kind != ErrorKind::kBadInput || error.message.rfind(name, 0) != 0) {
-    std::fprintf(stderr, "unexpected error (kind %d): %s\n", static_cast<int>(error.kind),
-                 error.message.c_str());
-    std::abort();
+  checkError(result.error(), name);
+}
+
+// Reads a point reader to its end: every batch with matching attribute arrays, finite positions
+// and unit normals, and `check(batch)` for what the reader promises besides; an error must be
+// bad input whose message starts with `prefix`.
+template <class Reader, class Check>
+void readPoints(Reader& reader, const std::string& prefix, const Check& check) {
+  PointBatch points;
+  while (true) {
+    Result<bool> more = reader.next(points);
+    if (!more) return checkError(more.error(), prefix);
+    if (!*more) return;
+    if (!points.colors.empty() && points.colors.size() != points.size()) std::abort();
+    if (!points.normals.empty() && points.normals.size() != points.size()) std::abort();
+    for (const Vec3d& p : points.positions)
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) std::abort();
+    for (const Vec3f& n : points.normals)
+      if (std::abs(length(n) - 1) > 1e-3f) std::abort();
+    check(points);
   }
 }
 

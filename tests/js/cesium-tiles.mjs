@@ -4,11 +4,9 @@
 //   node cesium-tiles.mjs TILESET_DIR SCREENSHOT.png [--min-coverage 0.02]
 import http from 'node:http';
 import { readFile, writeFile } from 'node:fs/promises';
-import { mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { coverageOf, keepLocal, launchChromium } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const [tilesetDir, screenshot] = process.argv.slice(2);
@@ -79,25 +77,11 @@ const server = http.createServer(async (request, response) => {
 await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
 const port = server.address().port;
 
-const profile = mkdtempSync(path.join(tmpdir(), 'lodforge-chromium-'));
-const context = await chromium.launchPersistentContext(profile, {
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  viewport: { width: 800, height: 600 },
-  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-         '--disable-background-networking', '--disable-component-update', '--disable-sync',
-         '--no-first-run', '--disable-quic'],
-});
+const { context, close: closeBrowser } = await launchChromium();
 const problems = [];
 try {
   const tab = context.pages()[0] ?? await context.newPage();
-  // Nothing may leave this machine: any other host is a failure.
-  await tab.route('**/*', (route) => {
-    const host = new URL(route.request().url()).hostname;
-    if (host === '127.0.0.1' || host === 'localhost') return route.continue();
-    problems.push(`request to ${route.request().url()}`);
-    return route.abort();
-  });
+  await keepLocal(tab, (p) => problems.push(p));
   tab.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
   tab.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
   tab.on('requestfailed', (r) => problems.push(`request failed: ${r.url()}`));
@@ -111,29 +95,14 @@ try {
   const png = await tab.screenshot();
   await writeFile(screenshot, png);
   // Share of pixels that are not the black background.
-  const coverage = await tab.evaluate(async (data) => {
-    const image = new Image();
-    image.src = 'data:image/png;base64,' + data;
-    await image.decode();
-    const canvas = document.createElement('canvas');
-    canvas.width = image.width;
-    canvas.height = image.height;
-    const g = canvas.getContext('2d');
-    g.drawImage(image, 0, 0);
-    const pixels = g.getImageData(0, 0, image.width, image.height).data;
-    let lit = 0;
-    for (let i = 0; i < pixels.length; i += 4)
-      if (pixels[i] + pixels[i + 1] + pixels[i + 2] > 30) lit++;
-    return lit / (pixels.length / 4);
-  }, png.toString('base64'));
+  const coverage = await coverageOf(tab, png, [0, 0, 0]);
   console.log(`coverage ${(100 * coverage).toFixed(1)} % of the pixels; screenshot ${screenshot}`);
   if (coverage < minCoverage) problems.push(`the model covers ${(100 * coverage).toFixed(2)} % of the view`);
 } catch (e) {
   problems.push(String(e));
 } finally {
-  await context.close();
+  await closeBrowser();
   server.close();
-  rmSync(profile, { recursive: true, force: true });
 }
 for (const url of failedRequests) problems.push(`not served: ${url}`);
 if (problems.length > 0) {

@@ -4,10 +4,9 @@
 // screenshot in which the model covers too little.
 //   node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage 0.02]
 import { spawn } from 'node:child_process';
-import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { chromium } from 'playwright-core';
+import { coverageOf, keepLocal, launchChromium } from './chromium.mjs';
 
 const [lodforge, tilesetDir, outDir] = process.argv.slice(2);
 const coverageArg = process.argv.indexOf('--min-coverage');
@@ -32,27 +31,13 @@ const port = await new Promise((resolve, reject) => {
   setTimeout(() => reject(new Error('lodforge serve did not start')), 20000);
 });
 
-const profile = mkdtempSync(path.join(tmpdir(), 'lodforge-chromium-'));
-const context = await chromium.launchPersistentContext(profile, {
-  executablePath: '/usr/bin/chromium',
-  headless: true,
-  viewport: { width: 800, height: 600 },
-  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-         '--disable-background-networking', '--disable-component-update', '--disable-sync',
-         '--no-first-run', '--disable-quic'],
-});
+const { context, close: closeBrowser } = await launchChromium();
 const problems = [];
 try {
   for (const viewer of ['cesium', 'three']) {
     const tab = await context.newPage();
     const mine = (p) => problems.push(`${viewer}: ${p}`);
-    // Nothing may leave this machine.
-    await tab.route('**/*', (route) => {
-      const host = new URL(route.request().url()).hostname;
-      if (host === '127.0.0.1' || host === 'localhost') return route.continue();
-      mine(`request to ${route.request().url()}`);
-      return route.abort();
-    });
+    await keepLocal(tab, mine);
     tab.on('console', (m) => { if (m.type() === 'error') mine(`console: ${m.text()}`); });
     tab.on('pageerror', (e) => mine(`page error: ${e.message}`));
     tab.on('requestfailed', (r) => mine(`request failed: ${r.url()}`));
@@ -71,28 +56,7 @@ try {
     const shot = path.join(outDir, `${viewer}.png`);
     writeFileSync(shot, png);
     // Share of pixels that differ from the page's background (#12151a) and the panel.
-    const coverage = await tab.evaluate(async (data) => {
-      const image = new Image();
-      image.src = 'data:image/png;base64,' + data;
-      await image.decode();
-      const canvas = document.createElement('canvas');
-      canvas.width = image.width;
-      canvas.height = image.height;
-      const g = canvas.getContext('2d');
-      g.drawImage(image, 0, 0);
-      const panel = document.getElementById('panel').getBoundingClientRect();
-      const pixels = g.getImageData(0, 0, image.width, image.height).data;
-      let lit = 0, counted = 0;
-      for (let y = 0; y < image.height; y++) {
-        for (let x = 0; x < image.width; x++) {
-          if (x <= panel.right && y <= panel.bottom) continue;
-          const i = 4 * (y * image.width + x);
-          counted++;
-          if (Math.abs(pixels[i] - 0x12) + Math.abs(pixels[i + 1] - 0x15) + Math.abs(pixels[i + 2] - 0x1a) > 30) lit++;
-        }
-      }
-      return lit / counted;
-    }, png.toString('base64'));
+    const coverage = await coverageOf(tab, png, [0x12, 0x15, 0x1a], 'panel');
     console.log(`${viewer}: ${report.tilesLoaded} tiles loaded, "${stats}", model covers ${(100 * coverage).toFixed(1)} % (${shot})`);
     if (coverage < minCoverage) mine(`the model covers ${(100 * coverage).toFixed(2)} % of the view`);
     await tab.close();
@@ -100,9 +64,8 @@ try {
 } catch (e) {
   problems.push(String(e));
 } finally {
-  await context.close();
+  await closeBrowser();
   server.kill('SIGINT');
-  rmSync(profile, { recursive: true, force: true });
 }
 const exitCode = await new Promise((resolve) => server.on('exit', (code) => resolve(code)));
 if (exitCode !== 0) problems.push(`lodforge serve exited with ${exitCode} after Ctrl-C`);

@@ -1,7 +1,7 @@
 // CesiumJS viewer for the tileset lodforge serve hands out at /tiles/: no Ion token, no online
 // imagery or terrain (no globe), flies to the tileset, shows what is loaded and drawn, and
 // lets the screen-space error be chosen. window.lodforge reports to tests.
-import { formatBytes, formatCount } from '../format.js';
+import { drawnSummary, formatBytes, onScreenSpaceError } from '../format.js';
 
 const Cesium = window.Cesium;
 const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0 });
@@ -37,17 +37,12 @@ async function main() {
   const stats = document.getElementById('stats');
   viewer.scene.postRender.addEventListener(() => {
     stats.textContent =
-      `${drawn.tiles} tiles drawn, ${report.tilesLoaded} loaded · ` +
-      (drawn.points > 0 ? `${formatCount(drawn.points)} points` : `${formatCount(drawn.triangles)} triangles`) +
+      drawnSummary(drawn.tiles, report.tilesLoaded, drawn.points, drawn.triangles) +
       ` · ${formatBytes(tileset.totalMemoryUsageInBytes)} in tiles`;
     report.drawn = drawn;
     drawn = { tiles: 0, triangles: 0, points: 0 };
   });
-  const slider = document.getElementById('sse');
-  slider.addEventListener('input', () => {
-    tileset.maximumScreenSpaceError = Number(slider.value);
-    document.getElementById('sse-value').textContent = slider.value;
-  });
+  onScreenSpaceError((pixels) => { tileset.maximumScreenSpaceError = pixels; });
   await viewer.flyTo(tileset, { duration: 0 });
 }
 

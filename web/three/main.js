@@ -7,7 +7,7 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { MeshoptDecoder } from 'three/examples/jsm/libs/meshopt_decoder.module.js';
 import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
-import { formatBytes, formatCount } from '../format.js';
+import { drawnSummary, formatBytes, formatCount, onScreenSpaceError } from '../format.js';
 
 const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0 });
 
@@ -64,11 +64,7 @@ function main() {
   });
   tiles.addEventListener('tiles-load-end', () => { if (framed && report.tilesLoaded > 0) report.loaded = true; });
 
-  const slider = document.getElementById('sse');
-  slider.addEventListener('input', () => {
-    tiles.errorTarget = Number(slider.value);
-    document.getElementById('sse-value').textContent = slider.value;
-  });
+  onScreenSpaceError((pixels) => { tiles.errorTarget = pixels; });
   window.addEventListener('resize', () => {
     camera.aspect = window.innerWidth / window.innerHeight;
     camera.updateProjectionMatrix();
@@ -85,8 +81,7 @@ function main() {
     const info = renderer.info;
     const points = info.render.points;
     stats.textContent =
-      `${tiles.visibleTiles.size} tiles drawn, ${report.tilesLoaded} loaded · ` +
-      (points > 0 ? `${formatCount(points)} points` : `${formatCount(info.render.triangles)} triangles`) +
+      drawnSummary(tiles.visibleTiles.size, report.tilesLoaded, points, info.render.triangles) +
       ` · ${formatCount(info.memory.geometries)} geometries, ${formatBytes(tiles.lruCache.cachedBytes ?? 0)} cached`;
   });
 }

@@ -223,9 +223,9 @@ struct PlyReader::State {
 
   // A binary element of scalar properties only has a fixed size: read whole, then decoded from
   // memory (one read per vertex instead of one per property). Empty: not fixed.
-  std::vector<std::size_t> recordOffsets;  // per property; back() is the record size
+  std::vector<std::size_t> recordOffsets;  // per property
   int recordElement = -1;
-  std::vector<std::byte> record;
+  std::vector<std::byte> record;  // one element's bytes
   std::vector<std::byte> cornerBytes;  // a binary face's corners
   void planRecord(const PlyElement& e);
   template <class T>
@@ -454,7 +454,6 @@ void PlyReader::State::planRecord(const PlyElement& e) {
     recordOffsets.push_back(offset);
     offset += plyTypeSize(p.type);
   }
-  recordOffsets.push_back(offset);
   record.resize(offset);
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <utility>
 
 namespace lodforge {
 
@@ -100,6 +101,19 @@ void split(const Polygon& polygon, int axis, double coordinate, Polygon& below, 
   }
 }
 
+// The grid planes of `axis` that may pass through [low, high] (the grid's outer faces never
+// cut): callers still test each strictly inside.
+std::pair<std::int32_t, std::int32_t> innerPlanes(const ChunkGrid& grid, int axis, double low,
+                                                  double high) {
+  const auto a = static_cast<std::size_t>(axis);
+  const auto first =
+      static_cast<std::int32_t>(std::max(1.0, std::floor((low - grid.origin[axis]) / grid.size)));
+  const auto last =
+      static_cast<std::int32_t>(std::min(static_cast<double>(grid.dims[a] - 1),
+                                         std::floor((high - grid.origin[axis]) / grid.size) + 1));
+  return {first, last};
+}
+
 struct Emitter {
   const ChunkGrid& grid;
   std::vector<ChunkCell>& cells;
@@ -159,12 +173,7 @@ struct Emitter {
       low = std::min(low, c.position[axis]);
       high = std::max(high, c.position[axis]);
     }
-    const auto a = static_cast<std::size_t>(axis);
-    const auto first =
-        static_cast<std::int32_t>(std::max(1.0, std::floor((low - grid.origin[axis]) / grid.size)));
-    const auto last =
-        static_cast<std::int32_t>(std::min(static_cast<double>(grid.dims[a] - 1),
-                                           std::floor((high - grid.origin[axis]) / grid.size) + 1));
+    const auto [first, last] = innerPlanes(grid, axis, low, high);
     Polygon rest = polygon, below, above;
     for (std::int32_t k = first; k <= last; ++k) {
       const double coordinate = grid.plane(axis, k);
@@ -182,16 +191,11 @@ struct Emitter {
 // is when Emitter::cut splits nothing (the same test, plane by plane).
 bool insideOneCell(const ChunkGrid& grid, const std::array<CutCorner, 3>& triangle) {
   for (int axis = 0; axis < 3; ++axis) {
-    const auto a = static_cast<std::size_t>(axis);
     const double low = std::min(
         {triangle[0].position[axis], triangle[1].position[axis], triangle[2].position[axis]});
     const double high = std::max(
         {triangle[0].position[axis], triangle[1].position[axis], triangle[2].position[axis]});
-    const auto first =
-        static_cast<std::int32_t>(std::max(1.0, std::floor((low - grid.origin[axis]) / grid.size)));
-    const auto last =
-        static_cast<std::int32_t>(std::min(static_cast<double>(grid.dims[a] - 1),
-                                           std::floor((high - grid.origin[axis]) / grid.size) + 1));
+    const auto [first, last] = innerPlanes(grid, axis, low, high);
     for (std::int32_t k = first; k <= last; ++k) {
       const double coordinate = grid.plane(axis, k);
       if (coordinate > low && coordinate < high) return false;

@@ -436,19 +436,16 @@ struct Builder {
       for (std::uint32_t c : result.nodes[i].children) parentOf[c] = i;
   }
 
-  // Priority among ready nodes: parents before leaves (their children's meshes are freshest in
-  // the page cache, or held in memory), then Morton order of the cell, so that siblings finish
-  // close together and their parent becomes ready early.
-  std::uint64_t priority(std::uint32_t index) const {
-    const OctreeNode& node = result.nodes[index];
+  // A cell's Morton code (20 bits per axis, interleaved): siblings are neighbours in it.
+  static std::uint64_t mortonOf(const ChunkCell& cell) {
     std::uint64_t morton = 0;
     for (int bit = 0; bit < 20; ++bit) {
       for (std::size_t axis = 0; axis < 3; ++axis) {
-        const auto c = static_cast<std::uint64_t>(static_cast<std::uint32_t>(node.cell[axis]));
+        const auto c = static_cast<std::uint64_t>(static_cast<std::uint32_t>(cell[axis]));
         morton |= ((c >> bit) & 1) << (3 * bit + static_cast<int>(axis));
       }
     }
-    return (static_cast<std::uint64_t>(63 - std::min(node.level, 63)) << 58) | (morton >> 6);
+    return morton;
   }
 
   // Builds every node on `threads` workers, each as soon as its children are done. With a
@@ -461,7 +458,15 @@ struct Builder {
     std::vector<std::uint32_t> pending(count, 0);
     for (std::uint32_t i = 0; i < count; ++i)
       pending[i] = static_cast<std::uint32_t>(result.nodes[i].children.size());
-    const auto later = [&](std::uint32_t a, std::uint32_t b) { return priority(a) > priority(b); };
+    // Priority among ready nodes: parents before leaves (their children's meshes are freshest
+    // in the page cache, or held in memory), then Morton order of the cell, so that siblings
+    // finish close together and their parent becomes ready early.
+    std::vector<std::uint64_t> morton(count);
+    for (std::uint32_t i = 0; i < count; ++i) morton[i] = mortonOf(result.nodes[i].cell);
+    const auto later = [&](std::uint32_t a, std::uint32_t b) {
+      const int levelA = result.nodes[a].level, levelB = result.nodes[b].level;
+      return levelA != levelB ? levelA < levelB : morton[a] > morton[b];
+    };
     std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, decltype(later)> ready(later);
     for (std::uint32_t i = 0; i < count; ++i)
       if (pending[i] == 0) ready.push(i);

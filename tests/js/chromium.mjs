@@ -1,0 +1,63 @@
+// Debian's chromium, headless through playwright-core, as both browser tests use it: software
+// WebGL (swiftshader), no background traffic, a throwaway profile.
+import { mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import { chromium } from 'playwright-core';
+
+// Returns { context, close }: close() closes the browser and removes its profile.
+export async function launchChromium() {
+  const profile = mkdtempSync(path.join(tmpdir(), 'lodforge-chromium-'));
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: '/usr/bin/chromium',
+    headless: true,
+    viewport: { width: 800, height: 600 },
+    args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+           '--disable-background-networking', '--disable-component-update', '--disable-sync',
+           '--no-first-run', '--disable-quic'],
+  });
+  const close = async () => {
+    await context.close();
+    rmSync(profile, { recursive: true, force: true });
+  };
+  return { context, close };
+}
+
+// Nothing may leave this machine: a request to any other host is aborted and reported.
+export async function keepLocal(tab, report) {
+  await tab.route('**/*', (route) => {
+    const host = new URL(route.request().url()).hostname;
+    if (host === '127.0.0.1' || host === 'localhost') return route.continue();
+    report(`request to ${route.request().url()}`);
+    return route.abort();
+  });
+}
+
+// Share of a screenshot's pixels that differ from the `background` colour ([r, g, b]; a summed
+// difference over 30), leaving out the element `skipId` covers (a stats panel), if given.
+export async function coverageOf(tab, png, background, skipId = null) {
+  return tab.evaluate(async ({ data, background, skipId }) => {
+    const image = new Image();
+    image.src = 'data:image/png;base64,' + data;
+    await image.decode();
+    const canvas = document.createElement('canvas');
+    canvas.width = image.width;
+    canvas.height = image.height;
+    const g = canvas.getContext('2d');
+    g.drawImage(image, 0, 0);
+    const skip = skipId ? document.getElementById(skipId).getBoundingClientRect() : null;
+    const pixels = g.getImageData(0, 0, image.width, image.height).data;
+    let lit = 0, counted = 0;
+    for (let y = 0; y < image.height; y++) {
+      for (let x = 0; x < image.width; x++) {
+        if (skip && x <= skip.right && y <= skip.bottom) continue;
+        const i = 4 * (y * image.width + x);
+        counted++;
+        const difference = Math.abs(pixels[i] - background[0]) +
+            Math.abs(pixels[i + 1] - background[1]) + Math.abs(pixels[i + 2] - background[2]);
+        if (difference > 30) lit++;
+      }
+    }
+    return lit / counted;
+  }, { data: png.toString('base64'), background, skipId });
+}

@@ -225,7 +225,7 @@ struct PlyReader::State {
   // memory (one read per vertex instead of one per property). Empty: not fixed.
   std::vector<std::size_t> recordOffsets;  // per property
   int recordElement = -1;
-  std::vector<std::byte> record;  // one element's bytes
+  std::vector<std::byte> record;       // one element's bytes
   std::vector<std::byte> cornerBytes;  // a binary face's corners
   void planRecord(const PlyElement& e);
   template <class T>

@@ -111,6 +111,62 @@ TEST(ObjRoundTrip, WriterOutputReadsBack) {
     ASSERT_EQ(back->normals[v], model.normals[v]);
 }
 
+TEST(ObjRead, VerticesWithoutFacesAreOneObjectOfAllOfThem) {
+  // As a PLY without faces reads: one object named after the file, no triangles.
+  Result<Model> model = readText("# points\nv 0 0 0\nv 1.5 2 3\nv -1 0 4\n");
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(model->vertexCount(), 3u);
+  EXPECT_EQ(model->triangleCount(), 0u);
+  ASSERT_EQ(model->objectCount(), 1u);
+  EXPECT_EQ(model->objectName(0), "test");
+  EXPECT_EQ(model->objects[0].vertexCount, 3u);
+  EXPECT_EQ(model->positions[1], (Vec3f{1.5f, 2, 3}));
+  EXPECT_FALSE(model->hasColors());
+  EXPECT_TRUE(isConsistent(*model));
+  // Vertex colours are kept.
+  Result<Model> colored = readText("v 0 0 0 1 0 0\nv 1 0 0 0 0 1\n");
+  ASSERT_TRUE(colored.ok()) << colored.error().message;
+  ASSERT_TRUE(colored->hasColors());
+  EXPECT_EQ(colored->colors[1], (Rgba8{0, 0, 255, 255}));
+  // Far from the origin: positions are kept relative to the model's origin.
+  Result<Model> far = readText("v 500000 4000000 10\nv 500001 4000000 10\n");
+  ASSERT_TRUE(far.ok()) << far.error().message;
+  EXPECT_EQ(far->origin + toDouble(far->positions[1]), (Vec3d{500001, 4000000, 10}));
+  // An empty file has no objects.
+  Result<Model> empty = readText("# nothing\n");
+  ASSERT_TRUE(empty.ok());
+  EXPECT_EQ(empty->objectCount(), 0u);
+}
+
+TEST(ObjBadInput, AVertexFileCutAnywhereReadsItsWholeLinesOrNamesTheCutLine) {
+  const std::string text = "v 1.25 -2.5 3\nv 4 5 6\nv 1.5 2.0 7.75\nv 8 9 10\n";
+  for (std::size_t size = 0; size <= text.size(); ++size) {
+    const std::string cut = text.substr(0, size);
+    // Lines with three numbers so far: a cut inside a number still leaves a number.
+    std::uint64_t lines = 0, complete = 0;
+    for (std::size_t start = 0; start < cut.size(); ++lines) {
+      std::size_t end = cut.find('\n', start);
+      if (end == std::string::npos) end = cut.size();
+      const std::string_view line = std::string_view(cut).substr(start, end - start);
+      std::size_t words = 0;
+      for (std::size_t i = 0; i < line.size(); ++i)
+        words += line[i] != ' ' && (i == 0 || line[i - 1] == ' ');
+      complete += words == 4;
+      start = end + 1;
+    }
+    Result<Model> model = readText(cut);
+    if (lines > complete) {  // the last line lacks a coordinate
+      ASSERT_FALSE(model.ok()) << "cut at " << size;
+      EXPECT_EQ(model.error().kind, ErrorKind::kBadInput);
+      EXPECT_NE(model.error().message.find(fmt::format("test.obj:{}: ", lines)), std::string::npos)
+          << "cut at " << size << ": " << model.error().message;
+    } else {
+      ASSERT_TRUE(model.ok()) << "cut at " << size << ": " << model.error().message;
+      EXPECT_EQ(model->vertexCount(), complete) << "cut at " << size;
+    }
+  }
+}
+
 TEST(ObjBadInput, ErrorsNameTheLine) {
   struct Case {
     const char* text;
@@ -122,6 +178,9 @@ TEST(ObjBadInput, ErrorsNameTheLine) {
         Case{"v 0 0 0\nv 1e999 1 2\n", "test.obj:2: expected a finite number, found '1e999'"},
         Case{"v 0 0 0\nv one 1 2\n", "test.obj:2: expected a finite number, found 'one'"},
         Case{"v 0 0\n", "test.obj:1: 'v' needs three coordinates"},
+        Case{"v 0 0 0\nv 1.5 2.0", "test.obj:2: 'v' needs three coordinates"},
+        Case{"v 0 0 0\nv 1.5 2.0 -", "test.obj:2: expected a finite number, found '-'"},
+        Case{"v 0 0 0\nv 1.5 2.0 1e", "test.obj:2: expected a finite number, found '1e'"},
         Case{"vn 0 0 inf\n", "test.obj:1: expected a finite number"},
         Case{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# c\nf 1 2 9\n",
              "test.obj:6: face refers to vertex 9 but the file has 3 vertices"},

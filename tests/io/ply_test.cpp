@@ -1,6 +1,8 @@
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -26,7 +28,8 @@ using Values = std::vector<std::vector<double>>;  // per element: per property, 
 struct PlySpec {
   PlyFormat format = PlyFormat::kBinaryLittleEndian;
   std::vector<Prop> vertexProps;
-  Values vertices;  // one value per scalar property, in order
+  Values vertices;                   // one value per scalar property, in order
+  std::string faceElement = "face";  // or "tristrips"
   std::vector<Prop> faceProps;
   std::vector<Values> faces;  // per face: per property, its values (lists have several)
   std::string extraElements;  // appended header text (elements with no data)
@@ -101,7 +104,7 @@ std::string encodePly(const PlySpec& spec) {
   out += fmt::format("element vertex {}\n", spec.vertices.size());
   declare(spec.vertexProps);
   if (!spec.faceProps.empty()) {
-    out += fmt::format("element face {}\n", spec.faces.size());
+    out += fmt::format("element {} {}\n", spec.faceElement, spec.faces.size());
     declare(spec.faceProps);
   }
   out += spec.extraElements;
@@ -126,20 +129,23 @@ Result<Model> readText(const std::string& text, const std::string& name = "test.
   return readPlyFromMemory(test::bytesOf(text), name);
 }
 
-// A 3x3 grid of integer coordinates as quads: every PLY type can hold them exactly.
-PlySpec gridSpec(PlyFormat format, PlyType coordinate, PlyType countType, PlyType indexType) {
+// A grid of integer coordinates (3x3 quads unless told) as quads: every PLY type can hold them
+// exactly.
+PlySpec gridSpec(PlyFormat format, PlyType coordinate, PlyType countType, PlyType indexType,
+                 int quadsPerSide = 3) {
+  const int side = quadsPerSide + 1;
   PlySpec spec;
   spec.format = format;
   spec.vertexProps = {{"x", coordinate}, {"y", coordinate}, {"z", coordinate}};
-  for (int j = 0; j < 4; ++j) {
-    for (int i = 0; i < 4; ++i)
+  for (int j = 0; j < side; ++j) {
+    for (int i = 0; i < side; ++i)
       spec.vertices.push_back({double(i), double(j), double((i + j) % 3)});
   }
   spec.faceProps = {{"vertex_indices", indexType, true, countType}};
-  for (int j = 0; j < 3; ++j) {
-    for (int i = 0; i < 3; ++i) {
-      const double a = j * 4 + i;
-      spec.faces.push_back({{a, a + 1, a + 5, a + 4}});
+  for (int j = 0; j < quadsPerSide; ++j) {
+    for (int i = 0; i < quadsPerSide; ++i) {
+      const double a = j * side + i;
+      spec.faces.push_back({{a, a + 1, a + side + 1, a + side}});
     }
   }
   return spec;
@@ -426,12 +432,180 @@ TEST(PlySalvage, TruncatedFacesKeepTheCompleteOnes) {
   EXPECT_EQ(model->triangleCount(), 16u);  // 8 complete quads
 }
 
+// --- triangle strips ------------------------------------------------------------------------
+
+// gridSpec's 4x4 quads as two triangle strips: quad rows 0 and 1 in one strip with a restart
+// (-1) between them, rows 2 and 3 in the other, joined by repeating the last index of row 2 and
+// the first of row 3 (four degenerate triangles).
+PlySpec stripSpec(PlyFormat format, PlyType countType, PlyType indexType) {
+  PlySpec spec = gridSpec(format, PlyType::kFloat32, countType, indexType, 4);
+  constexpr int kSide = 5;
+  const double restart = indexType == PlyType::kUint32 ? 4294967295.0 : -1.0;  // -1 as a uint
+  const auto row = [](int j) {
+    std::vector<double> indices;
+    for (int i = 0; i < kSide; ++i)
+      indices.insert(indices.end(), {double((j + 1) * kSide + i), double(j * kSide + i)});
+    return indices;
+  };
+  std::vector<double> first = row(0), second = row(2);
+  const std::vector<double> row1 = row(1), row3 = row(3);
+  first.push_back(restart);
+  first.insert(first.end(), row1.begin(), row1.end());
+  second.insert(second.end(), {second.back(), row3.front()});
+  second.insert(second.end(), row3.begin(), row3.end());
+  spec.faceElement = "tristrips";
+  spec.faces = {{first}, {second}};
+  return spec;
+}
+
+// Triangles with their winding, each turned to start at its smallest index.
+std::multiset<std::array<std::uint32_t, 3>> orientedTriangles(
+    const std::vector<std::uint32_t>& indices) {
+  std::multiset<std::array<std::uint32_t, 3>> out;
+  for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+    std::array<std::uint32_t, 3> corners = {indices[t], indices[t + 1], indices[t + 2]};
+    std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end()), corners.end());
+    out.insert(corners);
+  }
+  return out;
+}
+
+TEST(PlyStrips, ReadAsTheTrianglesOfTheSameMeshAsFacesFacingTheSameWay) {
+  Result<Model> faces = readText(encodePly(
+      gridSpec(PlyFormat::kAscii, PlyType::kFloat32, PlyType::kUint8, PlyType::kInt32, 4)));
+  ASSERT_TRUE(faces.ok()) << faces.error().message;
+  ASSERT_EQ(faces->triangleCount(), 32u);
+  const std::pair<PlyType, PlyType> listTypes[] = {{PlyType::kUint8, PlyType::kInt32},
+                                                   {PlyType::kInt32, PlyType::kInt32},
+                                                   {PlyType::kUint8, PlyType::kUint32},
+                                                   {PlyType::kInt32, PlyType::kUint32}};
+  for (PlyFormat format :
+       {PlyFormat::kAscii, PlyFormat::kBinaryLittleEndian, PlyFormat::kBinaryBigEndian}) {
+    for (const auto& [countType, indexType] : listTypes) {
+      const std::string what = fmt::format("{}, list {} {}", plyFormatName(format),
+                                           plyTypeName(countType), plyTypeName(indexType));
+      Result<Model> strips = readText(encodePly(stripSpec(format, countType, indexType)));
+      ASSERT_TRUE(strips.ok()) << strips.error().message << " (" << what << ")";
+      EXPECT_EQ(strips->objectCount(), 1u) << what;
+      EXPECT_EQ(strips->positions, faces->positions) << what;
+      // Restarted and joined: 2 x 16 triangles, the join's 4 degenerate ones dropped.
+      ASSERT_EQ(strips->triangleCount(), 32u) << what;
+      EXPECT_EQ(orientedTriangles(strips->indices), orientedTriangles(faces->indices)) << what;
+      // A height field over x and y, seen from above: every triangle faces up.
+      const auto& p = strips->positions;
+      const auto& i = strips->indices;
+      for (std::size_t t = 0; t < i.size(); t += 3)
+        ASSERT_GT(cross(p[i[t + 1]] - p[i[t]], p[i[t + 2]] - p[i[t]]).z, 0.0f) << what;
+    }
+  }
+}
+
+TEST(PlyStrips, HeaderCountsTheirTrianglesAndBatchesStreamThem) {
+  const std::string text =
+      encodePly(stripSpec(PlyFormat::kBinaryBigEndian, PlyType::kUint8, PlyType::kInt32));
+  Result<Model> whole = readText(text);
+  ASSERT_TRUE(whole.ok()) << whole.error().message;
+  // Every reader's header counts them, also one for vertices only (a tileset's first pass): a
+  // strip file is a mesh, not a point cloud.
+  PlyReadOptions verticesOnly;
+  verticesOnly.readFaces = false;
+  Result<PlyReader> vertices = PlyReader::fromMemory(test::bytesOf(text), "s.ply", verticesOnly);
+  ASSERT_TRUE(vertices.ok()) << vertices.error().message;
+  EXPECT_EQ(vertices->header().faceCount, 32u);
+  EXPECT_EQ(vertices->header().stripCount, 2u);
+  PlyBatch batch;
+  std::uint64_t vertexCount = 0;
+  while (true) {
+    Result<bool> more = vertices->next(batch);
+    ASSERT_TRUE(more.ok()) << more.error().message;
+    if (!*more) break;
+    ASSERT_EQ(batch.kind, PlyBatch::Kind::kVertices);
+    vertexCount += batch.count;
+  }
+  EXPECT_EQ(vertexCount, 25u);
+
+  // Batches of 5 triangles: strips go on from one batch to the next.
+  PlyReadOptions options;
+  options.batchSize = 5;
+  Result<PlyReader> reader = PlyReader::fromMemory(test::bytesOf(text), "s.ply", options);
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  std::vector<std::uint32_t> triangles;
+  std::uint64_t faceBatches = 0;
+  while (true) {
+    Result<bool> more = reader->next(batch);
+    ASSERT_TRUE(more.ok()) << more.error().message;
+    if (!*more) break;
+    if (batch.kind != PlyBatch::Kind::kFaces) continue;
+    ++faceBatches;
+    ASSERT_EQ(batch.first, triangles.size() / 3);
+    ASSERT_EQ(batch.count * 3, batch.triangles.size());
+    ASSERT_LE(batch.count, 5u);
+    triangles.insert(triangles.end(), batch.triangles.begin(), batch.triangles.end());
+  }
+  EXPECT_EQ(triangles, whole->indices);
+  EXPECT_EQ(faceBatches, 7u);  // 32 triangles
+}
+
+TEST(PlyStrips, ACutStripIsRefusedOrSalvagedUpToItsLastWholeTriangle) {
+  for (PlyFormat format : {PlyFormat::kBinaryLittleEndian, PlyFormat::kAscii}) {
+    const std::string whole = encodePly(stripSpec(format, PlyType::kUint8, PlyType::kInt32));
+    // The second strip loses its last 7 indices (in binary the cut splits the first of them):
+    // 9 of its 16 triangles are whole.
+    const std::string cut = format == PlyFormat::kAscii
+                                ? whole.substr(0, whole.rfind("16 22 17 23 18 24 19 \n"))
+                                : whole.substr(0, whole.size() - 4 * 7 + 2);
+    Result<Model> strict = readText(cut, "cut.ply");
+    ASSERT_FALSE(strict.ok());
+    EXPECT_EQ(strict.error().kind, ErrorKind::kBadInput);
+    EXPECT_NE(strict.error().message.find("tristrips 1"), std::string::npos)
+        << strict.error().message;
+    std::vector<std::string> warnings;
+    PlyReadOptions options;
+    options.salvageTruncated = true;
+    options.warnings = &warnings;
+    Result<Model> salvaged = readPlyFromMemory(test::bytesOf(cut), "cut.ply", options);
+    ASSERT_TRUE(salvaged.ok()) << salvaged.error().message;
+    ASSERT_EQ(salvaged->triangleCount(), 25u) << plyFormatName(format);
+    Result<Model> full = readText(whole);
+    ASSERT_TRUE(full.ok());
+    EXPECT_TRUE(
+        std::equal(salvaged->indices.begin(), salvaged->indices.end(), full->indices.begin()));
+    EXPECT_EQ(warnings.size(), 1u);
+  }
+}
+
+TEST(PlyStrips, ReadBesideFacesAndOtherPropertiesButNotBesideObjectIds) {
+  // Faces, then strips whose index list sits between two other properties.
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n{}"
+      "element tristrips 2\nproperty uchar flags\nproperty list int int vertex_indices\n"
+      "property float quality\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n";
+  const std::string text =
+      fmt::format(fmt::runtime(header), "") + "3 0 1 2\n7 4 1 3 0 2 0.5\n1 0 0.25\n";
+  Result<PlyReader> reader = PlyReader::fromMemory(test::bytesOf(text), "both.ply");
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  EXPECT_EQ(reader->header().faceCount, 3u);  // 1 face and 2 strip triangles
+  Result<Model> model = readText(text);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(model->indices, (std::vector<std::uint32_t>{0, 1, 2, 1, 3, 0, 0, 3, 2}));
+
+  // Strips carry no object id: beside faces that do, their triangles would have no object.
+  const std::string ids = fmt::format(fmt::runtime(header), "property int object_id\n") +
+                          "3 0 1 2 7\n7 4 1 3 0 2 0.5\n1 0 0.25\n";
+  model = readText(ids);
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.error().kind, ErrorKind::kUnsupported);
+  EXPECT_NE(model.error().message.find("object ids and 'tristrips'"), std::string::npos)
+      << model.error().message;
+}
+
 // --- bad input ------------------------------------------------------------------------------
 
 struct BadCase {
   const char* name;
   std::string text;
-  const char* expected;  // part of the message
+  std::string expected;  // part of the message
 };
 
 std::string binaryHeader(std::uint64_t vertices, std::uint64_t faces) {
@@ -454,12 +628,31 @@ std::string face(std::initializer_list<std::int32_t> indices) {
   return out;
 }
 
+// Three vertices and one strip, binary little-endian or ascii, with the strip's list types.
+std::string stripHeader(PlyFormat format, std::string_view listTypes = "int int") {
+  return fmt::format(
+      "ply\nformat {} 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
+      "z\nelement tristrips 1\nproperty list {} vertex_indices\nend_header\n",
+      plyFormatName(format), listTypes);
+}
+
+// A binary strip: an int length, int indices.
+std::string strip(std::initializer_list<std::int32_t> indices) {
+  const auto length = static_cast<std::int32_t>(indices.size());
+  std::string out(reinterpret_cast<const char*>(&length), 4);
+  for (std::int32_t i : indices) out.append(reinterpret_cast<const char*>(&i), 4);
+  return out;
+}
+
 TEST(PlyBadInput, EveryMalformationIsABadInputErrorWithAPosition) {
   const std::string ascii =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float "
       "z\n"
       "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
   const std::string nan = std::string(1, '\0') + floats({std::numeric_limits<float>::quiet_NaN()});
+  const std::string binaryStrip =
+      stripHeader(PlyFormat::kBinaryLittleEndian) + floats({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const std::string asciiStrip = stripHeader(PlyFormat::kAscii) + "0 0 0\n1 0 0\n0 1 0\n";
   const BadCase cases[] = {
       {"wrong magic", "plx\nformat ascii 1.0\n", "byte 0: not a PLY file"},
       {"empty", "", "not a PLY file"},
@@ -510,6 +703,25 @@ TEST(PlyBadInput, EveryMalformationIsABadInputErrorWithAPosition) {
       {"ascii extra", ascii + "0 0 0 9\n1 0 0\n0 1 0\n3 0 1 2\n", "unexpected '9'"},
       {"ascii fraction index", ascii + "0 0 0\n1 0 0\n0 1 0\n3 0 1.5 2\n", "expected an integer"},
       {"ascii huge list", ascii + "0 0 0\n1 0 0\n0 1 0\n255 0 1 2\n", "claims 255 items"},
+      // The index's own byte (after the 36 of the vertices, 4 of the length, 3 indices).
+      {"strip index out of range", binaryStrip + strip({0, 1, 2, 3}),
+       fmt::format("byte {}: tristrips 0: vertex index 3 out of range (the file has 3 vertices)",
+                   binaryStrip.size() + 4 + 12)},
+      {"negative strip index", binaryStrip + strip({0, 1, -1, 2, -2}),
+       "tristrips 0: vertex index -2 out of range"},
+      {"cut strip", binaryStrip + strip({0, 1, 2, 1}).substr(0, 14),
+       "tristrips 0: list 'vertex_indices' claims 4 items"},
+      // The index's own line: the strip goes on over a second line.
+      {"ascii strip index out of range", asciiStrip + "5 0 1 2\n-1 3\n",
+       ":14: tristrips 0: vertex index 3 out of range"},
+      {"ascii fraction strip index", asciiStrip + "3 0 1 1.5\n", "expected an integer"},
+      {"strip without indices",
+       "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty "
+       "float z\nelement tristrips 0\nproperty int vertex_indices\nend_header\n",
+       "tristrips element lacks the list 'vertex_indices'"},
+      {"float strip indices",
+       stripHeader(PlyFormat::kAscii, "uchar float") + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+       "tristrips vertex indices must have an integer type"},
   };
   for (const BadCase& c : cases) {
     Result<Model> model = readText(c.text, "bad.ply");

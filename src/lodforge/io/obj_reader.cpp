@@ -100,6 +100,26 @@ Rgba8 toRgba(double r, double g, double b) {
   return {c(r), c(g), c(b), 255};
 }
 
+// A file of vertices and no faces (a point cloud, or a mesh cut short before its faces) reads as
+// one object of all its vertices and no triangles, as a PLY without faces does.
+void addVerticesOnly(Model& model, const tinyobj::attrib_t& attrib, const std::string& name) {
+  const std::size_t count = attrib.vertices.size() / 3;
+  if (count == 0) return;
+  const bool colors = attrib.colors.size() == attrib.vertices.size();
+  ModelBuilder builder(model);
+  builder.beginObject(std::filesystem::path(name).stem().string());
+  model.positions.reserve(count);
+  if (colors) model.colors.reserve(count);
+  for (std::size_t v = 0; v < count; ++v) {
+    const Vec3d p{attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]};
+    model.positions.push_back(toFloat(p - model.origin));
+    if (colors)
+      model.colors.push_back(
+          toRgba(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]));
+  }
+  builder.endObject();
+}
+
 Result<Model> build(const std::string& text, const std::string& name, const std::string& baseDir) {
   LODFORGE_TRY(checkCoordinates(text, name));
   tinyobj::attrib_t attrib;
@@ -157,6 +177,10 @@ Result<Model> build(const std::string& text, const std::string& name, const std:
   }
   Model model;
   model.origin = chooseOrigin(world);
+  if (face == 0) {
+    addVerticesOnly(model, attrib, name);
+    return model;
+  }
   ModelBuilder builder(model);
   std::unordered_map<CornerKey, std::uint32_t, CornerHash> local;
   for (std::size_t s = 0; s < shapes.size(); ++s) {

@@ -1,6 +1,7 @@
 // Wavefront OBJ reader (tinyobjloader, double precision). Every `o` or `g` starts an object;
 // polygons are fan-triangulated; colours come from vertex colours (`v x y z r g b`) or the
-// material's diffuse colour (Kd) when the .mtl is found beside the file.
+// material's diffuse colour (Kd) when the .mtl is found beside the file. Only vertices that faces
+// use are kept, unless the file has no faces: then it is one object of all its vertices.
 #pragma once
 
 #include <span>

@@ -41,8 +41,11 @@ namespace {
 
 constexpr std::size_t kMaxHeaderBytes = 1 << 20;
 constexpr std::size_t kMaxHeaderLine = 1 << 16;
-constexpr std::size_t kMaxAsciiLine = 1 << 20;
+// An ascii element is one line, and a triangle strip is one element: 300 K six-digit indices
+// take 2 MB. The bound keeps a file without line breaks from growing the line without end.
+constexpr std::size_t kMaxAsciiLine = std::size_t{64} << 20;
 constexpr std::uint64_t kMaxPolygon = 1 << 20;  // corners in one face; more is not a mesh
+constexpr std::uint64_t kStripRun = 4096;       // binary strip indices read at once
 
 bool isIntegral(PlyType t) {
   return t != PlyType::kFloat32 && t != PlyType::kFloat64;
@@ -81,6 +84,7 @@ struct Roles {
   int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1;
   int red = -1, green = -1, blue = -1, alpha = -1;
   int faceIndices = -1, objectId = -1;
+  int stripElement = -1, stripIndices = -1;  // 'tristrips' and its index list
 };
 
 int findProperty(const PlyElement& e, std::initializer_list<std::string_view> names) {
@@ -92,10 +96,40 @@ int findProperty(const PlyElement& e, std::initializer_list<std::string_view> na
   return -1;
 }
 
+// The vertex index list of a face or strip element.
+int indexListRole(const std::string& file, const PlyElement& e) {
+  const int role = findProperty(e, {"vertex_indices", "vertex_index"});
+  if (role < 0 || !e.properties[static_cast<std::size_t>(role)].isList) {
+    throw ErrorException{
+        badInput(file, fmt::format("{} element lacks the list 'vertex_indices'", e.name))};
+  }
+  if (!isIntegral(e.properties[static_cast<std::size_t>(role)].type)) {
+    throw ErrorException{
+        badInput(file, fmt::format("{} vertex indices must have an integer type", e.name))};
+  }
+  return role;
+}
+
+// A strip restarts at index -1; in an unsigned index type that is the all-ones value, when it
+// is no vertex's index.
+bool isStripRestart(double raw, PlyType type, std::uint64_t vertexCount) {
+  switch (type) {
+    case PlyType::kUint8:
+      return raw == 0xFF && raw >= static_cast<double>(vertexCount);
+    case PlyType::kUint16:
+      return raw == 0xFFFF && raw >= static_cast<double>(vertexCount);
+    case PlyType::kUint32:
+      return raw == 0xFFFF'FFFF && raw >= static_cast<double>(vertexCount);
+    default:
+      return raw == -1;
+  }
+}
+
 }  // namespace
 
 struct PlyReader::State {
   ByteSource source;
+  std::optional<std::span<const std::byte>> memory;  // the bytes, when read from memory
   PlyReadOptions options;
   PlyHeader header;
   Roles roles;
@@ -118,11 +152,15 @@ struct PlyReader::State {
     return badInputAtByte(source.name(), elementStart, what);
   }
 
+  // What a user whose file was cut short can do (every command that reads PLY takes it).
+  static constexpr std::string_view kSalvageHint =
+      "; --salvage reads the complete elements before the cut";
+
   // The input stops early. An error, unless salvaging: then reading ends after the last
   // complete element and `truncation` says where.
   struct Truncated {};
   [[noreturn]] void fileEnds(std::string_view what) {
-    if (!options.salvageTruncated) fail(what);
+    if (!options.salvageTruncated) fail(fmt::format("{}{}", what, kSalvageHint));
     truncation = positioned(what).message;
     throw Truncated{};
   }
@@ -177,12 +215,18 @@ struct PlyReader::State {
     return decodeNumber(bytes, type);
   }
 
-  // A list's length, checked against what the rest of the file can hold.
-  std::uint64_t readListCount(const PlyElement& e, const PlyProperty& p) {
+  // A list's length, checked against what the rest of the file can hold (unless `mustFit` is
+  // false: then the list is read up to where the file ends).
+  std::uint64_t readListCount(const PlyElement& e, const PlyProperty& p, bool mustFit = true) {
     const double count = readNumber(e, p, p.countType);
     if (count < 0)
       fail(fmt::format("{} {}: negative list length for '{}'", e.name, elementDone, p.name));
+    if (count > 4294967295.0) {  // more than any count type holds (an ascii file may say so)
+      fail(fmt::format("{} {}: list length {} for '{}' is too large", e.name, elementDone, count,
+                       p.name));
+    }
     const auto n = static_cast<std::uint64_t>(count);
+    if (!mustFit) return n;
     // Items need a byte each plus a separator in ascii (the current line's rest counts too).
     const bool ascii = header.format == PlyFormat::kAscii;
     const std::uint64_t available = source.remaining() + (ascii ? line.size() - linePos + 1 : 0);
@@ -267,6 +311,24 @@ struct PlyReader::State {
   void readFace(PlyBatch& batch);
   void skipElement(const PlyElement& e);
   bool next(PlyBatch& batch);
+
+  // --- triangle strips ------------------------------------------------------------------------
+
+  // Where the strip being read stands. A strip can be longer than a batch (igea is one strip of
+  // 268 K triangles), so this carries over from one batch to the next.
+  struct Strip {
+    bool open = false;           // its length is read, not all its indices yet
+    std::uint64_t left = 0;      // indices still to read
+    std::uint64_t run = 0;       // indices since the strip began or restarted
+    std::uint32_t a = 0, b = 0;  // the last two indices of the run
+  } strip;
+  std::uint64_t stripTriangles = 0;  // delivered so far
+
+  void readStrips(PlyBatch& batch);
+  void beginStrip(const PlyElement& e);
+  void readStripIndices(const PlyElement& e, PlyBatch& batch, std::size_t limit);
+  void addStripIndex(double raw, PlyType type, std::uint64_t at, PlyBatch& batch);
+  std::uint64_t countStripTriangles();
 };
 
 void PlyReader::State::parseHeader() {
@@ -359,13 +421,13 @@ void PlyReader::State::assignRoles() {
   const std::string& name = source.name();
   for (std::size_t i = 0; i < header.elements.size(); ++i) {
     const PlyElement& e = header.elements[i];
-    if (e.name == "vertex") {
-      if (roles.vertexElement >= 0) throw ErrorException{badInput(name, "two 'vertex' elements")};
-      roles.vertexElement = static_cast<int>(i);
-    } else if (e.name == "face") {
-      if (roles.faceElement >= 0) throw ErrorException{badInput(name, "two 'face' elements")};
-      roles.faceElement = static_cast<int>(i);
-    }
+    int* role = e.name == "vertex"      ? &roles.vertexElement
+                : e.name == "face"      ? &roles.faceElement
+                : e.name == "tristrips" ? &roles.stripElement
+                                        : nullptr;
+    if (!role) continue;
+    if (*role >= 0) throw ErrorException{badInput(name, fmt::format("two '{}' elements", e.name))};
+    *role = static_cast<int>(i);
   }
   if (roles.vertexElement < 0)
     throw ErrorException{badInput(name, "no 'vertex' element in the header")};
@@ -398,11 +460,7 @@ void PlyReader::State::assignRoles() {
   }
   if (roles.faceElement >= 0) {
     const PlyElement& f = header.elements[static_cast<std::size_t>(roles.faceElement)];
-    roles.faceIndices = findProperty(f, {"vertex_indices", "vertex_index"});
-    if (roles.faceIndices < 0 || !f.properties[static_cast<std::size_t>(roles.faceIndices)].isList)
-      throw ErrorException{badInput(name, "face element lacks the list 'vertex_indices'")};
-    if (!isIntegral(f.properties[static_cast<std::size_t>(roles.faceIndices)].type))
-      throw ErrorException{badInput(name, "face vertex indices must have an integer type")};
+    roles.faceIndices = indexListRole(name, f);
     for (const std::string& candidate : options.objectIdProperties) {
       roles.objectId = findProperty(f, {candidate});
       if (roles.objectId >= 0 && !f.properties[static_cast<std::size_t>(roles.objectId)].isList)
@@ -411,6 +469,18 @@ void PlyReader::State::assignRoles() {
     }
     header.faceCount = f.count;
     header.hasObjectIds = roles.objectId >= 0;
+  }
+  if (roles.stripElement >= 0) {
+    const PlyElement& s = header.elements[static_cast<std::size_t>(roles.stripElement)];
+    roles.stripIndices = indexListRole(name, s);
+    header.stripCount = s.count;
+    // Strips carry no object id: their triangles would belong to no object.
+    if (header.hasObjectIds) {
+      throw ErrorException{Error{
+          ErrorKind::kUnsupported,
+          fmt::format("{}: faces with object ids and 'tristrips' in one file are not supported",
+                      name)}};
+    }
   }
 }
 
@@ -433,9 +503,9 @@ void PlyReader::State::checkCountsFitFile() {
       throw ErrorException{badInputAtByte(
           source.name(), header.dataOffset,
           fmt::format("header declares {} '{}' elements of at least {} bytes each, but only {} "
-                      "bytes follow the header (room for {} at most): the file is truncated",
+                      "bytes follow the header (room for {} at most): the file is truncated{}",
                       e.count, e.name, minBytes, available,
-                      (available - std::min(available, needed)) / minBytes))};
+                      (available - std::min(available, needed)) / minBytes, kSalvageHint))};
     }
     needed += e.count * minBytes;
   }
@@ -586,6 +656,111 @@ void PlyReader::State::skipElement(const PlyElement& e) {
   }
 }
 
+// Strips deliver triangles: a batch holds about batchSize of them, from as many strips as that
+// takes, and a strip longer than that goes on in the next batch.
+void PlyReader::State::readStrips(PlyBatch& batch) {
+  const PlyElement& e = header.elements[element];
+  const std::size_t limit = 3 * std::max<std::size_t>(options.batchSize, 1);
+  while (elementDone < e.count && batch.triangles.size() < limit) {
+    if (!strip.open) beginStrip(e);
+    readStripIndices(e, batch, limit);
+    if (strip.left > 0) continue;
+    // The properties after the index list, if any.
+    for (std::size_t i = static_cast<std::size_t>(roles.stripIndices) + 1; i < e.properties.size();
+         ++i)
+      skipProperty(e, e.properties[i]);
+    strip.open = false;
+    ++elementDone;
+  }
+}
+
+void PlyReader::State::beginStrip(const PlyElement& e) {
+  beginElement();
+  const auto list = static_cast<std::size_t>(roles.stripIndices);
+  for (std::size_t i = 0; i < list; ++i) skipProperty(e, e.properties[i]);
+  // Salvaging reads a strip up to where the file ends: its whole triangles are good.
+  strip = {.open = true,
+           .left = readListCount(e, e.properties[list], !options.salvageTruncated),
+           .run = 0};
+}
+
+// Reads indices of the open strip until it ends or the batch holds `limit` corners.
+void PlyReader::State::readStripIndices(const PlyElement& e, PlyBatch& batch, std::size_t limit) {
+  const PlyProperty& p = e.properties[static_cast<std::size_t>(roles.stripIndices)];
+  const std::size_t size = plyTypeSize(p.type);
+  while (strip.left > 0 && batch.triangles.size() < limit) {
+    if (header.format == PlyFormat::kAscii) {
+      const double raw = readNumber(e, p, p.type);
+      --strip.left;
+      addStripIndex(raw, p.type, lineNumber, batch);
+      continue;
+    }
+    // Binary: a run of indices in one read, no more than can fill the batch (each index adds a
+    // triangle at most).
+    const std::uint64_t room = (limit - batch.triangles.size() + 2) / 3;
+    const std::uint64_t n = std::min({strip.left, kStripRun, room, source.remaining() / size});
+    if (n == 0) {
+      fileEnds(fmt::format("{} {}: file ends inside list '{}' ({} indices to go)", e.name,
+                           elementDone, p.name, strip.left));
+    }
+    cornerBytes.resize(n * size);
+    if (!source.read(cornerBytes.data(), cornerBytes.size())) fail("cannot read a strip's indices");
+    const std::uint64_t start = source.offset() - n * size;
+    for (std::uint64_t k = 0; k < n; ++k)
+      addStripIndex(decodeNumber(cornerBytes.data() + k * size, p.type), p.type, start + k * size,
+                    batch);
+    strip.left -= n;
+  }
+}
+
+// Triangle k of a run (since the strip began or restarted) is (i[k], i[k+1], i[k+2]), with the
+// first two swapped for odd k so that all face the same way. Triangles with a repeated index
+// are how strips join (and turn): they are dropped, but still count for k. `at` is the index's
+// byte (binary) or line (ascii), for the error.
+void PlyReader::State::addStripIndex(double raw, PlyType type, std::uint64_t at, PlyBatch& batch) {
+  if (isStripRestart(raw, type, header.vertexCount)) {
+    strip.run = 0;
+    return;
+  }
+  if (raw < 0 || raw >= static_cast<double>(header.vertexCount)) {
+    elementStart = at;
+    fail(fmt::format("{} {}: vertex index {} out of range (the file has {} vertices)",
+                     header.elements[element].name, elementDone, raw, header.vertexCount));
+  }
+  const auto c = static_cast<std::uint32_t>(raw);
+  if (strip.run >= 2 && strip.a != strip.b && strip.b != c && strip.a != c) {
+    if (strip.run % 2 == 0)
+      batch.triangles.insert(batch.triangles.end(), {strip.a, strip.b, c});
+    else
+      batch.triangles.insert(batch.triangles.end(), {strip.b, strip.a, c});
+  }
+  strip.a = strip.b;
+  strip.b = c;
+  ++strip.run;
+}
+
+// A pass over the strips alone (the elements before them skipped, by seeking where they have a
+// fixed size) that counts their triangles. Salvaging, it counts those before the cut.
+std::uint64_t PlyReader::State::countStripTriangles() {
+  PlyBatch batch;
+  std::uint64_t triangles = 0;
+  try {
+    for (; element < static_cast<std::size_t>(roles.stripElement); ++element) {
+      elementDone = 0;
+      skipElement(header.elements[element]);
+    }
+    elementDone = 0;
+    while (elementDone < header.elements[element].count) {
+      batch.triangles.clear();
+      readStrips(batch);
+      triangles += batch.triangles.size() / 3;
+    }
+  } catch (const Truncated&) {
+    triangles += batch.triangles.size() / 3;
+  }
+  return triangles;
+}
+
 bool PlyReader::State::next(PlyBatch& batch) {
   batch.positions.clear();
   batch.normals.clear();
@@ -593,20 +768,34 @@ bool PlyReader::State::next(PlyBatch& batch) {
   batch.triangles.clear();
   batch.triangleObjects.clear();
   batch.count = 0;
-  bool reading = false;
+  bool reading = false, readingStrips = false;
   try {
     while (element < header.elements.size()) {
       const PlyElement& e = header.elements[element];
       const bool isVertex =
           static_cast<int>(element) == roles.vertexElement && options.readVertices;
       const bool isFace = static_cast<int>(element) == roles.faceElement && options.readFaces;
-      if (elementDone == e.count || (!isVertex && !isFace)) {
+      const bool isStrip = static_cast<int>(element) == roles.stripElement && options.readFaces;
+      if (elementDone == e.count || (!isVertex && !isFace && !isStrip)) {
         if (elementDone < e.count) skipElement(e);
         ++element;
         elementDone = 0;
         continue;
       }
       reading = true;
+      if (isStrip) {
+        // Numbered after the faces, so that faces and strips together count to faceCount.
+        readingStrips = true;
+        batch.kind = PlyBatch::Kind::kFaces;
+        batch.first = stripTriangles;
+        if (roles.faceElement >= 0)
+          batch.first += header.elements[static_cast<std::size_t>(roles.faceElement)].count;
+        readStrips(batch);
+        batch.count = batch.triangles.size() / 3;
+        stripTriangles += batch.count;
+        if (batch.count > 0) return true;
+        continue;  // the last strips were all degenerate
+      }
       batch.kind = isVertex ? PlyBatch::Kind::kVertices : PlyBatch::Kind::kFaces;
       batch.first = elementDone;
       const std::uint64_t end = std::min<std::uint64_t>(e.count, elementDone + options.batchSize);
@@ -624,6 +813,11 @@ bool PlyReader::State::next(PlyBatch& batch) {
     // Salvaging: keep the complete elements of this batch, drop the one cut short, and stop.
     element = header.elements.size();
     if (!reading) return false;
+    if (readingStrips) {  // every triangle read so far is whole
+      batch.count = batch.triangles.size() / 3;
+      stripTriangles += batch.count;
+      return batch.count > 0;
+    }
     if (batch.kind == PlyBatch::Kind::kFaces) batch.triangles.resize(faceFirstCorner);
     batch.count = elementDone - batch.first;
     return batch.count > 0;
@@ -646,6 +840,19 @@ Result<PlyReader> PlyReader::start(std::unique_ptr<State> state) {
     state->parseHeader();
     state->checkCountsFitFile();
     state->assignRoles();
+    if (state->roles.stripElement >= 0) {
+      // A second reader over the same bytes counts the strips' triangles; this one stays at the
+      // start of the data.
+      Result<ByteSource> source = state->memory
+                                      ? ByteSource::fromMemory(*state->memory, state->source.name())
+                                      : ByteSource::openFile(state->source.name());
+      if (!source) return source.status();
+      State counter(std::move(source.value()));
+      counter.options = state->options;
+      counter.parseHeader();
+      counter.assignRoles();
+      state->header.faceCount += counter.countStripTriangles();
+    }
   } catch (const ErrorException& e) {
     return e.error;
   }
@@ -663,6 +870,7 @@ Result<PlyReader> PlyReader::open(const std::string& path, const PlyReadOptions&
 Result<PlyReader> PlyReader::fromMemory(std::span<const std::byte> bytes, std::string name,
                                         const PlyReadOptions& options) {
   auto state = std::make_unique<State>(ByteSource::fromMemory(bytes, std::move(name)));
+  state->memory = bytes;
   state->options = options;
   return start(std::move(state));
 }

@@ -1,7 +1,8 @@
 // PLY reader: ascii, binary little- and big-endian, any property order, every PLY scalar type,
-// faces as lists of any count/index type (polygons fan-triangulated), optional per-face object
-// ids. PlyReader streams: it yields batches of vertices or faces in file order, so a file larger
-// than RAM is processed with a fixed amount of memory. readPly builds a whole Model.
+// faces as lists of any count/index type (polygons fan-triangulated), triangle strips (a
+// 'tristrips' element), optional per-face object ids. PlyReader streams: it yields batches of
+// vertices or faces in file order, so a file larger than RAM is processed with a fixed amount of
+// memory. readPly builds a whole Model.
 #pragma once
 
 #include <cstdint>
@@ -50,7 +51,11 @@ struct PlyHeader {
 
   // What lodforge reads from it.
   std::uint64_t vertexCount = 0;
+  // Faces, plus the triangles the strips make (0: no faces, a point cloud). Only reading strips
+  // tells how many triangles they make (restarts, degenerate joins), so opening a file with
+  // strips reads them once to count.
   std::uint64_t faceCount = 0;
+  std::uint64_t stripCount = 0;  // strips in the 'tristrips' element
   bool hasNormals = false;
   bool hasColors = false;
   bool hasObjectIds = false;
@@ -74,13 +79,17 @@ struct PlyReadOptions {
 struct PlyBatch {
   enum class Kind : std::uint8_t { kVertices, kFaces };
   Kind kind = Kind::kVertices;
-  std::uint64_t first = 0;  // index of the batch's first vertex or face in the file
-  std::uint64_t count = 0;  // vertices or faces (not triangles) in the batch
+  // Index of the batch's first vertex or face in the file, and how many the batch has (faces,
+  // not triangles). Strips count as their triangles, numbered after the faces; a strip longer
+  // than a batch goes on in the next one.
+  std::uint64_t first = 0;
+  std::uint64_t count = 0;
   // kVertices
   std::vector<Vec3d> positions;
   std::vector<Vec3f> normals;  // when the header has nx ny nz
   std::vector<Rgba8> colors;   // when the header has red green blue
-  // kFaces: 3 indices per triangle (polygons fan-triangulated), global vertex indices
+  // kFaces: 3 indices per triangle (polygons fan-triangulated, strips with every triangle facing
+  // the way the first does), global vertex indices
   std::vector<std::uint32_t> triangles;
   std::vector<std::uint32_t> triangleObjects;  // per triangle, when the header has object ids
 };

@@ -23,6 +23,7 @@
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
 #include "lodforge/runtime/stream.h"
+#include "outputs.h"
 #include "view_options.h"
 
 namespace lodforge::cli {
@@ -299,6 +300,8 @@ Status writeJson(const BenchOptions& o, const Package& package, const nlohmann::
 }
 
 Status runBench(const Global& global, const BenchOptions& o) {
+  LODFORGE_TRY(claimIfGiven(o.json, jsonOutput(), {o.input}));
+  LODFORGE_TRY(claimIfGiven(o.recordPath, jsonOutput(), {o.input}));
   Result<Package> package = Package::open(o.input);
   if (!package) return package.status();
   const LodScene scene = LodScene::fromPackage(*package, o.exponent);

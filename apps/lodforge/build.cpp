@@ -6,6 +6,7 @@
 #include "lodforge/core/memory.h"
 #include "lodforge/core/units.h"
 #include "lodforge/simplify/builder.h"
+#include "outputs.h"
 
 namespace lodforge::cli {
 
@@ -33,6 +34,9 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
       if (fileExtension(options->output) != "lfp")
         return Error{ErrorKind::kUsage,
                      fmt::format("{}: a package is written as .lfp", options->output)};
+      LODFORGE_TRY(refusePointCloud(options->input, "build"));
+      LODFORGE_TRY(
+          claimOutput(options->output, packageOutput(), std::vector<std::string>{options->input}));
       BuildOptions build;
       build.progressive.cost =
           options->cost == "melax" ? CollapseCost::kMelax : CollapseCost::kQuadric;

@@ -13,7 +13,7 @@
 namespace lodforge::cli {
 
 struct Global {
-  unsigned threads = 0;           // 0: all cores
+  unsigned threads = 0;           // 0: all cores; more than the cores is lowered to them
   int verbosity = 0;              // -1 quiet, 0 normal, 1 verbose
   std::uint64_t memoryLimit = 0;  // bytes, 0: unlimited
 };
@@ -27,6 +27,19 @@ CLI::Option* addCountOption(CLI::App& app, const std::string& name, std::uint64_
 // An option taking a byte size with binary suffixes (512M = 512 MiB, 2G).
 CLI::Option* addByteSizeOption(CLI::App& app, const std::string& name, std::uint64_t& target,
                                const std::string& description);
+
+// --threads N: 0 (all cores) or a count; anything else is a usage error that says so.
+CLI::Option* addThreadsOption(CLI::App& app, unsigned& target);
+// Lowers --threads above the machine's cores to them, with a note.
+Status checkThreads(Global& global);
+// --memory-limit: refused when 0 (it would mean nothing) and for a subcommand that does not
+// honour it, before any work.
+Status checkMemoryLimit(const CLI::App& app, const CLI::Option& option, std::uint64_t limit);
+// A mesh-only subcommand given a point file (by its extension): a usage error that says what to
+// run instead.
+Status refusePointCloud(const std::string& input, std::string_view command);
+// Runs a subcommand; an exception that still escapes becomes an error (exit 1), never an abort.
+Status runGuarded(const Run& run);
 
 // Normal output (suppressed by -q) and verbose output (shown with -v).
 void say(const Global& global, const std::string& text);

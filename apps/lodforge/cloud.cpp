@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cloud.h"
+
 #include "lodforge/core/file.h"
 #include "lodforge/core/units.h"
 #include "lodforge/render/context.h"
@@ -20,6 +21,7 @@
 #include "lodforge/render/point_renderer.h"
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/path.h"
+#include "outputs.h"
 #include "view_options.h"
 
 namespace lodforge::cli {
@@ -74,6 +76,7 @@ void addCloudOptions(CLI::App& sub, CloudRunOptions& options, bool severalRadii)
 }
 
 Status runCloudBench(const Global& global, const CloudRunOptions& o) {
+  LODFORGE_TRY(claimIfGiven(o.json, jsonOutput(), {o.input}));
   Result<CloudFile> cloud = CloudFile::open(o.input);
   if (!cloud) return cloud.status();
   Result<std::vector<Camera>> cameras = cloudPath(o, cloud->header().bounds);
@@ -220,6 +223,7 @@ Status runCloudBench(const Global& global, const CloudRunOptions& o) {
 }
 
 Status runCloudView(const Global& global, const CloudRunOptions& o) {
+  LODFORGE_TRY(claimIfGiven(o.screenshot, pngOutput(), {o.input}));
   Result<CloudFile> cloud = CloudFile::open(o.input);
   if (!cloud) return cloud.status();
   std::uint32_t width = 0, height = 0;

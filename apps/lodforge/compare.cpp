@@ -11,6 +11,7 @@
 #include "cli.h"
 #include "lodforge/core/file.h"
 #include "lodforge/render/image.h"
+#include "outputs.h"
 
 namespace lodforge::cli {
 namespace {
@@ -56,8 +57,22 @@ Result<std::vector<Pair>> pairsOf(const CompareOptions& o) {
 Status runCompare(const Global& global, const CompareOptions& o) {
   auto pairs = pairsOf(o);
   if (!pairs) return pairs.status();
-  const bool folders = pairs->size() > 1 || std::filesystem::is_directory(o.a);
-  if (!o.diff.empty() && folders) std::filesystem::create_directories(o.diff);
+  std::error_code error;
+  const bool folders = pairs->size() > 1 || std::filesystem::is_directory(o.a, error);
+  // Two folders: the heat maps must not go into either (they would replace its frames).
+  for (const std::string& folder : {o.a, o.b}) {
+    if (folders && !o.diff.empty() && std::filesystem::equivalent(o.diff, folder, error))
+      return Error{ErrorKind::kUsage,
+                   fmt::format("--diff {}: is an input folder; choose another", o.diff)};
+  }
+  const std::vector<std::string> inputs =
+      folders ? std::vector<std::string>{} : std::vector<std::string>{o.a, o.b};
+  LODFORGE_TRY(claimIfGiven(o.json, jsonOutput(), inputs));
+  LODFORGE_TRY(claimIfGiven(o.diff, folders ? pngFolderOutput() : pngOutput(), inputs));
+  if (!o.diff.empty() && folders) {
+    std::filesystem::create_directories(o.diff, error);
+    if (error) return ioError(o.diff, fmt::format("cannot create: {}", error.message()));
+  }
   nlohmann::json frames = nlohmann::json::array();
   say(global, fmt::format("| {:<24} | {:>9} | {:>8} | {:>8} | {:>9} |", "frame",
                           fmt::format("ΔE>{:.1f}", o.threshold), "mean ΔE", "max ΔE", "PSNR dB"));

@@ -10,6 +10,7 @@
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
 #include "lodforge/io/stl_writer.h"
+#include "outputs.h"
 
 namespace lodforge::cli {
 
@@ -17,7 +18,12 @@ namespace {
 
 // Refuses before loading when the header already tells the model will not fit the limit.
 Status checkMemory(const std::string& path, std::uint64_t limit) {
-  if (limit == 0 || formatFromPath(path) != FileFormat::kPly) return {};
+  if (limit == 0) return {};
+  if (formatFromPath(path) != FileFormat::kPly)
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: convert takes --memory-limit for PLY input only (its header "
+                             "tells what loading needs); leave it out for this file",
+                             path)};
   Result<PlyReader> reader = PlyReader::open(path);
   if (!reader) return reader.status();
   const PlyHeader& h = reader->header();
@@ -58,6 +64,9 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
             ErrorKind::kUsage,
             fmt::format("{}: cannot write this format (lodforge writes .ply .glb .obj .stl)",
                         options->output)};
+      LODFORGE_TRY(refusePointCloud(options->input, "convert"));
+      LODFORGE_TRY(claimOutput(options->output, modelFileOutput(options->output),
+                               std::vector<std::string>{options->input}));
       LODFORGE_TRY(checkMemory(options->input, global.memoryLimit));
       std::vector<std::string> warnings;
       Result<Model> model =

@@ -5,6 +5,7 @@
 #include "lodforge/core/units.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/simplify/extract.h"
+#include "outputs.h"
 
 namespace lodforge::cli {
 
@@ -32,6 +33,8 @@ void addExtract(CLI::App& app, const Global& global, Run& run) {
             ErrorKind::kUsage,
             fmt::format("{}: cannot write this format (lodforge writes .ply .glb .obj .stl)",
                         options->output)};
+      LODFORGE_TRY(claimOutput(options->output, modelFileOutput(options->output),
+                               std::vector<std::string>{options->input}));
       Result<Package> package = Package::open(options->input);
       if (!package) return package.status();
       const std::vector<std::uint32_t> counts =

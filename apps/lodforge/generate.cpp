@@ -10,6 +10,7 @@
 #include "lodforge/generate/cad.h"
 #include "lodforge/generate/points.h"
 #include "lodforge/generate/scan.h"
+#include "outputs.h"
 
 namespace lodforge::cli {
 
@@ -29,6 +30,7 @@ void report(const Global& global, const std::string& path, const Result<Generate
 
 template <class Generate>
 Status timed(const Global& global, const std::string& path, Generate&& generate) {
+  LODFORGE_TRY(claimOutput(path, modelFileOutput(path), {}));
   const auto start = std::chrono::steady_clock::now();
   Result<GenerateStats> stats = generate();
   if (!stats) return stats.status();

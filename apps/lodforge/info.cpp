@@ -8,8 +8,10 @@
 
 #include "cli.h"
 #include "lodforge/core/file.h"
+#include "lodforge/core/output_claim.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
+#include "lodforge/io/format_advice.h"
 #include "lodforge/io/las_reader.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
@@ -322,15 +324,16 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
                 "Read a truncated PLY up to the cut (with a warning)");
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
-      if (fileExtension(options->path) == "lfp")
-        return describePackage(options->path, options->json);
-      if (fileExtension(options->path) == "lfc") return describeCloud(options->path, options->json);
+      LODFORGE_TRY(refuseDirectoryInput(options->path));
+      const std::string ext = fileExtension(options->path);
+      if (ext != "lfp" && ext != "lfc" && !isPointCloudPath(options->path) &&
+          formatFromPath(options->path) == FileFormat::kUnknown)
+        return unknownFormatError(options->path, fmt::format("{}, {}, and .lfp .lfc packages",
+                                                             kMeshFormats, kPointFormats));
+      if (ext == "lfp") return describePackage(options->path, options->json);
+      if (ext == "lfc") return describeCloud(options->path, options->json);
       if (isPointCloudPath(options->path)) return describePointFile(options->path, options->json);
       const FileFormat format = formatFromPath(options->path);
-      if (format == FileFormat::kUnknown)
-        return Error{ErrorKind::kUsage,
-                     fmt::format("{}: unknown format (lodforge reads .ply .obj .stl .gltf .glb)",
-                                 options->path)};
       Result<std::uint64_t> bytes = fileSize(options->path);
       if (!bytes) return bytes.status();
       Result<Summary> summary = format == FileFormat::kPly

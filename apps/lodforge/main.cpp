@@ -16,14 +16,15 @@ int main(int argc, char** argv) {
   app.fallthrough();
 
   cli::Global global;
-  app.add_option("--threads", global.threads, "Threads to use (default: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  cli::addThreadsOption(app, global.threads);
   app.add_flag_callback(
       "-v,--verbose", [&] { global.verbosity = 1; }, "More detail on stderr");
   app.add_flag_callback(
       "-q,--quiet", [&] { global.verbosity = -1; }, "Only errors (no progress, no summary)");
-  cli::addByteSizeOption(app, "--memory-limit", global.memoryLimit,
-                         "Memory the command may use (e.g. 2G)");
+  CLI::Option* memoryLimit =
+      cli::addByteSizeOption(app, "--memory-limit", global.memoryLimit,
+                             "Memory the command may use (e.g. 2G); taken by tiles, points, build "
+                             "and convert, which refuse a limit too small to work with");
 
   cli::Run run;
   cli::addInfo(app, global, run);
@@ -46,11 +47,17 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   }
+  Status status = cli::checkMemoryLimit(app, *memoryLimit, global.memoryLimit);
+  if (status.ok()) status = cli::checkThreads(global);
+  if (!status.ok()) {
+    fmt::print(stderr, "lodforge: {}\n", status.message());
+    return exitCodeFor(status);
+  }
   if (global.verbosity < 0) setProgressMode(ProgressMode::kOff);
   installInterruptHandler();
   const ThreadLimit threads(global.threads);
 
-  const Status status = run ? run() : Status(Error{ErrorKind::kUsage, "no subcommand"});
+  status = run ? cli::runGuarded(run) : Status(Error{ErrorKind::kUsage, "no subcommand"});
   if (!status.ok()) fmt::print(stderr, "lodforge: {}\n", status.message());
   return exitCodeFor(status);
 }

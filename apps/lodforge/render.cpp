@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
@@ -17,6 +18,7 @@
 #include "lodforge/render/renderer.h"
 #include "lodforge/runtime/selection.h"
 #include "lodforge/runtime/stream.h"
+#include "outputs.h"
 #include "view_options.h"
 
 namespace lodforge::cli {
@@ -55,6 +57,9 @@ void fullDetail(const Package& package, Selection& selection) {
 }
 
 Status runRender(const Global& global, const RenderOptions& o) {
+  const std::vector<std::string> inputs{o.input};
+  LODFORGE_TRY(claimOutput(o.output, renderFolderOutput(), inputs));
+  if (!o.json.empty()) LODFORGE_TRY(claimOutput(o.json, jsonOutput(), inputs));
   Result<Package> package = Package::open(o.input);
   if (!package) return package.status();
   auto colorMode = parseColorMode(o.color);
@@ -78,17 +83,13 @@ Status runRender(const Global& global, const RenderOptions& o) {
   auto target = Framebuffer::create(cameras->front().width, cameras->front().height);
   if (!target) return target.status();
 
-  // Frames go into a temporary folder beside the output and move in when all are written.
-  const std::filesystem::path out(o.output);
-  const std::filesystem::path temporary(temporaryPathFor(o.output));
-  std::filesystem::create_directories(temporary);
-  struct Cleanup {
-    std::filesystem::path path;
-    ~Cleanup() {
-      std::error_code ignored;
-      std::filesystem::remove_all(path, ignored);
-    }
-  } cleanup{temporary};
+  // Frames go into a temporary folder beside the output, which replaces the output (an earlier
+  // render, as claimed above) when all are written.
+  ScopedDirectory staging(temporaryPathFor(o.output));
+  const std::filesystem::path temporary(staging.path);
+  std::error_code error;
+  std::filesystem::create_directories(temporary, error);
+  if (error) return ioError(staging.path, fmt::format("cannot create: {}", error.message()));
 
   say(global, fmt::format("{}: {} objects, {} vertices; {} frames at {} ({}), {} on {}", o.input,
                           formatCount(package->objectCount()), formatCount(full), cameras->size(),
@@ -135,25 +136,9 @@ Status runRender(const Global& global, const RenderOptions& o) {
       {"renderer", (*gl)->renderer()},
       {"frames", frames}};
   const std::string text = report.dump(2) + "\n";
-  {
-    auto file = OutputFile::create((temporary / "render.json").string());
-    if (!file) return file.status();
-    LODFORGE_TRY(file->write(text.data(), text.size()));
-    LODFORGE_TRY(file->commit());
-  }
-  std::error_code error;
-  std::filesystem::create_directories(out, error);
-  if (error) return Error{ErrorKind::kIo, fmt::format("{}: {}", o.output, error.message())};
-  for (const auto& entry : std::filesystem::directory_iterator(temporary)) {
-    std::filesystem::rename(entry.path(), out / entry.path().filename(), error);
-    if (error) return Error{ErrorKind::kIo, fmt::format("{}: {}", o.output, error.message())};
-  }
-  if (!o.json.empty()) {
-    auto file = OutputFile::create(o.json);
-    if (!file) return file.status();
-    LODFORGE_TRY(file->write(text.data(), text.size()));
-    LODFORGE_TRY(file->commit());
-  }
+  LODFORGE_TRY(OutputFile::writeWhole((temporary / "render.json").string(), text));
+  LODFORGE_TRY(replaceDirectory(staging, o.output));
+  if (!o.json.empty()) LODFORGE_TRY(OutputFile::writeWhole(o.json, text));
   double drawMs = 0;
   for (const auto& frame : frames) drawMs += frame["render_ms"].get<double>();
   say(global, fmt::format("wrote {} frames to {} (mean draw {:.1f} ms)", frames.size(), o.output,

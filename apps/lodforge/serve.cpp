@@ -18,6 +18,7 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "serve_paths.h"
+#include "serve_ranges.h"
 
 namespace lodforge::cli {
 
@@ -112,6 +113,29 @@ struct Caches {
   GzipCache gzip;
 };
 
+// cpp-httplib 0.11 cuts Range requests without clamping them to the file: an end past it sends
+// a Content-Length it never fills, a start past it underflows. The ranges it parsed are replaced
+// by one clamped to the file (RFC 9110 §14.1.2), and one past the end is answered 416 with the
+// size. The request is the server's own mutable object, handed to handlers as const.
+bool applyRanges(const httplib::Request& request, httplib::Response& response, std::size_t size) {
+  if (request.ranges.empty()) return true;
+  auto& ranges = const_cast<httplib::Request&>(request).ranges;
+  const ServedRanges served = serveRanges({ranges.begin(), ranges.end()}, size);
+  ranges.clear();
+  if (!served.satisfiable) {
+    response.status = 416;
+    response.set_header("Content-Range", fmt::format("bytes */{}", size));
+    response.set_content("range not satisfiable\n", "text/plain");
+    return false;
+  }
+  // Several ranges would go out as multipart/byteranges, which cpp-httplib 0.11 gets wrong for
+  // a streamed body (every part says size 0): the whole file instead, as RFC 9110 §14.2 allows.
+  if (served.ranges.size() == 1)
+    ranges.emplace_back(static_cast<ssize_t>(served.ranges[0].first),
+                        static_cast<ssize_t>(served.ranges[0].second));
+  return true;
+}
+
 void serveFile(const fs::path& root, const std::string& relative, const httplib::Request& request,
                httplib::Response& response, Caches& caches) {
   const ResolvedPath resolved = resolveInside(root, relative);
@@ -127,6 +151,7 @@ void serveFile(const fs::path& root, const std::string& relative, const httplib:
     return;
   }
   const auto bytes = file->bytes();
+  if (!applyRanges(request, response, bytes.size())) return;
   // cpp-httplib answers Range requests (206) and gzips text types on its own; HEAD drops the
   // body but keeps its length. JSON is compressed here, once ("; charset" keeps cpp-httplib from
   // compressing it again).
@@ -137,7 +162,9 @@ void serveFile(const fs::path& root, const std::string& relative, const httplib:
   };
   if (type == "application/json") {
     response.set_header("Vary", "Accept-Encoding");
-    if (request.get_header_value("Accept-Encoding").find("gzip") != std::string::npos) {
+    // A range is of the file as it is (identity): no gzip then.
+    if (request.ranges.empty() &&
+        request.get_header_value("Accept-Encoding").find("gzip") != std::string::npos) {
       response.set_header("Content-Encoding", "gzip");
       response.set_content(*caches.gzip.get(resolved.path, bytes),
                            "application/json; charset=utf-8");
@@ -159,9 +186,16 @@ void serveFile(const fs::path& root, const std::string& relative, const httplib:
 }
 
 Status runServe(const Global& global, const ServeOptions& o) {
-  const fs::path root = fs::weakly_canonical(o.directory);
-  if (!fs::is_directory(root))
-    return Error{ErrorKind::kUsage, fmt::format("{}: not a directory", o.directory)};
+  std::error_code error;
+  const fs::path root = fs::weakly_canonical(o.directory, error);
+  if (error || !fs::is_directory(root, error))
+    return Error{
+        ErrorKind::kUsage,
+        fmt::format("{}: not a directory; give the folder `lodforge tiles -o` wrote", o.directory)};
+  if (!fs::is_regular_file(root / "tileset.json", error))
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: holds no tileset.json; give the folder `lodforge tiles -o` wrote",
+                             o.directory)};
   const fs::path web = o.web.empty() ? findWebDirectory() : fs::path(o.web);
   httplib::Server server;
   Caches caches;
@@ -222,9 +256,12 @@ Status runServe(const Global& global, const ServeOptions& o) {
     return Error{ErrorKind::kIo, fmt::format("cannot listen on {}:{} (in use?)", o.host, o.port)};
   if (port < 0) return Error{ErrorKind::kIo, fmt::format("cannot listen on {}", o.host)};
   if (listening >= 0) ::listen(listening, SOMAXCONN);
-  say(global, fmt::format("serving {} on http://{}:{}/ (viewers: /cesium/ and /three/{}); Ctrl-C "
-                          "stops",
-                          root.string(), o.host, port, web.empty() ? ", not built: run make" : ""));
+  const std::string base = fmt::format("http://{}:{}", o.host, port);
+  say(global, fmt::format("serving {} as {}/tiles/tileset.json", root.string(), base));
+  if (web.empty())
+    say(global, "the viewers are not built (run make); Ctrl-C stops");
+  else
+    say(global, fmt::format("open {0}/cesium/ or {0}/three/ to view it; Ctrl-C stops", base));
   std::fflush(stdout);  // a script waiting for the port reads it now, not at exit
   if (o.host != "127.0.0.1" && o.host != "localhost" && o.host != "::1")
     fmt::print(stderr, "lodforge: warning: listening on {}, reachable from other machines\n",

@@ -7,7 +7,10 @@
 #include "cli.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
+#include "lodforge/core/output_claim.h"
 #include "lodforge/core/units.h"
+#include "lodforge/io/format_advice.h"
+#include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
 #include "lodforge/io/point_reader.h"
 #include "lodforge/tiles/point_tiles.h"
@@ -23,6 +26,23 @@ bool isPointInput(const std::string& path) {
   if (fileExtension(path) != "ply") return false;
   Result<PlyReader> ply = PlyReader::open(path, {.salvageTruncated = true});
   return ply.ok() && ply->header().faceCount == 0 && ply->header().vertexCount > 0;
+}
+
+Status checkTilesInput(const std::string& path) {
+  LODFORGE_TRY(refuseDirectoryInput(path));
+  if (!isPointCloudPath(path) && fileExtension(path) != "lfp" &&
+      formatFromPath(path) == FileFormat::kUnknown)
+    return unknownFormatError(
+        path, fmt::format("{}, {}, and .lfp packages", kMeshFormats, kPointFormats));
+  return checkInputPath(path);
+}
+
+// A tileset without a place on Earth sits at the Earth's centre in CesiumJS: say so.
+void warnIfNotPlaced(const Global& global, bool placed) {
+  if (placed || global.verbosity < 0) return;
+  fmt::print(stderr,
+             "lodforge: note: the tileset has no place on Earth (CesiumJS shows it at the "
+             "Earth's centre); place it with --origin LON,LAT,HEIGHT or --crs EPSG:N\n");
 }
 
 }  // namespace
@@ -55,7 +75,9 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("--chunk-size", options->chunkSize,
                   "Edge of a leaf chunk in model units (default: about 64K triangles per leaf)")
       ->check(CLI::NonNegativeNumber);
-  sub->add_option("--levels", options->levels, "Levels above the leaves (default: up to one root)")
+  sub->add_option("--levels", options->levels,
+                  "Levels above the leaves; leaves are made small enough for them (default: "
+                  "up to one root)")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--reduction", options->reduction,
                   "Share of its children's triangles a parent tile keeps (default 0.2)")
@@ -85,14 +107,15 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
   addCountOption(*sub, "--tile-points", options->tilePoints,
                  "Point clouds: about this many points in a tile above the blocks (default 50K)");
   sub->add_flag("--salvage", options->salvage,
-                "Point clouds: read a PLY cut short up to its last whole point");
+                "Read a PLY cut short up to its last whole element (with a warning)");
   sub->add_flag("--resume", options->resume,
-                "Continue an interrupted run from OUTPUT.work and OUTPUT.partial (same input and "
-                "options)");
+                "Continue an interrupted run from OUTPUT.work (same input and options)");
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
       TilesOptions tiles;
+      LODFORGE_TRY(checkTilesInput(options->input));
       tiles.input.chunkSize = options->chunkSize;
+      tiles.input.salvageTruncated = options->salvage;
       tiles.octree.levels = options->levels;
       tiles.octree.keep = options->reduction;
       tiles.octree.maxNormalDeviationDegrees = options->maxNormalDeviation;
@@ -114,6 +137,11 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
         tiles.origin = *origin;
       }
       if (isPointInput(options->input)) {
+        if (options->levels > 0 || options->chunkSize > 0 || options->resume)
+          return Error{ErrorKind::kUsage,
+                       fmt::format("{}: a point cloud; --levels, --chunk-size and --resume are for "
+                                   "meshes (a point tileset's depth follows --block-size)",
+                                   options->input)};
         PointTilesOptions points;
         points.blockSize = std::max<std::uint64_t>(1, options->blockSize);
         points.tilePoints = std::max<std::uint64_t>(1, options->tilePoints);
@@ -125,6 +153,7 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
         points.salvageTruncated = options->salvage;
         Result<PointTilesStats> stats = writePointTiles(options->input, options->output, points);
         if (!stats) return stats.status();
+        warnIfNotPlaced(global, !stats->crs.empty() || points.origin.has_value());
         say(global,
             fmt::format("wrote {}: a point tileset of {} points in {} tiles ({} blocks, depth {}), "
                         "{} in {:.1f} s ({} points/s){}",
@@ -138,14 +167,18 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
       }
       Result<TilesStats> stats = writeTiles(options->input, options->output, tiles);
       if (!stats) {
-        if (std::filesystem::exists(options->output + ".work/state.json"))
-          fmt::print(
-              stderr,
-              "lodforge: the finished chunks and tiles are kept in {0}.work and {0}.partial: "
-              "run again with --resume to continue, or delete them\n",
-              options->output);
+        std::error_code ignored;
+        if (std::filesystem::exists(options->output + ".work/state.json", ignored))
+          fmt::print(stderr,
+                     "lodforge: the finished chunks and tiles are kept in {}.work: run again "
+                     "with --resume to continue, or delete it\n",
+                     options->output);
         return stats.status();
       }
+      if (stats->truncation)
+        fmt::print(stderr, "lodforge: warning: {}; built from what came before\n",
+                   *stats->truncation);
+      warnIfNotPlaced(global, tiles.origin.has_value() || !tiles.crs.empty());
       say(global,
           fmt::format(
               "wrote {}: {} tiles ({} leaves, {} levels above them), {} in {:.1f} s ({} "

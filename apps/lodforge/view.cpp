@@ -25,6 +25,7 @@
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
 #include "lodforge/runtime/stream.h"
+#include "outputs.h"
 #include "view_options.h"
 
 namespace lodforge::cli {
@@ -80,6 +81,8 @@ double milliseconds(std::chrono::steady_clock::duration d) {
 }
 
 Status runView(const Global& global, const ViewOptions& o) {
+  LODFORGE_TRY(claimIfGiven(o.record, jsonOutput(), {o.input}));
+  LODFORGE_TRY(claimIfGiven(o.screenshot, pngOutput(), {o.input}));
   Result<Package> package = Package::open(o.input);
   if (!package) return package.status();
   auto colorMode = parseColorMode(o.color);

@@ -12,12 +12,14 @@
 #include <sstream>
 #include <thread>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <httplib.h>
 
 #include "lodforge/render/image.h"
+#include "run_lodforge.h"
 #include "test_support.h"
 
 extern char** environ;
@@ -25,27 +27,9 @@ extern char** environ;
 namespace lodforge {
 namespace {
 
-struct Outcome {
-  int code = -1;
-  std::string out, err;
-};
-
-// Runs `lodforge ARGS` through the shell, capturing stdout and stderr; `wrapper` goes in front
-// of the binary (an environment change, a virtual display).
-Outcome lodforge(const std::string& args, const test::TempDir& dir,
-                 const std::string& wrapper = "") {
-  const std::string out = dir.file(".stdout"), err = dir.file(".stderr");
-  const std::string command =
-      wrapper + std::string(LODFORGE_BINARY) + " " + args + " >" + out + " 2>" + err;
-  const int status = std::system(command.c_str());
-  Outcome o;
-  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  o.out = test::readFile(out);
-  o.err = test::readFile(err);
-  std::remove(out.c_str());
-  std::remove(err.c_str());
-  return o;
-}
+using test::glSubprocess;
+using test::lodforge;
+using test::Outcome;
 
 // `lodforge build` of a model in ../shared/data/meshes into `package`; the exit code.
 int buildPackage(const std::string& model, const std::string& package, const test::TempDir& dir) {
@@ -114,12 +98,167 @@ TEST(Cli, VersionHelpAndUsageErrors) {
   EXPECT_NE(o.err.find("expected a count such as"), std::string::npos) << o.err;
   o = lodforge("--memory-limit lots info x.ply", dir);
   EXPECT_EQ(o.code, 2);
-  o = lodforge("info " + dir.file("model.fbx"), dir);
+  o = lodforge("info " + dir.file("model.abc"), dir);
   EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.err.find("unknown format"), std::string::npos);
+  EXPECT_NE(o.err.find("unknown format"), std::string::npos) << o.err;
   o = lodforge("info " + dir.file("missing.ply"), dir);
   EXPECT_EQ(o.code, 1);  // the system failed, not the input
   EXPECT_NE(o.err.find("missing.ply: cannot stat: No such file"), std::string::npos) << o.err;
+}
+
+TEST(Cli, MemoryLimitIsHonouredOrRefusedWithTheLeastThatWorks) {
+  test::TempDir dir;
+  const std::string cloud = test::dataPath("points/simple.las");
+  const std::string mesh = test::dataPath("meshes/horse.ply");
+  struct Case {
+    std::string args;
+    int code;
+    std::string says;
+  };
+  for (const Case& c : {
+           Case{"--memory-limit 1K tiles " + cloud + " -o " + dir.file("t"), 1, "at least"},
+           Case{"--memory-limit 1K tiles " + mesh + " -o " + dir.file("t"), 1,
+                "--memory-limit 1.00 KiB is too small for tiles: at least 48.0 MiB"},
+           Case{"--memory-limit 1K points " + cloud + " -o " + dir.file("c.lfc"), 1, "at least"},
+           Case{"--memory-limit 1K build " + mesh + " -o " + dir.file("h.lfp"), 1, "at least"},
+           Case{"--memory-limit 0 build " + mesh + " -o " + dir.file("h.lfp"), 2, "means nothing"},
+           Case{"--memory-limit 1G info " + mesh, 2, "info does not take --memory-limit"},
+           Case{"--memory-limit 1G convert " + test::dataPath("meshes/as1_motor.glb") + " -o " +
+                    dir.file("m.ply"),
+                2, "PLY input only"},
+       }) {
+    const Outcome o = lodforge(c.args, dir);
+    EXPECT_EQ(o.code, c.code) << c.args << "\n" << o.err;
+    EXPECT_NE(o.err.find(c.says), std::string::npos) << c.args << "\n" << o.err;
+    EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{}) << c.args;
+  }
+}
+
+TEST(Cli, ThreadsOptionSaysWhatItTakes) {
+  test::TempDir dir;
+  const std::string mesh = test::dataPath("meshes/horse.ply");
+  Outcome o = lodforge("--threads -1 info " + mesh, dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("expected 0 (all cores) or a number of threads"), std::string::npos)
+      << o.err;
+  EXPECT_LT(o.err.size(), 200u) << "no range of 300 digits: " << o.err;
+  o = lodforge("--threads 100000 info " + mesh, dir);
+  EXPECT_EQ(o.code, 2) << o.err;
+  o = lodforge("--threads 1000 info " + mesh, dir);
+  EXPECT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.err.find("--threads 1000: this machine has"), std::string::npos) << o.err;
+  EXPECT_EQ(o.err.find("TBB"), std::string::npos) << o.err;
+  o = lodforge("--help", dir);
+  EXPECT_NE(o.out.find("0 or left out for all cores"), std::string::npos) << o.out;
+}
+
+TEST(Cli, UnknownFormatsSayWhatEachCommandReadsAndHowToBringThemIn) {
+  test::TempDir dir;
+  for (const char* name : {"part.step", "part.igs", "house.ifc", "scan.e57", "cloud.pcd", "a.xyz3"})
+    test::writeFile(dir.file(name), "not read\n");
+  struct Case {
+    std::string args;
+    std::vector<std::string> says;
+  };
+  for (const Case& c : {
+           Case{"info " + dir.file("part.step"),
+                {"a STEP CAD model", "tessellate it", ".las", ".lfp .lfc packages"}},
+           Case{"tiles " + dir.file("part.igs") + " -o " + dir.file("t"),
+                {"an IGES CAD model", ".glb meshes", ".las", ".lfp packages"}},
+           Case{"build " + dir.file("house.ifc") + " -o " + dir.file("h.lfp"),
+                {"an IFC building model", "IfcConvert", ".ply .obj .stl .gltf .glb meshes"}},
+           Case{"points " + dir.file("scan.e57") + " -o " + dir.file("s.lfc"),
+                {"an E57 scan", ".las .ply .xyz .txt .csv .pts point clouds"}},
+           Case{"tiles " + dir.file("cloud.pcd") + " -o " + dir.file("t"), {"a PCL point cloud"}},
+           Case{"convert " + dir.file("a.xyz3") + " -o " + dir.file("a.ply"),
+                {"unknown format (this command reads .ply .obj"}},
+       }) {
+    const Outcome o = lodforge(c.args, dir);
+    EXPECT_EQ(o.code, 2) << c.args << "\n" << o.err;
+    for (const std::string& s : c.says)
+      EXPECT_NE(o.err.find(s), std::string::npos) << c.args << ": " << s << "\n" << o.err;
+  }
+  EXPECT_EQ(test::listFolder(dir.path()).size(), 6u) << "nothing written";
+}
+
+// A directory given where a file is read: every command says so (exit 2), leaves nothing, and
+// never aborts, whatever the directory's name claims it is.
+TEST(Cli, EveryCommandRefusesADirectoryAsInput) {
+  test::TempDir dir;
+  for (const char* name : {"adir.ply", "adir.glb", "adir.las", "adir.lfp", "adir.lfc", "adir"})
+    std::filesystem::create_directories(dir.file(name));
+  const std::vector<std::string> before = test::listFolder(dir.path());
+  const auto in = [&](const char* name) { return dir.file(name); };
+  for (const std::string& args : {
+           "info " + in("adir.ply"),
+           "info " + in("adir"),
+           "info " + in("adir.lfp"),
+           "info " + in("adir.lfc"),
+           "info " + in("adir.las"),
+           "tiles " + in("adir.ply") + " -o " + dir.file("out"),
+           "tiles " + in("adir") + " -o " + dir.file("out"),
+           "tiles " + in("adir.las") + " -o " + dir.file("out"),
+           "tiles " + in("adir.lfp") + " -o " + dir.file("out"),
+           "build " + in("adir.glb") + " -o " + dir.file("m.lfp"),
+           "convert " + in("adir.ply") + " -o " + dir.file("m.obj"),
+           "extract " + in("adir.lfp") + " --ratio 0.5 -o " + dir.file("m.ply"),
+           "points " + in("adir.las") + " -o " + dir.file("c.lfc"),
+           "bench " + in("adir.lfp") + " --frames 2",
+           "bench " + in("adir.lfc") + " --frames 2",
+       }) {
+    const Outcome o = lodforge(args, dir);
+    EXPECT_EQ(o.code, 2) << args << "\n" << o.err;
+    EXPECT_NE(o.err.find("is a directory"), std::string::npos) << args << "\n" << o.err;
+    EXPECT_EQ(o.err.find("terminate"), std::string::npos) << args << "\n" << o.err;
+    EXPECT_EQ(test::listFolder(dir.path()), before) << args << ": nothing left";
+  }
+}
+
+// A PLY cut short names the option that reads what is there, and every command that reads
+// meshes from PLY takes it (tiles too).
+TEST(Cli, ATruncatedPlySaysSalvageAndEveryMeshCommandTakesIt) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate scan --triangles 4K -o " + dir.file("scan.ply"), dir).code, 0);
+  const std::string bytes = test::readFile(dir.file("scan.ply"));
+  test::writeFile(dir.file("cut.ply"), bytes.substr(0, bytes.size() * 3 / 4));
+  for (const std::string& command :
+       {std::string("info"), std::string("build"), std::string("convert"), std::string("tiles")}) {
+    const std::string out = command == "build"     ? " -o " + dir.file("c.lfp")
+                            : command == "convert" ? " -o " + dir.file("c.glb")
+                            : command == "tiles"   ? " -o " + dir.file("t")
+                                                   : "";
+    Outcome o = lodforge(command + " " + dir.file("cut.ply") + out, dir);
+    EXPECT_EQ(o.code, 2) << command << "\n" << o.err;
+    EXPECT_NE(o.err.find("--salvage"), std::string::npos) << command << "\n" << o.err;
+    o = lodforge(command + " " + dir.file("cut.ply") + out + " --salvage", dir);
+    EXPECT_EQ(o.code, 0) << command << " --salvage\n" << o.err;
+    EXPECT_NE((o.err + o.out).find("cut.ply"), std::string::npos)
+        << command << ": a warning names the cut\n"
+        << o.err;
+  }
+  nlohmann::json tileset = nlohmann::json::parse(test::readFile(dir.file("t/tileset.json")));
+  EXPECT_TRUE(tileset["root"].contains("children")) << "a mesh tileset of what was there";
+}
+
+TEST(Cli, MeshCommandsRefusePointCloudsAndModelsWithoutTriangles) {
+  test::TempDir dir;
+  const std::string cloud = test::dataPath("points/simple.las");
+  test::writeFile(dir.file("vertices.ply"),
+                  "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                  "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
+  struct Case {
+    std::string args, says;
+  };
+  for (const Case& c : {
+           Case{"build " + cloud + " -o " + dir.file("c.lfp"), "a point cloud; build takes meshes"},
+           Case{"convert " + cloud + " -o " + dir.file("c.ply"), "a point cloud; convert takes"},
+           Case{"build " + dir.file("vertices.ply") + " -o " + dir.file("v.lfp"), "no triangles"},
+       }) {
+    const Outcome o = lodforge(c.args, dir);
+    EXPECT_EQ(o.code, 2) << c.args << "\n" << o.err;
+    EXPECT_NE(o.err.find(c.says), std::string::npos) << c.args << "\n" << o.err;
+    EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"vertices.ply"}) << c.args;
+  }
 }
 
 TEST(Cli, InfoReportsEveryRealModel) {
@@ -340,8 +479,6 @@ TEST(CliPackage, BuildStaysUnderItsMemoryLimit) {
   EXPECT_EQ(info(dir.file("big.lfp"), dir)["objects"], 20'000u);
 }
 
-std::string glSubprocess();  // below, with the render tests
-
 TEST(CliPoints, BuildsAPackageFromLasAndInfoReportsBoth) {
   test::TempDir dir;
   const std::string las = test::dataPath("points/autzen_trim.las");
@@ -539,6 +676,55 @@ TEST(CliServe, ServesATilesetWithTypesRangesAndCompression) {
   ASSERT_TRUE(r);
   EXPECT_EQ(r->status, 206);
   EXPECT_EQ(r->body, glb.substr(12, 100));
+  // Every kind of range (RFC 9110 §14): suffix, open, an end past the file (clamped), several,
+  // and a start past the end (416 with the size). Each answer is complete, never short.
+  const std::size_t size = glb.size();
+  struct RangeCase {
+    std::string range;
+    int status;
+    std::string contentRange, body;
+  };
+  for (const RangeCase& c : {
+           RangeCase{"bytes=-100", 206, fmt::format("bytes {}-{}/{}", size - 100, size - 1, size),
+                     glb.substr(size - 100)},
+           RangeCase{fmt::format("bytes=-{}", size + 50), 206,
+                     fmt::format("bytes 0-{}/{}", size - 1, size), glb},
+           RangeCase{"bytes=20-", 206, fmt::format("bytes 20-{}/{}", size - 1, size),
+                     glb.substr(20)},
+           RangeCase{fmt::format("bytes={}-{}", size - 10, size + 100000), 206,
+                     fmt::format("bytes {}-{}/{}", size - 10, size - 1, size),
+                     glb.substr(size - 10)},
+           RangeCase{fmt::format("bytes={}-", size + 100000), 416, fmt::format("bytes */{}", size),
+                     ""},
+           RangeCase{fmt::format("bytes={}-{}", size, size + 5), 416,
+                     fmt::format("bytes */{}", size), ""},
+       }) {
+    r = http.Get("/tiles/tiles/" + tiles[0], {{"Range", c.range}});
+    ASSERT_TRUE(r) << c.range << ": an answer, not a timeout";
+    EXPECT_EQ(r->status, c.status) << c.range;
+    EXPECT_EQ(r->get_header_value("Content-Range"), c.contentRange) << c.range;
+    if (c.status == 206) {
+      EXPECT_EQ(r->body, c.body) << c.range;
+      EXPECT_EQ(r->get_header_value("Content-Length"), std::to_string(c.body.size())) << c.range;
+    }
+  }
+  // Several ranges: the whole file (RFC 9110 lets a server ignore Range), never a broken
+  // multipart answer.
+  r = http.Get("/tiles/tiles/" + tiles[0],
+               {{"Range", fmt::format("bytes=0-9,{}-{},{}-", size - 5, size + 99, size + 7)}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_EQ(r->body, glb);
+  // Several where only one is inside the file: that one.
+  r = http.Get("/tiles/tiles/" + tiles[0], {{"Range", fmt::format("bytes=0-9,{}-", size + 7)}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 206);
+  EXPECT_EQ(r->body, glb.substr(0, 10));
+  // A range of tileset.json is of the file itself, never of its gzip.
+  r = http.Get("/tiles/tileset.json", {{"Range", "bytes=0-9"}, {"Accept-Encoding", "gzip"}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 206);
+  EXPECT_EQ(r->body, tileset.substr(0, 10));
   r = http.Head("/tiles/tiles/" + tiles[0]);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->status, 200);
@@ -562,6 +748,12 @@ TEST(CliServe, ServesATilesetWithTypesRangesAndCompression) {
     EXPECT_EQ(r->status, 200) << page;
     EXPECT_EQ(r->get_header_value("Content-Type"), "text/html; charset=utf-8");
   }
+  // The first lines name the tileset's URL and the viewers.
+  const std::string said = test::readFile(dir.file(".serve-out"));
+  EXPECT_NE(said.find(fmt::format("as http://127.0.0.1:{}/tiles/tileset.json", served.port())),
+            std::string::npos)
+      << said;
+  EXPECT_NE(said.find("/cesium/"), std::string::npos) << said;
   // A request log line each, and a clean stop on Ctrl-C.
   const Finished end = served.stop();
   EXPECT_EQ(end.code, 0);
@@ -607,8 +799,14 @@ TEST(CliServe, RefusesEveryWayOutOfTheDirectory) {
   EXPECT_EQ(r->body, "{}");
   EXPECT_EQ(r->get_header_value("Access-Control-Allow-Origin"), "*");
   EXPECT_EQ(served.stop().code, 0);
-  // Not a directory: a usage error.
-  EXPECT_EQ(lodforge("serve " + dir.file("secret.txt"), dir).code, 2);
+  // Not a directory, or a directory without a tileset: a usage error that says what to give.
+  Outcome o = lodforge("serve " + dir.file("secret.txt"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("not a directory"), std::string::npos) << o.err;
+  std::filesystem::create_directories(dir.file("empty"));
+  o = lodforge("serve " + dir.file("empty"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("holds no tileset.json"), std::string::npos) << o.err;
 }
 
 TEST(CliTiles, WritesATilesetAndReplacesOnlyATileset) {
@@ -626,7 +824,8 @@ TEST(CliTiles, WritesATilesetAndReplacesOnlyATileset) {
   const std::size_t tiles = test::listFolder(out + "/tiles").size();
   EXPECT_GT(tiles, 9u);
   // Again over the previous tileset: replaced, nothing else left in the folder.
-  o = lodforge("tiles " + test::dataPath("meshes/horse.ply") + " -o " + out + " --levels 1", dir);
+  o = lodforge("tiles " + test::dataPath("meshes/horse.ply") + " -o " + out + " --chunk-size 0.2",
+               dir);
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_LT(test::listFolder(out + "/tiles").size(), tiles);
   EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"horse-tiles"});
@@ -637,6 +836,60 @@ TEST(CliTiles, WritesATilesetAndReplacesOnlyATileset) {
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("not a tileset"), std::string::npos) << o.err;
   EXPECT_TRUE(std::filesystem::exists(dir.file("mine/notes.txt")));
+}
+
+// The depth of a tileset: levels of tiles above its deepest leaves.
+int levelsAbove(const nlohmann::json& tile) {
+  int deepest = -1;
+  for (const auto& child : tile.value("children", nlohmann::json::array()))
+    deepest = std::max(deepest, levelsAbove(child));
+  return deepest + 1;
+}
+
+TEST(CliTiles, ASmallModelGetsLevelsAndLevelsAreHonouredOrRefused) {
+  test::TempDir dir;
+  const std::string part = test::dataPath("meshes/as1_motor.glb");  // 27,506 triangles
+  Outcome o = lodforge("tiles " + part + " -o " + dir.file("a"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  nlohmann::json tileset = nlohmann::json::parse(test::readFile(dir.file("a/tileset.json")));
+  EXPECT_GE(levelsAbove(tileset["root"]), 2) << "a hierarchy to refine through";
+  // The root is coarse: a viewer from afar loads a fraction of the part.
+  std::uintmax_t allTiles = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.file("a/tiles")))
+    allTiles += entry.file_size();
+  const std::string rootUri = tileset["root"]["content"]["uri"];
+  EXPECT_LT(std::filesystem::file_size(dir.file("a/" + rootUri)) * 3, allTiles);
+  for (int levels : {1, 3, 4}) {
+    o = lodforge("tiles " + part + " -o " + dir.file("a") + " --levels " + std::to_string(levels),
+                 dir);
+    ASSERT_EQ(o.code, 0) << o.err;
+    EXPECT_NE(o.out.find(std::to_string(levels) + " levels above them"), std::string::npos)
+        << o.out;
+  }
+  o = lodforge("tiles " + part + " -o " + dir.file("b") + " --levels 9", dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("--levels 9: the model's 27506 triangles make at most"), std::string::npos)
+      << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("b")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("b.work")));
+}
+
+TEST(CliTiles, SaysWhenATilesetHasNoPlaceOnEarth) {
+  test::TempDir dir;
+  const std::string mesh = test::dataPath("meshes/horse.ply");
+  Outcome o = lodforge("tiles " + mesh + " -o " + dir.file("a"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.err.find("no place on Earth"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("--origin"), std::string::npos) << o.err;
+  o = lodforge("tiles " + mesh + " -o " + dir.file("a") + " --origin 7.1,50.7,60", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(o.err.find("no place on Earth"), std::string::npos) << o.err;
+  o = lodforge("tiles " + test::dataPath("points/simple.las") + " -o " + dir.file("p"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.err.find("no place on Earth"), std::string::npos) << "a LAS without a CRS";
+  o = lodforge("tiles " + test::dataPath("points/autzen_trim.las") + " -o " + dir.file("p"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(o.err.find("no place on Earth"), std::string::npos) << "placed by its CRS";
 }
 
 TEST(CliTiles, BadInputAndArgumentsAreExitCode2AndLeaveNothing) {
@@ -703,7 +956,7 @@ TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
   EXPECT_EQ(stopped.code, 1);
   EXPECT_NE(err.find("--resume"), std::string::npos) << err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("b")));
-  const std::size_t kept = test::listFolder(dir.file("b.partial/tiles")).size();
+  const std::size_t kept = test::listFolder(dir.file("b.work/tileset/tiles")).size();
   EXPECT_GT(kept, 0u);
 
   std::vector<std::string> resume = args;
@@ -839,19 +1092,6 @@ TEST(CliCompare, MismatchedOrBadImagesAreExitCode2) {
   EXPECT_NE(o.err.find("text.png"), std::string::npos) << o.err;
   o = lodforge("compare " + dir.file("small.png") + " " + dir.path().string(), dir);
   EXPECT_EQ(o.code, 2) << "a file and a folder";
-}
-
-// Under ASan, LeakSanitizer's exit-time tracer crashes reading the main thread's TLS in a render
-// subprocess started from this test (Mesa's driver loaded; since PROJ joined the link), though
-// the same command passes on its own. Leaks of the render code stay checked in-process by
-// tests/render/*; the subprocess keeps ASan and UBSan, without the leak pass.
-std::string glSubprocess() {
-#ifdef LODFORGE_SANITIZED
-  const char* options = std::getenv("ASAN_OPTIONS");
-  return std::string("ASAN_OPTIONS=") + (options ? options : "") + ":detect_leaks=0 ";
-#else
-  return "";
-#endif
 }
 
 TEST(CliRender, FramesAlongAPathMatchTheReferenceAtFullBudget) {

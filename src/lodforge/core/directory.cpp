@@ -2,6 +2,8 @@
 
 #include <filesystem>
 
+#include "lodforge/core/file.h"
+
 namespace lodforge {
 
 namespace fs = std::filesystem;
@@ -13,16 +15,32 @@ ScopedDirectory::~ScopedDirectory() {
 
 Status replaceDirectory(ScopedDirectory& staging, const std::string& output) {
   std::error_code error;
-  if (fs::exists(output)) {
-    ScopedDirectory old(output + ".old");
-    fs::remove_all(old.path, error);
+  if (fs::exists(output, error)) {
+    // Aside under a fresh name of our own (never a name the user may hold), removed after.
+    ScopedDirectory old(temporaryPathFor(output));
     fs::rename(output, old.path, error);
-    if (error) return ioError(output, error.message());
+    if (error) {
+      old.path.clear();
+      return ioError(output, error.message());
+    }
   }
   fs::rename(staging.path, output, error);
   if (error) return ioError(output, error.message());
   staging.path.clear();
   return {};
+}
+
+std::uint64_t directoryBytes(const std::string& path) {
+  std::uint64_t bytes = 0;
+  std::error_code error;
+  fs::recursive_directory_iterator it(path, error), end;
+  for (; !error && it != end; it.increment(error)) {
+    std::error_code failed;
+    if (!it->is_regular_file(failed)) continue;
+    const std::uintmax_t size = it->file_size(failed);
+    if (!failed) bytes += size;
+  }
+  return bytes;
 }
 
 }  // namespace lodforge

@@ -2,6 +2,7 @@
 // go out of scope, and a finished staging folder put in place of the previous output.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "lodforge/core/status.h"
@@ -21,5 +22,8 @@ struct ScopedDirectory {
 // Renames the complete `staging` directory to `output`, replacing what was there (moved aside
 // first, removed after), and clears `staging.path` so it is kept.
 Status replaceDirectory(ScopedDirectory& staging, const std::string& output);
+
+// Bytes in the regular files below `path` (what could not be read counts 0).
+std::uint64_t directoryBytes(const std::string& path);
 
 }  // namespace lodforge

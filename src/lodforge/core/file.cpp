@@ -17,6 +17,12 @@ namespace lodforge {
 
 namespace {
 constexpr std::size_t kReadBuffer = 1 << 20;
+
+Error notARegularFile(const std::string& path, const struct stat& info) {
+  return {ErrorKind::kBadInput, fmt::format("{}: {}", path,
+                                            S_ISDIR(info.st_mode) ? "is a directory; give a file"
+                                                                  : "not a regular file")};
+}
 }  // namespace
 
 // --- ByteSource -------------------------------------------------------------------------------
@@ -27,7 +33,7 @@ Result<ByteSource> ByteSource::openFile(const std::string& path) {
   struct stat info {};
   if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
     ::close(fd);
-    return Error{ErrorKind::kBadInput, fmt::format("{}: not a regular file", path)};
+    return notARegularFile(path, info);
   }
   ByteSource source;
   source.name_ = path;
@@ -170,14 +176,21 @@ bool ByteSource::readLine(std::string& line, std::size_t maxLength) {
 
 std::string temporaryPathFor(const std::string& path) {
   static std::atomic<unsigned> counter{0};
-  return fmt::format("{}.tmp-{}-{}", path, ::getpid(), counter++);
+  for (;;) {
+    std::string name = fmt::format("{}.tmp-{}-{}", path, ::getpid(), counter++);
+    struct stat info {};
+    if (::lstat(name.c_str(), &info) != 0) return name;  // a name nobody holds
+  }
 }
 
 Result<OutputFile> OutputFile::create(const std::string& path, std::size_t bufferBytes) {
   OutputFile file;
   file.path_ = path;
-  file.tempPath_ = temporaryPathFor(path);
-  file.fd_ = ::open(file.tempPath_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  // O_EXCL: the temporary is a new file of ours, never one that appeared under that name since.
+  do {
+    file.tempPath_ = temporaryPathFor(path);
+    file.fd_ = ::open(file.tempPath_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  } while (file.fd_ < 0 && errno == EEXIST);
   if (file.fd_ < 0) return ioErrorFromErrno(path, "create");
   file.buffer_.resize(std::max<std::size_t>(bufferBytes, 4096));
   return file;
@@ -302,6 +315,13 @@ Status OutputFile::commit() {
   return {};
 }
 
+Status OutputFile::writeWhole(const std::string& path, std::string_view bytes) {
+  Result<OutputFile> file = create(path, 4096);
+  if (!file) return file.status();
+  LODFORGE_TRY(file->write(bytes.data(), bytes.size()));
+  return file->commit();
+}
+
 // --- MappedFile -------------------------------------------------------------------------------
 
 Result<MappedFile> MappedFile::open(const std::string& path) {
@@ -312,6 +332,10 @@ Result<MappedFile> MappedFile::open(const std::string& path) {
     Error e = ioErrorFromErrno(path, "stat");
     ::close(fd);
     return e;
+  }
+  if (!S_ISREG(info.st_mode)) {
+    ::close(fd);
+    return notARegularFile(path, info);
   }
   MappedFile file;
   file.path_ = path;

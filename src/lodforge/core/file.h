@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "lodforge/core/status.h"
@@ -57,8 +58,9 @@ class ByteSource {
   std::uint64_t bufferOffset_ = 0;    // file offset of begin_
 };
 
-// A file written under "<path>.tmp-<pid>" and renamed to <path> by commit(). Destroyed without
-// commit (error, cancel) it removes the temporary, so no half-written output is ever left.
+// A file written under "<path>.tmp-<pid>-<n>" (a name nobody holds) and renamed to <path> by
+// commit(). Destroyed without commit (error, cancel) it removes the temporary, so no half-written
+// output is ever left.
 class OutputFile {
  public:
   static Result<OutputFile> create(const std::string& path,
@@ -80,6 +82,8 @@ class OutputFile {
   // Appends the first `bytes` of another file (a spilled section written earlier).
   Status appendFileContents(const std::string& path, std::uint64_t bytes);
   Status commit();
+  // The whole file at once, atomically: every small file the library writes goes through this.
+  static Status writeWhole(const std::string& path, std::string_view bytes);
   std::uint64_t bytesWritten() const { return written_; }
   const std::string& path() const { return path_; }
 
@@ -120,7 +124,8 @@ Result<std::string> readFileToString(const std::string& path, std::uint64_t maxB
 Result<std::uint64_t> fileSize(const std::string& path);
 // Lower-cased extension without the dot ("glb", "ply"); empty when there is none.
 std::string fileExtension(const std::string& path);
-// A unique temporary name beside `path`, used for the rename-on-complete pattern.
+// A temporary name beside `path` that no file holds now ("<path>.tmp-<pid>-<n>"), for the
+// rename-on-complete pattern.
 std::string temporaryPathFor(const std::string& path);
 
 }  // namespace lodforge

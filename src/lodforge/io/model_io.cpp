@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/file.h"
+#include "lodforge/io/format_advice.h"
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/io/gltf_reader.h"
 #include "lodforge/io/obj_reader.h"
@@ -68,8 +69,7 @@ Result<Model> readModel(const std::string& path, const ReadOptions& options) {
     case FileFormat::kUnknown:
       break;
   }
-  return Error{ErrorKind::kUsage,
-               fmt::format("{}: unknown format (lodforge reads .ply .obj .stl .gltf .glb)", path)};
+  return unknownFormatError(path, kMeshFormats);
 }
 
 Status writeModel(const Model& model, const std::string& path) {

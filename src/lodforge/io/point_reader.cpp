@@ -3,6 +3,7 @@
 #include <variant>
 
 #include "lodforge/core/file.h"
+#include "lodforge/io/format_advice.h"
 #include "lodforge/io/las_reader.h"
 #include "lodforge/io/ply_reader.h"
 #include "lodforge/io/xyz_reader.h"
@@ -78,9 +79,7 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
     info.hasColors = layout.red >= 0;
     return PointReader(std::make_unique<State>(State{std::move(*xyz), std::move(info), {}}));
   }
-  return Error{
-      ErrorKind::kUsage,
-      fmt::format("{}: not a point file (expected .las, .ply, .xyz, .txt, .csv or .pts)", path)};
+  return unknownFormatError(path, kPointFormats);
 }
 
 Result<bool> PointReader::next(PointBatch& batch) {

@@ -61,34 +61,27 @@ constexpr std::uint64_t kBlockBytesPerPoint = 320;
 // Buffers of the streamed passes and the package writer.
 constexpr std::uint64_t kBufferBytes = std::uint64_t{12} << 20;
 
-struct MemoryPlan {
-  int threads = 1;
-  std::uint64_t partitionBytes = 0;  // points held in memory while splitting
-};
+}  // namespace
 
-// Under --memory-limit: what the process already holds, then the blocks in flight (as many
-// threads as fit in half of what is left), and the rest for splitting in memory.
-Result<MemoryPlan> planMemory(const PointsBuildOptions& options) {
-  MemoryPlan plan;
+Result<PointMemoryPlan> planPointMemory(std::uint64_t memoryLimit, std::uint64_t blockSize) {
+  PointMemoryPlan plan;
   plan.threads = tbb::this_task_arena::max_concurrency();
   plan.partitionBytes = PartitionOptions{}.memoryBytes;
-  if (options.memoryLimit == 0) return plan;
+  if (memoryLimit == 0) return plan;
   const std::uint64_t base = currentRssBytes() + kBufferBytes;
-  const std::uint64_t block = options.blockSize * kBlockBytesPerPoint;
-  const std::uint64_t least = base + block + 2 * options.blockSize * sizeof(CloudPoint);
-  if (options.memoryLimit < least)
-    return Error{
-        ErrorKind::kLimit,
-        fmt::format("--memory-limit {} is too small for blocks of {} points: at least {}",
-                    formatBytes(options.memoryLimit), options.blockSize, formatBytes(least))};
-  const std::uint64_t available = options.memoryLimit - base;
+  const std::uint64_t block = blockSize * kBlockBytesPerPoint;
+  const std::uint64_t least = base + block + 2 * blockSize * sizeof(CloudPoint);
+  if (memoryLimit < least)
+    return Error{ErrorKind::kLimit,
+                 fmt::format("--memory-limit {} is too small for blocks of {} points: at least {} "
+                             "(or smaller blocks with --block-size)",
+                             formatBytes(memoryLimit), blockSize, formatBytes(least))};
+  const std::uint64_t available = memoryLimit - base;
   plan.threads = static_cast<int>(std::clamp<std::uint64_t>(
       available / 2 / block, 1, static_cast<std::uint64_t>(plan.threads)));
   plan.partitionBytes = available - static_cast<std::uint64_t>(plan.threads) * block;
   return plan;
 }
-
-}  // namespace
 
 Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::string& output,
                                          const PointsBuildOptions& options) {
@@ -97,9 +90,11 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   PointsBuildStats stats;
-  ScopedDirectory work(options.workDirectory.empty() ? output + ".work" : options.workDirectory);
+  LODFORGE_TRY(claimPointPackageOutput(input, output));
+  // A work directory of our own: a fresh name unless the caller chose one.
+  ScopedDirectory work(options.workDirectory.empty() ? temporaryPathFor(output + ".work")
+                                                     : options.workDirectory);
   std::error_code error;
-  fs::remove_all(work.path, error);
   fs::create_directories(work.path, error);
   if (error) return ioError(work.path, error.message());
 
@@ -107,7 +102,7 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   partitionOptions.blockSize = options.blockSize;
   partitionOptions.workDirectory = work.path;
   partitionOptions.salvageTruncated = options.salvageTruncated;
-  Result<MemoryPlan> plan = planMemory(options);
+  Result<PointMemoryPlan> plan = planPointMemory(options.memoryLimit, options.blockSize);
   if (!plan) return plan.status();
   partitionOptions.memoryBytes = options.splitBytes > 0 ? options.splitBytes : plan->partitionBytes;
   stats.threads = plan->threads;
@@ -225,8 +220,8 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   // two leaves a package that refuses the new segments (other build id), never a mix.
   LODFORGE_TRY(replaceDirectory(staging, segments));
   LODFORGE_TRY(writeCloudFile(output, header, partition->info.crs, table, residentOf));
-  for (const auto& entry : fs::directory_iterator(segments)) stats.outputBytes += entry.file_size();
-  stats.outputBytes += fs::file_size(output);
+  const Result<std::uint64_t> packageBytes = fileSize(output);
+  stats.outputBytes = directoryBytes(segments) + (packageBytes ? *packageBytes : 0);
   stats.seconds = elapsed();
   return stats;
 }

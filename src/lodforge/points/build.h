@@ -25,6 +25,15 @@ struct PointsBuildOptions {
   bool salvageTruncated = false;  // a PLY cut short: read up to its last whole point
 };
 
+// Under --memory-limit: what the process already holds, then the blocks in flight (as many
+// threads as fit in half of what is left), and the rest for splitting in memory. A limit below
+// what one block needs is refused (kLimit) with the least that works.
+struct PointMemoryPlan {
+  int threads = 1;
+  std::uint64_t partitionBytes = 0;  // points held in memory while splitting
+};
+Result<PointMemoryPlan> planPointMemory(std::uint64_t memoryLimit, std::uint64_t blockSize);
+
 struct PointsBuildStats {
   std::uint64_t points = 0, blocks = 0;
   std::uint64_t residentNodes = 0, segmentNodes = 0, droppedNodes = 0;

@@ -1,9 +1,11 @@
 #include "lodforge/points/cloud_file.h"
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 
 #include "lodforge/core/checksum.h"
+#include "lodforge/core/output_claim.h"
 
 namespace lodforge {
 
@@ -29,6 +31,26 @@ std::string segmentDirectoryFor(const std::string& cloudPath) {
   std::filesystem::path p(cloudPath);
   p.replace_extension(".lfs");
   return p.string();
+}
+
+Status claimPointPackageOutput(const std::string& input, const std::string& output) {
+  const std::string inputs[] = {input};
+  const OutputKind package{.name = "a point package (.lfc)", .isOwn = [](const std::string& p) {
+                             return fileStartsWith(p, std::string_view(kCloudMagic, 8));
+                           }};
+  LODFORGE_TRY(claimOutput(output, package, inputs));
+  const OutputKind segments{.name = "the segment directory of a point package",
+                            .directory = true,
+                            .isOwn = [](const std::string& directory) {
+                              return directoryHoldsOnly(
+                                  directory, [](const std::string& name, bool isDirectory) {
+                                    return !isDirectory && name.size() == 16 &&
+                                           name.starts_with("block-") && name.ends_with(".seg") &&
+                                           std::all_of(name.begin() + 6, name.begin() + 12,
+                                                       [](char c) { return c >= '0' && c <= '9'; });
+                                  });
+                            }};
+  return claimOutput(segmentDirectoryFor(output), segments, inputs);
 }
 
 std::string segmentFileName(std::uint64_t block) {

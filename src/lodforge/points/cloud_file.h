@@ -57,6 +57,11 @@ struct CloudBlock {
 };
 static_assert(sizeof(CloudBlock) == 104);
 
+// Claims `output` (a .lfc) and its segment directory for a package of `input` before any work:
+// each is replaced only when it is a package (by its magic) or a segment directory (nothing but
+// block-NNNNNN.seg files) that lodforge wrote.
+Status claimPointPackageOutput(const std::string& input, const std::string& output);
+
 // Where a package keeps its segment files: "x.lfc" -> "x.lfs".
 std::string segmentDirectoryFor(const std::string& cloudPath);
 std::string segmentFileName(std::uint64_t block);

@@ -133,7 +133,8 @@ Result<std::array<PartNode, 2>> splitStreamed(const PartNode& node, const std::s
     children[side].bounds = stats[side].bounds;
     children[side].sum = stats[side].sum;
   }
-  std::filesystem::remove(node.path);
+  std::error_code ignored;
+  std::filesystem::remove(node.path, ignored);
   return children;
 }
 
@@ -232,7 +233,8 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
     }
     Result<std::vector<CloudPoint>> points = readPointRecords(node.path, 0, node.count);
     if (!points) return points.status();
-    std::filesystem::remove(node.path);
+    std::error_code ignored;
+    std::filesystem::remove(node.path, ignored);
     splitInMemory(*points, node.name, options.blockSize, options.workDirectory, blocks);
     if (!blocks.status.ok()) return blocks.status;
     progress.advance(node.count);

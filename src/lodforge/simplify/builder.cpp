@@ -50,14 +50,16 @@ Built buildOne(SourceObject& source, const ProgressiveOptions& options) {
   return built;
 }
 
-Result<BuildStats> build(ObjectStream& stream, const std::string& output,
+Result<BuildStats> build(const std::string& input, ObjectStream& stream, const std::string& output,
                          const BuildOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (options.memoryLimit && options.memoryLimit < kFixedBytes + (std::uint64_t{4} << 20)) {
-    return Error{ErrorKind::kLimit,
-                 fmt::format("a memory limit of {} is too small to build anything (it needs {} for "
-                             "itself plus the objects in flight)",
-                             formatBytes(options.memoryLimit), formatBytes(kFixedBytes))};
+    return Error{
+        ErrorKind::kLimit,
+        fmt::format("--memory-limit {} is too small to build anything: at least {} ({} "
+                    "for the program plus the objects in flight)",
+                    formatBytes(options.memoryLimit),
+                    formatBytes(kFixedBytes + (std::uint64_t{4} << 20)), formatBytes(kFixedBytes))};
   }
   // The objects in flight get what the limit leaves (a quarter of the machine by default).
   const std::uint64_t budget = options.memoryLimit
@@ -123,6 +125,10 @@ Result<BuildStats> build(ObjectStream& stream, const std::string& output,
     }
     LODFORGE_TRY(checkCancelled());
   }
+  if (stats.inputTriangles == 0)
+    return badInput(input,
+                    "no triangles: a package is built from a mesh (for a point cloud use "
+                    "`lodforge points` or `lodforge tiles`)");
   LODFORGE_TRY(writer->finish());
   progress.finish();
   Result<std::uint64_t> size = fileSize(output);
@@ -139,14 +145,14 @@ Result<BuildStats> buildPackage(const std::string& input, const std::string& out
   ObjectStreamOptions streamOptions{options.read, false};
   Result<std::unique_ptr<ObjectStream>> stream = openObjectStream(input, streamOptions);
   if (!stream) return stream.status();
-  Result<BuildStats> stats = build(**stream, output, options);
+  Result<BuildStats> stats = build(input, **stream, output, options);
   if (stats.ok() || stats.error().kind != ErrorKind::kUnsupported) return stats;
   // The PLY's objects are not grouped: load it whole instead of streaming (objects get grouped
   // by the reader), as long as it fits.
   streamOptions.load = true;
   stream = openObjectStream(input, streamOptions);
   if (!stream) return stream.status();
-  return build(**stream, output, options);
+  return build(input, **stream, output, options);
 }
 
 }  // namespace lodforge

@@ -8,14 +8,17 @@
 #include <mutex>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/glb_writer.h"
+#include "lodforge/points/build.h"
 #include "lodforge/points/partition.h"
 #include "lodforge/tiles/tileset.h"
+#include "lodforge/tiles/tileset_output.h"
 
 namespace lodforge {
 
@@ -204,14 +207,15 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
                                         const PointTilesOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   PointTilesStats stats;
+  LODFORGE_TRY(claimTilesetOutput(input, outputDirectory));
+  Result<PointMemoryPlan> plan = planPointMemory(options.memoryLimit, options.blockSize);
+  if (!plan) return plan.status();
+  // A fresh work directory of our own (nothing to resume) that also stages the tileset.
+  ScopedDirectory work(temporaryPathFor(outputDirectory + ".work"));
+  ScopedDirectory staging(work.path + "/tileset");
   std::error_code error;
-  ScopedDirectory staging(outputDirectory + ".partial");
-  ScopedDirectory work(outputDirectory + ".work");
-  fs::remove_all(staging.path, error);
-  fs::remove_all(work.path, error);
   fs::create_directories(fs::path(staging.path) / "tiles", error);
-  fs::create_directories(work.path, error);
-  if (error) return ioError(staging.path, error.message());
+  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
 
   // Georeferencing: the CRS goes through PROJ while the input is read (one thread), so the
   // blocks are in the local east-north-up frame already.
@@ -223,7 +227,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   partitionOptions.blockSize = options.blockSize;
   partitionOptions.workDirectory = work.path;
   partitionOptions.salvageTruncated = options.salvageTruncated;
-  if (options.memoryLimit > 0) partitionOptions.memoryBytes = options.memoryLimit / 2;
+  partitionOptions.memoryBytes = plan->partitionBytes;
   if (!stats.crs.empty()) {
     PointBatch first;
     Result<bool> some = probe->next(first);
@@ -245,14 +249,18 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   std::vector<BlockTiles> blocks(partition->blocks.size());
   std::vector<Status> failures(blocks.size());
   Progress progress("tiles: blocks", stats.points);
-  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
-    if (cancelRequested()) return;
-    const PointBlock& block = partition->blocks[b];
-    failures[b] = levelBlock(block, *partition, options, taus,
-                             work.path + "/" + block.name + ".tiles", blocks[b]);
-    std::error_code ignored;
-    fs::remove(block.path, ignored);
-    progress.advance(block.count);
+  // As many blocks at once as the memory plan allows.
+  tbb::task_arena arena(plan->threads);
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+      if (cancelRequested()) return;
+      const PointBlock& block = partition->blocks[b];
+      failures[b] = levelBlock(block, *partition, options, taus,
+                               work.path + "/" + block.name + ".tiles", blocks[b]);
+      std::error_code ignored;
+      fs::remove(block.path, ignored);
+      progress.advance(block.count);
+    });
   });
   for (const Status& f : failures) LODFORGE_TRY(f);
   LODFORGE_TRY(checkCancelled());
@@ -326,15 +334,8 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
       {"geometricError", std::max(static_cast<double>(rootError),
                                   taus.empty() ? 0.0 : 2.0 * static_cast<double>(taus.front()))},
       {"root", root}};
-  {
-    Result<OutputFile> out = OutputFile::create(staging.path + "/tileset.json");
-    if (!out) return out.status();
-    const std::string text = tileset.dump(1);
-    LODFORGE_TRY(out->write(text.data(), text.size()));
-    LODFORGE_TRY(out->commit());
-  }
-  for (const auto& entry : fs::recursive_directory_iterator(staging.path))
-    if (entry.is_regular_file()) stats.outputBytes += entry.file_size();
+  LODFORGE_TRY(OutputFile::writeWhole(staging.path + "/tileset.json", tileset.dump(1)));
+  stats.outputBytes = directoryBytes(staging.path);
 
   // Complete: replace the previous tileset, if any, by the new one.
   LODFORGE_TRY(replaceDirectory(staging, outputDirectory));

@@ -11,9 +11,12 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/directory.h"
+#include "lodforge/core/file.h"
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/core/units.h"
 #include "lodforge/io/glb_writer.h"
+#include "lodforge/tiles/tileset_output.h"
 #include "lodforge/tiling/chunk_grid.h"
 
 namespace lodforge {
@@ -46,16 +49,18 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
       {"streamed", input.streamed},
       {"frame", input.frame ? nlohmann::json(input.frame->m) : nlohmann::json()},
       {"counts", counts}};
-  const std::string temp = path + ".tmp";
-  {
-    std::ofstream out(temp);
-    out << state.dump();
-    if (!out.flush()) return ioError(temp, "cannot write");
-  }
+  return OutputFile::writeWhole(path, state.dump());
+}
+
+// What identifies the input of a resumable run besides its path.
+std::uint64_t fileBytes(const std::string& path) {
+  Result<std::uint64_t> size = fileSize(path);
+  return size ? *size : 0;
+}
+std::int64_t modifiedTicks(const std::string& path) {
   std::error_code error;
-  fs::rename(temp, path, error);
-  if (error) return ioError(path, error.message());
-  return {};
+  const auto time = fs::last_write_time(path, error);
+  return error ? 0 : static_cast<std::int64_t>(time.time_since_epoch().count());
 }
 
 std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::json& identity,
@@ -114,10 +119,11 @@ Status planMemory(const TilesOptions& options, ChunkInputOptions& input, OctreeO
     // the rest a quarter goes to the chunk buffer, an eighth to the vertex cache and half to the
     // nodes in flight (the octree lowers its parallelism to fit).
     constexpr std::uint64_t kProgram = std::uint64_t{32} << 20;
-    if (options.memoryLimit < kProgram + (std::uint64_t{16} << 20))
+    constexpr std::uint64_t kLeast = kProgram + (std::uint64_t{16} << 20);
+    if (options.memoryLimit < kLeast)
       return Error{ErrorKind::kLimit,
-                   fmt::format("--memory-limit {} MiB is too small for tiles: at least 48 MiB",
-                               options.memoryLimit >> 20)};
+                   fmt::format("--memory-limit {} is too small for tiles: at least {}",
+                               formatBytes(options.memoryLimit), formatBytes(kLeast))};
     const std::uint64_t usable = options.memoryLimit - kProgram;
     input.chunkBufferBytes = std::min(input.chunkBufferBytes, usable / 4);
     input.vertexCacheBytes = std::min(input.vertexCacheBytes, usable / 8);
@@ -230,46 +236,44 @@ Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
       {"geometricError", nothing},
       {"root", tile(octree.root)}};
   if (rootTransform) tileset["root"]["transform"] = rootTransform->m;
-  std::ofstream out(path);
-  if (!out) return ioError(path, "cannot create");
-  out << tileset.dump(1) << '\n';
-  if (!out.flush()) return ioError(path, "cannot write");
-  return {};
+  return OutputFile::writeWhole(path, tileset.dump(1) + '\n');
 }
 
 Result<TilesStats> writeTiles(const std::string& path, const std::string& outputDirectory,
                               const TilesOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   TilesStats stats;
-  std::error_code error;
-  if (fs::exists(outputDirectory) && !fs::exists(fs::path(outputDirectory) / "tileset.json") &&
-      !fs::is_empty(outputDirectory, error)) {
-    return Error{
-        ErrorKind::kUsage,
-        fmt::format("{}: exists and is not a tileset; not overwriting it", outputDirectory)};
-  }
-  // Stable names, so that an interrupted run can be resumed; removed once the tileset is done.
-  ScopedDirectory staging{outputDirectory + ".partial"};
+  LODFORGE_TRY(claimTilesetOutput(path, outputDirectory));
+  // One work directory with a stable name (so that an interrupted run can be resumed) holds the
+  // work files and the tileset being staged; removed once the tileset is in place.
+  LODFORGE_TRY(claimWorkDirectory(outputDirectory + ".work"));  // before it is ours to remove
   ScopedDirectory work{outputDirectory + ".work"};
+  ScopedDirectory staging{work.path + "/tileset"};
+  std::error_code error;
   if (!options.resume) {
     fs::remove_all(staging.path, error);
-    fs::remove_all(work.path, error);
+    fs::remove_all(work.path + "/nodes", error);
+    fs::remove(work.path + "/state.json", error);
   }
-  fs::create_directories(fs::path(staging.path) / "tiles");
-  fs::create_directories(fs::path(work.path) / "nodes");
-  // On failure or Ctrl-C after the chunks are complete, both stay for --resume; otherwise (bad
-  // input, or success) they go.
+  fs::create_directories(fs::path(staging.path) / "tiles", error);
+  if (!error) fs::create_directories(fs::path(work.path) / "nodes", error);
+  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
+  // On failure or Ctrl-C after the chunks are complete, the work directory stays for --resume;
+  // otherwise (bad input, or success) it goes.
   struct KeepOnFailure {
     ScopedDirectory& staging;
     ScopedDirectory& work;
     bool done = false;
     ~KeepOnFailure() {
-      if (!done && fs::exists(work.path + "/state.json")) staging.path.clear(), work.path.clear();
+      std::error_code ignored;
+      if (!done && fs::exists(work.path + "/state.json", ignored))
+        staging.path.clear(), work.path.clear();
     }
   } keep{staging, work};
 
   ChunkInputOptions input = options.input;
   OctreeOptions octree = options.octree;
+  input.levels = octree.levels;
   LODFORGE_TRY(planMemory(options, input, octree));
   stats.threads = octree.threads;
 
@@ -299,11 +303,13 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   const std::string statePath = work.path + "/state.json";
   const nlohmann::json identity = {
       {"workFormat", 2},  // 2: indexed chunk blocks; work files of another format start over
-      {"input", fs::absolute(path).string()},
-      {"bytes", fs::exists(path) ? fs::file_size(path) : 0},
-      {"modified", fs::exists(path) ? fs::last_write_time(path).time_since_epoch().count() : 0},
+      {"input", fs::absolute(path, error).string()},
+      {"bytes", fileBytes(path)},
+      {"modified", modifiedTicks(path)},
       {"chunkSize", input.chunkSize},
       {"trianglesPerChunk", input.trianglesPerChunk},
+      {"levels", input.levels},
+      {"salvage", input.salvageTruncated},
       {"keep", octree.keep},
       {"maxNormalDeviation", octree.maxNormalDeviationDegrees},
       {"errorSamples", octree.errorSamples},
@@ -320,7 +326,9 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   } else {
     fs::remove_all(work.path + "/nodes", error);
     fs::remove_all(fs::path(staging.path) / "tiles", error);
-    fs::create_directories(fs::path(staging.path) / "tiles");
+    fs::create_directories(fs::path(staging.path) / "tiles", error);
+    if (!error) fs::create_directories(work.path + "/nodes", error);
+    if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
     Result<ChunkInput> fresh = chunkInput(path, input);
     if (!fresh) return lazy->error.ok() ? fresh.status() : lazy->error;
     chunked = std::move(*fresh);
@@ -330,6 +338,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   }
   octree.resume = stats.resumed;
   stats.inputTriangles = chunked->inputTriangles;
+  stats.truncation = chunked->truncation;
   stats.streamed = chunked->streamed;
   stats.chunkSize = chunked->chunks->grid().size;
   stats.leafTriangles = chunked->chunks->triangleCount();
@@ -363,8 +372,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
     }
   }
   stats.levels = tree->levels;
-  for (const auto& entry : fs::recursive_directory_iterator(staging.path))
-    if (entry.is_regular_file()) stats.outputBytes += entry.file_size();
+  stats.outputBytes = directoryBytes(staging.path);
 
   // Complete: replace the previous tileset, if any, by the new one.
   keep.done = true;

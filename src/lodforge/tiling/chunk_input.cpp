@@ -125,10 +125,31 @@ void runOn(int threads, const Work& work) {
   arena.execute(work);
 }
 
-double chunkSizeFor(const ChunkInputOptions& options, const Aabbd& bounds,
-                    std::uint64_t triangles) {
-  return options.chunkSize > 0 ? options.chunkSize
-                               : ChunkGrid::sizeFor(bounds, triangles, options.trianglesPerChunk);
+// A small model still gets a hierarchy to refine through: leaves of at most a sixteenth of it
+// (not below kLeastLeafTriangles), so that a viewer shows a 30 K-triangle part from afar with a
+// coarse tile instead of loading all of it.
+constexpr std::uint64_t kLeastLeafTriangles = 2048;
+std::uint64_t leafTriangles(const ChunkInputOptions& options, std::uint64_t triangles) {
+  return std::min(options.trianglesPerChunk, std::max(triangles / 16, kLeastLeafTriangles));
+}
+
+// With --levels N the leaves are small enough for N levels above them (the grid's longest side
+// has 2^N cells), unless that leaves fewer than kLeastLevelTriangles per leaf of a surface.
+constexpr std::uint64_t kLeastLevelTriangles = 16;
+Result<double> chunkSizeFor(const ChunkInputOptions& options, const Aabbd& bounds,
+                            std::uint64_t triangles) {
+  if (options.chunkSize > 0) return options.chunkSize;
+  double size = ChunkGrid::sizeFor(bounds, triangles, leafTriangles(options, triangles));
+  if (options.levels <= 0) return size;
+  int most = 0;
+  while (most < 30 && (triangles >> (2 * (most + 1))) >= kLeastLevelTriangles) ++most;
+  if (options.levels > most)
+    return Error{ErrorKind::kUsage,
+                 fmt::format("--levels {}: the model's {} triangles make at most {} levels above "
+                             "the leaves (each level quarters a surface's leaves, and a leaf "
+                             "keeps at least {} triangles)",
+                             options.levels, triangles, most, kLeastLevelTriangles)};
+  return std::min(size, std::max(bounds.longestSide(), 1e-9) / std::ldexp(1.0, options.levels));
 }
 
 // A model file, or a progressive package (.lfp) at full detail: every object's mesh as it was
@@ -145,8 +166,7 @@ Result<Model> readInputModel(const std::string& path) {
 // crowd into far fewer chunks than a surface would). `visit(add)` calls add(point, triangles)
 // for where the triangles are: each triangle's centroid, or each object's centre.
 template <class Visit>
-double fitChunkSize(const Aabbd& bounds, double size, const ChunkInputOptions& options,
-                    const Visit& visit) {
+double fitChunkSize(const Aabbd& bounds, double size, std::uint64_t perChunk, const Visit& visit) {
   const double smallest = bounds.longestSide() / 4096;
   std::unordered_map<std::uint64_t, double> load;
   while (size / 2 >= smallest) {
@@ -158,7 +178,7 @@ double fitChunkSize(const Aabbd& bounds, double size, const ChunkInputOptions& o
       squares += count * count;
       triangles += count;
     }
-    if (squares / triangles <= 1.5 * static_cast<double>(options.trianglesPerChunk)) break;
+    if (squares / triangles <= 1.5 * static_cast<double>(perChunk)) break;
     size /= 2;
   }
   return size;
@@ -179,6 +199,7 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   // Pass 1: vertices to the work file, and the bounds.
   PlyReadOptions read;
   read.readFaces = false;
+  read.salvageTruncated = options.salvageTruncated;
   Result<PlyReader> vertices = PlyReader::open(path, read);
   if (!vertices) return vertices.status();
   const PlyHeader header = vertices->header();
@@ -320,13 +341,16 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   }
 
   // Pass 2: faces, corners from the cache, into the chunk files (cut, or whole by segment).
-  double size = chunkSizeFor(options, input.bounds, header.faceCount);
+  Result<double> fitted = chunkSizeFor(options, input.bounds, header.faceCount);
+  if (!fitted) return fitted.status();
+  double size = *fitted;
   if (options.chunkSize == 0 && header.hasObjectIds) {
     // Where the triangles are, as far as the objects tell (small ones stay whole anyway).
-    size = fitChunkSize(input.bounds, size, options, [&](const auto& add) {
-      for (const auto& [id, object] : objects)
-        add(object.bounds.center(), static_cast<double>(object.triangles));
-    });
+    size = fitChunkSize(input.bounds, size, leafTriangles(options, header.faceCount),
+                        [&](const auto& add) {
+                          for (const auto& [id, object] : objects)
+                            add(object.bounds.center(), static_cast<double>(object.triangles));
+                        });
   }
   const ChunkGrid grid = ChunkGrid::over(input.bounds, size);
   input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
@@ -410,7 +434,9 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   LODFORGE_TRY(failure);
   LODFORGE_TRY(input.chunks->flush());
   progress.finish();
-  std::filesystem::remove(vertexPath);
+  std::error_code ignored;
+  std::filesystem::remove(vertexPath, ignored);
+  input.truncation = faces->truncation() ? faces->truncation() : vertices->truncation();
   return input;
 }
 
@@ -446,19 +472,22 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
       normals[v] = transformNormal(options, model->origin + toDouble(model->positions[v]), world[v],
                                    normals[v]);
   }
-  double size = chunkSizeFor(options, input.bounds, input.inputTriangles);
+  Result<double> fitted = chunkSizeFor(options, input.bounds, input.inputTriangles);
+  if (!fitted) return fitted.status();
+  double size = *fitted;
   if (options.chunkSize == 0) {
-    size = fitChunkSize(input.bounds, size, options, [&](const auto& add) {
-      for (std::size_t o = 0; o < model->objectCount(); ++o) {
-        const std::uint64_t offset = model->objects[o].vertexOffset;
-        const auto indices = model->objectIndices(o);
-        for (std::size_t t = 0; t < indices.size(); t += 3)
-          add((world[offset + indices[t]] + world[offset + indices[t + 1]] +
-               world[offset + indices[t + 2]]) *
-                  (1.0 / 3.0),
-              1.0);
-      }
-    });
+    size = fitChunkSize(input.bounds, size, leafTriangles(options, input.inputTriangles),
+                        [&](const auto& add) {
+                          for (std::size_t o = 0; o < model->objectCount(); ++o) {
+                            const std::uint64_t offset = model->objects[o].vertexOffset;
+                            const auto indices = model->objectIndices(o);
+                            for (std::size_t t = 0; t < indices.size(); t += 3)
+                              add((world[offset + indices[t]] + world[offset + indices[t + 1]] +
+                                   world[offset + indices[t + 2]]) *
+                                      (1.0 / 3.0),
+                                  1.0);
+                          }
+                        });
   }
   const ChunkGrid grid = ChunkGrid::over(input.bounds, size);
   input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
@@ -503,7 +532,10 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
 }  // namespace
 
 Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options) {
-  std::filesystem::create_directories(options.workDirectory);
+  std::error_code error;
+  std::filesystem::create_directories(options.workDirectory, error);
+  if (error)
+    return ioError(options.workDirectory, fmt::format("cannot create: {}", error.message()));
   if (fileExtension(path) == "ply") return chunkPly(path, options);
   return chunkModel(path, options);
 }

@@ -30,6 +30,8 @@ struct ChunkInputOptions {
   // Applied to every input position before anything else (a CRS to a local frame); false:
   // the point cannot be transformed, which is bad input.
   std::function<bool(Vec3d, Vec3d&)> transform;
+  bool salvageTruncated = false;  // a PLY cut short: read up to its last whole element
+  int levels = 0;  // levels the octree must be able to build above the leaves (0: any)
 };
 
 struct ChunkInput {
@@ -39,6 +41,7 @@ struct ChunkInput {
   bool colors = false;
   bool streamed = false;       // a PLY read in two passes, never whole
   std::optional<Mat4d> frame;  // the local frame's place on Earth (ECEF), when georeferenced
+  std::optional<std::string> truncation;  // where a salvaged PLY was cut short
 };
 
 Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options);

@@ -13,6 +13,8 @@
 
 #include <fmt/format.h>
 
+#include "lodforge/core/file.h"
+
 namespace lodforge {
 
 namespace {
@@ -218,22 +220,17 @@ Status appendTo(const std::string& path, std::initializer_list<std::span<const s
 }  // namespace
 
 Status saveMesh(const MeshPart& mesh, const std::string& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) return ioError(path, "cannot create");
+  Result<OutputFile> out = OutputFile::create(path, std::size_t{1} << 20);
+  if (!out) return out.status();
   const std::uint64_t header[4] = {mesh.positions.size(), mesh.colors.size(), mesh.normals.size(),
                                    mesh.indices.size()};
-  out.write(kMeshMagic, sizeof kMeshMagic);
-  out.write(reinterpret_cast<const char*>(header), sizeof header);
-  out.write(reinterpret_cast<const char*>(mesh.positions.data()),
-            static_cast<std::streamsize>(mesh.positions.size() * sizeof(Vec3d)));
-  out.write(reinterpret_cast<const char*>(mesh.colors.data()),
-            static_cast<std::streamsize>(mesh.colors.size() * sizeof(Rgba8)));
-  out.write(reinterpret_cast<const char*>(mesh.normals.data()),
-            static_cast<std::streamsize>(mesh.normals.size() * sizeof(Vec3f)));
-  out.write(reinterpret_cast<const char*>(mesh.indices.data()),
-            static_cast<std::streamsize>(mesh.indices.size() * sizeof(std::uint32_t)));
-  if (!out.flush()) return ioError(path, "cannot write");
-  return {};
+  LODFORGE_TRY(out->write(kMeshMagic, sizeof kMeshMagic));
+  LODFORGE_TRY(out->write(header, sizeof header));
+  LODFORGE_TRY(out->writeSpan(std::span<const Vec3d>(mesh.positions)));
+  LODFORGE_TRY(out->writeSpan(std::span<const Rgba8>(mesh.colors)));
+  LODFORGE_TRY(out->writeSpan(std::span<const Vec3f>(mesh.normals)));
+  LODFORGE_TRY(out->writeSpan(std::span<const std::uint32_t>(mesh.indices)));
+  return out->commit();
 }
 
 Result<MeshPart> loadMesh(const std::string& path) {
@@ -291,7 +288,9 @@ ChunkWriter::ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bu
       directory_(std::move(directory)),
       bufferBytes_(bufferBytes),
       keepInMemory_(keepInMemory) {
-  std::filesystem::create_directories(directory_);
+  // A failure shows when the first chunk file cannot be created (a constructor has no Status).
+  std::error_code ignored;
+  std::filesystem::create_directories(directory_, ignored);
 }
 
 ChunkWriter ChunkWriter::reopen(ChunkGrid grid, std::string directory,

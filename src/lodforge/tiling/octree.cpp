@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/distance.h"
+#include "lodforge/core/file.h"
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/simplify/progressive.h"
@@ -252,16 +253,7 @@ struct Builder {
                                     {"vertices", node.vertices},
                                     {"lockedVertices", node.lockedVertices},
                                     {"droppedSegments", node.droppedSegments}};
-    const std::string path = summaryPath(node.meshPath), temp = path + ".tmp";
-    {
-      std::ofstream out(temp);
-      out << summary.dump();
-      if (!out.flush()) return ioError(temp, "cannot write");
-    }
-    std::error_code error;
-    std::filesystem::rename(temp, path, error);
-    if (error) return ioError(path, error.message());
-    return {};
+    return OutputFile::writeWhole(summaryPath(node.meshPath), summary.dump());
   }
 
   // A node is done when its summary is there and its mesh too, unless its parent is done as
@@ -271,9 +263,11 @@ struct Builder {
     const std::string mesh = meshPath(node);
     std::ifstream in(summaryPath(mesh));
     const auto up = parentOf[static_cast<std::size_t>(&node - result.nodes.data())];
+    std::error_code ignored;
     const bool parentDone =
-        up != kNoParent && std::filesystem::exists(summaryPath(meshPath(result.nodes[up])));
-    if (!in || (!parentDone && !std::filesystem::exists(mesh))) return false;
+        up != kNoParent &&
+        std::filesystem::exists(summaryPath(meshPath(result.nodes[up])), ignored);
+    if (!in || (!parentDone && !std::filesystem::exists(mesh, ignored))) return false;
     try {
       const nlohmann::json summary = nlohmann::json::parse(in);
       const auto& b = summary.at("bounds");
@@ -553,7 +547,12 @@ struct Builder {
 Result<OctreeResult> buildOctree(const ChunkWriter& chunks, const OctreeOptions& options,
                                  const NodeSink& sink) {
   Builder builder{chunks, options, sink, {}, {}, {}, {}, {}, {}};
-  if (!options.keepInMemory) std::filesystem::create_directories(options.workDirectory);
+  if (!options.keepInMemory) {
+    std::error_code error;
+    std::filesystem::create_directories(options.workDirectory, error);
+    if (error)
+      return ioError(options.workDirectory, fmt::format("cannot create: {}", error.message()));
+  }
   LODFORGE_TRY(builder.run());
   return std::move(builder.result);
 }

@@ -1,0 +1,167 @@
+#include "lodforge/core/output_claim.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+namespace lodforge {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kWorkMarker = ".lodforge-work";
+
+// `inner` is `outer` itself or lies below it (both resolved through links and "..").
+bool isWithin(const std::string& inner, const std::string& outer) {
+  std::error_code error;
+  const fs::path a = fs::weakly_canonical(inner, error);
+  if (error) return false;
+  const fs::path b = fs::weakly_canonical(outer, error);
+  if (error) return false;
+  auto ia = a.begin();
+  for (auto ib = b.begin(); ib != b.end(); ++ib, ++ia) {
+    if (ib->empty()) continue;  // a trailing separator
+    if (ia == a.end() || *ia != *ib) return false;
+  }
+  return true;
+}
+
+bool isEmpty(const std::string& path, bool directory) {
+  std::error_code error;
+  if (directory) return fs::is_empty(path, error) && !error;
+  return fs::file_size(path, error) == 0 && !error;
+}
+
+Status refuseInputs(const std::string& output, const OutputKind& kind,
+                    std::span<const std::string> inputs) {
+  for (const std::string& input : inputs) {
+    LODFORGE_TRY(checkInputPath(input));
+    std::error_code error;
+    if (fs::exists(output, error) && fs::equivalent(output, input, error))
+      return Error{ErrorKind::kUsage,
+                   fmt::format("{}: is the input; choose another output", output)};
+    if (kind.directory && isWithin(input, output))
+      return Error{
+          ErrorKind::kUsage,
+          fmt::format("{}: holds the input {}; choose another output directory", output, input)};
+  }
+  return {};
+}
+
+Status refuseForeign(const std::string& output, const OutputKind& kind) {
+  std::error_code error;
+  const fs::file_status status = fs::status(output, error);
+  if (error || !fs::exists(status)) return {};
+  const bool directory = fs::is_directory(status);
+  if (kind.directory && !directory)
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: exists and is not a directory; {} is written as a directory, so "
+                             "choose another output",
+                             output, kind.name)};
+  if (!kind.directory && directory)
+    return Error{ErrorKind::kUsage, fmt::format("{}: is a directory; give the name of {} to write",
+                                                output, kind.name)};
+  if (!kind.directory && !fs::is_regular_file(status))
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: exists and is not a regular file; not replacing it", output)};
+  if (isEmpty(output, directory) || (kind.isOwn && kind.isOwn(output))) return {};
+  return Error{ErrorKind::kUsage,
+               fmt::format("{}: exists and is not {} that lodforge wrote; not replacing it (move "
+                           "it away or choose another output)",
+                           output, kind.name)};
+}
+
+Status checkWritableParent(const std::string& output) {
+  fs::path parent = fs::path(output).parent_path();
+  if (parent.empty()) parent = ".";
+  std::error_code error;
+  fs::create_directories(parent, error);
+  if (error)
+    return Error{ErrorKind::kIo, fmt::format("{}: cannot create the directory {}: {}", output,
+                                             parent.string(), error.message())};
+  if (!fs::is_directory(parent, error))
+    return Error{ErrorKind::kIo, fmt::format("{}: {} is not a directory", output, parent.string())};
+  if (::access(parent.c_str(), W_OK | X_OK) != 0) {
+    const int code = errno;
+    return Error{ErrorKind::kIo, fmt::format("{}: cannot write in {}: {}", output, parent.string(),
+                                             std::strerror(code))};
+  }
+  return {};
+}
+
+}  // namespace
+
+Status checkInputPath(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0) return ioErrorFromErrno(path, "stat");
+  return refuseDirectoryInput(path);
+}
+
+Status refuseDirectoryInput(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode))
+    return Error{ErrorKind::kBadInput, fmt::format("{}: is a directory; give a file", path)};
+  return {};
+}
+
+Status claimOutput(const std::string& output, const OutputKind& kind,
+                   std::span<const std::string> inputs) {
+  LODFORGE_TRY(refuseInputs(output, kind, inputs));
+  LODFORGE_TRY(refuseForeign(output, kind));
+  return checkWritableParent(output);
+}
+
+bool isWorkDirectory(const std::string& path) {
+  std::error_code error;
+  return fs::is_regular_file(fs::path(path) / kWorkMarker, error);
+}
+
+Status claimWorkDirectory(const std::string& path) {
+  std::error_code error;
+  if (fs::exists(path, error)) {
+    if (isWorkDirectory(path)) return {};
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: exists and is not a work directory of lodforge; not touching "
+                             "it (move it away or choose another output)",
+                             path)};
+  }
+  fs::create_directories(path, error);
+  if (error) return ioError(path, fmt::format("cannot create: {}", error.message()));
+  const std::string marker = (fs::path(path) / kWorkMarker).string();
+  const int fd = ::open(marker.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return ioErrorFromErrno(marker, "create");
+  ::close(fd);
+  return {};
+}
+
+bool fileStartsWith(const std::string& path, std::string_view prefix) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return false;
+  std::string head(prefix.size(), '\0');
+  const ssize_t got = ::read(fd, head.data(), head.size());
+  ::close(fd);
+  return got == static_cast<ssize_t>(prefix.size()) && head == prefix;
+}
+
+bool directoryHoldsOnly(
+    const std::string& directory,
+    const std::function<bool(const std::string& relative, bool isDirectory)>& accept) {
+  std::error_code error;
+  fs::recursive_directory_iterator it(directory, error), end;
+  if (error) return false;
+  for (; it != end; it.increment(error)) {
+    if (error) return false;
+    const bool isDirectory = it->is_directory(error) && !it->is_symlink(error);
+    const std::string relative =
+        fs::path(it->path()).lexically_relative(directory).generic_string();
+    if (!accept(relative, isDirectory)) return false;
+  }
+  return !error;
+}
+
+}  // namespace lodforge

@@ -1,0 +1,56 @@
+#include "lodforge/io/format_advice.h"
+
+#include <array>
+
+#include "lodforge/core/file.h"
+
+namespace lodforge {
+
+namespace {
+
+struct Advice {
+  std::string_view extensions;  // space-separated, each surrounded by spaces
+  std::string_view what;
+  std::string_view how;
+};
+
+constexpr std::string_view kCadHow =
+    "tessellate it to glTF (.glb) or STL first, e.g. with FreeCAD (File > Export) or OCCT's "
+    "DRAW, then give lodforge that file";
+constexpr std::string_view kMeshHow =
+    "convert it to .ply, .obj or .glb first, e.g. with MeshLab, Blender or assimp "
+    "(`assimp export IN OUT.glb`)";
+
+constexpr std::array<Advice, 9> kAdvice = {{
+    {" step stp ", "a STEP CAD model", kCadHow},
+    {" iges igs ", "an IGES CAD model", kCadHow},
+    {" brep brp ", "an OpenCASCADE B-rep", kCadHow},
+    {" ifc ", "an IFC building model",
+     "convert it to glTF first, e.g. with IfcConvert (IfcOpenShell): `IfcConvert IN.ifc OUT.glb`"},
+    {" off fbx dae 3ds wrl vrml x3d dxf 3mf vtk vtp ", "a mesh format", kMeshHow},
+    {" pcd ", "a PCL point cloud",
+     "save it as .ply or as text .xyz first, e.g. with `pcl_pcd2ply` or CloudCompare"},
+    {" e57 ", "an E57 scan",
+     "export it as .las or .ply first, e.g. with CloudCompare or `pdal translate IN.e57 OUT.las`"},
+    {" ptx ", "a Leica PTX scan", "export it as .las or .ply first, e.g. with CloudCompare"},
+    {" zip gz bz2 xz 7z tar ", "an archive", "unpack it first and give lodforge the file inside"},
+}};
+
+}  // namespace
+
+Error unknownFormatError(const std::string& path, std::string_view reads) {
+  const std::string ext = fileExtension(path);
+  if (!ext.empty()) {
+    const std::string key = " " + ext + " ";
+    for (const Advice& a : kAdvice) {
+      if (a.extensions.find(key) != std::string_view::npos)
+        return {ErrorKind::kUsage,
+                fmt::format("{}: {} (.{}), which lodforge does not read: {}; this command reads {}",
+                            path, a.what, ext, a.how, reads)};
+    }
+  }
+  return {ErrorKind::kUsage,
+          fmt::format("{}: unknown format (this command reads {})", path, reads)};
+}
+
+}  // namespace lodforge

@@ -1,0 +1,20 @@
+// Where a tileset is written: what counts as a tileset of ours (which `lodforge tiles` may
+// replace), and the staging and work directories beside it.
+#pragma once
+
+#include <string>
+
+#include "lodforge/core/output_claim.h"
+
+namespace lodforge {
+
+// A directory is a lodforge tileset when its tileset.json names lodforge as `asset.generator`
+// and it holds nothing but that file and GLB contents under tiles/ — so a tileset the user has
+// put anything into is never replaced.
+bool isLodforgeTileset(const std::string& directory);
+OutputKind tilesetOutput();
+
+// Claims `outputDirectory` for a tileset of `input` (nothing is written yet).
+Status claimTilesetOutput(const std::string& input, const std::string& outputDirectory);
+
+}  // namespace lodforge

@@ -1,8 +1,8 @@
 #include "outputs.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstring>
-#include <regex>
 
 #include "lodforge/core/file.h"
 #include "lodforge/simplify/package.h"
@@ -34,15 +34,29 @@ std::string_view firstNonSpace(std::string_view text) {
 bool looksLikeObj(const std::string& path) {
   const std::string text = head(path, 4096);
   if (text.find('\0') != std::string::npos) return false;
-  static const std::regex statement(R"(^\s*(#|v |vt |vn |vp |f |l |p |o |g |s |mtllib |usemtl ))");
+  static constexpr std::string_view kStatements[] = {
+      "#", "v ", "vt ", "vn ", "vp ", "f ", "l ", "p ", "o ", "g ", "s ", "mtllib ", "usemtl "};
   std::size_t start = 0;
   while (start < text.size()) {
     const std::size_t end = std::min(text.find('\n', start), text.size());
-    const std::string line = text.substr(start, end - start);
-    if (!firstNonSpace(line).empty()) return std::regex_search(line, statement);
+    const std::string_view line = firstNonSpace(std::string_view(text).substr(start, end - start));
+    if (!line.empty())
+      return std::any_of(std::begin(kStatements), std::end(kStatements),
+                         [&](std::string_view keyword) { return line.starts_with(keyword); });
     start = end + 1;
   }
   return false;
+}
+
+// What `lodforge render` writes into its folder: frame_NNNN.png (four digits or more) and
+// render.json.
+bool isRenderFile(std::string_view name) {
+  if (name == "render.json") return true;
+  if (!name.starts_with("frame_") || !name.ends_with(".png")) return false;
+  const std::string_view digits = name.substr(6, name.size() - 10);
+  return digits.size() >= 4 && std::all_of(digits.begin(), digits.end(), [](char c) {
+           return std::isdigit(static_cast<unsigned char>(c)) != 0;
+         });
 }
 
 // Binary STL: 80 bytes of header, a count, 50 bytes per triangle; or ASCII "solid".
@@ -98,9 +112,8 @@ OutputKind renderFolderOutput() {
   return {.name = "a folder of rendered frames",
           .directory = true,
           .isOwn = [](const std::string& folder) {
-            static const std::regex frame(R"(frame_\d{4,}\.png|render\.json)");
             return directoryHoldsOnly(folder, [](const std::string& name, bool isDirectory) {
-              return !isDirectory && std::regex_match(name, frame);
+              return !isDirectory && isRenderFile(name);
             });
           }};
 }

@@ -312,6 +312,29 @@ TEST(Progressive, ErrorTableIsMonotoneAndGrowsAsDetailGoes) {
   EXPECT_TRUE(n == mesh.q || mesh.errorAt(n - 1) > e);
 }
 
+// The shared lookup over a non-increasing table is the first entry that fits, as a scan finds
+// it: random tables with runs of equal errors, queries on, between and beyond their entries.
+TEST(Progressive, VertexCountForErrorIsTheFirstEntryThatFits) {
+  Random random(17);
+  for (int round = 0; round < 500; ++round) {
+    std::vector<float> table(1 + random.below(40));
+    float e = static_cast<float>(random.uniform(0, 10));
+    for (float& entry : table) {
+      entry = e;
+      if (random.below(3) != 0) e = static_cast<float>(e * random.uniform(0.2, 1.0));
+    }
+    const auto fewest = static_cast<std::uint32_t>(random.below(100));
+    for (double allowed : {static_cast<double>(table[random.below(table.size())]),
+                           random.uniform(-1, 11), -1.0, 11.0}) {
+      const auto scan =
+          std::find_if(table.begin(), table.end(), [&](float entry) { return entry <= allowed; });
+      EXPECT_EQ(vertexCountForError(table, fewest, allowed),
+                fewest + static_cast<std::uint32_t>(scan - table.begin()))
+          << "round " << round << ", allowed " << allowed;
+    }
+  }
+}
+
 TEST(SimplifyMesh, StopsAtTheTargetKeepsLockedVerticesAndHonoursTheNormalLimit) {
   Result<Model> model = readModel(test::dataPath("meshes/stanford-bunny.obj"));
   ASSERT_TRUE(model.ok());

@@ -12,6 +12,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include "lodforge/simplify/progressive.h"
+
 namespace lodforge {
 
 LodScene LodScene::fromPackage(const Package& package, double exponent) {
@@ -497,9 +499,8 @@ void selectByError(const LodScene& scene, const Camera& camera, double pixels, S
     const Vec3d d = Vec3d{scene.cx[i], scene.cy[i], scene.cz[i]} - camera.position;
     const double distance = std::max(length(d), camera.nearPlane);
     const double allowed = pixels * distance / pixelScale;
-    const auto table = scene.package->error(i);
-    const auto it = std::find_if(table.begin(), table.end(), [&](float e) { return e <= allowed; });
-    out.vertexCounts[i] = scene.minVertices[i] + static_cast<std::uint32_t>(it - table.begin());
+    out.vertexCounts[i] =
+        vertexCountForError(scene.package->error(i), scene.minVertices[i], allowed);
   });
   out.firstPassVertices = 0;
   out.visibleObjects = static_cast<std::uint64_t>(

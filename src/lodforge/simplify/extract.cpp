@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lodforge/simplify/progressive.h"
 #include "lodforge/simplify/reform.h"
 
 namespace lodforge {
@@ -21,9 +22,7 @@ std::vector<std::uint32_t> vertexCountsForRatio(const Package& package, double r
 std::vector<std::uint32_t> vertexCountsForError(const Package& package, double error) {
   std::vector<std::uint32_t> counts(package.objectCount());
   for (std::size_t i = 0; i < counts.size(); ++i) {
-    const auto table = package.error(i);
-    const auto it = std::find_if(table.begin(), table.end(), [&](float e) { return e <= error; });
-    counts[i] = package.object(i).minVertexCount + static_cast<std::uint32_t>(it - table.begin());
+    counts[i] = vertexCountForError(package.error(i), package.object(i).minVertexCount, error);
   }
   return counts;
 }

@@ -10,17 +10,22 @@
 
 #include "lodforge/core/distance.h"
 #include "lodforge/core/quadric.h"
-#include "lodforge/simplify/reform.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 namespace lodforge {
 
+std::uint32_t vertexCountForError(std::span<const float> error, std::uint32_t fewest,
+                                  double allowed) {
+  // Non-increasing: the entries over `allowed` come first, and the first one that fits answers.
+  const auto fits = std::partition_point(error.begin(), error.end(),
+                                         [allowed](float e) { return !(e <= allowed); });
+  return fewest + static_cast<std::uint32_t>(fits - error.begin());
+}
+
 std::uint32_t ProgressiveMesh::vertexCountForError(float wanted) const {
-  // error[] is non-increasing in n: the first index whose error fits is the answer.
-  const auto it = std::find_if(error.begin(), error.end(), [&](float e) { return e <= wanted; });
-  return q + static_cast<std::uint32_t>(it - error.begin());
+  return lodforge::vertexCountForError(error, q, wanted);
 }
 
 std::uint64_t progressiveBuildBytes(std::uint64_t vertices, std::uint64_t triangles) {

@@ -70,6 +70,12 @@ struct ProgressiveMesh {
   std::uint32_t vertexCountForError(float error) const;
 };
 
+// An error table is non-increasing in the vertex count (entry i belongs to `fewest + i`
+// vertices): the fewest vertices whose error is at most `allowed`, `fewest + error.size()` when
+// no entry is. One lookup for the builder, `extract --error` and the runtime's selection.
+std::uint32_t vertexCountForError(std::span<const float> error, std::uint32_t fewest,
+                                  double allowed);
+
 // Builds the progressive mesh of one object. Expects a welded, indexed mesh without repeated
 // corners in a triangle and without unreferenced vertices (prepareObject in prepare.h does
 // that). `normals` and `colors` may be empty; they are carried along with their vertex.

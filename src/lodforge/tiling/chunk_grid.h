@@ -39,10 +39,6 @@ struct ChunkGrid {
                static_cast<std::uint64_t>(dims[0]) +
            static_cast<std::uint64_t>(cell[0]);
   }
-  std::uint64_t cellCount() const {
-    return static_cast<std::uint64_t>(dims[0]) * static_cast<std::uint64_t>(dims[1]) *
-           static_cast<std::uint64_t>(dims[2]);
-  }
 };
 
 // A corner of a triangle being cut: exact position, colour and unit normal (the input's, or

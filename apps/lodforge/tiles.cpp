@@ -15,6 +15,7 @@
 #include "lodforge/io/point_reader.h"
 #include "lodforge/tiles/point_tiles.h"
 #include "lodforge/tiles/tileset.h"
+#include "lodforge/tiling/resume.h"
 
 namespace lodforge::cli {
 
@@ -168,11 +169,12 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
       Result<TilesStats> stats = writeTiles(options->input, options->output, tiles);
       if (!stats) {
         std::error_code ignored;
-        if (std::filesystem::exists(options->output + ".work/state.json", ignored))
+        const std::string work = tilesWorkDirectory(options->output);
+        if (std::filesystem::exists(workStatePath(work), ignored))
           fmt::print(stderr,
-                     "lodforge: the finished chunks and tiles are kept in {}.work: run again "
-                     "with --resume to continue, or delete it\n",
-                     options->output);
+                     "lodforge: the finished chunks and tiles are kept in {}: run again with "
+                     "--resume to continue, or delete it\n",
+                     work);
         return stats.status();
       }
       if (stats->truncation)

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -16,13 +15,13 @@
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 #include <nanoflann.hpp>
-#include <nlohmann/json.hpp>
 
 #include "lodforge/core/distance.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/simplify/progressive.h"
+#include "lodforge/tiling/resume.h"
 
 namespace lodforge {
 namespace {
@@ -240,20 +239,9 @@ struct Builder {
                        node.cell[1], node.cell[2]);
   }
 
-  // A finished node's summary beside its mesh file: written last, so its presence means done.
-  static std::string summaryPath(const std::string& mesh) { return mesh + ".json"; }
-
   Status writeSummary(const OctreeNode& node) const {
     if (options.keepInMemory) return {};
-    const nlohmann::json summary = {{"bounds",
-                                     {node.bounds.min.x, node.bounds.min.y, node.bounds.min.z,
-                                      node.bounds.max.x, node.bounds.max.y, node.bounds.max.z}},
-                                    {"geometricError", node.geometricError},
-                                    {"triangles", node.triangles},
-                                    {"vertices", node.vertices},
-                                    {"lockedVertices", node.lockedVertices},
-                                    {"droppedSegments", node.droppedSegments}};
-    return OutputFile::writeWhole(summaryPath(node.meshPath), summary.dump());
+    return writeNodeSummary(node);
   }
 
   // A node is done when its summary is there and its mesh too, unless its parent is done as
@@ -261,26 +249,13 @@ struct Builder {
   bool readSummary(OctreeNode& node) const {
     if (!options.resume || options.keepInMemory) return false;
     const std::string mesh = meshPath(node);
-    std::ifstream in(summaryPath(mesh));
     const auto up = parentOf[static_cast<std::size_t>(&node - result.nodes.data())];
     std::error_code ignored;
     const bool parentDone =
         up != kNoParent &&
-        std::filesystem::exists(summaryPath(meshPath(result.nodes[up])), ignored);
-    if (!in || (!parentDone && !std::filesystem::exists(mesh, ignored))) return false;
-    try {
-      const nlohmann::json summary = nlohmann::json::parse(in);
-      const auto& b = summary.at("bounds");
-      node.bounds.min = {b.at(0).get<double>(), b.at(1).get<double>(), b.at(2).get<double>()};
-      node.bounds.max = {b.at(3).get<double>(), b.at(4).get<double>(), b.at(5).get<double>()};
-      node.geometricError = summary.at("geometricError").get<double>();
-      node.triangles = summary.at("triangles").get<std::uint64_t>();
-      node.vertices = summary.at("vertices").get<std::uint64_t>();
-      node.lockedVertices = summary.at("lockedVertices").get<std::uint64_t>();
-      node.droppedSegments = summary.at("droppedSegments").get<std::uint64_t>();
-    } catch (const nlohmann::json::exception&) {
-      return false;  // a damaged summary: build the node again
-    }
+        std::filesystem::exists(nodeSummaryPath(meshPath(result.nodes[up])), ignored);
+    if (!parentDone && !std::filesystem::exists(mesh, ignored)) return false;
+    if (!readNodeSummary(nodeSummaryPath(mesh), node)) return false;
     node.meshPath = mesh;
     return true;
   }

@@ -1,0 +1,57 @@
+#include "lodforge/tiles/memory_plan.h"
+
+#include <algorithm>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "lodforge/core/units.h"
+
+namespace lodforge {
+
+Status planTilesMemory(TilesMemory mode, std::uint64_t memoryLimit, int threads,
+                       ChunkInputOptions& input, OctreeOptions& octree) {
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  switch (mode) {
+    case TilesMemory::kMinimal:
+      octree.threads = 1;
+      input.chunkBufferBytes = std::min<std::uint64_t>(input.chunkBufferBytes, 32 << 20);
+      input.vertexCacheBytes = std::min<std::uint64_t>(input.vertexCacheBytes, 32 << 20);
+      break;
+    case TilesMemory::kModerate:
+      octree.threads = threads > 0 ? threads : std::max(1, cores / 4);
+      break;
+    case TilesMemory::kUnbounded:
+      octree.threads = threads > 0 ? threads : cores;
+      input.keepInMemory = true;
+      octree.keepInMemory = true;
+      break;
+  }
+  if (memoryLimit > 0) {
+    // The program itself (code, libraries, thread stacks, I/O buffers) takes about 32 MiB; of
+    // the rest a quarter goes to the chunk buffer, an eighth to the vertex cache and half to the
+    // nodes in flight (the octree lowers its parallelism to fit).
+    constexpr std::uint64_t kProgram = std::uint64_t{32} << 20;
+    constexpr std::uint64_t kLeast = kProgram + (std::uint64_t{16} << 20);
+    if (memoryLimit < kLeast)
+      return Error{ErrorKind::kLimit,
+                   fmt::format("--memory-limit {} is too small for tiles: at least {}",
+                               formatBytes(memoryLimit), formatBytes(kLeast))};
+    const std::uint64_t usable = memoryLimit - kProgram;
+    input.chunkBufferBytes = std::min(input.chunkBufferBytes, usable / 4);
+    input.vertexCacheBytes = std::min(input.vertexCacheBytes, usable / 8);
+    octree.memoryBudget = usable / 2;
+    // A parent holds about four children (eight in a volume) while it is simplified, at ~200
+    // bytes per triangle: smaller leaves when the budget cannot hold that for the default size.
+    if (input.chunkSize == 0) {
+      input.trianglesPerChunk =
+          std::clamp<std::uint64_t>(octree.memoryBudget / (4 * 200), 4096, input.trianglesPerChunk);
+    }
+    input.keepInMemory = false;
+    octree.keepInMemory = false;
+  }
+  input.threads = octree.threads;
+  return {};
+}
+
+}  // namespace lodforge

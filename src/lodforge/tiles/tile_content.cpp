@@ -1,0 +1,62 @@
+#include "lodforge/tiles/tile_content.h"
+
+#include <cmath>
+#include <vector>
+
+#include <meshoptimizer.h>
+
+#include "lodforge/core/mesh.h"
+#include "lodforge/io/glb_writer.h"
+
+namespace lodforge {
+
+Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path,
+                        const TileContentOptions& options) {
+  const Vec3d center = bounds.center();
+  // Triangles in vertex-cache order, then vertices in first-use order (faster to draw, and what
+  // the meshopt codec compresses best). The FIFO variant (Tipsify) is 2-3x faster than
+  // meshopt_optimizeVertexCache, as good on scan tiles (ACMR 0.60 vs 0.63 for a 16-entry FIFO),
+  // and tile writing was ~10 % of a build.
+  constexpr std::size_t kCacheSize = 16;
+  std::vector<std::uint32_t> indices(mesh.indices.size());
+  meshopt_optimizeVertexCacheFifo(indices.data(), mesh.indices.data(), mesh.indices.size(),
+                                  mesh.positions.size(), kCacheSize);
+  std::vector<std::uint32_t> remap(mesh.positions.size());
+  const std::size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), indices.data(),
+                                                            indices.size(), mesh.positions.size());
+  meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
+  std::vector<Vec3f> positions(used);
+  std::vector<Rgba8> colors(options.colors && !mesh.colors.empty() ? used : 0);
+  std::vector<Vec3f> normals(used);
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (remap[v] == ~0u) continue;
+    positions[remap[v]] = toFloat(mesh.positions[v] - center);
+    if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
+    if (!mesh.normals.empty()) normals[remap[v]] = mesh.normals[v];
+  }
+  // The input's normals, the same in every tile that holds a vertex; from this mesh alone only
+  // when there are none (which leaves shading seams along tile borders).
+  if (mesh.normals.empty()) computeVertexNormals(positions, indices, normals);
+  for (Vec3f& p : positions) p = toYUp(p);
+  for (Vec3f& n : normals) n = toYUp(n);
+  Result<GlbWriter> writer = GlbWriter::create(
+      path, {.doubleSided = false, .meshoptCompression = options.meshoptCompression});
+  if (!writer) return writer.status();
+  Result<std::uint32_t> glbMesh =
+      writer->addMesh({positions, normals, colors, indices, options.quantize}, "tile");
+  if (!glbMesh) return glbMesh.status();
+  writer->addNode("tile", *glbMesh);
+  writer->setRootTranslation(toYUp(center));
+  return writer->finish();
+}
+
+bool tileQuantized(const OctreeNode& node) {
+  return node.level == 0 || tileQuantizationError(node, true) <= node.geometricError / 32;
+}
+
+double tileQuantizationError(const OctreeNode& node, bool quantize) {
+  if (!quantize || node.triangles == 0) return 0;
+  return 0.5 * std::sqrt(3.0) * glbQuantizationStep(node.bounds);
+}
+
+}  // namespace lodforge

@@ -1,0 +1,70 @@
+#include "lodforge/tiles/tileset_json.h"
+
+#include <algorithm>
+#include <functional>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "lodforge/core/file.h"
+#include "lodforge/tiles/tile_content.h"
+
+namespace lodforge {
+
+namespace {
+
+nlohmann::json boxOf(const Aabbd& bounds) {
+  return {{"box", tileBox(bounds)}};
+}
+
+}  // namespace
+
+std::array<double, 12> tileBox(const Aabbd& bounds) {
+  const Vec3d c = bounds.center(), h = bounds.size() * 0.5;
+  return {c.x, c.y, c.z, h.x, 0, 0, 0, h.y, 0, 0, 0, h.z};
+}
+
+std::string tileContentUri(const OctreeNode& node) {
+  return fmt::format("tiles/{}-{}-{}-{}.glb", node.level, node.cell[0], node.cell[1], node.cell[2]);
+}
+
+Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
+                        const std::optional<Mat4d>& rootTransform, bool quantized) {
+  // Children come before their parents in the node list: one pass collects each subtree's
+  // largest quantisation error.
+  std::vector<double> quantization(octree.nodes.size(), 0.0);
+  for (std::size_t i = 0; i < octree.nodes.size(); ++i) {
+    const OctreeNode& node = octree.nodes[i];
+    quantization[i] = tileQuantizationError(node, quantized && tileQuantized(node));
+    for (std::uint32_t c : node.children)
+      quantization[i] = std::max(quantization[i], quantization[c]);
+  }
+  // Depth first; children listed in node order.
+  std::function<nlohmann::json(std::uint32_t)> tile = [&](std::uint32_t index) {
+    const OctreeNode& node = octree.nodes[index];
+    nlohmann::json out = {{"boundingVolume", boxOf(node.bounds)},
+                          {"geometricError", node.geometricError + quantization[index]},
+                          {"refine", "REPLACE"}};
+    if (node.triangles > 0 && !node.meshPath.empty())
+      out["content"] = {{"uri", tileContentUri(node)}};
+    if (!node.children.empty()) {
+      out["children"] = nlohmann::json::array();
+      for (std::uint32_t c : node.children) out["children"].push_back(tile(c));
+    }
+    return out;
+  };
+  const OctreeNode& root = octree.nodes[octree.root];
+  // Above the root: the error of showing nothing at all, the size of the model.
+  const Vec3d size = root.bounds.size();
+  const double nothing =
+      std::max((root.geometricError + quantization[octree.root]) * 2, length(size));
+  nlohmann::json tileset = {
+      {"asset", {{"version", "1.1"}, {"generator", "lodforge " LODFORGE_VERSION}}},
+      {"geometricError", nothing},
+      {"root", tile(octree.root)}};
+  if (rootTransform) tileset["root"]["transform"] = rootTransform->m;
+  return OutputFile::writeWhole(path, tileset.dump(1) + '\n');
+}
+
+}  // namespace lodforge

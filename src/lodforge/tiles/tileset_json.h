@@ -1,0 +1,29 @@
+// tileset.json of a mesh tileset (3D Tiles 1.1): the octree's nodes as tiles with box volumes,
+// measured geometric errors and REPLACE refinement.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+
+#include "lodforge/core/math.h"
+#include "lodforge/core/status.h"
+#include "lodforge/tiling/octree.h"
+
+namespace lodforge {
+
+// tileset.json for a built octree: asset 1.1, REPLACE refinement, box volumes, geometric errors,
+// contents at tiles/<name>.glb for the nodes with triangles, and the root's transform (local
+// frame to ECEF) when georeferenced. With `quantized` contents, each geometric error also holds
+// the largest quantisation error in the tile's subtree (still non-increasing parent to child).
+Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
+                        const std::optional<Mat4d>& rootTransform = std::nullopt,
+                        bool quantized = false);
+
+// A tile's "box" bounding volume for axis-aligned bounds: centre, then three half-axes.
+std::array<double, 12> tileBox(const Aabbd& bounds);
+
+// The relative URI of a node's content.
+std::string tileContentUri(const OctreeNode& node);
+
+}  // namespace lodforge

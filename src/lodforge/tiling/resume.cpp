@@ -1,0 +1,106 @@
+#include "lodforge/tiling/resume.h"
+
+#include <fstream>
+#include <map>
+
+#include "lodforge/core/file.h"
+
+namespace lodforge {
+
+std::string workStatePath(const std::string& workDirectory) {
+  return workDirectory + "/state.json";
+}
+
+nlohmann::json boundsToJson(const Aabbd& bounds) {
+  return {bounds.min.x, bounds.min.y, bounds.min.z, bounds.max.x, bounds.max.y, bounds.max.z};
+}
+
+Aabbd boundsFromJson(const nlohmann::json& json) {
+  Aabbd bounds;
+  bounds.min = {json.at(0).get<double>(), json.at(1).get<double>(), json.at(2).get<double>()};
+  bounds.max = {json.at(3).get<double>(), json.at(4).get<double>(), json.at(5).get<double>()};
+  return bounds;
+}
+
+Status saveChunkState(const std::string& path, const nlohmann::json& identity,
+                      const ChunkInput& input) {
+  const ChunkGrid& grid = input.chunks->grid();
+  nlohmann::json counts = nlohmann::json::array();
+  for (const auto& [index, count] : input.chunks->triangleCounts())
+    counts.push_back({index, count});
+  const nlohmann::json state = {
+      {"identity", identity},
+      {"grid",
+       {{"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
+        {"size", grid.size},
+        {"dims", grid.dims}}},
+      {"bounds", boundsToJson(input.bounds)},
+      {"inputTriangles", input.inputTriangles},
+      {"colors", input.colors},
+      {"streamed", input.streamed},
+      {"frame", input.frame ? nlohmann::json(input.frame->m) : nlohmann::json()},
+      {"counts", counts}};
+  return OutputFile::writeWhole(path, state.dump());
+}
+
+std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::json& identity,
+                                       const std::string& chunkDirectory) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  try {
+    const nlohmann::json state = nlohmann::json::parse(in);
+    if (state.at("identity") != identity) return std::nullopt;  // other input or options
+    ChunkGrid grid;
+    const auto& g = state.at("grid");
+    grid.origin = {g.at("origin").at(0).get<double>(), g.at("origin").at(1).get<double>(),
+                   g.at("origin").at(2).get<double>()};
+    grid.size = g.at("size").get<double>();
+    grid.dims = g.at("dims").get<ChunkCell>();
+    std::map<std::uint64_t, std::uint64_t> counts;
+    for (const auto& entry : state.at("counts"))
+      counts[entry.at(0).get<std::uint64_t>()] = entry.at(1).get<std::uint64_t>();
+    ChunkInput input;
+    input.bounds = boundsFromJson(state.at("bounds"));
+    input.inputTriangles = state.at("inputTriangles").get<std::uint64_t>();
+    input.colors = state.at("colors").get<bool>();
+    input.streamed = state.at("streamed").get<bool>();
+    if (!state.at("frame").is_null())
+      input.frame = Mat4d{state.at("frame").get<std::array<double, 16>>()};
+    input.chunks =
+        std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
+    return input;
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;  // damaged: chunk again
+  }
+}
+
+std::string nodeSummaryPath(const std::string& meshPath) {
+  return meshPath + ".json";
+}
+
+Status writeNodeSummary(const OctreeNode& node) {
+  const nlohmann::json summary = {
+      {"bounds", boundsToJson(node.bounds)},   {"geometricError", node.geometricError},
+      {"triangles", node.triangles},           {"vertices", node.vertices},
+      {"lockedVertices", node.lockedVertices}, {"droppedSegments", node.droppedSegments}};
+  return OutputFile::writeWhole(nodeSummaryPath(node.meshPath), summary.dump());
+}
+
+bool readNodeSummary(const std::string& path, OctreeNode& node) {
+  std::ifstream in(path);
+  if (!in) return false;
+  try {
+    const nlohmann::json summary = nlohmann::json::parse(in);
+    node.bounds = boundsFromJson(summary.at("bounds"));
+    node.geometricError = summary.at("geometricError").get<double>();
+    node.triangles = summary.at("triangles").get<std::uint64_t>();
+    node.vertices = summary.at("vertices").get<std::uint64_t>();
+    node.lockedVertices = summary.at("lockedVertices").get<std::uint64_t>();
+    node.droppedSegments = summary.at("droppedSegments").get<std::uint64_t>();
+  } catch (const nlohmann::json::exception&) {
+    return false;  // a damaged summary: build the node again
+  }
+  return true;
+}
+
+}  // namespace lodforge

@@ -398,11 +398,7 @@ void addBench(CLI::App& app, const Global& global, Run& run) {
   sub->callback([&global, &run, o, sub, cloud] {
     o->sizeGiven = sub->count("--size") > 0;
     if (fileExtension(o->input) == "lfc") {
-      cloud->input = o->input;
-      cloud->path = o->path;
-      cloud->frames = o->frames;
-      cloud->size = o->size;
-      cloud->fovY = o->fovY;
+      takePackageRun(*cloud, o->input, *o);
       cloud->render = o->render;
       cloud->json = o->json;
       if (cloud->foveaRadii.empty()) cloud->foveaRadii = {200};

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cloud.h"
+#include "imgui_panel.h"
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/units.h"
@@ -73,6 +74,11 @@ void addCloudOptions(CLI::App& sub, CloudRunOptions& options, bool severalRadii)
   sub.add_option("--loads-per-frame", options.loadsPerFrame,
                  "Point packages: segment files read per frame at most (default 2)")
       ->check(CLI::Range(1, 1'000'000));
+}
+
+void takePackageRun(CloudRunOptions& cloud, const std::string& input, const PathChoice& choice) {
+  static_cast<PathChoice&>(cloud) = choice;
+  cloud.input = input;
 }
 
 Status runCloudBench(const Global& global, const CloudRunOptions& o) {
@@ -234,18 +240,7 @@ Status runCloudView(const Global& global, const CloudRunOptions& o) {
   Result<PointRenderer> renderer = PointRenderer::create();
   if (!renderer) return renderer.status();
 
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
-  ImGui_ImplOpenGL3_Init("#version 450");
-  struct ImGuiShutdown {
-    ~ImGuiShutdown() {
-      ImGui_ImplOpenGL3_Shutdown();
-      ImGui_ImplGlfw_Shutdown();
-      ImGui::DestroyContext();
-    }
-  } imguiShutdown;
+  const ImGuiPanel panel(window);
 
   const Aabbd bounds = cloud->header().bounds;
   std::vector<Camera> played;

@@ -6,16 +6,14 @@
 #include <vector>
 
 #include "cli.h"
+#include "view_options.h"
 
 namespace lodforge::cli {
 
-struct CloudRunOptions {
+// The camera path and viewport (PathChoice) as bench and view of a package take them.
+struct CloudRunOptions : PathChoice {
   std::string input;
-  std::string path = "orbit";  // orbit, fly or a camera path file
-  bool play = false;           // view: play the path instead of the mouse
-  std::uint64_t frames = 120;
-  std::string size = "1280x720";
-  double fovY = 60;
+  bool play = false;                       // view: play the path instead of the mouse
   std::vector<double> foveaRadii = {200};  // bench: one run per radius; view: the first
   double fovealSplat = 2;
   std::size_t residentBlocks = 8;  // the paper's experiments keep 8
@@ -28,6 +26,9 @@ struct CloudRunOptions {
 
 // --fovea, --foveal-splat, --resident-blocks and --loads-per-frame, for view and bench.
 void addCloudOptions(CLI::App& sub, CloudRunOptions& options, bool severalRadii);
+
+// Bench and view are given a point package: its run takes their input, path and viewport.
+void takePackageRun(CloudRunOptions& cloud, const std::string& input, const PathChoice& choice);
 
 Status runCloudBench(const Global& global, const CloudRunOptions& options);
 Status runCloudView(const Global& global, const CloudRunOptions& options);

@@ -118,7 +118,7 @@ void addTiles(CLI::App& app, const Global& global, Run& run) {
       tiles.input.chunkSize = options->chunkSize;
       tiles.input.salvageTruncated = options->salvage;
       tiles.octree.levels = options->levels;
-      tiles.octree.keep = options->reduction;
+      tiles.octree.reduction = options->reduction;
       tiles.octree.maxNormalDeviationDegrees = options->maxNormalDeviation;
       tiles.memory = options->memory == "minimal"     ? TilesMemory::kMinimal
                      : options->memory == "unbounded" ? TilesMemory::kUnbounded

@@ -16,6 +16,7 @@
 
 #include "cli.h"
 #include "cloud.h"
+#include "imgui_panel.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
@@ -111,18 +112,7 @@ Status runView(const Global& global, const ViewOptions& o) {
   auto pipeline = FramePipeline::create(*package, capacity, Streaming::kCpu, /*switchable=*/true);
   if (!pipeline) return pipeline.status();
 
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini in the user's folder
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
-  ImGui_ImplOpenGL3_Init("#version 450");
-  struct ImGuiShutdown {
-    ~ImGuiShutdown() {
-      ImGui_ImplOpenGL3_Shutdown();
-      ImGui_ImplGlfw_Shutdown();
-      ImGui::DestroyContext();
-    }
-  } imguiShutdown;
+  const ImGuiPanel panel(window);
 
   const Aabbd bounds = packageBounds(*package);
   CameraControl control;
@@ -343,12 +333,9 @@ void addView(CLI::App& app, const Global& global, Run& run) {
   addCloudOptions(*sub, *cloud, /*severalRadii=*/false);
   sub->callback([&global, &run, o, cloud] {
     if (fileExtension(o->input) == "lfc") {
-      cloud->input = o->input;
-      cloud->size = o->size;
-      cloud->fovY = o->fovY;
+      takePackageRun(*cloud, o->input, *o);
       cloud->play = !o->play.empty();
       cloud->path = o->play.empty() ? "orbit" : o->play;
-      cloud->frames = o->frames;
       cloud->stopAfter = o->stopAfter;
       cloud->screenshot = o->screenshot;
       if (cloud->foveaRadii.empty()) cloud->foveaRadii = {200};

@@ -117,13 +117,8 @@ void PointRenderer::upload(const PointSelection& selection) {
 
 void PointRenderer::draw(const Camera& camera, const PointDrawOptions& options) const {
   const State& s = *state_;
-  glViewport(0, 0, static_cast<GLsizei>(camera.width), static_cast<GLsizei>(camera.height));
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
   glEnable(GL_PROGRAM_POINT_SIZE);
-  glClearColor(options.background[0] / 255.0f, options.background[1] / 255.0f,
-               options.background[2] / 255.0f, 1);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  beginFrame(camera, options.background);
   if (s.count == 0) return;
   // Splat positions are relative to the selection's origin: so is the camera here.
   Camera local = camera;

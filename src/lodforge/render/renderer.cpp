@@ -345,15 +345,18 @@ void viewProjectionMatrix(const Camera& camera, float out[16]) {
   }
 }
 
-void Renderer::draw(const Camera& camera, const DrawOptions& options) const {
-  const State& s = *state_;
+void beginFrame(const Camera& camera, const std::array<std::uint8_t, 3>& background) {
   glViewport(0, 0, static_cast<GLsizei>(camera.width), static_cast<GLsizei>(camera.height));
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glDisable(GL_CULL_FACE);
-  glClearColor(options.background[0] / 255.0f, options.background[1] / 255.0f,
-               options.background[2] / 255.0f, 1);
+  glClearColor(background[0] / 255.0f, background[1] / 255.0f, background[2] / 255.0f, 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+}
+
+void Renderer::draw(const Camera& camera, const DrawOptions& options) const {
+  const State& s = *state_;
+  glDisable(GL_CULL_FACE);
+  beginFrame(camera, options.background);
   if (s.commandCount == 0) return;
 
   // Per-object colours: the base colours, or a distinct one per object (re-sent only when the

@@ -93,4 +93,8 @@ class Renderer {
 // Column-major 4x4 view-projection of a camera (OpenGL clip space), in float.
 void viewProjectionMatrix(const Camera& camera, float out[16]);
 
+// The GL state every draw starts from: the camera's viewport, a depth test that keeps the
+// nearest, and the target cleared to `background`.
+void beginFrame(const Camera& camera, const std::array<std::uint8_t, 3>& background);
+
 }  // namespace lodforge

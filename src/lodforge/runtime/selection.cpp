@@ -424,7 +424,7 @@ void secondPass(const LodScene& scene, std::uint64_t budget, Selection& out) {
 
 // tc_i = map(vc_i), looked up only where vc_i changed since the last frame (a few percent of
 // the objects along a smooth path): each lookup is a cache miss in a table of the package's size.
-void finish(const LodScene& scene, Selection& out) {
+void lookUpTriangleCounts(const LodScene& scene, Selection& out) {
   const std::size_t n = scene.size();
   auto& previous = out.workspace.previousVertexCounts;
   const bool coherent = out.workspace.previousMap == scene.map && previous.size() == n &&
@@ -453,7 +453,7 @@ void finish(const LodScene& scene, Selection& out) {
 }
 
 // Last frame's counts move aside (every entry of vertexCounts is rewritten this frame), so
-// finish() can see which changed without copying them.
+// lookUpTriangleCounts() can see which changed without copying them.
 void keepLastFrame(Selection& out) {
   std::swap(out.vertexCounts, out.workspace.previousVertexCounts);
 }
@@ -478,7 +478,7 @@ void selectTwoPass(const LodScene& scene, const Camera& camera, std::uint64_t bu
   out.timings.firstPass = millisecondsSince(clock);
   if (!options.firstPassOnly) secondPass(scene, budget, out);
   out.timings.secondPass = millisecondsSince(clock);
-  finish(scene, out);
+  lookUpTriangleCounts(scene, out);
   out.timings.finish = millisecondsSince(clock);
 }
 
@@ -507,7 +507,7 @@ void selectByError(const LodScene& scene, const Camera& camera, double pixels, S
       std::count_if(out.importance.begin(), out.importance.end(), [](float w) { return w > 0; }));
   out.timings.firstPass = millisecondsSince(clock);
   out.timings.secondPass = 0;
-  finish(scene, out);
+  lookUpTriangleCounts(scene, out);
   out.timings.finish = millisecondsSince(clock);
 }
 

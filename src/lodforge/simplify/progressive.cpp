@@ -6,6 +6,8 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <span>
 #include <utility>
 
 #include "lodforge/core/distance.h"
@@ -121,6 +123,18 @@ class Simplifier {
   SimplifiedMesh current() const;
 
  private:
+  // The neighbours of a collapse's two ends (each once, the ends left out), as valid() found
+  // them: whom markChanged() re-ranks if the collapse goes ahead. They live in ringFrom_ and
+  // ringTo_ until the next valid().
+  struct Rings {
+    std::span<const std::uint32_t> from, to;
+  };
+  // A collapse target with the rings of its edge; vertex kNone: none.
+  struct Target {
+    std::uint32_t vertex = kNone;
+    Rings rings;
+  };
+
   Vec3d position(std::uint32_t v) const {
     const VertexState& s = vertex_[v];
     return {s.x, s.y, s.z};
@@ -149,14 +163,14 @@ class Simplifier {
   void rankCollapses();
   void rankVertex(std::uint32_t u);
   float cost(std::uint32_t from, std::uint32_t to) const;
-  bool valid(std::uint32_t from, std::uint32_t to);
+  std::optional<Rings> valid(std::uint32_t from, std::uint32_t to);
   std::uint32_t removedTriangleCount() const {
     return static_cast<std::uint32_t>(removedTriangles_.size());
   }
   // The cheapest valid, untouched target of `from` (its ranked best first); kNone if none.
-  std::uint32_t validTarget(std::uint32_t from, float bestCost);
-  void collapse(std::uint32_t from, std::uint32_t to);
-  void markChanged(std::uint32_t from, std::uint32_t to);
+  Target validTarget(std::uint32_t from, float bestCost);
+  void collapse(std::uint32_t from, const Target& to);
+  void markChanged(std::uint32_t from, const Target& to);
   void rankNewNeighbours();
 
   std::span<const Vec3f> positions_;
@@ -177,9 +191,8 @@ class Simplifier {
   // (vertex, new neighbour): the one new cost to compare next pass.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> newNeighbour_;
   std::size_t newNeighbourCount_ = 0;
-  std::vector<std::uint32_t> ringFrom_, ringTo_;  // valid(): the last pair's rings
-  std::size_t ringFromCount_ = 0, ringToCount_ = 0;
-  std::vector<std::uint32_t> live_;
+  std::vector<std::uint32_t> ringFrom_, ringTo_;  // storage of the Rings valid() returns
+  std::vector<std::uint32_t> liveTriangles_;
   std::vector<std::uint32_t> active_;  // vertices that may still collapse
   std::uint32_t stampToken_ = 0;
   std::uint32_t pass_ = 0;
@@ -300,17 +313,17 @@ bool Simplifier::allowed(std::uint32_t from, std::uint32_t to) const {
 void Simplifier::buildIncidence() {
   // Only the live triangles and vertices. Between rebuilds, collapse() appends the one fan that
   // grows, so the array fills with stale lists; a rebuild compacts it.
-  if (live_.empty()) {
-    live_.resize(triangleCount_);
-    for (std::uint32_t t = 0; t < triangleCount_; ++t) live_[t] = t;
+  if (liveTriangles_.empty()) {
+    liveTriangles_.resize(triangleCount_);
+    for (std::uint32_t t = 0; t < triangleCount_; ++t) liveTriangles_[t] = t;
     liveVertices_.resize(vertexCount_);
     for (std::uint32_t v = 0; v < vertexCount_; ++v) liveVertices_[v] = v;
   } else {
-    std::erase_if(live_, [&](std::uint32_t t) { return !alive(t); });
+    std::erase_if(liveTriangles_, [&](std::uint32_t t) { return !alive(t); });
     std::erase_if(liveVertices_, [&](std::uint32_t v) { return vertex_[v].removed != 0; });
   }
   for (std::uint32_t v : liveVertices_) vertex_[v].incidentCount = 0;
-  for (std::uint32_t t : live_) {
+  for (std::uint32_t t : liveTriangles_) {
     for (std::uint32_t v : corners_[t]) ++vertex_[v].incidentCount;
   }
   std::uint32_t end = 0;
@@ -320,7 +333,7 @@ void Simplifier::buildIncidence() {
   }
   incident_.resize(end);
   // Backwards, so that each fan lists its triangles in increasing order.
-  for (auto t = live_.rbegin(); t != live_.rend(); ++t) {
+  for (auto t = liveTriangles_.rbegin(); t != liveTriangles_.rend(); ++t) {
     for (std::uint32_t v : corners_[*t]) incident_[--vertex_[v].incidentStart] = *t;
   }
 }
@@ -350,10 +363,10 @@ void Simplifier::mergeFans(std::uint32_t from, std::uint32_t to) {
 }
 
 void Simplifier::updateFaceNormals() {
-  std::erase_if(live_, [&](std::uint32_t t) { return !alive(t); });
+  std::erase_if(liveTriangles_, [&](std::uint32_t t) { return !alive(t); });
   faceNormals_.resize(triangleCount_);
-  tbb::parallel_for(std::size_t{0}, live_.size(), [&](std::size_t i) {
-    const std::uint32_t t = live_[i];
+  tbb::parallel_for(std::size_t{0}, liveTriangles_.size(), [&](std::size_t i) {
+    const std::uint32_t t = liveTriangles_[i];
     const Vec3d a = position(corners_[t][0]), b = position(corners_[t][1]),
                 c = position(corners_[t][2]);
     faceNormals_[t] = normalizeOr(cross(b - a, c - a), Vec3d{});
@@ -444,10 +457,10 @@ void Simplifier::rankVertex(std::uint32_t u) {
   su.bestCost = best;
 }
 
-bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
+std::optional<Simplifier::Rings> Simplifier::valid(std::uint32_t from, std::uint32_t to) {
   // Neighbourhoods from the pass's incidence: complete for any vertex no collapse of this pass
   // has targeted (dead triangles skipped, moved corners updated). Stamps instead of sets.
-  // Both rings are kept (each vertex once, the ends left out): if the collapse goes ahead,
+  // Both rings are returned (each vertex once, the ends left out): if the collapse goes ahead,
   // markChanged() walks them instead of the fans. Branch-free: which corner is new is random.
   const std::uint32_t stamp = ++stampToken_;
   const auto toFan = around(to), fromFan = around(from);
@@ -464,7 +477,6 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
       sw.nearStamp = stamp;
     }
   }
-  ringToCount_ = ringTo;
   std::uint32_t shared = 0, common = 0, fan = 0;
   for (std::uint32_t t : fromFan) {
     if (!alive(t)) continue;
@@ -483,13 +495,12 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
       ringFrom += fresh;
     }
   }
-  ringFromCount_ = ringFrom;
-  if (shared == 0) return false;  // the edge is gone
+  if (shared == 0) return std::nullopt;  // the edge is gone
   // Link condition: the common neighbours of the two ends are exactly the opposite corners of
   // the triangles on the edge; otherwise the collapse would create a non-manifold edge.
-  if (common != shared) return false;
+  if (common != shared) return std::nullopt;
   // A rim vertex moves only along its rim: over a boundary edge (one triangle), into the next.
-  if (vertex_[from].boundary != 0 && shared != 1) return false;
+  if (vertex_[from].boundary != 0 && shared != 1) return std::nullopt;
   const Vec3d target = position(to);
   const bool tetrahedron = fan == 3;
   for (std::uint32_t t : around(from)) {
@@ -503,7 +514,7 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
         (x == kNone ? x : y) = w;
       }
       for (std::uint32_t s : around(to)) {
-        if (alive(s) && contains(s, x) && contains(s, y)) return false;
+        if (alive(s) && contains(s, x) && contains(s, y)) return std::nullopt;
       }
     }
     // No flip and no degenerate result.
@@ -517,16 +528,17 @@ bool Simplifier::valid(std::uint32_t from, std::uint32_t to) {
     // No flip, and no face turned by more than ~75 degrees either: near-flips make slivers
     // that stick out of the surface.
     const double d = dot(n0, n1), l0 = dot(n0, n0), l1 = dot(n1, n1);
-    if (d <= 0 || l1 <= 0 || d * d <= minNormalCos2_ * l0 * l1) return false;  // without roots
+    if (d <= 0 || l1 <= 0 || d * d <= minNormalCos2_ * l0 * l1)
+      return std::nullopt;  // without roots
   }
-  return true;
+  return Rings{std::span(ringFrom_).first(ringFrom), std::span(ringTo_).first(ringTo)};
 }
 
-std::uint32_t Simplifier::validTarget(std::uint32_t from, float bestCost) {
+Simplifier::Target Simplifier::validTarget(std::uint32_t from, float bestCost) {
   const std::uint32_t best = vertex_[from].bestTarget;
   // A touched target has a new quadric and fan: `from` is dirty and re-ranked next pass.
-  if (vertex_[best].touched == pass_) return kNone;
-  if (valid(from, best)) return best;
+  if (vertex_[best].touched == pass_) return {};
+  if (std::optional<Rings> rings = valid(from, best)) return {best, *rings};
   // The best is blocked: the others in cost order, as long as they are not much dearer than
   // what this pass is collapsing anyway.
   std::array<std::pair<float, std::uint32_t>, 64> others;
@@ -548,12 +560,14 @@ std::uint32_t Simplifier::validTarget(std::uint32_t from, float bestCost) {
   std::sort(others.begin(), others.begin() + static_cast<std::ptrdiff_t>(count));
   for (std::size_t i = 0; i < count; ++i) {
     if (others[i].first > passLimit_ && others[i].first > bestCost) break;
-    if (valid(from, others[i].second)) return others[i].second;
+    if (std::optional<Rings> rings = valid(from, others[i].second))
+      return {others[i].second, *rings};
   }
-  return kNone;
+  return {};
 }
 
-void Simplifier::markChanged(std::uint32_t from, std::uint32_t to) {
+void Simplifier::markChanged(std::uint32_t from, const Target& target) {
+  const std::uint32_t to = target.vertex;
   // Who must be re-ranked after `from` collapses into `to`. Half-edge collapses move no vertex
   // and only Q_to changes, growing, so around the two ends only costs to `to` change: up for
   // the old neighbours of `to`, new for those `from` hands over. A vertex whose best was one of
@@ -561,10 +575,11 @@ void Simplifier::markChanged(std::uint32_t from, std::uint32_t to) {
   // their best. Melax's cost looks at whole fans: everyone around is re-ranked.
   const bool melax = options_.cost == CollapseCost::kMelax;
   vertex_[to].dirty = 1;
-  // The rings valid() just collected: from's ring first (who gains `to`), then to's.
-  if (newNeighbour_.size() < newNeighbourCount_ + ringFromCount_)
-    newNeighbour_.resize(2 * (newNeighbourCount_ + ringFromCount_));
-  for (std::uint32_t w : std::span(ringFrom_).first(ringFromCount_)) {
+  // The rings valid() collected: from's ring first (who gains `to`), then to's.
+  const Rings& rings = target.rings;
+  if (newNeighbour_.size() < newNeighbourCount_ + rings.from.size())
+    newNeighbour_.resize(2 * (newNeighbourCount_ + rings.from.size()));
+  for (std::uint32_t w : rings.from) {
     VertexState& sw = vertex_[w];
     const bool other = !sw.dirty;
     const bool redo = other & (melax | (sw.bestTarget == from) | (sw.bestTarget == to));
@@ -572,7 +587,7 @@ void Simplifier::markChanged(std::uint32_t from, std::uint32_t to) {
     newNeighbour_[newNeighbourCount_] = {w, to};
     newNeighbourCount_ += other & !redo & (sw.gains != 0);
   }
-  for (std::uint32_t w : std::span(ringTo_).first(ringToCount_)) {
+  for (std::uint32_t w : rings.to) {
     VertexState& sw = vertex_[w];
     const bool redo = (sw.dirty == 0) & (melax | (sw.bestTarget == from) | (sw.bestTarget == to));
     sw.dirty = static_cast<std::uint8_t>(sw.dirty | redo);
@@ -594,7 +609,8 @@ void Simplifier::rankNewNeighbours() {
   newNeighbourCount_ = 0;
 }
 
-void Simplifier::collapse(std::uint32_t from, std::uint32_t to) {
+void Simplifier::collapse(std::uint32_t from, const Target& target) {
+  const std::uint32_t to = target.vertex;
   const Vec3d moved = position(from);
   double distance = std::numeric_limits<double>::max();
   // Only the two ends are off limits for the rest of the pass: `to` is the one vertex whose fan
@@ -603,7 +619,7 @@ void Simplifier::collapse(std::uint32_t from, std::uint32_t to) {
   // place), so later checks in the pass see the current mesh. Everyone whose cost inputs change
   // is re-ranked next pass.
   vertex_[from].touched = vertex_[to].touched = pass_;
-  markChanged(from, to);
+  markChanged(from, target);
   for (std::uint32_t t : around(from)) {
     if (!alive(t)) continue;
     if (contains(t, to)) {
@@ -688,8 +704,8 @@ void Simplifier::collapseAll() {
         }
         const std::uint32_t from = ranked[i].second;
         if (vertex_[from].touched == pass_ || vertex_[from].removed) continue;
-        const std::uint32_t to = validTarget(from, ranked[i].first);
-        if (to == kNone) continue;
+        const Target to = validTarget(from, ranked[i].first);
+        if (to.vertex == kNone) continue;
         collapse(from, to);
         if (triangleCount_ - removedTriangleCount() <= options_.stopAtTriangles) return;
       }

@@ -97,7 +97,7 @@ nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
           {"trianglesPerChunk", input.trianglesPerChunk},
           {"levels", input.levels},
           {"salvage", input.salvageTruncated},
-          {"keep", octree.keep},
+          {"keep", octree.reduction},  // the key of earlier work directories
           {"maxNormalDeviation", octree.maxNormalDeviationDegrees},
           {"errorSamples", octree.errorSamples},
           {"crs", options.crs},

@@ -298,7 +298,7 @@ struct Builder {
     ProgressiveOptions simplify;
     simplify.minNormalCos = std::cos(options.maxNormalDeviationDegrees * std::numbers::pi / 180);
     simplify.stopAtTriangles = static_cast<std::uint32_t>(std::max<double>(
-        1, std::floor(options.keep * static_cast<double>(merged.triangleCount()))));
+        1, std::floor(options.reduction * static_cast<double>(merged.triangleCount()))));
     // Only the node's outer faces are shared with other tiles: vertices there never move. The
     // input's own rims (and seams inside the node) may simplify, along themselves.
     const std::vector<std::uint8_t> outer = onOuterFaces(merged, chunks.grid(), node);

@@ -21,7 +21,7 @@ namespace lodforge {
 struct OctreeOptions {
   // Share of its children's triangles a parent keeps (the paper's reduction factor 0.2: each
   // level keeps a fifth, i.e. removes four fifths; docs/tiles.md).
-  double keep = 0.2;
+  double reduction = 0.2;
   // Largest angle a collapse may turn a face by (the paper's normal deviation, default 30).
   double maxNormalDeviationDegrees = 30;
   // Levels above the leaves (0: up to a single root).

@@ -81,6 +81,271 @@ double milliseconds(std::chrono::steady_clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
 
+// What the panel, the keys and the mouse change from frame to frame.
+struct ViewControls {
+  std::uint64_t budget = 0;  // N, vertices
+  float budgetPercent = 0;
+  bool firstPassOnly = false, gpuReform = false, gpuStreaming = false;
+  float minT = 0;
+  int colorMode = 0;
+  bool recording = false, playing = false, screenshotNow = false;
+  std::vector<Camera> recorded, played;
+  std::size_t playIndex = 0;
+  std::string message;  // the last thing saved
+};
+
+// One window on one package: each frame steers the camera, selects, streams and draws the
+// model, saves a screenshot when asked and draws the panel.
+class PackageViewer {
+ public:
+  PackageViewer(const ViewOptions& options, const Package& package, const LodScene& scene,
+                GLFWwindow* window, FramePipeline& pipeline)
+      : o_(options),
+        package_(package),
+        scene_(scene),
+        full_(scene.totalMaxVertices()),
+        window_(window),
+        pipeline_(pipeline),
+        bounds_(packageBounds(package)) {
+    control_.target = (bounds_.min + bounds_.max) * 0.5;
+    control_.distance = 1.6 * length(bounds_.max - bounds_.min);
+    control_.speed = 0.25 * length(bounds_.max - bounds_.min);
+    control_.yaw = -kPi / 2;
+    glfwGetCursorPos(window_, &lastX_, &lastY_);
+  }
+
+  ViewControls& controls() { return controls_; }
+  std::uint64_t fullVertices() const { return full_; }
+  std::uint64_t frames() const { return frame_ + 1; }
+
+  Status run();
+  // Still recording at exit (always so with --record and no button pressed): save it.
+  Status saveRecording() const;
+
+ private:
+  void steer(double seconds);
+  Camera nextCamera(std::uint32_t width, std::uint32_t height);
+  Status drawModel(const Camera& camera);
+  Status saveScreenshot(bool last, std::uint32_t width, std::uint32_t height);
+  Status drawPanel();
+  Status toggleRecording();
+
+  const ViewOptions& o_;
+  const Package& package_;
+  const LodScene& scene_;
+  const std::uint64_t full_;
+  GLFWwindow* window_;
+  FramePipeline& pipeline_;
+  const Aabbd bounds_;
+  CameraControl control_;
+  ViewControls controls_;
+  Selection selection_;
+  FrameFigures figures_;
+  double lastX_ = 0, lastY_ = 0;
+  std::uint64_t frame_ = 0;
+};
+
+Status PackageViewer::run() {
+  auto previous = std::chrono::steady_clock::now();
+  while (!glfwWindowShouldClose(window_)) {
+    LODFORGE_TRY(checkCancelled());
+    glfwPollEvents();
+    const auto now = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(now - previous).count();
+    previous = now;
+    int fbWidth = 0, fbHeight = 0;
+    glfwGetFramebufferSize(window_, &fbWidth, &fbHeight);
+    if (fbWidth <= 0 || fbHeight <= 0) continue;  // minimised
+    const auto width = static_cast<std::uint32_t>(fbWidth);
+    const auto height = static_cast<std::uint32_t>(fbHeight);
+    steer(dt);
+    const Camera camera = nextCamera(width, height);
+    LODFORGE_TRY(drawModel(camera));
+    // The last frame of a scripted run, or P: a screenshot of the model without the panel.
+    const bool last = o_.stopAfter != 0 && frame_ + 1 >= o_.stopAfter;
+    LODFORGE_TRY(saveScreenshot(last, width, height));
+    LODFORGE_TRY(drawPanel());
+    glfwSwapBuffers(window_);
+    if (last) break;
+    ++frame_;
+  }
+  return {};
+}
+
+// Mouse and keys, unless the panel has them: drag turns, the wheel zooms, WASD/QE fly.
+void PackageViewer::steer(double seconds) {
+  const ImGuiIO& io = ImGui::GetIO();
+  double x = 0, y = 0;
+  glfwGetCursorPos(window_, &x, &y);
+  if (!io.WantCaptureMouse) {
+    if (glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
+      control_.yaw -= 0.005 * (x - lastX_);
+      control_.pitch = std::clamp(control_.pitch + 0.005 * (y - lastY_), -1.5, 1.5);
+      controls_.playing = false;
+    }
+    if (io.MouseWheel != 0) control_.distance *= std::pow(0.9, io.MouseWheel);
+  }
+  lastX_ = x;
+  lastY_ = y;
+  if (io.WantCaptureKeyboard) return;
+  const Vec3d f = control_.forward(), r = normalizeOr(cross(f, Vec3d{0, 0, 1}), Vec3d{1, 0, 0});
+  const double step = control_.speed * seconds;
+  const auto key = [&](int k) { return glfwGetKey(window_, k) == GLFW_PRESS; };
+  Vec3d move{0, 0, 0};
+  if (key(GLFW_KEY_W)) move = move + f;
+  if (key(GLFW_KEY_S)) move = move - f;
+  if (key(GLFW_KEY_D)) move = move + r;
+  if (key(GLFW_KEY_A)) move = move - r;
+  if (key(GLFW_KEY_E)) move = move + Vec3d{0, 0, 1};
+  if (key(GLFW_KEY_Q)) move = move - Vec3d{0, 0, 1};
+  if (move.x != 0 || move.y != 0 || move.z != 0) {
+    if (!control_.fly) {  // moving switches to fly from where the orbit stands
+      control_.position = control_.target - f * control_.distance;
+      control_.fly = true;
+    }
+    control_.position = control_.position + move * step;
+    controls_.playing = false;
+  }
+  if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
+    glfwSetWindowShouldClose(window_, 1);
+  if (ImGui::IsKeyPressed(GLFW_KEY_P)) controls_.screenshotNow = true;
+}
+
+// The steered camera, or the played path's next one (which the steering then follows).
+Camera PackageViewer::nextCamera(std::uint32_t width, std::uint32_t height) {
+  Camera camera = control_.camera(width, height, o_.fovY, bounds_);
+  if (controls_.playing) {
+    const auto& played = controls_.played;
+    camera = played[controls_.playIndex % played.size()];
+    camera.width = width;
+    camera.height = height;
+    control_.follow(camera);
+    ++controls_.playIndex;
+  }
+  if (controls_.recording) controls_.recorded.push_back(camera);
+  return camera;
+}
+
+// Select (§4), stream (§3.3) on the CPU or the GPU, re-form and draw.
+Status PackageViewer::drawModel(const Camera& camera) {
+  const auto t0 = std::chrono::steady_clock::now();
+  selectTwoPass(scene_, camera, controls_.budget,
+                {.minT = controls_.minT, .firstPassOnly = controls_.firstPassOnly}, selection_);
+  const auto t1 = std::chrono::steady_clock::now();
+  // CPU stream + upload, or the paper's GPU path where only the Δ crosses over.
+  pipeline_.setStreaming(controls_.gpuStreaming ? Streaming::kGpu
+                         : controls_.gpuReform  ? Streaming::kCpuGpuReform
+                                                : Streaming::kCpu);
+  auto stream = pipeline_.update(selection_.vertexCounts, selection_.triangleCounts);
+  if (!stream) return stream.status();
+  bindWindowFramebuffer();
+  pipeline_.draw(camera, {.colorMode = static_cast<ColorMode>(controls_.colorMode)});
+  const PipelineTimings& p = pipeline_.timings();
+  figures_ = {milliseconds(t1 - t0),
+              p.streamMs,
+              p.uploadMs,
+              p.reformMs,
+              p.drawMs,
+              *stream,
+              selection_.totalVertices,
+              selection_.totalTriangles,
+              selection_.visibleObjects};
+  return {};
+}
+
+Status PackageViewer::saveScreenshot(bool last, std::uint32_t width, std::uint32_t height) {
+  if (!controls_.screenshotNow && !(last && !o_.screenshot.empty())) return {};
+  const std::string name =
+      !o_.screenshot.empty() && last ? o_.screenshot : fmt::format("lodforge-{:04}.png", frame_);
+  LODFORGE_TRY(writePng(name, readPixels(0, width, height)));
+  controls_.message = "saved " + name;
+  controls_.screenshotNow = false;
+  return {};
+}
+
+Status PackageViewer::drawPanel() {
+  ViewControls& c = controls_;
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::Begin("lodforge");
+  ImGui::Text("%s", o_.input.c_str());
+  // The count stays exactly what --budget said until the slider moves.
+  if (ImGui::SliderFloat("budget N (%)", &c.budgetPercent, 0.01f, 100.0f, "%.2f %%",
+                         ImGuiSliderFlags_Logarithmic))
+    c.budget = std::max<std::uint64_t>(
+        1, static_cast<std::uint64_t>(
+               std::llround(c.budgetPercent / 100.0 * static_cast<double>(full_))));
+  ImGui::Text("N = %s of %s vertices", formatCount(c.budget).c_str(), formatCount(full_).c_str());
+  ImGui::Checkbox("first pass only (Eq. 2-3)", &c.firstPassOnly);
+  ImGui::SliderFloat("MinT (Eq. 3)", &c.minT, 0.0f, 1.0f);
+  ImGui::Checkbox("GPU streaming (Δ upload, reassembly and reformation on the GPU)",
+                  &c.gpuStreaming);
+  if (!c.gpuStreaming) ImGui::Checkbox("GPU reformation (compute shader)", &c.gpuReform);
+  const char* modes[] = {"shaded", "object", "LOD ratio", "normal"};
+  ImGui::Combo("colour", &c.colorMode, modes, 4);
+  ImGui::Separator();
+  const FrameFigures& f = figures_;
+  ImGui::Text("selection   %7.2f ms", f.selectionMs);
+  ImGui::Text("generation  %7.2f ms", f.generationMs);
+  ImGui::Text("upload      %7.2f ms", f.uploadMs);
+  const bool onGpu = c.gpuStreaming || c.gpuReform;
+  ImGui::Text("reformation %7.2f ms (%s)", onGpu ? f.reformMs : f.stream.reformationMs,
+              onGpu ? "GPU" : "CPU, in generation");
+  ImGui::Text("draw        %7.2f ms", f.drawMs);
+  ImGui::Text("drawn: %s vertices, %s triangles, %s objects visible",
+              formatCount(f.vertices).c_str(), formatCount(f.triangles).c_str(),
+              formatCount(f.objects).c_str());
+  ImGui::Text("streamed: %s read, %s moved", formatBytes(f.stream.bytesRead).c_str(),
+              formatBytes(f.stream.bytesMoved).c_str());
+  ImGui::Separator();
+  ImGui::Text("camera: %s (drag, wheel; WASD/QE fly)", control_.fly ? "fly" : "orbit");
+  if (ImGui::Button("orbit")) control_.fly = false;
+  ImGui::SameLine();
+  if (ImGui::Button(c.recording ? "stop recording" : "record path"))
+    LODFORGE_TRY(toggleRecording());
+  ImGui::SameLine();
+  if (!c.played.empty() && ImGui::Button(c.playing ? "pause" : "play")) c.playing = !c.playing;
+  if (ImGui::Button("screenshot (P)")) c.screenshotNow = true;
+  if (!c.message.empty()) ImGui::Text("%s", c.message.c_str());
+  ImGui::End();
+  ImGui::Render();
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  return {};
+}
+
+// A recording that stops is saved at once (to --record or a numbered file) and ready to play.
+Status PackageViewer::toggleRecording() {
+  ViewControls& c = controls_;
+  c.recording = !c.recording;
+  if (c.recording) {
+    c.recorded.clear();
+    return {};
+  }
+  if (c.recorded.empty()) return {};
+  const std::string file =
+      o_.record.empty() ? fmt::format("lodforge-path-{:04}.json", frame_) : o_.record;
+  LODFORGE_TRY(writeCameraPath(file, c.recorded, package_.origin()));
+  c.message = fmt::format("saved {} cameras to {}", c.recorded.size(), file);
+  c.played = c.recorded;
+  c.playIndex = 0;
+  return {};
+}
+
+Status PackageViewer::saveRecording() const {
+  if (!controls_.recording || o_.record.empty() || controls_.recorded.empty()) return {};
+  return writeCameraPath(o_.record, controls_.recorded, package_.origin());
+}
+
+// The cameras of --play, if given.
+Result<std::vector<Camera>> playedPath(const ViewOptions& o, const Package& package) {
+  if (o.play.empty()) return std::vector<Camera>{};
+  PathChoice choice = o;
+  choice.path = o.play;
+  return cameraPath(choice, package);
+}
+
 Status runView(const Global& global, const ViewOptions& o) {
   LODFORGE_TRY(claimIfGiven(o.record, jsonOutput(), {o.input}));
   LODFORGE_TRY(claimIfGiven(o.screenshot, pngOutput(), {o.input}));
@@ -94,14 +359,8 @@ Status runView(const Global& global, const ViewOptions& o) {
   if (!budget) return budget.status();
   std::uint32_t width = 0, height = 0;
   LODFORGE_TRY(parseSize(o.size, width, height));
-  std::vector<Camera> played;
-  if (!o.play.empty()) {
-    PathChoice choice = o;
-    choice.path = o.play;
-    auto path = cameraPath(choice, *package);
-    if (!path) return path.status();
-    played = std::move(*path);
-  }
+  Result<std::vector<Camera>> played = playedPath(o, *package);
+  if (!played) return played.status();
   auto gl = GlContext::window(width, height, "lodforge — " + o.input);
   if (!gl) return gl.status();
   GLFWwindow* window = (*gl)->glfwWindow();
@@ -111,194 +370,24 @@ Status runView(const Global& global, const ViewOptions& o) {
   // Every arrangement prepared: the panel switches between them.
   auto pipeline = FramePipeline::create(*package, capacity, Streaming::kCpu, /*switchable=*/true);
   if (!pipeline) return pipeline.status();
-
   const ImGuiPanel panel(window);
 
-  const Aabbd bounds = packageBounds(*package);
-  CameraControl control;
-  control.target = (bounds.min + bounds.max) * 0.5;
-  control.distance = 1.6 * length(bounds.max - bounds.min);
-  control.speed = 0.25 * length(bounds.max - bounds.min);
-  control.yaw = -kPi / 2;
-
-  float budgetPercent =
+  PackageViewer viewer(o, *package, scene, window, *pipeline);
+  ViewControls& controls = viewer.controls();
+  controls.budget = *budget;
+  controls.budgetPercent =
       static_cast<float>(100.0 * static_cast<double>(*budget) / static_cast<double>(full));
-  std::uint64_t n = *budget;
-  bool firstPassOnly = o.firstPassOnly, gpuReform = o.gpuReform, gpuStreaming = o.gpuStream;
-  float minT = static_cast<float>(o.minT);
-  int mode = static_cast<int>(*colorMode);
-  bool recording = !o.record.empty();
-  std::vector<Camera> recorded;
-  std::size_t playIndex = 0;
-  bool playing = !played.empty();
-  Selection selection;
-  FrameFigures figures;
-  double lastX = 0, lastY = 0;
-  glfwGetCursorPos(window, &lastX, &lastY);
-  auto previous = std::chrono::steady_clock::now();
-  std::uint64_t frame = 0;
-  bool screenshotNow = false;
-  std::string message;
-
-  while (!glfwWindowShouldClose(window)) {
-    LODFORGE_TRY(checkCancelled());
-    glfwPollEvents();
-    const auto now = std::chrono::steady_clock::now();
-    const double dt = std::chrono::duration<double>(now - previous).count();
-    previous = now;
-    int fbWidth = 0, fbHeight = 0;
-    glfwGetFramebufferSize(window, &fbWidth, &fbHeight);
-    if (fbWidth <= 0 || fbHeight <= 0) continue;  // minimised
-
-    // Input, unless the panel has it.
-    const ImGuiIO& io = ImGui::GetIO();
-    double x = 0, y = 0;
-    glfwGetCursorPos(window, &x, &y);
-    if (!io.WantCaptureMouse) {
-      if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
-        control.yaw -= 0.005 * (x - lastX);
-        control.pitch = std::clamp(control.pitch + 0.005 * (y - lastY), -1.5, 1.5);
-        playing = false;
-      }
-      if (io.MouseWheel != 0) control.distance *= std::pow(0.9, io.MouseWheel);
-    }
-    lastX = x;
-    lastY = y;
-    if (!io.WantCaptureKeyboard) {
-      const Vec3d f = control.forward(), r = normalizeOr(cross(f, Vec3d{0, 0, 1}), Vec3d{1, 0, 0});
-      const double step = control.speed * dt;
-      const auto key = [&](int k) { return glfwGetKey(window, k) == GLFW_PRESS; };
-      Vec3d move{0, 0, 0};
-      if (key(GLFW_KEY_W)) move = move + f;
-      if (key(GLFW_KEY_S)) move = move - f;
-      if (key(GLFW_KEY_D)) move = move + r;
-      if (key(GLFW_KEY_A)) move = move - r;
-      if (key(GLFW_KEY_E)) move = move + Vec3d{0, 0, 1};
-      if (key(GLFW_KEY_Q)) move = move - Vec3d{0, 0, 1};
-      if (move.x != 0 || move.y != 0 || move.z != 0) {
-        if (!control.fly) {  // moving switches to fly from where the orbit stands
-          control.position = control.target - f * control.distance;
-          control.fly = true;
-        }
-        control.position = control.position + move * step;
-        playing = false;
-      }
-      if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape)))
-        glfwSetWindowShouldClose(window, 1);
-      if (ImGui::IsKeyPressed(GLFW_KEY_P)) screenshotNow = true;
-    }
-    Camera camera = control.camera(static_cast<std::uint32_t>(fbWidth),
-                                   static_cast<std::uint32_t>(fbHeight), o.fovY, bounds);
-    if (playing) {
-      camera = played[playIndex % played.size()];
-      camera.width = static_cast<std::uint32_t>(fbWidth);
-      camera.height = static_cast<std::uint32_t>(fbHeight);
-      control.follow(camera);
-      ++playIndex;
-    }
-    if (recording) recorded.push_back(camera);
-
-    // Select, stream, re-form, draw.
-    const auto t0 = std::chrono::steady_clock::now();
-    selectTwoPass(scene, camera, n, {.minT = minT, .firstPassOnly = firstPassOnly}, selection);
-    const auto t1 = std::chrono::steady_clock::now();
-    // CPU stream + upload, or the paper's GPU path where only the Δ crosses over.
-    pipeline->setStreaming(gpuStreaming ? Streaming::kGpu
-                           : gpuReform  ? Streaming::kCpuGpuReform
-                                        : Streaming::kCpu);
-    auto stream = pipeline->update(selection.vertexCounts, selection.triangleCounts);
-    if (!stream) return stream.status();
-    bindWindowFramebuffer();
-    pipeline->draw(camera, {.colorMode = static_cast<ColorMode>(mode)});
-    const PipelineTimings& p = pipeline->timings();
-    figures = {milliseconds(t1 - t0),
-               p.streamMs,
-               p.uploadMs,
-               p.reformMs,
-               p.drawMs,
-               *stream,
-               selection.totalVertices,
-               selection.totalTriangles,
-               selection.visibleObjects};
-
-    // The last frame of a scripted run, or P: a screenshot of the model without the panel.
-    const bool last = o.stopAfter != 0 && frame + 1 >= o.stopAfter;
-    if (screenshotNow || (last && !o.screenshot.empty())) {
-      const std::string name =
-          !o.screenshot.empty() && last ? o.screenshot : fmt::format("lodforge-{:04}.png", frame);
-      const Image image =
-          readPixels(0, static_cast<std::uint32_t>(fbWidth), static_cast<std::uint32_t>(fbHeight));
-      LODFORGE_TRY(writePng(name, image));
-      message = "saved " + name;
-      screenshotNow = false;
-    }
-
-    ImGui_ImplOpenGL3_NewFrame();
-    ImGui_ImplGlfw_NewFrame();
-    ImGui::NewFrame();
-    ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-    ImGui::Begin("lodforge");
-    ImGui::Text("%s", o.input.c_str());
-    // The count stays exactly what --budget said until the slider moves.
-    if (ImGui::SliderFloat("budget N (%)", &budgetPercent, 0.01f, 100.0f, "%.2f %%",
-                           ImGuiSliderFlags_Logarithmic))
-      n = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(
-                                         budgetPercent / 100.0 * static_cast<double>(full))));
-    ImGui::Text("N = %s of %s vertices", formatCount(n).c_str(), formatCount(full).c_str());
-    ImGui::Checkbox("first pass only (Eq. 2-3)", &firstPassOnly);
-    ImGui::SliderFloat("MinT (Eq. 3)", &minT, 0.0f, 1.0f);
-    ImGui::Checkbox("GPU streaming (Δ upload, reassembly and reformation on the GPU)",
-                    &gpuStreaming);
-    if (!gpuStreaming) ImGui::Checkbox("GPU reformation (compute shader)", &gpuReform);
-    const char* modes[] = {"shaded", "object", "LOD ratio", "normal"};
-    ImGui::Combo("colour", &mode, modes, 4);
-    ImGui::Separator();
-    ImGui::Text("selection   %7.2f ms", figures.selectionMs);
-    ImGui::Text("generation  %7.2f ms", figures.generationMs);
-    ImGui::Text("upload      %7.2f ms", figures.uploadMs);
-    const bool onGpu = gpuStreaming || gpuReform;
-    ImGui::Text("reformation %7.2f ms (%s)",
-                onGpu ? figures.reformMs : figures.stream.reformationMs,
-                onGpu ? "GPU" : "CPU, in generation");
-    ImGui::Text("draw        %7.2f ms", figures.drawMs);
-    ImGui::Text("drawn: %s vertices, %s triangles, %s objects visible",
-                formatCount(figures.vertices).c_str(), formatCount(figures.triangles).c_str(),
-                formatCount(figures.objects).c_str());
-    ImGui::Text("streamed: %s read, %s moved", formatBytes(figures.stream.bytesRead).c_str(),
-                formatBytes(figures.stream.bytesMoved).c_str());
-    ImGui::Separator();
-    ImGui::Text("camera: %s (drag, wheel; WASD/QE fly)", control.fly ? "fly" : "orbit");
-    if (ImGui::Button("orbit")) control.fly = false;
-    ImGui::SameLine();
-    if (ImGui::Button(recording ? "stop recording" : "record path")) {
-      recording = !recording;
-      if (recording) {
-        recorded.clear();
-      } else if (!recorded.empty()) {
-        // Saved at once (to --record or a numbered file), and ready to play back.
-        const std::string file =
-            o.record.empty() ? fmt::format("lodforge-path-{:04}.json", frame) : o.record;
-        LODFORGE_TRY(writeCameraPath(file, recorded, package->origin()));
-        message = fmt::format("saved {} cameras to {}", recorded.size(), file);
-        played = recorded;
-        playIndex = 0;
-      }
-    }
-    ImGui::SameLine();
-    if (!played.empty() && ImGui::Button(playing ? "pause" : "play")) playing = !playing;
-    if (ImGui::Button("screenshot (P)")) screenshotNow = true;
-    if (!message.empty()) ImGui::Text("%s", message.c_str());
-    ImGui::End();
-    ImGui::Render();
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-    glfwSwapBuffers(window);
-    if (last) break;
-    ++frame;
-  }
-  // Still recording at exit (always so with --record and no button pressed): save it.
-  if (recording && !o.record.empty() && !recorded.empty())
-    LODFORGE_TRY(writeCameraPath(o.record, recorded, package->origin()));
-  say(global, fmt::format("{} frames shown{}", frame + 1,
+  controls.firstPassOnly = o.firstPassOnly;
+  controls.gpuReform = o.gpuReform;
+  controls.gpuStreaming = o.gpuStream;
+  controls.minT = static_cast<float>(o.minT);
+  controls.colorMode = static_cast<int>(*colorMode);
+  controls.recording = !o.record.empty();
+  controls.played = std::move(*played);
+  controls.playing = !controls.played.empty();
+  LODFORGE_TRY(viewer.run());
+  LODFORGE_TRY(viewer.saveRecording());
+  say(global, fmt::format("{} frames shown{}", viewer.frames(),
                           o.record.empty() ? "" : fmt::format(", path written to {}", o.record)));
   return {};
 }

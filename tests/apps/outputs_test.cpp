@@ -103,7 +103,8 @@ class WritingCommands : public ::testing::Test {
   Outcome run(const Command& command, const fs::path& folder, const std::string& output,
               const std::string& wrapper = "") {
     const std::string in = command.input.empty() ? "" : (folder / command.input).string();
-    return lodforge(command.args(in, output), dir_, wrapper + command.wrapper);
+    // An environment prefix (the command's) goes first, in front of a wrapper such as setpriv.
+    return lodforge(command.args(in, output), dir_, command.wrapper + wrapper);
   }
 
   // Runs `command` at `output` and checks that it is refused with `code` and that nothing in

@@ -1,0 +1,467 @@
+#include "lodforge/tiling/chunk_ply.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <unordered_map>
+
+#include <tbb/parallel_pipeline.h>
+
+#include <fmt/format.h>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/io/ply_reader.h"
+#include "lodforge/tiling/chunk_grid.h"
+#include "lodforge/tiling/chunk_sizing.h"
+
+namespace lodforge {
+namespace {
+
+// A vertex in the work file: position (3 doubles), colour, normal (3 floats; a sum of face
+// normals while a normals pass accumulates it).
+constexpr std::size_t kVertexBytes = 3 * sizeof(double) + sizeof(Rgba8) + 3 * sizeof(float);
+constexpr std::size_t kNormalOffset = 3 * sizeof(double) + sizeof(Rgba8);
+constexpr std::uint64_t kBlockVertices = 1 << 14;
+
+// Corners of the faces, fetched from the vertex work file through a direct-mapped cache of
+// fixed-size blocks: meshes written in scan or grid order touch a few blocks at a time. Blocks
+// changed by addNormal are written back when evicted and by flush().
+class VertexCache {
+ public:
+  VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes) : fd_(fd), vertices_(vertices) {
+    const std::uint64_t blockBytes = kBlockVertices * kVertexBytes;
+    slots_ = std::max<std::uint64_t>(4, bytes / blockBytes);
+    data_.resize(slots_ * blockBytes);
+    tags_.assign(slots_, ~std::uint64_t{0});
+    dirty_.assign(slots_, 0);
+  }
+
+  bool fetch(std::uint64_t vertex, CutCorner& out) {
+    const std::byte* at = record(vertex);
+    if (at == nullptr) return false;
+    double xyz[3];
+    float normal[3];
+    std::memcpy(xyz, at, sizeof xyz);
+    std::memcpy(&out.color, at + sizeof xyz, sizeof(Rgba8));
+    std::memcpy(normal, at + kNormalOffset, sizeof normal);
+    out.position = {xyz[0], xyz[1], xyz[2]};
+    out.normal = normalizeOr(Vec3f{normal[0], normal[1], normal[2]}, Vec3f{0, 0, 1});
+    out.source = vertex;
+    return true;
+  }
+
+  bool addNormal(std::uint64_t vertex, Vec3f add) {
+    std::byte* at = record(vertex);
+    if (at == nullptr) return false;
+    float normal[3];
+    std::memcpy(normal, at + kNormalOffset, sizeof normal);
+    normal[0] += add.x, normal[1] += add.y, normal[2] += add.z;
+    std::memcpy(at + kNormalOffset, normal, sizeof normal);
+    dirty_[vertex / kBlockVertices % slots_] = 1;
+    return true;
+  }
+
+  bool flush() {
+    for (std::uint64_t slot = 0; slot < slots_; ++slot)
+      if (dirty_[slot] != 0 && !writeBack(slot)) return false;
+    return true;
+  }
+
+ private:
+  std::byte* record(std::uint64_t vertex) {
+    if (vertex >= vertices_) return nullptr;
+    const std::uint64_t block = vertex / kBlockVertices;
+    const std::uint64_t slot = block % slots_;
+    std::byte* base = data_.data() + slot * kBlockVertices * kVertexBytes;
+    if (tags_[slot] != block) {
+      if (dirty_[slot] != 0 && !writeBack(slot)) return nullptr;
+      const std::uint64_t first = block * kBlockVertices;
+      const auto wanted = static_cast<std::size_t>(blockVertices(block) * kVertexBytes);
+      if (::pread(fd_, base, wanted, static_cast<off_t>(first * kVertexBytes)) !=
+          static_cast<ssize_t>(wanted))
+        return nullptr;
+      tags_[slot] = block;
+    }
+    return base + (vertex % kBlockVertices) * kVertexBytes;
+  }
+
+  std::uint64_t blockVertices(std::uint64_t block) const {
+    return std::min(kBlockVertices, vertices_ - block * kBlockVertices);
+  }
+
+  bool writeBack(std::uint64_t slot) {
+    const std::uint64_t block = tags_[slot];
+    const auto bytes = static_cast<std::size_t>(blockVertices(block) * kVertexBytes);
+    const std::byte* base = data_.data() + slot * kBlockVertices * kVertexBytes;
+    if (::pwrite(fd_, base, bytes, static_cast<off_t>(block * kBlockVertices * kVertexBytes)) !=
+        static_cast<ssize_t>(bytes))
+      return false;
+    dirty_[slot] = 0;
+    return true;
+  }
+
+  int fd_;
+  std::uint64_t vertices_, slots_ = 0;
+  std::vector<std::byte> data_;
+  std::vector<std::uint64_t> tags_;
+  std::vector<std::uint8_t> dirty_;
+};
+
+// The failure of a pipeline over batches, from any of its stages: the one nearest the start of
+// the file is kept (the same message whatever the timing), and every stage stops once one is.
+class PipelineFailure {
+ public:
+  void fail(std::uint64_t position, Status status, tbb::flow_control* control = nullptr) {
+    std::lock_guard lock(mutex_);
+    if (status_.ok() || position < position_) status_ = std::move(status), position_ = position;
+    failed_ = true;
+    if (control) control->stop();
+  }
+  bool failed() const { return failed_; }
+  const Status& status() const { return status_; }
+
+ private:
+  std::mutex mutex_;
+  Status status_;
+  std::uint64_t position_ = std::numeric_limits<std::uint64_t>::max();
+  std::atomic<bool> failed_ = false;
+};
+
+// Where a PLY's objects are, for the chunk size and for segments (§3.3): small objects go into
+// the chunk of their centre whole.
+struct ObjectExtent {
+  Aabbd bounds;
+  std::uint64_t triangles = 0;
+};
+
+// A batch of faces through the cutting pipeline.
+struct FaceBatch {
+  std::uint64_t first = 0;             // the batch's first face in the file
+  std::vector<CutCorner> corners;      // 3 per triangle
+  std::vector<const Aabbd*> segments;  // per triangle, with object ids
+  std::vector<ChunkCell> cells;        // per piece
+  std::vector<CutCorner> pieces;       // 3 per piece
+  std::uint64_t faces = 0, triangles = 0;
+};
+
+class PlyChunking {
+ public:
+  PlyChunking(const std::string& path, const ChunkInputOptions& options)
+      : path_(path), options_(options), vertexPath_(options.workDirectory + "/vertices.bin") {}
+  ~PlyChunking() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  PlyChunking(const PlyChunking&) = delete;
+  PlyChunking& operator=(const PlyChunking&) = delete;
+
+  Status openVertices();
+  Status copyVertices();
+  Status scanFaces();
+  Status cutFaces();
+  ChunkInput finish();
+
+ private:
+  std::shared_ptr<PlyBatch> readVertexBatch(tbb::flow_control& control);
+  void writeVertexBatch(const PlyBatch& batch);
+  Status fetch(const PlyBatch& batch, std::size_t t, std::array<CutCorner, 3>& triangle);
+  PlyReadOptions faceReading() const;
+  Result<ChunkGrid> chunkGrid() const;
+  std::shared_ptr<FaceBatch> readFaceBatch(tbb::flow_control& control);
+  void cutFaceBatch(FaceBatch& work) const;
+  void addFaceBatch(const FaceBatch& work);
+
+  const std::string& path_;
+  const ChunkInputOptions& options_;
+  const std::string vertexPath_;
+  std::optional<PlyReader> vertices_, faces_;
+  PlyHeader header_;
+  int fd_ = -1;
+  ChunkInput input_;
+  std::optional<VertexCache> cache_;
+  std::unordered_map<std::uint32_t, ObjectExtent> objects_;
+  std::optional<ChunkGrid> grid_;
+  // The pipelines' state: the failure, the faces or vertices read so far, a reader's batch.
+  PipelineFailure failure_;
+  std::uint64_t read_ = 0;
+  PlyBatch batch_;
+  std::vector<std::byte> buffer_;
+  std::optional<Progress> progress_;
+};
+
+// Pass 1, set-up: the header (a mesh, or refused) and the vertex work file.
+Status PlyChunking::openVertices() {
+  input_.streamed = true;
+  PlyReadOptions read;
+  read.readFaces = false;
+  read.salvageTruncated = options_.salvageTruncated;
+  Result<PlyReader> vertices = PlyReader::open(path_, read);
+  if (!vertices) return vertices.status();
+  vertices_ = std::move(*vertices);
+  header_ = vertices_->header();
+  if (header_.faceCount == 0) return badInput(path_, "no faces: a tileset needs a mesh");
+  input_.colors = header_.hasColors;
+  fd_ = ::open(vertexPath_.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
+  if (fd_ < 0) return ioErrorFromErrno(vertexPath_, "create");
+  return {};
+}
+
+// Pass 1: vertices to the work file, and the bounds. Two stages over batches, so that parsing
+// the next batch overlaps writing this one (the copy into the page cache is a large part of the
+// pass): read (the reader is sequential), then transform, bound and write in file order.
+Status PlyChunking::copyVertices() {
+  progress_.emplace("tiles: vertices", header_.vertexCount);
+  const auto pipeline = [&] {
+    using Work = std::shared_ptr<PlyBatch>;
+    tbb::parallel_pipeline(
+        3, tbb::make_filter<void, Work>(
+               tbb::filter_mode::serial_in_order,
+               [&](tbb::flow_control& control) { return readVertexBatch(control); }) &
+               tbb::make_filter<Work, void>(tbb::filter_mode::serial_in_order,
+                                            [&](const Work& batch) { writeVertexBatch(*batch); }));
+  };
+  runOn(options_.threads, pipeline);
+  LODFORGE_TRY(failure_.status());
+  progress_->finish();
+  if (input_.bounds.empty()) return badInput(path_, "no vertices");
+  cache_.emplace(fd_, header_.vertexCount, options_.vertexCacheBytes);
+  return {};
+}
+
+std::shared_ptr<PlyBatch> PlyChunking::readVertexBatch(tbb::flow_control& control) {
+  auto batch = std::make_shared<PlyBatch>();
+  while (!failure_.failed()) {
+    Status status = checkCancelled();
+    Result<bool> more = status.ok() ? vertices_->next(*batch) : Result<bool>(status);
+    if (!more) {
+      failure_.fail(read_, more.status(), &control);
+      return nullptr;
+    }
+    if (!*more) break;
+    if (batch->kind == PlyBatch::Kind::kVertices) {
+      read_ += batch->positions.size();
+      return batch;
+    }
+  }
+  control.stop();
+  return nullptr;
+}
+
+void PlyChunking::writeVertexBatch(const PlyBatch& batch) {
+  if (failure_.failed()) return;
+  buffer_.resize(batch.positions.size() * kVertexBytes);
+  for (std::size_t i = 0; i < batch.positions.size(); ++i) {
+    Vec3d p = batch.positions[i];
+    if (options_.transform && !options_.transform(batch.positions[i], p)) {
+      failure_.fail(batch.first + i,
+                    badInput(path_, fmt::format("vertex {}: cannot be transformed to the tileset's "
+                                                "frame (outside the coordinate system?)",
+                                                batch.first + i)));
+      return;
+    }
+    input_.bounds.add(p);
+    const double xyz[3] = {p.x, p.y, p.z};
+    const Rgba8 color = batch.colors.empty() ? Rgba8{255, 255, 255, 255} : batch.colors[i];
+    // The file's normals (turned with the positions), or zero for the normals pass to fill.
+    const Vec3f n = batch.normals.empty()
+                        ? Vec3f{}
+                        : transformNormal(options_, batch.positions[i], p, batch.normals[i]);
+    const float normal[3] = {n.x, n.y, n.z};
+    std::byte* record = buffer_.data() + i * kVertexBytes;
+    std::memcpy(record, xyz, sizeof xyz);
+    std::memcpy(record + sizeof xyz, &color, sizeof color);
+    std::memcpy(record + kNormalOffset, normal, sizeof normal);
+  }
+  if (::write(fd_, buffer_.data(), buffer_.size()) != static_cast<ssize_t>(buffer_.size())) {
+    failure_.fail(batch.first, ioErrorFromErrno(vertexPath_, "write"));
+    return;
+  }
+  progress_->advance(batch.positions.size());
+}
+
+Status PlyChunking::fetch(const PlyBatch& batch, std::size_t t,
+                          std::array<CutCorner, 3>& triangle) {
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (!cache_->fetch(batch.triangles[t + k], triangle[k]))
+      return badInput(path_, fmt::format("face {}: vertex {} is not in the file (or the "
+                                         "vertex work file could not be read)",
+                                         batch.first, batch.triangles[t + k]));
+  }
+  return {};
+}
+
+PlyReadOptions PlyChunking::faceReading() const {
+  PlyReadOptions read;
+  read.salvageTruncated = options_.salvageTruncated;
+  read.readFaces = true;
+  read.readVertices = false;
+  read.batchSize = 1 << 14;  // the batches in flight below stay a few MiB each
+  return read;
+}
+
+// One more pass over the faces when the file has no normals (area-weighted sums of the face
+// normals, over the whole input, so that tiles agree along their borders) or has object ids
+// (the objects are the segments, §3.3: their bounds, memory per object, so that small ones
+// stay whole).
+Status PlyChunking::scanFaces() {
+  if (header_.hasNormals && !header_.hasObjectIds) return {};
+  Result<PlyReader> faces = PlyReader::open(path_, faceReading());
+  if (!faces) return faces.status();
+  Progress progress(header_.hasNormals ? "tiles: objects" : "tiles: normals", header_.faceCount);
+  while (true) {
+    Result<bool> more = faces->next(batch_);
+    if (!more) return more.status();
+    if (!*more) break;
+    if (batch_.kind != PlyBatch::Kind::kFaces) continue;
+    for (std::size_t t = 0; t + 2 < batch_.triangles.size(); t += 3) {
+      std::array<CutCorner, 3> triangle;
+      LODFORGE_TRY(fetch(batch_, t, triangle));
+      if (header_.hasObjectIds) {
+        ObjectExtent& object = objects_[batch_.triangleObjects[t / 3]];
+        for (const CutCorner& corner : triangle) object.bounds.add(corner.position);
+        ++object.triangles;
+      }
+      if (!header_.hasNormals) {
+        const Vec3f face = toFloat(cross(triangle[1].position - triangle[0].position,
+                                         triangle[2].position - triangle[0].position));
+        for (std::size_t k = 0; k < 3; ++k) {
+          if (!cache_->addNormal(batch_.triangles[t + k], face))
+            return ioErrorFromErrno(vertexPath_, "update");
+        }
+      }
+    }
+    progress.advance(batch_.count);
+    LODFORGE_TRY(checkCancelled());
+  }
+  progress.finish();
+  return {};
+}
+
+// The chunk grid over the bounds, its size fitted to where the objects are when there are some
+// (small ones stay whole anyway).
+Result<ChunkGrid> PlyChunking::chunkGrid() const {
+  Result<double> fitted = chunkSizeFor(options_, input_.bounds, header_.faceCount);
+  if (!fitted) return fitted.status();
+  double size = *fitted;
+  if (options_.chunkSize == 0 && header_.hasObjectIds) {
+    size = fitChunkSize(input_.bounds, size, leafTriangles(options_, header_.faceCount),
+                        [&](const auto& add) {
+                          for (const auto& [id, object] : objects_)
+                            add(object.bounds.center(), static_cast<double>(object.triangles));
+                        });
+  }
+  return ChunkGrid::over(input_.bounds, size);
+}
+
+// Pass 2: faces, corners from the cache, into the chunk files (cut, or whole by segment). Three
+// stages over batches of faces, so reading, cutting and writing overlap: read and fetch corners
+// (the reader and the cache are sequential), cut (in parallel), add the pieces in file order
+// (the chunk files come out the same as from one thread).
+Status PlyChunking::cutFaces() {
+  Result<ChunkGrid> grid = chunkGrid();
+  if (!grid) return grid.status();
+  grid_ = *grid;
+  input_.chunks = std::make_unique<ChunkWriter>(*grid_, options_.workDirectory + "/chunks",
+                                                options_.chunkBufferBytes, options_.keepInMemory);
+  Result<PlyReader> faces = PlyReader::open(path_, faceReading());
+  if (!faces) return faces.status();
+  faces_ = std::move(*faces);
+  read_ = 0;
+  progress_.emplace("tiles: chunks", header_.faceCount);
+  // A few batches in flight: enough to keep every thread busy, little memory.
+  const std::size_t tokens = static_cast<std::size_t>(std::max(2, options_.threads + 1));
+  const auto pipeline = [&] {
+    using Work = std::shared_ptr<FaceBatch>;
+    tbb::parallel_pipeline(
+        tokens, tbb::make_filter<void, Work>(
+                    tbb::filter_mode::serial_in_order,
+                    [&](tbb::flow_control& control) { return readFaceBatch(control); }) &
+                    tbb::make_filter<Work, Work>(tbb::filter_mode::parallel,
+                                                 [&](Work work) {
+                                                   cutFaceBatch(*work);
+                                                   return work;
+                                                 }) &
+                    tbb::make_filter<Work, void>(tbb::filter_mode::serial_in_order,
+                                                 [&](const Work& work) { addFaceBatch(*work); }));
+  };
+  runOn(options_.threads, pipeline);
+  LODFORGE_TRY(failure_.status());
+  LODFORGE_TRY(input_.chunks->flush());
+  progress_->finish();
+  return {};
+}
+
+std::shared_ptr<FaceBatch> PlyChunking::readFaceBatch(tbb::flow_control& control) {
+  while (true) {
+    if (failure_.failed()) return control.stop(), nullptr;
+    Status status = checkCancelled();
+    Result<bool> more = status.ok() ? faces_->next(batch_) : Result<bool>(status);
+    if (!more) return failure_.fail(read_, more.status(), &control), nullptr;
+    if (!*more) return control.stop(), nullptr;
+    if (batch_.kind != PlyBatch::Kind::kFaces) continue;
+    read_ += batch_.count;
+    auto next = std::make_shared<FaceBatch>();
+    next->first = batch_.first;
+    next->faces = batch_.count;
+    next->triangles = batch_.triangles.size() / 3;
+    next->corners.resize(batch_.triangles.size());
+    next->pieces.reserve(batch_.triangles.size() + batch_.triangles.size() / 8);
+    next->cells.reserve(next->triangles + next->triangles / 8);
+    for (std::size_t t = 0; t + 2 < batch_.triangles.size(); t += 3) {
+      std::array<CutCorner, 3> triangle;
+      if (status = fetch(batch_, t, triangle); !status.ok())
+        return failure_.fail(batch_.first, std::move(status), &control), nullptr;
+      std::copy(triangle.begin(), triangle.end(), next->corners.data() + t);
+      if (header_.hasObjectIds) {
+        const auto found = objects_.find(batch_.triangleObjects[t / 3]);
+        next->segments.push_back(found == objects_.end() ? nullptr : &found->second.bounds);
+      }
+    }
+    return next;
+  }
+}
+
+void PlyChunking::cutFaceBatch(FaceBatch& work) const {
+  std::array<CutCorner, 3> triangle;
+  for (std::size_t t = 0; t < work.corners.size(); t += 3) {
+    std::copy_n(work.corners.data() + t, 3, triangle.begin());
+    cutSegmentTriangle(*grid_, work.segments.empty() ? nullptr : work.segments[t / 3], triangle,
+                       work.cells, work.pieces);
+  }
+  work.corners = {};
+}
+
+void PlyChunking::addFaceBatch(const FaceBatch& work) {
+  if (failure_.failed()) return;
+  if (Status status = input_.chunks->addPieces(work.cells, work.pieces); !status.ok())
+    return failure_.fail(work.first, std::move(status));
+  input_.inputTriangles += work.triangles;
+  progress_->advance(work.faces);
+}
+
+// The vertex work file goes; the input says where a salvaged file was cut short.
+ChunkInput PlyChunking::finish() {
+  std::error_code ignored;
+  std::filesystem::remove(vertexPath_, ignored);
+  input_.truncation = faces_->truncation() ? faces_->truncation() : vertices_->truncation();
+  return std::move(input_);
+}
+
+}  // namespace
+
+Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& options) {
+  PlyChunking chunking(path, options);
+  LODFORGE_TRY(chunking.openVertices());
+  LODFORGE_TRY(chunking.copyVertices());
+  LODFORGE_TRY(chunking.scanFaces());
+  LODFORGE_TRY(chunking.cutFaces());
+  return chunking.finish();
+}
+
+}  // namespace lodforge

@@ -46,166 +46,187 @@ void warnIfNotPlaced(const Global& global, bool placed) {
              "Earth's centre); place it with --origin LON,LAT,HEIGHT or --crs EPSG:N\n");
 }
 
+// What `lodforge tiles` takes on the command line.
+struct TilesCommand {
+  std::string input, output;
+  double chunkSize = 0;
+  int levels = 0;
+  double reduction = 0.2;
+  double maxNormalDeviation = 30;
+  std::string memory = "moderate";
+  bool resume = false;
+  std::string origin, crs;
+  std::string compress = "none";
+  bool noQuantization = false;
+  std::uint64_t blockSize = 50'000;
+  std::uint64_t tilePoints = 50'000;
+  bool salvage = false;
+};
+
+void addTilesOptions(CLI::App& sub, TilesCommand& options) {
+  sub.add_option("INPUT", options.input,
+                 "A .ply .obj .stl .gltf or .glb mesh or assembly, an .lfp package, or a point "
+                 "cloud (.las .xyz .txt .csv .pts, or a PLY without faces)")
+      ->required();
+  sub.add_option("-o,--output", options.output, "The tileset directory to write")->required();
+  sub.add_option("--chunk-size", options.chunkSize,
+                 "Edge of a leaf chunk in model units (default: about 64K triangles per leaf)")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--levels", options.levels,
+                 "Levels above the leaves; leaves are made small enough for them (default: "
+                 "up to one root)")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("--reduction", options.reduction,
+                 "Share of its children's triangles a parent tile keeps (default 0.2)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub.add_option("--max-normal-deviation", options.maxNormalDeviation,
+                 "Largest angle in degrees a simplification step may turn a face (default 30)")
+      ->check(CLI::Range(0.0, 90.0));
+  sub.add_option("--memory", options.memory,
+                 "minimal (one thread), moderate (--threads, default a quarter of the cores) or "
+                 "unbounded (every core, chunks kept in memory); --memory-limit caps the whole "
+                 "build")
+      ->check(CLI::IsMember({"minimal", "moderate", "unbounded"}));
+  sub.add_option("--origin", options.origin,
+                 "Place the model's (0,0,0) at LON,LAT,HEIGHT (degrees, metres) with x east, y "
+                 "north, z up");
+  sub.add_option("--crs", options.crs,
+                 "The input's coordinate system (e.g. EPSG:32633), placed on Earth through PROJ");
+  sub.add_option("--compress", options.compress,
+                 "none, or meshopt: EXT_meshopt_compression (smaller tiles; CesiumJS and "
+                 "three.js decode it)")
+      ->check(CLI::IsMember({"none", "meshopt"}));
+  sub.add_flag("--no-quantization", options.noQuantization,
+               "Float positions and normals everywhere instead of KHR_mesh_quantization (16-bit "
+               "positions, 8-bit normals) in the tiles where it is invisible");
+  addCountOption(sub, "--block-size", options.blockSize,
+                 "Point clouds: most points per leaf tile (a block of the partition; default 50K)");
+  addCountOption(sub, "--tile-points", options.tilePoints,
+                 "Point clouds: about this many points in a tile above the blocks (default 50K)");
+  sub.add_flag("--salvage", options.salvage,
+               "Read a PLY cut short up to its last whole element (with a warning)");
+  sub.add_flag("--resume", options.resume,
+               "Continue an interrupted run from OUTPUT.work (same input and options)");
+}
+
+// The command line as the mesh pipeline's options.
+Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& options) {
+  TilesOptions tiles;
+  tiles.input.chunkSize = options.chunkSize;
+  tiles.input.salvageTruncated = options.salvage;
+  tiles.octree.levels = options.levels;
+  tiles.octree.reduction = options.reduction;
+  tiles.octree.maxNormalDeviationDegrees = options.maxNormalDeviation;
+  tiles.memory = options.memory == "minimal"     ? TilesMemory::kMinimal
+                 : options.memory == "unbounded" ? TilesMemory::kUnbounded
+                                                 : TilesMemory::kModerate;
+  tiles.threads = static_cast<int>(global.threads);
+  tiles.memoryLimit = global.memoryLimit;
+  tiles.resume = options.resume;
+  tiles.crs = options.crs;
+  tiles.meshoptCompression = options.compress == "meshopt";
+  tiles.quantize = !options.noQuantization;
+  if (!options.origin.empty()) {
+    if (!options.crs.empty())
+      return Error{ErrorKind::kUsage,
+                   "--origin and --crs: give one (a CRS already places the model)"};
+    Result<Geodetic> origin = parseOrigin(options.origin);
+    if (!origin) return origin.status();
+    tiles.origin = *origin;
+  }
+  return tiles;
+}
+
+Status runPointTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
+  if (options.levels > 0 || options.chunkSize > 0 || options.resume)
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: a point cloud; --levels, --chunk-size and --resume are for "
+                             "meshes (a point tileset's depth follows --block-size)",
+                             options.input)};
+  PointTilesOptions points;
+  points.blockSize = std::max<std::uint64_t>(1, options.blockSize);
+  points.tilePoints = std::max<std::uint64_t>(1, options.tilePoints);
+  points.memoryLimit = global.memoryLimit;
+  points.crs = options.crs;
+  points.origin = tiles.origin;
+  points.quantize = !options.noQuantization;
+  points.meshoptCompression = tiles.meshoptCompression;
+  points.salvageTruncated = options.salvage;
+  Result<PointTilesStats> stats = writePointTiles(options.input, options.output, points);
+  if (!stats) return stats.status();
+  warnIfNotPlaced(global, !stats->crs.empty() || points.origin.has_value());
+  say(global,
+      fmt::format("wrote {}: a point tileset of {} points in {} tiles ({} blocks, depth {}), "
+                  "{} in {:.1f} s ({} points/s){}",
+                  options.output, formatCount(stats->points), formatCount(stats->tiles),
+                  formatCount(stats->blocks), stats->depth, formatBytes(stats->outputBytes),
+                  stats->seconds,
+                  formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->points) /
+                                                         std::max(stats->seconds, 1e-9))),
+                  stats->crs.empty() ? "" : "; placed on Earth from its coordinate system"));
+  return {};
+}
+
+void reportMeshTiles(const Global& global, const TilesCommand& options, const TilesStats& stats) {
+  say(global,
+      fmt::format("wrote {}: {} tiles ({} leaves, {} levels above them), {} in {:.1f} s ({} "
+                  "input triangles/s)",
+                  options.output, formatCount(stats.tiles), formatCount(stats.leaves), stats.levels,
+                  formatBytes(stats.outputBytes), stats.seconds,
+                  formatCount(static_cast<std::uint64_t>(static_cast<double>(stats.inputTriangles) /
+                                                         std::max(stats.seconds, 1e-9)))));
+  detail(global,
+         fmt::format("{} ({:.1f} s to chunks); {} threads; chunk size {:.4g}; {} triangles "
+                     "after cutting; parents kept {} border vertices of {} ({:.1f} %, at most {} "
+                     "in one tile) and left out {} small segments; peak memory {}",
+                     stats.resumed    ? "chunks resumed"
+                     : stats.streamed ? "streamed"
+                                      : "loaded whole",
+                     stats.chunkSeconds, stats.threads, stats.chunkSize,
+                     formatCount(stats.leafTriangles), formatCount(stats.lockedVertices),
+                     formatCount(stats.vertices),
+                     100.0 * static_cast<double>(stats.lockedVertices) /
+                         static_cast<double>(std::max<std::uint64_t>(1, stats.vertices)),
+                     formatCount(stats.maxLockedVertices), formatCount(stats.droppedSegments),
+                     formatBytes(peakRssBytes())));
+}
+
+Status runMeshTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
+  Result<TilesStats> stats = writeTiles(options.input, options.output, tiles);
+  if (!stats) {
+    std::error_code ignored;
+    const std::string work = tilesWorkDirectory(options.output);
+    if (std::filesystem::exists(workStatePath(work), ignored))
+      fmt::print(stderr,
+                 "lodforge: the finished chunks and tiles are kept in {}: run again with "
+                 "--resume to continue, or delete it\n",
+                 work);
+    return stats.status();
+  }
+  if (stats->truncation)
+    fmt::print(stderr, "lodforge: warning: {}; built from what came before\n", *stats->truncation);
+  warnIfNotPlaced(global, tiles.origin.has_value() || !tiles.crs.empty());
+  reportMeshTiles(global, options, *stats);
+  return {};
+}
+
+Status runTiles(const Global& global, const TilesCommand& options) {
+  LODFORGE_TRY(checkTilesInput(options.input));
+  Result<TilesOptions> tiles = meshTilesOptions(global, options);
+  if (!tiles) return tiles.status();
+  if (isPointInput(options.input)) return runPointTiles(global, options, *tiles);
+  return runMeshTiles(global, options, *tiles);
+}
+
 }  // namespace
 
 void addTiles(CLI::App& app, const Global& global, Run& run) {
-  struct Options {
-    std::string input, output;
-    double chunkSize = 0;
-    int levels = 0;
-    double reduction = 0.2;
-    double maxNormalDeviation = 30;
-    std::string memory = "moderate";
-    bool resume = false;
-    std::string origin, crs;
-    std::string compress = "none";
-    bool noQuantization = false;
-    std::uint64_t blockSize = 50'000;
-    std::uint64_t tilePoints = 50'000;
-    bool salvage = false;
-  };
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<TilesCommand>();
   CLI::App* sub =
       app.add_subcommand("tiles", "Write a 3D Tiles 1.1 tileset of a mesh or an assembly");
-  sub->add_option(
-         "INPUT", options->input,
-         "A .ply .obj .stl .gltf or .glb mesh or assembly, an .lfp package, or a point cloud "
-         "(.las .xyz .txt .csv .pts, or a PLY without faces)")
-      ->required();
-  sub->add_option("-o,--output", options->output, "The tileset directory to write")->required();
-  sub->add_option("--chunk-size", options->chunkSize,
-                  "Edge of a leaf chunk in model units (default: about 64K triangles per leaf)")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--levels", options->levels,
-                  "Levels above the leaves; leaves are made small enough for them (default: "
-                  "up to one root)")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--reduction", options->reduction,
-                  "Share of its children's triangles a parent tile keeps (default 0.2)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--max-normal-deviation", options->maxNormalDeviation,
-                  "Largest angle in degrees a simplification step may turn a face (default 30)")
-      ->check(CLI::Range(0.0, 90.0));
-  sub->add_option("--memory", options->memory,
-                  "minimal (one thread), moderate (--threads, default a quarter of the cores) or "
-                  "unbounded (every core, chunks kept in memory); --memory-limit caps the whole "
-                  "build")
-      ->check(CLI::IsMember({"minimal", "moderate", "unbounded"}));
-  sub->add_option("--origin", options->origin,
-                  "Place the model's (0,0,0) at LON,LAT,HEIGHT (degrees, metres) with x east, y "
-                  "north, z up");
-  sub->add_option("--crs", options->crs,
-                  "The input's coordinate system (e.g. EPSG:32633), placed on Earth through PROJ");
-  sub->add_option("--compress", options->compress,
-                  "none, or meshopt: EXT_meshopt_compression (smaller tiles; CesiumJS and "
-                  "three.js decode it)")
-      ->check(CLI::IsMember({"none", "meshopt"}));
-  sub->add_flag("--no-quantization", options->noQuantization,
-                "Float positions and normals everywhere instead of KHR_mesh_quantization (16-bit "
-                "positions, 8-bit normals) in the tiles where it is invisible");
-  addCountOption(*sub, "--block-size", options->blockSize,
-                 "Point clouds: most points per leaf tile (a block of the partition; default 50K)");
-  addCountOption(*sub, "--tile-points", options->tilePoints,
-                 "Point clouds: about this many points in a tile above the blocks (default 50K)");
-  sub->add_flag("--salvage", options->salvage,
-                "Read a PLY cut short up to its last whole element (with a warning)");
-  sub->add_flag("--resume", options->resume,
-                "Continue an interrupted run from OUTPUT.work (same input and options)");
+  addTilesOptions(*sub, *options);
   sub->callback([&global, &run, options] {
-    run = [&global, options]() -> Status {
-      TilesOptions tiles;
-      LODFORGE_TRY(checkTilesInput(options->input));
-      tiles.input.chunkSize = options->chunkSize;
-      tiles.input.salvageTruncated = options->salvage;
-      tiles.octree.levels = options->levels;
-      tiles.octree.reduction = options->reduction;
-      tiles.octree.maxNormalDeviationDegrees = options->maxNormalDeviation;
-      tiles.memory = options->memory == "minimal"     ? TilesMemory::kMinimal
-                     : options->memory == "unbounded" ? TilesMemory::kUnbounded
-                                                      : TilesMemory::kModerate;
-      tiles.threads = static_cast<int>(global.threads);
-      tiles.memoryLimit = global.memoryLimit;
-      tiles.resume = options->resume;
-      tiles.crs = options->crs;
-      tiles.meshoptCompression = options->compress == "meshopt";
-      tiles.quantize = !options->noQuantization;
-      if (!options->origin.empty()) {
-        if (!options->crs.empty())
-          return Error{ErrorKind::kUsage,
-                       "--origin and --crs: give one (a CRS already places the model)"};
-        Result<Geodetic> origin = parseOrigin(options->origin);
-        if (!origin) return origin.status();
-        tiles.origin = *origin;
-      }
-      if (isPointInput(options->input)) {
-        if (options->levels > 0 || options->chunkSize > 0 || options->resume)
-          return Error{ErrorKind::kUsage,
-                       fmt::format("{}: a point cloud; --levels, --chunk-size and --resume are for "
-                                   "meshes (a point tileset's depth follows --block-size)",
-                                   options->input)};
-        PointTilesOptions points;
-        points.blockSize = std::max<std::uint64_t>(1, options->blockSize);
-        points.tilePoints = std::max<std::uint64_t>(1, options->tilePoints);
-        points.memoryLimit = global.memoryLimit;
-        points.crs = options->crs;
-        points.origin = tiles.origin;
-        points.quantize = !options->noQuantization;
-        points.meshoptCompression = tiles.meshoptCompression;
-        points.salvageTruncated = options->salvage;
-        Result<PointTilesStats> stats = writePointTiles(options->input, options->output, points);
-        if (!stats) return stats.status();
-        warnIfNotPlaced(global, !stats->crs.empty() || points.origin.has_value());
-        say(global,
-            fmt::format("wrote {}: a point tileset of {} points in {} tiles ({} blocks, depth {}), "
-                        "{} in {:.1f} s ({} points/s){}",
-                        options->output, formatCount(stats->points), formatCount(stats->tiles),
-                        formatCount(stats->blocks), stats->depth, formatBytes(stats->outputBytes),
-                        stats->seconds,
-                        formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->points) /
-                                                               std::max(stats->seconds, 1e-9))),
-                        stats->crs.empty() ? "" : "; placed on Earth from its coordinate system"));
-        return {};
-      }
-      Result<TilesStats> stats = writeTiles(options->input, options->output, tiles);
-      if (!stats) {
-        std::error_code ignored;
-        const std::string work = tilesWorkDirectory(options->output);
-        if (std::filesystem::exists(workStatePath(work), ignored))
-          fmt::print(stderr,
-                     "lodforge: the finished chunks and tiles are kept in {}: run again with "
-                     "--resume to continue, or delete it\n",
-                     work);
-        return stats.status();
-      }
-      if (stats->truncation)
-        fmt::print(stderr, "lodforge: warning: {}; built from what came before\n",
-                   *stats->truncation);
-      warnIfNotPlaced(global, tiles.origin.has_value() || !tiles.crs.empty());
-      say(global,
-          fmt::format(
-              "wrote {}: {} tiles ({} leaves, {} levels above them), {} in {:.1f} s ({} "
-              "input triangles/s)",
-              options->output, formatCount(stats->tiles), formatCount(stats->leaves), stats->levels,
-              formatBytes(stats->outputBytes), stats->seconds,
-              formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->inputTriangles) /
-                                                     std::max(stats->seconds, 1e-9)))));
-      detail(global,
-             fmt::format("{} ({:.1f} s to chunks); {} threads; chunk size {:.4g}; {} triangles "
-                         "after cutting; parents "
-                         "kept {} border vertices of {} ({:.1f} %, at most {} in one tile) and "
-                         "left out {} small segments; peak memory {}",
-                         stats->resumed    ? "chunks resumed"
-                         : stats->streamed ? "streamed"
-                                           : "loaded whole",
-                         stats->chunkSeconds, stats->threads, stats->chunkSize,
-                         formatCount(stats->leafTriangles), formatCount(stats->lockedVertices),
-                         formatCount(stats->vertices),
-                         100.0 * static_cast<double>(stats->lockedVertices) /
-                             static_cast<double>(std::max<std::uint64_t>(1, stats->vertices)),
-                         formatCount(stats->maxLockedVertices), formatCount(stats->droppedSegments),
-                         formatBytes(peakRssBytes())));
-      return {};
-    };
+    run = [&global, options] { return runTiles(global, *options); };
   });
 }
 

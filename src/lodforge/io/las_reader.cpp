@@ -70,6 +70,8 @@ std::uint16_t lasRecordSize(int pointFormat) {
   return pointFormat >= 0 && pointFormat <= 10 ? kSizes[pointFormat] : 0;
 }
 
+struct CrsRecords;
+
 struct LasReader::State {
   std::string path;                   // to open a second reader for the EVLRs and the probe
   std::span<const std::byte> memory;  // or the bytes of an in-memory file
@@ -79,6 +81,16 @@ struct LasReader::State {
   std::uint64_t nextPoint = 0;
   std::size_t rgb = 0;
   std::vector<std::byte> records;
+  std::uint8_t formatByte = 0;   // as stored (LASzip sets its top bits)
+  std::uint64_t evlrOffset = 0;  // LAS 1.4's extended records
+  std::uint32_t evlrCount = 0;
+
+  Status readHeader(std::vector<std::byte>& bytes);
+  Status readScalesAndBounds(std::span<const std::byte> bytes);
+  Status checkPointData() const;
+  Status readRecords(CrsRecords& crs);
+  Status readExtendedRecords(CrsRecords& crs);
+  Status probeColorDepth();
 
   Result<ByteSource> reopen() const {
     if (!path.empty()) return ByteSource::openFile(path);
@@ -117,96 +129,10 @@ Result<LasReader> LasReader::fromMemory(std::span<const std::byte> bytes, std::s
   return start(std::move(state));
 }
 
-Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
-  ByteSource& source = *state->source;
-  LasHeader& h = state->header;
-  const std::uint64_t fileSize = source.size();
-  std::vector<std::byte> bytes(kHeader12);
-  if (!source.read(bytes.data(), kHeader12))
-    return state->fail(
-        0, fmt::format("{} bytes are too few for a LAS header ({} bytes)", fileSize, kHeader12));
-  if (std::memcmp(bytes.data(), "LASF", 4) != 0)
-    return state->fail(0, "not a LAS file: it does not start with \"LASF\"");
-  h.versionMajor = static_cast<int>(bytes[24]);
-  h.versionMinor = static_cast<int>(bytes[25]);
-  if (h.versionMajor != 1 || h.versionMinor > 4)
-    return state->fail(24, fmt::format("LAS version {}.{} is not supported (1.0 to 1.4 are)",
-                                       h.versionMajor, h.versionMinor));
-  h.systemIdentifier = fixedString(bytes.data() + 26, 32);
-  h.generatingSoftware = fixedString(bytes.data() + 58, 32);
-  h.headerSize = load<std::uint16_t>(bytes.data() + 94);
-  h.pointOffset = load<std::uint32_t>(bytes.data() + 96);
-  h.vlrCount = load<std::uint32_t>(bytes.data() + 100);
-  const auto formatByte = static_cast<std::uint8_t>(bytes[104]);
-  h.recordLength = load<std::uint16_t>(bytes.data() + 105);
-  h.pointCount = load<std::uint32_t>(bytes.data() + 107);
-  const std::size_t wanted = h.versionMinor >= 4   ? kHeader14
-                             : h.versionMinor == 3 ? kHeader13
-                                                   : kHeader12;
-  if (h.headerSize < wanted)
-    return state->fail(94, fmt::format("header size {} is smaller than LAS {}.{}'s {} bytes",
-                                       h.headerSize, h.versionMajor, h.versionMinor, wanted));
-  if (h.headerSize > fileSize)
-    return state->fail(94, fmt::format("header size {} runs past the end of the file ({} bytes)",
-                                       h.headerSize, fileSize));
-  bytes.resize(h.headerSize);
-  if (!source.read(bytes.data() + kHeader12, h.headerSize - kHeader12))
-    return state->fail(kHeader12, "the file ends inside the header");
-  // LASzip marks compressed files by setting the format's top bits.
-  if ((formatByte & 0xC0) != 0)
-    return state->fail(
-        104, fmt::format("LAZ (compressed) point data (point format byte {:#x}) is not "
-                         "supported; decompress it first, e.g. `pdal translate in.laz "
-                         "out.las` (Debian package pdal) or `laszip -i in.laz -o out.las`",
-                         formatByte));
-  h.pointFormat = formatByte;
-  if (lasRecordSize(h.pointFormat) == 0)
-    return state->fail(
-        104, fmt::format("point format {} is not a LAS format (0 to 10 are)", h.pointFormat));
-  if (h.recordLength < lasRecordSize(h.pointFormat))
-    return state->fail(105,
-                       fmt::format("point records of {} bytes are shorter than format {}'s {}",
-                                   h.recordLength, h.pointFormat, lasRecordSize(h.pointFormat)));
-  std::uint64_t evlrOffset = 0;
-  std::uint32_t evlrCount = 0;
-  if (h.versionMinor >= 4) {
-    evlrOffset = load<std::uint64_t>(bytes.data() + 235);
-    evlrCount = load<std::uint32_t>(bytes.data() + 243);
-    const auto count64 = load<std::uint64_t>(bytes.data() + 247);
-    if (count64 != 0) h.pointCount = count64;
-  }
-  for (int k = 0; k < 3; ++k) {
-    h.scale[k] = load<double>(bytes.data() + 131 + 8 * static_cast<std::size_t>(k));
-    h.offset[k] = load<double>(bytes.data() + 155 + 8 * static_cast<std::size_t>(k));
-    h.bounds.max[k] = load<double>(bytes.data() + 179 + 16 * static_cast<std::size_t>(k));
-    h.bounds.min[k] = load<double>(bytes.data() + 187 + 16 * static_cast<std::size_t>(k));
-    if (!std::isfinite(h.scale[k]) || h.scale[k] == 0)
-      return state->fail(
-          131 + 8 * static_cast<std::uint64_t>(k),
-          fmt::format("scale factor {} is not a finite non-zero number", h.scale[k]));
-    if (!std::isfinite(h.offset[k]))
-      return state->fail(155 + 8 * static_cast<std::uint64_t>(k), "offset is not finite");
-    // Every stored integer must give a finite coordinate.
-    if (!std::isfinite(std::abs(h.scale[k]) * 2147483648.0 + std::abs(h.offset[k])))
-      return state->fail(131 + 8 * static_cast<std::uint64_t>(k),
-                         fmt::format("scale factor {} and offset {} overflow a coordinate",
-                                     h.scale[k], h.offset[k]));
-    if (!std::isfinite(h.bounds.min[k]) || !std::isfinite(h.bounds.max[k]))
-      return state->fail(179 + 16 * static_cast<std::uint64_t>(k), "bounds are not finite");
-  }
-  if (h.pointOffset < h.headerSize)
-    return state->fail(96, fmt::format("point data offset {} lies inside the {}-byte header",
-                                       h.pointOffset, h.headerSize));
-  const std::uint64_t pointBytes = h.pointCount * h.recordLength;
-  if (h.pointCount > (fileSize / h.recordLength) || h.pointOffset + pointBytes > fileSize)
-    return state->fail(107, fmt::format("{} points of {} bytes from byte {} run past the end of "
-                                        "the file ({} bytes)",
-                                        h.pointCount, h.recordLength, h.pointOffset, fileSize));
-
-  // Variable length records, between the header and the points.
+// The CRS records (LASF_Projection) met among the VLRs and EVLRs: WKT wins over GeoTIFF keys.
+struct CrsRecords {
   std::string wkt, epsg;
-  const auto takeRecord = [&](std::uint16_t id, std::string_view user,
-                              std::span<const std::byte> data) {
+  void take(std::uint16_t id, std::string_view user, std::span<const std::byte> data) {
     if (user != "LASF_Projection") return;
     if (id == kWktRecord) {
       wkt = fixedString(data.data(), data.size());
@@ -215,77 +141,204 @@ Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
       if (!keys.empty()) std::memcpy(keys.data(), data.data(), 2 * keys.size());
       epsg = epsgFromGeoKeys(keys);
     }
-  };
+  }
+  std::string crs() const { return !wkt.empty() ? wkt : epsg; }
+};
+
+// The public header block: version, sizes, counts and the point format (LAZ refused).
+Status LasReader::State::readHeader(std::vector<std::byte>& bytes) {
+  ByteSource& in = *source;
+  LasHeader& h = header;
+  const std::uint64_t fileSize = in.size();
+  bytes.resize(kHeader12);
+  if (!in.read(bytes.data(), kHeader12))
+    return fail(
+        0, fmt::format("{} bytes are too few for a LAS header ({} bytes)", fileSize, kHeader12));
+  if (std::memcmp(bytes.data(), "LASF", 4) != 0)
+    return fail(0, "not a LAS file: it does not start with \"LASF\"");
+  h.versionMajor = static_cast<int>(bytes[24]);
+  h.versionMinor = static_cast<int>(bytes[25]);
+  if (h.versionMajor != 1 || h.versionMinor > 4)
+    return fail(24, fmt::format("LAS version {}.{} is not supported (1.0 to 1.4 are)",
+                                h.versionMajor, h.versionMinor));
+  h.systemIdentifier = fixedString(bytes.data() + 26, 32);
+  h.generatingSoftware = fixedString(bytes.data() + 58, 32);
+  h.headerSize = load<std::uint16_t>(bytes.data() + 94);
+  h.pointOffset = load<std::uint32_t>(bytes.data() + 96);
+  h.vlrCount = load<std::uint32_t>(bytes.data() + 100);
+  formatByte = static_cast<std::uint8_t>(bytes[104]);
+  h.recordLength = load<std::uint16_t>(bytes.data() + 105);
+  h.pointCount = load<std::uint32_t>(bytes.data() + 107);
+  const std::size_t wanted = h.versionMinor >= 4   ? kHeader14
+                             : h.versionMinor == 3 ? kHeader13
+                                                   : kHeader12;
+  if (h.headerSize < wanted)
+    return fail(94, fmt::format("header size {} is smaller than LAS {}.{}'s {} bytes", h.headerSize,
+                                h.versionMajor, h.versionMinor, wanted));
+  if (h.headerSize > fileSize)
+    return fail(94, fmt::format("header size {} runs past the end of the file ({} bytes)",
+                                h.headerSize, fileSize));
+  bytes.resize(h.headerSize);
+  if (!in.read(bytes.data() + kHeader12, h.headerSize - kHeader12))
+    return fail(kHeader12, "the file ends inside the header");
+  // LASzip marks compressed files by setting the format's top bits.
+  if ((formatByte & 0xC0) != 0)
+    return fail(104, fmt::format("LAZ (compressed) point data (point format byte {:#x}) is not "
+                                 "supported; decompress it first, e.g. `pdal translate in.laz "
+                                 "out.las` (Debian package pdal) or `laszip -i in.laz -o out.las`",
+                                 formatByte));
+  h.pointFormat = formatByte;
+  if (lasRecordSize(h.pointFormat) == 0)
+    return fail(104,
+                fmt::format("point format {} is not a LAS format (0 to 10 are)", h.pointFormat));
+  if (h.recordLength < lasRecordSize(h.pointFormat))
+    return fail(105, fmt::format("point records of {} bytes are shorter than format {}'s {}",
+                                 h.recordLength, h.pointFormat, lasRecordSize(h.pointFormat)));
+  if (h.versionMinor >= 4) {
+    evlrOffset = load<std::uint64_t>(bytes.data() + 235);
+    evlrCount = load<std::uint32_t>(bytes.data() + 243);
+    const auto count64 = load<std::uint64_t>(bytes.data() + 247);
+    if (count64 != 0) h.pointCount = count64;
+  }
+  return {};
+}
+
+// Scale, offset and bounds per axis: finite, and no stored integer overflows a coordinate.
+Status LasReader::State::readScalesAndBounds(std::span<const std::byte> bytes) {
+  LasHeader& h = header;
+  for (int k = 0; k < 3; ++k) {
+    h.scale[k] = load<double>(bytes.data() + 131 + 8 * static_cast<std::size_t>(k));
+    h.offset[k] = load<double>(bytes.data() + 155 + 8 * static_cast<std::size_t>(k));
+    h.bounds.max[k] = load<double>(bytes.data() + 179 + 16 * static_cast<std::size_t>(k));
+    h.bounds.min[k] = load<double>(bytes.data() + 187 + 16 * static_cast<std::size_t>(k));
+    if (!std::isfinite(h.scale[k]) || h.scale[k] == 0)
+      return fail(131 + 8 * static_cast<std::uint64_t>(k),
+                  fmt::format("scale factor {} is not a finite non-zero number", h.scale[k]));
+    if (!std::isfinite(h.offset[k]))
+      return fail(155 + 8 * static_cast<std::uint64_t>(k), "offset is not finite");
+    // Every stored integer must give a finite coordinate.
+    if (!std::isfinite(std::abs(h.scale[k]) * 2147483648.0 + std::abs(h.offset[k])))
+      return fail(131 + 8 * static_cast<std::uint64_t>(k),
+                  fmt::format("scale factor {} and offset {} overflow a coordinate", h.scale[k],
+                              h.offset[k]));
+    if (!std::isfinite(h.bounds.min[k]) || !std::isfinite(h.bounds.max[k]))
+      return fail(179 + 16 * static_cast<std::uint64_t>(k), "bounds are not finite");
+  }
+  return {};
+}
+
+// The point records lie inside the file, after the header.
+Status LasReader::State::checkPointData() const {
+  const LasHeader& h = header;
+  const std::uint64_t fileSize = source->size();
+  const std::uint64_t pointBytes = h.pointCount * h.recordLength;
+  if (h.pointOffset < h.headerSize)
+    return fail(96, fmt::format("point data offset {} lies inside the {}-byte header",
+                                h.pointOffset, h.headerSize));
+  if (h.pointCount > (fileSize / h.recordLength) || h.pointOffset + pointBytes > fileSize)
+    return fail(107, fmt::format("{} points of {} bytes from byte {} run past the end of "
+                                 "the file ({} bytes)",
+                                 h.pointCount, h.recordLength, h.pointOffset, fileSize));
+
+  return {};
+}
+
+// Variable length records, between the header and the points.
+Status LasReader::State::readRecords(CrsRecords& crs) {
+  ByteSource& in = *source;
+  const LasHeader& h = header;
   std::vector<std::byte> record;
   for (std::uint32_t v = 0; v < h.vlrCount; ++v) {
-    const std::uint64_t at = source.offset();
+    const std::uint64_t at = in.offset();
     std::byte head[kVlrHeader];
-    if (at + kVlrHeader > h.pointOffset || !source.read(head, kVlrHeader))
-      return state->fail(at, fmt::format("variable length record {} of {} runs past the point "
-                                         "data at byte {}",
-                                         v + 1, h.vlrCount, h.pointOffset));
+    if (at + kVlrHeader > h.pointOffset || !in.read(head, kVlrHeader))
+      return fail(at, fmt::format("variable length record {} of {} runs past the point "
+                                  "data at byte {}",
+                                  v + 1, h.vlrCount, h.pointOffset));
     const auto id = load<std::uint16_t>(head + 18);
     const auto length = load<std::uint16_t>(head + 20);
     if (at + kVlrHeader + length > h.pointOffset)
-      return state->fail(at + 20, fmt::format("variable length record {} ({} bytes) runs past "
-                                              "the point data at byte {}",
-                                              v + 1, length, h.pointOffset));
+      return fail(at + 20, fmt::format("variable length record {} ({} bytes) runs past "
+                                       "the point data at byte {}",
+                                       v + 1, length, h.pointOffset));
     record.resize(length);
-    if (!source.read(record.data(), length)) return state->fail(at, "the file ends in a record");
-    takeRecord(id, fixedString(head + 2, 16), record);
+    if (!in.read(record.data(), length)) return fail(at, "the file ends in a record");
+    crs.take(id, fixedString(head + 2, 16), record);
   }
-  if (evlrCount > 0) {
-    // Extended records (LAS 1.4) follow the points; a second reader fetches them.
-    Result<ByteSource> extra = state->reopen();
-    if (!extra) return extra.status();
-    if (evlrOffset < h.pointOffset + pointBytes || !extra->skip(evlrOffset))
-      return state->fail(235, fmt::format("extended records at byte {} are not after the points "
-                                          "within the file",
-                                          evlrOffset));
-    for (std::uint32_t v = 0; v < evlrCount; ++v) {
-      const std::uint64_t at = extra->offset();
-      std::byte head[kEvlrHeader];
-      if (!extra->read(head, kEvlrHeader))
-        return state->fail(at, fmt::format("extended record {} of {} runs past the end of the "
-                                           "file",
-                                           v + 1, evlrCount));
-      const auto id = load<std::uint16_t>(head + 18);
-      const auto length = load<std::uint64_t>(head + 20);
-      if (length > extra->remaining())
-        return state->fail(at + 20, fmt::format("extended record {} ({} bytes) runs past the "
-                                                "end of the file",
-                                                v + 1, length));
-      const std::string user = fixedString(head + 2, 16);
-      if (user == "LASF_Projection" && (id == kWktRecord || id == kGeoKeyRecord) &&
-          length < (std::uint64_t{1} << 24)) {
-        record.resize(length);
-        extra->read(record.data(), record.size());
-        takeRecord(id, user, record);
-      } else {
-        extra->skip(length);
-      }
-    }
-  }
-  h.crs = !wkt.empty() ? wkt : epsg;
-  if (!source.skip(h.pointOffset - source.offset()))
-    return state->fail(source.offset(), "the file ends before the point data");
+  return {};
+}
 
-  state->rgb = colorOffset(h.pointFormat);
-  h.hasColors = state->rgb != 0;
-  if (h.hasColors) {
-    // 8- or 16-bit colours: the first points tell.
-    Result<ByteSource> probe = state->reopen();
-    if (!probe) return probe.status();
-    probe->skip(h.pointOffset);
-    const std::uint64_t count = std::min<std::uint64_t>(h.pointCount, kColorProbe);
-    std::uint16_t largest = 0;
-    std::vector<std::byte> buffer(h.recordLength);
-    for (std::uint64_t i = 0; i < count && probe->read(buffer.data(), buffer.size()); ++i) {
-      for (std::size_t c = 0; c < 3; ++c)
-        largest = std::max(largest, load<std::uint16_t>(buffer.data() + state->rgb + 2 * c));
+// Extended records (LAS 1.4) follow the points; a second reader fetches them.
+Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
+  const LasHeader& h = header;
+  if (evlrCount == 0) return {};
+  const std::uint64_t pointBytes = h.pointCount * h.recordLength;
+  std::vector<std::byte> record;
+  Result<ByteSource> extra = reopen();
+  if (!extra) return extra.status();
+  if (evlrOffset < h.pointOffset + pointBytes || !extra->skip(evlrOffset))
+    return fail(235, fmt::format("extended records at byte {} are not after the points "
+                                 "within the file",
+                                 evlrOffset));
+  for (std::uint32_t v = 0; v < evlrCount; ++v) {
+    const std::uint64_t at = extra->offset();
+    std::byte head[kEvlrHeader];
+    if (!extra->read(head, kEvlrHeader))
+      return fail(at, fmt::format("extended record {} of {} runs past the end of the "
+                                  "file",
+                                  v + 1, evlrCount));
+    const auto id = load<std::uint16_t>(head + 18);
+    const auto length = load<std::uint64_t>(head + 20);
+    if (length > extra->remaining())
+      return fail(at + 20, fmt::format("extended record {} ({} bytes) runs past the "
+                                       "end of the file",
+                                       v + 1, length));
+    const std::string user = fixedString(head + 2, 16);
+    if (user == "LASF_Projection" && (id == kWktRecord || id == kGeoKeyRecord) &&
+        length < (std::uint64_t{1} << 24)) {
+      record.resize(length);
+      extra->read(record.data(), record.size());
+      crs.take(id, user, record);
+    } else {
+      extra->skip(length);
     }
-    h.eightBitColors = largest <= 255;
   }
+  return {};
+}
+
+// 8- or 16-bit colours: the first points tell.
+Status LasReader::State::probeColorDepth() {
+  LasHeader& h = header;
+  rgb = colorOffset(h.pointFormat);
+  h.hasColors = rgb != 0;
+  if (!h.hasColors) return {};
+  Result<ByteSource> probe = reopen();
+  if (!probe) return probe.status();
+  probe->skip(h.pointOffset);
+  const std::uint64_t count = std::min<std::uint64_t>(h.pointCount, kColorProbe);
+  std::uint16_t largest = 0;
+  std::vector<std::byte> buffer(h.recordLength);
+  for (std::uint64_t i = 0; i < count && probe->read(buffer.data(), buffer.size()); ++i) {
+    for (std::size_t c = 0; c < 3; ++c)
+      largest = std::max(largest, load<std::uint16_t>(buffer.data() + rgb + 2 * c));
+  }
+  h.eightBitColors = largest <= 255;
+  return {};
+}
+
+Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
+  std::vector<std::byte> bytes;
+  LODFORGE_TRY(state->readHeader(bytes));
+  LODFORGE_TRY(state->readScalesAndBounds(bytes));
+  LODFORGE_TRY(state->checkPointData());
+  CrsRecords crs;
+  LODFORGE_TRY(state->readRecords(crs));
+  LODFORGE_TRY(state->readExtendedRecords(crs));
+  state->header.crs = crs.crs();
+  ByteSource& source = *state->source;
+  if (!source.skip(state->header.pointOffset - source.offset()))
+    return state->fail(source.offset(), "the file ends before the point data");
+  LODFORGE_TRY(state->probeColorDepth());
   return LasReader(std::move(state));
 } catch (const ErrorException& e) {
   return e.error;

@@ -83,99 +83,80 @@ Result<PointMemoryPlan> planPointMemory(std::uint64_t memoryLimit, std::uint64_t
   return plan;
 }
 
-Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::string& output,
-                                         const PointsBuildOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  const auto elapsed = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
-  PointsBuildStats stats;
-  LODFORGE_TRY(claimPointPackageOutput(input, output));
-  // A work directory of our own: a fresh name unless the caller chose one.
-  ScopedDirectory work(options.workDirectory.empty() ? temporaryPathFor(output + ".work")
-                                                     : options.workDirectory);
-  std::error_code error;
-  fs::create_directories(work.path, error);
-  if (error) return ioError(work.path, error.message());
+namespace {
 
-  PartitionOptions partitionOptions;
-  partitionOptions.blockSize = options.blockSize;
-  partitionOptions.workDirectory = work.path;
-  partitionOptions.salvageTruncated = options.salvageTruncated;
-  Result<PointMemoryPlan> plan = planPointMemory(options.memoryLimit, options.blockSize);
-  if (!plan) return plan.status();
-  partitionOptions.memoryBytes = options.splitBytes > 0 ? options.splitBytes : plan->partitionBytes;
-  stats.threads = plan->threads;
-  Result<Partition> partition = partitionPoints(input, partitionOptions);
-  if (!partition) return partition.status();
-  stats.partitionSeconds = elapsed();
-  stats.points = partition->pointCount;
-  stats.blocks = partition->blocks.size();
-  stats.streamedPasses = partition->streamedPasses;
-  stats.truncation = partition->truncation;
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void countPartition(const Partition& partition, PointsBuildStats& stats) {
+  stats.points = partition.pointCount;
+  stats.blocks = partition.blocks.size();
+  stats.streamedPasses = partition.streamedPasses;
+  stats.truncation = partition.truncation;
   stats.minBlock = stats.points;
-  for (const PointBlock& b : partition->blocks) {
+  for (const PointBlock& b : partition.blocks) {
     stats.minBlock = std::min(stats.minBlock, b.count);
     stats.maxBlock = std::max(stats.maxBlock, b.count);
   }
-  const bool hasNormals = partition->info.hasNormals;
-  stats.estimatedNormals = !hasNormals;
-  stats.tolerance = options.tolerance;
-  // Blocks (the sampled ones too) are built by as many threads as the memory plan allows.
-  tbb::task_arena arena(plan->threads);
-  if (stats.tolerance <= 0) {
-    Result<double> picked =
-        arena.execute([&] { return pickTolerance(*partition, options, hasNormals); });
-    if (!picked) return picked.status();
-    stats.tolerance = *picked;
-  }
+}
 
-  // Segment files go straight into a staging directory renamed when the package is complete.
-  const std::string segments = segmentDirectoryFor(output);
-  ScopedDirectory staging(temporaryPathFor(segments));
-  fs::create_directories(staging.path, error);
-  if (error) return ioError(staging.path, error.message());
-  const std::uint64_t buildId =
-      std::random_device{}() ^ (std::uint64_t{std::random_device{}()} << 32);
+// One block: its clustering tree, the cut at `tolerance` (Part II in `cut`, Part III to its
+// segment file) and its table entry.
+Status buildBlock(const PointBlock& block, std::size_t b, bool hasNormals, double tolerance,
+                  const PointsBuildOptions& options, const std::string& segmentDirectory,
+                  std::uint64_t buildId, LodCut& cut, CloudBlock& entry) {
+  Result<std::vector<CloudPoint>> points = loadBlock(block);
+  if (!points) return points.status();
+  const std::vector<ClusterNode> tree =
+      clusterBlock(*points, block.centroid, hasNormals, options.cluster);
+  cut = cutTree(tree, static_cast<float>(tolerance));
+  entry.bounds = block.bounds;
+  entry.origin = block.centroid;
+  entry.pointCount = block.count;
+  entry.residentCount = static_cast<std::uint32_t>(cut.resident.size());
+  entry.segmentCount = static_cast<std::uint32_t>(cut.segment.size());
+  entry.maxError = tree.front().error;
+  for (const ClusterNode& n : cut.resident)
+    entry.residentError = std::max(entry.residentError, n.error);
+  return writeSegmentFile(segmentDirectory + "/" + segmentFileName(b), buildId, b, cut.segment);
+}
 
-  // Blocks in parallel; Part II goes to a work file in completion order, placed at the end.
-  std::vector<CloudBlock> table(partition->blocks.size());
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> residentAt(table.size());
-  Result<OutputFile> residentFile = OutputFile::create(work.path + "/resident");
+// The blocks' table and, per block, where its Part II lies in the resident work file.
+struct BuiltBlocks {
+  std::vector<CloudBlock> table;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> residentAt;  // first record, count
+};
+
+// Blocks in parallel; Part II goes to a work file in completion order, placed at the end.
+Result<BuiltBlocks> buildBlocks(const Partition& partition, const PointsBuildOptions& options,
+                                double tolerance, const std::string& segmentDirectory,
+                                std::uint64_t buildId, const std::string& residentPath,
+                                tbb::task_arena& arena, PointsBuildStats& stats) {
+  const bool hasNormals = partition.info.hasNormals;
+  BuiltBlocks built;
+  built.table.resize(partition.blocks.size());
+  built.residentAt.resize(built.table.size());
+  Result<OutputFile> residentFile = OutputFile::create(residentPath);
   if (!residentFile) return residentFile.status();
   std::mutex mutex;
   std::uint64_t residentWritten = 0;
   Status failure;
   Progress progress("points: blocks", stats.points);
   arena.execute([&] {
-    tbb::parallel_for(std::size_t{0}, table.size(), [&](std::size_t b) {
+    tbb::parallel_for(std::size_t{0}, built.table.size(), [&](std::size_t b) {
       if (cancelRequested()) return;
-      const PointBlock& block = partition->blocks[b];
-      Result<std::vector<CloudPoint>> points = loadBlock(block);
-      Status status = points.status();
+      const PointBlock& block = partition.blocks[b];
       LodCut cut;
-      if (status.ok()) {
-        const std::vector<ClusterNode> tree =
-            clusterBlock(*points, block.centroid, hasNormals, options.cluster);
-        cut = cutTree(tree, static_cast<float>(stats.tolerance));
-        CloudBlock& entry = table[b];
-        entry.bounds = block.bounds;
-        entry.origin = block.centroid;
-        entry.pointCount = block.count;
-        entry.residentCount = static_cast<std::uint32_t>(cut.resident.size());
-        entry.segmentCount = static_cast<std::uint32_t>(cut.segment.size());
-        entry.maxError = tree.front().error;
-        for (const ClusterNode& n : cut.resident)
-          entry.residentError = std::max(entry.residentError, n.error);
-        status = writeSegmentFile(staging.path + "/" + segmentFileName(b), buildId, b, cut.segment);
-      }
+      Status status = buildBlock(block, b, hasNormals, tolerance, options, segmentDirectory,
+                                 buildId, cut, built.table[b]);
       std::lock_guard lock(mutex);
       if (status.ok()) status = residentFile->writeSpan(std::span<const ClusterNode>(cut.resident));
       if (!status.ok()) {
         if (failure.ok()) failure = status;
         return;
       }
-      residentAt[b] = {residentWritten, static_cast<std::uint32_t>(cut.resident.size())};
+      built.residentAt[b] = {residentWritten, static_cast<std::uint32_t>(cut.resident.size())};
       residentWritten += cut.resident.size();
       stats.residentNodes += cut.resident.size();
       stats.segmentNodes += cut.segment.size();
@@ -189,40 +170,102 @@ Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::st
   LODFORGE_TRY(checkCancelled());
   progress.finish();
   LODFORGE_TRY(residentFile->commit());
+  return built;
+}
 
-  // Part II in block order, each block's records read back from the work file as the package
-  // is written (holding all of Part II would grow with the input).
+// Part II in block order, each block's records read back from the work file as the package is
+// written (holding all of Part II would grow with the input).
+ResidentSource residentReader(const std::string& residentPath, BuiltBlocks& built) {
   std::uint64_t first = 0;
-  for (CloudBlock& entry : table) {
+  for (CloudBlock& entry : built.table) {
     entry.residentFirst = first;
     first += entry.residentCount;
   }
-  const std::string residentPath = work.path + "/resident";
-  const ResidentSource residentOf = [&](std::size_t b) -> Result<std::vector<ClusterNode>> {
+  return [residentPath, &built](std::size_t b) -> Result<std::vector<ClusterNode>> {
     std::ifstream in(residentPath, std::ios::binary);
-    std::vector<ClusterNode> part(residentAt[b].second);
-    in.seekg(static_cast<std::streamoff>(residentAt[b].first * sizeof(ClusterNode)));
+    std::vector<ClusterNode> part(built.residentAt[b].second);
+    in.seekg(static_cast<std::streamoff>(built.residentAt[b].first * sizeof(ClusterNode)));
     in.read(reinterpret_cast<char*>(part.data()),
             static_cast<std::streamsize>(part.size() * sizeof(ClusterNode)));
     if (!in && !part.empty()) return ioError(residentPath, "work file is shorter than expected");
     return part;
   };
+}
+
+CloudHeader packageHeader(const Partition& partition, const PointsBuildStats& stats,
+                          std::uint64_t buildId) {
   CloudHeader header{};
-  header.flags =
-      (hasNormals ? kCloudInputNormals : 0u) | (partition->info.hasColors ? kCloudInputColors : 0u);
+  header.flags = (partition.info.hasNormals ? kCloudInputNormals : 0u) |
+                 (partition.info.hasColors ? kCloudInputColors : 0u);
   header.buildId = buildId;
   header.pointCount = stats.points;
   header.segmentCount = stats.segmentNodes;
   header.droppedCount = stats.droppedNodes;
   header.tolerance = stats.tolerance;
-  header.bounds = partition->bounds;
+  header.bounds = partition.bounds;
+  return header;
+}
+
+}  // namespace
+
+Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::string& output,
+                                         const PointsBuildOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PointsBuildStats stats;
+  LODFORGE_TRY(claimPointPackageOutput(input, output));
+  // A work directory of our own: a fresh name unless the caller chose one.
+  ScopedDirectory work(options.workDirectory.empty() ? temporaryPathFor(output + ".work")
+                                                     : options.workDirectory);
+  std::error_code error;
+  fs::create_directories(work.path, error);
+  if (error) return ioError(work.path, error.message());
+
+  // The partition into blocks (§4.1 of the points paper), split in memory as far as it allows.
+  Result<PointMemoryPlan> plan = planPointMemory(options.memoryLimit, options.blockSize);
+  if (!plan) return plan.status();
+  PartitionOptions partitionOptions;
+  partitionOptions.blockSize = options.blockSize;
+  partitionOptions.workDirectory = work.path;
+  partitionOptions.salvageTruncated = options.salvageTruncated;
+  partitionOptions.memoryBytes = options.splitBytes > 0 ? options.splitBytes : plan->partitionBytes;
+  stats.threads = plan->threads;
+  Result<Partition> partition = partitionPoints(input, partitionOptions);
+  if (!partition) return partition.status();
+  stats.partitionSeconds = secondsSince(start);
+  countPartition(*partition, stats);
+  stats.estimatedNormals = !partition->info.hasNormals;
+
+  // Blocks (the sampled ones too) are built by as many threads as the memory plan allows.
+  tbb::task_arena arena(plan->threads);
+  stats.tolerance = options.tolerance;
+  if (stats.tolerance <= 0) {
+    Result<double> picked = arena.execute(
+        [&] { return pickTolerance(*partition, options, partition->info.hasNormals); });
+    if (!picked) return picked.status();
+    stats.tolerance = *picked;
+  }
+
+  // Segment files go straight into a staging directory renamed when the package is complete.
+  const std::string segments = segmentDirectoryFor(output);
+  ScopedDirectory staging(temporaryPathFor(segments));
+  fs::create_directories(staging.path, error);
+  if (error) return ioError(staging.path, error.message());
+  const std::uint64_t buildId =
+      std::random_device{}() ^ (std::uint64_t{std::random_device{}()} << 32);
+  const std::string residentPath = work.path + "/resident";
+  Result<BuiltBlocks> built = buildBlocks(*partition, options, stats.tolerance, staging.path,
+                                          buildId, residentPath, arena, stats);
+  if (!built) return built.status();
+
   // The segment directory first, then the package that names its build: a crash between the
   // two leaves a package that refuses the new segments (other build id), never a mix.
+  const ResidentSource residentOf = residentReader(residentPath, *built);
   LODFORGE_TRY(replaceDirectory(staging, segments));
-  LODFORGE_TRY(writeCloudFile(output, header, partition->info.crs, table, residentOf));
+  LODFORGE_TRY(writeCloudFile(output, packageHeader(*partition, stats, buildId),
+                              partition->info.crs, built->table, residentOf));
   const Result<std::uint64_t> packageBytes = fileSize(output);
   stats.outputBytes = directoryBytes(segments) + (packageBytes ? *packageBytes : 0);
-  stats.seconds = elapsed();
+  stats.seconds = secondsSince(start);
   return stats;
 }
 

@@ -47,6 +47,14 @@ struct GlbWriter::State {
   std::optional<std::uint32_t> defaultMaterial;
   // Per mesh: the grid of its quantised positions (origin, step), for the nodes that draw it.
   std::vector<std::optional<std::pair<Vec3d, double>>> dequantize;
+
+  // A mesh's vertex attributes into `attributes`; its indices (the accessor).
+  Status addQuantizedAttributes(const GlbMeshData& mesh, const Aabb& bounds,
+                                nlohmann::json& attributes);
+  Status addFloatAttributes(const GlbMeshData& mesh, const Aabb& bounds,
+                            nlohmann::json& attributes);
+  Status addColors(const GlbMeshData& mesh, nlohmann::json& attributes);
+  Result<std::uint32_t> addIndices(const GlbMeshData& mesh);
   // Binary chunk: in memory until it exceeds options.spillBytes, then appended to `spill`.
   std::vector<std::byte> binary;
   std::optional<OutputFile> spill;
@@ -163,6 +171,104 @@ std::uint32_t GlbWriter::addMaterial(const std::array<float, 4>& baseColor, std:
   return static_cast<std::uint32_t>(state_->materials.size() - 1);
 }
 
+Status GlbWriter::State::addQuantizedAttributes(const GlbMeshData& mesh, const Aabb& bounds,
+                                                nlohmann::json& attributes) {
+  const std::size_t vertexCount = mesh.positions.size();
+  // KHR_mesh_quantization: integer positions on a uniform grid (a uniform scale leaves the
+  // normals' directions alone), padded to 8 bytes; normals as normalised bytes, padded to 4.
+  const Aabbd box{toDouble(bounds.min), toDouble(bounds.max)};
+  const double step = glbQuantizationStep(box);
+  std::vector<std::uint16_t> grid(vertexCount * 4, 0);
+  std::array<std::uint16_t, 3> lo{65535, 65535, 65535}, hi{0, 0, 0};
+  for (std::size_t v = 0; v < vertexCount; ++v) {
+    const Vec3d p = (toDouble(mesh.positions[v]) - box.min) * (1.0 / step);
+    const double axes[3] = {p.x, p.y, p.z};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto q = static_cast<std::uint16_t>(std::clamp(std::lround(axes[a]), 0L, 65535L));
+      grid[4 * v + a] = q;
+      lo[a] = std::min(lo[a], q);
+      hi[a] = std::max(hi[a], q);
+    }
+  }
+  const nlohmann::json min = lo, max = hi;
+  Result<std::uint32_t> position =
+      addAccessor(grid.data(), grid.size() * 2, vertexCount, kUnsignedShort, "VEC3", kArrayBuffer,
+                  false, &min, &max, 8);
+  if (!position) return position.status();
+  attributes["POSITION"] = *position;
+  dequantize.emplace_back(std::pair{box.min, step});
+  if (!mesh.normals.empty()) {
+    std::vector<std::int8_t> packed(vertexCount * 4, 0);
+    for (std::size_t v = 0; v < vertexCount; ++v) {
+      const Vec3f n = normalizeOr(mesh.normals[v], Vec3f{0, 0, 1});
+      const float axes[3] = {n.x, n.y, n.z};
+      for (std::size_t a = 0; a < 3; ++a)
+        packed[4 * v + a] = static_cast<std::int8_t>(roundToLong(axes[a] * 127.0f));
+    }
+    Result<std::uint32_t> normal = addAccessor(packed.data(), packed.size(), vertexCount, kByte,
+                                               "VEC3", kArrayBuffer, true, nullptr, nullptr, 4);
+    if (!normal) return normal.status();
+    attributes["NORMAL"] = *normal;
+  }
+  return {};
+}
+
+Status GlbWriter::State::addFloatAttributes(const GlbMeshData& mesh, const Aabb& bounds,
+                                            nlohmann::json& attributes) {
+  const std::size_t vertexCount = mesh.positions.size();
+  const nlohmann::json min = {bounds.min.x, bounds.min.y, bounds.min.z};
+  const nlohmann::json max = {bounds.max.x, bounds.max.y, bounds.max.z};
+  Result<std::uint32_t> position =
+      addAccessor(mesh.positions.data(), mesh.positions.size_bytes(), vertexCount, kFloat, "VEC3",
+                  kArrayBuffer, false, &min, &max, sizeof(Vec3f));
+  if (!position) return position.status();
+  attributes["POSITION"] = *position;
+  dequantize.emplace_back(std::nullopt);
+  if (!mesh.normals.empty()) {
+    // The validator requires unit normals; fix up zero or unnormalised ones here.
+    std::vector<Vec3f> unit(mesh.normals.begin(), mesh.normals.end());
+    for (Vec3f& n : unit) n = normalizeOr(n, Vec3f{0, 0, 1});
+    Result<std::uint32_t> normal =
+        addAccessor(unit.data(), unit.size() * sizeof(Vec3f), vertexCount, kFloat, "VEC3",
+                    kArrayBuffer, false, nullptr, nullptr, sizeof(Vec3f));
+    if (!normal) return normal.status();
+    attributes["NORMAL"] = *normal;
+  }
+  return {};
+}
+
+Status GlbWriter::State::addColors(const GlbMeshData& mesh, nlohmann::json& attributes) {
+  const std::size_t vertexCount = mesh.positions.size();
+  if (!mesh.colors.empty()) {
+    Result<std::uint32_t> color =
+        addAccessor(mesh.colors.data(), mesh.colors.size_bytes(), vertexCount, kUnsignedByte,
+                    "VEC4", kArrayBuffer, true, nullptr, nullptr, sizeof(Rgba8));
+    if (!color) return color.status();
+    attributes["COLOR_0"] = *color;
+  }
+  return {};
+}
+
+// 16-bit indices when they fit; 65535 itself is the primitive-restart value glTF forbids.
+Result<std::uint32_t> GlbWriter::State::addIndices(const GlbMeshData& mesh) {
+  const std::size_t vertexCount = mesh.positions.size();
+  if (mesh.points) return 0u;  // unused
+  if (vertexCount < 65535) {
+    // Narrowed only for the uncompressed layout (the meshopt codec takes the 32-bit ones).
+    scratch.resize(options.meshoptCompression ? 0 : mesh.indices.size() * 2);
+    for (std::size_t i = 0; i < scratch.size() / 2; ++i) {
+      const auto v = static_cast<std::uint16_t>(mesh.indices[i]);
+      std::memcpy(scratch.data() + 2 * i, &v, 2);
+    }
+    return addAccessor(scratch.data(), mesh.indices.size() * 2, mesh.indices.size(), kUnsignedShort,
+                       "SCALAR", kElementArrayBuffer, false, nullptr, nullptr, 2, mesh.indices,
+                       vertexCount);
+  }
+  return addAccessor(mesh.indices.data(), mesh.indices.size_bytes(), mesh.indices.size(),
+                     kUnsignedInt, "SCALAR", kElementArrayBuffer, false, nullptr, nullptr, 4,
+                     mesh.indices, vertexCount);
+}
+
 Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_view name,
                                          std::optional<std::uint32_t> material) {
   State& s = *state_;
@@ -171,96 +277,16 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
                      : (!mesh.indices.empty() && mesh.indices.size() % 3 == 0));
   assert(mesh.normals.empty() || mesh.normals.size() == mesh.positions.size());
   assert(mesh.colors.empty() || mesh.colors.size() == mesh.positions.size());
-  const std::size_t vertexCount = mesh.positions.size();
-
-  const Aabb bounds = [&] {
-    Aabb box;
-    for (const Vec3f& p : mesh.positions) box.add(p);
-    return box;
-  }();
+  Aabb bounds;
+  for (const Vec3f& p : mesh.positions) bounds.add(p);
   nlohmann::json attributes;
   if (mesh.quantized) {
-    // KHR_mesh_quantization: integer positions on a uniform grid (a uniform scale leaves the
-    // normals' directions alone), padded to 8 bytes; normals as normalised bytes, padded to 4.
-    const Aabbd box{toDouble(bounds.min), toDouble(bounds.max)};
-    const double step = glbQuantizationStep(box);
-    std::vector<std::uint16_t> grid(vertexCount * 4, 0);
-    std::array<std::uint16_t, 3> lo{65535, 65535, 65535}, hi{0, 0, 0};
-    for (std::size_t v = 0; v < vertexCount; ++v) {
-      const Vec3d p = (toDouble(mesh.positions[v]) - box.min) * (1.0 / step);
-      const double axes[3] = {p.x, p.y, p.z};
-      for (std::size_t a = 0; a < 3; ++a) {
-        const auto q = static_cast<std::uint16_t>(std::clamp(std::lround(axes[a]), 0L, 65535L));
-        grid[4 * v + a] = q;
-        lo[a] = std::min(lo[a], q);
-        hi[a] = std::max(hi[a], q);
-      }
-    }
-    const nlohmann::json min = lo, max = hi;
-    Result<std::uint32_t> position =
-        s.addAccessor(grid.data(), grid.size() * 2, vertexCount, kUnsignedShort, "VEC3",
-                      kArrayBuffer, false, &min, &max, 8);
-    if (!position) return position.status();
-    attributes["POSITION"] = *position;
-    s.dequantize.emplace_back(std::pair{box.min, step});
-    if (!mesh.normals.empty()) {
-      std::vector<std::int8_t> packed(vertexCount * 4, 0);
-      for (std::size_t v = 0; v < vertexCount; ++v) {
-        const Vec3f n = normalizeOr(mesh.normals[v], Vec3f{0, 0, 1});
-        const float axes[3] = {n.x, n.y, n.z};
-        for (std::size_t a = 0; a < 3; ++a)
-          packed[4 * v + a] = static_cast<std::int8_t>(roundToLong(axes[a] * 127.0f));
-      }
-      Result<std::uint32_t> normal = s.addAccessor(packed.data(), packed.size(), vertexCount, kByte,
-                                                   "VEC3", kArrayBuffer, true, nullptr, nullptr, 4);
-      if (!normal) return normal.status();
-      attributes["NORMAL"] = *normal;
-    }
+    LODFORGE_TRY(s.addQuantizedAttributes(mesh, bounds, attributes));
   } else {
-    const nlohmann::json min = {bounds.min.x, bounds.min.y, bounds.min.z};
-    const nlohmann::json max = {bounds.max.x, bounds.max.y, bounds.max.z};
-    Result<std::uint32_t> position =
-        s.addAccessor(mesh.positions.data(), mesh.positions.size_bytes(), vertexCount, kFloat,
-                      "VEC3", kArrayBuffer, false, &min, &max, sizeof(Vec3f));
-    if (!position) return position.status();
-    attributes["POSITION"] = *position;
-    s.dequantize.emplace_back(std::nullopt);
-    if (!mesh.normals.empty()) {
-      // The validator requires unit normals; fix up zero or unnormalised ones here.
-      std::vector<Vec3f> unit(mesh.normals.begin(), mesh.normals.end());
-      for (Vec3f& n : unit) n = normalizeOr(n, Vec3f{0, 0, 1});
-      Result<std::uint32_t> normal =
-          s.addAccessor(unit.data(), unit.size() * sizeof(Vec3f), vertexCount, kFloat, "VEC3",
-                        kArrayBuffer, false, nullptr, nullptr, sizeof(Vec3f));
-      if (!normal) return normal.status();
-      attributes["NORMAL"] = *normal;
-    }
+    LODFORGE_TRY(s.addFloatAttributes(mesh, bounds, attributes));
   }
-  if (!mesh.colors.empty()) {
-    Result<std::uint32_t> color =
-        s.addAccessor(mesh.colors.data(), mesh.colors.size_bytes(), vertexCount, kUnsignedByte,
-                      "VEC4", kArrayBuffer, true, nullptr, nullptr, sizeof(Rgba8));
-    if (!color) return color.status();
-    attributes["COLOR_0"] = *color;
-  }
-  // 16-bit indices when they fit; 65535 itself is the primitive-restart value glTF forbids.
-  Result<std::uint32_t> indices = [&]() -> Result<std::uint32_t> {
-    if (mesh.points) return 0u;  // unused
-    if (vertexCount < 65535) {
-      // Narrowed only for the uncompressed layout (the meshopt codec takes the 32-bit ones).
-      s.scratch.resize(s.options.meshoptCompression ? 0 : mesh.indices.size() * 2);
-      for (std::size_t i = 0; i < s.scratch.size() / 2; ++i) {
-        const auto v = static_cast<std::uint16_t>(mesh.indices[i]);
-        std::memcpy(s.scratch.data() + 2 * i, &v, 2);
-      }
-      return s.addAccessor(s.scratch.data(), mesh.indices.size() * 2, mesh.indices.size(),
-                           kUnsignedShort, "SCALAR", kElementArrayBuffer, false, nullptr, nullptr,
-                           2, mesh.indices, vertexCount);
-    }
-    return s.addAccessor(mesh.indices.data(), mesh.indices.size_bytes(), mesh.indices.size(),
-                         kUnsignedInt, "SCALAR", kElementArrayBuffer, false, nullptr, nullptr, 4,
-                         mesh.indices, vertexCount);
-  }();
+  LODFORGE_TRY(s.addColors(mesh, attributes));
+  Result<std::uint32_t> indices = s.addIndices(mesh);
   if (!indices) return indices.status();
 
   if (!material) {

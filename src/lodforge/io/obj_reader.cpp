@@ -120,16 +120,21 @@ void addVerticesOnly(Model& model, const tinyobj::attrib_t& attrib, const std::s
   builder.endObject();
 }
 
-Result<Model> build(const std::string& text, const std::string& name, const std::string& baseDir) {
-  LODFORGE_TRY(checkCoordinates(text, name));
+// What tinyobjloader read.
+struct ParsedObj {
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
+};
+
+Result<ParsedObj> parseObj(const std::string& text, const std::string& name,
+                           const std::string& baseDir) {
+  ParsedObj obj;
   std::string warnings, errors;
   std::istringstream stream(text);
   tinyobj::MaterialFileReader materialReader(baseDir);
-  const bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warnings, &errors, &stream,
-                                   baseDir.empty() ? nullptr : &materialReader,
+  const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &warnings, &errors,
+                                   &stream, baseDir.empty() ? nullptr : &materialReader,
                                    /*triangulate=*/false, /*default_vcols_fallback=*/false);
   if (!ok) {
     std::string message = errors.empty() ? "cannot parse" : errors;
@@ -137,114 +142,133 @@ Result<Model> build(const std::string& text, const std::string& name, const std:
       message.pop_back();
     return badInput(name, message);
   }
+  return obj;
+}
 
-  const int vertexCount = static_cast<int>(attrib.vertices.size() / 3);
-  const int normalCount = static_cast<int>(attrib.normals.size() / 3);
-  const bool vertexColors = !attrib.colors.empty();
-  bool anyColor = vertexColors;
+// What the faces hold, once every index is checked against the file's counts.
+struct FaceSummary {
+  std::uint64_t faces = 0;
   bool anyNormal = false;
-  std::uint64_t face = 0;
-  for (const tinyobj::shape_t& shape : shapes) {
+  bool anyColor = false;  // vertex colours, or a face with a known material
+};
+
+Result<FaceSummary> checkFaces(const std::string& text, const std::string& name,
+                               const ParsedObj& obj) {
+  const int vertexCount = static_cast<int>(obj.attrib.vertices.size() / 3);
+  const int normalCount = static_cast<int>(obj.attrib.normals.size() / 3);
+  FaceSummary summary;
+  summary.anyColor = !obj.attrib.colors.empty();
+  for (const tinyobj::shape_t& shape : obj.shapes) {
     std::size_t corner = 0;
-    for (std::size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f, ++face) {
+    for (std::size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f, ++summary.faces) {
       for (unsigned k = 0; k < shape.mesh.num_face_vertices[f]; ++k, ++corner) {
         const tinyobj::index_t& index = shape.mesh.indices[corner];
         if (index.vertex_index < 0 || index.vertex_index >= vertexCount) {
-          return badInputAtLine(name, lineOfFace(text, face),
+          return badInputAtLine(name, lineOfFace(text, summary.faces),
                                 fmt::format("face refers to vertex {} but the file has {} vertices",
                                             index.vertex_index + 1, vertexCount));
         }
         if (index.normal_index >= normalCount) {
-          return badInputAtLine(name, lineOfFace(text, face),
+          return badInputAtLine(name, lineOfFace(text, summary.faces),
                                 fmt::format("face refers to normal {} but the file has {} normals",
                                             index.normal_index + 1, normalCount));
         }
-        anyNormal = anyNormal || index.normal_index >= 0;
+        summary.anyNormal = summary.anyNormal || index.normal_index >= 0;
       }
       if (!shape.mesh.material_ids.empty() && shape.mesh.material_ids[f] >= 0 &&
-          static_cast<std::size_t>(shape.mesh.material_ids[f]) < materials.size()) {
-        anyColor = true;
+          static_cast<std::size_t>(shape.mesh.material_ids[f]) < obj.materials.size()) {
+        summary.anyColor = true;
       }
     }
   }
+  return summary;
+}
 
+// One shape as one object: a vertex per distinct (position, normal, material colour) corner,
+// polygons fan-triangulated; smooth normals for the whole object where some corners lack `vn`.
+void addShape(Model& model, ModelBuilder& builder, const ParsedObj& obj, std::size_t s,
+              const FaceSummary& summary) {
+  const tinyobj::attrib_t& attrib = obj.attrib;
+  const tinyobj::mesh_t& mesh = obj.shapes[s].mesh;
+  const bool vertexColors = !attrib.colors.empty();
+  builder.beginObject(obj.shapes[s].name.empty() ? fmt::format("object {}", s)
+                                                 : obj.shapes[s].name);
+  const std::size_t firstVertex = model.positions.size();
+  std::unordered_map<CornerKey, std::uint32_t, CornerHash> local;
+  bool allNormals = true;
+  std::size_t corner = 0;
+  std::vector<std::uint32_t> polygon;
+  for (std::size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
+    const int material = mesh.material_ids.empty() ? -1 : mesh.material_ids[f];
+    const bool materialColor =
+        !vertexColors && material >= 0 && static_cast<std::size_t>(material) < obj.materials.size();
+    polygon.clear();
+    for (unsigned k = 0; k < mesh.num_face_vertices[f]; ++k, ++corner) {
+      const tinyobj::index_t& index = mesh.indices[corner];
+      const CornerKey key{index.vertex_index, index.normal_index, materialColor ? material : -1};
+      auto [it, inserted] =
+          local.try_emplace(key, static_cast<std::uint32_t>(model.positions.size() - firstVertex));
+      polygon.push_back(it->second);
+      if (!inserted) continue;
+      const auto v = static_cast<std::size_t>(index.vertex_index);
+      const Vec3d p{attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]};
+      model.positions.push_back(toFloat(p - model.origin));
+      if (summary.anyNormal) {
+        Vec3f n{};
+        if (index.normal_index >= 0) {
+          const auto i = static_cast<std::size_t>(index.normal_index);
+          n = {static_cast<float>(attrib.normals[3 * i]),
+               static_cast<float>(attrib.normals[3 * i + 1]),
+               static_cast<float>(attrib.normals[3 * i + 2])};
+        } else {
+          allNormals = false;
+        }
+        model.normals.push_back(n);
+      }
+      if (summary.anyColor) {
+        Rgba8 color;
+        if (vertexColors) {
+          color = toRgba(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]);
+        } else if (materialColor) {
+          const auto& kd = obj.materials[static_cast<std::size_t>(material)].diffuse;
+          color = toRgba(kd[0], kd[1], kd[2]);
+        }
+        model.colors.push_back(color);
+      }
+    }
+    for (std::size_t k = 2; k < polygon.size(); ++k)
+      model.indices.insert(model.indices.end(), {polygon[0], polygon[k - 1], polygon[k]});
+  }
+  builder.endObject();
+  if (summary.anyNormal && !allNormals) {
+    const std::size_t o = model.objects.size() - 1;
+    computeVertexNormals(
+        model.objectPositions(o), model.objectIndices(o),
+        std::span(model.normals).subspan(firstVertex, model.objects[o].vertexCount));
+  }
+}
+
+Result<Model> build(const std::string& text, const std::string& name, const std::string& baseDir) {
+  LODFORGE_TRY(checkCoordinates(text, name));
+  Result<ParsedObj> obj = parseObj(text, name, baseDir);
+  if (!obj) return obj.status();
+  Result<FaceSummary> summary = checkFaces(text, name, *obj);
+  if (!summary) return summary.status();
   // World positions in double, then one origin for the model.
   Aabbd world;
-  for (int v = 0; v < vertexCount; ++v) {
-    world.add(Vec3d{attrib.vertices[3 * static_cast<std::size_t>(v)],
-                    attrib.vertices[3 * static_cast<std::size_t>(v) + 1],
-                    attrib.vertices[3 * static_cast<std::size_t>(v) + 2]});
-  }
+  const std::vector<tinyobj::real_t>& vertices = obj->attrib.vertices;
+  for (std::size_t v = 0; v + 2 < vertices.size(); v += 3)
+    world.add(Vec3d{vertices[v], vertices[v + 1], vertices[v + 2]});
   Model model;
   model.origin = chooseOrigin(world);
-  if (face == 0) {
-    addVerticesOnly(model, attrib, name);
+  if (summary->faces == 0) {
+    addVerticesOnly(model, obj->attrib, name);
     return model;
   }
   ModelBuilder builder(model);
-  std::unordered_map<CornerKey, std::uint32_t, CornerHash> local;
-  for (std::size_t s = 0; s < shapes.size(); ++s) {
-    const tinyobj::mesh_t& mesh = shapes[s].mesh;
-    if (mesh.num_face_vertices.empty()) continue;  // lines or points only
-    builder.beginObject(shapes[s].name.empty() ? fmt::format("object {}", s) : shapes[s].name);
-    const std::size_t firstVertex = model.positions.size();
-    local.clear();
-    bool allNormals = true;
-    std::size_t corner = 0;
-    std::vector<std::uint32_t> polygon;
-    for (std::size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
-      const int material = mesh.material_ids.empty() ? -1 : mesh.material_ids[f];
-      const bool materialColor =
-          !vertexColors && material >= 0 && static_cast<std::size_t>(material) < materials.size();
-      polygon.clear();
-      for (unsigned k = 0; k < mesh.num_face_vertices[f]; ++k, ++corner) {
-        const tinyobj::index_t& index = mesh.indices[corner];
-        const CornerKey key{index.vertex_index, index.normal_index, materialColor ? material : -1};
-        auto [it, inserted] = local.try_emplace(
-            key, static_cast<std::uint32_t>(model.positions.size() - firstVertex));
-        if (inserted) {
-          const auto v = static_cast<std::size_t>(index.vertex_index);
-          const Vec3d p{attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
-                        attrib.vertices[3 * v + 2]};
-          model.positions.push_back(toFloat(p - model.origin));
-          if (anyNormal) {
-            Vec3f n{};
-            if (index.normal_index >= 0) {
-              const auto i = static_cast<std::size_t>(index.normal_index);
-              n = {static_cast<float>(attrib.normals[3 * i]),
-                   static_cast<float>(attrib.normals[3 * i + 1]),
-                   static_cast<float>(attrib.normals[3 * i + 2])};
-            } else {
-              allNormals = false;
-            }
-            model.normals.push_back(n);
-          }
-          if (anyColor) {
-            Rgba8 color;
-            if (vertexColors) {
-              color =
-                  toRgba(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]);
-            } else if (materialColor) {
-              const auto& kd = materials[static_cast<std::size_t>(material)].diffuse;
-              color = toRgba(kd[0], kd[1], kd[2]);
-            }
-            model.colors.push_back(color);
-          }
-        }
-        polygon.push_back(it->second);
-      }
-      for (std::size_t k = 2; k < polygon.size(); ++k) {
-        model.indices.insert(model.indices.end(), {polygon[0], polygon[k - 1], polygon[k]});
-      }
-    }
-    builder.endObject();
-    if (anyNormal && !allNormals) {
-      // Some corners lacked `vn`: give the whole object smooth normals instead of zeros.
-      const std::size_t o = model.objects.size() - 1;
-      computeVertexNormals(
-          model.objectPositions(o), model.objectIndices(o),
-          std::span(model.normals).subspan(firstVertex, model.objects[o].vertexCount));
-    }
+  for (std::size_t s = 0; s < obj->shapes.size(); ++s) {
+    if (obj->shapes[s].mesh.num_face_vertices.empty()) continue;  // lines or points only
+    addShape(model, builder, *obj, s, *summary);
   }
   return model;
 }

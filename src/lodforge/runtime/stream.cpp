@@ -170,17 +170,14 @@ void StreamBuffer::clear() {
   std::fill(c.triangleCounts.begin(), c.triangleCounts.end(), 0);
 }
 
-Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCounts,
-                                        std::span<const std::uint32_t> triangleCounts) {
-  const Package& package = *state_->package;
-  const std::size_t n = package.objectCount();
-  assert(vertexCounts.size() == n && triangleCounts.size() == n);
-  const BufferCopy& old = state_->current();
-  BufferCopy& next = state_->copies[1 - state_->front];
-  FrameStats stats;
-  const auto reassemblyStart = std::chrono::steady_clock::now();
+namespace {
 
-  // The new layout: prefix sums of the counts.
+// The new layout: prefix sums of the counts, refused when it does not fit the capacity (only the
+// back copy is touched; the front one still holds last frame).
+Status layOut(const Package& package, const StreamCapacity& capacity,
+              std::span<const std::uint32_t> vertexCounts,
+              std::span<const std::uint32_t> triangleCounts, BufferCopy& next) {
+  const std::size_t n = package.objectCount();
   std::copy(vertexCounts.begin(), vertexCounts.end(), next.vertexCounts.begin());
   std::copy(triangleCounts.begin(), triangleCounts.end(), next.triangleCounts.begin());
   for (std::size_t i = 0; i < n; ++i) {
@@ -189,25 +186,25 @@ Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCou
     next.vertexStart[i + 1] = next.vertexStart[i] + vertexCounts[i];
     next.triangleStart[i + 1] = next.triangleStart[i] + triangleCounts[i];
   }
-  if (next.vertices() > state_->capacity.vertices ||
-      next.triangles() > state_->capacity.triangles) {
-    // Only the back copy was touched; the front one still holds last frame.
-    const std::uint64_t v = next.vertices(), t = next.triangles();
-    return Error{
-        ErrorKind::kLimit,
-        fmt::format("{}: the selection ({} vertices, {} triangles) does not fit the "
-                    "stream buffer ({} vertices, {} triangles)",
-                    package.name(), v, t, state_->capacity.vertices, state_->capacity.triangles)};
-  }
+  if (next.vertices() <= capacity.vertices && next.triangles() <= capacity.triangles) return {};
+  return Error{ErrorKind::kLimit,
+               fmt::format("{}: the selection ({} vertices, {} triangles) does not fit the "
+                           "stream buffer ({} vertices, {} triangles)",
+                           package.name(), next.vertices(), next.triangles(), capacity.vertices,
+                           capacity.triangles)};
+}
 
-  // What the frame reads and moves, per object: the kept part min(old, new), the read part
-  // new - kept; triangles of objects whose count changed are re-formed.
+// What the frame reads and moves, per object: the kept part min(old, new), the read part
+// new - kept; triangles of objects whose count changed are re-formed.
+void tallyFrame(const Package& package, const BufferCopy& old,
+                std::span<const std::uint32_t> vertexCounts,
+                std::span<const std::uint32_t> triangleCounts, FrameStats& stats) {
   struct Tally {
     std::uint64_t vertexKept = 0, vertexRead = 0, triangleKept = 0, triangleRead = 0;
     std::uint64_t reformed = 0, indicesKept = 0, changed = 0;
   };
   const Tally tally = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, n, 1 << 14), Tally{},
+      tbb::blocked_range<std::size_t>(0, package.objectCount(), 1 << 14), Tally{},
       [&](const tbb::blocked_range<std::size_t>& range, Tally t) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
           const std::uint32_t vo = old.vertexCounts[i], vn = vertexCounts[i];
@@ -244,8 +241,10 @@ Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCou
   stats.trianglesReformed = tally.reformed;
   stats.trianglesKept = tally.indicesKept;
   stats.objectsChanged = tally.changed;
+}
 
-  // §3.3: vertices and source triangles, each element from the old buffer or the package.
+// §3.3: vertices and source triangles, each element from the old buffer or the package.
+void reassembleFrame(const Package& package, const BufferCopy& old, BufferCopy& next) {
   const std::span<const PackageObject> objects = package.objects();
   const auto vertexOffset = [&](std::size_t i) { return objects[i].vertexOffset; };
   const auto triangleOffset = [&](std::size_t i) { return objects[i].triangleOffset; };
@@ -261,11 +260,13 @@ Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCou
   reassemble(next.triangleStart, old.triangleStart,
              std::span<const std::uint32_t>(old.triangleCounts), old.source.get(),
              package.allTriangles().data(), triangleOffset, 3, next.source.get());
-  stats.reassemblyMs = millisecondsSince(reassemblyStart);
+}
 
-  // Algorithm 2 over every triangle whose object changed; the others keep last frame's indices,
-  // shifted by how far their object's vertices moved (beyond the paper, which re-forms all).
-  const auto reformationStart = std::chrono::steady_clock::now();
+// Algorithm 2 over every triangle whose object changed; the others keep last frame's indices,
+// shifted by how far their object's vertices moved (beyond the paper, which re-forms all).
+void reformFrame(const Package& package, const BufferCopy& old,
+                 std::span<const std::uint32_t> vertexCounts, BufferCopy& next) {
+  const std::span<const PackageObject> objects = package.objects();
   const std::uint32_t* ecolAll = package.allEcol().data();
   tbb::parallel_for(
       tbb::blocked_range<std::uint64_t>(0, next.triangles(), 1 << 13),
@@ -293,6 +294,25 @@ Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCou
           at = end;
         }
       });
+}
+
+}  // namespace
+
+Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCounts,
+                                        std::span<const std::uint32_t> triangleCounts) {
+  const Package& package = *state_->package;
+  assert(vertexCounts.size() == package.objectCount() &&
+         triangleCounts.size() == package.objectCount());
+  const BufferCopy& old = state_->current();
+  BufferCopy& next = state_->copies[1 - state_->front];
+  FrameStats stats;
+  const auto reassemblyStart = std::chrono::steady_clock::now();
+  LODFORGE_TRY(layOut(package, state_->capacity, vertexCounts, triangleCounts, next));
+  tallyFrame(package, old, vertexCounts, triangleCounts, stats);
+  reassembleFrame(package, old, next);
+  stats.reassemblyMs = millisecondsSince(reassemblyStart);
+  const auto reformationStart = std::chrono::steady_clock::now();
+  reformFrame(package, old, vertexCounts, next);
   stats.reformationMs = millisecondsSince(reformationStart);
   state_->front = 1 - state_->front;
   return stats;

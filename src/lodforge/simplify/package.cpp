@@ -261,15 +261,23 @@ Result<Package> Package::fromBytes(std::span<const std::byte> bytes, const std::
   return package;
 }
 
+Status Package::badAt(std::uint64_t at, std::string_view what) const {
+  return badInputAtByte(name_, at, what);
+}
+
 Status Package::validate(const OpenOptions& options) {
+  LODFORGE_TRY(validateHeader());
+  LODFORGE_TRY(validateSections(options));
+  return validateObjects();
+}
+
+// Magic, alignment, version, the header's checksum and the section count.
+Status Package::validateHeader() {
   const std::uint64_t size = bytes_.size();
-  auto bad = [&](std::uint64_t at, std::string_view what) {
-    return Status(badInputAtByte(name_, at, what));
-  };
   if (size < sizeof(PackageHeader) || !looksLikePackage(bytes_)) {
     if (looksLikePackage(bytes_))
-      return bad(size, "the package ends inside its 512-byte header (truncated)");
-    return bad(0, "not a lodforge package (wrong magic)");
+      return badAt(size, "the package ends inside its 512-byte header (truncated)");
+    return badAt(0, "not a lodforge package (wrong magic)");
   }
   if (reinterpret_cast<std::uintptr_t>(bytes_.data()) % alignof(std::uint64_t) != 0) {
     return Error{ErrorKind::kInternal, name_ + ": package bytes are not 8-byte aligned"};
@@ -277,21 +285,27 @@ Status Package::validate(const OpenOptions& options) {
   header_ = reinterpret_cast<const PackageHeader*>(bytes_.data());
   const PackageHeader& h = *header_;
   if (h.version != kPackageVersion) {
-    return bad(8, fmt::format("package version {} (this lodforge reads version {})", h.version,
-                              kPackageVersion));
+    return badAt(8, fmt::format("package version {} (this lodforge reads version {})", h.version,
+                                kPackageVersion));
   }
   if (h.headerChecksum != headerChecksumOf(h))
-    return bad(504, "header checksum mismatch: the package is corrupted");
+    return badAt(504, "header checksum mismatch: the package is corrupted");
   if (h.sectionCount != kPackageSections)
-    return bad(96, fmt::format("{} sections (expected {})", h.sectionCount, kPackageSections));
+    return badAt(96, fmt::format("{} sections (expected {})", h.sectionCount, kPackageSections));
+  return {};
+}
 
-  // Section sizes follow from the counts; refuse counts the file cannot hold before multiplying.
+// Section sizes follow from the counts (counts the file cannot hold are refused before
+// multiplying); every section lies inside the file; checksums when asked.
+Status Package::validateSections(const OpenOptions& options) const {
+  const std::uint64_t size = bytes_.size();
+  const PackageHeader& h = *header_;
   auto sectionAt = [&](std::uint32_t s) {
     return offsetof(PackageHeader, sections) + s * sizeof(PackageSectionEntry);
   };
   for (std::uint64_t count : {h.objectCount, h.vertexCount, h.triangleCount, h.levelCount}) {
     if (count > size)
-      return bad(16, "counts larger than the file can hold: the package is corrupted");
+      return badAt(16, "counts larger than the file can hold: the package is corrupted");
   }
   const std::uint64_t expected[kPackageSections] = {
       h.objectCount * sizeof(PackageObject),
@@ -308,96 +322,92 @@ Status Package::validate(const OpenOptions& options) {
     const auto name = packageSectionName(static_cast<PackageSection>(s));
     if (e.offset % kPackageAlignment != 0 || e.offset < sizeof(PackageHeader) || e.offset > size ||
         e.bytes > size - e.offset) {
-      return bad(
+      return badAt(
           sectionAt(s),
           fmt::format("section '{}' ({} bytes at byte {}) lies outside the {}-byte file{}", name,
                       e.bytes, e.offset, size, e.offset <= size ? " (truncated?)" : ""));
     }
     if (e.bytes != expected[s]) {
-      return bad(sectionAt(s), fmt::format("section '{}' has {} bytes, the counts need {}", name,
-                                           e.bytes, expected[s]));
+      return badAt(sectionAt(s), fmt::format("section '{}' has {} bytes, the counts need {}", name,
+                                             e.bytes, expected[s]));
     }
   }
-  if (options.verifyChecksums) {
-    std::atomic<int> failed{-1};
-    tbb::parallel_for(std::uint32_t{0}, kPackageSections, [&](std::uint32_t s) {
-      const PackageSectionEntry& e = h.sections[s];
-      if (checksum64(bytes_.subspan(e.offset, e.bytes)) != e.checksum) failed = static_cast<int>(s);
-    });
-    if (failed >= 0) {
-      const auto s = static_cast<std::uint32_t>(failed.load());
-      return bad(h.sections[s].offset,
-                 fmt::format("section '{}' checksum mismatch: the package is corrupted",
-                             packageSectionName(static_cast<PackageSection>(s))));
-    }
-  }
+  if (!options.verifyChecksums) return {};
+  std::atomic<int> failed{-1};
+  tbb::parallel_for(std::uint32_t{0}, kPackageSections, [&](std::uint32_t s) {
+    const PackageSectionEntry& e = h.sections[s];
+    if (checksum64(bytes_.subspan(e.offset, e.bytes)) != e.checksum) failed = static_cast<int>(s);
+  });
+  if (failed < 0) return {};
+  const auto s = static_cast<std::uint32_t>(failed.load());
+  return badAt(h.sections[s].offset,
+               fmt::format("section '{}' checksum mismatch: the package is corrupted",
+                           packageSectionName(static_cast<PackageSection>(s))));
+}
 
-  // Per object: ranges inside the sections, and the invariants the kernels rely on.
-  const auto objectList = objects();
+std::string Package::objectProblem(std::size_t i) const {
+  const PackageHeader& h = *header_;
   const std::uint64_t nameBytes =
       h.sections[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
-  const std::uint64_t objectsAt =
-      h.sections[static_cast<std::uint32_t>(PackageSection::kObjects)].offset;
-  std::atomic<std::uint64_t> firstBad{std::numeric_limits<std::uint64_t>::max()};
-  std::vector<std::string> why(1);
-  std::mutex whyMutex;
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, objectList.size(), 256),
-      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t i = range.begin(); i < range.end(); ++i) {
-          if (i > firstBad.load()) return;
-          const PackageObject& o = objectList[i];
-          std::string problem;
-          const std::uint64_t levels = std::uint64_t{o.vertexCount} - o.minVertexCount + 1;
-          if (o.minVertexCount > o.vertexCount)
-            problem = "q > p";
-          else if (o.vertexOffset > h.vertexCount || o.vertexCount > h.vertexCount - o.vertexOffset)
-            problem = "vertices outside the section";
-          else if (o.triangleOffset > h.triangleCount ||
-                   o.triangleCount > h.triangleCount - o.triangleOffset)
-            problem = "triangles outside the section";
-          else if (o.levelOffset > h.levelCount || levels > h.levelCount - o.levelOffset)
-            problem = "levels outside the section";
-          else if (o.nameOffset > nameBytes || o.nameLength > nameBytes - o.nameOffset)
-            problem = "name outside the section";
-          else if (o.minTriangleCount > o.triangleCount)
-            problem = "map(q) > map(p)";
-          else {
-            const auto e = ecol(i);
-            for (std::uint32_t v = 0; v < o.vertexCount && problem.empty(); ++v) {
-              if (v < o.minVertexCount ? e[v] != v : e[v] >= v)
-                problem = fmt::format("ecol[{}] = {} breaks the decreasing chains", v, e[v]);
-            }
-            for (std::uint32_t c : triangles(i)) {
-              if (c >= o.vertexCount && problem.empty())
-                problem = fmt::format("triangle corner {} >= {} vertices", c, o.vertexCount);
-            }
-            const auto m = map(i);
-            const auto err = error(i);
-            if (problem.empty() && (m.front() != o.minTriangleCount || m.back() != o.triangleCount))
-              problem = "map ends do not match";
-            for (std::size_t k = 1; k < m.size() && problem.empty(); ++k) {
-              if (m[k] < m[k - 1]) problem = "map decreases";
-            }
-            for (std::size_t k = 0; k < err.size() && problem.empty(); ++k) {
-              if (!std::isfinite(err[k]) || err[k] < 0 || (k > 0 && err[k] > err[k - 1]))
-                problem = "error table is not finite and non-increasing";
-            }
-          }
-          if (!problem.empty()) {
-            std::lock_guard lock(whyMutex);
-            if (i < firstBad.load()) {
-              firstBad = i;
-              why[0] = problem;
-            }
-          }
-        }
-      });
-  if (firstBad.load() != std::numeric_limits<std::uint64_t>::max()) {
-    const std::uint64_t i = firstBad.load();
-    return bad(objectsAt + i * sizeof(PackageObject), fmt::format("object {}: {}", i, why[0]));
+  const PackageObject& o = objects()[i];
+  const std::uint64_t levels = std::uint64_t{o.vertexCount} - o.minVertexCount + 1;
+  if (o.minVertexCount > o.vertexCount) return "q > p";
+  if (o.vertexOffset > h.vertexCount || o.vertexCount > h.vertexCount - o.vertexOffset)
+    return "vertices outside the section";
+  if (o.triangleOffset > h.triangleCount || o.triangleCount > h.triangleCount - o.triangleOffset)
+    return "triangles outside the section";
+  if (o.levelOffset > h.levelCount || levels > h.levelCount - o.levelOffset)
+    return "levels outside the section";
+  if (o.nameOffset > nameBytes || o.nameLength > nameBytes - o.nameOffset)
+    return "name outside the section";
+  if (o.minTriangleCount > o.triangleCount) return "map(q) > map(p)";
+  const auto e = ecol(i);
+  for (std::uint32_t v = 0; v < o.vertexCount; ++v) {
+    if (v < o.minVertexCount ? e[v] != v : e[v] >= v)
+      return fmt::format("ecol[{}] = {} breaks the decreasing chains", v, e[v]);
+  }
+  for (std::uint32_t c : triangles(i)) {
+    if (c >= o.vertexCount)
+      return fmt::format("triangle corner {} >= {} vertices", c, o.vertexCount);
+  }
+  const auto m = map(i);
+  const auto err = error(i);
+  if (m.front() != o.minTriangleCount || m.back() != o.triangleCount)
+    return "map ends do not match";
+  for (std::size_t k = 1; k < m.size(); ++k) {
+    if (m[k] < m[k - 1]) return "map decreases";
+  }
+  for (std::size_t k = 0; k < err.size(); ++k) {
+    if (!std::isfinite(err[k]) || err[k] < 0 || (k > 0 && err[k] > err[k - 1]))
+      return "error table is not finite and non-increasing";
   }
   return {};
+}
+
+// Per object, in parallel: the first broken object (by index) is reported.
+Status Package::validateObjects() const {
+  const auto objectList = objects();
+  const std::uint64_t objectsAt =
+      header_->sections[static_cast<std::uint32_t>(PackageSection::kObjects)].offset;
+  std::atomic<std::uint64_t> firstBad{std::numeric_limits<std::uint64_t>::max()};
+  std::string why;
+  std::mutex whyMutex;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, objectList.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                        if (i > firstBad.load()) return;
+                        std::string problem = objectProblem(i);
+                        if (problem.empty()) continue;
+                        std::lock_guard lock(whyMutex);
+                        if (i < firstBad.load()) {
+                          firstBad = i;
+                          why = std::move(problem);
+                        }
+                      }
+                    });
+  if (firstBad.load() == std::numeric_limits<std::uint64_t>::max()) return {};
+  const std::uint64_t i = firstBad.load();
+  return badAt(objectsAt + i * sizeof(PackageObject), fmt::format("object {}: {}", i, why));
 }
 
 }  // namespace lodforge

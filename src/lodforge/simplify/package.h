@@ -167,6 +167,13 @@ class Package {
  private:
   Package() = default;
   Status validate(const OpenOptions& options);
+  Status validateHeader();
+  Status validateSections(const OpenOptions& options) const;
+  Status validateObjects() const;
+  // What breaks object i's invariants (ranges inside the sections, ECol chains, corners, Map and
+  // the error table), empty when nothing does.
+  std::string objectProblem(std::size_t i) const;
+  Status badAt(std::uint64_t at, std::string_view what) const;
   template <class T>
   std::span<const T> section(PackageSection s) const;
 

@@ -202,61 +202,42 @@ std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> t
   return reps;
 }
 
-Result<PointTilesStats> writePointTiles(const std::string& input,
-                                        const std::string& outputDirectory,
-                                        const PointTilesOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  PointTilesStats stats;
-  LODFORGE_TRY(claimTilesetOutput(input, outputDirectory));
-  Result<PointMemoryPlan> plan = planPointMemory(options.memoryLimit, options.blockSize);
-  if (!plan) return plan.status();
-  // A fresh work directory of our own (nothing to resume) that also stages the tileset.
-  ScopedDirectory work(temporaryPathFor(outputDirectory + ".work"));
-  ScopedDirectory staging(work.path + "/tileset");
-  std::error_code error;
-  fs::create_directories(fs::path(staging.path) / "tiles", error);
-  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
+namespace {
 
-  // Georeferencing: the CRS goes through PROJ while the input is read (one thread), so the
-  // blocks are in the local east-north-up frame already.
+// Georeferencing: a CRS (given, or the input's) sets up the local east-north-up frame at the
+// first point; the partition applies it while the input is read (one thread).
+Result<std::optional<CrsToLocal>> localFrame(const std::string& input,
+                                             const PointTilesOptions& options,
+                                             PointTilesStats& stats) {
   Result<PointReader> probe = PointReader::open(input, 1, options.salvageTruncated);
   if (!probe) return probe.status();
   stats.crs = !options.crs.empty() || options.origin ? options.crs : probe->info().crs;
-  std::optional<CrsToLocal> frame;
-  PartitionOptions partitionOptions;
-  partitionOptions.blockSize = options.blockSize;
-  partitionOptions.workDirectory = work.path;
-  partitionOptions.salvageTruncated = options.salvageTruncated;
-  partitionOptions.memoryBytes = plan->partitionBytes;
-  if (!stats.crs.empty()) {
-    PointBatch first;
-    Result<bool> some = probe->next(first);
-    if (!some) return some.status();
-    if (!*some) return badInput(input, "the file has no points");
-    Result<CrsToLocal> created = CrsToLocal::create(stats.crs, first.positions.front());
-    if (!created) return created.status();
-    frame.emplace(std::move(*created));
-    partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) { return frame->apply(in, out); };
-  }
-  Result<Partition> partition = partitionPoints(input, partitionOptions);
-  if (!partition) return partition.status();
-  stats.points = partition->pointCount;
-  stats.blocks = partition->blocks.size();
-  for (const PointBlock& b : partition->blocks) stats.depth = std::max(stats.depth, depthOf(b));
-  const std::vector<float> taus = toleranceSchedule(*partition, options, stats.depth);
+  if (stats.crs.empty()) return std::optional<CrsToLocal>();
+  PointBatch first;
+  Result<bool> some = probe->next(first);
+  if (!some) return some.status();
+  if (!*some) return badInput(input, "the file has no points");
+  Result<CrsToLocal> created = CrsToLocal::create(stats.crs, first.positions.front());
+  if (!created) return created.status();
+  return std::optional<CrsToLocal>(std::move(*created));
+}
 
-  // Every block's points sorted by the tile that holds them.
-  std::vector<BlockTiles> blocks(partition->blocks.size());
+// Every block's points sorted by the tile that holds them, as many blocks at once as the memory
+// plan allows.
+Result<std::vector<BlockTiles>> levelBlocks(const Partition& partition,
+                                            const PointTilesOptions& options,
+                                            const std::vector<float>& taus,
+                                            const std::string& workDirectory, int threads) {
+  std::vector<BlockTiles> blocks(partition.blocks.size());
   std::vector<Status> failures(blocks.size());
-  Progress progress("tiles: blocks", stats.points);
-  // As many blocks at once as the memory plan allows.
-  tbb::task_arena arena(plan->threads);
+  Progress progress("tiles: blocks", partition.pointCount);
+  tbb::task_arena arena(threads);
   arena.execute([&] {
     tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
       if (cancelRequested()) return;
-      const PointBlock& block = partition->blocks[b];
-      failures[b] = levelBlock(block, *partition, options, taus,
-                               work.path + "/" + block.name + ".tiles", blocks[b]);
+      const PointBlock& block = partition.blocks[b];
+      failures[b] = levelBlock(block, partition, options, taus,
+                               workDirectory + "/" + block.name + ".tiles", blocks[b]);
       std::error_code ignored;
       fs::remove(block.path, ignored);
       progress.advance(block.count);
@@ -265,11 +246,15 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   for (const Status& f : failures) LODFORGE_TRY(f);
   LODFORGE_TRY(checkCancelled());
   progress.finish();
+  return blocks;
+}
 
-  // The tile tree: every prefix of a block's name.
+// The tile tree: every prefix of a block's name is a tile; those with points get a content URI.
+std::map<std::string, TileNode> tileTree(const Partition& partition,
+                                         const std::vector<BlockTiles>& blocks) {
   std::map<std::string, TileNode> nodes;
   for (std::size_t b = 0; b < blocks.size(); ++b) {
-    const std::string& name = partition->blocks[b].name;
+    const std::string& name = partition.blocks[b].name;
     for (std::size_t length = 1; length <= name.size(); ++length) {
       TileNode& node = nodes[name.substr(0, length)];
       node.name = name.substr(0, length);
@@ -284,29 +269,40 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
       }
     }
   }
-  std::vector<TileNode*> withContent;
   for (auto& [name, node] : nodes) {
     std::sort(node.children.begin(), node.children.end());
-    if (node.points == 0) continue;
-    node.uri = "tiles/" + name + ".glb";
-    withContent.push_back(&node);
+    if (node.points > 0) node.uri = "tiles/" + name + ".glb";
   }
-  const bool colors = partition->info.hasColors;
+  return nodes;
+}
+
+// The GLB of every tile with points, in parallel; how many were written.
+Result<std::uint64_t> writeContents(std::map<std::string, TileNode>& nodes,
+                                    const std::vector<BlockTiles>& blocks,
+                                    const PointTilesOptions& options, bool colors,
+                                    const std::string& tilesetDirectory) {
+  std::vector<TileNode*> withContent;
+  for (auto& [name, node] : nodes)
+    if (!node.uri.empty()) withContent.push_back(&node);
   std::vector<Status> written(withContent.size());
   Progress writing("tiles: contents", withContent.size());
   tbb::parallel_for(std::size_t{0}, withContent.size(), [&](std::size_t i) {
     if (cancelRequested()) return;
     written[i] = writeContent(*withContent[i], blocks, options, colors,
-                              staging.path + "/" + withContent[i]->uri);
+                              tilesetDirectory + "/" + withContent[i]->uri);
     writing.advance(1);
   });
   for (const Status& f : written) LODFORGE_TRY(f);
   LODFORGE_TRY(checkCancelled());
   writing.finish();
-  stats.tiles = withContent.size();
+  return withContent.size();
+}
 
-  // tileset.json: ADD refinement; a tile at depth d stands for the cut at τ_d, a block's tile
-  // for every point (error 0).
+// tileset.json: ADD refinement; a tile at depth d stands for the cut at τ_d, a block's tile for
+// every point (error 0); the root placed by the local frame or --origin.
+Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
+                             const std::vector<BlockTiles>& blocks, const std::vector<float>& taus,
+                             const std::optional<Mat4d>& rootTransform, const std::string& path) {
   float rootError = 0;
   for (const BlockTiles& b : blocks) rootError = std::max(rootError, b.rootError);
   const std::function<nlohmann::json(const TileNode&)> tile = [&](const TileNode& node) {
@@ -324,17 +320,66 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   };
   nlohmann::json root = tile(nodes.at("b"));
   root["refine"] = "ADD";
-  if (frame) {
-    root["transform"] = frame->localToEcef().m;
-  } else if (options.origin) {
-    root["transform"] = eastNorthUpToEcef(*options.origin).m;
-  }
+  if (rootTransform) root["transform"] = rootTransform->m;
   const nlohmann::json tileset = {
       {"asset", {{"version", "1.1"}, {"generator", "lodforge " LODFORGE_VERSION}}},
       {"geometricError", std::max(static_cast<double>(rootError),
                                   taus.empty() ? 0.0 : 2.0 * static_cast<double>(taus.front()))},
       {"root", root}};
-  LODFORGE_TRY(OutputFile::writeWhole(staging.path + "/tileset.json", tileset.dump(1)));
+  return OutputFile::writeWhole(path, tileset.dump(1));
+}
+
+}  // namespace
+
+Result<PointTilesStats> writePointTiles(const std::string& input,
+                                        const std::string& outputDirectory,
+                                        const PointTilesOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PointTilesStats stats;
+  LODFORGE_TRY(claimTilesetOutput(input, outputDirectory));
+  Result<PointMemoryPlan> plan = planPointMemory(options.memoryLimit, options.blockSize);
+  if (!plan) return plan.status();
+  // A fresh work directory of our own (nothing to resume) that also stages the tileset.
+  ScopedDirectory work(temporaryPathFor(outputDirectory + ".work"));
+  ScopedDirectory staging(work.path + "/tileset");
+  std::error_code error;
+  fs::create_directories(fs::path(staging.path) / "tiles", error);
+  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
+
+  Result<std::optional<CrsToLocal>> frame = localFrame(input, options, stats);
+  if (!frame) return frame.status();
+  PartitionOptions partitionOptions;
+  partitionOptions.blockSize = options.blockSize;
+  partitionOptions.workDirectory = work.path;
+  partitionOptions.salvageTruncated = options.salvageTruncated;
+  partitionOptions.memoryBytes = plan->partitionBytes;
+  if (frame->has_value())
+    partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) {
+      return (*frame)->apply(in, out);
+    };
+  Result<Partition> partition = partitionPoints(input, partitionOptions);
+  if (!partition) return partition.status();
+  stats.points = partition->pointCount;
+  stats.blocks = partition->blocks.size();
+  for (const PointBlock& b : partition->blocks) stats.depth = std::max(stats.depth, depthOf(b));
+  const std::vector<float> taus = toleranceSchedule(*partition, options, stats.depth);
+
+  Result<std::vector<BlockTiles>> blocks =
+      levelBlocks(*partition, options, taus, work.path, plan->threads);
+  if (!blocks) return blocks.status();
+  std::map<std::string, TileNode> nodes = tileTree(*partition, *blocks);
+  Result<std::uint64_t> tiles =
+      writeContents(nodes, *blocks, options, partition->info.hasColors, staging.path);
+  if (!tiles) return tiles.status();
+  stats.tiles = *tiles;
+  std::optional<Mat4d> rootTransform;
+  if (frame->has_value()) {
+    rootTransform = (*frame)->localToEcef();
+  } else if (options.origin) {
+    rootTransform = eastNorthUpToEcef(*options.origin);
+  }
+  LODFORGE_TRY(
+      writePointTilesetJson(nodes, *blocks, taus, rootTransform, staging.path + "/tileset.json"));
   stats.outputBytes = directoryBytes(staging.path);
 
   // Complete: replace the previous tileset, if any, by the new one.

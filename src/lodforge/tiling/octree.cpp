@@ -1,535 +1,187 @@
 #include "lodforge/tiling/octree.h"
 
 #include <algorithm>
-#include <array>
-#include <cmath>
 #include <filesystem>
-#include <limits>
 #include <map>
-#include <mutex>
-#include <numbers>
-#include <queue>
 
 #include <fmt/format.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-#include <tbb/task_group.h>
-#include <nanoflann.hpp>
 
-#include "lodforge/core/distance.h"
-#include "lodforge/core/file.h"
-#include "lodforge/core/mesh.h"
-#include "lodforge/core/progress.h"
-#include "lodforge/simplify/progressive.h"
-#include "lodforge/tiling/resume.h"
+#include "lodforge/tiling/node_scheduler.h"
+#include "lodforge/tiling/node_store.h"
+#include "lodforge/tiling/simplify_node.h"
 
 namespace lodforge {
 namespace {
 
-Aabbd boundsOf(const MeshPart& mesh) {
-  Aabbd box;
-  for (const Vec3d& p : mesh.positions) box.add(p);
-  return box;
-}
-
-// Float positions relative to `center`: what the simplifier and the distance kernel take.
-std::vector<Vec3f> relativeTo(const MeshPart& mesh, Vec3d center) {
-  std::vector<Vec3f> out(mesh.positions.size());
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = toFloat(mesh.positions[i] - center);
-  return out;
-}
-
-// A sampling seed per node, so errors are reproducible.
-std::uint64_t seedOf(const OctreeNode& node) {
-  std::uint64_t seed = static_cast<std::uint64_t>(node.level) + 1;
-  for (std::int32_t c : node.cell) seed = seed * 1'000'003 + static_cast<std::uint32_t>(c);
-  return seed;
-}
-
-// The kept vertices for nanoflann's k-d tree.
-struct KeptVertices {
-  const std::vector<Vec3f>& points;
-  std::size_t kdtree_get_point_count() const { return points.size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t axis) const {
-    return axis == 0 ? points[i].x : axis == 1 ? points[i].y : points[i].z;
-  }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, KeptVertices>,
-                                        KeptVertices, 3, std::uint32_t>;
-
-// Flags the vertices on the outer faces of a node's cell: the planes of the leaf grid at its
-// cell's ends (a level-L cell spans 2^L leaf cells per axis), compared exactly, as cuts set them.
-std::vector<std::uint8_t> onOuterFaces(const MeshPart& mesh, const ChunkGrid& grid,
-                                       const OctreeNode& node) {
-  // Faces on the grid's own ends have no neighbour beyond them: NaN matches nothing.
-  std::array<double, 6> planes{};
-  for (int axis = 0; axis < 3; ++axis) {
-    const auto a = static_cast<std::size_t>(axis);
-    const std::int32_t first = node.cell[a] * (1 << node.level);
-    const std::int32_t last = first + (1 << node.level);
-    planes[2 * a] = first > 0 ? grid.plane(axis, first) : std::nan("");
-    planes[2 * a + 1] = last < grid.dims[a] ? grid.plane(axis, last) : std::nan("");
-  }
-  std::vector<std::uint8_t> flags(mesh.positions.size(), 0);
-  for (std::size_t v = 0; v < flags.size(); ++v) {
-    const Vec3d& p = mesh.positions[v];
-    for (int axis = 0; axis < 3; ++axis) {
-      const auto a = static_cast<std::size_t>(axis);
-      if (p[axis] == planes[2 * a] || p[axis] == planes[2 * a + 1]) flags[v] = 1;
-    }
-  }
-  return flags;
-}
-
-// A bound on how far any input vertex is from the simplified surface, without a search: each is
-// at most its distance to the triangles around the vertex it was collapsed into (a part of that
-// surface). Every vertex is covered, where area samples could miss a rim or a spike.
-double removedVertexBound(std::span<const Vec3f> input, std::span<const Vec3f> positions,
-                          std::span<const std::uint32_t> indices,
-                          const SimplifiedMesh& simplified) {
-  // Triangles around each kept vertex (offsets into `fans`).
-  std::vector<std::uint32_t> start(positions.size() + 1, 0), fans(indices.size());
-  for (std::uint32_t v : indices) ++start[v + 1];
-  for (std::size_t v = 0; v < positions.size(); ++v) start[v + 1] += start[v];
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  for (std::size_t i = 0; i < indices.size(); ++i)
-    fans[fill[indices[i]]++] = static_cast<std::uint32_t>(i / 3);
-  double worst = 0;
-  for (std::size_t v = 0; v < input.size(); ++v) {
-    const std::uint32_t r = simplified.representative[v];
-    if (r == ~0u || simplified.vertices[r] == v) continue;  // unused, or kept
-    double best = std::numeric_limits<double>::max();
-    for (std::uint32_t i = start[r]; i < start[r + 1] && best > worst; ++i) {
-      // (A vertex already within `worst` of the fan cannot raise it: its search ends there.)
-      const std::size_t t = 3 * std::size_t{fans[i]};
-      best = std::min(
-          best, pointTriangleDistanceSquared(toDouble(input[v]), toDouble(positions[indices[t]]),
-                                             toDouble(positions[indices[t + 1]]),
-                                             toDouble(positions[indices[t + 2]])));
-    }
-    if (best < std::numeric_limits<double>::max()) worst = std::max(worst, best);
-  }
-  return std::sqrt(worst);
-}
-
-struct Dropped {
-  std::uint64_t segments = 0;
-  double error = 0;  // bound on the distance from any dropped point to what remains
-};
-
-// Whole segments too small to matter at this level: a CAD part that cannot simplify further (a
-// closed tube at the normal limit, a sheet's corners) would otherwise keep every parent above
-// its target. When the simplified mesh is over its target, its connected components with no
-// vertex on the node's outer faces (`shared`) — so no neighbouring tile meets them — go,
-// smallest first, until the target is met or one component is left. `border` (a flag per
-// vertex) is compacted with the mesh.
-Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border,
-                          std::span<const std::uint8_t> shared, std::uint64_t target,
-                          Vec3d center) {
-  if (mesh.triangleCount() <= target) return {};
-  std::vector<std::uint32_t> component(mesh.triangleCount());
-  const std::uint32_t count = connectedComponents(mesh.vertexCount(), mesh.indices, component);
-  if (count < 2) return {};
-  std::vector<Aabbd> bounds(count);
-  std::vector<std::uint64_t> triangles(count, 0);
-  std::vector<std::uint8_t> touchesPlane(count, 0);
-  for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
-    const std::uint32_t c = component[i / 3];
-    const Vec3d& p = mesh.positions[mesh.indices[i]];
-    bounds[c].add(p);
-    if (shared[mesh.indices[i]] != 0) touchesPlane[c] = 1;
-    if (i % 3 == 0) ++triangles[c];
-  }
-  std::vector<std::uint32_t> order;
-  for (std::uint32_t c = 0; c < count; ++c)
-    if (touchesPlane[c] == 0) order.push_back(c);
-  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return length(bounds[a].size()) < length(bounds[b].size());
-  });
-  std::vector<std::uint8_t> drop(count, 0);
-  Dropped dropped;
-  std::uint64_t remaining = mesh.triangleCount();
-  for (std::uint32_t c : order) {
-    if (remaining <= target || dropped.segments + 1 == count) break;
-    drop[c] = 1;
-    remaining -= triangles[c];
-    ++dropped.segments;
-  }
-  if (dropped.segments == 0) return {};
-
-  // Keep the rest.
-  std::vector<std::uint32_t> remap(mesh.vertexCount(), ~0u);
-  std::vector<std::uint32_t> representative(count, ~0u);  // a vertex of each dropped component
-  MeshPart kept;
-  std::vector<std::uint8_t> keptBorder;
-  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
-    const std::uint32_t c = component[t / 3];
-    if (drop[c] != 0) {
-      representative[c] = mesh.indices[t];
-      continue;
-    }
-    for (std::size_t k = 0; k < 3; ++k) {
-      std::uint32_t& to = remap[mesh.indices[t + k]];
-      if (to == ~0u) {
-        to = kept.vertexCount();
-        kept.positions.push_back(mesh.positions[mesh.indices[t + k]]);
-        if (!mesh.colors.empty()) kept.colors.push_back(mesh.colors[mesh.indices[t + k]]);
-        if (!mesh.normals.empty()) kept.normals.push_back(mesh.normals[mesh.indices[t + k]]);
-        keptBorder.push_back(border[mesh.indices[t + k]]);
-      }
-      kept.indices.push_back(to);
-    }
-  }
-  // The cost, bounded without searching far from the surface: every point of a dropped
-  // component is within its bounds' diagonal of its representative vertex, which is within the
-  // distance to the nearest kept vertex (a point of what remains) of the kept surface.
-  const std::vector<Vec3f> keptPositions = relativeTo(kept, center);
-  const KeptVertices cloud{keptPositions};
-  const KdTree tree(3, cloud);
-  for (std::uint32_t c = 0; c < count; ++c) {
-    if (drop[c] == 0) continue;
-    const Vec3f p = toFloat(mesh.positions[representative[c]] - center);
-    const float query[3] = {p.x, p.y, p.z};
-    std::uint32_t nearest = 0;
-    float squared = 0;
-    tree.knnSearch(query, 1, &nearest, &squared);
-    dropped.error =
-        std::max(dropped.error, std::sqrt(static_cast<double>(squared)) + length(bounds[c].size()));
-  }
-  mesh = std::move(kept);
-  border = std::move(keptBorder);
-  return dropped;
-}
-
-struct Builder {
-  const ChunkWriter& chunks;
-  const OctreeOptions& options;
-  const NodeSink& sink;
+// The tree before anything is built, and what the build needs to walk it.
+struct OctreePlan {
   OctreeResult result;
-  std::mutex memoryMutex;
-  std::map<std::string, MeshPart> inMemory;  // keepInMemory: node meshes by path
+  std::vector<std::uint64_t> inputTriangles;  // per node: what it is built from
+  std::vector<std::uint32_t> parentOf;        // per node (kNoParent for the top level)
+  std::vector<std::uint32_t> topLevel;
+};
 
-  // Takes the mesh: kept in memory it moves into the map, on disk it is written.
-  Status save(MeshPart&& mesh, const std::string& path) {
-    if (!options.keepInMemory) return saveMesh(mesh, path);
-    std::lock_guard lock(memoryMutex);
-    inMemory[path] = std::move(mesh);
-    return {};
+// The whole tree from the leaf cells alone: leaves first, then level by level, 2x2x2 nodes of a
+// level under one parent, up to one root or --levels.
+OctreePlan planOctree(const ChunkWriter& chunks, int levels) {
+  OctreePlan plan;
+  OctreeResult& result = plan.result;
+  std::vector<std::uint64_t>& inputTriangles = plan.inputTriangles;
+  std::vector<std::uint32_t> level;
+  for (const auto& [index, count] : chunks.triangleCounts()) {
+    OctreeNode node;
+    node.cell = cellOfIndex(chunks.grid(), index);
+    level.push_back(static_cast<std::uint32_t>(result.nodes.size()));
+    result.nodes.push_back(std::move(node));
+    inputTriangles.push_back(count);
   }
-  Result<MeshPart> take(const std::string& path) {
-    if (!options.keepInMemory) return loadMesh(path);  // kept for a resumed run
-    std::lock_guard lock(memoryMutex);
-    auto node = inMemory.extract(path);
-    if (node.empty()) return Error{ErrorKind::kInternal, path + ": node mesh missing"};
-    return std::move(node.mapped());
+  int depth = 0;
+  while (level.size() > 1 && (levels == 0 || depth < levels)) {
+    ++depth;
+    // 2x2x2 nodes of this level share a parent.
+    std::map<ChunkCell, std::vector<std::uint32_t>> groups;
+    for (std::uint32_t i : level) {
+      const ChunkCell& c = result.nodes[i].cell;
+      groups[{c[0] >> 1, c[1] >> 1, c[2] >> 1}].push_back(i);
+    }
+    std::vector<std::uint32_t> parents;
+    for (auto& [cell, children] : groups) {
+      OctreeNode node;
+      node.level = depth;
+      node.cell = cell;
+      node.children = std::move(children);
+      parents.push_back(static_cast<std::uint32_t>(result.nodes.size()));
+      result.nodes.push_back(std::move(node));
+      inputTriangles.push_back(0);  // known once its children are built
+    }
+    level = std::move(parents);
+  }
+  result.levels = depth;
+  plan.topLevel = std::move(level);
+  std::vector<std::uint32_t>& parentOf = plan.parentOf;
+  parentOf.assign(result.nodes.size(), kNoParent);
+  for (std::uint32_t i = 0; i < result.nodes.size(); ++i)
+    for (std::uint32_t c : result.nodes[i].children) parentOf[c] = i;
+  return plan;
+}
+
+// Stopped below a single root (--levels): a root without content over the top level.
+void finishRoot(OctreePlan& plan) {
+  OctreeResult& result = plan.result;
+  const std::vector<std::uint32_t>& topLevel = plan.topLevel;
+  if (topLevel.size() == 1) {
+    result.root = topLevel[0];
+    return;
+  }
+  OctreeNode root;
+  root.level = result.levels + 1;
+  root.children = topLevel;
+  for (std::uint32_t c : topLevel) {
+    root.bounds.add(result.nodes[c].bounds);
+    root.geometricError = std::max(root.geometricError, result.nodes[c].geometricError);
+  }
+  root.geometricError = std::max(root.geometricError * 2, root.bounds.longestSide() / 100);
+  result.root = static_cast<std::uint32_t>(result.nodes.size());
+  result.nodes.push_back(std::move(root));
+}
+
+// Builds the planned nodes: leaves from their chunks, parents from their children (§3.3), each
+// handed to the sink and saved in the store as soon as it is built.
+class OctreeBuild {
+ public:
+  OctreeBuild(const ChunkWriter& chunks, const OctreeOptions& options, const NodeSink& sink,
+              OctreePlan& plan)
+      : chunks_(chunks), options_(options), sink_(sink), plan_(plan), store_(options) {}
+
+  Status run() {
+    return buildWhenReady(plan_.result.nodes, plan_.parentOf, plan_.inputTriangles,
+                          {.threads = options_.threads, .memoryBudget = options_.memoryBudget},
+                          [this](std::uint32_t index) {
+                            OctreeNode& node = plan_.result.nodes[index];
+                            return node.level == 0 ? buildLeaf(index) : buildParent(index);
+                          });
   }
 
-  // Bytes one node takes while it is built: its mesh, the simplifier, the distance grids.
-  static std::uint64_t estimateBytes(std::uint64_t triangles) {
-    return triangles * 320 + (1 << 20);
+ private:
+  // With --resume, a node a previous run finished is taken as it is.
+  bool resumed(std::uint32_t index) {
+    const std::uint32_t up = plan_.parentOf[index];
+    return store_.resumeNode(plan_.result.nodes[index],
+                             up == kNoParent ? nullptr : &plan_.result.nodes[up]);
   }
 
-  std::string meshPath(const OctreeNode& node) const {
-    return fmt::format("{}/L{}_{}_{}_{}.mesh", options.workDirectory, node.level, node.cell[0],
-                       node.cell[1], node.cell[2]);
+  // The node's mesh to the sink, then to the store, then its summary (which marks it done).
+  Status finish(OctreeNode& node, MeshPart&& mesh) {
+    node.triangles = mesh.triangleCount();
+    node.vertices = mesh.vertexCount();
+    node.meshPath = store_.meshPath(node);
+    LODFORGE_TRY(sink_(node, mesh));
+    LODFORGE_TRY(store_.save(std::move(mesh), node.meshPath));
+    return store_.writeSummary(node);
   }
 
-  Status writeSummary(const OctreeNode& node) const {
-    if (options.keepInMemory) return {};
-    return writeNodeSummary(node);
-  }
-
-  // A node is done when its summary is there and its mesh too, unless its parent is done as
-  // well (which removed the mesh: nothing needs it any more).
-  bool readSummary(OctreeNode& node) const {
-    if (!options.resume || options.keepInMemory) return false;
-    const std::string mesh = meshPath(node);
-    const auto up = parentOf[static_cast<std::size_t>(&node - result.nodes.data())];
-    std::error_code ignored;
-    const bool parentDone =
-        up != kNoParent &&
-        std::filesystem::exists(nodeSummaryPath(meshPath(result.nodes[up])), ignored);
-    if (!parentDone && !std::filesystem::exists(mesh, ignored)) return false;
-    if (!readNodeSummary(nodeSummaryPath(mesh), node)) return false;
-    node.meshPath = mesh;
-    return true;
-  }
-
-  Status buildLeaf(OctreeNode& node) {
-    if (readSummary(node)) return {};
-    Result<MeshPart> mesh = chunks.load(node.cell);
+  Status buildLeaf(std::uint32_t index) {
+    if (resumed(index)) return {};
+    OctreeNode& node = plan_.result.nodes[index];
+    Result<MeshPart> mesh = chunks_.load(node.cell);
     if (!mesh) return mesh.status();
     node.bounds = boundsOf(*mesh);
-    node.triangles = mesh->triangleCount();
-    node.vertices = mesh->vertexCount();
-    node.meshPath = meshPath(node);
-    LODFORGE_TRY(sink(node, *mesh));
-    LODFORGE_TRY(save(std::move(*mesh), node.meshPath));
-    LODFORGE_TRY(writeSummary(node));
+    LODFORGE_TRY(finish(node, std::move(*mesh)));
     // The chunk is no longer needed, even to resume: its work file goes now, while its pages
     // may still be unwritten, rather than in one long removal at the end.
-    if (!options.keepInMemory) removeWorkFile(chunks.chunkPath(node.cell));
+    store_.release(chunks_.chunkPath(node.cell));
     return {};
   }
 
-  Status buildParent(OctreeNode& node) {
-    if (readSummary(node)) return {};
+  Status buildParent(std::uint32_t index) {
+    if (resumed(index)) return {};
+    OctreeNode& node = plan_.result.nodes[index];
     std::vector<MeshPart> parts;
     double childError = 0;
     for (std::uint32_t c : node.children) {
-      const OctreeNode& child = result.nodes[c];
-      Result<MeshPart> part = take(child.meshPath);
+      const OctreeNode& child = plan_.result.nodes[c];
+      Result<MeshPart> part = store_.take(child.meshPath);
       if (!part) return part.status();
       parts.push_back(std::move(*part));
       node.bounds.add(child.bounds);
       childError = std::max(childError, child.geometricError);
     }
-    // Weld the children along their shared borders: the cut vertices are bit-identical.
-    MeshPart merged = concatenate(parts);
-    parts.clear();
-    weldExact(merged);
-    const Vec3d center = node.bounds.center();
-    const std::vector<Vec3f> positions = relativeTo(merged, center);
-    ProgressiveOptions simplify;
-    simplify.minNormalCos = std::cos(options.maxNormalDeviationDegrees * std::numbers::pi / 180);
-    simplify.stopAtTriangles = static_cast<std::uint32_t>(std::max<double>(
-        1, std::floor(options.reduction * static_cast<double>(merged.triangleCount()))));
-    // Only the node's outer faces are shared with other tiles: vertices there never move. The
-    // input's own rims (and seams inside the node) may simplify, along themselves.
-    const std::vector<std::uint8_t> outer = onOuterFaces(merged, chunks.grid(), node);
-    simplify.locked = outer;
-    simplify.collapseBorders = true;
-    SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
-    MeshPart mesh;
-    mesh.positions.resize(simplified.vertices.size());
-    if (!merged.colors.empty()) mesh.colors.resize(simplified.vertices.size());
-    if (!merged.normals.empty()) mesh.normals.resize(simplified.vertices.size());
-    for (std::size_t i = 0; i < simplified.vertices.size(); ++i) {
-      mesh.positions[i] = merged.positions[simplified.vertices[i]];
-      if (!mesh.colors.empty()) mesh.colors[i] = merged.colors[simplified.vertices[i]];
-      if (!mesh.normals.empty()) mesh.normals[i] = merged.normals[simplified.vertices[i]];
-    }
-    mesh.indices = simplified.indices;
-    // Geometric error: measured against the children's geometry, plus what they already
-    // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
-    // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
-    // excursions, which area samples could miss, are bounded by the simplifier's own record and
-    // by each one's distance to the fan it went into (removedVertexBound). Measured before small
-    // segments are left out (whose cost is bounded apart: a sample near one would search far for
-    // the nearest remaining surface).
-    const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);
-    const double sampled =
-        sampledHausdorff(simplifiedPositions, mesh.indices, positions, merged.indices,
-                         options.errorSamples, seedOf(node), /*corners=*/false);
-    const double vertexError =
-        removedVertexBound(positions, simplifiedPositions, mesh.indices, simplified);
-    std::vector<std::uint8_t> shared(mesh.vertexCount());
-    for (std::size_t i = 0; i < shared.size(); ++i) shared[i] = outer[simplified.vertices[i]];
-    const Dropped dropped =
-        dropSmallSegments(mesh, simplified.border, shared, simplify.stopAtTriangles, center);
-    node.droppedSegments = dropped.segments;
-    // The price of locking: border vertices the tile had to keep.
-    node.lockedVertices = static_cast<std::uint64_t>(
-        std::count(simplified.border.begin(), simplified.border.end(), 1));
-    node.geometricError = childError +
-                          std::max({sampled, static_cast<double>(simplified.error), vertexError}) +
-                          dropped.error;
-    node.triangles = mesh.triangleCount();
-    node.vertices = mesh.vertexCount();
-    node.meshPath = meshPath(node);
-    LODFORGE_TRY(sink(node, mesh));
-    LODFORGE_TRY(save(std::move(mesh), node.meshPath));
-    LODFORGE_TRY(writeSummary(node));
+    SimplifiedNode simplified = simplifyNode(std::move(parts), chunks_.grid(), node, options_);
+    node.droppedSegments = simplified.droppedSegments;
+    node.lockedVertices = simplified.lockedVertices;
+    // Plus what the children already deviate from the finest: the triangle inequality keeps it
+    // an upper bound and makes it non-increasing from parent to child.
+    node.geometricError = childError + simplified.simplificationError + simplified.droppedError;
+    LODFORGE_TRY(finish(node, std::move(simplified.mesh)));
     // The children's meshes are no longer needed, even to resume (their summaries stay).
-    if (!options.keepInMemory) {
-      for (std::uint32_t c : node.children) removeWorkFile(result.nodes[c].meshPath);
-    }
+    for (std::uint32_t c : node.children) store_.release(plan_.result.nodes[c].meshPath);
     return {};
   }
 
-  static void removeWorkFile(const std::string& path) {
-    std::error_code ignored;  // what is left goes with the work directory
-    std::filesystem::remove(path, ignored);
-  }
-
-  // The whole tree from the leaf cells alone (nodes: leaves first, then level by level), then
-  // every node built as soon as its children are.
-  Status run() {
-    if (chunks.triangleCounts().empty())
-      return Error{ErrorKind::kBadInput, "the input has no triangles"};
-    planTree();
-    LODFORGE_TRY(buildAll());
-    finishRoot();
-    return {};
-  }
-
-  void planTree() {
-    std::vector<std::uint32_t> level;
-    for (const auto& [index, count] : chunks.triangleCounts()) {
-      OctreeNode node;
-      node.cell = cellOfIndex(chunks.grid(), index);
-      level.push_back(static_cast<std::uint32_t>(result.nodes.size()));
-      result.nodes.push_back(std::move(node));
-      inputTriangles.push_back(count);
-    }
-    int depth = 0;
-    while (level.size() > 1 && (options.levels == 0 || depth < options.levels)) {
-      ++depth;
-      // 2x2x2 nodes of this level share a parent.
-      std::map<ChunkCell, std::vector<std::uint32_t>> groups;
-      for (std::uint32_t i : level) {
-        const ChunkCell& c = result.nodes[i].cell;
-        groups[{c[0] >> 1, c[1] >> 1, c[2] >> 1}].push_back(i);
-      }
-      std::vector<std::uint32_t> parents;
-      for (auto& [cell, children] : groups) {
-        OctreeNode node;
-        node.level = depth;
-        node.cell = cell;
-        node.children = std::move(children);
-        parents.push_back(static_cast<std::uint32_t>(result.nodes.size()));
-        result.nodes.push_back(std::move(node));
-        inputTriangles.push_back(0);  // known once its children are built
-      }
-      level = std::move(parents);
-    }
-    result.levels = depth;
-    topLevel = std::move(level);
-    parentOf.assign(result.nodes.size(), kNoParent);
-    for (std::uint32_t i = 0; i < result.nodes.size(); ++i)
-      for (std::uint32_t c : result.nodes[i].children) parentOf[c] = i;
-  }
-
-  // A cell's Morton code (20 bits per axis, interleaved): siblings are neighbours in it.
-  static std::uint64_t mortonOf(const ChunkCell& cell) {
-    std::uint64_t morton = 0;
-    for (int bit = 0; bit < 20; ++bit) {
-      for (std::size_t axis = 0; axis < 3; ++axis) {
-        const auto c = static_cast<std::uint64_t>(static_cast<std::uint32_t>(cell[axis]));
-        morton |= ((c >> bit) & 1) << (3 * bit + static_cast<int>(axis));
-      }
-    }
-    return morton;
-  }
-
-  // Builds every node on `threads` workers, each as soon as its children are done. With a
-  // memory budget, a node starts only while the nodes in progress and it fit in the budget (or
-  // nothing else is in progress). Each node's work is isolated: a worker waiting inside it (in
-  // the simplifier's parallel loops) never picks up another node, which would hold two nodes'
-  // memory on one stack. The first failure wins; nothing new starts after it.
-  Status buildAll() {
-    const auto count = static_cast<std::uint32_t>(result.nodes.size());
-    std::vector<std::uint32_t> pending(count, 0);
-    for (std::uint32_t i = 0; i < count; ++i)
-      pending[i] = static_cast<std::uint32_t>(result.nodes[i].children.size());
-    // Priority among ready nodes: parents before leaves (their children's meshes are freshest
-    // in the page cache, or held in memory), then Morton order of the cell, so that siblings
-    // finish close together and their parent becomes ready early.
-    std::vector<std::uint64_t> morton(count);
-    for (std::uint32_t i = 0; i < count; ++i) morton[i] = mortonOf(result.nodes[i].cell);
-    const auto later = [&](std::uint32_t a, std::uint32_t b) {
-      const int levelA = result.nodes[a].level, levelB = result.nodes[b].level;
-      return levelA != levelB ? levelA < levelB : morton[a] > morton[b];
-    };
-    std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, decltype(later)> ready(later);
-    for (std::uint32_t i = 0; i < count; ++i)
-      if (pending[i] == 0) ready.push(i);
-    Progress progress("tiles: octree", count);
-    std::mutex mutex;  // guards ready, pending, inFlight and failure
-    Status failure;
-    std::uint64_t inFlightBytes = 0;
-    std::uint32_t inFlight = 0;
-    const int threads =
-        options.threads > 0 ? options.threads : tbb::this_task_arena::max_concurrency();
-    tbb::task_arena arena(threads);
-    tbb::task_group group;
-    std::function<void()> admit;  // called with the mutex held
-    const auto process = [&](std::uint32_t index, std::uint64_t bytes) {
-      Status status = checkCancelled();
-      if (status.ok()) {
-        tbb::this_task_arena::isolate([&] {
-          OctreeNode& node = result.nodes[index];
-          status = node.level == 0 ? buildLeaf(node) : buildParent(node);
-        });
-      }
-      progress.advance(1);
-      std::lock_guard lock(mutex);
-      inFlightBytes -= bytes;
-      --inFlight;
-      if (!status.ok() && failure.ok()) failure = std::move(status);
-      const std::uint32_t up = parentOf[index];
-      if (up != kNoParent) {
-        inputTriangles[up] += result.nodes[index].triangles;
-        if (--pending[up] == 0) ready.push(up);
-      }
-      admit();
-    };
-    admit = [&] {
-      while (failure.ok() && !ready.empty() && inFlight < static_cast<std::uint32_t>(threads)) {
-        const std::uint32_t next = ready.top();
-        const std::uint64_t bytes = estimateBytes(inputTriangles[next]);
-        if (options.memoryBudget > 0 && inFlight > 0 &&
-            inFlightBytes + bytes > options.memoryBudget)
-          return;  // waits for a node in progress to finish
-        ready.pop();
-        inFlightBytes += bytes;
-        ++inFlight;
-        group.run([&process, next, bytes] { process(next, bytes); });
-      }
-    };
-    arena.execute([&] {
-      {
-        std::lock_guard lock(mutex);
-        admit();
-      }
-      group.wait();
-    });
-    progress.finish();
-    return failure;
-  }
-
-  // Stopped below a single root (--levels): a root without content over the top level.
-  void finishRoot() {
-    if (topLevel.size() == 1) {
-      result.root = topLevel[0];
-      return;
-    }
-    OctreeNode root;
-    root.level = result.levels + 1;
-    root.children = topLevel;
-    for (std::uint32_t c : topLevel) {
-      root.bounds.add(result.nodes[c].bounds);
-      root.geometricError = std::max(root.geometricError, result.nodes[c].geometricError);
-    }
-    root.geometricError = std::max(root.geometricError * 2, root.bounds.longestSide() / 100);
-    result.root = static_cast<std::uint32_t>(result.nodes.size());
-    result.nodes.push_back(std::move(root));
-  }
-
-  static constexpr std::uint32_t kNoParent = ~0u;
-  std::vector<std::uint64_t> inputTriangles;  // per node: what it is built from
-  std::vector<std::uint32_t> parentOf;        // per node (kNoParent for the top level)
-  std::vector<std::uint32_t> topLevel;
+  const ChunkWriter& chunks_;
+  const OctreeOptions& options_;
+  const NodeSink& sink_;
+  OctreePlan& plan_;
+  NodeStore store_;
 };
 
 }  // namespace
 
 Result<OctreeResult> buildOctree(const ChunkWriter& chunks, const OctreeOptions& options,
                                  const NodeSink& sink) {
-  Builder builder{chunks, options, sink, {}, {}, {}, {}, {}, {}};
   if (!options.keepInMemory) {
     std::error_code error;
     std::filesystem::create_directories(options.workDirectory, error);
     if (error)
       return ioError(options.workDirectory, fmt::format("cannot create: {}", error.message()));
   }
-  LODFORGE_TRY(builder.run());
-  return std::move(builder.result);
+  if (chunks.triangleCounts().empty())
+    return Error{ErrorKind::kBadInput, "the input has no triangles"};
+  OctreePlan plan = planOctree(chunks, options.levels);
+  OctreeBuild build(chunks, options, sink, plan);
+  LODFORGE_TRY(build.run());
+  finishRoot(plan);
+  return std::move(plan.result);
 }
 
 }  // namespace lodforge

@@ -1,0 +1,256 @@
+#include "lodforge/tiling/simplify_node.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <nanoflann.hpp>
+
+#include "lodforge/core/distance.h"
+#include "lodforge/core/mesh.h"
+#include "lodforge/simplify/progressive.h"
+
+namespace lodforge {
+namespace {
+
+// Float positions relative to `center`: what the simplifier and the distance kernel take.
+std::vector<Vec3f> relativeTo(const MeshPart& mesh, Vec3d center) {
+  std::vector<Vec3f> out(mesh.positions.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = toFloat(mesh.positions[i] - center);
+  return out;
+}
+
+// A sampling seed per node, so errors are reproducible.
+std::uint64_t seedOf(const OctreeNode& node) {
+  std::uint64_t seed = static_cast<std::uint64_t>(node.level) + 1;
+  for (std::int32_t c : node.cell) seed = seed * 1'000'003 + static_cast<std::uint32_t>(c);
+  return seed;
+}
+
+// The kept vertices for nanoflann's k-d tree.
+struct KeptVertices {
+  const std::vector<Vec3f>& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  float kdtree_get_pt(std::size_t i, std::size_t axis) const {
+    return axis == 0 ? points[i].x : axis == 1 ? points[i].y : points[i].z;
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, KeptVertices>,
+                                        KeptVertices, 3, std::uint32_t>;
+
+// Flags the vertices on the outer faces of a node's cell: the planes of the leaf grid at its
+// cell's ends (a level-L cell spans 2^L leaf cells per axis), compared exactly, as cuts set them.
+std::vector<std::uint8_t> onOuterFaces(const MeshPart& mesh, const ChunkGrid& grid,
+                                       const OctreeNode& node) {
+  // Faces on the grid's own ends have no neighbour beyond them: NaN matches nothing.
+  std::array<double, 6> planes{};
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    const std::int32_t first = node.cell[a] * (1 << node.level);
+    const std::int32_t last = first + (1 << node.level);
+    planes[2 * a] = first > 0 ? grid.plane(axis, first) : std::nan("");
+    planes[2 * a + 1] = last < grid.dims[a] ? grid.plane(axis, last) : std::nan("");
+  }
+  std::vector<std::uint8_t> flags(mesh.positions.size(), 0);
+  for (std::size_t v = 0; v < flags.size(); ++v) {
+    const Vec3d& p = mesh.positions[v];
+    for (int axis = 0; axis < 3; ++axis) {
+      const auto a = static_cast<std::size_t>(axis);
+      if (p[axis] == planes[2 * a] || p[axis] == planes[2 * a + 1]) flags[v] = 1;
+    }
+  }
+  return flags;
+}
+
+// A bound on how far any input vertex is from the simplified surface, without a search: each is
+// at most its distance to the triangles around the vertex it was collapsed into (a part of that
+// surface). Every vertex is covered, where area samples could miss a rim or a spike.
+double removedVertexBound(std::span<const Vec3f> input, std::span<const Vec3f> positions,
+                          std::span<const std::uint32_t> indices,
+                          const SimplifiedMesh& simplified) {
+  // Triangles around each kept vertex (offsets into `fans`).
+  std::vector<std::uint32_t> start(positions.size() + 1, 0), fans(indices.size());
+  for (std::uint32_t v : indices) ++start[v + 1];
+  for (std::size_t v = 0; v < positions.size(); ++v) start[v + 1] += start[v];
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    fans[fill[indices[i]]++] = static_cast<std::uint32_t>(i / 3);
+  double worst = 0;
+  for (std::size_t v = 0; v < input.size(); ++v) {
+    const std::uint32_t r = simplified.representative[v];
+    if (r == ~0u || simplified.vertices[r] == v) continue;  // unused, or kept
+    double best = std::numeric_limits<double>::max();
+    for (std::uint32_t i = start[r]; i < start[r + 1] && best > worst; ++i) {
+      // (A vertex already within `worst` of the fan cannot raise it: its search ends there.)
+      const std::size_t t = 3 * std::size_t{fans[i]};
+      best = std::min(
+          best, pointTriangleDistanceSquared(toDouble(input[v]), toDouble(positions[indices[t]]),
+                                             toDouble(positions[indices[t + 1]]),
+                                             toDouble(positions[indices[t + 2]])));
+    }
+    if (best < std::numeric_limits<double>::max()) worst = std::max(worst, best);
+  }
+  return std::sqrt(worst);
+}
+
+struct Dropped {
+  std::uint64_t segments = 0;
+  double error = 0;  // bound on the distance from any dropped point to what remains
+};
+
+// Whole segments too small to matter at this level: a CAD part that cannot simplify further (a
+// closed tube at the normal limit, a sheet's corners) would otherwise keep every parent above
+// its target. When the simplified mesh is over its target, its connected components with no
+// vertex on the node's outer faces (`shared`) — so no neighbouring tile meets them — go,
+// smallest first, until the target is met or one component is left. `border` (a flag per
+// vertex) is compacted with the mesh.
+Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border,
+                          std::span<const std::uint8_t> shared, std::uint64_t target,
+                          Vec3d center) {
+  if (mesh.triangleCount() <= target) return {};
+  std::vector<std::uint32_t> component(mesh.triangleCount());
+  const std::uint32_t count = connectedComponents(mesh.vertexCount(), mesh.indices, component);
+  if (count < 2) return {};
+  std::vector<Aabbd> bounds(count);
+  std::vector<std::uint64_t> triangles(count, 0);
+  std::vector<std::uint8_t> touchesPlane(count, 0);
+  for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
+    const std::uint32_t c = component[i / 3];
+    const Vec3d& p = mesh.positions[mesh.indices[i]];
+    bounds[c].add(p);
+    if (shared[mesh.indices[i]] != 0) touchesPlane[c] = 1;
+    if (i % 3 == 0) ++triangles[c];
+  }
+  std::vector<std::uint32_t> order;
+  for (std::uint32_t c = 0; c < count; ++c)
+    if (touchesPlane[c] == 0) order.push_back(c);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return length(bounds[a].size()) < length(bounds[b].size());
+  });
+  std::vector<std::uint8_t> drop(count, 0);
+  Dropped dropped;
+  std::uint64_t remaining = mesh.triangleCount();
+  for (std::uint32_t c : order) {
+    if (remaining <= target || dropped.segments + 1 == count) break;
+    drop[c] = 1;
+    remaining -= triangles[c];
+    ++dropped.segments;
+  }
+  if (dropped.segments == 0) return {};
+
+  // Keep the rest.
+  std::vector<std::uint32_t> remap(mesh.vertexCount(), ~0u);
+  std::vector<std::uint32_t> representative(count, ~0u);  // a vertex of each dropped component
+  MeshPart kept;
+  std::vector<std::uint8_t> keptBorder;
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    const std::uint32_t c = component[t / 3];
+    if (drop[c] != 0) {
+      representative[c] = mesh.indices[t];
+      continue;
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      std::uint32_t& to = remap[mesh.indices[t + k]];
+      if (to == ~0u) {
+        to = kept.vertexCount();
+        kept.positions.push_back(mesh.positions[mesh.indices[t + k]]);
+        if (!mesh.colors.empty()) kept.colors.push_back(mesh.colors[mesh.indices[t + k]]);
+        if (!mesh.normals.empty()) kept.normals.push_back(mesh.normals[mesh.indices[t + k]]);
+        keptBorder.push_back(border[mesh.indices[t + k]]);
+      }
+      kept.indices.push_back(to);
+    }
+  }
+  // The cost, bounded without searching far from the surface: every point of a dropped
+  // component is within its bounds' diagonal of its representative vertex, which is within the
+  // distance to the nearest kept vertex (a point of what remains) of the kept surface.
+  const std::vector<Vec3f> keptPositions = relativeTo(kept, center);
+  const KeptVertices cloud{keptPositions};
+  const KdTree tree(3, cloud);
+  for (std::uint32_t c = 0; c < count; ++c) {
+    if (drop[c] == 0) continue;
+    const Vec3f p = toFloat(mesh.positions[representative[c]] - center);
+    const float query[3] = {p.x, p.y, p.z};
+    std::uint32_t nearest = 0;
+    float squared = 0;
+    tree.knnSearch(query, 1, &nearest, &squared);
+    dropped.error =
+        std::max(dropped.error, std::sqrt(static_cast<double>(squared)) + length(bounds[c].size()));
+  }
+  mesh = std::move(kept);
+  border = std::move(keptBorder);
+  return dropped;
+}
+
+}  // namespace
+
+Aabbd boundsOf(const MeshPart& mesh) {
+  Aabbd box;
+  for (const Vec3d& p : mesh.positions) box.add(p);
+  return box;
+}
+
+SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& grid,
+                            const OctreeNode& node, const OctreeOptions& options) {
+  // Weld the children along their shared borders: the cut vertices are bit-identical.
+  MeshPart merged = concatenate(children);
+  children.clear();
+  weldExact(merged);
+  const Vec3d center = node.bounds.center();
+  const std::vector<Vec3f> positions = relativeTo(merged, center);
+  ProgressiveOptions simplify;
+  simplify.minNormalCos = std::cos(options.maxNormalDeviationDegrees * std::numbers::pi / 180);
+  simplify.stopAtTriangles = static_cast<std::uint32_t>(std::max<double>(
+      1, std::floor(options.reduction * static_cast<double>(merged.triangleCount()))));
+  // Only the node's outer faces are shared with other tiles: vertices there never move. The
+  // input's own rims (and seams inside the node) may simplify, along themselves.
+  const std::vector<std::uint8_t> outer = onOuterFaces(merged, grid, node);
+  simplify.locked = outer;
+  simplify.collapseBorders = true;
+  SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
+  MeshPart mesh;
+  mesh.positions.resize(simplified.vertices.size());
+  if (!merged.colors.empty()) mesh.colors.resize(simplified.vertices.size());
+  if (!merged.normals.empty()) mesh.normals.resize(simplified.vertices.size());
+  for (std::size_t i = 0; i < simplified.vertices.size(); ++i) {
+    mesh.positions[i] = merged.positions[simplified.vertices[i]];
+    if (!mesh.colors.empty()) mesh.colors[i] = merged.colors[simplified.vertices[i]];
+    if (!mesh.normals.empty()) mesh.normals[i] = merged.normals[simplified.vertices[i]];
+  }
+  mesh.indices = simplified.indices;
+  // Geometric error: measured against the children's geometry, plus what they already
+  // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
+  // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
+  // excursions, which area samples could miss, are bounded by the simplifier's own record and
+  // by each one's distance to the fan it went into (removedVertexBound). Measured before small
+  // segments are left out (whose cost is bounded apart: a sample near one would search far for
+  // the nearest remaining surface).
+  const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);
+  const double sampled =
+      sampledHausdorff(simplifiedPositions, mesh.indices, positions, merged.indices,
+                       options.errorSamples, seedOf(node), /*corners=*/false);
+  const double vertexError =
+      removedVertexBound(positions, simplifiedPositions, mesh.indices, simplified);
+  std::vector<std::uint8_t> shared(mesh.vertexCount());
+  for (std::size_t i = 0; i < shared.size(); ++i) shared[i] = outer[simplified.vertices[i]];
+  const Dropped dropped =
+      dropSmallSegments(mesh, simplified.border, shared, simplify.stopAtTriangles, center);
+  SimplifiedNode out;
+  out.droppedSegments = dropped.segments;
+  // The price of locking: border vertices the tile had to keep.
+  out.lockedVertices =
+      static_cast<std::uint64_t>(std::count(simplified.border.begin(), simplified.border.end(), 1));
+  out.simplificationError = std::max({sampled, static_cast<double>(simplified.error), vertexError});
+  out.droppedError = dropped.error;
+  out.mesh = std::move(mesh);
+  return out;
+}
+
+}  // namespace lodforge

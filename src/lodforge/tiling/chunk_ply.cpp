@@ -169,7 +169,7 @@ class PlyChunking {
 
  private:
   std::shared_ptr<PlyBatch> readVertexBatch(tbb::flow_control& control);
-  void writeVertexBatch(const PlyBatch& batch);
+  void writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>& buffer);
   Status fetch(const PlyBatch& batch, std::size_t t, std::array<CutCorner, 3>& triangle);
   PlyReadOptions faceReading() const;
   Result<ChunkGrid> chunkGrid() const;
@@ -191,7 +191,6 @@ class PlyChunking {
   PipelineFailure failure_;
   std::uint64_t read_ = 0;
   PlyBatch batch_;
-  std::vector<std::byte> buffer_;
   std::optional<Progress> progress_;
 };
 
@@ -217,14 +216,17 @@ Status PlyChunking::openVertices() {
 // pass): read (the reader is sequential), then transform, bound and write in file order.
 Status PlyChunking::copyVertices() {
   progress_.emplace("tiles: vertices", header_.vertexCount);
+  std::vector<std::byte> buffer;  // one batch's records; freed after this pass
   const auto pipeline = [&] {
     using Work = std::shared_ptr<PlyBatch>;
-    tbb::parallel_pipeline(
-        3, tbb::make_filter<void, Work>(
-               tbb::filter_mode::serial_in_order,
-               [&](tbb::flow_control& control) { return readVertexBatch(control); }) &
-               tbb::make_filter<Work, void>(tbb::filter_mode::serial_in_order,
-                                            [&](const Work& batch) { writeVertexBatch(*batch); }));
+    tbb::parallel_pipeline(3, tbb::make_filter<void, Work>(tbb::filter_mode::serial_in_order,
+                                                           [&](tbb::flow_control& control) {
+                                                             return readVertexBatch(control);
+                                                           }) &
+                                  tbb::make_filter<Work, void>(tbb::filter_mode::serial_in_order,
+                                                               [&](const Work& batch) {
+                                                                 writeVertexBatch(*batch, buffer);
+                                                               }));
   };
   runOn(options_.threads, pipeline);
   LODFORGE_TRY(failure_.status());
@@ -253,9 +255,9 @@ std::shared_ptr<PlyBatch> PlyChunking::readVertexBatch(tbb::flow_control& contro
   return nullptr;
 }
 
-void PlyChunking::writeVertexBatch(const PlyBatch& batch) {
+void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>& buffer) {
   if (failure_.failed()) return;
-  buffer_.resize(batch.positions.size() * kVertexBytes);
+  buffer.resize(batch.positions.size() * kVertexBytes);
   for (std::size_t i = 0; i < batch.positions.size(); ++i) {
     Vec3d p = batch.positions[i];
     if (options_.transform && !options_.transform(batch.positions[i], p)) {
@@ -273,12 +275,12 @@ void PlyChunking::writeVertexBatch(const PlyBatch& batch) {
                         ? Vec3f{}
                         : transformNormal(options_, batch.positions[i], p, batch.normals[i]);
     const float normal[3] = {n.x, n.y, n.z};
-    std::byte* record = buffer_.data() + i * kVertexBytes;
+    std::byte* record = buffer.data() + i * kVertexBytes;
     std::memcpy(record, xyz, sizeof xyz);
     std::memcpy(record + sizeof xyz, &color, sizeof color);
     std::memcpy(record + kNormalOffset, normal, sizeof normal);
   }
-  if (::write(fd_, buffer_.data(), buffer_.size()) != static_cast<ssize_t>(buffer_.size())) {
+  if (::write(fd_, buffer.data(), buffer.size()) != static_cast<ssize_t>(buffer.size())) {
     failure_.fail(batch.first, ioErrorFromErrno(vertexPath_, "write"));
     return;
   }

@@ -401,7 +401,6 @@ void addBench(CLI::App& app, const Global& global, Run& run) {
       takePackageRun(*cloud, o->input, *o);
       cloud->render = o->render;
       cloud->json = o->json;
-      if (cloud->foveaRadii.empty()) cloud->foveaRadii = {200};
       run = [&global, cloud] { return runCloudBench(global, *cloud); };
       return;
     }

@@ -79,6 +79,7 @@ void addCloudOptions(CLI::App& sub, CloudRunOptions& options, bool severalRadii)
 void takePackageRun(CloudRunOptions& cloud, const std::string& input, const PathChoice& choice) {
   static_cast<PathChoice&>(cloud) = choice;
   cloud.input = input;
+  if (cloud.foveaRadii.empty()) cloud.foveaRadii = {200};
 }
 
 namespace {

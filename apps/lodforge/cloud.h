@@ -27,7 +27,8 @@ struct CloudRunOptions : PathChoice {
 // --fovea, --foveal-splat, --resident-blocks and --loads-per-frame, for view and bench.
 void addCloudOptions(CLI::App& sub, CloudRunOptions& options, bool severalRadii);
 
-// Bench and view are given a point package: its run takes their input, path and viewport.
+// Bench and view are given a point package: its run takes their input, path and viewport (and
+// a fovea of 200 pixels unless --fovea gave one).
 void takePackageRun(CloudRunOptions& cloud, const std::string& input, const PathChoice& choice);
 
 Status runCloudBench(const Global& global, const CloudRunOptions& options);

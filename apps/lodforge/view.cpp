@@ -427,7 +427,6 @@ void addView(CLI::App& app, const Global& global, Run& run) {
       cloud->path = o->play.empty() ? "orbit" : o->play;
       cloud->stopAfter = o->stopAfter;
       cloud->screenshot = o->screenshot;
-      if (cloud->foveaRadii.empty()) cloud->foveaRadii = {200};
       run = [&global, cloud] { return runCloudView(global, *cloud); };
       return;
     }

@@ -123,13 +123,8 @@ void PointRenderer::draw(const Camera& camera, const PointDrawOptions& options) 
   // Splat positions are relative to the selection's origin: so is the camera here.
   Camera local = camera;
   local.position = camera.position - s.origin;
-  float matrix[16];
-  viewProjectionMatrix(local, matrix);
   const GLuint p = s.program.id();
-  glUseProgram(p);
-  glUniformMatrix4fv(glGetUniformLocation(p, "viewProjection"), 1, GL_FALSE, matrix);
-  glUniform3f(glGetUniformLocation(p, "eye"), static_cast<float>(local.position.x),
-              static_cast<float>(local.position.y), static_cast<float>(local.position.z));
+  useCameraProgram(p, local);
   glUniform3f(glGetUniformLocation(p, "forward"), static_cast<float>(camera.forward.x),
               static_cast<float>(camera.forward.y), static_cast<float>(camera.forward.z));
   glUniform1f(glGetUniformLocation(p, "pixelScale"), static_cast<float>(camera.pixelScale()));

@@ -353,6 +353,15 @@ void beginFrame(const Camera& camera, const std::array<std::uint8_t, 3>& backgro
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 }
 
+void useCameraProgram(unsigned program, const Camera& camera) {
+  float matrix[16];
+  viewProjectionMatrix(camera, matrix);
+  glUseProgram(program);
+  glUniformMatrix4fv(glGetUniformLocation(program, "viewProjection"), 1, GL_FALSE, matrix);
+  glUniform3f(glGetUniformLocation(program, "eye"), static_cast<float>(camera.position.x),
+              static_cast<float>(camera.position.y), static_cast<float>(camera.position.z));
+}
+
 void Renderer::draw(const Camera& camera, const DrawOptions& options) const {
   const State& s = *state_;
   glDisable(GL_CULL_FACE);
@@ -386,13 +395,8 @@ void Renderer::draw(const Camera& camera, const DrawOptions& options) const {
   fitted.farPlane = 1.01 * std::sqrt(farthest) + 1e-6;
   fitted.nearPlane =
       std::max({camera.nearPlane, 0.99 * std::sqrt(nearest), fitted.farPlane * 1e-4});
-  float matrix[16];
-  viewProjectionMatrix(fitted, matrix);
   const GLuint p = s.program.id();
-  glUseProgram(p);
-  glUniformMatrix4fv(glGetUniformLocation(p, "viewProjection"), 1, GL_FALSE, matrix);
-  glUniform3f(glGetUniformLocation(p, "eye"), static_cast<float>(camera.position.x),
-              static_cast<float>(camera.position.y), static_cast<float>(camera.position.z));
+  useCameraProgram(p, fitted);  // fitted.position is camera.position
   glUniform1i(glGetUniformLocation(p, "mode"), static_cast<int>(options.colorMode));
   glUniform1i(glGetUniformLocation(p, "useVertexColor"), s.colors ? 1 : 0);
   glUniform1i(glGetUniformLocation(p, "useVertexNormal"), s.normals ? 1 : 0);

@@ -96,5 +96,7 @@ void viewProjectionMatrix(const Camera& camera, float out[16]);
 // The GL state every draw starts from: the camera's viewport, a depth test that keeps the
 // nearest, and the target cleared to `background`.
 void beginFrame(const Camera& camera, const std::array<std::uint8_t, 3>& background);
+// Uses `program` with the camera's "viewProjection" matrix and "eye" position set.
+void useCameraProgram(unsigned program, const Camera& camera);
 
 }  // namespace lodforge

@@ -193,17 +193,29 @@ Status describePointFile(const std::string& path, bool json) {
   Aabbd bounds;
   std::uint64_t count = 0;
   if (fileExtension(path) == "las" || fileExtension(path) == "laz") {
-    Result<LasReader> las = LasReader::open(path);
-    if (!las) return las.status();
-    const LasHeader& h = las->header();
-    j["format"] = "LAS";
+    Result<LasHeader> header = LasReader::readHeader(path);
+    if (!header) return header.status();
+    const LasHeader& h = *header;
+    j["format"] = h.copc ? "COPC" : h.compressed ? "LAZ" : "LAS";
+    if (h.laz) {
+      const LazInfo& laz = *h.laz;
+      nlohmann::json items = nlohmann::json::array();
+      for (const LazItem& item : laz.items)
+        items.push_back(
+            {{"type", lazItemName(item.type)}, {"size", item.size}, {"version", item.version}});
+      j["laz"] = {{"compressor", static_cast<int>(laz.compressor)},
+                  {"chunkSize", laz.chunkSize},
+                  {"variableChunks", laz.chunkSize == kLazVariableChunks},
+                  {"items", items},
+                  {"description", describeLaz(laz)}};
+    }
     j["version"] = fmt::format("{}.{}", h.versionMajor, h.versionMinor);
     j["pointFormat"] = h.pointFormat;
     j["recordLength"] = h.recordLength;
     j["scale"] = {h.scale.x, h.scale.y, h.scale.z};
     j["offset"] = {h.offset.x, h.offset.y, h.offset.z};
     j["colors"] = h.hasColors;
-    if (h.hasColors) j["colorBits"] = h.eightBitColors ? 8 : 16;
+    if (h.hasColors && !h.compressed) j["colorBits"] = h.eightBitColors ? 8 : 16;
     j["crs"] = h.crs;
     j["software"] = h.generatingSoftware;
     count = h.pointCount;
@@ -235,12 +247,16 @@ Status describePointFile(const std::string& path, bool json) {
   }
   fmt::print("file       {}\n", path);
   if (j.contains("version")) {
-    fmt::print("format     LAS {}, point format {} ({}-byte records{}) ({})\n",
-               j["version"].get<std::string>(), j["pointFormat"].get<int>(),
-               j["recordLength"].get<int>(),
-               j["colors"].get<bool>() ? fmt::format(", {}-bit colours", j["colorBits"].get<int>())
-                                       : std::string(),
+    const std::string colors = !j["colors"].get<bool>() ? std::string()
+                               : j.contains("colorBits")
+                                   ? fmt::format(", {}-bit colours", j["colorBits"].get<int>())
+                                   : std::string(", colours");
+    fmt::print("format     {} {}, point format {} ({}-byte records{}) ({})\n",
+               j["format"].get<std::string>(), j["version"].get<std::string>(),
+               j["pointFormat"].get<int>(), j["recordLength"].get<int>(), colors,
                formatBytes(*bytes));
+    if (j.contains("laz"))
+      fmt::print("compressed {}\n", j["laz"]["description"].get<std::string>());
     fmt::print("scale      {:.6g} {:.6g} {:.6g}, offset {:.10g} {:.10g} {:.10g}\n",
                j["scale"][0].get<double>(), j["scale"][1].get<double>(),
                j["scale"][2].get<double>(), j["offset"][0].get<double>(),

@@ -293,13 +293,130 @@ TEST(LasReader, RefusesBadFilesWithTheirPosition) {
   expectBad(evlr, "extended records");
 }
 
-TEST(LasReader, RefusesLazWithAdviceOnDecompressing) {
+TEST(LasReader, RefusesLazPointsSayingWhatTheyAre) {
   Result<LasReader> reader = LasReader::open(test::dataPath("points/autzen_trim.laz"));
   ASSERT_FALSE(reader.ok());
   EXPECT_EQ(reader.status().kind(), ErrorKind::kBadInput);
-  EXPECT_NE(reader.error().message.find("autzen_trim.laz: byte 104: LAZ"), std::string::npos)
-      << reader.error().message;
-  EXPECT_NE(reader.error().message.find("pdal translate"), std::string::npos);
+  const std::string& message = reader.error().message;
+  EXPECT_NE(message.find("autzen_trim.laz: byte 104: LAZ (point-wise chunked"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("items POINT10 v2, GPSTIME11 v2, RGB12 v2"), std::string::npos) << message;
+  EXPECT_NE(message.find("convert the file to LAS first"), std::string::npos) << message;
+}
+
+// The LASzip record of the real LAZ files, as their LAS twins and the issue describe them.
+TEST(LasReader, ReadsTheLaszipRecordOfRealLazAndCopc) {
+  struct Case {
+    std::string file;
+    LazCompressor compressor;
+    int pointFormat;
+    std::uint16_t itemVersion;
+    std::vector<std::string> items;
+    bool chunked, copc;
+  };
+  for (const Case& c : {
+           Case{"autzen_trim.laz",
+                LazCompressor::kPointwiseChunked,
+                3,
+                2,
+                {"POINT10", "GPSTIME11", "RGB12"},
+                true,
+                false},
+           Case{"simple-v1.laz",
+                LazCompressor::kPointwise,
+                3,
+                1,
+                {"POINT10", "GPSTIME11", "RGB12"},
+                false,
+                false},
+           Case{"1.2-with-color.copc.laz",
+                LazCompressor::kLayeredChunked,
+                7,
+                3,
+                {"POINT14", "RGB14"},
+                true,
+                true},
+       }) {
+    Result<LasHeader> h = LasReader::readHeader(test::dataPath("points/" + c.file));
+    ASSERT_TRUE(h.ok()) << c.file << ": " << h.error().message;
+    EXPECT_TRUE(h->compressed) << c.file;
+    EXPECT_EQ(h->copc, c.copc) << c.file;
+    EXPECT_EQ(h->pointFormat, c.pointFormat) << c.file;
+    ASSERT_TRUE(h->laz.has_value()) << c.file;
+    EXPECT_EQ(h->laz->compressor, c.compressor) << c.file;
+    EXPECT_EQ(h->laz->coder, 0) << c.file;
+    EXPECT_EQ(h->laz->recordBytes(), h->recordLength) << c.file;
+    ASSERT_EQ(h->laz->items.size(), c.items.size()) << c.file;
+    for (std::size_t i = 0; i < c.items.size(); ++i) {
+      EXPECT_EQ(lazItemName(h->laz->items[i].type), c.items[i]) << c.file;
+      EXPECT_EQ(h->laz->items[i].version, c.itemVersion) << c.file;
+    }
+    if (c.chunked) {
+      EXPECT_GT(h->laz->chunkSize, 0u) << c.file;
+    }
+  }
+  // The same header as the LAS of the same points: counts, scale and bounds.
+  Result<LasHeader> laz = LasReader::readHeader(test::dataPath("points/autzen_trim.laz"));
+  Result<LasHeader> las = LasReader::readHeader(test::dataPath("points/autzen_trim.las"));
+  ASSERT_TRUE(laz.ok() && las.ok());
+  EXPECT_FALSE(las->compressed);
+  EXPECT_FALSE(las->laz.has_value());
+  EXPECT_EQ(laz->pointCount, las->pointCount);
+  EXPECT_EQ(laz->scale, las->scale);
+  EXPECT_EQ(laz->bounds.min, las->bounds.min);
+  EXPECT_EQ(laz->crs, las->crs);
+}
+
+TEST(LasReader, RefusesADamagedLaszipRecordWithItsPosition) {
+  // A compressed format byte and a LASzip record of POINT10 v2 (20 bytes, format 0).
+  std::string record(34 + 6, '\0');
+  put<std::uint16_t>(record, 0, 2);       // point-wise chunked
+  put<std::uint32_t>(record, 12, 50000);  // chunk size
+  put<std::int64_t>(record, 16, -1);
+  put<std::int64_t>(record, 24, -1);
+  put<std::uint16_t>(record, 32, 1);
+  put<std::uint16_t>(record, 34, 6);   // POINT10
+  put<std::uint16_t>(record, 36, 20);  // bytes
+  put<std::uint16_t>(record, 38, 2);
+  const auto laz = [&](const std::string& data) {
+    std::string file = makeLas(2, 0, {}, {{"laszip encoded", kLazRecordId, data}});
+    file[104] = static_cast<char>(0x80);
+    return file;
+  };
+  const auto header = [](const std::string& bytes) {
+    // readHeader wants a file: through a temporary one.
+    test::TempDir dir;
+    test::writeFile(dir.file("x.laz"), bytes);
+    return LasReader::readHeader(dir.file("x.laz"));
+  };
+  Result<LasHeader> good = header(laz(record));
+  ASSERT_TRUE(good.ok()) << good.error().message;
+  EXPECT_EQ(good->laz->items.size(), 1u);
+  std::string wrong = record;
+  put<std::uint16_t>(wrong, 32, 3);  // three items in room for one
+  Result<LasHeader> bad = header(laz(wrong));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("byte 313: LASzip record: 3 items need 52 bytes"),
+            std::string::npos)
+      << bad.error().message;
+  wrong = record;
+  put<std::uint16_t>(wrong, 36, 24);  // items cover more than the record
+  bad = header(laz(wrong));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("LASzip items cover 24 bytes of a 20-byte point record"),
+            std::string::npos)
+      << bad.error().message;
+  wrong = record;
+  put<std::uint16_t>(wrong, 2, 7);  // an unknown coder
+  bad = header(laz(wrong));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("unknown coder 7"), std::string::npos) << bad.error().message;
+  // Compressed points without the record at all.
+  std::string bare = makeLas(2, 0, {});
+  bare[104] = static_cast<char>(0x80);
+  bad = header(bare);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("no LASzip record"), std::string::npos) << bad.error().message;
 }
 
 TEST(PointReader, ReadsLasThroughTheCommonReader) {

@@ -84,6 +84,9 @@ struct LasReader::State {
   std::uint8_t formatByte = 0;   // as stored (LASzip sets its top bits)
   std::uint64_t evlrOffset = 0;  // LAS 1.4's extended records
   std::uint32_t evlrCount = 0;
+  bool headerOnly = false;           // readHeader: LAZ accepted, no point read
+  std::vector<std::byte> lazRecord;  // the LASzip record's data, and where it lies
+  std::uint64_t lazAt = 0;
 
   Status readHeader(std::vector<std::byte>& bytes);
   Status readScalesAndBounds(std::span<const std::byte> bytes);
@@ -91,6 +94,7 @@ struct LasReader::State {
   Status readRecords(CrsRecords& crs);
   Status readExtendedRecords(CrsRecords& crs);
   Status probeColorDepth();
+  Status readLazRecord();
 
   Result<ByteSource> reopen() const {
     if (!path.empty()) return ByteSource::openFile(path);
@@ -182,12 +186,8 @@ Status LasReader::State::readHeader(std::vector<std::byte>& bytes) {
   if (!in.read(bytes.data() + kHeader12, h.headerSize - kHeader12))
     return fail(kHeader12, "the file ends inside the header");
   // LASzip marks compressed files by setting the format's top bits.
-  if ((formatByte & 0xC0) != 0)
-    return fail(104, fmt::format("LAZ (compressed) point data (point format byte {:#x}) is not "
-                                 "supported; decompress it first, e.g. `pdal translate in.laz "
-                                 "out.las` (Debian package pdal) or `laszip -i in.laz -o out.las`",
-                                 formatByte));
-  h.pointFormat = formatByte;
+  h.compressed = (formatByte & 0xC0) != 0;
+  h.pointFormat = formatByte & 0x3F;
   if (lasRecordSize(h.pointFormat) == 0)
     return fail(104,
                 fmt::format("point format {} is not a LAS format (0 to 10 are)", h.pointFormat));
@@ -231,11 +231,13 @@ Status LasReader::State::readScalesAndBounds(std::span<const std::byte> bytes) {
 Status LasReader::State::checkPointData() const {
   const LasHeader& h = header;
   const std::uint64_t fileSize = source->size();
-  const std::uint64_t pointBytes = h.pointCount * h.recordLength;
+  // Compressed points take less than their records: only where they start is known here.
+  const std::uint64_t pointBytes = h.compressed ? 0 : h.pointCount * h.recordLength;
   if (h.pointOffset < h.headerSize)
     return fail(96, fmt::format("point data offset {} lies inside the {}-byte header",
                                 h.pointOffset, h.headerSize));
-  if (h.pointCount > (fileSize / h.recordLength) || h.pointOffset + pointBytes > fileSize)
+  if ((!h.compressed && h.pointCount > fileSize / h.recordLength) ||
+      h.pointOffset + pointBytes > fileSize)
     return fail(107, fmt::format("{} points of {} bytes from byte {} run past the end of "
                                  "the file ({} bytes)",
                                  h.pointCount, h.recordLength, h.pointOffset, fileSize));
@@ -263,7 +265,13 @@ Status LasReader::State::readRecords(CrsRecords& crs) {
                                        v + 1, length, h.pointOffset));
     record.resize(length);
     if (!in.read(record.data(), length)) return fail(at, "the file ends in a record");
-    crs.take(id, fixedString(head + 2, 16), record);
+    const std::string user = fixedString(head + 2, 16);
+    crs.take(id, user, record);
+    if (user == "laszip encoded" && id == kLazRecordId) {
+      lazRecord = record;
+      lazAt = at + kVlrHeader;
+    }
+    if (user == "copc" && id == 1) header.copc = true;
   }
   return {};
 }
@@ -272,7 +280,7 @@ Status LasReader::State::readRecords(CrsRecords& crs) {
 Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
   const LasHeader& h = header;
   if (evlrCount == 0) return {};
-  const std::uint64_t pointBytes = h.pointCount * h.recordLength;
+  const std::uint64_t pointBytes = h.compressed ? 0 : h.pointCount * h.recordLength;
   std::vector<std::byte> record;
   Result<ByteSource> extra = reopen();
   if (!extra) return extra.status();
@@ -306,12 +314,34 @@ Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
   return {};
 }
 
+// LAZ: the LASzip record must be there and describe the records the header states; reading
+// points from it is refused (decoding is not built yet) unless only the header is wanted.
+Status LasReader::State::readLazRecord() {
+  LasHeader& h = header;
+  if (!h.compressed) return {};
+  if (lazRecord.empty())
+    return fail(104,
+                "the point format byte marks LAZ (compressed) points, but the file has no "
+                "LASzip record (\"laszip encoded\", 22204)");
+  Result<LazInfo> laz = parseLazVlr(lazRecord, source->name(), lazAt);
+  if (!laz) return laz.status();
+  if (laz->recordBytes() != h.recordLength)
+    return fail(lazAt + 32, fmt::format("LASzip items cover {} bytes of a {}-byte point record",
+                                        laz->recordBytes(), h.recordLength));
+  h.laz = std::move(*laz);
+  if (headerOnly) return {};
+  return fail(104, fmt::format("LAZ ({}{}): lodforge does not decode compressed points yet; "
+                               "convert the file to LAS first (e.g. with LAStools' laszip or "
+                               "PDAL, which Debian 12 does not package)",
+                               h.copc ? "COPC, " : "", describeLaz(*h.laz)));
+}
+
 // 8- or 16-bit colours: the first points tell.
 Status LasReader::State::probeColorDepth() {
   LasHeader& h = header;
   rgb = colorOffset(h.pointFormat);
   h.hasColors = rgb != 0;
-  if (!h.hasColors) return {};
+  if (!h.hasColors || h.compressed) return {};
   Result<ByteSource> probe = reopen();
   if (!probe) return probe.status();
   probe->skip(h.pointOffset);
@@ -326,6 +356,18 @@ Status LasReader::State::probeColorDepth() {
   return {};
 }
 
+Result<LasHeader> LasReader::readHeader(const std::string& path) {
+  Result<ByteSource> source = ByteSource::openFile(path);
+  if (!source) return source.status();
+  auto state = std::make_unique<State>();
+  state->path = path;
+  state->source.emplace(std::move(*source));
+  state->headerOnly = true;
+  Result<LasReader> reader = start(std::move(state));
+  if (!reader) return reader.status();
+  return reader->header();
+}
+
 Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
   std::vector<std::byte> bytes;
   LODFORGE_TRY(state->readHeader(bytes));
@@ -335,6 +377,7 @@ Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
   LODFORGE_TRY(state->readRecords(crs));
   LODFORGE_TRY(state->readExtendedRecords(crs));
   state->header.crs = crs.crs();
+  LODFORGE_TRY(state->readLazRecord());
   ByteSource& source = *state->source;
   if (!source.skip(state->header.pointOffset - source.offset()))
     return state->fail(source.offset(), "the file ends before the point data");

@@ -1,16 +1,19 @@
 // LAS reader (ASPRS LAS 1.0–1.4, point formats 0–10, uncompressed): the header, the variable
 // length records that carry the coordinate system (OGC WKT, or GeoTIFF keys naming an EPSG
 // code), and the points streamed in batches with scale and offset applied in double precision.
-// LAZ (compressed) files are refused with a message that says how to decompress them.
+// LAZ (compressed) point data is not decoded yet: its header and LASzip record are read
+// (LasReader::readHeader, for `info`), and opening it to read points is refused with what it is.
 #pragma once
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/status.h"
+#include "lodforge/io/laz_vlr.h"
 #include "lodforge/io/point_batch.h"
 
 namespace lodforge {
@@ -33,6 +36,11 @@ struct LasHeader {
   // Colours are 16-bit in the spec, but many writers store 0–255: true when the first points'
   // colours all fit in 8 bits, and then they are taken as they are.
   bool eightBitColors = false;
+  // LAZ: the point data is compressed (the format byte's top bits); what LASzip wrote it with,
+  // and whether a COPC record ("copc", 1) says it is in COPC order.
+  bool compressed = false;
+  std::optional<LazInfo> laz;
+  bool copc = false;
 };
 
 // The smallest record of a point format (0–10), 0 for an unknown format.
@@ -43,6 +51,8 @@ class LasReader {
   static Result<LasReader> open(const std::string& path, std::size_t batchSize = 1 << 16);
   static Result<LasReader> fromMemory(std::span<const std::byte> bytes, std::string name,
                                       std::size_t batchSize = 1 << 16);
+  // The header and records alone, LAZ too (no point is read; colour depth is not probed).
+  static Result<LasHeader> readHeader(const std::string& path);
   LasReader(LasReader&&) noexcept;
   LasReader& operator=(LasReader&&) noexcept;
   ~LasReader();

@@ -55,9 +55,9 @@ Status refuseInputs(const std::string& output, const OutputKind& kind,
 
 Status refuseForeign(const std::string& output, const OutputKind& kind) {
   std::error_code error;
-  const fs::file_status status = fs::status(output, error);
-  if (error || !fs::exists(status)) return {};
-  const bool directory = fs::is_directory(status);
+  const fs::file_type type = fs::status(output, error).type();
+  if (error || type == fs::file_type::not_found) return {};
+  const bool directory = type == fs::file_type::directory;
   if (kind.directory && !directory)
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: exists and is not a directory; {} is written as a directory, so "
@@ -66,7 +66,7 @@ Status refuseForeign(const std::string& output, const OutputKind& kind) {
   if (!kind.directory && directory)
     return Error{ErrorKind::kUsage, fmt::format("{}: is a directory; give the name of {} to write",
                                                 output, kind.name)};
-  if (!kind.directory && !fs::is_regular_file(status))
+  if (!kind.directory && type != fs::file_type::regular)
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: exists and is not a regular file; not replacing it", output)};
   if (isEmpty(output, directory) || (kind.isOwn && kind.isOwn(output))) return {};

@@ -21,6 +21,11 @@ bool cancelRequested();
 // An ErrorKind::kCancelled status when cancellation was requested, ok otherwise.
 Status checkCancelled();
 
+// Wall time since `start`, for the figures long work reports.
+inline double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 enum class ProgressMode : std::uint8_t { kAuto, kBar, kLines, kOff };
 // Process-wide choice (the CLI sets kOff for -q); kAuto picks a bar when stderr is a terminal.
 void setProgressMode(ProgressMode mode);

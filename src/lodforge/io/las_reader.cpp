@@ -5,6 +5,8 @@
 #include <cstring>
 #include <optional>
 
+#include "lodforge/io/record_field.h"
+
 namespace lodforge {
 
 namespace {
@@ -16,13 +18,6 @@ constexpr std::size_t kVlrHeader = 54, kEvlrHeader = 60;
 constexpr std::uint16_t kWktRecord = 2112, kGeoKeyRecord = 34735;
 constexpr std::uint16_t kProjectedCsKey = 3072, kGeographicKey = 2048, kUserDefined = 32767;
 constexpr std::size_t kColorProbe = 1 << 16;  // points looked at to tell 8- from 16-bit colours
-
-template <class T>
-T load(const std::byte* at) {
-  T value;
-  std::memcpy(&value, at, sizeof value);
-  return value;
-}
 
 std::string fixedString(const std::byte* at, std::size_t size) {
   std::string s(reinterpret_cast<const char*>(at), size);
@@ -167,12 +162,12 @@ Status LasReader::State::readHeader(std::vector<std::byte>& bytes) {
                                 h.versionMajor, h.versionMinor));
   h.systemIdentifier = fixedString(bytes.data() + 26, 32);
   h.generatingSoftware = fixedString(bytes.data() + 58, 32);
-  h.headerSize = load<std::uint16_t>(bytes.data() + 94);
-  h.pointOffset = load<std::uint32_t>(bytes.data() + 96);
-  h.vlrCount = load<std::uint32_t>(bytes.data() + 100);
+  h.headerSize = loadField<std::uint16_t>(bytes.data() + 94);
+  h.pointOffset = loadField<std::uint32_t>(bytes.data() + 96);
+  h.vlrCount = loadField<std::uint32_t>(bytes.data() + 100);
   formatByte = static_cast<std::uint8_t>(bytes[104]);
-  h.recordLength = load<std::uint16_t>(bytes.data() + 105);
-  h.pointCount = load<std::uint32_t>(bytes.data() + 107);
+  h.recordLength = loadField<std::uint16_t>(bytes.data() + 105);
+  h.pointCount = loadField<std::uint32_t>(bytes.data() + 107);
   const std::size_t wanted = h.versionMinor >= 4   ? kHeader14
                              : h.versionMinor == 3 ? kHeader13
                                                    : kHeader12;
@@ -195,9 +190,9 @@ Status LasReader::State::readHeader(std::vector<std::byte>& bytes) {
     return fail(105, fmt::format("point records of {} bytes are shorter than format {}'s {}",
                                  h.recordLength, h.pointFormat, lasRecordSize(h.pointFormat)));
   if (h.versionMinor >= 4) {
-    evlrOffset = load<std::uint64_t>(bytes.data() + 235);
-    evlrCount = load<std::uint32_t>(bytes.data() + 243);
-    const auto count64 = load<std::uint64_t>(bytes.data() + 247);
+    evlrOffset = loadField<std::uint64_t>(bytes.data() + 235);
+    evlrCount = loadField<std::uint32_t>(bytes.data() + 243);
+    const auto count64 = loadField<std::uint64_t>(bytes.data() + 247);
     if (count64 != 0) h.pointCount = count64;
   }
   return {};
@@ -207,10 +202,10 @@ Status LasReader::State::readHeader(std::vector<std::byte>& bytes) {
 Status LasReader::State::readScalesAndBounds(std::span<const std::byte> bytes) {
   LasHeader& h = header;
   for (int k = 0; k < 3; ++k) {
-    h.scale[k] = load<double>(bytes.data() + 131 + 8 * static_cast<std::size_t>(k));
-    h.offset[k] = load<double>(bytes.data() + 155 + 8 * static_cast<std::size_t>(k));
-    h.bounds.max[k] = load<double>(bytes.data() + 179 + 16 * static_cast<std::size_t>(k));
-    h.bounds.min[k] = load<double>(bytes.data() + 187 + 16 * static_cast<std::size_t>(k));
+    h.scale[k] = loadField<double>(bytes.data() + 131 + 8 * static_cast<std::size_t>(k));
+    h.offset[k] = loadField<double>(bytes.data() + 155 + 8 * static_cast<std::size_t>(k));
+    h.bounds.max[k] = loadField<double>(bytes.data() + 179 + 16 * static_cast<std::size_t>(k));
+    h.bounds.min[k] = loadField<double>(bytes.data() + 187 + 16 * static_cast<std::size_t>(k));
     if (!std::isfinite(h.scale[k]) || h.scale[k] == 0)
       return fail(131 + 8 * static_cast<std::uint64_t>(k),
                   fmt::format("scale factor {} is not a finite non-zero number", h.scale[k]));
@@ -257,8 +252,8 @@ Status LasReader::State::readRecords(CrsRecords& crs) {
       return fail(at, fmt::format("variable length record {} of {} runs past the point "
                                   "data at byte {}",
                                   v + 1, h.vlrCount, h.pointOffset));
-    const auto id = load<std::uint16_t>(head + 18);
-    const auto length = load<std::uint16_t>(head + 20);
+    const auto id = loadField<std::uint16_t>(head + 18);
+    const auto length = loadField<std::uint16_t>(head + 20);
     if (at + kVlrHeader + length > h.pointOffset)
       return fail(at + 20, fmt::format("variable length record {} ({} bytes) runs past "
                                        "the point data at byte {}",
@@ -295,8 +290,8 @@ Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
       return fail(at, fmt::format("extended record {} of {} runs past the end of the "
                                   "file",
                                   v + 1, evlrCount));
-    const auto id = load<std::uint16_t>(head + 18);
-    const auto length = load<std::uint64_t>(head + 20);
+    const auto id = loadField<std::uint16_t>(head + 18);
+    const auto length = loadField<std::uint64_t>(head + 20);
     if (length > extra->remaining())
       return fail(at + 20, fmt::format("extended record {} ({} bytes) runs past the "
                                        "end of the file",
@@ -350,7 +345,7 @@ Status LasReader::State::probeColorDepth() {
   std::vector<std::byte> buffer(h.recordLength);
   for (std::uint64_t i = 0; i < count && probe->read(buffer.data(), buffer.size()); ++i) {
     for (std::size_t c = 0; c < 3; ++c)
-      largest = std::max(largest, load<std::uint16_t>(buffer.data() + rgb + 2 * c));
+      largest = std::max(largest, loadField<std::uint16_t>(buffer.data() + rgb + 2 * c));
   }
   h.eightBitColors = largest <= 255;
   return {};
@@ -406,7 +401,7 @@ Result<bool> LasReader::next(PointBatch& batch) try {
     Vec3d& p = batch.positions[i];
     for (int k = 0; k < 3; ++k) {
       // Double precision: scale 0.01 at offset 6e5 keeps the centimetres exactly as written.
-      p[k] = static_cast<double>(load<std::int32_t>(r + 4 * static_cast<std::size_t>(k))) *
+      p[k] = static_cast<double>(loadField<std::int32_t>(r + 4 * static_cast<std::size_t>(k))) *
                  h.scale[k] +
              h.offset[k];
     }

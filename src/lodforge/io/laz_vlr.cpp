@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/units.h"
+#include "lodforge/io/record_field.h"
 
 namespace lodforge {
 
@@ -12,13 +13,6 @@ namespace {
 
 constexpr std::size_t kFixedBytes = 34;  // everything before the items
 constexpr std::size_t kItemBytes = 6;
-
-template <class T>
-T load(const std::byte* at) {
-  T value;
-  std::memcpy(&value, at, sizeof value);
-  return value;
-}
 
 const char* compressorName(LazCompressor compressor) {
   switch (compressor) {
@@ -60,28 +54,28 @@ Result<LazInfo> parseLazVlr(std::span<const std::byte> data, const std::string& 
     return bad(
         0, fmt::format("{} bytes, fewer than the {} its fields take", data.size(), kFixedBytes));
   LazInfo laz;
-  const std::uint16_t compressor = load<std::uint16_t>(data.data());
+  const std::uint16_t compressor = loadField<std::uint16_t>(data.data());
   if (compressor > 3) return bad(0, fmt::format("unknown compressor {}", compressor));
   laz.compressor = static_cast<LazCompressor>(compressor);
-  laz.coder = load<std::uint16_t>(data.data() + 2);
+  laz.coder = loadField<std::uint16_t>(data.data() + 2);
   if (laz.coder != 0)
     return bad(2, fmt::format("unknown coder {} (0, arithmetic, is defined)", laz.coder));
   laz.versionMajor = static_cast<std::uint8_t>(data[4]);
   laz.versionMinor = static_cast<std::uint8_t>(data[5]);
-  laz.versionRevision = load<std::uint16_t>(data.data() + 6);
-  laz.options = load<std::uint32_t>(data.data() + 8);
-  laz.chunkSize = load<std::uint32_t>(data.data() + 12);
-  laz.specialEvlrCount = load<std::int64_t>(data.data() + 16);
-  laz.specialEvlrOffset = load<std::int64_t>(data.data() + 24);
-  const std::uint16_t count = load<std::uint16_t>(data.data() + 32);
+  laz.versionRevision = loadField<std::uint16_t>(data.data() + 6);
+  laz.options = loadField<std::uint32_t>(data.data() + 8);
+  laz.chunkSize = loadField<std::uint32_t>(data.data() + 12);
+  laz.specialEvlrCount = loadField<std::int64_t>(data.data() + 16);
+  laz.specialEvlrOffset = loadField<std::int64_t>(data.data() + 24);
+  const std::uint16_t count = loadField<std::uint16_t>(data.data() + 32);
   if (data.size() != kFixedBytes + kItemBytes * count)
     return bad(32, fmt::format("{} items need {} bytes, the record has {}", count,
                                kFixedBytes + kItemBytes * count, data.size()));
   if (count == 0) return bad(32, "no items");
   for (std::uint16_t i = 0; i < count; ++i) {
     const std::byte* item = data.data() + kFixedBytes + kItemBytes * i;
-    LazItem entry{load<std::uint16_t>(item), load<std::uint16_t>(item + 2),
-                  load<std::uint16_t>(item + 4)};
+    LazItem entry{loadField<std::uint16_t>(item), loadField<std::uint16_t>(item + 2),
+                  loadField<std::uint16_t>(item + 4)};
     if (entry.type > 14 || (entry.type >= 1 && entry.type <= 5))
       return bad(kFixedBytes + kItemBytes * i, fmt::format("unknown item type {}", entry.type));
     laz.items.push_back(entry);

@@ -85,10 +85,6 @@ Result<PointMemoryPlan> planPointMemory(std::uint64_t memoryLimit, std::uint64_t
 
 namespace {
 
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 void countPartition(const Partition& partition, PointsBuildStats& stats) {
   stats.points = partition.pointCount;
   stats.blocks = partition.blocks.size();

@@ -384,7 +384,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
 
   // Complete: replace the previous tileset, if any, by the new one.
   LODFORGE_TRY(replaceDirectory(staging, outputDirectory));
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats.seconds = secondsSince(start);
   return stats;
 }
 

@@ -11,6 +11,7 @@
 
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
 #include "lodforge/tiles/tileset_output.h"
 #include "lodforge/tiling/resume.h"
 
@@ -18,10 +19,6 @@ namespace lodforge {
 namespace {
 
 namespace fs = std::filesystem;
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // What identifies the input of a resumable run besides its path.
 std::uint64_t fileBytes(const std::string& path) {

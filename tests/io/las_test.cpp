@@ -293,17 +293,6 @@ TEST(LasReader, RefusesBadFilesWithTheirPosition) {
   expectBad(evlr, "extended records");
 }
 
-TEST(LasReader, RefusesLazPointsSayingWhatTheyAre) {
-  Result<LasReader> reader = LasReader::open(test::dataPath("points/autzen_trim.laz"));
-  ASSERT_FALSE(reader.ok());
-  EXPECT_EQ(reader.status().kind(), ErrorKind::kBadInput);
-  const std::string& message = reader.error().message;
-  EXPECT_NE(message.find("autzen_trim.laz: byte 104: LAZ (point-wise chunked"), std::string::npos)
-      << message;
-  EXPECT_NE(message.find("items POINT10 v2, GPSTIME11 v2, RGB12 v2"), std::string::npos) << message;
-  EXPECT_NE(message.find("convert the file to LAS first"), std::string::npos) << message;
-}
-
 // The LASzip record of the real LAZ files, as their LAS twins and the issue describe them.
 TEST(LasReader, ReadsTheLaszipRecordOfRealLazAndCopc) {
   struct Case {

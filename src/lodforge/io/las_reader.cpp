@@ -5,6 +5,7 @@
 #include <cstring>
 #include <optional>
 
+#include "lodforge/io/laz_reader.h"
 #include "lodforge/io/record_field.h"
 
 namespace lodforge {
@@ -82,6 +83,7 @@ struct LasReader::State {
   bool headerOnly = false;           // readHeader: LAZ accepted, no point read
   std::vector<std::byte> lazRecord;  // the LASzip record's data, and where it lies
   std::uint64_t lazAt = 0;
+  std::optional<LazPointStream> lazPoints;  // LAZ: the decoded point records
 
   Status readHeader(std::vector<std::byte>& bytes);
   Status readScalesAndBounds(std::span<const std::byte> bytes);
@@ -90,6 +92,7 @@ struct LasReader::State {
   Status readExtendedRecords(CrsRecords& crs);
   Status probeColorDepth();
   Status readLazRecord();
+  Result<LazPointStream> openLazPoints() const;
 
   Result<ByteSource> reopen() const {
     if (!path.empty()) return ByteSource::openFile(path);
@@ -309,8 +312,7 @@ Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
   return {};
 }
 
-// LAZ: the LASzip record must be there and describe the records the header states; reading
-// points from it is refused (decoding is not built yet) unless only the header is wanted.
+// LAZ: the LASzip record must be there and describe the records the header states.
 Status LasReader::State::readLazRecord() {
   LasHeader& h = header;
   if (!h.compressed) return {};
@@ -325,10 +327,22 @@ Status LasReader::State::readLazRecord() {
                                         laz->recordBytes(), h.recordLength));
   h.laz = std::move(*laz);
   if (headerOnly) return {};
-  return fail(104, fmt::format("LAZ ({}{}): lodforge does not decode compressed points yet; "
-                               "convert the file to LAS first (e.g. with LAStools' laszip or "
-                               "PDAL, which Debian 12 does not package)",
-                               h.copc ? "COPC, " : "", describeLaz(*h.laz)));
+  Result<LazPointStream> points = openLazPoints();
+  if (!points) return points.status();
+  lazPoints.emplace(std::move(*points));
+  return {};
+}
+
+// The compressed points end where LAS 1.4's extended records begin, else at the file's end.
+Result<LazPointStream> LasReader::State::openLazPoints() const {
+  LazLayout layout;
+  layout.file = source->name();
+  layout.fileSize = source->size();
+  layout.pointOffset = header.pointOffset;
+  layout.dataEnd = evlrCount > 0 ? std::min(evlrOffset, layout.fileSize) : layout.fileSize;
+  layout.pointCount = header.pointCount;
+  layout.recordLength = header.recordLength;
+  return LazPointStream::open(path, memory, layout, *header.laz);
 }
 
 // 8- or 16-bit colours: the first points tell.
@@ -336,16 +350,23 @@ Status LasReader::State::probeColorDepth() {
   LasHeader& h = header;
   rgb = colorOffset(h.pointFormat);
   h.hasColors = rgb != 0;
-  if (!h.hasColors || h.compressed) return {};
-  Result<ByteSource> probe = reopen();
-  if (!probe) return probe.status();
-  probe->skip(h.pointOffset);
+  if (!h.hasColors || (h.compressed && headerOnly)) return {};
   const std::uint64_t count = std::min<std::uint64_t>(h.pointCount, kColorProbe);
+  std::vector<std::byte> probed(count * h.recordLength);
+  if (h.compressed) {  // a second decoder, so the first still starts at point 0
+    Result<LazPointStream> probe = openLazPoints();
+    if (!probe) return probe.status();
+    LODFORGE_TRY(probe->read(probed.data(), count));
+  } else {
+    Result<ByteSource> probe = reopen();
+    if (!probe) return probe.status();
+    probe->skip(h.pointOffset);
+    if (!probe->read(probed.data(), probed.size())) probed.clear();
+  }
   std::uint16_t largest = 0;
-  std::vector<std::byte> buffer(h.recordLength);
-  for (std::uint64_t i = 0; i < count && probe->read(buffer.data(), buffer.size()); ++i) {
+  for (std::size_t at = 0; at + h.recordLength <= probed.size(); at += h.recordLength) {
     for (std::size_t c = 0; c < 3; ++c)
-      largest = std::max(largest, loadField<std::uint16_t>(buffer.data() + rgb + 2 * c));
+      largest = std::max(largest, loadField<std::uint16_t>(probed.data() + at + rgb + 2 * c));
   }
   h.eightBitColors = largest <= 255;
   return {};
@@ -382,18 +403,35 @@ Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
   return e.error;
 }
 
-Result<bool> LasReader::next(PointBatch& batch) try {
+Result<bool> LasReader::nextRecords(std::vector<std::byte>& records) try {
+  State& s = *state_;
+  const LasHeader& h = s.header;
+  records.clear();
+  if (s.nextPoint >= h.pointCount) return false;
+  const std::size_t count =
+      static_cast<std::size_t>(std::min<std::uint64_t>(s.batchSize, h.pointCount - s.nextPoint));
+  records.resize(count * h.recordLength);
+  if (s.lazPoints) {
+    LODFORGE_TRY(s.lazPoints->read(records.data(), count));
+  } else {
+    const std::uint64_t at = s.source->offset();
+    if (!s.source->read(records.data(), records.size()))
+      return s.fail(at, fmt::format("the file ends inside point {}", s.nextPoint));
+  }
+  s.nextPoint += count;
+  return true;
+} catch (const ErrorException& e) {
+  return e.error;
+}
+
+Result<bool> LasReader::next(PointBatch& batch) {
   State& s = *state_;
   const LasHeader& h = s.header;
   batch.clear();
   batch.first = s.nextPoint;
-  if (s.nextPoint >= h.pointCount) return false;
-  const std::size_t count =
-      static_cast<std::size_t>(std::min<std::uint64_t>(s.batchSize, h.pointCount - s.nextPoint));
-  s.records.resize(count * h.recordLength);
-  const std::uint64_t at = s.source->offset();
-  if (!s.source->read(s.records.data(), s.records.size()))
-    return s.fail(at, fmt::format("the file ends inside point {}", s.nextPoint));
+  Result<bool> more = nextRecords(s.records);
+  if (!more || !*more) return more;
+  const std::size_t count = s.records.size() / h.recordLength;
   batch.positions.resize(count);
   if (h.hasColors) batch.colors.resize(count);
   for (std::size_t i = 0; i < count; ++i) {
@@ -414,10 +452,7 @@ Result<bool> LasReader::next(PointBatch& batch) try {
                          static_cast<std::uint8_t>(std::min(255, rgb[2] >> shift)), 255};
     }
   }
-  s.nextPoint += count;
   return true;
-} catch (const ErrorException& e) {
-  return e.error;
 }
 
 }  // namespace lodforge

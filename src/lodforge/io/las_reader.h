@@ -1,8 +1,8 @@
 // LAS reader (ASPRS LAS 1.0–1.4, point formats 0–10, uncompressed): the header, the variable
 // length records that carry the coordinate system (OGC WKT, or GeoTIFF keys naming an EPSG
 // code), and the points streamed in batches with scale and offset applied in double precision.
-// LAZ (compressed) point data is not decoded yet: its header and LASzip record are read
-// (LasReader::readHeader, for `info`), and opening it to read points is refused with what it is.
+// LAZ (LASzip-compressed, COPC included) is decoded as it is read (io/laz_reader): the records
+// come out as the LAS file of the same points would hold them.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +10,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/status.h"
@@ -61,6 +62,9 @@ class LasReader {
   // The next batch of points (positions, and colours when the format has them); false at the
   // end of the point records.
   Result<bool> next(PointBatch& batch);
+  // Or the next batch as the point records themselves (record length bytes each, decoded when
+  // the file is LAZ); false at the end.
+  Result<bool> nextRecords(std::vector<std::byte>& records);
 
  private:
   struct State;

@@ -1,12 +1,16 @@
 // `lodforge convert IN -o OUT`: between the formats lodforge reads (.ply .obj .stl .gltf .glb)
-// and writes (.ply .glb .obj .stl), optionally welding vertices on the way.
+// and writes (.ply .glb .obj .stl), optionally welding vertices on the way; and LAZ (or LAS) to
+// plain LAS, the point records as decoded.
 #include <chrono>
 
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "lodforge/core/file.h"
 #include "lodforge/core/mesh.h"
+#include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
+#include "lodforge/io/las_copy.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
 #include "lodforge/io/stl_writer.h"
@@ -34,6 +38,30 @@ Status checkMemory(const std::string& path, std::uint64_t limit) {
                                               path, formatBytes(need), formatBytes(limit))};
 }
 
+bool isLasPath(const std::string& path) {
+  const std::string ext = fileExtension(path);
+  return ext == "las" || ext == "laz";
+}
+
+// LAZ (or LAS) in, plain LAS out.
+Status convertToLas(const Global& global, const std::string& input, const std::string& output) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!isLasPath(input))
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: convert writes .las from .laz or .las input only", output)};
+  LODFORGE_TRY(claimOutput(output, modelFileOutput(output), std::vector<std::string>{input}));
+  Result<LasCopyReport> report = writeUncompressedLas(input, output);
+  if (!report) return report.status();
+  say(global, fmt::format("wrote {}: {} points, {} records kept{} in {:.2f} s", output,
+                          formatCount(report->points), report->recordsKept,
+                          report->recordsDropped > 0
+                              ? fmt::format(", {} compression records dropped",
+                                            report->recordsDropped)
+                              : std::string{},
+                          secondsSince(start)));
+  return {};
+}
+
 }  // namespace
 
 void addConvert(CLI::App& app, const Global& global, Run& run) {
@@ -46,8 +74,11 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("convert", "Convert a model between formats (by extension)");
-  sub->add_option("INPUT", options->input, "A .ply .obj .stl .gltf or .glb file")->required();
-  sub->add_option("-o,--output", options->output, "A .ply .glb .obj or .stl file")->required();
+  sub->add_option("INPUT", options->input, "A .ply .obj .stl .gltf or .glb file (or .laz/.las)")
+      ->required();
+  sub->add_option("-o,--output", options->output,
+                  "A .ply .glb .obj or .stl file (or .las from .laz/.las)")
+      ->required();
   sub->add_flag("--weld", options->weld,
                 "Merge vertices with equal positions (keeping normal and colour splits)");
   sub->add_option("--weld-epsilon", options->weldEpsilon,
@@ -59,6 +90,8 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
       const auto start = std::chrono::steady_clock::now();
+      if (fileExtension(options->output) == "las")
+        return convertToLas(global, options->input, options->output);
       if (!canWrite(formatFromPath(options->output)))
         return Error{
             ErrorKind::kUsage,

@@ -90,6 +90,9 @@ OutputKind modelFileOutput(const std::string& path) {
   if (ext == "gltf") return {.name = "a glTF file", .isOwn = looksLikeJson};
   if (ext == "obj") return {.name = "an OBJ file", .isOwn = looksLikeObj};
   if (ext == "stl") return {.name = "an STL file", .isOwn = looksLikeStl};
+  if (ext == "las")
+    return {.name = "a LAS file",
+            .isOwn = [](const std::string& p) { return fileStartsWith(p, "LASF"); }};
   return {.name = "a model file", .isOwn = {}};
 }
 

@@ -9,7 +9,8 @@
 
 namespace lodforge::cli {
 
-// A model file of the kind its extension names (.ply .glb .gltf .obj .stl), by its content.
+// A model file of the kind its extension names (.ply .glb .gltf .obj .stl, and .las for
+// convert's point copies), by its content.
 OutputKind modelFileOutput(const std::string& path);
 OutputKind packageOutput();  // .lfp, by its magic
 OutputKind pngOutput();      // by the PNG signature

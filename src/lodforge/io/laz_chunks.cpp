@@ -119,6 +119,7 @@ Result<LazChunkTable> readLazChunkTable(const LazLayout& layout, const LazInfo& 
                           fmt::format("the chunk table lists {} chunks but {} points in chunks "
                                       "of {} make {}",
                                       count, layout.pointCount, laz.chunkSize, expected));
+  if (count == 0) return LazChunkTable{};
   const std::uint64_t codedBytes =
       std::min<std::uint64_t>(layout.dataEnd - at - 8, kTableEntryBound * count + 8);
   Result<std::vector<std::byte>> coded = read(at + 8, codedBytes);
@@ -245,6 +246,9 @@ Result<std::uint64_t> LazChunkDecoder::State::decodeLayered(std::span<const std:
     firstLayer += n;
   }
   for (std::uint64_t p = 1; p < chunk.points; ++p) {
+    // LASzip passes channel 0 to the items after POINT14 unless the channel changes at this very
+    // point (its context starts at 0 per point); the encoder does the same, so the decoder must.
+    context = 0;
     std::byte* record = out + p * recordLength;
     for (std::size_t i = 0; i < layeredItems.size(); ++i)
       layeredItems[i]->read(record + itemOffsets[i], context);

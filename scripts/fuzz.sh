@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
-readers=(ply obj stl gltf lfp png tiles las xyz lfc)
+readers=(ply obj stl gltf lfp png tiles las laz xyz lfc)
 mkdir -p build/fuzz/artifacts
 run() {
   local reader=$1 work=build/fuzz/work/$1

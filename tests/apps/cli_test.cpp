@@ -516,11 +516,24 @@ TEST(CliPoints, BuildsAPackageFromLasAndInfoReportsBoth) {
 
 TEST(CliPoints, BadInputIsExitCode2AndLeavesNothing) {
   test::TempDir dir;
-  Outcome o = lodforge(
-      "points " + test::dataPath("points/autzen_trim.laz") + " -o " + dir.file("a.lfc"), dir);
+  // A LAZ cut inside its last chunk: the chunk table went with the cut.
+  const std::string laz = test::readFile(test::dataPath("points/autzen_trim.laz"));
+  test::writeFile(dir.file("cut.laz"), laz.substr(0, laz.size() * 9 / 10));
+  Outcome o = lodforge("points " + dir.file("cut.laz") + " -o " + dir.file("a.lfc"), dir);
   EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.err.find("LAZ (point-wise chunked"), std::string::npos) << o.err;
-  EXPECT_NE(o.err.find("convert the file to LAS first"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("cut.laz: byte 2144: the chunk table is said to be at byte 603333"),
+            std::string::npos)
+      << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a.lfc")));
+  // Bytes of a chunk overwritten: the chunk is named.
+  std::string damaged = laz;
+  for (std::size_t i = 300'000; i < 300'100; ++i) damaged[i] = static_cast<char>(i * 31);
+  test::writeFile(dir.file("damaged.laz"), damaged);
+  o = lodforge("tiles " + dir.file("damaged.laz") + " -o " + dir.file("t"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("damaged.laz: byte "), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("LAZ chunk 2 of 3"), std::string::npos) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("t")));
   // info reads what a LAZ is without decoding it.
   o = lodforge("info " + test::dataPath("points/autzen_trim.laz"), dir);
   EXPECT_EQ(o.code, 0) << o.err;
@@ -559,8 +572,65 @@ TEST(CliPoints, BadInputIsExitCode2AndLeavesNothing) {
   EXPECT_NE(o.err.find("bad.lfc"), std::string::npos) << o.err;
   // Nothing half written.
   for (const auto& name : test::listFolder(dir.path())) {
-    EXPECT_TRUE(name == "cut.las" || name == "bad.xyz" || name == "bad.lfc") << name;
+    EXPECT_TRUE(name == "cut.las" || name == "bad.xyz" || name == "bad.lfc" || name == "cut.laz" ||
+                name == "damaged.laz")
+        << name;
   }
+}
+
+// LAZ in: convert writes the LAS it was made from, byte for byte, and the tiles of a LAZ are
+// the tiles of its LAS.
+TEST(CliLaz, ConvertsToTheLasItCameFromAndTilesLikeIt) {
+  test::TempDir dir;
+  for (const auto& [laz, las] : {std::pair{"autzen_trim.laz", "autzen_trim.las"},
+                                 std::pair{"simple-v1.laz", "simple.las"}}) {
+    const Outcome o = lodforge("convert " + test::dataPath(std::string("points/") + laz) +
+                                   " -o " + dir.file("out.las"),
+                               dir);
+    ASSERT_EQ(o.code, 0) << o.err;
+    EXPECT_NE(o.out.find("1 compression records dropped"), std::string::npos) << o.out;
+    EXPECT_TRUE(test::readFile(dir.file("out.las")) ==
+                test::readFile(test::dataPath(std::string("points/") + las)))
+        << laz;
+  }
+  // COPC: LAS 1.4 format 7 out, its COPC records dropped, the CRS kept.
+  Outcome o = lodforge("convert " + test::dataPath("points/1.2-with-color.copc.laz") + " -o " +
+                           dir.file("copc.las"),
+                       dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("1,065 points, 1 records kept, 3 compression records dropped"),
+            std::string::npos)
+      << o.out;
+  o = lodforge("info " + dir.file("copc.las") + " --json", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const nlohmann::json copc = nlohmann::json::parse(o.out);
+  EXPECT_EQ(copc["format"], "LAS");
+  EXPECT_EQ(copc["pointFormat"], 7);
+  EXPECT_NE(copc["crs"].get<std::string>().find("NAD83"), std::string::npos);
+  // The tiles of the LAZ are the tiles of the LAS, file for file.
+  for (const char* input : {"autzen_trim.laz", "autzen_trim.las"}) {
+    o = lodforge("-q tiles " + test::dataPath(std::string("points/") + input) + " -o " +
+                     dir.file(input) + " --block-size 20K --tile-points 10K",
+                 dir);
+    ASSERT_EQ(o.code, 0) << o.err;
+  }
+  std::size_t files = 0;
+  for (const auto& entry :
+       std::filesystem::recursive_directory_iterator(dir.file("autzen_trim.las"))) {
+    if (!entry.is_regular_file()) continue;
+    const std::string relative =
+        std::filesystem::relative(entry.path(), dir.file("autzen_trim.las")).string();
+    EXPECT_TRUE(test::readFile(entry.path().string()) ==
+                test::readFile(dir.file("autzen_trim.laz") + "/" + relative))
+        << relative;
+    ++files;
+  }
+  EXPECT_GE(files, 10u);
+  // convert writes .las from LAS input only.
+  o = lodforge("convert " + test::dataPath("meshes/horse.ply") + " -o " + dir.file("h.las"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("convert writes .las from .laz or .las input only"), std::string::npos)
+      << o.err;
 }
 
 TEST(CliPoints, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {

@@ -81,8 +81,7 @@ Result<LazChunkTable> readLazChunkTable(const LazLayout& layout, const LazInfo& 
   if (laz.compressor == LazCompressor::kPointwise) {  // one chunk, no table
     LazChunkTable table;
     if (layout.pointCount > 0)
-      table.chunks.push_back(
-          {layout.pointOffset, layout.dataEnd - layout.pointOffset, layout.pointCount});
+      table.chunks.push_back({layout.pointOffset, 0, layout.pointCount});  // its end: decoded
     return table;
   }
   Result<std::vector<std::byte>> pointer = read(layout.pointOffset, 8);
@@ -195,18 +194,27 @@ Result<std::uint64_t> LazChunkDecoder::State::decodePointwise(std::span<const st
                                                               std::byte* out) {
   for (std::size_t i = 0; i < pointwise.size(); ++i) pointwise[i]->start(out + itemOffsets[i]);
   dec.start(bytes.subspan(recordLength));
-  for (std::uint64_t p = 1; p < chunk.points; ++p) {
+  std::uint64_t whole = chunk.points;  // points decoded before the bytes ran out
+  for (std::uint64_t p = 1; p < chunk.points && whole == chunk.points; ++p) {
     std::byte* record = out + p * recordLength;
     for (std::size_t i = 0; i < pointwise.size(); ++i)
       pointwise[i]->read(dec, record + itemOffsets[i]);
+    if (dec.overrun()) whole = p;
   }
   const std::uint64_t end = chunk.offset + recordLength + dec.consumed();
   if (dec.overrun())
     return damaged(end, index, count,
-                   fmt::format("the compressed points end early: the chunk is truncated or "
-                               "damaged ({} of its points expected)",
-                               chunk.points));
+                   fmt::format("the compressed points end after {} of the chunk's {}: the chunk "
+                               "is truncated or damaged, or the header's point count is wrong",
+                               whole, chunk.points));
   if (dec.invalid()) return damaged(end, index, count, "the arithmetic-coded points are damaged");
+  // LASzip's decoder ends exactly where the encoder did: a chunk that decodes to another length
+  // is damaged (the coder itself cannot tell good bytes from bad).
+  if (chunk.bytes != 0 && recordLength + dec.consumed() != chunk.bytes)
+    return damaged(end, index, count,
+                   fmt::format("the points decode from {} bytes but the chunk table gives the "
+                               "chunk {}: the chunk is damaged",
+                               recordLength + dec.consumed(), chunk.bytes));
   return recordLength + dec.consumed();
 }
 

@@ -84,15 +84,20 @@ LazSymbolModel& lazyModel(std::unique_ptr<LazSymbolModel>& model, std::uint32_t 
 }
 
 // One layer's decoder: `present` is false when the layer is empty (the field is constant in the
-// chunk), and then nothing is decoded from it.
+// chunk), and then nothing is decoded from it. A layer decodes from exactly its bytes, as
+// LASzip's encoder wrote them; any other length means damage.
 struct Layer {
   LazDecoder dec;
   bool present = false;
+  std::size_t size = 0;
   void start(std::span<const std::byte> bytes) {
     present = !bytes.empty();
+    size = bytes.size();
     if (present) dec.start(bytes);
   }
-  bool damaged() const { return present && (dec.overrun() || dec.invalid()); }
+  bool damaged() const {
+    return present && (dec.overrun() || dec.invalid() || dec.consumed() != size);
+  }
 };
 
 class Point14V3 final : public LazLayeredItem {

@@ -70,6 +70,8 @@ std::vector<Command> writingCommands() {
        [](auto& in, auto& out) { return "-q extract " + in + " --ratio 0.5 -o " + out; }, ""},
       {"convert", "scan.ply", "scan.obj", false,
        [](auto& in, auto& out) { return "-q convert " + in + " -o " + out; }, ""},
+      {"convert (LAZ to LAS)", "cloud.laz", "cloud.las", false,
+       [](auto& in, auto& out) { return "-q convert " + in + " -o " + out; }, ""},
       {"render", "model.lfp", "frames", true,
        [](auto& in, auto& out) { return "-q render " + in + " --frames 1 --size 32x24 -o " + out; },
        test::glSubprocess()},
@@ -86,6 +88,8 @@ class WritingCommands : public ::testing::Test {
     ASSERT_EQ(lodforge("-q generate scan --triangles 20K -o " + scan, *sources_).code, 0);
     fs::copy_file(test::dataPath("points/simple.las"), sources_->file("cloud.las"));
     fs::permissions(sources_->file("cloud.las"), fs::perms::owner_write, fs::perm_options::add);
+    fs::copy_file(test::dataPath("points/simple-v1.laz"), sources_->file("cloud.laz"));
+    fs::permissions(sources_->file("cloud.laz"), fs::perms::owner_write, fs::perm_options::add);
     ASSERT_EQ(lodforge("-q build " + scan + " -o " + sources_->file("model.lfp"), *sources_).code,
               0);
   }

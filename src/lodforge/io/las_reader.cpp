@@ -353,10 +353,11 @@ Status LasReader::State::probeColorDepth() {
   if (!h.hasColors || (h.compressed && headerOnly)) return {};
   const std::uint64_t count = std::min<std::uint64_t>(h.pointCount, kColorProbe);
   std::vector<std::byte> probed(count * h.recordLength);
-  if (h.compressed) {  // a second decoder, so the first still starts at point 0
-    Result<LazPointStream> probe = openLazPoints();
-    if (!probe) return probe.status();
-    LODFORGE_TRY(probe->read(probed.data(), count));
+  if (h.compressed) {  // the first batch the reader decodes anyway
+    Result<std::span<const std::byte>> ahead = lazPoints->peek();
+    if (!ahead) return ahead.status();
+    probed.assign(ahead->begin(),
+                  ahead->begin() + static_cast<std::ptrdiff_t>(std::min(ahead->size(), probed.size())));
   } else {
     Result<ByteSource> probe = reopen();
     if (!probe) return probe.status();

@@ -113,7 +113,8 @@ Status LazPointStream::State::decodeOne(std::size_t index, std::byte* out) {
 // The next chunks, as many as the threads can decode at once (one at a time without a table).
 Status LazPointStream::State::decodeBatch() {
   const std::size_t threads = static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
-  const std::size_t batch = table.complete ? std::min(2 * threads, table.chunks.size() - nextChunk) : 1;
+  const std::size_t batch =
+      table.complete ? std::min(2 * threads, table.chunks.size() - nextChunk) : 1;
   std::vector<std::uint64_t> starts(batch + 1, 0);
   for (std::size_t i = 0; i < batch; ++i)
     starts[i + 1] = starts[i] + table.chunks[nextChunk + i].points * layout.recordLength;
@@ -127,6 +128,13 @@ Status LazPointStream::State::decodeBatch() {
   for (Status& status : results)  // the first damaged chunk in file order, whatever the timing
     if (!status) return status;
   return {};
+}
+
+Result<std::span<const std::byte>> LazPointStream::peek() {
+  State& s = *state_;
+  if (s.handedOut == s.decoded.size() && s.nextChunk < s.table.chunks.size())
+    LODFORGE_TRY(s.decodeBatch());
+  return std::span<const std::byte>(s.decoded).subspan(s.handedOut);
 }
 
 Status LazPointStream::read(std::byte* out, std::uint64_t count) {

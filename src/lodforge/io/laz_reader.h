@@ -24,6 +24,9 @@ class LazPointStream {
 
   // The next `count` records into `out` (count × record length bytes).
   Status read(std::byte* out, std::uint64_t count);
+  // The records decoded ahead and not read yet (a batch is decoded when none are): a look at the
+  // first points without decoding them twice.
+  Result<std::span<const std::byte>> peek();
   std::size_t chunkCount() const;
 
  private:

@@ -95,10 +95,10 @@ void addGenerate(CLI::App& app, const Global& global, Run& run) {
     };
     auto options = std::make_shared<Options>();
     CLI::App* sub =
-        generate->add_subcommand("points", "A scanned-surface point cloud of N points (PLY)");
+        generate->add_subcommand("points", "A scanned-surface point cloud of N points (PLY, or LAS with lidar attributes)");
     addCountOption(*sub, "--points", options->points.points, "Number of points (default 1M)");
     sub->add_option("--seed", options->points.seed, "Random seed");
-    sub->add_option("-o,--output", options->output, "Output .ply (default points.ply)");
+    sub->add_option("-o,--output", options->output, "Output .ply or .las (default points.ply)");
     sub->callback([&global, &run, options] {
       run = [&global, options] {
         return timed(global, options->output,

@@ -81,6 +81,8 @@ class OutputFile {
   Status writeAt(std::uint64_t offset, const void* data, std::size_t size);
   // Appends the first `bytes` of another file (a spilled section written earlier).
   Status appendFileContents(const std::string& path, std::uint64_t bytes);
+  // Writes out what write() has buffered, so writeAt() may then overwrite those bytes.
+  Status flush();
   Status commit();
   // The whole file at once, atomically: every small file the library writes goes through this.
   static Status writeWhole(const std::string& path, std::string_view bytes);
@@ -89,7 +91,6 @@ class OutputFile {
 
  private:
   OutputFile() = default;
-  Status flush();
   void discard();
 
   std::string path_;

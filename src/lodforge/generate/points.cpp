@@ -1,6 +1,8 @@
 #include "lodforge/generate/points.h"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -9,6 +11,7 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/terrain.h"
+#include "lodforge/io/las_writer.h"
 #include "lodforge/io/ply_writer.h"
 
 namespace lodforge {
@@ -17,17 +20,66 @@ namespace {
 constexpr std::uint64_t kBatch = 1 << 15;       // points per independently seeded batch
 constexpr std::uint64_t kBatchesPerRound = 32;  // batches computed in parallel, then written
 
+constexpr double kStripWidth = 250.0;  // metres across one flight line
+constexpr double kFlightSpeed = 60.0;  // metres per second along it
+
 struct PointBatch {
   std::vector<Vec3f> positions, normals;
   std::vector<Rgba8> colors;
+  std::vector<LasPoint3> lidar;  // for LAS output
 };
 
+// What an airborne scanner would record at a point: the ASPRS class (ground, low, medium and
+// high vegetation where the surface is green, water in the lowest hollows, rare noise above),
+// returns (vegetation gives several), an intensity by material and incidence, the flight line
+// (point source), the time along it and the scan angle across it.
+LasPoint3 lidarPoint(Vec3d p, Vec3d n, Rgba8 c, double u, double v, Random& random) {
+  LasPoint3 point;
+  point.position = p;
+  const bool green = c.g > c.r + 15 && c.g > c.b + 15;
+  double reflectance = 0.45;  // soil
+  point.classification = 2;
+  if (p.z < -30.0) {
+    point.classification = 9;
+    reflectance = 0.05;
+  } else if (green) {
+    const double draw = random.uniform(0, 1);
+    point.classification = draw < 0.35 ? 2 : draw < 0.6 ? 3 : draw < 0.8 ? 4 : 5;
+    point.numberOfReturns = static_cast<std::uint8_t>(point.classification == 2 ? 1 : 2 + (draw > 0.9));
+    point.returnNumber = static_cast<std::uint8_t>(1 + random.below(point.numberOfReturns));
+    reflectance = point.classification == 2 ? 0.4 : 0.3;
+  } else if (c.r > 200) {
+    reflectance = 0.9;  // snow
+  } else if (n.z < 0.6) {
+    reflectance = 0.55;  // rock
+  }
+  if (random.uniform(0, 1) < 0.001) {  // a bird or a dust return, well above the ground
+    point.classification = 7;
+    point.returnNumber = point.numberOfReturns = 1;
+    point.position.z += random.uniform(20, 80);
+    reflectance = 0.1;
+  }
+  const double shade = 0.3 + 0.7 * std::abs(n.z);
+  point.intensity = static_cast<std::uint16_t>(
+      std::clamp(65535.0 * reflectance * shade * random.uniform(0.85, 1.15), 0.0, 65535.0));
+  const double strip = std::floor(u / kStripWidth);
+  point.pointSource = static_cast<std::uint16_t>(1 + strip);
+  point.gpsTime = 300000.0 + strip * 900.0 + v / kFlightSpeed + random.uniform(0, 1e-4);
+  point.scanAngle = static_cast<std::int8_t>(
+      std::lround(((u - strip * kStripWidth) / kStripWidth - 0.5) * 40.0));
+  point.rgb = {static_cast<std::uint16_t>(c.r * 257), static_cast<std::uint16_t>(c.g * 257),
+               static_cast<std::uint16_t>(c.b * 257)};
+  return point;
+}
+
 void sampleBatch(const Terrain& terrain, const PointsOptions& options, std::uint64_t batch,
-                 std::uint64_t count, PointBatch& out) {
+                 std::uint64_t count, bool lidar, PointBatch& out) {
   Random random = Random::forItem(options.seed, batch);
+  Random attributes = Random::forItem(options.seed ^ 0x4C4153ull, batch);  // "LAS"
   out.positions.clear();
   out.normals.clear();
   out.colors.clear();
+  out.lidar.clear();
   while (out.positions.size() < count) {
     const double u = random.uniform(0, terrain.width());
     const double v = random.uniform(0, terrain.depth());
@@ -35,30 +87,64 @@ void sampleBatch(const Terrain& terrain, const PointsOptions& options, std::uint
     if (terrain.inHole(u, v)) continue;  // the scanner saw nothing there
     const Vec3d n = terrain.normal(u, v);
     const Vec3d p = terrain.position(u, v) + n * jitter;
+    const Rgba8 color = terrain.color(u, v, p, n);
     out.positions.push_back(toFloat(p));
     out.normals.push_back(toFloat(n));
-    out.colors.push_back(terrain.color(u, v, p, n));
+    out.colors.push_back(color);
+    if (lidar) out.lidar.push_back(lidarPoint(p, n, color, u, v, attributes));
   }
 }
+
+// Where the points go: a PLY (positions, normals, colours) or a LAS (format 3, lidar fields).
+struct PointSink {
+  std::optional<PlyWriter> ply;
+  std::optional<LasWriter> las;
+  Status write(const PointBatch& batch) {
+    if (las) return las->write(batch.lidar);
+    return ply->writeVertices(batch.positions, batch.normals, batch.colors);
+  }
+  std::uint64_t fileBytes() const { return las ? las->fileBytes() : ply->fileBytes(); }
+  Status finish() { return las ? las->finish() : ply->finish(); }
+};
+
+Result<PointSink> openSink(const PointsOptions& options, const std::string& path) {
+  PointSink sink;
+  const std::string command =
+      fmt::format("lodforge generate points --points {} --seed {}", options.points, options.seed);
+  if (fileExtension(path) == "las") {
+    // Millimetres: the terrain spans kilometres at most, far inside 32-bit integers.
+    Result<LasWriter> las = LasWriter::create(path, {0.001, 0.001, 0.001}, {0, 0, 0},
+                                              "lodforge generate points");
+    if (!las) return las.status();
+    sink.las.emplace(std::move(*las));
+    return sink;
+  }
+  PlyLayout layout;
+  layout.vertexCount = options.points;
+  layout.normals = true;
+  layout.colors = true;
+  layout.comments = {command};
+  Result<PlyWriter> writer = PlyWriter::create(path, layout);
+  if (!writer) return writer.status();
+  sink.ply.emplace(std::move(*writer));
+  return sink;
+}
+
 }  // namespace
 
 Result<GenerateStats> generatePoints(const PointsOptions& options, const std::string& path) {
   if (options.points == 0)
     return Error{ErrorKind::kUsage, "a point cloud needs at least one point"};
-  if (fileExtension(path) != "ply")
-    return Error{ErrorKind::kUsage, fmt::format("{}: the points generator writes .ply", path)};
+  const std::string ext = fileExtension(path);
+  if (ext != "ply" && ext != "las")
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: the points generator writes .ply or .las", path)};
   const double depth = options.width * 2.0 / 3.0;
   const double spacing = std::sqrt(options.width * depth / static_cast<double>(options.points));
   const Terrain terrain(options.seed, options.width, depth, spacing);
-
-  PlyLayout layout;
-  layout.vertexCount = options.points;
-  layout.normals = true;
-  layout.colors = true;
-  layout.comments = {
-      fmt::format("lodforge generate points --points {} --seed {}", options.points, options.seed)};
-  Result<PlyWriter> writer = PlyWriter::create(path, layout);
-  if (!writer) return writer.status();
+  Result<PointSink> sink = openSink(options, path);
+  if (!sink) return sink.status();
+  const bool lidar = sink->las.has_value();
 
   const std::uint64_t batches = (options.points + kBatch - 1) / kBatch;
   std::vector<PointBatch> round(kBatchesPerRound);
@@ -69,16 +155,16 @@ Result<GenerateStats> generatePoints(const PointsOptions& options, const std::st
     tbb::parallel_for(std::uint64_t{0}, count, [&](std::uint64_t i) {
       const std::uint64_t batch = first + i;
       const std::uint64_t points = std::min(kBatch, options.points - batch * kBatch);
-      sampleBatch(terrain, options, batch, points, round[i]);
+      sampleBatch(terrain, options, batch, points, lidar, round[i]);
     });
     for (std::uint64_t i = 0; i < count; ++i) {
-      LODFORGE_TRY(writer->writeVertices(round[i].positions, round[i].normals, round[i].colors));
+      LODFORGE_TRY(sink->write(round[i]));
       progress.advance(round[i].positions.size());
     }
   }
   progress.finish();
-  const std::uint64_t bytes = writer->fileBytes();
-  LODFORGE_TRY(writer->finish());
+  const std::uint64_t bytes = sink->fileBytes();
+  LODFORGE_TRY(sink->finish());
   return GenerateStats{1, options.points, 0, bytes};
 }
 

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -236,6 +236,15 @@ serve_section() {
 }
 if [[ ${BENCH_ONLY:-} == serve ]]; then serve_section; exit 0; fi
 
+laz_section() {
+  echo
+  echo "== LAZ decoding: records per second, one thread and all, beside the same points as LAS (bench_laz)"
+  # The LAZ files of the data folder, and any more named in LAZ_FILES (space-separated paths).
+  # shellcheck disable=SC2086
+  build/release/bench/bench_laz ${LAZ_FILES:+$(ls ${LODFORGE_DATA:-../shared/data}/points/*.laz) $LAZ_FILES}
+}
+if [[ ${BENCH_ONLY:-} == laz ]]; then laz_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -257,5 +266,6 @@ simplify_section
 tiles_section
 points_section
 serve_section
+laz_section
 render_section
 runtime_section

@@ -38,7 +38,8 @@ double readSeconds(const std::string& path) {
       }
       if (!*more) break;
     }
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    best = std::min(
+        best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   return best;
 }
@@ -58,9 +59,10 @@ int main(int argc, char** argv) {
     std::sort(files.begin(), files.end());
   }
   const std::size_t cores = std::max(1u, std::thread::hardware_concurrency());
-  std::printf("| file | points | LAZ MiB | LAZ 1 thread Mpts/s | LAZ %zu threads Mpts/s | LAS Mpts/s | "
-              "LAZ %zu threads / LAS time |\n|---|---:|---:|---:|---:|---:|---:|\n",
-              cores, cores);
+  std::printf(
+      "| file | points | LAZ MiB | LAZ 1 thread Mpts/s | LAZ %zu threads Mpts/s | LAS Mpts/s | "
+      "LAZ %zu threads / LAS time |\n|---|---:|---:|---:|---:|---:|---:|\n",
+      cores, cores);
   const std::string las = (std::filesystem::temp_directory_path() / "bench_laz.las").string();
   for (const std::string& file : files) {
     Result<LasHeader> header = LasReader::readHeader(file);

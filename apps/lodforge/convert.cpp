@@ -52,13 +52,13 @@ Status convertToLas(const Global& global, const std::string& input, const std::s
   LODFORGE_TRY(claimOutput(output, modelFileOutput(output), std::vector<std::string>{input}));
   Result<LasCopyReport> report = writeUncompressedLas(input, output);
   if (!report) return report.status();
-  say(global, fmt::format("wrote {}: {} points, {} records kept{} in {:.2f} s", output,
-                          formatCount(report->points), report->recordsKept,
-                          report->recordsDropped > 0
-                              ? fmt::format(", {} compression records dropped",
-                                            report->recordsDropped)
-                              : std::string{},
-                          secondsSince(start)));
+  say(global,
+      fmt::format("wrote {}: {} points, {} records kept{} in {:.2f} s", output,
+                  formatCount(report->points), report->recordsKept,
+                  report->recordsDropped > 0
+                      ? fmt::format(", {} compression records dropped", report->recordsDropped)
+                      : std::string{},
+                  secondsSince(start)));
   return {};
 }
 

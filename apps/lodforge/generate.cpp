@@ -94,8 +94,8 @@ void addGenerate(CLI::App& app, const Global& global, Run& run) {
       std::string output = "points.ply";
     };
     auto options = std::make_shared<Options>();
-    CLI::App* sub =
-        generate->add_subcommand("points", "A scanned-surface point cloud of N points (PLY, or LAS with lidar attributes)");
+    CLI::App* sub = generate->add_subcommand(
+        "points", "A scanned-surface point cloud of N points (PLY, or LAS with lidar attributes)");
     addCountOption(*sub, "--points", options->points.points, "Number of points (default 1M)");
     sub->add_option("--seed", options->points.seed, "Random seed");
     sub->add_option("-o,--output", options->output, "Output .ply or .las (default points.ply)");

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "info_attributes.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/output_claim.h"
 #include "lodforge/core/progress.h"
@@ -184,9 +185,10 @@ Status describePackage(const std::string& path, bool json) {
   return {};
 }
 
-// A point file: a LAS header as it stands (nothing else is read); text files are streamed to
-// count their points and find their bounds.
-Status describePointFile(const std::string& path, bool json) {
+// A point file: a LAS or LAZ header as it stands, then (unless `headerOnly`) every point read
+// for the lidar fields' ranges; text files are streamed to count their points and find their
+// bounds.
+Status describePointFile(const std::string& path, bool json, bool headerOnly) {
   Result<std::uint64_t> bytes = fileSize(path);
   if (!bytes) return bytes.status();
   nlohmann::json j = {{"file", path}, {"fileBytes", *bytes}};
@@ -220,6 +222,11 @@ Status describePointFile(const std::string& path, bool json) {
     j["software"] = h.generatingSoftware;
     count = h.pointCount;
     bounds = h.bounds;
+    if (!headerOnly) {
+      Result<nlohmann::json> attributes = scanPointAttributes(path, *bytes);
+      if (!attributes) return attributes.status();
+      j["attributes"] = std::move(*attributes);
+    }
   } else {
     Result<PointReader> reader = PointReader::open(path);
     if (!reader) return reader.status();
@@ -273,6 +280,7 @@ Status describePointFile(const std::string& path, bool json) {
     fmt::print("crs        {}\n", crs.empty()        ? std::string("none stated")
                                   : crs.size() > 100 ? crs.substr(0, 97) + "..."
                                                      : crs);
+  if (j.contains("attributes")) printPointAttributes(j["attributes"]);
   return {};
 }
 
@@ -327,6 +335,7 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
     std::string path;
     bool json = false;
     bool salvage = false;
+    bool headerOnly = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("info", "Print a file's format, counts, bounds and load cost");
@@ -336,6 +345,9 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
          "or .lfc package")
       ->required();
   sub->add_flag("--json", options->json, "Print JSON instead of text");
+  sub->add_flag("--header-only", options->headerOnly,
+                "LAS and LAZ: the header alone, without reading the points for the ranges of "
+                "their fields");
   sub->add_flag("--salvage", options->salvage,
                 "Read a truncated PLY up to the cut (with a warning)");
   sub->callback([&global, &run, options] {
@@ -348,7 +360,8 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
                                                              kMeshFormats, kPointFormats));
       if (ext == "lfp") return describePackage(options->path, options->json);
       if (ext == "lfc") return describeCloud(options->path, options->json);
-      if (isPointCloudPath(options->path)) return describePointFile(options->path, options->json);
+      if (isPointCloudPath(options->path))
+        return describePointFile(options->path, options->json, options->headerOnly);
       const FileFormat format = formatFromPath(options->path);
       Result<std::uint64_t> bytes = fileSize(options->path);
       if (!bytes) return bytes.status();

@@ -13,6 +13,7 @@
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
 #include "lodforge/io/point_reader.h"
+#include "lodforge/tiles/point_attributes.h"
 #include "lodforge/tiles/point_tiles.h"
 #include "lodforge/tiles/tileset.h"
 #include "lodforge/tiling/resume.h"
@@ -60,6 +61,7 @@ struct TilesCommand {
   bool noQuantization = false;
   std::uint64_t blockSize = 50'000;
   std::uint64_t tilePoints = 50'000;
+  std::string attributes = "all";
   bool salvage = false;
 };
 
@@ -103,6 +105,10 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
                  "Point clouds: most points per leaf tile (a block of the partition; default 50K)");
   addCountOption(sub, "--tile-points", options.tilePoints,
                  "Point clouds: about this many points in a tile above the blocks (default 50K)");
+  sub.add_option("--attributes", options.attributes,
+                 "Point clouds: the LAS fields the tiles carry, comma-separated: classification, "
+                 "intensity, returns, flags, scan-angle, user-data, point-source, gps-time, nir; "
+                 "or all (default: all the input has) or none");
   sub.add_flag("--salvage", options.salvage,
                "Read a PLY cut short up to its last whole element (with a warning)");
   sub.add_flag("--resume", options.resume,
@@ -152,6 +158,9 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
   points.quantize = !options.noQuantization;
   points.meshoptCompression = tiles.meshoptCompression;
   points.salvageTruncated = options.salvage;
+  Result<std::uint32_t> attributes = parsePointAttributes(options.attributes);
+  if (!attributes) return attributes.status();
+  points.attributes = *attributes;
   Result<PointTilesStats> stats = writePointTiles(options.input, options.output, points);
   if (!stats) return stats.status();
   warnIfNotPlaced(global, !stats->crs.empty() || points.origin.has_value());
@@ -164,6 +173,8 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
                   formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->points) /
                                                          std::max(stats->seconds, 1e-9))),
                   stats->crs.empty() ? "" : "; placed on Earth from its coordinate system"));
+  if (stats->attributes != 0)
+    detail(global, fmt::format("point attributes: {}", pointAttributeNames(stats->attributes)));
   return {};
 }
 

@@ -534,7 +534,21 @@ TEST(CliPoints, BadInputIsExitCode2AndLeavesNothing) {
   EXPECT_NE(o.err.find("damaged.laz: byte "), std::string::npos) << o.err;
   EXPECT_NE(o.err.find("LAZ chunk 2 of 3"), std::string::npos) << o.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("t")));
-  // info reads what a LAZ is without decoding it.
+  // info reads the header, then every point for the fields' ranges (--header-only: not).
+  o = lodforge("info " + test::dataPath("points/autzen_trim.laz") + " --json", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const nlohmann::json attributes = nlohmann::json::parse(o.out)["attributes"];
+  EXPECT_EQ(attributes["intensity"]["max"], 254);
+  EXPECT_EQ(attributes["numberOfReturns"]["max"], 4);
+  EXPECT_EQ(attributes["classification"]["2"]["name"], "Ground");
+  EXPECT_EQ(attributes["classification"]["2"]["points"].get<std::uint64_t>() +
+                attributes["classification"]["1"]["points"].get<std::uint64_t>(),
+            110'000u);
+  o = lodforge("info " + dir.file("damaged.laz") + " --header-only", dir);
+  EXPECT_EQ(o.code, 0) << o.err;
+  o = lodforge("info " + dir.file("damaged.laz"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("LAZ chunk 2 of 3"), std::string::npos) << o.err;
   o = lodforge("info " + test::dataPath("points/autzen_trim.laz"), dir);
   EXPECT_EQ(o.code, 0) << o.err;
   EXPECT_NE(o.out.find("compressed point-wise chunked (50,000 points per chunk)"),
@@ -584,9 +598,9 @@ TEST(CliLaz, ConvertsToTheLasItCameFromAndTilesLikeIt) {
   test::TempDir dir;
   for (const auto& [laz, las] : {std::pair{"autzen_trim.laz", "autzen_trim.las"},
                                  std::pair{"simple-v1.laz", "simple.las"}}) {
-    const Outcome o = lodforge("convert " + test::dataPath(std::string("points/") + laz) +
-                                   " -o " + dir.file("out.las"),
-                               dir);
+    const Outcome o = lodforge(
+        "convert " + test::dataPath(std::string("points/") + laz) + " -o " + dir.file("out.las"),
+        dir);
     ASSERT_EQ(o.code, 0) << o.err;
     EXPECT_NE(o.out.find("1 compression records dropped"), std::string::npos) << o.out;
     EXPECT_TRUE(test::readFile(dir.file("out.las")) ==
@@ -594,9 +608,9 @@ TEST(CliLaz, ConvertsToTheLasItCameFromAndTilesLikeIt) {
         << laz;
   }
   // COPC: LAS 1.4 format 7 out, its COPC records dropped, the CRS kept.
-  Outcome o = lodforge("convert " + test::dataPath("points/1.2-with-color.copc.laz") + " -o " +
-                           dir.file("copc.las"),
-                       dir);
+  Outcome o = lodforge(
+      "convert " + test::dataPath("points/1.2-with-color.copc.laz") + " -o " + dir.file("copc.las"),
+      dir);
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_NE(o.out.find("1,065 points, 1 records kept, 3 compression records dropped"),
             std::string::npos)

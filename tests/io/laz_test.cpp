@@ -28,8 +28,8 @@ std::vector<std::byte> allRecords(const std::string& path, std::size_t batch = 1
 }
 
 std::size_t firstDifference(const std::vector<std::byte>& a, const std::vector<std::byte>& b) {
-  return static_cast<std::size_t>(
-      std::mismatch(a.begin(), a.end(), b.begin(), b.end()).first - a.begin());
+  return static_cast<std::size_t>(std::mismatch(a.begin(), a.end(), b.begin(), b.end()).first -
+                                  a.begin());
 }
 
 TEST(Laz, PointwiseChunkedVersion2DecodesToTheLasRecords) {
@@ -169,8 +169,8 @@ TEST(Laz, DamagedChunksAreBadInputNamingChunkAndByte) {
   {  // a header that counts one point more than the chunks hold
     std::string bytes = autzen;
     poke<std::uint32_t>(bytes, 107, peek<std::uint32_t>(autzen, 107) + 1);
-    expectDamage(bytes, {"LAZ chunk 3 of 3", "end after 10000 of the chunk's 10001",
-                         "point count"});
+    expectDamage(bytes,
+                 {"LAZ chunk 3 of 3", "end after 10000 of the chunk's 10001", "point count"});
   }
 }
 

@@ -156,9 +156,41 @@ TEST(Partition, RefusesAnEmptyInputAndBadPoints) {
   ASSERT_FALSE(empty.ok());
   EXPECT_EQ(empty.status().kind(), ErrorKind::kBadInput);
   EXPECT_NE(empty.error().message.find("no points"), std::string::npos);
-  Result<Partition> laz = partitionPoints(test::dataPath("points/autzen_trim.laz"), options);
-  ASSERT_FALSE(laz.ok());
-  EXPECT_EQ(laz.status().kind(), ErrorKind::kBadInput);
+  // A LAZ whose last chunk is cut off.
+  const std::string laz = test::readFile(test::dataPath("points/autzen_trim.laz"));
+  test::writeFile(dir.file("cut.laz"), laz.substr(0, laz.size() - 1000));
+  Result<Partition> cut = partitionPoints(dir.file("cut.laz"), options);
+  ASSERT_FALSE(cut.ok());
+  EXPECT_EQ(cut.status().kind(), ErrorKind::kBadInput);
+  EXPECT_NE(cut.error().message.find("cut.laz: byte"), std::string::npos);
+}
+
+// A LAZ partitions like its LAS: the same points, attributes and all.
+TEST(Partition, KeepsTheLidarAttributesOfLasAndLaz) {
+  test::TempDir dir;
+  for (const char* name : {"autzen_trim.las", "autzen_trim.laz"}) {
+    PartitionOptions options;
+    options.blockSize = 30'000;
+    options.workDirectory = dir.path().string();
+    Result<Partition> partition =
+        partitionPoints(test::dataPath(std::string("points/") + name), options);
+    ASSERT_TRUE(partition.ok()) << partition.error().message;
+    EXPECT_EQ(partition->pointCount, 110'000u);
+    EXPECT_NE(partition->info.attributes & kAttrGpsTime, 0u);
+    EXPECT_EQ(partition->info.attributes & kAttrNir, 0u);
+    std::uint64_t ground = 0, withTime = 0;
+    for (const PointBlock& block : partition->blocks) {
+      Result<std::vector<CloudPoint>> points = readPointRecords(block.path, 0, block.count);
+      ASSERT_TRUE(points.ok());
+      for (const CloudPoint& p : *points) {
+        ground += p.attributes.classification == 2;
+        withTime += p.attributes.gpsTime > 0;
+        ASSERT_GE(p.attributes.returnNumber, 1);
+      }
+    }
+    EXPECT_GT(ground, 10'000u) << name;
+    EXPECT_EQ(withTime, 110'000u) << name;
+  }
 }
 
 }  // namespace

@@ -13,6 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/random.h"
+#include "lodforge/io/las_reader.h"
+#include "lodforge/tiles/point_attributes.h"
 #include "test_support.h"
 
 namespace lodforge {
@@ -248,6 +250,138 @@ TEST(PointTiles, PlacesALasOnEarthFromItsCoordinateSystem) {
     EXPECT_NE(gltf["extensionsUsed"].dump().find("KHR_mesh_quantization"), std::string::npos);
   }
   EXPECT_EQ(total, 110'000u);
+}
+
+// A scalar vertex attribute of a point GLB (4 bytes per element), as doubles; the property
+// attribute's offset added back.
+std::vector<double> readPointAttribute(const std::string& path, const std::string& semantic) {
+  const std::string bytes = test::readFile(path);
+  std::uint32_t jsonLength = 0;
+  std::memcpy(&jsonLength, bytes.data() + 12, 4);
+  const nlohmann::json gltf = nlohmann::json::parse(bytes.substr(20, jsonLength));
+  const auto& attributes = gltf["meshes"][0]["primitives"][0]["attributes"];
+  if (!attributes.contains(semantic)) return {};
+  const auto& accessor = gltf["accessors"][attributes[semantic].get<int>()];
+  const auto& view = gltf["bufferViews"][accessor["bufferView"].get<int>()];
+  const int type = accessor["componentType"];
+  // 4 bytes per element: implied for floats, spelled out for the narrower types.
+  EXPECT_EQ(view.value("byteStride", type == 5126 ? 4u : 0u), 4u) << semantic;
+  double offset = 0;
+  for (const auto& [name, property] :
+       gltf["extensions"]["EXT_structural_metadata"]["propertyAttributes"][0]["properties"].items())
+    if (property["attribute"] == semantic) offset = property.value("offset", 0.0);
+  const std::size_t at = 20 + jsonLength + 8 + view.value("byteOffset", 0u);
+  std::vector<double> values(accessor["count"].get<std::size_t>());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const char* element = bytes.data() + at + 4 * i;
+    if (type == 5126) {
+      float f;
+      std::memcpy(&f, element, 4);
+      values[i] = f + offset;
+    } else if (type == 5123) {
+      std::uint16_t u;
+      std::memcpy(&u, element, 2);
+      values[i] = u;
+    } else {
+      values[i] = static_cast<std::uint8_t>(element[0]);
+    }
+  }
+  return values;
+}
+
+// Every LAS field reaches the tiles: over all tiles (refine ADD: each point once) the fields
+// are the LAS's, as multisets; the metadata names them and the classes.
+TEST(PointTiles, CarryTheLasAttributesAsStructuralMetadata) {
+  test::TempDir dir;
+  const std::string las = test::dataPath("points/autzen_trim.las");
+  PointTilesOptions options;
+  options.blockSize = 20'000;
+  options.tilePoints = 10'000;
+  Result<PointTilesStats> stats = writePointTiles(las, dir.file("t"), options);
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  EXPECT_EQ(pointAttributeNames(stats->attributes),
+            "classification, intensity, returns, flags, scan-angle, user-data, point-source, "
+            "gps-time");
+  // The LAS's own values.
+  using Key = std::tuple<int, int, int, int, int>;
+  std::multiset<Key> expected, found;
+  std::vector<double> expectedTimes, foundTimes;
+  Result<LasReader> reader = LasReader::open(las);
+  ASSERT_TRUE(reader.ok());
+  PointBatch batch;
+  while (*reader->next(batch))
+    for (const PointAttributes& a : batch.attributes) {
+      expected.insert(
+          {a.classification, a.intensity, a.returnNumber, a.numberOfReturns, a.pointSource});
+      expectedTimes.push_back(a.gpsTime);
+    }
+  ASSERT_EQ(expected.size(), 110'000u);
+  const auto tileset = nlohmann::json::parse(test::readFile(dir.file("t/tileset.json")));
+  std::vector<std::string> uris;
+  checkTileset(tileset["root"], dir.file("t"), tileset["geometricError"], nullptr, uris);
+  for (const std::string& uri : uris) {
+    const std::string glb = dir.file("t/" + uri);
+    const auto cls = readPointAttribute(glb, "_CLASSIFICATION");
+    const auto intensity = readPointAttribute(glb, "_INTENSITY");
+    const auto r = readPointAttribute(glb, "_RETURN_NUMBER");
+    const auto n = readPointAttribute(glb, "_NUMBER_OF_RETURNS");
+    const auto source = readPointAttribute(glb, "_POINT_SOURCE_ID");
+    const auto time = readPointAttribute(glb, "_GPS_TIME");
+    ASSERT_EQ(cls.size(), time.size());
+    for (std::size_t i = 0; i < cls.size(); ++i)
+      found.insert({int(cls[i]), int(intensity[i]), int(r[i]), int(n[i]), int(source[i])});
+    foundTimes.insert(foundTimes.end(), time.begin(), time.end());
+    nlohmann::json gltf;
+    readPointGlb(glb, &gltf);
+    const auto& metadata = gltf["extensions"]["EXT_structural_metadata"];
+    EXPECT_EQ(metadata["schema"]["classes"]["lidar"]["properties"]["classification"]["type"],
+              "ENUM");
+    EXPECT_NE(
+        metadata["schema"]["enums"]["classification"].dump().find(R"({"name":"Ground","value":2})"),
+        std::string::npos);
+    EXPECT_EQ(gltf["meshes"][0]["primitives"][0]["extensions"]["EXT_structural_metadata"]
+                  ["propertyAttributes"],
+              nlohmann::json::array({0}));
+  }
+  ASSERT_EQ(found.size(), expected.size());
+  std::vector<Key> missing;
+  std::set_difference(expected.begin(), expected.end(), found.begin(), found.end(),
+                      std::back_inserter(missing));
+  EXPECT_TRUE(missing.empty()) << missing.size() << " points differ";
+  // GPS times as floats from each tile's first second: within a millisecond.
+  std::sort(expectedTimes.begin(), expectedTimes.end());
+  std::sort(foundTimes.begin(), foundTimes.end());
+  ASSERT_EQ(foundTimes.size(), expectedTimes.size());
+  double worst = 0;
+  for (std::size_t i = 0; i < foundTimes.size(); ++i)
+    worst = std::max(worst, std::abs(foundTimes[i] - expectedTimes[i]));
+  EXPECT_LT(worst, 1e-3);
+
+  // Only what is asked for; a text file has none.
+  options.attributes = kAttrClassification;
+  stats = writePointTiles(las, dir.file("c"), options);
+  ASSERT_TRUE(stats.ok());
+  EXPECT_EQ(readPointAttribute(dir.file("c/tiles/b.glb"), "_INTENSITY").size(), 0u);
+  EXPECT_GT(readPointAttribute(dir.file("c/tiles/b.glb"), "_CLASSIFICATION").size(), 0u);
+  options.attributes = ~0u;
+  stats = writePointTiles(test::dataPath("points/kitten.xyz"), dir.file("p"), options);
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  EXPECT_EQ(stats->attributes, 0u);
+  nlohmann::json gltf;
+  readPointGlb(dir.file("p/tiles/b.glb"), &gltf);
+  EXPECT_FALSE(gltf.contains("extensions"));
+}
+
+TEST(PointTiles, AttributeNamesParse) {
+  EXPECT_EQ(*parsePointAttributes("classification,intensity"),
+            kAttrClassification | kAttrIntensity);
+  EXPECT_EQ(*parsePointAttributes("none"), 0u);
+  EXPECT_EQ(*parsePointAttributes("all"), ~0u);
+  Result<std::uint32_t> bad = parsePointAttributes("classification,colour");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("\"colour\" is not one of"), std::string::npos);
+  EXPECT_EQ(asprsClassName(9), "Water");
+  EXPECT_EQ(asprsClassName(200), "Class 200");
 }
 
 }  // namespace

@@ -45,7 +45,8 @@ LasPoint3 lidarPoint(Vec3d p, Vec3d n, Rgba8 c, double u, double v, Random& rand
   } else if (green) {
     const double draw = random.uniform(0, 1);
     point.classification = draw < 0.35 ? 2 : draw < 0.6 ? 3 : draw < 0.8 ? 4 : 5;
-    point.numberOfReturns = static_cast<std::uint8_t>(point.classification == 2 ? 1 : 2 + (draw > 0.9));
+    point.numberOfReturns =
+        static_cast<std::uint8_t>(point.classification == 2 ? 1 : 2 + (draw > 0.9));
     point.returnNumber = static_cast<std::uint8_t>(1 + random.below(point.numberOfReturns));
     reflectance = point.classification == 2 ? 0.4 : 0.3;
   } else if (c.r > 200) {
@@ -65,8 +66,8 @@ LasPoint3 lidarPoint(Vec3d p, Vec3d n, Rgba8 c, double u, double v, Random& rand
   const double strip = std::floor(u / kStripWidth);
   point.pointSource = static_cast<std::uint16_t>(1 + strip);
   point.gpsTime = 300000.0 + strip * 900.0 + v / kFlightSpeed + random.uniform(0, 1e-4);
-  point.scanAngle = static_cast<std::int8_t>(
-      std::lround(((u - strip * kStripWidth) / kStripWidth - 0.5) * 40.0));
+  point.scanAngle =
+      static_cast<std::int8_t>(std::lround(((u - strip * kStripWidth) / kStripWidth - 0.5) * 40.0));
   point.rgb = {static_cast<std::uint16_t>(c.r * 257), static_cast<std::uint16_t>(c.g * 257),
                static_cast<std::uint16_t>(c.b * 257)};
   return point;
@@ -113,8 +114,8 @@ Result<PointSink> openSink(const PointsOptions& options, const std::string& path
       fmt::format("lodforge generate points --points {} --seed {}", options.points, options.seed);
   if (fileExtension(path) == "las") {
     // Millimetres: the terrain spans kilometres at most, far inside 32-bit integers.
-    Result<LasWriter> las = LasWriter::create(path, {0.001, 0.001, 0.001}, {0, 0, 0},
-                                              "lodforge generate points");
+    Result<LasWriter> las =
+        LasWriter::create(path, {0.001, 0.001, 0.001}, {0, 0, 0}, "lodforge generate points");
     if (!las) return las.status();
     sink.las.emplace(std::move(*las));
     return sink;

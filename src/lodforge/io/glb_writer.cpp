@@ -42,6 +42,7 @@ struct GlbWriter::State {
   nlohmann::json meshes = nlohmann::json::array();
   nlohmann::json materials = nlohmann::json::array();
   nlohmann::json nodes = nlohmann::json::array();
+  std::string structuralMetadata;  // EXT_structural_metadata at the root, when set
   std::vector<std::uint32_t> rootChildren;
   std::optional<Vec3d> rootTranslation;
   std::optional<std::uint32_t> defaultMaterial;
@@ -54,6 +55,7 @@ struct GlbWriter::State {
   Status addFloatAttributes(const GlbMeshData& mesh, const Aabb& bounds,
                             nlohmann::json& attributes);
   Status addColors(const GlbMeshData& mesh, nlohmann::json& attributes);
+  Status addExtraAttributes(const GlbMeshData& mesh, nlohmann::json& attributes);
   Result<std::uint32_t> addIndices(const GlbMeshData& mesh);
   // Binary chunk: in memory until it exceeds options.spillBytes, then appended to `spill`.
   std::vector<std::byte> binary;
@@ -249,6 +251,19 @@ Status GlbWriter::State::addColors(const GlbMeshData& mesh, nlohmann::json& attr
   return {};
 }
 
+Status GlbWriter::State::addExtraAttributes(const GlbMeshData& mesh, nlohmann::json& attributes) {
+  const std::size_t vertexCount = mesh.positions.size();
+  for (const GlbVertexAttribute& extra : mesh.extraAttributes) {
+    assert(extra.data.size() == 4 * vertexCount && extra.semantic.starts_with('_'));
+    Result<std::uint32_t> index =
+        addAccessor(extra.data.data(), extra.data.size(), vertexCount, extra.componentType,
+                    "SCALAR", kArrayBuffer, false, nullptr, nullptr, 4);
+    if (!index) return index.status();
+    attributes[extra.semantic] = *index;
+  }
+  return {};
+}
+
 // 16-bit indices when they fit; 65535 itself is the primitive-restart value glTF forbids.
 Result<std::uint32_t> GlbWriter::State::addIndices(const GlbMeshData& mesh) {
   const std::size_t vertexCount = mesh.positions.size();
@@ -269,6 +284,10 @@ Result<std::uint32_t> GlbWriter::State::addIndices(const GlbMeshData& mesh) {
                      mesh.indices, vertexCount);
 }
 
+void GlbWriter::setStructuralMetadata(std::string json) {
+  state_->structuralMetadata = std::move(json);
+}
+
 Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_view name,
                                          std::optional<std::uint32_t> material) {
   State& s = *state_;
@@ -286,6 +305,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
     LODFORGE_TRY(s.addFloatAttributes(mesh, bounds, attributes));
   }
   LODFORGE_TRY(s.addColors(mesh, attributes));
+  LODFORGE_TRY(s.addExtraAttributes(mesh, attributes));
   Result<std::uint32_t> indices = s.addIndices(mesh);
   if (!indices) return indices.status();
 
@@ -294,6 +314,9 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
     material = s.defaultMaterial;
   }
   nlohmann::json primitive = {{"attributes", attributes}, {"mode", 4}, {"material", *material}};
+  if (mesh.propertyAttribute)
+    primitive["extensions"]["EXT_structural_metadata"]["propertyAttributes"] = {
+        *mesh.propertyAttribute};
   if (mesh.points) {
     primitive["mode"] = 0;
   } else {
@@ -305,13 +328,26 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
   return static_cast<std::uint32_t>(s.meshes.size() - 1);
 }
 
+namespace {
+bool isTranslation(const Mat4d& m) {
+  for (int i = 0; i < 12; ++i)
+    if (m.m[static_cast<std::size_t>(i)] != (i % 5 == 0 ? 1.0 : 0.0)) return false;
+  return m.m[15] == 1.0;
+}
+}  // namespace
+
 void GlbWriter::addNode(std::string_view name, std::optional<std::uint32_t> mesh,
                         const Mat4d* transform) {
   nlohmann::json node = nlohmann::json::object();
   if (!name.empty()) node["name"] = std::string(name);
   if (mesh) node["mesh"] = *mesh;
   const auto& grid = mesh ? state_->dequantize[*mesh] : std::nullopt;
-  if (grid && !transform) {
+  if (state_->options.flatScene && transform && isTranslation(*transform)) {
+    const Vec3d t{transform->m[12], transform->m[13], transform->m[14]};
+    const Vec3d at = grid ? t + grid->first : t;
+    node["translation"] = {at.x, at.y, at.z};
+    if (grid) node["scale"] = {grid->second, grid->second, grid->second};
+  } else if (grid && !transform) {
     // Integer grid coordinates back to the mesh's own units.
     node["translation"] = {grid->first.x, grid->first.y, grid->first.z};
     node["scale"] = {grid->second, grid->second, grid->second};
@@ -336,16 +372,20 @@ std::uint64_t GlbWriter::binaryBytes() const {
 
 Status GlbWriter::finish() {
   State& s = *state_;
+  assert(!s.options.flatScene || !s.rootTranslation);
   // The root node holds every object node, and the origin offset if there is one.
   nlohmann::json root = {{"name", "root"}};
   if (!s.rootChildren.empty()) root["children"] = s.rootChildren;
   if (s.rootTranslation && *s.rootTranslation != Vec3d{})
     root["translation"] = {s.rootTranslation->x, s.rootTranslation->y, s.rootTranslation->z};
-  s.nodes.push_back(std::move(root));
-
+  nlohmann::json sceneNodes = s.rootChildren;
+  if (!s.options.flatScene) {
+    s.nodes.push_back(std::move(root));
+    sceneNodes = {s.nodes.size() - 1};
+  }
   nlohmann::json document = {{"asset", {{"version", "2.0"}, {"generator", kGenerator}}},
                              {"scene", 0},
-                             {"scenes", {{{"nodes", {s.nodes.size() - 1}}}}},
+                             {"scenes", {{{"nodes", sceneNodes}}}},
                              {"nodes", std::move(s.nodes)}};
   if (!s.meshes.empty()) {
     document["meshes"] = std::move(s.meshes);
@@ -368,6 +408,10 @@ Status GlbWriter::finish() {
     }
   }
   if (!s.materials.empty()) document["materials"] = std::move(s.materials);
+  if (!s.structuralMetadata.empty()) {
+    document["extensions"]["EXT_structural_metadata"] = nlohmann::json::parse(s.structuralMetadata);
+    document["extensionsUsed"].push_back("EXT_structural_metadata");
+  }
   std::string json = document.dump();
   while (json.size() % 4 != 0) json += ' ';
 

@@ -18,6 +18,15 @@
 
 namespace lodforge {
 
+// A vertex attribute of the application's own: scalar, one element per vertex, each padded to 4
+// bytes (glTF aligns vertex attribute elements to 4 bytes).
+struct GlbVertexAttribute {
+  std::string semantic;  // begins with an underscore: "_CLASSIFICATION"
+  int componentType =
+      0;  // glTF's: 5120 BYTE, 5121 UNSIGNED_BYTE, 5122 SHORT, 5123 UNSIGNED_SHORT, 5126 FLOAT
+  std::span<const std::byte> data;  // 4 bytes per vertex
+};
+
 struct GlbMeshData {
   std::span<const Vec3f> positions;
   std::span<const Vec3f> normals;          // empty or one per vertex (normalised on write)
@@ -29,6 +38,10 @@ struct GlbMeshData {
   bool quantized = false;
   // A point cloud: one POINTS primitive over the vertices (glTF mode 0), no indices.
   bool points = false;
+  std::span<const GlbVertexAttribute> extraAttributes = {};
+  // EXT_structural_metadata: the property attribute (of setStructuralMetadata's) that describes
+  // the extra attributes.
+  std::optional<std::uint32_t> propertyAttribute = std::nullopt;
 };
 
 // The grid step of a quantised mesh inside `bounds`: its longest side over 65535.
@@ -42,6 +55,11 @@ struct GlbWriteOptions {
   // EXT_meshopt_compression: vertex and index data encoded with meshoptimizer's codecs (a
   // required extension: viewers without it cannot read the file).
   bool meshoptCompression = false;
+  // The nodes straight in the scene, without the root node that holds them (point tiles: a node
+  // without a mesh trips three.js's EXT_structural_metadata loader in 3d-tiles-renderer 0.4);
+  // setRootTranslation is then not used, and addNode's translation-only transforms stay
+  // translations.
+  bool flatScene = false;
 };
 
 class GlbWriter {
@@ -56,6 +74,8 @@ class GlbWriter {
   // Writes the mesh's data; returns its mesh index for addNode. Empty meshes are refused (assert).
   Result<std::uint32_t> addMesh(const GlbMeshData& mesh, std::string_view name = {},
                                 std::optional<std::uint32_t> material = std::nullopt);
+  // The document's EXT_structural_metadata object (schema and property attributes), as JSON.
+  void setStructuralMetadata(std::string json);
   // A node drawing `mesh` (or nothing) with an optional transform, a child of the root node.
   void addNode(std::string_view name, std::optional<std::uint32_t> mesh,
                const Mat4d* transform = nullptr);

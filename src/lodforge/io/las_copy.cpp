@@ -33,7 +33,8 @@ struct Sections {
 
 // The header, the VLRs (and any bytes between them and the points) and the EVLRs, the compression
 // records left out.
-Result<Sections> readSections(const std::string& input, const LasHeader& h, LasCopyReport& report) try {
+Result<Sections> readSections(const std::string& input, const LasHeader& h,
+                              LasCopyReport& report) try {
   Result<ByteSource> in = ByteSource::openFile(input);
   if (!in) return in.status();
   Sections s;

@@ -59,6 +59,43 @@ std::string epsgFromGeoKeys(std::span<const std::uint16_t> keys) {
   return code != 0 ? fmt::format("EPSG:{}", code) : std::string{};
 }
 
+// The lidar fields every format has, GPS time where it has one, NIR in formats 8 and 10.
+std::uint32_t formatAttributes(int format) {
+  std::uint32_t bits = kAttrIntensity | kAttrClassification | kAttrReturns | kAttrFlags |
+                       kAttrScanAngle | kAttrUserData | kAttrPointSource;
+  if (format != 0 && format != 2) bits |= kAttrGpsTime;
+  if (format == 8 || format == 10) bits |= kAttrNir;
+  return bits;
+}
+
+// A record's lidar fields: formats 0–5 (LAS 1.0–1.3 layout) and 6–10 (LAS 1.4 R15, Table 17).
+PointAttributes recordAttributes(const std::byte* r, int format) {
+  PointAttributes a;
+  a.intensity = loadField<std::uint16_t>(r + 12);
+  const auto b14 = static_cast<std::uint8_t>(r[14]), b15 = static_cast<std::uint8_t>(r[15]);
+  if (format < 6) {
+    a.returnNumber = b14 & 7;
+    a.numberOfReturns = (b14 >> 3) & 7;
+    a.flags = static_cast<std::uint8_t>((b14 & 0xC0) | (b15 >> 5));  // direction, edge; 3 flags
+    a.classification = b15 & 31;
+    a.scanAngle = loadField<std::int8_t>(r + 16);
+    a.userData = static_cast<std::uint8_t>(r[17]);
+    a.pointSource = loadField<std::uint16_t>(r + 18);
+    if (format == 1 || format >= 3) a.gpsTime = loadField<double>(r + 20);
+  } else {
+    a.returnNumber = b14 & 15;
+    a.numberOfReturns = b14 >> 4;
+    a.flags = b15;
+    a.classification = static_cast<std::uint8_t>(r[16]);
+    a.userData = static_cast<std::uint8_t>(r[17]);
+    a.scanAngle = static_cast<float>(loadField<std::int16_t>(r + 18) * 0.006);
+    a.pointSource = loadField<std::uint16_t>(r + 20);
+    a.gpsTime = loadField<double>(r + 22);
+    if (format == 8 || format == 10) a.nir = loadField<std::uint16_t>(r + 36);
+  }
+  return a;
+}
+
 }  // namespace
 
 std::uint16_t lasRecordSize(int pointFormat) {
@@ -186,6 +223,7 @@ Status LasReader::State::readHeader(std::vector<std::byte>& bytes) {
   // LASzip marks compressed files by setting the format's top bits.
   h.compressed = (formatByte & 0xC0) != 0;
   h.pointFormat = formatByte & 0x3F;
+  h.attributes = formatAttributes(h.pointFormat);
   if (lasRecordSize(h.pointFormat) == 0)
     return fail(104,
                 fmt::format("point format {} is not a LAS format (0 to 10 are)", h.pointFormat));
@@ -356,8 +394,8 @@ Status LasReader::State::probeColorDepth() {
   if (h.compressed) {  // the first batch the reader decodes anyway
     Result<std::span<const std::byte>> ahead = lazPoints->peek();
     if (!ahead) return ahead.status();
-    probed.assign(ahead->begin(),
-                  ahead->begin() + static_cast<std::ptrdiff_t>(std::min(ahead->size(), probed.size())));
+    probed.assign(ahead->begin(), ahead->begin() + static_cast<std::ptrdiff_t>(
+                                                       std::min(ahead->size(), probed.size())));
   } else {
     Result<ByteSource> probe = reopen();
     if (!probe) return probe.status();
@@ -434,9 +472,11 @@ Result<bool> LasReader::next(PointBatch& batch) {
   if (!more || !*more) return more;
   const std::size_t count = s.records.size() / h.recordLength;
   batch.positions.resize(count);
+  batch.attributes.resize(count);
   if (h.hasColors) batch.colors.resize(count);
   for (std::size_t i = 0; i < count; ++i) {
     const std::byte* r = s.records.data() + i * h.recordLength;
+    batch.attributes[i] = recordAttributes(r, h.pointFormat);
     Vec3d& p = batch.positions[i];
     for (int k = 0; k < 3; ++k) {
       // Double precision: scale 0.01 at offset 6e5 keeps the centimetres exactly as written.

@@ -42,6 +42,7 @@ struct LasHeader {
   bool compressed = false;
   std::optional<LazInfo> laz;
   bool copc = false;
+  std::uint32_t attributes = 0;  // PointAttributeBit: the lidar fields of the point format
 };
 
 // The smallest record of a point format (0–10), 0 for an unknown format.
@@ -59,8 +60,8 @@ class LasReader {
   ~LasReader();
 
   const LasHeader& header() const;
-  // The next batch of points (positions, and colours when the format has them); false at the
-  // end of the point records.
+  // The next batch of points (positions, the lidar attributes, and colours when the format has
+  // them); false at the end of the point records.
   Result<bool> next(PointBatch& batch);
   // Or the next batch as the point records themselves (record length bytes each, decoded when
   // the file is LAZ); false at the end.

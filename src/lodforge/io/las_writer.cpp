@@ -41,7 +41,8 @@ std::array<std::byte, 227> LasWriter::header() const {
   put<std::uint32_t>(h, 96, 227);
   put<std::uint8_t>(h, 104, 3);
   put<std::uint16_t>(h, 105, static_cast<std::uint16_t>(kLasFormat3Size));
-  put<std::uint32_t>(h, 107, static_cast<std::uint32_t>(std::min<std::uint64_t>(points_, 0xFFFFFFFFu)));
+  put<std::uint32_t>(h, 107,
+                     static_cast<std::uint32_t>(std::min<std::uint64_t>(points_, 0xFFFFFFFFu)));
   for (std::size_t r = 0; r < 5; ++r) put<std::uint32_t>(h, 111 + 4 * r, byReturn_[r]);
   const bool empty = points_ == 0;
   for (int k = 0; k < 3; ++k) {

@@ -240,9 +240,9 @@ std::int32_t LazIntegerDecoder::decode(LazDecoder& dec, std::int32_t predicted,
                                        std::uint32_t context) {
   assert(context < kModels_.size());
   // Unsigned sums wrap as the format's 32-bit arithmetic does.
-  std::int32_t real = static_cast<std::int32_t>(static_cast<std::uint32_t>(predicted) +
-                                                static_cast<std::uint32_t>(
-                                                    readCorrector(dec, kModels_[context])));
+  std::int32_t real =
+      static_cast<std::int32_t>(static_cast<std::uint32_t>(predicted) +
+                                static_cast<std::uint32_t>(readCorrector(dec, kModels_[context])));
   if (real < 0) {
     real = static_cast<std::int32_t>(static_cast<std::uint32_t>(real) + correctorRange_);
   } else if (static_cast<std::uint32_t>(real) >= correctorRange_) {

@@ -28,8 +28,8 @@ Result<LazChunkTable> chunksWithoutTable(const LazLayout& layout, const LazInfo&
   LazChunkTable table;
   table.complete = false;
   for (std::uint64_t done = 0; done < layout.pointCount; done += laz.chunkSize)
-    table.chunks.push_back(
-        {done == 0 ? firstChunk : 0, 0, std::min<std::uint64_t>(laz.chunkSize, layout.pointCount - done)});
+    table.chunks.push_back({done == 0 ? firstChunk : 0, 0,
+                            std::min<std::uint64_t>(laz.chunkSize, layout.pointCount - done)});
   return table;
 }
 
@@ -52,8 +52,10 @@ Result<LazChunkTable> decodeTableEntries(const LazLayout& layout, const LazInfo&
     chunk.offset = offset;
     if (variable) lastCount = ic.decode(dec, lastCount, 0);
     lastBytes = ic.decode(dec, lastBytes, 1);
-    chunk.points = variable ? static_cast<std::uint32_t>(lastCount)
-                            : std::min<std::uint64_t>(laz.chunkSize, layout.pointCount - std::min(points, layout.pointCount));
+    chunk.points =
+        variable ? static_cast<std::uint32_t>(lastCount)
+                 : std::min<std::uint64_t>(laz.chunkSize,
+                                           layout.pointCount - std::min(points, layout.pointCount));
     chunk.bytes = static_cast<std::uint32_t>(lastBytes);
     if (chunk.bytes == 0 || offset + chunk.bytes > tableAt)
       return badInputAtByte(layout.file, tableAt,
@@ -109,8 +111,7 @@ Result<LazChunkTable> readLazChunkTable(const LazLayout& layout, const LazInfo& 
   const auto version = loadField<std::uint32_t>(head->data());
   const auto count = loadField<std::uint32_t>(head->data() + 4);
   if (version != 0)
-    return badInputAtByte(layout.file, at,
-                          fmt::format("chunk table version {} is not 0", version));
+    return badInputAtByte(layout.file, at, fmt::format("chunk table version {} is not 0", version));
   const std::uint64_t expected =
       variableChunks(laz) ? count : (layout.pointCount + laz.chunkSize - 1) / laz.chunkSize;
   if (count != expected || count > layout.dataEnd - firstChunk)
@@ -135,7 +136,8 @@ struct LazChunkDecoder::State {
   std::size_t recordLength = 0;
   LazDecoder dec;
 
-  Error damaged(std::uint64_t at, std::size_t index, std::size_t count, std::string_view what) const {
+  Error damaged(std::uint64_t at, std::size_t index, std::size_t count,
+                std::string_view what) const {
     return badInputAtByte(file, at, fmt::format("LAZ chunk {} of {}: {}", index + 1, count, what));
   }
   Result<std::uint64_t> decodePointwise(std::span<const std::byte> bytes, const LazChunk& chunk,
@@ -229,9 +231,9 @@ Result<std::uint64_t> LazChunkDecoder::State::decodeLayered(std::span<const std:
     return damaged(chunk.offset + at, index, count, "the chunk ends inside its layer sizes");
   const auto points = loadField<std::uint32_t>(bytes.data() + at);
   if (points != chunk.points)
-    return damaged(chunk.offset + at, index, count,
-                   fmt::format("the chunk holds {} points but the chunk table says {}", points,
-                               chunk.points));
+    return damaged(
+        chunk.offset + at, index, count,
+        fmt::format("the chunk holds {} points but the chunk table says {}", points, chunk.points));
   at += 4;
   std::vector<std::uint32_t> sizes(layerCount);
   std::memcpy(sizes.data(), bytes.data() + at, 4 * layerCount);
@@ -249,8 +251,7 @@ Result<std::uint64_t> LazChunkDecoder::State::decodeLayered(std::span<const std:
   std::size_t firstLayer = 0;
   for (std::size_t i = 0; i < layeredItems.size(); ++i) {
     const std::size_t n = layeredItems[i]->layerCount();
-    layeredItems[i]->start(out + itemOffsets[i],
-                           std::span(layers).subspan(firstLayer, n), context);
+    layeredItems[i]->start(out + itemOffsets[i], std::span(layers).subspan(firstLayer, n), context);
     firstLayer += n;
   }
   for (std::uint64_t p = 1; p < chunk.points; ++p) {

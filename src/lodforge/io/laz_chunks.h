@@ -31,7 +31,7 @@ struct LazChunkTable {
 };
 
 struct LazLayout {
-  std::string file;              // for messages
+  std::string file;  // for messages
   std::uint64_t fileSize = 0;
   std::uint64_t pointOffset = 0;  // where the point data (and the table's pointer) start
   std::uint64_t dataEnd = 0;      // where the point data must end (EVLRs or the file's end)

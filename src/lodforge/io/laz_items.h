@@ -73,9 +73,8 @@ inline std::uint32_t lazReturnLevel(std::uint32_t n, std::uint32_t r) {
 // change.
 struct LazRgbModels {
   LazSymbolModel used{128};
-  std::array<LazSymbolModel, 6> diff{LazSymbolModel(256), LazSymbolModel(256),
-                                     LazSymbolModel(256), LazSymbolModel(256),
-                                     LazSymbolModel(256), LazSymbolModel(256)};
+  std::array<LazSymbolModel, 6> diff{LazSymbolModel(256), LazSymbolModel(256), LazSymbolModel(256),
+                                     LazSymbolModel(256), LazSymbolModel(256), LazSymbolModel(256)};
   void reset();
 };
 void lazDecodeRgb(LazDecoder& dec, LazRgbModels& models, const std::uint16_t* last,
@@ -125,8 +124,8 @@ struct LazWavePacketCodec {
   std::int32_t lastOffsetDiff = 0;
   std::uint32_t offsetCase = 0;
   LazSymbolModel packetIndex{256};
-  std::array<LazSymbolModel, 4> offsetCases{LazSymbolModel(4), LazSymbolModel(4),
-                                            LazSymbolModel(4), LazSymbolModel(4)};
+  std::array<LazSymbolModel, 4> offsetCases{LazSymbolModel(4), LazSymbolModel(4), LazSymbolModel(4),
+                                            LazSymbolModel(4)};
   LazIntegerDecoder offsetDiff{32}, packetSize{32}, returnPoint{32}, xyz{32, 3};
 
   void reset();

@@ -47,7 +47,8 @@ class Point10V1 final : public LazPointwiseItem {
     k = (k + dy_.k()) / 2;
     last_.z = z_.decode(dec, last_.z, k < 19 ? k : 19);
     const std::uint32_t changed = dec.decodeSymbol(changed_);
-    if (changed & 32) last_.intensity = static_cast<std::uint16_t>(intensity_.decode(dec, last_.intensity));
+    if (changed & 32)
+      last_.intensity = static_cast<std::uint16_t>(intensity_.decode(dec, last_.intensity));
     if (changed & 16) last_.flags = decodeByte(dec, flagModels_, last_.flags);
     if (changed & 8) last_.classification = decodeByte(dec, classModels_, last_.classification);
     if (changed & 4)
@@ -170,7 +171,8 @@ class ByteV1 final : public LazPointwiseItem {
   }
   void read(LazDecoder& dec, std::byte* out) override {
     for (std::size_t i = 0; i < last_.size(); ++i) {
-      last_[i] = static_cast<std::uint8_t>(ic_.decode(dec, last_[i], static_cast<std::uint32_t>(i)));
+      last_[i] =
+          static_cast<std::uint8_t>(ic_.decode(dec, last_[i], static_cast<std::uint32_t>(i)));
       out[i] = static_cast<std::byte>(last_[i]);
     }
   }

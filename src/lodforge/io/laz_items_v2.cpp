@@ -63,10 +63,10 @@ std::uint32_t lazReturnMap(std::uint32_t n, std::uint32_t r) {
   // Single, first, intermediate and last returns of up to 5 get their own contexts; the rest
   // share the outer ones (the LAZ specification's table).
   static constexpr std::uint8_t kMap[8][8] = {
-      {15, 14, 13, 12, 11, 10, 9, 8},    {14, 0, 1, 3, 6, 10, 10, 9},
-      {13, 1, 2, 4, 7, 11, 11, 10},      {12, 3, 4, 5, 8, 12, 12, 11},
-      {11, 6, 7, 8, 9, 13, 13, 12},      {10, 10, 11, 12, 13, 14, 14, 13},
-      {9, 10, 11, 12, 13, 14, 15, 14},   {8, 9, 10, 11, 12, 13, 14, 15}};
+      {15, 14, 13, 12, 11, 10, 9, 8},  {14, 0, 1, 3, 6, 10, 10, 9},
+      {13, 1, 2, 4, 7, 11, 11, 10},    {12, 3, 4, 5, 8, 12, 12, 11},
+      {11, 6, 7, 8, 9, 13, 13, 12},    {10, 10, 11, 12, 13, 14, 14, 13},
+      {9, 10, 11, 12, 13, 14, 15, 14}, {8, 9, 10, 11, 12, 13, 14, 15}};
   return kMap[n & 7][r & 7];
 }
 
@@ -148,8 +148,8 @@ class Point10V2 final : public LazPointwiseItem {
     const std::uint32_t r = last_.returnNumber(), n = last_.numberOfReturns();
     const std::uint32_t m = lazReturnMap(n, r), l = lazReturnLevel(n, r);
     if (changed & 16) {
-      last_.intensity = static_cast<std::uint16_t>(
-          intensity_.decode(dec, lastIntensity_[m], m < 3 ? m : 3));
+      last_.intensity =
+          static_cast<std::uint16_t>(intensity_.decode(dec, lastIntensity_[m], m < 3 ? m : 3));
       lastIntensity_[m] = last_.intensity;
     } else {
       last_.intensity = lastIntensity_[m];
@@ -256,11 +256,12 @@ bool LazGpsTimeCodec::decodeOne(LazDecoder& dec) {
   std::uint32_t multi = dec.decodeSymbol(multiModel_);
   if (layered_ && multi >= kUnchanged) ++multi;
   if (multi == 1) {
-    times_[last_] += static_cast<std::uint64_t>(
-        static_cast<std::int64_t>(ic_.decode(dec, diffs_[last_], 1)));
+    times_[last_] +=
+        static_cast<std::uint64_t>(static_cast<std::int64_t>(ic_.decode(dec, diffs_[last_], 1)));
     extremes_[last_] = 0;
   } else if (multi < kUnchanged) {
-    times_[last_] += static_cast<std::uint64_t>(static_cast<std::int64_t>(multipleDiff(dec, multi)));
+    times_[last_] +=
+        static_cast<std::uint64_t>(static_cast<std::int64_t>(multipleDiff(dec, multi)));
   } else if (multi == kCodeFull) {
     readFull(dec);
   } else if (multi > kCodeFull) {

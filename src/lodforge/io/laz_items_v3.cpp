@@ -28,7 +28,8 @@ struct Point14 {
     p.y = loadField<std::int32_t>(r + 4);
     p.z = loadField<std::int32_t>(r + 8);
     p.intensity = loadField<std::uint16_t>(r + 12);
-    const auto returns = static_cast<std::uint32_t>(r[14]), flags = static_cast<std::uint32_t>(r[15]);
+    const auto returns = static_cast<std::uint32_t>(r[14]),
+               flags = static_cast<std::uint32_t>(r[15]);
     p.returnNumber = returns & 15;
     p.numberOfReturns = returns >> 4;
     p.classFlags = flags & 15;
@@ -60,15 +61,22 @@ struct Point14 {
 
 // Contexts from return r of n (16×16, LAS 1.4's 4-bit counts): six for x and y.
 std::uint32_t returnMap6(std::uint32_t n, std::uint32_t r) {
-  static constexpr std::uint8_t kMap[16][16] = {
-      {0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5}, {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
-      {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3}, {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-      {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-      {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
-      {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
-      {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
-      {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
-      {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
+  static constexpr std::uint8_t kMap[16][16] = {{0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5},
+                                                {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
+                                                {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3},
+                                                {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+                                                {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+                                                {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+                                                {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+                                                {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
+                                                {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4},
+                                                {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
+                                                {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4},
+                                                {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
+                                                {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4},
+                                                {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
+                                                {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5},
+                                                {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
   return kMap[n & 15][r & 15];
 }
 
@@ -373,7 +381,8 @@ class Rgb14V3 final : public FollowerItem<RgbNirModels> {
       const std::uint32_t used = dec.decodeSymbol(m.nirUsed);
       std::int32_t low = values[3] & 0xFF, high = values[3] >> 8;
       if (used & 1) low = lazFold(static_cast<std::int32_t>(dec.decodeSymbol(m.nirDiff[0])) + low);
-      if (used & 2) high = lazFold(static_cast<std::int32_t>(dec.decodeSymbol(m.nirDiff[1])) + high);
+      if (used & 2)
+        high = lazFold(static_cast<std::int32_t>(dec.decodeSymbol(m.nirDiff[1])) + high);
       values[3] = static_cast<std::uint16_t>(low | (high << 8));
     }
     std::memcpy(last, values, bytes);
@@ -409,8 +418,8 @@ class Byte14V3 final : public FollowerItem<std::vector<LazSymbolModel>> {
   void decode(std::vector<LazSymbolModel>& models, std::uint8_t* last, std::byte* out) override {
     for (std::size_t i = 0; i < layers_.size(); ++i) {
       if (layers_[i].present)
-        last[i] = lazFold(
-            static_cast<std::int32_t>(last[i] + layers_[i].dec.decodeSymbol(models[i])));
+        last[i] =
+            lazFold(static_cast<std::int32_t>(last[i] + layers_[i].dec.decodeSymbol(models[i])));
       out[i] = static_cast<std::byte>(last[i]);
     }
   }

@@ -72,7 +72,8 @@ Result<LazPointStream> LazPointStream::open(const std::string& path,
   if (!probe) return probe.status();
   State* s = state.get();
   Result<LazChunkTable> table = readLazChunkTable(
-      layout, laz, [s](std::uint64_t offset, std::uint64_t size) { return s->readBytes(offset, size); });
+      layout, laz,
+      [s](std::uint64_t offset, std::uint64_t size) { return s->readBytes(offset, size); });
   if (!table) return table.status();
   state->table = std::move(*table);
   state->decoders.emplace();
@@ -112,7 +113,8 @@ Status LazPointStream::State::decodeOne(std::size_t index, std::byte* out) {
 
 // The next chunks, as many as the threads can decode at once (one at a time without a table).
 Status LazPointStream::State::decodeBatch() {
-  const std::size_t threads = static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  const std::size_t threads =
+      static_cast<std::size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
   const std::size_t batch =
       table.complete ? std::min(2 * threads, table.chunks.size() - nextChunk) : 1;
   std::vector<std::uint64_t> starts(batch + 1, 0);

@@ -44,12 +44,16 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
     if (!las) return las.status();
     const LasHeader& h = las->header();
     PointCloudInfo info;
-    info.format =
-        fmt::format("LAS {}.{}, point format {}", h.versionMajor, h.versionMinor, h.pointFormat);
+    info.format = fmt::format("{} {}.{}, point format {}",
+                              h.copc         ? "COPC"
+                              : h.compressed ? "LAZ"
+                                             : "LAS",
+                              h.versionMajor, h.versionMinor, h.pointFormat);
     info.count = h.pointCount;
     info.bounds = h.bounds;
     info.crs = h.crs;
     info.hasColors = h.hasColors;
+    info.attributes = h.attributes;
     return PointReader(std::make_unique<State>(State{std::move(*las), std::move(info), {}}));
   }
   if (ext == "ply") {

@@ -18,6 +18,7 @@ struct PointCloudInfo {
   std::optional<Aabbd> bounds;         // as a LAS header states it
   std::string crs;                     // WKT or "EPSG:N" from a LAS file; empty when unknown
   bool hasNormals = false, hasColors = false;
+  std::uint32_t attributes = 0;  // PointAttributeBit: the lidar fields a LAS or LAZ has
 };
 
 // Whether `path` names a point file by its extension (las laz xyz txt csv pts); a PLY may hold

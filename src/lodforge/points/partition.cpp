@@ -75,6 +75,7 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
                                            batch.positions[i].y, batch.positions[i].z));
       p.normal = batch.normals.empty() ? Vec3f{} : batch.normals[i];
       p.color = batch.colors.empty() ? Rgba8{} : batch.colors[i];
+      p.attributes = batch.attributes.empty() ? PointAttributes{} : batch.attributes[i];
       stats.add(p);
     }
     LODFORGE_TRY(out->writeSpan(std::span<const CloudPoint>(records)));

@@ -18,14 +18,15 @@
 
 namespace lodforge {
 
-// One point in the work files (40 bytes): double position, normal (zero when the input has
-// none), colour (white when it has none).
+// One point in the work files (64 bytes): double position, normal (zero when the input has
+// none), colour (white when it has none), lidar attributes (zero when it has none).
 struct CloudPoint {
   Vec3d position;
   Vec3f normal;
   Rgba8 color;
+  PointAttributes attributes;
 };
-static_assert(sizeof(CloudPoint) == 40);
+static_assert(sizeof(CloudPoint) == 64);
 
 struct PartitionOptions {
   std::uint64_t blockSize = 50'000;  // at most this many points per block

@@ -17,6 +17,7 @@
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/points/build.h"
 #include "lodforge/points/partition.h"
+#include "lodforge/tiles/point_attributes.h"
 #include "lodforge/tiles/tileset.h"
 #include "lodforge/tiles/tileset_output.h"
 
@@ -139,8 +140,16 @@ struct TileNode {
   std::string uri;           // empty when it has no content
 };
 
+// What a tile's GLB carries besides positions and normals: colours, and the lidar attributes.
+struct ContentFields {
+  bool colors = false;
+  std::uint32_t attributes = 0;  // PointAttributeBit
+};
+
 Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
-                    const PointTilesOptions& options, bool colors, const std::string& path) {
+                    const PointTilesOptions& options, ContentFields fields,
+                    const std::string& path) {
+  const bool colors = fields.colors;
   std::vector<CloudPoint> points;
   points.reserve(node.points);
   for (std::size_t b : node.blocks) {
@@ -162,19 +171,26 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
     normals[i] = toYUp(normalizeOr(points[i].normal, Vec3f{0, 0, 1}));
     if (colors) rgba[i] = points[i].color;
   }
+  const PointTileAttributes lidar = pointTileAttributes(points, fields.attributes);
   Result<GlbWriter> writer = GlbWriter::create(
-      path, {.doubleSided = false, .meshoptCompression = options.meshoptCompression});
+      path,
+      {.doubleSided = false, .meshoptCompression = options.meshoptCompression, .flatScene = true});
   if (!writer) return writer.status();
-  Result<std::uint32_t> mesh = writer->addMesh({.positions = positions,
-                                                .normals = normals,
-                                                .colors = rgba,
-                                                .indices = {},
-                                                .quantized = options.quantize,
-                                                .points = true},
-                                               "points");
+  if (!lidar.metadata.empty()) writer->setStructuralMetadata(lidar.metadata);
+  Result<std::uint32_t> mesh =
+      writer->addMesh({.positions = positions,
+                       .normals = normals,
+                       .colors = rgba,
+                       .indices = {},
+                       .quantized = options.quantize,
+                       .points = true,
+                       .extraAttributes = lidar.attributes,
+                       .propertyAttribute =
+                           lidar.metadata.empty() ? std::nullopt : std::optional<std::uint32_t>(0)},
+                      "points");
   if (!mesh) return mesh.status();
-  writer->addNode("points", *mesh);
-  writer->setRootTranslation(toYUp(center));
+  const Mat4d placed = Mat4d::translation(toYUp(center));
+  writer->addNode("points", *mesh, &placed);
   return writer->finish();
 }
 
@@ -279,7 +295,7 @@ std::map<std::string, TileNode> tileTree(const Partition& partition,
 // The GLB of every tile with points, in parallel; how many were written.
 Result<std::uint64_t> writeContents(std::map<std::string, TileNode>& nodes,
                                     const std::vector<BlockTiles>& blocks,
-                                    const PointTilesOptions& options, bool colors,
+                                    const PointTilesOptions& options, ContentFields fields,
                                     const std::string& tilesetDirectory) {
   std::vector<TileNode*> withContent;
   for (auto& [name, node] : nodes)
@@ -288,7 +304,7 @@ Result<std::uint64_t> writeContents(std::map<std::string, TileNode>& nodes,
   Progress writing("tiles: contents", withContent.size());
   tbb::parallel_for(std::size_t{0}, withContent.size(), [&](std::size_t i) {
     if (cancelRequested()) return;
-    written[i] = writeContent(*withContent[i], blocks, options, colors,
+    written[i] = writeContent(*withContent[i], blocks, options, fields,
                               tilesetDirectory + "/" + withContent[i]->uri);
     writing.advance(1);
   });
@@ -360,6 +376,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   Result<Partition> partition = partitionPoints(input, partitionOptions);
   if (!partition) return partition.status();
   stats.points = partition->pointCount;
+  stats.attributes = partition->info.attributes & options.attributes;
   stats.blocks = partition->blocks.size();
   for (const PointBlock& b : partition->blocks) stats.depth = std::max(stats.depth, depthOf(b));
   const std::vector<float> taus = toleranceSchedule(*partition, options, stats.depth);
@@ -368,8 +385,9 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
       levelBlocks(*partition, options, taus, work.path, plan->threads);
   if (!blocks) return blocks.status();
   std::map<std::string, TileNode> nodes = tileTree(*partition, *blocks);
-  Result<std::uint64_t> tiles =
-      writeContents(nodes, *blocks, options, partition->info.hasColors, staging.path);
+  Result<std::uint64_t> tiles = writeContents(
+      nodes, *blocks, options,
+      {partition->info.hasColors, partition->info.attributes & options.attributes}, staging.path);
   if (!tiles) return tiles.status();
   stats.tiles = *tiles;
   std::optional<Mat4d> rootTransform;

@@ -29,12 +29,15 @@ struct PointTilesOptions {
   bool quantize = true;  // KHR_mesh_quantization positions (16-bit over the tile's box)
   bool meshoptCompression = false;
   bool salvageTruncated = false;
+  // The lidar fields to carry (PointAttributeBit), of those the input has: all by default.
+  std::uint32_t attributes = ~std::uint32_t{0};
 };
 
 struct PointTilesStats {
   std::uint64_t points = 0, blocks = 0, tiles = 0;
   int depth = 0;  // of the deepest block tile
   std::string crs;
+  std::uint32_t attributes = 0;  // the lidar fields the tiles carry
   std::uint64_t outputBytes = 0;
   double seconds = 0;
 };

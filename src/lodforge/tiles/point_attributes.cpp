@@ -1,0 +1,180 @@
+#include "lodforge/tiles/point_attributes.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+namespace lodforge {
+
+namespace {
+
+constexpr int kUnsignedByte = 5121, kUnsignedShort = 5123, kFloat = 5126;
+
+// One lidar field as a tile carries it: its bit, property name, vertex attribute, glTF and
+// metadata component types, and its value as the attribute stores it.
+struct Field {
+  std::uint32_t bit;
+  const char* property;
+  const char* semantic;
+  int componentType;
+  const char* metadataType;  // componentType of the class property, or "ENUM"
+  std::function<double(const PointAttributes&)> value;
+};
+
+const std::vector<Field>& fields() {
+  static const std::vector<Field> kFields = {
+      {kAttrClassification, "classification", "_CLASSIFICATION", kUnsignedByte, "ENUM",
+       [](const PointAttributes& a) { return a.classification; }},
+      {kAttrIntensity, "intensity", "_INTENSITY", kUnsignedShort, "UINT16",
+       [](const PointAttributes& a) { return a.intensity; }},
+      {kAttrReturns, "return_number", "_RETURN_NUMBER", kUnsignedByte, "UINT8",
+       [](const PointAttributes& a) { return a.returnNumber; }},
+      {kAttrReturns, "number_of_returns", "_NUMBER_OF_RETURNS", kUnsignedByte, "UINT8",
+       [](const PointAttributes& a) { return a.numberOfReturns; }},
+      {kAttrFlags, "classification_flags", "_CLASSIFICATION_FLAGS", kUnsignedByte, "UINT8",
+       [](const PointAttributes& a) { return a.flags & 15; }},
+      {kAttrScanAngle, "scan_angle", "_SCAN_ANGLE", kFloat, "FLOAT32",
+       [](const PointAttributes& a) { return a.scanAngle; }},
+      {kAttrUserData, "user_data", "_USER_DATA", kUnsignedByte, "UINT8",
+       [](const PointAttributes& a) { return a.userData; }},
+      {kAttrPointSource, "point_source_id", "_POINT_SOURCE_ID", kUnsignedShort, "UINT16",
+       [](const PointAttributes& a) { return a.pointSource; }},
+      {kAttrGpsTime, "gps_time", "_GPS_TIME", kFloat, "FLOAT32",
+       [](const PointAttributes& a) { return a.gpsTime; }},
+      {kAttrNir, "nir", "_NIR", kUnsignedShort, "UINT16",
+       [](const PointAttributes& a) { return a.nir; }},
+  };
+  return kFields;
+}
+
+// The names `--attributes` takes: one per bit (returns covers both return fields).
+struct Named {
+  const char* name;
+  std::uint32_t bit;
+};
+constexpr std::array<Named, 9> kNames = {{{"classification", kAttrClassification},
+                                          {"intensity", kAttrIntensity},
+                                          {"returns", kAttrReturns},
+                                          {"flags", kAttrFlags},
+                                          {"scan-angle", kAttrScanAngle},
+                                          {"user-data", kAttrUserData},
+                                          {"point-source", kAttrPointSource},
+                                          {"gps-time", kAttrGpsTime},
+                                          {"nir", kAttrNir}}};
+
+// Each value in 4 bytes (glTF aligns vertex attribute elements to 4); GPS time as a float from
+// the tile's first whole second, which the property attribute's offset adds back.
+std::vector<std::byte> packField(const Field& field, std::span<const CloudPoint> points,
+                                 double offset) {
+  std::vector<std::byte> bytes(4 * points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double v = field.value(points[i].attributes);
+    std::byte* at = bytes.data() + 4 * i;
+    if (field.componentType == kFloat) {
+      const auto f = static_cast<float>(v - offset);
+      std::memcpy(at, &f, 4);
+    } else if (field.componentType == kUnsignedShort) {
+      const auto u = static_cast<std::uint16_t>(v);
+      std::memcpy(at, &u, 2);
+    } else {
+      at[0] = static_cast<std::byte>(static_cast<std::uint8_t>(v));
+    }
+  }
+  return bytes;
+}
+
+nlohmann::json classificationEnum(std::span<const CloudPoint> points) {
+  std::set<int> values;
+  for (int c = 0; c <= 22; ++c) values.insert(c);
+  for (const CloudPoint& p : points) values.insert(p.attributes.classification);
+  nlohmann::json list = nlohmann::json::array();
+  for (int c : values)
+    list.push_back({{"name", asprsClassName(static_cast<std::uint8_t>(c))}, {"value", c}});
+  return {{"valueType", "UINT8"}, {"values", list}};
+}
+
+}  // namespace
+
+std::string asprsClassName(std::uint8_t classification) {
+  static constexpr std::array<const char*, 23> kNames = {
+      "Created, never classified", "Unclassified", "Ground", "Low Vegetation",
+      "Medium Vegetation", "High Vegetation", "Building", "Low Point (noise)", "Reserved",
+      "Water", "Rail", "Road Surface", "Reserved (overlap)", "Wire - Guard (Shield)",
+      "Wire - Conductor (Phase)", "Transmission Tower", "Wire-Structure Connector (Insulator)",
+      "Bridge Deck", "High Noise", "Overhead Structure", "Ignored Ground", "Snow",
+      "Temporal Exclusion"};
+  if (classification < kNames.size()) return kNames[classification];
+  return fmt::format("Class {}", classification);
+}
+
+PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std::uint32_t mask) {
+  PointTileAttributes out;
+  if (mask == 0 || points.empty()) return out;
+  double firstSecond = points.front().attributes.gpsTime;
+  for (const CloudPoint& p : points) firstSecond = std::min(firstSecond, p.attributes.gpsTime);
+  firstSecond = std::floor(firstSecond);
+  nlohmann::json properties, mapped;
+  std::vector<const Field*> chosen;
+  for (const Field& field : fields()) {
+    if ((mask & field.bit) == 0) continue;
+    const bool time = field.bit == kAttrGpsTime;
+    chosen.push_back(&field);
+    out.data.push_back(packField(field, points, time ? firstSecond : 0));
+    properties[field.property] =
+        std::string(field.metadataType) == "ENUM"
+            ? nlohmann::json{{"type", "ENUM"}, {"enumType", "classification"}}
+            : nlohmann::json{{"type", "SCALAR"}, {"componentType", field.metadataType}};
+    mapped[field.property] = {{"attribute", field.semantic}};
+    if (time) mapped[field.property]["offset"] = firstSecond;
+  }
+  // Spans into `data`, complete now.
+  for (std::size_t i = 0; i < chosen.size(); ++i)
+    out.attributes.push_back({chosen[i]->semantic, chosen[i]->componentType, out.data[i]});
+  nlohmann::json schema = {{"id", "lodforge_lidar"},
+                           {"classes", {{"lidar", {{"name", "Lidar point"},
+                                                   {"properties", properties}}}}}};
+  if ((mask & kAttrClassification) != 0)
+    schema["enums"]["classification"] = classificationEnum(points);
+  const nlohmann::json metadata = {
+      {"schema", schema},
+      {"propertyAttributes", {{{"class", "lidar"}, {"properties", mapped}}}}};
+  out.metadata = metadata.dump();
+  return out;
+}
+
+Result<std::uint32_t> parsePointAttributes(const std::string& list) {
+  if (list == "all") return ~std::uint32_t{0};
+  if (list == "none" || list.empty()) return std::uint32_t{0};
+  std::uint32_t mask = 0;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string name = list.substr(start, comma - start);
+    const auto known = std::find_if(kNames.begin(), kNames.end(),
+                                     [&](const Named& n) { return name == n.name; });
+    if (known == kNames.end())
+      return Error{ErrorKind::kUsage,
+                   fmt::format("--attributes: \"{}\" is not one of all, none, {}", name,
+                               pointAttributeNames(~std::uint32_t{0}))};
+    mask |= known->bit;
+    start = comma + 1;
+  }
+  return mask;
+}
+
+std::string pointAttributeNames(std::uint32_t mask) {
+  std::string names;
+  for (const Named& n : kNames) {
+    if ((mask & n.bit) == 0) continue;
+    if (!names.empty()) names += ", ";
+    names += n.name;
+  }
+  return names;
+}
+
+}  // namespace lodforge

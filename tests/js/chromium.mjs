@@ -61,3 +61,34 @@ export async function coverageOf(tab, png, background, skipId = null) {
     return lit / counted;
   }, { data: png.toString('base64'), background, skipId });
 }
+
+// Share of pixels outside the element `skipId` that differ between two screenshots of a tab.
+export async function differenceOf(tab, pngA, pngB, skipId = null) {
+  return tab.evaluate(async ({ a, b, skipId }) => {
+    const decode = async (data) => {
+      const image = new Image();
+      image.src = 'data:image/png;base64,' + data;
+      await image.decode();
+      const canvas = document.createElement('canvas');
+      canvas.width = image.width;
+      canvas.height = image.height;
+      const g = canvas.getContext('2d');
+      g.drawImage(image, 0, 0);
+      return { pixels: g.getImageData(0, 0, image.width, image.height).data, width: image.width, height: image.height };
+    };
+    const [first, second] = [await decode(a), await decode(b)];
+    const skip = skipId ? document.getElementById(skipId).getBoundingClientRect() : null;
+    let changed = 0, counted = 0;
+    for (let y = 0; y < first.height; y++) {
+      for (let x = 0; x < first.width; x++) {
+        if (skip && x <= skip.right && y <= skip.bottom) continue;
+        const i = 4 * (y * first.width + x);
+        counted++;
+        const d = Math.abs(first.pixels[i] - second.pixels[i]) + Math.abs(first.pixels[i + 1] - second.pixels[i + 1]) +
+            Math.abs(first.pixels[i + 2] - second.pixels[i + 2]);
+        if (d > 30) changed++;
+      }
+    }
+    return changed / counted;
+  }, { a: pngA.toString('base64'), b: pngB.toString('base64'), skipId });
+}

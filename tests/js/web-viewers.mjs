@@ -1,12 +1,14 @@
 // The browser viewers end to end: `lodforge serve TILESET` on a free loopback port, each page
 // (/cesium/, /three/) in Debian's headless chromium (playwright-core) until all tiles are
 // loaded; fails on a console error, a failed or outside request, a tile failure, or a
-// screenshot in which the model covers too little.
+// screenshot in which the model covers too little. A point tileset with LAS fields is drawn in
+// every colour mode the panel offers (each must cover the view and differ from the one before),
+// and hiding every class in the legend must empty the view.
 //   node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage 0.02]
 import { spawn } from 'node:child_process';
 import { writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { coverageOf, keepLocal, launchChromium } from './chromium.mjs';
+import { coverageOf, differenceOf, keepLocal, launchChromium } from './chromium.mjs';
 
 const [lodforge, tilesetDir, outDir] = process.argv.slice(2);
 const coverageArg = process.argv.indexOf('--min-coverage');
@@ -30,6 +32,41 @@ const port = await new Promise((resolve, reject) => {
   server.on('exit', (code) => reject(new Error(`lodforge serve exited with ${code}: ${serverLog}`)));
   setTimeout(() => reject(new Error('lodforge serve did not start')), 20000);
 });
+
+// Each colour mode draws (covers the view) and draws differently from the mode before; hiding
+// every class leaves (almost) nothing, showing them again brings the points back.
+async function checkColorModes(tab, viewer, coverage, firstPng, mine) {
+  const modes = await tab.evaluate(() => window.lodforge.colorModes);
+  let previous = firstPng;
+  const shots = [];
+  for (const [i, mode] of modes.entries()) {
+    await tab.evaluate((m) => window.lodforge.setColorMode(m), mode);
+    await tab.waitForTimeout(1500);
+    const png = await tab.screenshot();
+    writeFileSync(path.join(outDir, `${viewer}-${mode.replace(' ', '-')}.png`), png);
+    const covered = await coverageOf(tab, png, [0x12, 0x15, 0x1a], 'panel');
+    const changed = i === 0 ? 1 : await differenceOf(tab, previous, png, 'panel');
+    shots.push(`${mode} ${(100 * covered).toFixed(1)} % covered, ${(100 * changed).toFixed(1)} % changed`);
+    if (covered < minCoverage) mine(`colour mode ${mode}: the model covers ${(100 * covered).toFixed(2)} %`);
+    if (i > 0 && changed < 0.005) mine(`colour mode ${mode} draws like ${modes[i - 1]} (${(100 * changed).toFixed(2)} % of pixels changed)`);
+    previous = png;
+  }
+  const classes = await tab.evaluate(() => window.lodforge.classes());
+  if (classes.length === 0) mine('the legend lists no class');
+  await tab.evaluate(() => window.lodforge.setColorMode('classification'));
+  await tab.evaluate((list) => { for (const c of list) window.lodforge.setClassVisible(c, false); }, classes);
+  await tab.waitForTimeout(1500);
+  const hiddenPng = await tab.screenshot();
+  writeFileSync(path.join(outDir, `${viewer}-classes-hidden.png`), hiddenPng);
+  const hidden = await coverageOf(tab, hiddenPng, [0x12, 0x15, 0x1a], 'panel');
+  await tab.evaluate((list) => { for (const c of list) window.lodforge.setClassVisible(c, true); }, classes);
+  await tab.waitForTimeout(1500);
+  const shown = await coverageOf(tab, await tab.screenshot(), [0x12, 0x15, 0x1a], 'panel');
+  console.log(`${viewer}: colour modes: ${shots.join('; ')}; classes ${classes.join(',')} hidden: ` +
+              `${(100 * hidden).toFixed(2)} % covered, shown again: ${(100 * shown).toFixed(1)} %`);
+  if (hidden > 0.1 * coverage) mine(`with every class hidden the model still covers ${(100 * hidden).toFixed(2)} %`);
+  if (shown < minCoverage) mine(`with the classes shown again the model covers ${(100 * shown).toFixed(2)} %`);
+}
 
 const { context, close: closeBrowser } = await launchChromium();
 const problems = [];
@@ -59,6 +96,7 @@ try {
     const coverage = await coverageOf(tab, png, [0x12, 0x15, 0x1a], 'panel');
     console.log(`${viewer}: ${report.tilesLoaded} tiles loaded, "${stats}", model covers ${(100 * coverage).toFixed(1)} % (${shot})`);
     if (coverage < minCoverage) mine(`the model covers ${(100 * coverage).toFixed(2)} % of the view`);
+    if (report.colorModes) await checkColorModes(tab, viewer, coverage, png, mine);
     await tab.close();
   }
 } catch (e) {

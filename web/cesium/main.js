@@ -2,9 +2,111 @@
 // imagery or terrain (no globe), flies to the tileset, shows what is loaded and drawn, and
 // lets the screen-space error be chosen. window.lodforge reports to tests.
 import { drawnSummary, formatBytes, onScreenSpaceError } from '../format.js';
+import { CLASSES, classColor, colorModes, colorPanel, hexToRgb } from '../point_colors.js';
 
 const Cesium = window.Cesium;
 const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0 });
+
+// The root tile's glTF: its primitive's attribute names, and the classes it holds (the root's
+// points are spread over the whole cloud, so its classes are the common ones).
+async function rootContent(tileset) {
+  const json = await (await fetch('/tiles/tileset.json')).json();
+  let tile = json.root;
+  while (!tile.content && tile.children) tile = tile.children[0];
+  if (!tile.content) return null;
+  const bytes = await (await fetch(`/tiles/${tile.content.uri}`)).arrayBuffer();
+  const view = new DataView(bytes);
+  const jsonLength = view.getUint32(12, true);
+  const gltf = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, 20, jsonLength)));
+  const attributes = gltf.meshes[0].primitives[0].attributes;
+  // A scalar attribute's values (4 bytes apart), unless meshopt-compressed.
+  const values = (name, read) => {
+    if (!(name in attributes)) return [];
+    const accessor = gltf.accessors[attributes[name]];
+    const bufferView = gltf.bufferViews[accessor.bufferView];
+    if (bufferView.extensions) return [];
+    const at = 20 + jsonLength + 8 + (bufferView.byteOffset ?? 0);
+    return Array.from({ length: accessor.count }, (_, i) => read(at + 4 * i));
+  };
+  const classes = new Set(values('_CLASSIFICATION', (at) => view.getUint8(at)));
+  const wide = values('_INTENSITY', (at) => view.getUint16(at, true)).some((v) => v > 255);
+  return { names: Object.keys(attributes), classes, intensityMax: wide ? 65535 : 255,
+           hasMetadata: !!(gltf.extensions && gltf.extensions.EXT_structural_metadata) };
+}
+
+const vec3 = (rgb) => `vec3(${rgb.map((x) => x.toFixed(3)).join(', ')})`;
+
+// A custom shader over the metadata the tiles carry: u_mode picks the colouring, u_hidden has a
+// bit per hidden class (0–30), elevation is the distance from the Earth's centre across the
+// tileset's range.
+function pointShader(modes, names) {
+  const has = (name) => names.includes(name);
+  const classLookup = CLASSES.map(([v, , hex]) => `if (c == ${v}) return ${vec3(hexToRgb(hex))};`).join('\n    ');
+  const index = (mode) => modes.indexOf(mode);
+  return new Cesium.CustomShader({
+    uniforms: {
+      u_mode: { type: Cesium.UniformType.INT, value: 0 },
+      u_hidden: { type: Cesium.UniformType.INT, value: 0 },
+      u_intensityMax: { type: Cesium.UniformType.FLOAT, value: 255 },
+      u_heights: { type: Cesium.UniformType.VEC2, value: new Cesium.Cartesian2(0, 1) },
+    },
+    fragmentShaderText: `
+  vec3 classColor(int c) {
+    ${classLookup}
+    return ${vec3(classColor(-1))};
+  }
+  vec3 ramp(float t) {
+    t = clamp(t, 0.0, 1.0) * 4.0;
+    vec3 a = vec3(0.19, 0.21, 0.58), b = vec3(0.0, 0.6, 0.85), c = vec3(0.25, 0.75, 0.3),
+         d = vec3(0.95, 0.85, 0.2), e = vec3(0.85, 0.2, 0.15);
+    if (t < 1.0) return mix(a, b, t);
+    if (t < 2.0) return mix(b, c, t - 1.0);
+    if (t < 3.0) return mix(c, d, t - 2.0);
+    return mix(d, e, t - 3.0);
+  }
+  void fragmentMain(FragmentInput fsInput, inout czm_modelMaterial material) {
+    int c = ${has('_CLASSIFICATION') ? 'int(fsInput.metadata.classification)' : '-1'};
+    if (c >= 0 && c < 31 && ((u_hidden >> c) & 1) == 1) discard;
+    if (u_mode == ${index('classification')}) material.diffuse = classColor(c);
+    ${has('_INTENSITY') ? `if (u_mode == ${index('intensity')}) material.diffuse = vec3(0.15 + 0.85 * clamp(float(fsInput.metadata.intensity) / u_intensityMax, 0.0, 1.0));` : ''}
+    if (u_mode == ${index('elevation')})
+      material.diffuse = ramp((length(fsInput.attributes.positionWC) - u_heights.x) / (u_heights.y - u_heights.x));
+    ${has('_RETURN_NUMBER') ? `if (u_mode == ${index('return number')}) {
+      int r = clamp(int(fsInput.metadata.return_number), 1, 5);
+      material.diffuse = r == 1 ? vec3(0.9, 0.2, 0.15) : r == 2 ? vec3(0.95, 0.6, 0.1) : r == 3 ? vec3(0.95, 0.9, 0.2) : r == 4 ? vec3(0.3, 0.8, 0.3) : vec3(0.2, 0.5, 0.95);
+    }` : ''}
+  }`,
+  });
+}
+
+// Point tilesets with LAS fields get the mode picker and the legend.
+async function addColouring(tileset) {
+  const root = await rootContent(tileset);
+  if (!root || !root.hasMetadata) return;
+  const modes = colorModes(root.names);
+  const shader = pointShader(modes, root.names);
+  tileset.customShader = shader;
+  const sphere = tileset.boundingSphere;
+  const centre = Cesium.Cartesian3.magnitude(sphere.center);
+  shader.setUniform('u_heights', new Cesium.Cartesian2(centre - sphere.radius, centre + sphere.radius));
+  shader.setUniform('u_intensityMax', root.intensityMax);
+  let hidden = 0;
+  const panel = colorPanel(modes, root.classes, (mode) => {
+    shader.setUniform('u_mode', modes.indexOf(mode));
+  }, (value, visible) => {
+    if (value < 31) hidden = visible ? hidden & ~(1 << value) : hidden | (1 << value);
+    shader.setUniform('u_hidden', hidden);
+  });
+  report.colorModes = modes;
+  report.setColorMode = (mode) => panel.setMode(mode);
+  report.setClassVisible = (value, visible) => {
+    const box = document.querySelector(`#legend input[data-class="${value}"]`);
+    if (box) box.checked = visible;
+    if (value < 31) hidden = visible ? hidden & ~(1 << value) : hidden | (1 << value);
+    shader.setUniform('u_hidden', hidden);
+  };
+  report.classes = () => [...root.classes];
+}
 
 async function main() {
   const viewer = new Cesium.Viewer('view', {
@@ -43,6 +145,7 @@ async function main() {
     drawn = { tiles: 0, triangles: 0, points: 0 };
   });
   onScreenSpaceError((pixels) => { tileset.maximumScreenSpaceError = pixels; });
+  await addColouring(tileset);
   await viewer.flyTo(tileset, { duration: 0 });
 }
 

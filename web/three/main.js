@@ -8,8 +8,105 @@ import { MeshoptDecoder } from 'three/examples/jsm/libs/meshopt_decoder.module.j
 import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
 import { drawnSummary, formatBytes, formatCount, onScreenSpaceError } from '../format.js';
+import { classColor, colorModes, colorPanel, intensityGrey, ramp } from '../point_colors.js';
 
 const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0 });
+
+// Point tiles coloured by a LAS field: each loaded Points object keeps its own colours and is
+// recoloured on the CPU (RGBA; a hidden class gets alpha 0, which alphaTest discards).
+const RETURN_COLORS = [[0.9, 0.2, 0.15], [0.95, 0.6, 0.1], [0.95, 0.9, 0.2], [0.3, 0.8, 0.3], [0.2, 0.5, 0.95]];
+const colouring = { mode: null, hidden: new Set(), classes: new Set(), heights: null, intensityMax: 1,
+                    panel: null, points: new Set() };
+
+function recolour(points) {
+  const g = points.geometry;
+  const color = g.getAttribute('color');
+  const rgb = points.userData.rgb;
+  const cls = g.getAttribute('_classification');
+  const intensity = g.getAttribute('_intensity');
+  const returns = g.getAttribute('_return_number');
+  const position = g.getAttribute('position');
+  const p = new THREE.Vector3();
+  for (let i = 0; i < color.count; ++i) {
+    let c = [1, 1, 1];
+    const mode = colouring.mode;
+    if (mode === 'rgb' && rgb) c = [rgb[4 * i] / 255, rgb[4 * i + 1] / 255, rgb[4 * i + 2] / 255];
+    else if (mode === 'classification' && cls) c = classColor(cls.getX(i));
+    else if (mode === 'intensity' && intensity) c = new Array(3).fill(intensityGrey(intensity.getX(i) / colouring.intensityMax));
+    else if (mode === 'return number' && returns) c = RETURN_COLORS[Math.min(Math.max(returns.getX(i), 1), 5) - 1];
+    else if (mode === 'elevation' && colouring.heights) {
+      p.fromBufferAttribute(position, i).applyMatrix4(points.matrixWorld);
+      c = ramp((p.y - colouring.heights[0]) / (colouring.heights[1] - colouring.heights[0]));
+    }
+    const hidden = cls && colouring.hidden.has(cls.getX(i));
+    const out = color.array;  // Uint8, normalised: written as bytes
+    out[4 * i] = Math.round(c[0] * 255);
+    out[4 * i + 1] = Math.round(c[1] * 255);
+    out[4 * i + 2] = Math.round(c[2] * 255);
+    out[4 * i + 3] = hidden ? 0 : 255;
+  }
+  color.needsUpdate = true;
+}
+
+function recolourAll() {
+  for (const points of colouring.points) recolour(points);
+}
+
+// A tile's Points, as they load: RGBA colours to write into, the original RGB kept, the
+// classes and intensities it holds noted; the panel made for the first.
+function preparePoints(points) {
+  const g = points.geometry;
+  const names = Object.keys(g.attributes).map((n) => (n === 'color' ? 'COLOR_0' : n.toUpperCase()));
+  const old = g.getAttribute('color');
+  let rgb = null;
+  if (old) {  // COLOR_0 (normalised: getX and friends give 0..1)
+    rgb = new Uint8Array(old.count * 4);
+    for (let i = 0; i < old.count; ++i) {
+      rgb[4 * i] = Math.round(old.getX(i) * 255);
+      rgb[4 * i + 1] = Math.round(old.getY(i) * 255);
+      rgb[4 * i + 2] = Math.round(old.getZ(i) * 255);
+    }
+  }
+  points.userData.rgb = rgb;
+  g.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(g.getAttribute('position').count * 4), 4, true));
+  points.material.vertexColors = true;
+  points.material.alphaTest = 0.5;
+  points.material.needsUpdate = true;
+  const cls = g.getAttribute('_classification');
+  let added = false;
+  if (cls) for (let i = 0; i < cls.count; ++i) {
+    if (!colouring.classes.has(cls.getX(i))) { colouring.classes.add(cls.getX(i)); added = true; }
+  }
+  const intensity = g.getAttribute('_intensity');
+  if (intensity) for (let i = 0; i < intensity.count; ++i)
+    colouring.intensityMax = Math.max(colouring.intensityMax, intensity.getX(i) > 255 ? 65535 : 255);
+  if (!colouring.panel) {
+    const modes = colorModes(names);
+    colouring.mode = modes[0];
+    report.colorModes = modes;
+    colouring.panel = colorPanel(modes, colouring.classes, (mode) => {
+      colouring.mode = mode;
+      recolourAll();
+    }, (value, visible) => {
+      if (visible) colouring.hidden.delete(value); else colouring.hidden.add(value);
+      recolourAll();
+    });
+  } else if (added) {
+    colouring.panel.addClasses();
+  }
+  colouring.points.add(points);
+  points.updateMatrixWorld(true);
+  recolour(points);
+}
+
+report.setColorMode = (mode) => colouring.panel && colouring.panel.setMode(mode);
+report.setClassVisible = (value, visible) => {
+  const box = document.querySelector(`#legend input[data-class="${value}"]`);
+  if (visible) colouring.hidden.delete(value); else colouring.hidden.add(value);
+  if (box) box.checked = visible;
+  recolourAll();
+};
+report.classes = () => [...colouring.classes];
 
 function main() {
   const renderer = new THREE.WebGLRenderer({ antialias: true });
@@ -56,9 +153,16 @@ function main() {
     camera.far = sphere.radius * 100;
     camera.updateProjectionMatrix();
     controls.update();
+    colouring.heights = [sphere.center.y - sphere.radius, sphere.center.y + sphere.radius];
     return true;
   };
-  tiles.addEventListener('load-model', () => { report.tilesLoaded += 1; });
+  tiles.addEventListener('load-model', (e) => {
+    report.tilesLoaded += 1;
+    e.scene.traverse((o) => { if (o.isPoints) preparePoints(o); });
+  });
+  tiles.addEventListener('dispose-model', (e) => {
+    e.scene.traverse((o) => colouring.points.delete(o));
+  });
   tiles.addEventListener('load-error', (e) => {
     report.failed.push(`${e.url}: ${e.error && e.error.message}`);
   });

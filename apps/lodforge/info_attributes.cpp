@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <functional>
 #include <limits>
 
 #include <fmt/format.h>
@@ -26,27 +25,13 @@ struct Range {
   }
 };
 
-struct RangedField {
-  std::uint32_t bit;
-  const char* name;
-  std::function<double(const PointAttributes&)> value;
-};
-
-const std::vector<RangedField>& rangedFields() {
-  static const std::vector<RangedField> kFields = {
-      {kAttrIntensity, "intensity", [](const PointAttributes& a) { return a.intensity; }},
-      {kAttrReturns, "returnNumber", [](const PointAttributes& a) { return a.returnNumber; }},
-      {kAttrReturns, "numberOfReturns",
-       [](const PointAttributes& a) { return a.numberOfReturns; }},
-      {kAttrFlags, "classificationFlags", [](const PointAttributes& a) { return a.flags & 15; }},
-      {kAttrScanAngle, "scanAngle",
-       [](const PointAttributes& a) { return std::round(a.scanAngle * 1000.0) / 1000.0; }},
-      {kAttrUserData, "userData", [](const PointAttributes& a) { return a.userData; }},
-      {kAttrPointSource, "pointSource", [](const PointAttributes& a) { return a.pointSource; }},
-      {kAttrGpsTime, "gpsTime", [](const PointAttributes& a) { return a.gpsTime; }},
-      {kAttrNir, "nir", [](const PointAttributes& a) { return a.nir; }},
-  };
-  return kFields;
+// Classification is counted per class, not ranged; scan angles are shown to the millidegree.
+bool ranged(const PointAttributeField& field) {
+  return field.bit != kAttrClassification;
+}
+double shown(const PointAttributeField& field, const PointAttributes& a) {
+  const double v = field.value(a);
+  return field.bit == kAttrScanAngle ? std::round(v * 1000.0) / 1000.0 : v;
 }
 
 }  // namespace
@@ -55,7 +40,8 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
   Result<PointReader> reader = PointReader::open(path);
   if (!reader) return reader.status();
   const std::uint32_t mask = reader->info().attributes;
-  std::vector<Range> ranges(rangedFields().size());
+  const auto fields = pointAttributeFields();
+  std::vector<Range> ranges(fields.size());
   std::array<std::uint64_t, 256> classes{};
   Progress progress("reading", reader->info().count.value_or(fileBytes / 20));
   PointBatch batch;
@@ -65,17 +51,17 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
     if (!more) return more.status();
     if (!*more) break;
     for (const PointAttributes& a : batch.attributes) {
-      for (std::size_t f = 0; f < ranges.size(); ++f)
-        if ((mask & rangedFields()[f].bit) != 0) ranges[f].add(rangedFields()[f].value(a));
+      for (std::size_t f = 0; f < fields.size(); ++f)
+        if ((mask & fields[f].bit) != 0 && ranged(fields[f])) ranges[f].add(shown(fields[f], a));
       ++classes[a.classification];
     }
     progress.advance(batch.size());
   }
   progress.finish();
   nlohmann::json j = nlohmann::json::object();
-  for (std::size_t f = 0; f < ranges.size(); ++f)
-    if ((mask & rangedFields()[f].bit) != 0 && ranges[f].min <= ranges[f].max)
-      j[rangedFields()[f].name] = {{"min", ranges[f].min}, {"max", ranges[f].max}};
+  for (std::size_t f = 0; f < fields.size(); ++f)
+    if (ranges[f].min <= ranges[f].max)
+      j[fields[f].property] = {{"min", ranges[f].min}, {"max", ranges[f].max}};
   if ((mask & kAttrClassification) != 0) {
     nlohmann::json counts = nlohmann::json::object();
     for (std::size_t c = 0; c < classes.size(); ++c)
@@ -88,22 +74,16 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
 }
 
 void printPointAttributes(const nlohmann::json& attributes) {
-  static const std::vector<std::pair<const char*, const char*>> kLabels = {
-      {"intensity", "intensity"},     {"returnNumber", "return number"},
-      {"numberOfReturns", "returns"}, {"classificationFlags", "class flags"},
-      {"scanAngle", "scan angle °"},  {"userData", "user data"},
-      {"pointSource", "point source"}, {"gpsTime", "GPS time"},
-      {"nir", "NIR"}};
-  for (const auto& [key, label] : kLabels) {
-    if (!attributes.contains(key)) continue;
-    fmt::print("{:<15}{:.10g} to {:.10g}\n", label, attributes[key]["min"].get<double>(),
-               attributes[key]["max"].get<double>());
+  for (const PointAttributeField& field : pointAttributeFields()) {
+    if (!attributes.contains(field.property) || !ranged(field)) continue;
+    const nlohmann::json& range = attributes[field.property];
+    fmt::print("{:<22}{:.10g} to {:.10g}\n", field.property, range["min"].get<double>(),
+               range["max"].get<double>());
   }
   if (!attributes.contains("classification")) return;
   for (const auto& [value, entry] : attributes["classification"].items())
     fmt::print("class {:<9}{} points, {}\n", value,
-               formatCount(entry["points"].get<std::uint64_t>()),
-               entry["name"].get<std::string>());
+               formatCount(entry["points"].get<std::uint64_t>()), entry["name"].get<std::string>());
 }
 
 }  // namespace lodforge::cli

@@ -539,7 +539,7 @@ TEST(CliPoints, BadInputIsExitCode2AndLeavesNothing) {
   ASSERT_EQ(o.code, 0) << o.err;
   const nlohmann::json attributes = nlohmann::json::parse(o.out)["attributes"];
   EXPECT_EQ(attributes["intensity"]["max"], 254);
-  EXPECT_EQ(attributes["numberOfReturns"]["max"], 4);
+  EXPECT_EQ(attributes["number_of_returns"]["max"], 4);
   EXPECT_EQ(attributes["classification"]["2"]["name"], "Ground");
   EXPECT_EQ(attributes["classification"]["2"]["points"].get<std::uint64_t>() +
                 attributes["classification"]["1"]["points"].get<std::uint64_t>(),

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <functional>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -15,42 +14,7 @@ namespace {
 
 constexpr int kUnsignedByte = 5121, kUnsignedShort = 5123, kFloat = 5126;
 
-// One lidar field as a tile carries it: its bit, property name, vertex attribute, glTF and
-// metadata component types, and its value as the attribute stores it.
-struct Field {
-  std::uint32_t bit;
-  const char* property;
-  const char* semantic;
-  int componentType;
-  const char* metadataType;  // componentType of the class property, or "ENUM"
-  std::function<double(const PointAttributes&)> value;
-};
-
-const std::vector<Field>& fields() {
-  static const std::vector<Field> kFields = {
-      {kAttrClassification, "classification", "_CLASSIFICATION", kUnsignedByte, "ENUM",
-       [](const PointAttributes& a) { return a.classification; }},
-      {kAttrIntensity, "intensity", "_INTENSITY", kUnsignedShort, "UINT16",
-       [](const PointAttributes& a) { return a.intensity; }},
-      {kAttrReturns, "return_number", "_RETURN_NUMBER", kUnsignedByte, "UINT8",
-       [](const PointAttributes& a) { return a.returnNumber; }},
-      {kAttrReturns, "number_of_returns", "_NUMBER_OF_RETURNS", kUnsignedByte, "UINT8",
-       [](const PointAttributes& a) { return a.numberOfReturns; }},
-      {kAttrFlags, "classification_flags", "_CLASSIFICATION_FLAGS", kUnsignedByte, "UINT8",
-       [](const PointAttributes& a) { return a.flags & 15; }},
-      {kAttrScanAngle, "scan_angle", "_SCAN_ANGLE", kFloat, "FLOAT32",
-       [](const PointAttributes& a) { return a.scanAngle; }},
-      {kAttrUserData, "user_data", "_USER_DATA", kUnsignedByte, "UINT8",
-       [](const PointAttributes& a) { return a.userData; }},
-      {kAttrPointSource, "point_source_id", "_POINT_SOURCE_ID", kUnsignedShort, "UINT16",
-       [](const PointAttributes& a) { return a.pointSource; }},
-      {kAttrGpsTime, "gps_time", "_GPS_TIME", kFloat, "FLOAT32",
-       [](const PointAttributes& a) { return a.gpsTime; }},
-      {kAttrNir, "nir", "_NIR", kUnsignedShort, "UINT16",
-       [](const PointAttributes& a) { return a.nir; }},
-  };
-  return kFields;
-}
+using Field = PointAttributeField;
 
 // The names `--attributes` takes: one per bit (returns covers both return fields).
 struct Named {
@@ -100,14 +64,57 @@ nlohmann::json classificationEnum(std::span<const CloudPoint> points) {
 
 }  // namespace
 
+std::span<const PointAttributeField> pointAttributeFields() {
+  using A = PointAttributes;
+  static const std::array<PointAttributeField, 10> kFields = {{
+      {kAttrClassification, "classification", "_CLASSIFICATION", kUnsignedByte, "ENUM",
+       [](const A& a) -> double { return a.classification; }},
+      {kAttrIntensity, "intensity", "_INTENSITY", kUnsignedShort, "UINT16",
+       [](const A& a) -> double { return a.intensity; }},
+      {kAttrReturns, "return_number", "_RETURN_NUMBER", kUnsignedByte, "UINT8",
+       [](const A& a) -> double { return a.returnNumber; }},
+      {kAttrReturns, "number_of_returns", "_NUMBER_OF_RETURNS", kUnsignedByte, "UINT8",
+       [](const A& a) -> double { return a.numberOfReturns; }},
+      {kAttrFlags, "classification_flags", "_CLASSIFICATION_FLAGS", kUnsignedByte, "UINT8",
+       [](const A& a) -> double { return a.flags & 15; }},
+      {kAttrScanAngle, "scan_angle", "_SCAN_ANGLE", kFloat, "FLOAT32",
+       [](const A& a) -> double { return a.scanAngle; }},
+      {kAttrUserData, "user_data", "_USER_DATA", kUnsignedByte, "UINT8",
+       [](const A& a) -> double { return a.userData; }},
+      {kAttrPointSource, "point_source_id", "_POINT_SOURCE_ID", kUnsignedShort, "UINT16",
+       [](const A& a) -> double { return a.pointSource; }},
+      {kAttrGpsTime, "gps_time", "_GPS_TIME", kFloat, "FLOAT32",
+       [](const A& a) -> double { return a.gpsTime; }},
+      {kAttrNir, "nir", "_NIR", kUnsignedShort, "UINT16",
+       [](const A& a) -> double { return a.nir; }},
+  }};
+  return kFields;
+}
+
 std::string asprsClassName(std::uint8_t classification) {
-  static constexpr std::array<const char*, 23> kNames = {
-      "Created, never classified", "Unclassified", "Ground", "Low Vegetation",
-      "Medium Vegetation", "High Vegetation", "Building", "Low Point (noise)", "Reserved",
-      "Water", "Rail", "Road Surface", "Reserved (overlap)", "Wire - Guard (Shield)",
-      "Wire - Conductor (Phase)", "Transmission Tower", "Wire-Structure Connector (Insulator)",
-      "Bridge Deck", "High Noise", "Overhead Structure", "Ignored Ground", "Snow",
-      "Temporal Exclusion"};
+  static constexpr std::array<const char*, 23> kNames = {"Created, never classified",
+                                                         "Unclassified",
+                                                         "Ground",
+                                                         "Low Vegetation",
+                                                         "Medium Vegetation",
+                                                         "High Vegetation",
+                                                         "Building",
+                                                         "Low Point (noise)",
+                                                         "Reserved",
+                                                         "Water",
+                                                         "Rail",
+                                                         "Road Surface",
+                                                         "Reserved (overlap)",
+                                                         "Wire - Guard (Shield)",
+                                                         "Wire - Conductor (Phase)",
+                                                         "Transmission Tower",
+                                                         "Wire-Structure Connector (Insulator)",
+                                                         "Bridge Deck",
+                                                         "High Noise",
+                                                         "Overhead Structure",
+                                                         "Ignored Ground",
+                                                         "Snow",
+                                                         "Temporal Exclusion"};
   if (classification < kNames.size()) return kNames[classification];
   return fmt::format("Class {}", classification);
 }
@@ -120,7 +127,7 @@ PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std:
   firstSecond = std::floor(firstSecond);
   nlohmann::json properties, mapped;
   std::vector<const Field*> chosen;
-  for (const Field& field : fields()) {
+  for (const Field& field : pointAttributeFields()) {
     if ((mask & field.bit) == 0) continue;
     const bool time = field.bit == kAttrGpsTime;
     chosen.push_back(&field);
@@ -135,14 +142,13 @@ PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std:
   // Spans into `data`, complete now.
   for (std::size_t i = 0; i < chosen.size(); ++i)
     out.attributes.push_back({chosen[i]->semantic, chosen[i]->componentType, out.data[i]});
-  nlohmann::json schema = {{"id", "lodforge_lidar"},
-                           {"classes", {{"lidar", {{"name", "Lidar point"},
-                                                   {"properties", properties}}}}}};
+  nlohmann::json schema = {
+      {"id", "lodforge_lidar"},
+      {"classes", {{"lidar", {{"name", "Lidar point"}, {"properties", properties}}}}}};
   if ((mask & kAttrClassification) != 0)
     schema["enums"]["classification"] = classificationEnum(points);
   const nlohmann::json metadata = {
-      {"schema", schema},
-      {"propertyAttributes", {{{"class", "lidar"}, {"properties", mapped}}}}};
+      {"schema", schema}, {"propertyAttributes", {{{"class", "lidar"}, {"properties", mapped}}}}};
   out.metadata = metadata.dump();
   return out;
 }
@@ -155,8 +161,8 @@ Result<std::uint32_t> parsePointAttributes(const std::string& list) {
   while (start <= list.size()) {
     const std::size_t comma = std::min(list.find(',', start), list.size());
     const std::string name = list.substr(start, comma - start);
-    const auto known = std::find_if(kNames.begin(), kNames.end(),
-                                     [&](const Named& n) { return name == n.name; });
+    const auto known =
+        std::find_if(kNames.begin(), kNames.end(), [&](const Named& n) { return name == n.name; });
     if (known == kNames.end())
       return Error{ErrorKind::kUsage,
                    fmt::format("--attributes: \"{}\" is not one of all, none, {}", name,

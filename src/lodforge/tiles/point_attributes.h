@@ -16,6 +16,18 @@
 
 namespace lodforge {
 
+// One lidar field as tiles carry it (and info names it): its bit, property name, vertex
+// attribute, glTF and metadata component types, and its value from a point.
+struct PointAttributeField {
+  std::uint32_t bit;
+  const char* property;      // "classification", "return_number", …
+  const char* semantic;      // "_CLASSIFICATION", …
+  int componentType;         // glTF's, of the vertex attribute
+  const char* metadataType;  // componentType of the class property, or "ENUM"
+  double (*value)(const PointAttributes&);
+};
+std::span<const PointAttributeField> pointAttributeFields();
+
 struct PointTileAttributes {
   std::vector<std::vector<std::byte>> data;  // 4 bytes per point each
   std::vector<GlbVertexAttribute> attributes;

@@ -16,8 +16,7 @@ constexpr std::size_t kVlrHeader = 54, kEvlrHeader = 60;
 
 // Records of compressed layouts: LASzip's, and COPC's info and hierarchy.
 bool describesCompression(const std::byte* recordHeader) {
-  std::string user(reinterpret_cast<const char*>(recordHeader) + 2, 16);
-  user.erase(user.find_last_not_of(std::string("\0 ", 2)) + 1);
+  const std::string user = loadText(recordHeader + 2, 16);
   return user == "laszip encoded" || user == "copc";
 }
 

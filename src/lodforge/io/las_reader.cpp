@@ -20,13 +20,6 @@ constexpr std::uint16_t kWktRecord = 2112, kGeoKeyRecord = 34735;
 constexpr std::uint16_t kProjectedCsKey = 3072, kGeographicKey = 2048, kUserDefined = 32767;
 constexpr std::size_t kColorProbe = 1 << 16;  // points looked at to tell 8- from 16-bit colours
 
-std::string fixedString(const std::byte* at, std::size_t size) {
-  std::string s(reinterpret_cast<const char*>(at), size);
-  s.erase(std::find(s.begin(), s.end(), '\0'), s.end());
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
-
 // Where a format keeps red, green, blue (three uint16), 0 when it has no colour.
 std::size_t colorOffset(int format) {
   switch (format) {
@@ -174,7 +167,7 @@ struct CrsRecords {
   void take(std::uint16_t id, std::string_view user, std::span<const std::byte> data) {
     if (user != "LASF_Projection") return;
     if (id == kWktRecord) {
-      wkt = fixedString(data.data(), data.size());
+      wkt = loadText(data.data(), data.size());
     } else if (id == kGeoKeyRecord) {
       std::vector<std::uint16_t> keys(data.size() / 2);
       if (!keys.empty()) std::memcpy(keys.data(), data.data(), 2 * keys.size());
@@ -200,8 +193,8 @@ Status LasReader::State::readHeader(std::vector<std::byte>& bytes) {
   if (h.versionMajor != 1 || h.versionMinor > 4)
     return fail(24, fmt::format("LAS version {}.{} is not supported (1.0 to 1.4 are)",
                                 h.versionMajor, h.versionMinor));
-  h.systemIdentifier = fixedString(bytes.data() + 26, 32);
-  h.generatingSoftware = fixedString(bytes.data() + 58, 32);
+  h.systemIdentifier = loadText(bytes.data() + 26, 32);
+  h.generatingSoftware = loadText(bytes.data() + 58, 32);
   h.headerSize = loadField<std::uint16_t>(bytes.data() + 94);
   h.pointOffset = loadField<std::uint32_t>(bytes.data() + 96);
   h.vlrCount = loadField<std::uint32_t>(bytes.data() + 100);
@@ -301,7 +294,7 @@ Status LasReader::State::readRecords(CrsRecords& crs) {
                                        v + 1, length, h.pointOffset));
     record.resize(length);
     if (!in.read(record.data(), length)) return fail(at, "the file ends in a record");
-    const std::string user = fixedString(head + 2, 16);
+    const std::string user = loadText(head + 2, 16);
     crs.take(id, user, record);
     if (user == "laszip encoded" && id == kLazRecordId) {
       lazRecord = record;
@@ -337,7 +330,7 @@ Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
       return fail(at + 20, fmt::format("extended record {} ({} bytes) runs past the "
                                        "end of the file",
                                        v + 1, length));
-    const std::string user = fixedString(head + 2, 16);
+    const std::string user = loadText(head + 2, 16);
     if (user == "LASF_Projection" && (id == kWktRecord || id == kGeoKeyRecord) &&
         length < (std::uint64_t{1} << 24)) {
       record.resize(length);

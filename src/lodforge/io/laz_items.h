@@ -80,6 +80,21 @@ struct LazRgbModels {
 void lazDecodeRgb(LazDecoder& dec, LazRgbModels& models, const std::uint16_t* last,
                   std::uint16_t* out);
 
+// A model made on first use (LASzip makes context models lazily; a new one is what a reset one
+// would be, so dropping them resets them).
+inline LazSymbolModel& lazModelOnUse(std::unique_ptr<LazSymbolModel>& model,
+                                     std::uint32_t symbols) {
+  if (!model) model = std::make_unique<LazSymbolModel>(symbols);
+  return *model;
+}
+// A byte coded with a 256-symbol model chosen by its previous value (POINT10's flags, class and
+// user data in versions 1 and 2).
+inline std::uint8_t lazDecodeByteByLast(LazDecoder& dec,
+                                        std::array<std::unique_ptr<LazSymbolModel>, 256>& models,
+                                        std::uint8_t last) {
+  return static_cast<std::uint8_t>(dec.decodeSymbol(lazModelOnUse(models[last], 256)));
+}
+
 inline std::uint8_t lazFold(std::int32_t v) {
   return static_cast<std::uint8_t>(v);  // the format's U8_FOLD: modulo 256
 }

@@ -15,13 +15,6 @@ std::int32_t medianOfThree(const std::array<std::int32_t, 3>& v) {
   return v[0] < v[2] ? v[0] : v[1] < v[2] ? v[2] : v[1];
 }
 
-std::uint8_t decodeByte(LazDecoder& dec, std::array<std::unique_ptr<LazSymbolModel>, 256>& models,
-                        std::uint8_t last) {
-  auto& model = models[last];
-  if (!model) model = std::make_unique<LazSymbolModel>(256);
-  return static_cast<std::uint8_t>(dec.decodeSymbol(*model));
-}
-
 // POINT10 v1: coordinates first (x and y from the median of the last three differences, z from
 // the last z), then which other fields changed.
 class Point10V1 final : public LazPointwiseItem {
@@ -49,11 +42,12 @@ class Point10V1 final : public LazPointwiseItem {
     const std::uint32_t changed = dec.decodeSymbol(changed_);
     if (changed & 32)
       last_.intensity = static_cast<std::uint16_t>(intensity_.decode(dec, last_.intensity));
-    if (changed & 16) last_.flags = decodeByte(dec, flagModels_, last_.flags);
-    if (changed & 8) last_.classification = decodeByte(dec, classModels_, last_.classification);
+    if (changed & 16) last_.flags = lazDecodeByteByLast(dec, flagModels_, last_.flags);
+    if (changed & 8)
+      last_.classification = lazDecodeByteByLast(dec, classModels_, last_.classification);
     if (changed & 4)
       last_.scanAngle = static_cast<std::uint8_t>(scanAngle_.decode(dec, last_.scanAngle, k < 3));
-    if (changed & 2) last_.userData = decodeByte(dec, userModels_, last_.userData);
+    if (changed & 2) last_.userData = lazDecodeByteByLast(dec, userModels_, last_.userData);
     if (changed & 1)
       last_.pointSource = static_cast<std::uint16_t>(pointSource_.decode(dec, last_.pointSource));
     xDiffs_[ring_] = xDiff;

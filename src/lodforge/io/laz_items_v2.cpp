@@ -144,7 +144,7 @@ class Point10V2 final : public LazPointwiseItem {
 
   void read(LazDecoder& dec, std::byte* out) override {
     const std::uint32_t changed = dec.decodeSymbol(changed_);
-    if (changed & 32) last_.flags = decodeByte(dec, flagModels_, last_.flags);
+    if (changed & 32) last_.flags = lazDecodeByteByLast(dec, flagModels_, last_.flags);
     const std::uint32_t r = last_.returnNumber(), n = last_.numberOfReturns();
     const std::uint32_t m = lazReturnMap(n, r), l = lazReturnLevel(n, r);
     if (changed & 16) {
@@ -154,12 +154,13 @@ class Point10V2 final : public LazPointwiseItem {
     } else {
       last_.intensity = lastIntensity_[m];
     }
-    if (changed & 8) last_.classification = decodeByte(dec, classModels_, last_.classification);
+    if (changed & 8)
+      last_.classification = lazDecodeByteByLast(dec, classModels_, last_.classification);
     if (changed & 4) {
       const std::uint32_t delta = dec.decodeSymbol(scanAngle_[last_.scanDirection()]);
       last_.scanAngle = lazFold(static_cast<std::int32_t>(delta + last_.scanAngle));
     }
-    if (changed & 2) last_.userData = decodeByte(dec, userModels_, last_.userData);
+    if (changed & 2) last_.userData = lazDecodeByteByLast(dec, userModels_, last_.userData);
     if (changed & 1)
       last_.pointSource = static_cast<std::uint16_t>(pointSource_.decode(dec, last_.pointSource));
     readCoordinates(dec, m, l, n);
@@ -167,15 +168,6 @@ class Point10V2 final : public LazPointwiseItem {
   }
 
  private:
-  // A byte coded with a model chosen by its previous value (made on first use).
-  static std::uint8_t decodeByte(LazDecoder& dec,
-                                 std::array<std::unique_ptr<LazSymbolModel>, 256>& models,
-                                 std::uint8_t last) {
-    auto& model = models[last];
-    if (!model) model = std::make_unique<LazSymbolModel>(256);
-    return static_cast<std::uint8_t>(dec.decodeSymbol(*model));
-  }
-
   void readCoordinates(LazDecoder& dec, std::uint32_t m, std::uint32_t l, std::uint32_t n) {
     const std::uint32_t single = n == 1 ? 1 : 0;
     std::int32_t diff = dx_.decode(dec, xDiffs_[m].get(), single);

@@ -86,11 +86,6 @@ std::uint32_t returnLevel8(std::uint32_t n, std::uint32_t r) {
   return level < 7 ? level : 7;
 }
 
-LazSymbolModel& lazyModel(std::unique_ptr<LazSymbolModel>& model, std::uint32_t symbols) {
-  if (!model) model = std::make_unique<LazSymbolModel>(symbols);
-  return *model;
-}
-
 // One layer's decoder: `present` is false when the layer is empty (the field is constant in the
 // chunk), and then nothing is decoded from it. A layer decodes from exactly its bytes, as
 // LASzip's encoder wrote them; any other length means damage.
@@ -210,7 +205,7 @@ class Point14V3 final : public LazLayeredItem {
     Models& m = *c.models;
     const std::uint32_t lastN = c.last.numberOfReturns, lastR = c.last.returnNumber;
     if (changed & (1 << 2))
-      c.last.numberOfReturns = xy.decodeSymbol(lazyModel(m.numberOfReturns[lastN], 16));
+      c.last.numberOfReturns = xy.decodeSymbol(lazModelOnUse(m.numberOfReturns[lastN], 16));
     switch (changed & 3) {
       case 0:
         break;
@@ -222,7 +217,7 @@ class Point14V3 final : public LazLayeredItem {
         break;
       default:
         if (gpsChanged) {
-          c.last.returnNumber = xy.decodeSymbol(lazyModel(m.returnNumber[lastR], 16));
+          c.last.returnNumber = xy.decodeSymbol(lazModelOnUse(m.returnNumber[lastR], 16));
         } else {
           c.last.returnNumber = (lastR + xy.decodeSymbol(m.returnNumberGpsSame) + 2) % 16;
         }
@@ -258,11 +253,12 @@ class Point14V3 final : public LazLayeredItem {
     if (layers_[kClass].present) {
       const std::uint32_t slot = ((p.classification & 0x1Fu) << 1) + (returnKind == 3 ? 1 : 0);
       p.classification = static_cast<std::uint8_t>(
-          layers_[kClass].dec.decodeSymbol(lazyModel(m.classification[slot], 256)));
+          layers_[kClass].dec.decodeSymbol(lazModelOnUse(m.classification[slot], 256)));
     }
     if (layers_[kFlags].present) {
       const std::uint32_t last = (p.edge << 5) | (p.scanDirection << 4) | p.classFlags;
-      const std::uint32_t flags = layers_[kFlags].dec.decodeSymbol(lazyModel(m.flags[last], 64));
+      const std::uint32_t flags =
+          layers_[kFlags].dec.decodeSymbol(lazModelOnUse(m.flags[last], 64));
       p.edge = (flags >> 5) & 1;
       p.scanDirection = (flags >> 4) & 1;
       p.classFlags = flags & 15;
@@ -278,7 +274,7 @@ class Point14V3 final : public LazLayeredItem {
           m.scanAngle.decode(layers_[kScanAngle].dec, p.scanAngle, gpsChanged ? 1 : 0));
     if (layers_[kUserData].present)
       p.userData = static_cast<std::uint8_t>(
-          layers_[kUserData].dec.decodeSymbol(lazyModel(m.userData[p.userData / 4], 256)));
+          layers_[kUserData].dec.decodeSymbol(lazModelOnUse(m.userData[p.userData / 4], 256)));
     if (layers_[kSource].present && (changed & (1 << 5)))
       p.pointSource =
           static_cast<std::uint16_t>(m.pointSource.decode(layers_[kSource].dec, p.pointSource));

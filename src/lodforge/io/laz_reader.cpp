@@ -67,9 +67,10 @@ Result<LazPointStream> LazPointStream::open(const std::string& path,
   state->memory = memory;
   state->layout = layout;
   state->laz = laz;
-  // One decoder per thread, made on first use; checked once here so bad items fail at open.
-  Result<LazChunkDecoder> probe = LazChunkDecoder::create(laz, layout.file);
-  if (!probe) return probe.status();
+  // One decoder per thread, made on first use; the opening thread's is made here, so bad items
+  // fail at open.
+  Result<LazChunkDecoder> first = LazChunkDecoder::create(laz, layout.file);
+  if (!first) return first.status();
   State* s = state.get();
   Result<LazChunkTable> table = readLazChunkTable(
       layout, laz,
@@ -77,6 +78,7 @@ Result<LazPointStream> LazPointStream::open(const std::string& path,
   if (!table) return table.status();
   state->table = std::move(*table);
   state->decoders.emplace();
+  state->decoders->local().emplace(std::move(*first));
   return LazPointStream(std::move(state));
 }
 

@@ -133,7 +133,7 @@ PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std:
     chosen.push_back(&field);
     out.data.push_back(packField(field, points, time ? firstSecond : 0));
     properties[field.property] =
-        std::string(field.metadataType) == "ENUM"
+        field.bit == kAttrClassification
             ? nlohmann::json{{"type", "ENUM"}, {"enumType", "classification"}}
             : nlohmann::json{{"type", "SCALAR"}, {"componentType", field.metadataType}};
     mapped[field.property] = {{"attribute", field.semantic}};

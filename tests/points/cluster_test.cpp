@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include <gtest/gtest.h>
@@ -80,14 +81,14 @@ TEST(Cluster, BuildsABinaryTreeDownToSinglePoints) {
   EXPECT_LT(tree[0].error, 0.05);
 }
 
-TEST(Cluster, EstimatesNormalsByPcaFacingUp) {
+TEST(Cluster, EstimatesNormalsByPcaOverTreeCellsFacingUp) {
   std::vector<CloudPoint> plane = tiltedPlane(2'000, 0, 2);
-  estimateNormals(plane, 12);
+  clusterBlock(plane, {}, false);
   const Vec3f want = toFloat(normalizeOr(Vec3d{-0.5, 0, 1}, Vec3d{}));
   for (const CloudPoint& p : plane) EXPECT_GT(dot(p.normal, want), 0.9999f);
   // On a sphere the normals are radial (up to sign; they face +z).
   std::vector<CloudPoint> ball = sphere(4'000, 3, 3);
-  estimateNormals(ball, 12);
+  clusterBlock(ball, {}, false);
   std::size_t good = 0;
   for (const CloudPoint& p : ball) {
     const Vec3f radial = toFloat(normalizeOr(p.position, Vec3d{}));
@@ -95,6 +96,31 @@ TEST(Cluster, EstimatesNormalsByPcaFacingUp) {
     EXPECT_GE(p.normal.z, 0);
   }
   EXPECT_GT(good, ball.size() * 97 / 100);
+}
+
+// Leaves cover half the gap to their nearest neighbour (the clustering tree searched as a k-d
+// tree), exactly as a brute-force search finds it, duplicates included.
+TEST(Cluster, LeafRadiiAreHalfTheGapToTheNearestNeighbour) {
+  for (std::uint64_t seed : {5, 6}) {
+    std::vector<CloudPoint> points =
+        seed == 5 ? tiltedPlane(3'000, 0.02, seed) : sphere(3'000, 4, seed);
+    points[17].position = points[400].position;  // a duplicate
+    std::vector<std::uint32_t> firstPoint;
+    const std::vector<ClusterNode> tree = clusterBlock(points, {}, false, {}, &firstPoint);
+    std::size_t leaves = 0, zero = 0;
+    for (std::size_t i = 0; i < tree.size(); ++i) {
+      if (!tree[i].leaf()) continue;
+      ++leaves;
+      const CloudPoint& p = points[firstPoint[i]];
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const CloudPoint& q : points)
+        if (&q != &p) nearest = std::min(nearest, length(q.position - p.position));
+      EXPECT_NEAR(tree[i].radius, nearest / 2, 1e-6 * nearest) << "seed " << seed;
+      zero += tree[i].radius == 0;
+    }
+    EXPECT_EQ(leaves, points.size());
+    EXPECT_EQ(zero, 2u);
+  }
 }
 
 TEST(Cluster, ErrorGrowsWithCurvatureAndNoise) {

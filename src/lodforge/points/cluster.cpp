@@ -1,152 +1,205 @@
 #include "lodforge/points/cluster.h"
+#include <atomic>
+#include <chrono>
+#include <cstdio>
 
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
+#include <optional>
 
 #include <tbb/parallel_for.h>
 #include <Eigen/Eigenvalues>
-#include <nanoflann.hpp>
 
 namespace lodforge {
 
 namespace {
 
-// Positions relative to a local origin, in float, for nanoflann.
-struct LocalPoints {
-  std::vector<Vec3f> positions;
-  std::size_t kdtree_get_point_count() const { return positions.size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t axis) const {
-    return axis == 0 ? positions[i].x : axis == 1 ? positions[i].y : positions[i].z;
-  }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
+// Node i's points are points[begin, end) once the tree is built (splitting reorders in place).
+struct Range {
+  std::uint32_t begin, end;
+  std::uint32_t size() const { return end - begin; }
 };
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, LocalPoints>,
-                                                   LocalPoints, 3, std::uint32_t>;
 
-LocalPoints localPoints(std::span<const CloudPoint> points) {
-  LocalPoints local;
-  local.positions.resize(points.size());
-  const Vec3d origin = points.empty() ? Vec3d{} : points[0].position;
-  for (std::size_t i = 0; i < points.size(); ++i)
-    local.positions[i] = toFloat(points[i].position - origin);
-  return local;
-}
+// How a node was split: its first child's points have coordinate `axis` ≤ value, the second's
+// ≥ value. The clustering tree is a k-d tree, searched for nearest neighbours with these.
+struct Separator {
+  int axis = 0;
+  double value = 0;
+};
 
-// Half the distance from every point to its nearest other point (0 for a lone point).
-std::vector<float> halfSpacing(std::span<const CloudPoint> points) {
-  std::vector<float> spacing(points.size(), 0);
-  if (points.size() < 2) return spacing;
-  const LocalPoints local = localPoints(points);
-  KdTree tree(3, local, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-  tree.buildIndex();
-  tbb::parallel_for(std::size_t{0}, points.size(), [&](std::size_t i) {
-    std::uint32_t found[2];
-    float squared[2];
-    const std::size_t n = tree.knnSearch(&local.positions[i].x, 2, found, squared);
-    // The nearest is usually the point itself; a duplicate has distance 0 either way.
-    float nearest = 0;
-    for (std::size_t k = 0; k < n; ++k)
-      if (found[k] != i) nearest = std::sqrt(squared[k]);
-    spacing[i] = nearest / 2;
-  });
-  return spacing;
-}
-
-}  // namespace
-
-void estimateNormals(std::span<CloudPoint> points, int neighbours) {
-  if (points.size() < 3) {
-    for (CloudPoint& p : points) p.normal = {0, 0, 1};
-    return;
-  }
-  const LocalPoints local = localPoints(points);
-  KdTree tree(3, local, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-  tree.buildIndex();
-  const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(neighbours), points.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      std::vector<std::uint32_t> found(k);
-                      std::vector<float> squared(k);
-                      for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                        const std::size_t n =
-                            tree.knnSearch(&local.positions[i].x, k, found.data(), squared.data());
-                        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-                        for (std::size_t j = 0; j < n; ++j) {
-                          const Vec3f& q = local.positions[found[j]];
-                          mean += Eigen::Vector3d(q.x, q.y, q.z);
-                        }
-                        mean /= static_cast<double>(n);
-                        Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-                        for (std::size_t j = 0; j < n; ++j) {
-                          const Vec3f& q = local.positions[found[j]];
-                          const Eigen::Vector3d d = Eigen::Vector3d(q.x, q.y, q.z) - mean;
-                          covariance += d * d.transpose();
-                        }
-                        // The direction of least spread (eigenvalues come in increasing order).
-                        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-                        Eigen::Vector3d normal = solver.eigenvectors().col(0);
-                        if (normal.z() < 0) normal = -normal;
-                        points[i].normal = normalizeOr(
-                            Vec3f{static_cast<float>(normal.x()), static_cast<float>(normal.y()),
-                                  static_cast<float>(normal.z())},
-                            Vec3f{0, 0, 1});
-                      }
-                    });
-}
-
-std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin, bool hasNormals,
-                                      const ClusterOptions& options,
-                                      std::vector<std::uint32_t>* firstPoint) {
-  std::vector<ClusterNode> nodes;
-  if (points.empty()) return nodes;
-  if (!hasNormals) estimateNormals(points, options.neighbours);
-  // Top-down splitting (§4.1, "Hierarchical clustering"), breadth-first: node i's points are the
-  // range ranges[i], and splitting it reorders only inside that range.
-  struct Range {
-    std::uint32_t begin, end;
-  };
-  std::vector<Range> ranges;
+// Top-down splitting (§4.1, "Hierarchical clustering"), breadth-first: each node's centroid,
+// mean colour and count; splitting node i reorders only inside ranges[i].
+void splitTree(std::span<CloudPoint> points, Vec3d origin, std::vector<ClusterNode>& nodes,
+               std::vector<Range>& ranges, std::vector<Separator>& separators) {
   nodes.reserve(2 * points.size() - 1);
   ranges.reserve(2 * points.size() - 1);
+  separators.resize(2 * points.size() - 1);
   nodes.emplace_back();
   ranges.push_back({0, static_cast<std::uint32_t>(points.size())});
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const Range r = ranges[i];
-    const std::span<CloudPoint> mine = points.subspan(r.begin, r.end - r.begin);
+    const std::span<CloudPoint> mine = points.subspan(r.begin, r.size());
     Aabbd bounds;
     Vec3d sum, color;
-    Vec3d normalSum;
     for (const CloudPoint& p : mine) {
       bounds.add(p.position);
       sum = sum + p.position;
-      normalSum = normalSum + toDouble(p.normal);
       color = color + Vec3d{double(p.color.r), double(p.color.g), double(p.color.b)};
     }
     const double n = static_cast<double>(mine.size());
     const Vec3d centroid = sum * (1 / n);
     ClusterNode& node = nodes[i];
     node.position = toFloat(centroid - origin);
-    node.normal = toFloat(normalizeOr(normalSum, toDouble(mine[0].normal)));
     color = color * (1 / n);
     node.color = {static_cast<std::uint8_t>(std::lround(color.x)),
                   static_cast<std::uint8_t>(std::lround(color.y)),
                   static_cast<std::uint8_t>(std::lround(color.z)), 255};
     node.pointCount = static_cast<std::uint32_t>(mine.size());
     if (mine.size() == 1) continue;
-    const std::size_t below = splitPoints(mine, centroidSplit(bounds, centroid));
+    const SplitPlane plane = centroidSplit(bounds, centroid);
+    const auto below = static_cast<std::uint32_t>(splitPoints(mine, plane));
+    // When the centroid leaves every point on one side, splitPoints splits at the median.
+    const bool median =
+        bounds.min[plane.axis] >= plane.value || bounds.max[plane.axis] < plane.value;
+    separators[i] = {plane.axis, median ? mine[below].position[plane.axis] : plane.value};
     node.firstChild = static_cast<std::uint32_t>(nodes.size());
     nodes.emplace_back();
     nodes.emplace_back();
-    ranges.push_back({r.begin, r.begin + static_cast<std::uint32_t>(below)});
-    ranges.push_back({r.begin + static_cast<std::uint32_t>(below), r.end});
+    ranges.push_back({r.begin, r.begin + below});
+    ranges.push_back({r.begin + below, r.end});
   }
-  // Radii bottom-up: a leaf covers half the gap to its nearest neighbour, a parent covers its
-  // children's squares (in its own plane).
-  const std::vector<float> spacing = halfSpacing(points);
+}
+
+// The direction of least spread of `points` (PCA), facing +z; +z for fewer than three points.
+Vec3f pcaNormal(std::span<const CloudPoint> points) {
+  if (points.size() < 3) return {0, 0, 1};
+  Vec3d mean;
+  for (const CloudPoint& p : points) mean = mean + p.position;
+  mean = mean * (1.0 / static_cast<double>(points.size()));
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const CloudPoint& p : points) {
+    const Vec3d d = p.position - mean;
+    const Eigen::Vector3d e(d.x, d.y, d.z);
+    covariance += e * e.transpose();
+  }
+  // Eigenvalues come in increasing order.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  Eigen::Vector3d normal = solver.eigenvectors().col(0);
+  if (normal.z() < 0) normal = -normal;
+  return normalizeOr(Vec3f{static_cast<float>(normal.x()), static_cast<float>(normal.y()),
+                           static_cast<float>(normal.z())},
+                     Vec3f{0, 0, 1});
+}
+
+// Each point's normal, when the input has none, by PCA over its cell: the smallest node of
+// the tree holding at least k points (the splitting made every node's points contiguous, so
+// no k-nearest-neighbour search is needed).
+void cellNormals(std::span<CloudPoint> points, std::span<const ClusterNode> nodes,
+                 std::span<const Range> ranges, std::uint32_t k) {
+  const auto settle = [&](const Range& cell, const Range& own) {
+    const Vec3f normal = pcaNormal(points.subspan(cell.begin, cell.size()));
+    for (CloudPoint& p : points.subspan(own.begin, own.size())) p.normal = normal;
+  };
+  if (ranges[0].size() < k) return settle(ranges[0], ranges[0]);
+  // Nodes with at least k points hand their small children (fewer than k) their plane.
+  tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t i) {
+    if (ranges[i].size() < k || nodes[i].leaf()) return;
+    const std::uint32_t a = nodes[i].firstChild, b = a + 1;
+    if (ranges[a].size() < k && ranges[b].size() < k) return settle(ranges[i], ranges[i]);
+    for (std::uint32_t c : {a, b})
+      if (ranges[c].size() < k) settle(ranges[i], ranges[c]);
+  });
+}
+
+// Half the distance from every point to its nearest other point (0 for a lone point or a
+// duplicate), by searching the clustering tree as the k-d tree it is: up from the point's
+// leaf, into each sibling subtree only where its side of the separator is nearer than the
+// best so far. Exact, and no second spatial index per block.
+std::vector<float> halfSpacing(std::span<const CloudPoint> points,
+                               std::span<const ClusterNode> nodes, std::span<const Range> ranges,
+                               std::span<const Separator> separators) {
+  std::vector<float> spacing(points.size(), 0);
+  if (points.size() < 2) return spacing;
+  // The tree packed for the search, depth first (a subtree's nodes close together; the tree's
+  // own breadth-first order scatters them, and the search waited on memory): a split's axis,
+  // value and first child (children stay adjacent), or a leaf's point.
+  struct KdNode {
+    double value;
+    std::uint32_t next;  // first child, or the leaf's point
+    std::int32_t axis;   // −1 for a leaf
+  };
+  std::vector<KdNode> kd(nodes.size());
+  std::vector<std::uint32_t> parent(nodes.size(), 0), leafOf(points.size(), 0);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> order{{0, 0}};  // tree node, packed index
+  std::uint32_t placed = 1;
+  while (!order.empty()) {
+    const auto [i, at] = order.back();
+    order.pop_back();
+    if (nodes[i].leaf()) {
+      kd[at] = {0, ranges[i].begin, -1};
+      leafOf[ranges[i].begin] = at;
+      continue;
+    }
+    kd[at] = {separators[i].value, placed, separators[i].axis};
+    parent[placed] = parent[placed + 1] = at;
+    order.emplace_back(nodes[i].firstChild + 1, placed + 1);
+    order.emplace_back(nodes[i].firstChild, placed);
+    placed += 2;
+  }
+  std::vector<Vec3d> positions(points.size());
+  for (std::size_t j = 0; j < points.size(); ++j) positions[j] = points[j].position;
+  tbb::parallel_for(
+      tbb::blocked_range<std::uint32_t>(0, static_cast<std::uint32_t>(points.size()), 256),
+      [&](const tbb::blocked_range<std::uint32_t>& range) {
+        std::vector<std::pair<std::uint32_t, double>> stack;  // node, least distance² to it
+        for (std::uint32_t j = range.begin(); j < range.end(); ++j) {
+          const Vec3d p = positions[j];
+          double best = std::numeric_limits<double>::infinity();
+          for (std::uint32_t node = leafOf[j]; node != 0; node = parent[node]) {
+            const KdNode& up = kd[parent[node]];
+            const double gap = p[up.axis] - up.value;
+            if (gap * gap >= best) continue;
+            stack.assign(1, {node == up.next ? node + 1 : node - 1, gap * gap});
+            while (!stack.empty()) {
+              const auto [t, least] = stack.back();
+              stack.pop_back();
+              if (least >= best) continue;
+              const KdNode& n = kd[t];
+              if (n.axis < 0) {
+                const Vec3d d = positions[n.next] - p;
+                best = std::min(best, dot(d, d));
+                continue;
+              }
+              const double side = p[n.axis] - n.value;
+              // The far child first onto the stack: the near one is searched before it.
+              stack.emplace_back(side < 0 ? n.next + 1 : n.next, side * side);
+              stack.emplace_back(side < 0 ? n.next : n.next + 1, least);
+            }
+          }
+          spacing[j] = static_cast<float>(std::sqrt(best) / 2);
+        }
+      });
+  return spacing;
+}
+
+// Node normals bottom-up: the normalised sum of their points' normals (the paper's V).
+void nodeNormals(std::span<const CloudPoint> points, std::span<ClusterNode> nodes,
+                 std::span<const Range> ranges) {
+  std::vector<Vec3d> sums(nodes.size());
+  for (std::size_t i = nodes.size(); i-- > 0;) {
+    ClusterNode& node = nodes[i];
+    const Vec3f first = points[ranges[i].begin].normal;
+    sums[i] = node.leaf() ? toDouble(first) : sums[node.firstChild] + sums[node.firstChild + 1];
+    node.normal = toFloat(normalizeOr(sums[i], toDouble(first)));
+  }
+}
+
+// Radii bottom-up: a leaf covers half the gap to its nearest neighbour, a parent covers its
+// children's squares (in its own plane).
+void nodeRadii(std::span<ClusterNode> nodes, std::span<const Range> ranges,
+               std::span<const float> spacing) {
   for (std::size_t i = nodes.size(); i-- > 0;) {
     ClusterNode& node = nodes[i];
     if (node.leaf()) {
@@ -161,7 +214,11 @@ std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin
     }
     node.radius = radius;
   }
-  // Fitting error (§4.1, the paper's E with α1 = α2 = 0.5), then made monotone bottom-up.
+}
+
+// Fitting error (§4.1, the paper's E with α1 = α2 = 0.5), then made monotone bottom-up.
+void nodeErrors(std::span<const CloudPoint> points, Vec3d origin, std::span<ClusterNode> nodes,
+                std::span<const Range> ranges, const ClusterOptions& options) {
   tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t i) {
     ClusterNode& node = nodes[i];
     if (node.leaf()) return;
@@ -172,7 +229,7 @@ std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin
       distance += std::abs(dot(points[k].position - c, normal));
       turn += 1 - dot(toDouble(points[k].normal), normal);
     }
-    const double n = static_cast<double>(ranges[i].end - ranges[i].begin);
+    const double n = static_cast<double>(ranges[i].size());
     node.error =
         static_cast<float>(options.alpha1 * distance / n + options.alpha2 * node.radius * turn / n);
   });
@@ -182,6 +239,40 @@ std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin
       node.error =
           std::max({node.error, nodes[node.firstChild].error, nodes[node.firstChild + 1].error});
   }
+}
+
+}  // namespace
+
+std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin, bool hasNormals,
+                                      const ClusterOptions& options,
+                                      std::vector<std::uint32_t>* firstPoint) {
+  std::vector<ClusterNode> nodes;
+  if (points.empty()) return nodes;
+  std::vector<Range> ranges;
+  std::vector<Separator> separators;
+  auto t0 = std::chrono::steady_clock::now();
+  auto lap = [&](int k) {
+    static std::atomic<long> acc[6];
+    auto t = std::chrono::steady_clock::now();
+    acc[k] += std::chrono::duration_cast<std::chrono::microseconds>(t - t0).count();
+    t0 = t;
+    if (k == 5 && points.size() > 1000)
+      fprintf(stderr, "%ld %ld %ld %ld %ld %ld\n", acc[0].load(), acc[1].load(), acc[2].load(),
+              acc[3].load(), acc[4].load(), acc[5].load());
+  };
+  splitTree(points, origin, nodes, ranges, separators);
+  lap(0);
+  if (!hasNormals)
+    cellNormals(points, nodes, ranges, static_cast<std::uint32_t>(std::max(3, options.neighbours)));
+  lap(1);
+  const std::vector<float> spacing = halfSpacing(points, nodes, ranges, separators);
+  lap(2);
+  nodeNormals(points, nodes, ranges);
+  lap(3);
+  nodeRadii(nodes, ranges, spacing);
+  lap(4);
+  nodeErrors(points, origin, nodes, ranges, options);
+  lap(5);
   if (firstPoint) {
     firstPoint->resize(nodes.size());
     for (std::size_t i = 0; i < nodes.size(); ++i) (*firstPoint)[i] = ranges[i].begin;
@@ -237,7 +328,8 @@ LodCut cutTree(std::span<const ClusterNode> tree, float tolerance) {
   return cut;
 }
 
-float toleranceForResident(std::span<const ClusterNode> tree, std::size_t residentNodes) {
+std::vector<float> tolerancesForResident(std::span<const ClusterNode> tree,
+                                         std::span<const std::size_t> residentNodes) {
   std::vector<float> errors;
   errors.reserve(tree.size());
   for (const ClusterNode& n : tree) errors.push_back(n.error);
@@ -259,16 +351,24 @@ float toleranceForResident(std::span<const ClusterNode> tree, std::size_t reside
     }
     return count;
   };
-  std::size_t lo = 0, hi = errors.size() - 1;
-  while (lo < hi) {
-    const std::size_t mid = (lo + hi) / 2;
-    if (residentAt(errors[mid]) <= residentNodes) {
-      hi = mid;
-    } else {
-      lo = mid + 1;
+  std::vector<float> tolerances;
+  for (const std::size_t budget : residentNodes) {
+    std::size_t lo = 0, hi = errors.size() - 1;
+    while (lo < hi) {
+      const std::size_t mid = (lo + hi) / 2;
+      if (residentAt(errors[mid]) <= budget) {
+        hi = mid;
+      } else {
+        lo = mid + 1;
+      }
     }
+    tolerances.push_back(errors[lo]);
   }
-  return errors[lo];
+  return tolerances;
+}
+
+float toleranceForResident(std::span<const ClusterNode> tree, std::size_t residentNodes) {
+  return tolerancesForResident(tree, std::span<const std::size_t>(&residentNodes, 1)).front();
 }
 
 }  // namespace lodforge

@@ -1,8 +1,7 @@
-// Per-block data reorganisation (points paper §4.1): normals where the input has none (PCA over
-// the k nearest neighbours), top-down hierarchical clustering into a binary tree down to single
-// points, a planar square fitted to every node with its error, and the cut of the tree by an
-// error tolerance into Part I (dropped), Part II (kept in memory) and Part III (the block's
-// segment file), Fig. 4.
+// Per-block data reorganisation (points paper §4.1): top-down hierarchical clustering into a binary
+// tree down to single points, a planar square fitted to every node with its error, and the cut of
+// the tree by an error tolerance into Part I (dropped), Part II (kept in memory) and Part III (the
+// block's segment file), Fig. 4.
 #pragma once
 
 #include <cstdint>
@@ -32,14 +31,13 @@ static_assert(sizeof(ClusterNode) == 44);
 
 struct ClusterOptions {
   double alpha1 = 0.5, alpha2 = 0.5;  // weights of distance and normal difference (the paper's)
-  int neighbours = 12;                // k for normal estimation and spacing
+  int neighbours = 12;                // k: the fewest points in a normal's neighbourhood
 };
 
-// Unit normals by PCA over each point's k nearest neighbours (nanoflann + Eigen), turned to face
-// +z (up, for aerial and terrestrial scans; a normal in the horizontal plane keeps its sign).
-void estimateNormals(std::span<CloudPoint> points, int neighbours);
-
 // The clustering tree of one block, breadth-first with the root first; `points` is reordered.
+// Without `hasNormals`, each point's normal is estimated (and written into `points`) by PCA over
+// its cell: the smallest node of the tree with at least k points, turned to face +z (up, for
+// aerial and terrestrial scans). The cell also gives the nearest-neighbour spacing.
 // Node error E = α1·mean|(p_i − c)·n| + α2·r·mean(1 − n_i·n): the paper's distance and normal
 // terms, the second scaled by the square's radius so that E is a length (see docs/points.md).
 // Leaves are single points whose radius is half the distance to their nearest neighbour.
@@ -62,5 +60,8 @@ LodCut cutTree(std::span<const ClusterNode> tree, float tolerance);
 
 // The smallest tolerance whose cut keeps at most `residentNodes` nodes in Part II.
 float toleranceForResident(std::span<const ClusterNode> tree, std::size_t residentNodes);
+// The same for several budgets at once (the tree's errors sorted once).
+std::vector<float> tolerancesForResident(std::span<const ClusterNode> tree,
+                                         std::span<const std::size_t> residentNodes);
 
 }  // namespace lodforge

@@ -53,12 +53,14 @@ std::vector<float> toleranceSchedule(const Partition& partition, const PointTile
     if (!points) return;  // the block pass reports it
     const std::vector<ClusterNode> tree = tileErrorTree(
         clusterBlock(*points, block.centroid, partition.info.hasNormals, options.cluster));
+    std::vector<std::size_t> budgets;
     for (int d = 0; d < maxDepth; ++d) {
       const double share = std::min(1.0, std::ldexp(static_cast<double>(options.tilePoints), d) /
                                              static_cast<double>(partition.pointCount));
-      perSample[s].push_back(toleranceForResident(
-          tree, static_cast<std::size_t>(std::max(1.0, share * static_cast<double>(block.count)))));
+      budgets.push_back(
+          static_cast<std::size_t>(std::max(1.0, share * static_cast<double>(block.count))));
     }
+    perSample[s] = tolerancesForResident(tree, budgets);
   });
   for (int d = 0; d < maxDepth; ++d) {
     std::vector<float> values;

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -245,6 +245,51 @@ laz_section() {
 }
 if [[ ${BENCH_ONLY:-} == laz ]]; then laz_section; exit 0; fi
 
+# Point tiles beside PotreeConverter 2 (issue 18), in one run on the same inputs: POTREE names
+# its binary (built outside the project from its public source); LAZ_COMPRESS a command
+# `LAZ_COMPRESS IN.las OUT.laz` that writes the same points as LAZ (lodforge writes no LAZ;
+# e.g. a LASzip-based compressor). POTREE_SIZES (default "1M 20M") picks the clouds.
+potree_row() {  # tool, input; prints wall, points/s, peak RSS and output size
+  local tool=$1 input=$2 log=$work/time.log out=$work/potree-out
+  rm -rf "$out"
+  local cmd
+  if [[ $tool == lodforge ]]; then cmd=("$lodforge" -q tiles "$input" -o "$out"); else cmd=("$POTREE" "$input" -o "$out"); fi
+  /usr/bin/time -v "${cmd[@]}" > /dev/null 2> "$log" || { tail -20 "$log"; exit 1; }
+  local wall rss seconds points
+  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
+  rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
+  seconds=$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")
+  points=$("$lodforge" info --header-only "$input" | awk '/^points / {print $2}' | tr -d ,)
+  printf '| %-5s | %-4s | %-16s | %8ss | %9.2f M/s | %8d MiB | %7s |\n' "$3" "${input##*.}" "$tool" "$seconds" \
+    "$(awk -v n="$points" -v s="$seconds" 'BEGIN { print n / s / 1e6 }')" $((rss / 1024)) "$(du -sh "$out" | cut -f1)"
+  rm -rf "$out"
+}
+potree_section() {
+  echo
+  echo "== point tiles beside PotreeConverter 2 (same input, one run; $(nproc) threads each)"
+  if [[ -z ${POTREE:-} || ! -x ${POTREE:-} ]]; then
+    echo "POTREE is not set to a PotreeConverter binary: nothing to compare against (skipped)"
+    return
+  fi
+  [[ -n ${LAZ_COMPRESS:-} ]] || echo "LAZ_COMPRESS is not set: LAS rows only"
+  printf '| %-5s | %-4s | %-16s | %9s | %13s | %12s | %7s |\n' cloud file tool wall points/s "peak RSS" output
+  printf '|%s|%s|%s|%s|%s|%s|%s|\n' ------- ------ ------------------ ----------- --------------- -------------- ---------
+  for n in ${POTREE_SIZES:-1M 20M}; do
+    "$lodforge" -q generate points --points "$n" -o "$work/cloud.las"
+    local files=("$work/cloud.las")
+    if [[ -n ${LAZ_COMPRESS:-} ]]; then
+      $LAZ_COMPRESS "$work/cloud.las" "$work/cloud.laz" > /dev/null
+      files+=("$work/cloud.laz")
+    fi
+    for input in "${files[@]}"; do
+      potree_row lodforge "$input" "$n"
+      potree_row potree "$input" "$n"
+    done
+    rm -f "$work/cloud.las" "$work/cloud.laz"
+  done
+}
+if [[ ${BENCH_ONLY:-} == potree ]]; then potree_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -267,5 +312,6 @@ tiles_section
 points_section
 serve_section
 laz_section
+potree_section
 render_section
 runtime_section

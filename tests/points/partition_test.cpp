@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 
 #include <gtest/gtest.h>
 
@@ -111,6 +112,51 @@ TEST(Partition, StreamedSplitsGiveTheSameBlocksAsSplitsInMemory) {
     for (std::size_t i = 0; i < results[0][b].size(); ++i)
       EXPECT_EQ(results[0][b][i].position, results[1][b][i].position);
   }
+}
+
+// A block sink receives, from several threads, exactly the blocks the files would hold (in
+// name order afterwards), and a failing sink fails the partition.
+TEST(Partition, ASinkTakesTheBlocksInsteadOfFiles) {
+  test::TempDir dir;
+  writeCloud(dir.file("cloud.xyz"), 12'000, 7);
+  PartitionOptions options;
+  options.blockSize = 700;
+  options.workDirectory = dir.file("files");
+  options.memoryBytes = 3'000 * sizeof(CloudPoint);
+  std::filesystem::create_directories(options.workDirectory);
+  Result<Partition> files = partitionPoints(dir.file("cloud.xyz"), options);
+  ASSERT_TRUE(files.ok()) << files.error().message;
+  std::mutex mutex;
+  std::map<std::string, Multiset> sunk;
+  options.workDirectory = dir.file("sink");
+  std::filesystem::create_directories(options.workDirectory);
+  options.blockSink = [&](std::span<CloudPoint> points, PointBlock& block) {
+    Multiset content;
+    for (const CloudPoint& p : points) ++content[{p.position.x, p.position.y, p.position.z}];
+    std::reverse(points.begin(), points.end());  // the sink may reorder
+    std::lock_guard lock(mutex);
+    EXPECT_EQ(block.count, points.size());
+    sunk[block.name] = std::move(content);
+    return Status{};
+  };
+  Result<Partition> sinks = partitionPoints(dir.file("cloud.xyz"), options);
+  ASSERT_TRUE(sinks.ok()) << sinks.error().message;
+  ASSERT_EQ(sinks->blocks.size(), files->blocks.size());
+  for (std::size_t b = 0; b < files->blocks.size(); ++b) {
+    const PointBlock &file = files->blocks[b], &sink = sinks->blocks[b];
+    EXPECT_EQ(sink.name, file.name);
+    EXPECT_EQ(sink.bounds, file.bounds);
+    Multiset want;
+    for (const CloudPoint& p : readBlock(file)) ++want[{p.position.x, p.position.y, p.position.z}];
+    EXPECT_EQ(sunk.at(sink.name), want) << sink.name;
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(options.workDirectory));  // no block files
+  options.blockSink = [](std::span<CloudPoint>, PointBlock& block) -> Status {
+    return ioError(block.name, "disk full");
+  };
+  Result<Partition> failed = partitionPoints(dir.file("cloud.xyz"), options);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_NE(failed.error().message.find("disk full"), std::string::npos);
 }
 
 TEST(Partition, SplitsCoincidentPointsByCount) {

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
 
 #include "lodforge/core/file.h"
@@ -90,7 +92,8 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
 }
 
 // One streamed split: the node's file into two, lower side first.
-Result<std::array<PartNode, 2>> splitStreamed(const PartNode& node, const std::string& work) {
+Result<std::array<PartNode, 2>> splitStreamed(const PartNode& node, const std::string& work,
+                                              Progress& progress) {
   const SplitPlane plane = centroidSplit(node.bounds, centroidOf(node.sum, node.count));
   std::array<PartNode, 2> children;
   std::array<Stats, 2> stats;
@@ -121,6 +124,7 @@ Result<std::array<PartNode, 2>> splitStreamed(const PartNode& node, const std::s
     for (std::size_t side = 0; side < 2; ++side)
       LODFORGE_TRY(outs[side]->writeSpan(std::span<const CloudPoint>(sides[side])));
     done += n;
+    progress.advance(n);
     LODFORGE_TRY(checkCancelled());
   }
   if (stats[0].count == 0 || stats[1].count == 0) {
@@ -145,18 +149,25 @@ struct Blocks {
   Status status;
 };
 
-// A node in memory, split recursively into blocks (both halves in parallel).
-void splitInMemory(std::span<CloudPoint> points, std::string name, std::uint64_t blockSize,
-                   const std::string& work, Blocks& blocks) {
+// A node in memory, split recursively into blocks (both halves in parallel); each block to its
+// file, or to the sink.
+void splitInMemory(std::span<CloudPoint> points, std::string name, const PartitionOptions& options,
+                   Blocks& blocks) {
   Stats stats;
   for (const CloudPoint& p : points) stats.add(p);
-  if (points.size() <= blockSize) {
+  if (points.size() <= options.blockSize) {
     PointBlock block;
-    block.path = work + "/" + name + ".block";
+    block.name = name;
     block.count = points.size();
     block.bounds = stats.bounds;
     block.centroid = centroidOf(stats.sum, stats.count);
-    Status written = writePoints(block.path, points);
+    Status written;
+    if (options.blockSink) {
+      written = cancelRequested() ? Status{} : options.blockSink(points, block);
+    } else {
+      block.path = options.workDirectory + "/" + name + ".block";
+      written = writePoints(block.path, points);
+    }
     std::lock_guard lock(blocks.mutex);
     if (!written.ok() && blocks.status.ok()) blocks.status = written;
     blocks.named.emplace_back(std::move(name), std::move(block));
@@ -165,9 +176,47 @@ void splitInMemory(std::span<CloudPoint> points, std::string name, std::uint64_t
   const std::size_t below =
       splitPoints(points, centroidSplit(stats.bounds, centroidOf(stats.sum, stats.count)));
   tbb::task_group group;
-  group.run([&] { splitInMemory(points.first(below), name + "0", blockSize, work, blocks); });
-  splitInMemory(points.subspan(below), name + "1", blockSize, work, blocks);
+  group.run([&] { splitInMemory(points.first(below), name + "0", options, blocks); });
+  splitInMemory(points.subspan(below), name + "1", options, blocks);
   group.wait();
+}
+
+// Nodes too big for memory split by streamed passes, a level of the tree at a time with that
+// level's nodes in parallel (each pass streams its own files); what is left, in split-tree
+// order, fits in memory (or could not be split by streaming: every point on one side).
+Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t inMemory,
+                                                  const std::string& work, Partition& partition) {
+  // About one pass over every point per level: levels halve the nodes until they fit.
+  int levels = 0;
+  for (std::uint64_t n = root.count; n > inMemory; n = (n + 1) / 2) ++levels;
+  Progress progress("points: streamed splits", root.count * static_cast<std::uint64_t>(levels));
+  std::vector<PartNode> level, small;
+  level.push_back(std::move(root));
+  while (!level.empty()) {
+    std::vector<std::optional<Result<std::array<PartNode, 2>>>> halves(level.size());
+    tbb::parallel_for(std::size_t{0}, level.size(), [&](std::size_t i) {
+      if (level[i].count > inMemory && !cancelRequested())
+        halves[i] = splitStreamed(level[i], work, progress);
+    });
+    LODFORGE_TRY(checkCancelled());
+    std::vector<PartNode> next;
+    for (std::size_t i = 0; i < level.size(); ++i) {
+      if (halves[i] && *halves[i]) {
+        ++partition.streamedPasses;
+        next.push_back(std::move((**halves[i])[0]));
+        next.push_back(std::move((**halves[i])[1]));
+        continue;
+      }
+      if (halves[i] && halves[i]->error().kind != ErrorKind::kUnsupported)
+        return halves[i]->status();
+      small.push_back(std::move(level[i]));
+    }
+    level = std::move(next);
+  }
+  if (levels > 0) progress.finish();
+  std::sort(small.begin(), small.end(),
+            [](const PartNode& a, const PartNode& b) { return a.name < b.name; });
+  return small;
 }
 
 }  // namespace
@@ -215,28 +264,18 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
   partition.bounds = root->bounds;
   const std::uint64_t inMemory =
       std::max<std::uint64_t>(options.blockSize, options.memoryBytes / sizeof(CloudPoint));
-  // Depth-first over the nodes too big for memory; the rest split in memory.
-  std::vector<PartNode> stack{std::move(*root)};
+  Result<std::vector<PartNode>> nodes =
+      splitStreamedLevels(std::move(*root), inMemory, options.workDirectory, partition);
+  if (!nodes) return nodes.status();
+  // Then one node at a time in memory (so that only one is held), its halves in parallel.
   Blocks blocks;
   Progress progress("points: partition", partition.pointCount);
-  while (!stack.empty()) {
-    PartNode node = std::move(stack.back());
-    stack.pop_back();
-    if (node.count > inMemory) {
-      Result<std::array<PartNode, 2>> children = splitStreamed(node, options.workDirectory);
-      if (children) {
-        ++partition.streamedPasses;
-        stack.push_back(std::move((*children)[1]));
-        stack.push_back(std::move((*children)[0]));
-        continue;
-      }
-      if (children.error().kind != ErrorKind::kUnsupported) return children.status();
-    }
+  for (const PartNode& node : *nodes) {
     Result<std::vector<CloudPoint>> points = readPointRecords(node.path, 0, node.count);
     if (!points) return points.status();
     std::error_code ignored;
     std::filesystem::remove(node.path, ignored);
-    splitInMemory(*points, node.name, options.blockSize, options.workDirectory, blocks);
+    splitInMemory(*points, node.name, options, blocks);
     if (!blocks.status.ok()) return blocks.status;
     progress.advance(node.count);
     LODFORGE_TRY(checkCancelled());
@@ -245,7 +284,6 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
   std::sort(blocks.named.begin(), blocks.named.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [name, block] : blocks.named) {
-    block.name = name;
     partition.blocks.push_back(std::move(block));
   }
   return partition;

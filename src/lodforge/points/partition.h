@@ -28,6 +28,14 @@ struct CloudPoint {
 };
 static_assert(sizeof(CloudPoint) == 64);
 
+struct PointBlock {
+  std::string name;  // its path in the split tree: "b", then "0" (lower side) or "1" per split
+  std::string path;  // CloudPoint records (set by the sink, if any)
+  std::uint64_t count = 0;
+  Aabbd bounds;
+  Vec3d centroid;
+};
+
 struct PartitionOptions {
   std::uint64_t blockSize = 50'000;  // at most this many points per block
   // Points held in memory at once while splitting (bytes); nodes above it are split by streamed
@@ -38,15 +46,12 @@ struct PartitionOptions {
   // Applied to every point as it is read (one thread): e.g. a CRS to a local frame. False
   // refuses the point.
   std::function<bool(Vec3d, Vec3d&)> transform;
+  // Where finished blocks go: by default each is written to `<name>.block` in the work
+  // directory (PointBlock::path); a sink takes the block's points instead (it may reorder
+  // them), called from several threads at once while the points are in memory.
+  std::function<Status(std::span<CloudPoint>, PointBlock&)> blockSink;
 };
 
-struct PointBlock {
-  std::string name;  // its path in the split tree: "b", then "0" (lower side) or "1" per split
-  std::string path;  // CloudPoint records
-  std::uint64_t count = 0;
-  Aabbd bounds;
-  Vec3d centroid;
-};
 
 struct Partition {
   PointCloudInfo info;

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <mutex>
 
@@ -38,35 +39,103 @@ std::vector<ClusterNode> tileErrorTree(std::vector<ClusterNode> tree) {
   return tree;
 }
 
+// One block, ranked while the partition holds it in memory: its points sorted by their key,
+// highest first, in `path` and the keys in `keysPath`. A point's key is the tile error of the
+// parent of the highest node it represents (+∞ for the root's): the cut at τ holds the point
+// exactly when τ < key, so a tile at depth d (tolerance τ_d, non-increasing with d) holds a
+// prefix of the sorted block whatever the τ turn out to be.
+struct BlockTiles {
+  std::string path, keysPath;
+  std::vector<std::uint64_t> counts;  // per depth 0..depthOf(block), once the τ are known
+  Aabbd bounds;
+  float rootError = 0;
+  float leastError = 0;  // the least tile error in the block's tree
+};
+
+Status rankBlock(std::span<CloudPoint> points, const PointBlock& block, bool hasNormals,
+                 const PointTilesOptions& options, const std::string& workDirectory,
+                 BlockTiles& out) {
+  std::vector<std::uint32_t> firstPoint;
+  const std::vector<ClusterNode> tree =
+      tileErrorTree(clusterBlock(points, block.centroid, hasNormals, options.cluster, &firstPoint));
+  const std::vector<std::uint32_t> reps =
+      clusterRepresentatives(tree, points, firstPoint, block.centroid);
+  std::vector<float> key(points.size());
+  key[reps[0]] = std::numeric_limits<float>::infinity();
+  out.leastError = tree.front().error;
+  for (const ClusterNode& node : tree) {
+    out.leastError = std::min(out.leastError, node.error);
+    if (node.leaf()) continue;
+    const std::uint32_t parentRep = reps[static_cast<std::size_t>(&node - tree.data())];
+    for (std::uint32_t c = node.firstChild; c < node.firstChild + 2; ++c)
+      if (reps[c] != parentRep) key[reps[c]] = node.error;
+  }
+  std::vector<std::uint32_t> order(points.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return key[a] > key[b]; });
+  std::vector<CloudPoint> sorted(points.size());
+  std::vector<float> sortedKeys(points.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    sorted[i] = points[order[i]];
+    sortedKeys[i] = key[order[i]];
+  }
+  out.path = workDirectory + "/" + block.name + ".tiles";
+  out.keysPath = workDirectory + "/" + block.name + ".keys";
+  out.bounds = block.bounds;
+  out.rootError = tree.front().error;
+  Result<OutputFile> file = OutputFile::create(out.path, std::size_t{1} << 20);
+  if (!file) return file.status();
+  LODFORGE_TRY(file->writeSpan(std::span<const CloudPoint>(sorted)));
+  LODFORGE_TRY(file->commit());
+  Result<OutputFile> keys = OutputFile::create(out.keysPath, std::size_t{1} << 20);
+  if (!keys) return keys.status();
+  LODFORGE_TRY(keys->writeSpan(std::span<const float>(sortedKeys)));
+  return keys->commit();
+}
+
+Result<std::vector<float>> readKeys(const BlockTiles& block, std::uint64_t count) {
+  Result<ByteSource> in = ByteSource::openFile(block.keysPath);
+  if (!in) return in.status();
+  std::vector<float> keys(count);
+  if (!in->read(keys.data(), keys.size() * sizeof(float)))
+    return ioError(block.keysPath, "work file is shorter than expected");
+  return keys;
+}
+
+// The least τ of the block's tree whose cut holds at most `budget` points: the (budget + 1)-th
+// key (toleranceForResident over the tree, from the keys alone).
+float toleranceForBudget(std::span<const float> keys, const BlockTiles& block, std::size_t budget) {
+  if (budget >= keys.size()) return block.leastError;
+  return std::min(keys[budget], block.rootError);
+}
+
 // τ_d per depth of the partition tree: a tile at depth d should hold about `tilePoints`, so the
 // cut at τ_d keeps 2^d · tilePoints of the N points (the median over up to 8 sample blocks),
 // and τ never grows with depth.
-std::vector<float> toleranceSchedule(const Partition& partition, const PointTilesOptions& options,
-                                     int maxDepth) {
+Result<std::vector<float>> toleranceSchedule(const Partition& partition,
+                                             std::span<const BlockTiles> blocks,
+                                             const PointTilesOptions& options, int maxDepth) {
   std::vector<float> taus(static_cast<std::size_t>(maxDepth), 0);
   if (maxDepth == 0) return taus;
   const std::size_t samples = std::min<std::size_t>(8, partition.blocks.size());
   std::vector<std::vector<float>> perSample(samples);
-  tbb::parallel_for(std::size_t{0}, samples, [&](std::size_t s) {
-    const PointBlock& block = partition.blocks[s * partition.blocks.size() / samples];
-    Result<std::vector<CloudPoint>> points = readPointRecords(block.path, 0, block.count);
-    if (!points) return;  // the block pass reports it
-    const std::vector<ClusterNode> tree = tileErrorTree(
-        clusterBlock(*points, block.centroid, partition.info.hasNormals, options.cluster));
-    std::vector<std::size_t> budgets;
+  for (std::size_t s = 0; s < samples; ++s) {
+    const std::size_t b = s * partition.blocks.size() / samples;
+    const std::uint64_t count = partition.blocks[b].count;
+    Result<std::vector<float>> keys = readKeys(blocks[b], count);
+    if (!keys) return keys.status();
     for (int d = 0; d < maxDepth; ++d) {
       const double share = std::min(1.0, std::ldexp(static_cast<double>(options.tilePoints), d) /
                                              static_cast<double>(partition.pointCount));
-      budgets.push_back(
-          static_cast<std::size_t>(std::max(1.0, share * static_cast<double>(block.count))));
+      const auto budget =
+          static_cast<std::size_t>(std::max(1.0, share * static_cast<double>(count)));
+      perSample[s].push_back(toleranceForBudget(*keys, blocks[b], budget));
     }
-    perSample[s] = tolerancesForResident(tree, budgets);
-  });
+  }
   for (int d = 0; d < maxDepth; ++d) {
     std::vector<float> values;
-    for (const auto& v : perSample)
-      if (static_cast<int>(v.size()) > d) values.push_back(v[static_cast<std::size_t>(d)]);
-    if (values.empty()) continue;
+    for (const auto& v : perSample) values.push_back(v[static_cast<std::size_t>(d)]);
     std::nth_element(values.begin(),
                      values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
     taus[static_cast<std::size_t>(d)] = values[values.size() / 2];
@@ -77,59 +146,30 @@ std::vector<float> toleranceSchedule(const Partition& partition, const PointTile
   return taus;
 }
 
-// One block: its points sorted by the depth of the tile that holds them (0 = the root), with
-// the count per depth.
-struct BlockTiles {
-  std::string path;
-  std::vector<std::uint64_t> counts;  // per depth 0..depthOf(block)
-  Aabbd bounds;
-  float rootError = 0;
-};
-
-Status levelBlock(const PointBlock& block, const Partition& partition,
-                  const PointTilesOptions& options, std::span<const float> taus,
-                  const std::string& path, BlockTiles& out) {
-  Result<std::vector<CloudPoint>> loaded = readPointRecords(block.path, 0, block.count);
-  if (!loaded) return loaded.status();
-  std::vector<CloudPoint>& points = *loaded;
-  std::vector<std::uint32_t> firstPoint;
-  const std::vector<ClusterNode> tree = tileErrorTree(clusterBlock(
-      points, block.centroid, partition.info.hasNormals, options.cluster, &firstPoint));
-  const std::vector<std::uint32_t> reps =
-      clusterRepresentatives(tree, points, firstPoint, block.centroid);
-  const int depth = depthOf(block);
-  // The shallowest depth whose cut holds each point's node as a representative.
-  std::vector<std::uint8_t> level(points.size(), static_cast<std::uint8_t>(depth));
-  for (int d = depth - 1; d >= 0; --d) {
-    std::vector<std::uint32_t> stack{0};
-    while (!stack.empty()) {
-      const std::uint32_t t = stack.back();
-      stack.pop_back();
-      if (tree[t].error <= taus[static_cast<std::size_t>(d)] || tree[t].leaf()) {
-        level[reps[t]] = static_cast<std::uint8_t>(d);
-      } else {
-        stack.push_back(tree[t].firstChild);
-        stack.push_back(tree[t].firstChild + 1);
-      }
+// Each block's points per depth, now that the τ are known: the shallowest depth whose τ is
+// below a point's key holds it, the block's own tile the rest.
+Status countLevels(const Partition& partition, std::span<const float> taus,
+                   std::span<BlockTiles> blocks) {
+  std::vector<Status> failures(blocks.size());
+  tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
+    const int depth = depthOf(partition.blocks[b]);
+    Result<std::vector<float>> keys = readKeys(blocks[b], partition.blocks[b].count);
+    if (!keys) {
+      failures[b] = keys.status();
+      return;
     }
-  }
-  std::vector<std::uint32_t> order(points.size());
-  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::uint32_t a, std::uint32_t b) { return level[a] < level[b]; });
-  std::vector<CloudPoint> sorted(points.size());
-  out.counts.assign(static_cast<std::size_t>(depth) + 1, 0);
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    sorted[i] = points[order[i]];
-    ++out.counts[level[order[i]]];
-    out.bounds.add(sorted[i].position);
-  }
-  out.path = path;
-  out.rootError = tree.front().error;
-  Result<OutputFile> file = OutputFile::create(path, std::size_t{1} << 20);
-  if (!file) return file.status();
-  LODFORGE_TRY(file->writeSpan(std::span<const CloudPoint>(sorted)));
-  return file->commit();
+    std::vector<std::uint64_t>& counts = blocks[b].counts;
+    counts.assign(static_cast<std::size_t>(depth) + 1, 0);
+    std::size_t d = 0;
+    for (const float key : *keys) {
+      while (d < static_cast<std::size_t>(depth) && !(taus[d] < key)) ++d;
+      ++counts[d];
+    }
+    std::error_code ignored;
+    fs::remove(blocks[b].keysPath, ignored);
+  });
+  for (const Status& f : failures) LODFORGE_TRY(f);
+  return Status{};
 }
 
 struct TileNode {
@@ -226,9 +266,10 @@ namespace {
 // first point; the partition applies it while the input is read (one thread).
 Result<std::optional<CrsToLocal>> localFrame(const std::string& input,
                                              const PointTilesOptions& options,
-                                             PointTilesStats& stats) {
+                                             PointTilesStats& stats, bool& hasNormals) {
   Result<PointReader> probe = PointReader::open(input, 1, options.salvageTruncated);
   if (!probe) return probe.status();
+  hasNormals = probe->info().hasNormals;
   stats.crs = !options.crs.empty() || options.origin ? options.crs : probe->info().crs;
   if (stats.crs.empty()) return std::optional<CrsToLocal>();
   PointBatch first;
@@ -238,33 +279,6 @@ Result<std::optional<CrsToLocal>> localFrame(const std::string& input,
   Result<CrsToLocal> created = CrsToLocal::create(stats.crs, first.positions.front());
   if (!created) return created.status();
   return std::optional<CrsToLocal>(std::move(*created));
-}
-
-// Every block's points sorted by the tile that holds them, as many blocks at once as the memory
-// plan allows.
-Result<std::vector<BlockTiles>> levelBlocks(const Partition& partition,
-                                            const PointTilesOptions& options,
-                                            const std::vector<float>& taus,
-                                            const std::string& workDirectory, int threads) {
-  std::vector<BlockTiles> blocks(partition.blocks.size());
-  std::vector<Status> failures(blocks.size());
-  Progress progress("tiles: blocks", partition.pointCount);
-  tbb::task_arena arena(threads);
-  arena.execute([&] {
-    tbb::parallel_for(std::size_t{0}, blocks.size(), [&](std::size_t b) {
-      if (cancelRequested()) return;
-      const PointBlock& block = partition.blocks[b];
-      failures[b] = levelBlock(block, partition, options, taus,
-                               workDirectory + "/" + block.name + ".tiles", blocks[b]);
-      std::error_code ignored;
-      fs::remove(block.path, ignored);
-      progress.advance(block.count);
-    });
-  });
-  for (const Status& f : failures) LODFORGE_TRY(f);
-  LODFORGE_TRY(checkCancelled());
-  progress.finish();
-  return blocks;
 }
 
 // The tile tree: every prefix of a block's name is a tile; those with points get a content URI.
@@ -364,7 +378,8 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   fs::create_directories(fs::path(staging.path) / "tiles", error);
   if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
 
-  Result<std::optional<CrsToLocal>> frame = localFrame(input, options, stats);
+  bool hasNormals = false;
+  Result<std::optional<CrsToLocal>> frame = localFrame(input, options, stats, hasNormals);
   if (!frame) return frame.status();
   PartitionOptions partitionOptions;
   partitionOptions.blockSize = options.blockSize;
@@ -375,20 +390,37 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
     partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) {
       return (*frame)->apply(in, out);
     };
-  Result<Partition> partition = partitionPoints(input, partitionOptions);
+  // Blocks are ranked as the partition makes them, while their points are in memory (no block
+  // files written and read back), as many at once as the memory plan allows.
+  std::mutex ranked;
+  std::map<std::string, BlockTiles> byName;
+  partitionOptions.blockSink = [&](std::span<CloudPoint> points, PointBlock& block) {
+    BlockTiles tiles;
+    LODFORGE_TRY(rankBlock(points, block, hasNormals, options, work.path, tiles));
+    block.path = tiles.path;
+    std::lock_guard lock(ranked);
+    byName[block.name] = std::move(tiles);
+    return Status{};
+  };
+  tbb::task_arena arena(plan->threads);
+  Result<Partition> partition =
+      arena.execute([&] { return partitionPoints(input, partitionOptions); });
   if (!partition) return partition.status();
   stats.points = partition->pointCount;
   stats.attributes = partition->info.attributes & options.attributes;
   stats.blocks = partition->blocks.size();
-  for (const PointBlock& b : partition->blocks) stats.depth = std::max(stats.depth, depthOf(b));
-  const std::vector<float> taus = toleranceSchedule(*partition, options, stats.depth);
+  std::vector<BlockTiles> blocks;
+  for (const PointBlock& b : partition->blocks) {
+    stats.depth = std::max(stats.depth, depthOf(b));
+    blocks.push_back(std::move(byName.at(b.name)));
+  }
+  Result<std::vector<float>> taus = toleranceSchedule(*partition, blocks, options, stats.depth);
+  if (!taus) return taus.status();
+  LODFORGE_TRY(countLevels(*partition, *taus, blocks));
 
-  Result<std::vector<BlockTiles>> blocks =
-      levelBlocks(*partition, options, taus, work.path, plan->threads);
-  if (!blocks) return blocks.status();
-  std::map<std::string, TileNode> nodes = tileTree(*partition, *blocks);
+  std::map<std::string, TileNode> nodes = tileTree(*partition, blocks);
   Result<std::uint64_t> tiles = writeContents(
-      nodes, *blocks, options,
+      nodes, blocks, options,
       {partition->info.hasColors, partition->info.attributes & options.attributes}, staging.path);
   if (!tiles) return tiles.status();
   stats.tiles = *tiles;
@@ -399,7 +431,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
     rootTransform = eastNorthUpToEcef(*options.origin);
   }
   LODFORGE_TRY(
-      writePointTilesetJson(nodes, *blocks, taus, rootTransform, staging.path + "/tileset.json"));
+      writePointTilesetJson(nodes, blocks, *taus, rootTransform, staging.path + "/tileset.json"));
   stats.outputBytes = directoryBytes(staging.path);
 
   // Complete: replace the previous tileset, if any, by the new one.

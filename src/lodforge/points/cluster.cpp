@@ -123,26 +123,29 @@ std::vector<float> halfSpacing(std::span<const CloudPoint> points,
   std::vector<float> spacing(points.size(), 0);
   if (points.size() < 2) return spacing;
   // The tree packed for the search, depth first (a subtree's nodes close together; the tree's
-  // own breadth-first order scatters them, and the search waited on memory): a split's axis,
-  // value and first child (children stay adjacent), or a leaf's point.
+  // own breadth-first order scatters them, and the search waited on memory), with subtrees of
+  // at most kBucket points as buckets searched by brute force (fewer unpredictable branches):
+  // a split's axis, value and first child (children stay adjacent), or a bucket's points.
+  constexpr std::uint32_t kBucket = 16;
   struct KdNode {
     double value;
-    std::uint32_t next;  // first child, or the leaf's point
-    std::int32_t axis;   // −1 for a leaf
+    std::uint32_t next;   // first child, or the bucket's first point
+    std::uint32_t count;  // 0 for a split, else the bucket's points
+    int axis;
   };
   std::vector<KdNode> kd(nodes.size());
-  std::vector<std::uint32_t> parent(nodes.size(), 0), leafOf(points.size(), 0);
+  std::vector<std::uint32_t> parent(nodes.size(), 0), bucketOf(points.size(), 0);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> order{{0, 0}};  // tree node, packed index
   std::uint32_t placed = 1;
   while (!order.empty()) {
     const auto [i, at] = order.back();
     order.pop_back();
-    if (nodes[i].leaf()) {
-      kd[at] = {0, ranges[i].begin, -1};
-      leafOf[ranges[i].begin] = at;
+    if (nodes[i].leaf() || ranges[i].size() <= kBucket) {
+      kd[at] = {0, ranges[i].begin, ranges[i].size(), 0};
+      for (std::uint32_t j = ranges[i].begin; j < ranges[i].end; ++j) bucketOf[j] = at;
       continue;
     }
-    kd[at] = {separators[i].value, placed, separators[i].axis};
+    kd[at] = {separators[i].value, placed, 0, separators[i].axis};
     parent[placed] = parent[placed + 1] = at;
     order.emplace_back(nodes[i].firstChild + 1, placed + 1);
     order.emplace_back(nodes[i].firstChild, placed);
@@ -157,7 +160,14 @@ std::vector<float> halfSpacing(std::span<const CloudPoint> points,
         for (std::uint32_t j = range.begin(); j < range.end(); ++j) {
           const Vec3d p = positions[j];
           double best = std::numeric_limits<double>::infinity();
-          for (std::uint32_t node = leafOf[j]; node != 0; node = parent[node]) {
+          const auto bucket = [&](const KdNode& n) {
+            for (std::uint32_t q = n.next; q < n.next + n.count; ++q) {
+              const Vec3d d = positions[q] - p;
+              if (q != j) best = std::min(best, dot(d, d));
+            }
+          };
+          bucket(kd[bucketOf[j]]);
+          for (std::uint32_t node = bucketOf[j]; node != 0; node = parent[node]) {
             const KdNode& up = kd[parent[node]];
             const double gap = p[up.axis] - up.value;
             if (gap * gap >= best) continue;
@@ -167,9 +177,8 @@ std::vector<float> halfSpacing(std::span<const CloudPoint> points,
               stack.pop_back();
               if (least >= best) continue;
               const KdNode& n = kd[t];
-              if (n.axis < 0) {
-                const Vec3d d = positions[n.next] - p;
-                best = std::min(best, dot(d, d));
+              if (n.count > 0) {
+                bucket(n);
                 continue;
               }
               const double side = p[n.axis] - n.value;

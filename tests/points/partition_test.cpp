@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "lodforge/core/file.h"
@@ -34,6 +35,7 @@ std::vector<Vec3d> writeCloud(const std::string& path, std::size_t n, std::uint6
 std::vector<CloudPoint> readBlock(const PointBlock& block) {
   std::vector<CloudPoint> points(block.count);
   std::ifstream in(block.path, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(block.first * sizeof(CloudPoint)));
   in.read(reinterpret_cast<char*>(points.data()),
           static_cast<std::streamsize>(points.size() * sizeof(CloudPoint)));
   EXPECT_TRUE(in.good());
@@ -82,41 +84,93 @@ TEST(Partition, EveryPointLandsInExactlyOneBlockOfAtMostTheBlockSize) {
   }
 }
 
-TEST(Partition, StreamedSplitsGiveTheSameBlocksAsSplitsInMemory) {
-  test::TempDir dir;
-  writeCloud(dir.file("cloud.xyz"), 12'000, 5);
-  std::vector<std::vector<CloudPoint>> results[2];
-  for (int streamed = 0; streamed < 2; ++streamed) {
-    const std::string work = dir.file("work" + std::to_string(streamed));
-    std::filesystem::create_directories(work);
-    PartitionOptions options;
-    options.blockSize = 700;
-    options.workDirectory = work;
-    // 2,000 points in memory at most: the top levels split by streaming their files.
-    if (streamed) options.memoryBytes = 2'000 * sizeof(CloudPoint);
-    Result<Partition> partition = partitionPoints(dir.file("cloud.xyz"), options);
-    ASSERT_TRUE(partition.ok()) << partition.error().message;
-    EXPECT_EQ(partition->streamedPasses > 0, streamed == 1);
-    for (const PointBlock& b : partition->blocks) {
-      std::vector<CloudPoint> points = readBlock(b);
-      std::sort(points.begin(), points.end(), [](const CloudPoint& a, const CloudPoint& c) {
-        return std::tie(a.position.x, a.position.y, a.position.z) <
-               std::tie(c.position.x, c.position.y, c.position.z);
-      });
-      results[streamed].push_back(std::move(points));
-    }
+// The blocks of a cloud, each sorted by position, with `inMemory` points split in memory at
+// most (0: all of them).
+std::vector<std::vector<CloudPoint>> sortedBlocks(const std::string& input, const std::string& work,
+                                                  std::uint64_t blockSize, std::uint64_t inMemory,
+                                                  int& streamedPasses) {
+  std::filesystem::create_directories(work);
+  PartitionOptions options;
+  options.blockSize = blockSize;
+  options.workDirectory = work;
+  if (inMemory > 0) options.memoryBytes = inMemory * sizeof(CloudPoint);
+  Result<Partition> partition = partitionPoints(input, options);
+  EXPECT_TRUE(partition.ok()) << partition.error().message;
+  if (!partition) return {};
+  streamedPasses = partition->streamedPasses;
+  std::vector<std::vector<CloudPoint>> blocks;
+  for (const PointBlock& b : partition->blocks) {
+    std::vector<CloudPoint> points = readBlock(b);
+    std::sort(points.begin(), points.end(), [](const CloudPoint& a, const CloudPoint& c) {
+      return std::tie(a.position.x, a.position.y, a.position.z) <
+             std::tie(c.position.x, c.position.y, c.position.z);
+    });
+    blocks.push_back(std::move(points));
   }
-  ASSERT_EQ(results[0].size(), results[1].size());
-  for (std::size_t b = 0; b < results[0].size(); ++b) {
-    ASSERT_EQ(results[0][b].size(), results[1][b].size()) << "block " << b;
-    for (std::size_t i = 0; i < results[0][b].size(); ++i)
-      EXPECT_EQ(results[0][b][i].position, results[1][b][i].position);
+  return blocks;
+}
+
+void expectSameBlocks(const std::vector<std::vector<CloudPoint>>& a,
+                      const std::vector<std::vector<CloudPoint>>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    ASSERT_EQ(a[k].size(), b[k].size()) << "block " << k;
+    for (std::size_t i = 0; i < a[k].size(); ++i) EXPECT_EQ(a[k][i].position, b[k][i].position);
   }
 }
 
-// A block sink receives, from several threads, exactly the blocks the files would hold (in
-// name order afterwards), and a failing sink fails the partition.
-TEST(Partition, ASinkTakesTheBlocksInsteadOfFiles) {
+TEST(Partition, StreamedSplitsGiveTheSameBlocksAsSplitsInMemory) {
+  test::TempDir dir;
+  writeCloud(dir.file("cloud.xyz"), 12'000, 5);
+  int passes[2] = {0, 0};
+  const auto inMemory = sortedBlocks(dir.file("cloud.xyz"), dir.file("work0"), 700, 0, passes[0]);
+  // 2,000 points in memory at most: the top levels split by streaming their ranges.
+  const auto streamed =
+      sortedBlocks(dir.file("cloud.xyz"), dir.file("work1"), 700, 2'000, passes[1]);
+  EXPECT_EQ(passes[0], 0);
+  EXPECT_GT(passes[1], 0);
+  expectSameBlocks(inMemory, streamed);
+}
+
+// Streamed splits rewrite a node's range in place from both ends, a chunk (16,384 points) at a
+// time: inputs many chunks long whose points lie all above the first plane first, all below
+// first, or alternate by runs still give the blocks of an in-memory split.
+TEST(Partition, InPlaceSplitsHandleAnyOrderOfTheFile) {
+  test::TempDir dir;
+  Random random(9);
+  std::vector<Vec3d> points(90'000);
+  for (Vec3d& p : points)
+    p = {random.uniform(0, 400), random.uniform(0, 100), random.uniform(0, 1)};
+  for (int order = 0; order < 3; ++order) {
+    SCOPED_TRACE(order);
+    if (order == 0)
+      std::sort(points.begin(), points.end(), [](auto& a, auto& b) { return a.x > b.x; });
+    if (order == 1)
+      std::sort(points.begin(), points.end(), [](auto& a, auto& b) { return a.x < b.x; });
+    if (order == 2)  // runs of 20,000 alternating sides
+      std::sort(points.begin(), points.end(), [](auto& a, auto& b) {
+        return std::tuple(int(a.x) % 2, a.x) < std::tuple(int(b.x) % 2, b.x);
+      });
+    const std::string input = dir.file(fmt::format("cloud{}.xyz", order));
+    {
+      std::ofstream out(input);
+      out.precision(17);
+      for (const Vec3d& p : points) out << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    }
+    int passes[2] = {0, 0};
+    const auto inMemory =
+        sortedBlocks(input, dir.file(fmt::format("m{}", order)), 5'000, 0, passes[0]);
+    const auto streamed =
+        sortedBlocks(input, dir.file(fmt::format("s{}", order)), 5'000, 10'000, passes[1]);
+    EXPECT_GE(passes[1], 3);
+    expectSameBlocks(inMemory, streamed);
+  }
+}
+
+// A block sink receives, from several threads, exactly the blocks the partition holds (in
+// name order afterwards); what it leaves in the points is written back; a failing sink fails
+// the partition.
+TEST(Partition, ASinkSeesEveryBlockAndItsOrderIsWrittenBack) {
   test::TempDir dir;
   writeCloud(dir.file("cloud.xyz"), 12'000, 7);
   PartitionOptions options;
@@ -128,6 +182,7 @@ TEST(Partition, ASinkTakesTheBlocksInsteadOfFiles) {
   ASSERT_TRUE(files.ok()) << files.error().message;
   std::mutex mutex;
   std::map<std::string, Multiset> sunk;
+  std::map<std::string, Vec3d> lastOf;
   options.workDirectory = dir.file("sink");
   std::filesystem::create_directories(options.workDirectory);
   options.blockSink = [&](std::span<CloudPoint> points, PointBlock& block) {
@@ -137,6 +192,7 @@ TEST(Partition, ASinkTakesTheBlocksInsteadOfFiles) {
     std::lock_guard lock(mutex);
     EXPECT_EQ(block.count, points.size());
     sunk[block.name] = std::move(content);
+    lastOf[block.name] = points.back().position;
     return Status{};
   };
   Result<Partition> sinks = partitionPoints(dir.file("cloud.xyz"), options);
@@ -149,8 +205,8 @@ TEST(Partition, ASinkTakesTheBlocksInsteadOfFiles) {
     Multiset want;
     for (const CloudPoint& p : readBlock(file)) ++want[{p.position.x, p.position.y, p.position.z}];
     EXPECT_EQ(sunk.at(sink.name), want) << sink.name;
+    EXPECT_EQ(readBlock(sink).back().position, lastOf.at(sink.name)) << sink.name;
   }
-  EXPECT_TRUE(std::filesystem::is_empty(options.workDirectory));  // no block files
   options.blockSink = [](std::span<CloudPoint>, PointBlock& block) -> Status {
     return ioError(block.name, "disk full");
   };

@@ -252,6 +252,57 @@ Status OutputFile::write(const void* data, std::size_t size) {
   return {};
 }
 
+Result<WorkFile> WorkFile::open(const std::string& path) {
+  WorkFile file;
+  file.path_ = path;
+  file.fd_ = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+  if (file.fd_ < 0) return ioErrorFromErrno(path, "open");
+  return file;
+}
+
+WorkFile::WorkFile(WorkFile&& other) noexcept
+    : path_(std::move(other.path_)), fd_(std::exchange(other.fd_, -1)) {}
+
+WorkFile& WorkFile::operator=(WorkFile&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    path_ = std::move(other.path_);
+    fd_ = std::exchange(other.fd_, -1);
+  }
+  return *this;
+}
+
+WorkFile::~WorkFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+Status WorkFile::readAt(std::uint64_t offset, void* data, std::size_t size) const {
+  auto* bytes = static_cast<std::byte*>(data);
+  while (size > 0) {
+    const ssize_t got = ::pread(fd_, bytes, size, static_cast<off_t>(offset));
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) return ioErrorFromErrno(path_, "read");
+    if (got == 0) return ioError(path_, fmt::format("work file ends before byte {}", offset));
+    bytes += got;
+    size -= static_cast<std::size_t>(got);
+    offset += static_cast<std::uint64_t>(got);
+  }
+  return {};
+}
+
+Status WorkFile::writeAt(std::uint64_t offset, const void* data, std::size_t size) const {
+  const auto* bytes = static_cast<const std::byte*>(data);
+  while (size > 0) {
+    const ssize_t put = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));
+    if (put < 0 && errno == EINTR) continue;
+    if (put < 0) return ioErrorFromErrno(path_, "write");
+    bytes += put;
+    size -= static_cast<std::size_t>(put);
+    offset += static_cast<std::uint64_t>(put);
+  }
+  return {};
+}
+
 Status OutputFile::writeAt(std::uint64_t offset, const void* data, std::size_t size) {
   assert(fd_ >= 0);
   const auto* bytes = static_cast<const std::byte*>(data);

@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 namespace {
 
 Result<std::vector<CloudPoint>> loadBlock(const PointBlock& block) {
-  return readPointRecords(block.path, 0, block.count);
+  return readPointRecords(block.path, block.first, block.count);
 }
 
 // The automatic tolerance: the median over sample blocks of the one that keeps `share` of a
@@ -157,8 +157,6 @@ Result<BuiltBlocks> buildBlocks(const Partition& partition, const PointsBuildOpt
       stats.residentNodes += cut.resident.size();
       stats.segmentNodes += cut.segment.size();
       stats.droppedNodes += cut.dropped;
-      std::error_code ignored;
-      fs::remove(block.path, ignored);
       progress.advance(block.count);
     });
   });

@@ -1,7 +1,4 @@
 #include "lodforge/points/cluster.h"
-#include <atomic>
-#include <chrono>
-#include <cstdio>
 
 #include <algorithm>
 #include <cmath>
@@ -259,29 +256,13 @@ std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin
   if (points.empty()) return nodes;
   std::vector<Range> ranges;
   std::vector<Separator> separators;
-  auto t0 = std::chrono::steady_clock::now();
-  auto lap = [&](int k) {
-    static std::atomic<long> acc[6];
-    auto t = std::chrono::steady_clock::now();
-    acc[k] += std::chrono::duration_cast<std::chrono::microseconds>(t - t0).count();
-    t0 = t;
-    if (k == 5 && points.size() > 1000)
-      fprintf(stderr, "%ld %ld %ld %ld %ld %ld\n", acc[0].load(), acc[1].load(), acc[2].load(),
-              acc[3].load(), acc[4].load(), acc[5].load());
-  };
   splitTree(points, origin, nodes, ranges, separators);
-  lap(0);
   if (!hasNormals)
     cellNormals(points, nodes, ranges, static_cast<std::uint32_t>(std::max(3, options.neighbours)));
-  lap(1);
   const std::vector<float> spacing = halfSpacing(points, nodes, ranges, separators);
-  lap(2);
   nodeNormals(points, nodes, ranges);
-  lap(3);
   nodeRadii(nodes, ranges, spacing);
-  lap(4);
   nodeErrors(points, origin, nodes, ranges, options);
-  lap(5);
   if (firstPoint) {
     firstPoint->resize(nodes.size());
     for (std::size_t i = 0; i < nodes.size(); ++i) (*firstPoint)[i] = ranges[i].begin;

@@ -1,8 +1,8 @@
 // Block partition of a point cloud (points paper §4.1, "Data partition"): split at the centroid
 // along the longest axis until every block holds at most `blockSize` points. Out-of-core: the
 // input is streamed once into a work file, nodes larger than the memory allowance are split by
-// streamed passes (each writes two files), smaller ones are split in memory; every block ends as
-// a file of CloudPoint records in the work directory.
+// streamed passes over their range of it (in place), smaller ones are split in memory; every
+// block ends as a contiguous range of CloudPoint records in that file.
 #pragma once
 
 #include <cstdint>
@@ -30,7 +30,8 @@ static_assert(sizeof(CloudPoint) == 64);
 
 struct PointBlock {
   std::string name;  // its path in the split tree: "b", then "0" (lower side) or "1" per split
-  std::string path;  // CloudPoint records (set by the sink, if any)
+  std::string path;  // the work file that holds its CloudPoint records, from `first` on
+  std::uint64_t first = 0;
   std::uint64_t count = 0;
   Aabbd bounds;
   Vec3d centroid;
@@ -46,12 +47,10 @@ struct PartitionOptions {
   // Applied to every point as it is read (one thread): e.g. a CRS to a local frame. False
   // refuses the point.
   std::function<bool(Vec3d, Vec3d&)> transform;
-  // Where finished blocks go: by default each is written to `<name>.block` in the work
-  // directory (PointBlock::path); a sink takes the block's points instead (it may reorder
-  // them), called from several threads at once while the points are in memory.
+  // Called with each finished block's points while they are in memory, from several threads
+  // at once; it may reorder them, and they are written back to the work file as it left them.
   std::function<Status(std::span<CloudPoint>, PointBlock&)> blockSink;
 };
-
 
 struct Partition {
   PointCloudInfo info;

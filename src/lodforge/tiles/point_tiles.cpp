@@ -45,13 +45,16 @@ std::vector<ClusterNode> tileErrorTree(std::vector<ClusterNode> tree) {
 // exactly when τ < key, so a tile at depth d (tolerance τ_d, non-increasing with d) holds a
 // prefix of the sorted block whatever the τ turn out to be.
 struct BlockTiles {
-  std::string path, keysPath;
+  std::string path, keysPath;  // the partition's work file (from `first` on), the keys
+  std::uint64_t first = 0;
   std::vector<std::uint64_t> counts;  // per depth 0..depthOf(block), once the τ are known
   Aabbd bounds;
   float rootError = 0;
   float leastError = 0;  // the least tile error in the block's tree
 };
 
+// Sorts the block's points by key (the partition writes them back in that order) and writes
+// the keys beside.
 Status rankBlock(std::span<CloudPoint> points, const PointBlock& block, bool hasNormals,
                  const PointTilesOptions& options, const std::string& workDirectory,
                  BlockTiles& out) {
@@ -74,20 +77,17 @@ Status rankBlock(std::span<CloudPoint> points, const PointBlock& block, bool has
   for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return key[a] > key[b]; });
-  std::vector<CloudPoint> sorted(points.size());
+  const std::vector<CloudPoint> unsorted(points.begin(), points.end());
   std::vector<float> sortedKeys(points.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
-    sorted[i] = points[order[i]];
+    points[i] = unsorted[order[i]];
     sortedKeys[i] = key[order[i]];
   }
-  out.path = workDirectory + "/" + block.name + ".tiles";
+  out.path = block.path;
+  out.first = block.first;
   out.keysPath = workDirectory + "/" + block.name + ".keys";
   out.bounds = block.bounds;
   out.rootError = tree.front().error;
-  Result<OutputFile> file = OutputFile::create(out.path, std::size_t{1} << 20);
-  if (!file) return file.status();
-  LODFORGE_TRY(file->writeSpan(std::span<const CloudPoint>(sorted)));
-  LODFORGE_TRY(file->commit());
   Result<OutputFile> keys = OutputFile::create(out.keysPath, std::size_t{1} << 20);
   if (!keys) return keys.status();
   LODFORGE_TRY(keys->writeSpan(std::span<const float>(sortedKeys)));
@@ -197,7 +197,7 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
   for (std::size_t b : node.blocks) {
     const BlockTiles& block = blocks[b];
     const auto d = static_cast<std::size_t>(node.depth);
-    std::uint64_t first = 0;
+    std::uint64_t first = block.first;
     for (std::size_t k = 0; k < d; ++k) first += block.counts[k];
     Result<std::vector<CloudPoint>> section = readPointRecords(block.path, first, block.counts[d]);
     if (!section) return section.status();
@@ -397,7 +397,6 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   partitionOptions.blockSink = [&](std::span<CloudPoint> points, PointBlock& block) {
     BlockTiles tiles;
     LODFORGE_TRY(rankBlock(points, block, hasNormals, options, work.path, tiles));
-    block.path = tiles.path;
     std::lock_guard lock(ranked);
     byName[block.name] = std::move(tiles);
     return Status{};

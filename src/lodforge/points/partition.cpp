@@ -1,6 +1,7 @@
 #include "lodforge/points/partition.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <mutex>
@@ -56,15 +57,24 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
   if (!out) return out.status();
   Progress progress("points: reading", info.count.value_or(0));
   PointBatch batch;
-  std::vector<CloudPoint> records;
+  // Each batch is written (a kernel copy into new pages, as costly as the parsing) while the
+  // next is converted: two buffers, one write in flight, awaited on every way out.
+  std::array<std::vector<CloudPoint>, 2> records;
+  Status written;
+  tbb::task_group writing;
+  struct Await {
+    tbb::task_group& group;
+    ~Await() { group.wait(); }
+  } await{writing};
   Stats stats;
-  while (true) {
+  for (std::size_t turn = 0;; turn ^= 1) {
     Result<bool> more = reader->next(batch);
     if (!more) return more.status();
     if (!*more) break;
-    records.resize(batch.size());
+    std::vector<CloudPoint>& mine = records[turn];
+    mine.resize(batch.size());
     for (std::size_t i = 0; i < batch.size(); ++i) {
-      CloudPoint& p = records[i];
+      CloudPoint& p = mine[i];
       p.position = batch.positions[i];
       if (!isFinite(p.position))
         return badInput(input, fmt::format("point {}: coordinate is not finite", batch.first + i));
@@ -78,10 +88,15 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
       p.attributes = batch.attributes.empty() ? PointAttributes{} : batch.attributes[i];
       stats.add(p);
     }
-    LODFORGE_TRY(out->writeSpan(std::span<const CloudPoint>(records)));
+    writing.wait();
+    LODFORGE_TRY(written);
+    writing.run(
+        [&out, &written, &mine] { written = out->writeSpan(std::span<const CloudPoint>(mine)); });
     progress.advance(batch.size());
     LODFORGE_TRY(checkCancelled());
   }
+  writing.wait();
+  LODFORGE_TRY(written);
   progress.finish();
   partition.truncation = reader->truncation();
   LODFORGE_TRY(out->commit());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <filesystem>
 #include <limits>
@@ -73,15 +74,18 @@ Status rankBlock(std::span<CloudPoint> points, const PointBlock& block, bool has
     for (std::uint32_t c = node.firstChild; c < node.firstChild + 2; ++c)
       if (reps[c] != parentRep) key[reps[c]] = node.error;
   }
-  std::vector<std::uint32_t> order(points.size());
-  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::uint32_t a, std::uint32_t b) { return key[a] > key[b]; });
+  // Highest key first, ties in tree order: one 64-bit sort key per point (a non-negative
+  // float's bits order like the float; inverted for descending), far cheaper than a stable sort.
+  std::vector<std::uint64_t> order(points.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i)
+    order[i] = std::uint64_t{~std::bit_cast<std::uint32_t>(key[i])} << 32 | i;
+  std::sort(order.begin(), order.end());
   const std::vector<CloudPoint> unsorted(points.begin(), points.end());
   std::vector<float> sortedKeys(points.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
-    points[i] = unsorted[order[i]];
-    sortedKeys[i] = key[order[i]];
+    const auto from = static_cast<std::uint32_t>(order[i]);
+    points[i] = unsorted[from];
+    sortedKeys[i] = key[from];
   }
   out.path = block.path;
   out.first = block.first;

@@ -248,44 +248,59 @@ if [[ ${BENCH_ONLY:-} == laz ]]; then laz_section; exit 0; fi
 # Point tiles beside PotreeConverter 2 (issue 18), in one run on the same inputs: POTREE names
 # its binary (built outside the project from its public source); LAZ_COMPRESS a command
 # `LAZ_COMPRESS IN.las OUT.laz` that writes the same points as LAZ (lodforge writes no LAZ;
-# e.g. a LASzip-based compressor). POTREE_SIZES (default "1M 20M") picks the clouds.
-potree_row() {  # tool, input; prints wall, points/s, peak RSS and output size
+# e.g. a LASzip-based compressor). POTREE_SIZES (default "1M 20M") picks the clouds, kept in
+# the bench folder as cloud-N.las/.laz for the next run; POTREE_RUNS (default 3) runs of each
+# tool alternate and the median wall time is shown (this machine is shared and noisy).
+potree_once() {  # tool, input; prints "seconds peak-KiB output-size"
   local tool=$1 input=$2 log=$work/time.log out=$work/potree-out
   rm -rf "$out"
   local cmd
   if [[ $tool == lodforge ]]; then cmd=("$lodforge" -q tiles "$input" -o "$out"); else cmd=("$POTREE" "$input" -o "$out"); fi
-  /usr/bin/time -v "${cmd[@]}" > /dev/null 2> "$log" || { tail -20 "$log"; exit 1; }
-  local wall rss seconds points
+  /usr/bin/time -v "${cmd[@]}" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
+  local wall
   wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
-  rss=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")
-  seconds=$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")
-  points=$("$lodforge" info --header-only "$input" | awk '/^points / {print $2}' | tr -d ,)
-  printf '| %-5s | %-4s | %-16s | %8ss | %9.2f M/s | %8d MiB | %7s |\n' "$3" "${input##*.}" "$tool" "$seconds" \
-    "$(awk -v n="$points" -v s="$seconds" 'BEGIN { print n / s / 1e6 }')" $((rss / 1024)) "$(du -sh "$out" | cut -f1)"
+  echo "$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")" \
+    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")" "$(du -sh "$out" | cut -f1)"
   rm -rf "$out"
 }
 potree_section() {
   echo
-  echo "== point tiles beside PotreeConverter 2 (same input, one run; $(nproc) threads each)"
+  echo "== point tiles beside PotreeConverter 2 (same input, one run; $(nproc) threads each; median of ${POTREE_RUNS:-3} alternating runs)"
   if [[ -z ${POTREE:-} || ! -x ${POTREE:-} ]]; then
     echo "POTREE is not set to a PotreeConverter binary: nothing to compare against (skipped)"
     return
   fi
   [[ -n ${LAZ_COMPRESS:-} ]] || echo "LAZ_COMPRESS is not set: LAS rows only"
-  printf '| %-5s | %-4s | %-16s | %9s | %13s | %12s | %7s |\n' cloud file tool wall points/s "peak RSS" output
-  printf '|%s|%s|%s|%s|%s|%s|%s|\n' ------- ------ ------------------ ----------- --------------- -------------- ---------
+  printf '| %-5s | %-4s | %-9s | %9s | %11s | %10s | %7s | %s\n' cloud file tool wall points/s "peak RSS" output "runs (s)"
+  printf '|%s|%s|%s|%s|%s|%s|%s|%s\n' ------- ------ ----------- ----------- ------------- ------------ --------- ---------
   for n in ${POTREE_SIZES:-1M 20M}; do
-    "$lodforge" -q generate points --points "$n" -o "$work/cloud.las"
-    local files=("$work/cloud.las")
+    local las=$work/cloud-$n.las laz=$work/cloud-$n.laz
+    [[ -f $las ]] || "$lodforge" -q generate points --points "$n" -o "$las"
+    local files=("$las")
     if [[ -n ${LAZ_COMPRESS:-} ]]; then
-      $LAZ_COMPRESS "$work/cloud.las" "$work/cloud.laz" > /dev/null
-      files+=("$work/cloud.laz")
+      [[ -f $laz ]] || $LAZ_COMPRESS "$las" "$laz" > /dev/null
+      files+=("$laz")
     fi
+    local points
+    points=$("$lodforge" info --header-only "$las" | awk '/^points / {print $2}' | tr -d ,)
     for input in "${files[@]}"; do
-      potree_row lodforge "$input" "$n"
-      potree_row potree "$input" "$n"
+      declare -A runs=() rss=() size=()
+      for ((r = 0; r < ${POTREE_RUNS:-3}; ++r)); do
+        for tool in lodforge potree; do
+          read -r seconds kib out < <(potree_once "$tool" "$input")
+          runs[$tool]+="$seconds "
+          rss[$tool]=$(( ${rss[$tool]:-0} > kib ? ${rss[$tool]:-0} : kib ))
+          size[$tool]=$out
+        done
+      done
+      for tool in lodforge potree; do
+        local median
+        median=$(tr ' ' '\n' <<< "${runs[$tool]}" | grep . | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
+        printf '| %-5s | %-4s | %-9s | %8ss | %7.2f M/s | %6d MiB | %7s | %s\n' "$n" "${input##*.}" "$tool" "$median" \
+          "$(awk -v n="$points" -v s="$median" 'BEGIN { print n / s / 1e6 }')" $((rss[$tool] / 1024)) "${size[$tool]}" "${runs[$tool]}"
+      done
+      unset runs rss size
     done
-    rm -f "$work/cloud.las" "$work/cloud.laz"
   done
 }
 if [[ ${BENCH_ONLY:-} == potree ]]; then potree_section; exit 0; fi

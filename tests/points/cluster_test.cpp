@@ -123,6 +123,34 @@ TEST(Cluster, LeafRadiiAreHalfTheGapToTheNearestNeighbour) {
   }
 }
 
+// The same where the tree's separators come from median splits and points lie on them: a
+// lattice (many points share each coordinate) with 40 copies of one point and pairs one float
+// step apart.
+TEST(Cluster, LeafRadiiAreExactOnLatticesAndManyDuplicates) {
+  std::vector<CloudPoint> points;
+  const auto add = [&](Vec3d position) {
+    CloudPoint p;
+    p.position = position;
+    points.push_back(p);
+  };
+  for (int x = 0; x < 30; ++x)
+    for (int y = 0; y < 30; ++y) add({double(x), double(y), 0.0});
+  for (int k = 0; k < 40; ++k) add({7.0, 7.0, 0.0});
+  for (int k = 0; k < 5; ++k) add({std::nextafter(3.0 + k, 100.0), 20.0, 0.0});
+  std::vector<std::uint32_t> firstPoint;
+  const std::vector<ClusterNode> tree = clusterBlock(points, {}, false, {}, &firstPoint);
+  for (std::size_t i = 0; i < tree.size(); ++i) {
+    if (!tree[i].leaf()) continue;
+    const CloudPoint& p = points[firstPoint[i]];
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const CloudPoint& q : points)
+      if (&q != &p) nearest = std::min(nearest, length(q.position - p.position));
+    ASSERT_EQ(static_cast<double>(tree[i].radius),
+              static_cast<double>(static_cast<float>(nearest / 2)))
+        << p.position.x << " " << p.position.y;
+  }
+}
+
 TEST(Cluster, ErrorGrowsWithCurvatureAndNoise) {
   std::vector<CloudPoint> flat = tiltedPlane(2'000, 0, 4);
   std::vector<CloudPoint> noisy = tiltedPlane(2'000, 0.3, 4);

@@ -222,6 +222,51 @@ TEST(PointTiles, RepresentativesMakeCoarserCutsSubsetsOfFinerOnes) {
   EXPECT_EQ(coarser.size(), points.size());
 }
 
+// A point's key says at which tolerances it is a representative of the cut: for every error
+// value of the tree, the points with key > τ are exactly the cut's representatives, and the
+// (B + 1)-th largest key is the tolerance whose cut holds B points (what ranking blocks before
+// the tolerances are known relies on).
+TEST(PointTiles, KeysHoldExactlyTheCutsRepresentatives) {
+  Random random(8);
+  std::vector<CloudPoint> points(2'000);
+  for (CloudPoint& p : points) {
+    const double x = random.uniform(0, 10), y = random.uniform(0, 10);
+    p.position = {x, y, std::sin(x) + random.uniform(0, 0.05)};
+  }
+  points[7].position = points[9].position;  // a duplicate: a leaf of radius 0
+  std::vector<std::uint32_t> first;
+  std::vector<ClusterNode> tree = clusterBlock(points, {5, 5, 0}, false, {}, &first);
+  for (ClusterNode& n : tree) n.error = pointTileError(n);
+  const std::vector<std::uint32_t> reps = clusterRepresentatives(tree, points, first, {5, 5, 0});
+  const std::vector<float> keys = pointKeys(tree, reps);
+  ASSERT_EQ(keys.size(), points.size());
+  std::set<float> errors;
+  for (const ClusterNode& n : tree) errors.insert(n.error);
+  std::size_t checked = 0;
+  for (const float tau : errors) {
+    if (checked++ % 7 != 0 && tau != *errors.rbegin()) continue;  // every 7th, and the largest
+    std::set<std::uint32_t> cut, held;
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+      const std::uint32_t t = stack.back();
+      stack.pop_back();
+      if (tree[t].error <= tau || tree[t].leaf()) {
+        cut.insert(reps[t]);
+      } else {
+        stack.push_back(tree[t].firstChild);
+        stack.push_back(tree[t].firstChild + 1);
+      }
+    }
+    for (std::uint32_t p = 0; p < keys.size(); ++p)
+      if (tau < keys[p]) held.insert(p);
+    ASSERT_EQ(held, cut) << "tau " << tau;
+  }
+  std::vector<float> sorted = keys;
+  std::sort(sorted.begin(), sorted.end(), std::greater<>());
+  for (std::size_t budget : {1, 2, 10, 100, 777, 1'999})
+    EXPECT_EQ(sorted[budget], toleranceForResident(tree, budget)) << budget;
+}
+
 TEST(PointTiles, PlacesALasOnEarthFromItsCoordinateSystem) {
   test::TempDir dir;
   PointTilesOptions options;

@@ -37,7 +37,7 @@ struct ClusterOptions {
 // The clustering tree of one block, breadth-first with the root first; `points` is reordered.
 // Without `hasNormals`, each point's normal is estimated (and written into `points`) by PCA over
 // its cell: the smallest node of the tree with at least k points, turned to face +z (up, for
-// aerial and terrestrial scans). The cell also gives the nearest-neighbour spacing.
+// aerial and terrestrial scans).
 // Node error E = α1·mean|(p_i − c)·n| + α2·r·mean(1 − n_i·n): the paper's distance and normal
 // terms, the second scaled by the square's radius so that E is a length (see docs/points.md).
 // Leaves are single points whose radius is half the distance to their nearest neighbour.

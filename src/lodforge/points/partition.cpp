@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <mutex>
 #include <optional>
@@ -90,8 +91,13 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
     }
     writing.wait();
     LODFORGE_TRY(written);
-    writing.run(
-        [&out, &written, &mine] { written = out->writeSpan(std::span<const CloudPoint>(mine)); });
+    writing.run([&out, &written, &mine] {
+      try {  // nothing may escape into the waiting destructor
+        written = out->writeSpan(std::span<const CloudPoint>(mine));
+      } catch (const std::exception& e) {
+        written = ioError(out->path(), e.what());
+      }
+    });
     progress.advance(batch.size());
     LODFORGE_TRY(checkCancelled());
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cassert>
 #include <chrono>
 #include <filesystem>
 #include <limits>
@@ -64,16 +65,9 @@ Status rankBlock(std::span<CloudPoint> points, const PointBlock& block, bool has
       tileErrorTree(clusterBlock(points, block.centroid, hasNormals, options.cluster, &firstPoint));
   const std::vector<std::uint32_t> reps =
       clusterRepresentatives(tree, points, firstPoint, block.centroid);
-  std::vector<float> key(points.size());
-  key[reps[0]] = std::numeric_limits<float>::infinity();
+  const std::vector<float> key = pointKeys(tree, reps);
   out.leastError = tree.front().error;
-  for (const ClusterNode& node : tree) {
-    out.leastError = std::min(out.leastError, node.error);
-    if (node.leaf()) continue;
-    const std::uint32_t parentRep = reps[static_cast<std::size_t>(&node - tree.data())];
-    for (std::uint32_t c = node.firstChild; c < node.firstChild + 2; ++c)
-      if (reps[c] != parentRep) key[reps[c]] = node.error;
-  }
+  for (const ClusterNode& node : tree) out.leastError = std::min(out.leastError, node.error);
   // Highest key first, ties in tree order: one 64-bit sort key per point (a non-negative
   // float's bits order like the float; inverted for descending), far cheaper than a stable sort.
   std::vector<std::uint64_t> order(points.size());
@@ -262,6 +256,22 @@ std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> t
     reps[i] = length(points[a].position - c) <= length(points[b].position - c) ? a : b;
   }
   return reps;
+}
+
+std::vector<float> pointKeys(std::span<const ClusterNode> tree,
+                             std::span<const std::uint32_t> reps) {
+  std::vector<float> key(tree.empty() ? 0 : (tree.size() + 1) / 2);
+  if (tree.empty()) return key;
+  key[reps[0]] = std::numeric_limits<float>::infinity();
+  for (std::size_t t = 0; t < tree.size(); ++t) {
+    const ClusterNode& node = tree[t];
+    if (node.leaf()) continue;
+    // Tile errors are non-negative; + 0 turns a −0 into +0 so that the keys' bits sort.
+    assert(node.error >= 0);
+    for (std::uint32_t c = node.firstChild; c < node.firstChild + 2; ++c)
+      if (reps[c] != reps[t]) key[reps[c]] = node.error + 0.0f;
+  }
+  return key;
 }
 
 namespace {

@@ -54,6 +54,13 @@ std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> t
                                                   std::span<const std::uint32_t> firstPoint,
                                                   Vec3d origin);
 
+// Each point's key (indexed like `points`, from the tree's representatives `reps`): the tile
+// error of the parent of the highest node the point represents, +∞ for the root's. The cut of
+// the tree at τ holds the point exactly when τ < its key, whatever τ (so a block can be ranked
+// before the tolerances are known).
+std::vector<float> pointKeys(std::span<const ClusterNode> tree,
+                             std::span<const std::uint32_t> reps);
+
 // `lodforge tiles cloud.las`: the whole pipeline into `outputDirectory` (written under a
 // temporary name and renamed when complete).
 Result<PointTilesStats> writePointTiles(const std::string& input,

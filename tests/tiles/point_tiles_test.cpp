@@ -180,6 +180,26 @@ TEST(PointTiles, EveryPointIsInExactlyOneTileOfAnAddTree) {
         << entry.path();
 }
 
+// The representatives of the cut of `tree` at `tolerance` (nodes with error ≤ it, or leaves,
+// whose parents are above it).
+std::set<std::uint32_t> cutRepresentatives(const std::vector<ClusterNode>& tree,
+                                           const std::vector<std::uint32_t>& reps,
+                                           float tolerance) {
+  std::set<std::uint32_t> out;
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t t = stack.back();
+    stack.pop_back();
+    if (tree[t].error <= tolerance || tree[t].leaf()) {
+      out.insert(reps[t]);
+    } else {
+      stack.push_back(tree[t].firstChild);
+      stack.push_back(tree[t].firstChild + 1);
+    }
+  }
+  return out;
+}
+
 TEST(PointTiles, RepresentativesMakeCoarserCutsSubsetsOfFinerOnes) {
   Random random(6);
   std::vector<CloudPoint> points(3'000);
@@ -196,21 +216,7 @@ TEST(PointTiles, RepresentativesMakeCoarserCutsSubsetsOfFinerOnes) {
       EXPECT_TRUE(reps[i] == reps[tree[i].firstChild] || reps[i] == reps[tree[i].firstChild + 1]);
     }
   }
-  const auto repsOfCut = [&](float tolerance) {
-    std::set<std::uint32_t> out;
-    std::vector<std::uint32_t> stack{0};
-    while (!stack.empty()) {
-      const std::uint32_t t = stack.back();
-      stack.pop_back();
-      if (tree[t].error <= tolerance || tree[t].leaf()) {
-        out.insert(reps[t]);
-      } else {
-        stack.push_back(tree[t].firstChild);
-        stack.push_back(tree[t].firstChild + 1);
-      }
-    }
-    return out;
-  };
+  const auto repsOfCut = [&](float tolerance) { return cutRepresentatives(tree, reps, tolerance); };
   std::set<std::uint32_t> coarser = repsOfCut(1e9f);
   EXPECT_EQ(coarser.size(), 1u);
   for (float tolerance : {2.0f, 1.0f, 0.5f, 0.2f, 0.1f, 0.0f}) {
@@ -245,21 +251,10 @@ TEST(PointTiles, KeysHoldExactlyTheCutsRepresentatives) {
   std::size_t checked = 0;
   for (const float tau : errors) {
     if (checked++ % 7 != 0 && tau != *errors.rbegin()) continue;  // every 7th, and the largest
-    std::set<std::uint32_t> cut, held;
-    std::vector<std::uint32_t> stack{0};
-    while (!stack.empty()) {
-      const std::uint32_t t = stack.back();
-      stack.pop_back();
-      if (tree[t].error <= tau || tree[t].leaf()) {
-        cut.insert(reps[t]);
-      } else {
-        stack.push_back(tree[t].firstChild);
-        stack.push_back(tree[t].firstChild + 1);
-      }
-    }
+    std::set<std::uint32_t> held;
     for (std::uint32_t p = 0; p < keys.size(); ++p)
       if (tau < keys[p]) held.insert(p);
-    ASSERT_EQ(held, cut) << "tau " << tau;
+    ASSERT_EQ(held, cutRepresentatives(tree, reps, tau)) << "tau " << tau;
   }
   std::vector<float> sorted = keys;
   std::sort(sorted.begin(), sorted.end(), std::greater<>());

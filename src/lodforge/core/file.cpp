@@ -18,6 +18,21 @@ namespace lodforge {
 namespace {
 constexpr std::size_t kReadBuffer = 1 << 20;
 
+// pwrite until all `size` bytes are at `offset` (short writes and EINTR retried).
+Status writeAllAt(int fd, const std::string& path, std::uint64_t offset, const void* data,
+                  std::size_t size) {
+  const auto* bytes = static_cast<const std::byte*>(data);
+  while (size > 0) {
+    const ssize_t put = ::pwrite(fd, bytes, size, static_cast<off_t>(offset));
+    if (put < 0 && errno == EINTR) continue;
+    if (put < 0) return ioErrorFromErrno(path, "write");
+    bytes += put;
+    size -= static_cast<std::size_t>(put);
+    offset += static_cast<std::uint64_t>(put);
+  }
+  return {};
+}
+
 Error notARegularFile(const std::string& path, const struct stat& info) {
   return {ErrorKind::kBadInput, fmt::format("{}: {}", path,
                                             S_ISDIR(info.st_mode) ? "is a directory; give a file"
@@ -291,32 +306,12 @@ Status WorkFile::readAt(std::uint64_t offset, void* data, std::size_t size) cons
 }
 
 Status WorkFile::writeAt(std::uint64_t offset, const void* data, std::size_t size) const {
-  const auto* bytes = static_cast<const std::byte*>(data);
-  while (size > 0) {
-    const ssize_t put = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));
-    if (put < 0 && errno == EINTR) continue;
-    if (put < 0) return ioErrorFromErrno(path_, "write");
-    bytes += put;
-    size -= static_cast<std::size_t>(put);
-    offset += static_cast<std::uint64_t>(put);
-  }
-  return {};
+  return writeAllAt(fd_, path_, offset, data, size);
 }
 
 Status OutputFile::writeAt(std::uint64_t offset, const void* data, std::size_t size) {
   assert(fd_ >= 0);
-  const auto* bytes = static_cast<const std::byte*>(data);
-  while (size > 0) {
-    const ssize_t put = ::pwrite(fd_, bytes, size, static_cast<off_t>(offset));
-    if (put < 0) {
-      if (errno == EINTR) continue;
-      return ioErrorFromErrno(path_, "write");
-    }
-    bytes += put;
-    size -= static_cast<std::size_t>(put);
-    offset += static_cast<std::uint64_t>(put);
-  }
-  return {};
+  return writeAllAt(fd_, path_, offset, data, size);
 }
 
 Status OutputFile::appendFileContents(const std::string& path, std::uint64_t bytes) {

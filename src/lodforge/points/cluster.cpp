@@ -317,8 +317,7 @@ LodCut cutTree(std::span<const ClusterNode> tree, float tolerance) {
   return cut;
 }
 
-std::vector<float> tolerancesForResident(std::span<const ClusterNode> tree,
-                                         std::span<const std::size_t> residentNodes) {
+float toleranceForResident(std::span<const ClusterNode> tree, std::size_t residentNodes) {
   std::vector<float> errors;
   errors.reserve(tree.size());
   for (const ClusterNode& n : tree) errors.push_back(n.error);
@@ -340,24 +339,16 @@ std::vector<float> tolerancesForResident(std::span<const ClusterNode> tree,
     }
     return count;
   };
-  std::vector<float> tolerances;
-  for (const std::size_t budget : residentNodes) {
-    std::size_t lo = 0, hi = errors.size() - 1;
-    while (lo < hi) {
-      const std::size_t mid = (lo + hi) / 2;
-      if (residentAt(errors[mid]) <= budget) {
-        hi = mid;
-      } else {
-        lo = mid + 1;
-      }
+  std::size_t lo = 0, hi = errors.size() - 1;
+  while (lo < hi) {
+    const std::size_t mid = (lo + hi) / 2;
+    if (residentAt(errors[mid]) <= residentNodes) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
     }
-    tolerances.push_back(errors[lo]);
   }
-  return tolerances;
-}
-
-float toleranceForResident(std::span<const ClusterNode> tree, std::size_t residentNodes) {
-  return tolerancesForResident(tree, std::span<const std::size_t>(&residentNodes, 1)).front();
+  return errors[lo];
 }
 
 }  // namespace lodforge

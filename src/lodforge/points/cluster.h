@@ -60,8 +60,5 @@ LodCut cutTree(std::span<const ClusterNode> tree, float tolerance);
 
 // The smallest tolerance whose cut keeps at most `residentNodes` nodes in Part II.
 float toleranceForResident(std::span<const ClusterNode> tree, std::size_t residentNodes);
-// The same for several budgets at once (the tree's errors sorted once).
-std::vector<float> tolerancesForResident(std::span<const ClusterNode> tree,
-                                         std::span<const std::size_t> residentNodes);
 
 }  // namespace lodforge

@@ -99,6 +99,9 @@ void addGenerate(CLI::App& app, const Global& global, Run& run) {
     addCountOption(*sub, "--points", options->points.points, "Number of points (default 1M)");
     sub->add_option("--seed", options->points.seed, "Random seed");
     sub->add_option("-o,--output", options->output, "Output .ply or .las (default points.ply)");
+    sub->add_flag("--extra-bytes", options->points.extraBytes,
+                  "LAS: add described extra bytes (height above ground, echo width, range, "
+                  "amplitude)");
     sub->callback([&global, &run, options] {
       run = [&global, options] {
         return timed(global, options->output,

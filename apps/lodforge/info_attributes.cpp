@@ -43,6 +43,9 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
   const auto fields = pointAttributeFields();
   std::vector<Range> ranges(fields.size());
   std::array<std::uint64_t, 256> classes{};
+  const PointExtras& extras = reader->info().extras;
+  std::vector<Range> extraRanges(extras.fields.size());
+  std::vector<std::uint64_t> noData(extras.fields.size(), 0);
   Progress progress("reading", reader->info().count.value_or(fileBytes / 20));
   PointBatch batch;
   while (true) {
@@ -55,6 +58,17 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
         if ((mask & fields[f].bit) != 0 && ranged(fields[f])) ranges[f].add(shown(fields[f], a));
       ++classes[a.classification];
     }
+    for (std::size_t i = 0; i < batch.size() && extras.stride != 0; ++i) {
+      const std::byte* point = batch.extras.data() + i * extras.stride;
+      for (std::size_t f = 0; f < extras.fields.size(); ++f) {
+        const ExtraField& field = extras.fields[f];
+        if (field.noData && extraRaw(point, field) == *field.noData) {
+          ++noData[f];
+        } else {
+          extraRanges[f].add(extraValue(point, field));
+        }
+      }
+    }
     progress.advance(batch.size());
   }
   progress.finish();
@@ -62,6 +76,28 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
   for (std::size_t f = 0; f < fields.size(); ++f)
     if (ranges[f].min <= ranges[f].max)
       j[fields[f].property] = {{"min", ranges[f].min}, {"max", ranges[f].max}};
+  if (!extras.fields.empty()) {
+    nlohmann::json list = nlohmann::json::array();
+    for (std::size_t f = 0; f < extras.fields.size(); ++f) {
+      const ExtraField& field = extras.fields[f];
+      nlohmann::json entry = {{"name", field.name}, {"type", extraTypeName(field.type)}};
+      if (!field.description.empty()) entry["description"] = field.description;
+      if (field.scaled()) {
+        entry["scale"] = field.scale;
+        entry["offset"] = field.add;
+      }
+      if (extraRanges[f].min <= extraRanges[f].max) {
+        entry["min"] = extraRanges[f].min;
+        entry["max"] = extraRanges[f].max;
+      }
+      if (field.noData) {
+        entry["noData"] = *field.noData;
+        entry["noDataPoints"] = noData[f];
+      }
+      list.push_back(std::move(entry));
+    }
+    j["extras"] = std::move(list);
+  }
   if ((mask & kAttrClassification) != 0) {
     nlohmann::json counts = nlohmann::json::object();
     for (std::size_t c = 0; c < classes.size(); ++c)
@@ -79,6 +115,21 @@ void printPointAttributes(const nlohmann::json& attributes) {
     const nlohmann::json& range = attributes[field.property];
     fmt::print("{:<22}{:.10g} to {:.10g}\n", field.property, range["min"].get<double>(),
                range["max"].get<double>());
+  }
+  if (attributes.contains("extras")) {
+    for (const nlohmann::json& e : attributes["extras"]) {
+      std::string range = "no values";
+      if (e.contains("min"))
+        range = fmt::format("{:.10g} to {:.10g}", e["min"].get<double>(), e["max"].get<double>());
+      std::string notes = e["type"].get<std::string>();
+      if (e.contains("scale"))
+        notes += fmt::format(", ×{:g} + {:g}", e["scale"].get<double>(), e["offset"].get<double>());
+      if (e.contains("noData"))
+        notes += fmt::format(", no data {:g} at {} points", e["noData"].get<double>(),
+                             formatCount(e["noDataPoints"].get<std::uint64_t>()));
+      if (e.contains("description")) notes += ", " + e["description"].get<std::string>();
+      fmt::print("{:<22}{} (extra: {})\n", e["name"].get<std::string>(), range, notes);
+    }
   }
   if (!attributes.contains("classification")) return;
   for (const auto& [value, entry] : attributes["classification"].items())

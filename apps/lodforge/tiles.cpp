@@ -106,9 +106,10 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
   addCountOption(sub, "--tile-points", options.tilePoints,
                  "Point clouds: about this many points in a tile above the blocks (default 50K)");
   sub.add_option("--attributes", options.attributes,
-                 "Point clouds: the LAS fields the tiles carry, comma-separated: classification, "
-                 "intensity, returns, flags, scan-angle, user-data, point-source, gps-time, nir; "
-                 "or all (default: all the input has) or none");
+                 "Point clouds: the fields the tiles carry, comma-separated: classification, "
+                 "intensity, returns, flags, scan-angle, user-data, point-source, gps-time, nir, "
+                 "extras (LAS extra bytes, other PLY properties); or all (default: all the input "
+                 "has) or none");
   sub.add_flag("--salvage", options.salvage,
                "Read a PLY cut short up to its last whole element (with a warning)");
   sub.add_flag("--resume", options.resume,

@@ -514,6 +514,35 @@ TEST(CliPoints, BuildsAPackageFromLasAndInfoReportsBoth) {
   EXPECT_EQ(info(dir.file("p.lfc"), dir)["points"], 20'000);
 }
 
+// Described extra bytes: generated, listed by info with their ranges, carried by tiles.
+TEST(CliPoints, ExtraBytesAreListedAndCarried) {
+  test::TempDir dir;
+  Outcome o = lodforge("-q generate points --points 5K --extra-bytes -o " + dir.file("e.las"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  o = lodforge("info " + dir.file("e.las") + " --json", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const nlohmann::json extras = nlohmann::json::parse(o.out)["attributes"]["extras"];
+  ASSERT_EQ(extras.size(), 4u);
+  EXPECT_EQ(extras[0]["name"], "height_above_ground");
+  EXPECT_EQ(extras[0]["type"], "uint16");
+  EXPECT_EQ(extras[0]["scale"], 0.01);
+  EXPECT_LE(extras[0]["max"].get<double>(), 25.0);
+  EXPECT_EQ(extras[2]["name"], "range");
+  EXPECT_GT(extras[2]["min"].get<double>(), 900.0);
+  o = lodforge("info " + dir.file("e.las"), dir);
+  EXPECT_NE(o.out.find("echo_width            25 to "), std::string::npos) << o.out;
+  o = lodforge("tiles " + dir.file("e.las") + " -o " + dir.file("t") + " --block-size 2K", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(test::readFile(dir.file("t/tiles/b.glb")).find("_ECHO_WIDTH"), std::string::npos);
+  o = lodforge("tiles " + dir.file("e.las") + " -o " + dir.file("n") + " --attributes none", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(test::readFile(dir.file("n/tiles/b.glb")).find("_ECHO_WIDTH"), std::string::npos);
+  o = lodforge("generate points --points 5K --extra-bytes -o " + dir.file("e.ply"), dir);
+  EXPECT_NE(o.code, 0);
+  EXPECT_NE(o.err.find("--extra-bytes needs a .las output"), std::string::npos) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("e.ply")));
+}
+
 TEST(CliPoints, BadInputIsExitCode2AndLeavesNothing) {
   test::TempDir dir;
   // A LAZ cut inside its last chunk: the chunk table went with the cut.

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lodforge/io/las_writer.h"
 #include "lodforge/io/point_reader.h"
 #include "test_support.h"
 
@@ -406,6 +407,105 @@ TEST(LasReader, RefusesADamagedLaszipRecordWithItsPosition) {
   bad = header(bare);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("no LASzip record"), std::string::npos) << bad.error().message;
+}
+
+// One descriptor of the Extra Bytes record, field by field (LAS 1.4 R15, Table 24).
+std::string descriptor(std::uint8_t type, std::uint8_t options, const std::string& name,
+                       std::array<double, 3> scale = {1, 1, 1},
+                       std::array<double, 3> offset = {0, 0, 0}, std::int64_t noData = 0) {
+  std::string d(192, '\0');
+  d[2] = static_cast<char>(type);
+  d[3] = static_cast<char>(options);
+  std::memcpy(d.data() + 4, name.data(), std::min<std::size_t>(32, name.size()));
+  put(d, 40, noData);
+  for (std::size_t k = 0; k < 3; ++k) {
+    put(d, 112 + 8 * k, scale[k]);
+    put(d, 136 + 8 * k, offset[k]);
+  }
+  std::memcpy(d.data() + 160, "described", 9);
+  return d;
+}
+
+TEST(LasExtraBytes, DescriptorsGiveTypesOffsetsScalesAndNoData) {
+  // Undocumented 3 bytes, a scaled uint16 with no-data, a 3-element float array (LAS 1.3's
+  // type 29) and a double: 3 + 2 + 12 + 8 = 25 bytes of the 27 the records have.
+  const std::string record = descriptor(0, 3, "pad") +
+                             descriptor(3, 1 | 8 | 16, "height", {0.01, 1, 1}, {5, 0, 0}, 65535) +
+                             descriptor(29, 0, "xyz") + descriptor(10, 0, "range");
+  Result<PointExtras> extras = parseLasExtraBytes(bytesOf(record), 27, "f.las", 1000);
+  ASSERT_TRUE(extras.ok()) << extras.error().message;
+  EXPECT_EQ(extras->stride, 27u);
+  ASSERT_EQ(extras->fields.size(), 5u);
+  const ExtraField& height = extras->fields[0];
+  EXPECT_EQ(height.name, "height");
+  EXPECT_EQ(height.description, "described");
+  EXPECT_EQ(height.type, ExtraType::kUint16);
+  EXPECT_EQ(height.offset, 3u);
+  EXPECT_EQ(height.scale, 0.01);
+  EXPECT_EQ(height.add, 5);
+  EXPECT_EQ(height.noData, 65535.0);
+  EXPECT_EQ(extras->fields[1].name, "xyz[0]");
+  EXPECT_EQ(extras->fields[3].name, "xyz[2]");
+  EXPECT_EQ(extras->fields[3].offset, 13u);
+  EXPECT_EQ(extras->fields[3].type, ExtraType::kFloat32);
+  EXPECT_EQ(extras->fields[4].offset, 17u);
+  EXPECT_EQ(extras->fields[4].type, ExtraType::kFloat64);
+  EXPECT_FALSE(extras->fields[4].noData.has_value());
+  std::vector<std::byte> point(27);
+  const std::uint16_t raw = 1234;
+  std::memcpy(point.data() + 3, &raw, 2);
+  EXPECT_DOUBLE_EQ(extraValue(point.data(), height), 17.34);
+  // Bad records name the file, the byte and the field.
+  Result<PointExtras> tooLong = parseLasExtraBytes(bytesOf(record), 20, "f.las", 1000);
+  ASSERT_FALSE(tooLong.ok());
+  EXPECT_NE(tooLong.error().message.find("f.las"), std::string::npos);
+  EXPECT_NE(tooLong.error().message.find("\"range\" end at byte 25"), std::string::npos);
+  EXPECT_FALSE(parseLasExtraBytes(bytesOf(record.substr(0, 300)), 27, "f.las", 0).ok());
+  Result<PointExtras> badType = parseLasExtraBytes(bytesOf(descriptor(31, 0, "x")), 8, "f.las", 0);
+  ASSERT_FALSE(badType.ok());
+  EXPECT_NE(badType.error().message.find("data type 31"), std::string::npos);
+  EXPECT_FALSE(
+      parseLasExtraBytes(bytesOf(descriptor(9, 8, "zero", {0, 1, 1})), 4, "f.las", 0).ok());
+}
+
+// What the writer describes, the reader reads back: the fields and each point's bytes.
+TEST(LasExtraBytes, WrittenAndReadBackWithEveryPoint) {
+  test::TempDir dir;
+  PointExtras layout;
+  layout.fields = {{"label", "", ExtraType::kUint8, 0, 1, 0, std::nullopt},
+                   {"depth", "metres", ExtraType::kInt32, 1, 0.001, -10, -1}};
+  layout.stride = 5;
+  Result<LasWriter> writer =
+      LasWriter::create(dir.file("x.las"), {0.01, 0.01, 0.01}, {0, 0, 0}, "test", layout);
+  ASSERT_TRUE(writer.ok()) << writer.error().message;
+  std::vector<LasPoint3> points(300);
+  std::vector<std::byte> extras(300 * 5);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    points[i].position = {double(i), 2, 3};
+    const auto label = static_cast<std::uint8_t>(i % 11);
+    const auto depth = static_cast<std::int32_t>(i * 1000 - 7);
+    std::memcpy(extras.data() + 5 * i, &label, 1);
+    std::memcpy(extras.data() + 5 * i + 1, &depth, 4);
+  }
+  ASSERT_TRUE(writer->write(points, extras).ok());
+  EXPECT_FALSE(writer->write(points, {}).ok());  // extra bytes missing: refused
+  ASSERT_TRUE(writer->finish().ok());
+  Result<PointReader> reader = PointReader::open(dir.file("x.las"));
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  const PointExtras& read = reader->info().extras;
+  ASSERT_EQ(read.fields.size(), 2u);
+  EXPECT_EQ(read.stride, 5u);
+  EXPECT_EQ(read.fields[1].name, "depth");
+  EXPECT_EQ(read.fields[1].description, "metres");
+  EXPECT_EQ(read.fields[1].scale, 0.001);
+  EXPECT_EQ(read.fields[1].add, -10);
+  EXPECT_EQ(read.fields[1].noData, -1.0);
+  EXPECT_NE(reader->info().attributes & kAttrExtras, 0u);
+  PointBatch batch;
+  std::vector<std::byte> all;
+  while (*reader->next(batch)) all.insert(all.end(), batch.extras.begin(), batch.extras.end());
+  EXPECT_TRUE(all == extras);
+  EXPECT_DOUBLE_EQ(extraValue(all.data() + 5 * 3, read.fields[1]), 2.993 - 10);
 }
 
 TEST(PointReader, ReadsLasThroughTheCommonReader) {

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -221,6 +222,59 @@ TEST(PlyRead, AnyPropertyOrderExtraPropertiesAndElementsAreSkipped) {
     EXPECT_EQ(model->positions[1], (Vec3f{4, 5, 6}));
     EXPECT_EQ(model->indices, (std::vector<std::uint32_t>{2, 1, 0}));
   }
+}
+
+// With readExtras, the vertex's other scalar properties come packed in their own types (lists
+// and the properties lodforge reads itself left out).
+TEST(PlyRead, OtherVertexPropertiesComeAsExtraFields) {
+  const std::string ply =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 2\nproperty float x\n"
+      "property uchar label\nproperty float y\nproperty list uchar int ring\n"
+      "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+      "property short segment_index\nproperty double psz\nend_header\n";
+  std::string body;
+  const auto be = [&body](auto v) {
+    char b[sizeof v];
+    std::memcpy(b, &v, sizeof v);
+    std::reverse(b, b + sizeof v);
+    body.append(b, sizeof v);
+  };
+  for (int i = 0; i < 2; ++i) {
+    be(1.0f * float(i));
+    be(static_cast<std::uint8_t>(200 + i));
+    be(2.0f);
+    be(static_cast<std::uint8_t>(1));
+    be(std::int32_t{7});
+    be(3.0f);
+    be(0.0f), be(0.0f), be(1.0f);
+    be(static_cast<std::int16_t>(-300 - i));
+    be(0.125 * i);
+  }
+  PlyReadOptions options;
+  options.readExtras = true;
+  Result<PlyReader> reader = PlyReader::fromMemory(test::bytesOf(ply + body), "x.ply", options);
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  const PointExtras& extras = reader->header().extras;
+  ASSERT_EQ(extras.fields.size(), 3u);
+  EXPECT_EQ(extras.stride, 11u);
+  EXPECT_EQ(extras.fields[0].name, "label");
+  EXPECT_EQ(extras.fields[0].type, ExtraType::kUint8);
+  EXPECT_EQ(extras.fields[1].name, "segment_index");
+  EXPECT_EQ(extras.fields[1].offset, 1u);
+  EXPECT_EQ(extras.fields[2].type, ExtraType::kFloat64);
+  PlyBatch batch;
+  ASSERT_TRUE(*reader->next(batch));
+  ASSERT_EQ(batch.extras.size(), 22u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::byte* e = batch.extras.data() + 11 * i;
+    EXPECT_EQ(extraRaw(e, extras.fields[0]), 200.0 + double(i));
+    EXPECT_EQ(extraRaw(e, extras.fields[1]), -300.0 - double(i));
+    EXPECT_EQ(extraRaw(e, extras.fields[2]), 0.125 * double(i));
+  }
+  // Without the option (meshes), nothing is packed.
+  Result<PlyReader> plain = PlyReader::fromMemory(test::bytesOf(ply + body), "x.ply");
+  ASSERT_TRUE(plain.ok());
+  EXPECT_TRUE(plain->header().extras.fields.empty());
 }
 
 TEST(PlyRead, ColoursFromEveryChannelType) {

@@ -1,10 +1,12 @@
 #include "lodforge/points/partition.h"
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <numeric>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -185,7 +187,9 @@ TEST(Partition, ASinkSeesEveryBlockAndItsOrderIsWrittenBack) {
   std::map<std::string, Vec3d> lastOf;
   options.workDirectory = dir.file("sink");
   std::filesystem::create_directories(options.workDirectory);
-  options.blockSink = [&](std::span<CloudPoint> points, PointBlock& block) {
+  options.blockSink = [&](std::span<CloudPoint> points, std::span<std::uint32_t> ids,
+                          PointBlock& block) {
+    EXPECT_TRUE(ids.empty());  // the input has no extra fields
     Multiset content;
     for (const CloudPoint& p : points) ++content[{p.position.x, p.position.y, p.position.z}];
     std::reverse(points.begin(), points.end());  // the sink may reorder
@@ -207,12 +211,85 @@ TEST(Partition, ASinkSeesEveryBlockAndItsOrderIsWrittenBack) {
     EXPECT_EQ(sunk.at(sink.name), want) << sink.name;
     EXPECT_EQ(readBlock(sink).back().position, lastOf.at(sink.name)) << sink.name;
   }
-  options.blockSink = [](std::span<CloudPoint>, PointBlock& block) -> Status {
-    return ioError(block.name, "disk full");
-  };
+  options.blockSink = [](std::span<CloudPoint>, std::span<std::uint32_t>,
+                         PointBlock& block) -> Status { return ioError(block.name, "disk full"); };
   Result<Partition> failed = partitionPoints(dir.file("cloud.xyz"), options);
   ASSERT_FALSE(failed.ok());
   EXPECT_NE(failed.error().message.find("disk full"), std::string::npos);
+}
+
+// A PLY of `points` with one extra property: each point's index in the file (an int, so that
+// the partition carries 4 extra bytes a point).
+void writeIndexedPly(const std::string& path, const std::vector<Vec3d>& points) {
+  std::ofstream out(path);
+  out.precision(17);
+  out << "ply\nformat ascii 1.0\nelement vertex " << points.size()
+      << "\nproperty double x\nproperty double y\nproperty double z\nproperty int index\n"
+         "end_header\n";
+  for (std::size_t i = 0; i < points.size(); ++i)
+    out << points[i].x << ' ' << points[i].y << ' ' << points[i].z << ' ' << i << '\n';
+}
+
+// Extra fields travel in step with their points through every reorder: the reading pass,
+// streamed splits, in-memory splits (the median fallback too: a tenth of the points coincide)
+// and a sink that shuffles the points and their ids.
+TEST(Partition, ExtraBytesFollowTheirPointsThroughEveryReorder) {
+  test::TempDir dir;
+  Random random(31);
+  std::vector<Vec3d> points;
+  for (int i = 0; i < 40'000; ++i) {
+    points.push_back(
+        i % 10 == 0 ? Vec3d{7, 7, 7}
+                    : Vec3d{random.uniform(0, 100), random.uniform(0, 50), random.uniform(0, 2)});
+  }
+  writeIndexedPly(dir.file("cloud.ply"), points);
+  for (const std::uint64_t memory : {std::uint64_t{0}, std::uint64_t{6'000}}) {
+    PartitionOptions options;
+    options.blockSize = 900;
+    options.workDirectory = dir.file(fmt::format("w{}", memory));
+    if (memory != 0) options.memoryBytes = memory * sizeof(CloudPoint);
+    std::filesystem::create_directories(options.workDirectory);
+    std::mutex mutex;
+    std::uint64_t shuffled = 0;
+    options.blockSink = [&](std::span<CloudPoint> block, std::span<std::uint32_t> ids,
+                            PointBlock&) {
+      EXPECT_EQ(ids.size(), block.size());
+      Random order(block.size());
+      for (std::size_t i = block.size(); i > 1; --i) {
+        const auto j = static_cast<std::size_t>(order.uniform(0, static_cast<double>(i)));
+        std::swap(block[i - 1], block[std::min(j, i - 1)]);
+        std::swap(ids[i - 1], ids[std::min(j, i - 1)]);
+      }
+      std::lock_guard lock(mutex);
+      shuffled += block.size();
+      return Status{};
+    };
+    Result<Partition> partition = partitionPoints(dir.file("cloud.ply"), options);
+    ASSERT_TRUE(partition.ok()) << partition.error().message;
+    EXPECT_EQ(shuffled, points.size());
+    if (memory != 0) {
+      EXPECT_GE(partition->streamedPasses, 2);
+    }
+    ASSERT_EQ(partition->info.extras.stride, 4u);
+    ASSERT_EQ(partition->info.extras.fields.size(), 1u);
+    EXPECT_EQ(partition->info.extras.fields[0].name, "index");
+    std::vector<int> seen(points.size(), 0);
+    for (const PointBlock& block : partition->blocks) {
+      Result<std::vector<std::byte>> extras =
+          readExtraRecords(partition->extrasPath, 4, block.first, block.count);
+      ASSERT_TRUE(extras.ok()) << extras.error().message;
+      const std::vector<CloudPoint> records = readBlock(block);
+      for (std::size_t i = 0; i < records.size(); ++i) {
+        std::int32_t index = -1;
+        std::memcpy(&index, extras->data() + 4 * i, 4);
+        ASSERT_TRUE(index >= 0 && index < static_cast<std::int32_t>(points.size()));
+        ++seen[static_cast<std::size_t>(index)];
+        EXPECT_EQ(records[i].position, points[static_cast<std::size_t>(index)])
+            << block.name << " record " << i;
+      }
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(points.size()));
+  }
 }
 
 TEST(Partition, SplitsCoincidentPointsByCount) {
@@ -239,9 +316,32 @@ TEST(Partition, SplitPointsSeparatesAtThePlane) {
   Random random(8);
   std::vector<CloudPoint> points(1'000);
   for (CloudPoint& p : points) p.position = {random.uniform(-1, 1), random.uniform(-5, 5), 0};
-  const std::size_t below = splitPoints(points, {1, 0.5});
-  for (std::size_t i = 0; i < points.size(); ++i)
+  const std::vector<CloudPoint> original = points;
+  std::vector<CloudPoint> plain = points;
+  std::vector<std::uint32_t> ids(points.size());
+  std::iota(ids.begin(), ids.end(), 0u);
+  const std::size_t below = splitPoints(points, {1, 0.5}, ids);
+  for (std::size_t i = 0; i < points.size(); ++i) {
     EXPECT_EQ(points[i].position.y < 0.5, i < below) << i;
+    EXPECT_EQ(points[i].position, original[ids[i]].position) << i;  // ids moved in step
+  }
+  // The same order with ids as without (and as std::partition leaves it).
+  EXPECT_EQ(splitPoints(plain, {1, 0.5}), below);
+  std::vector<CloudPoint> standard = original;
+  std::partition(standard.begin(), standard.end(),
+                 [](const CloudPoint& p) { return p.position.y < 0.5; });
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_EQ(plain[i].position, points[i].position) << i;
+    EXPECT_EQ(standard[i].position, points[i].position) << i;
+  }
+  // All on one side: the median split moves the ids too.
+  std::vector<CloudPoint> same = original;
+  for (CloudPoint& p : same) p.position.x = 3;
+  std::iota(ids.begin(), ids.end(), 0u);
+  const std::size_t half = splitPoints(same, {0, 3.0}, ids);
+  EXPECT_EQ(half, same.size() / 2);
+  for (std::size_t i = 0; i < same.size(); ++i)
+    EXPECT_EQ(same[i].position.y, original[ids[i]].position.y) << i;
   Aabbd box;
   box.add(Vec3d{0, 0, 0});
   box.add(Vec3d{1, 3, 2});

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/random.h"
+#include "lodforge/generate/points.h"
 #include "lodforge/io/las_reader.h"
 #include "lodforge/tiles/point_attributes.h"
 #include "test_support.h"
@@ -322,6 +323,12 @@ std::vector<double> readPointAttribute(const std::string& path, const std::strin
       std::uint16_t u;
       std::memcpy(&u, element, 2);
       values[i] = u;
+    } else if (type == 5122) {
+      std::int16_t v;
+      std::memcpy(&v, element, 2);
+      values[i] = v;
+    } else if (type == 5120) {
+      values[i] = static_cast<std::int8_t>(element[0]);
     } else {
       values[i] = static_cast<std::uint8_t>(element[0]);
     }
@@ -412,10 +419,157 @@ TEST(PointTiles, CarryTheLasAttributesAsStructuralMetadata) {
   EXPECT_FALSE(gltf.contains("extensions"));
 }
 
+// The class property `name` of a tile's lidar class.
+nlohmann::json lidarProperty(const std::string& glb, const std::string& name) {
+  nlohmann::json gltf;
+  readPointGlb(glb, &gltf);
+  return gltf["extensions"]["EXT_structural_metadata"]["schema"]["classes"]["lidar"]["properties"]
+             [name];
+}
+
+// A LAS's described extra bytes reach the tiles as properties of their own, each value with
+// its point: per point (classification, intensity, height in cm or none, echo width) over all
+// tiles equals the LAS's as multisets; ranges as floats from each tile's least metre.
+TEST(PointTiles, CarryLasExtraBytesWithTheirPoints) {
+  test::TempDir dir;
+  const std::string las = dir.file("g.las");
+  PointsOptions generated;
+  generated.points = 30'000;
+  generated.extraBytes = true;
+  ASSERT_TRUE(generatePoints(generated, las).ok());
+  using Key = std::tuple<int, int, int, int>;
+  std::multiset<Key> expected, found;
+  std::vector<double> expectedRanges, foundRanges;
+  int noHeight = 0, foundNoHeight = 0;
+  Result<LasReader> reader = LasReader::open(las);
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  const PointExtras& layout = reader->header().extras;
+  ASSERT_EQ(layout.fields.size(), 4u);
+  PointBatch batch;
+  while (*reader->next(batch)) {
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      const std::byte* e = batch.extras.data() + i * layout.stride;
+      const double raw = extraRaw(e, layout.fields[0]);
+      noHeight += raw == 65535;
+      expected.insert({batch.attributes[i].classification, batch.attributes[i].intensity,
+                       raw == 65535 ? -1 : int(raw), int(extraRaw(e, layout.fields[1]))});
+      expectedRanges.push_back(extraValue(e, layout.fields[2]));
+    }
+  }
+  EXPECT_GT(noHeight, 0);
+  PointTilesOptions options;
+  options.blockSize = 4'000;
+  options.tilePoints = 3'000;
+  Result<PointTilesStats> stats = writePointTiles(las, dir.file("t"), options);
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  EXPECT_NE(pointAttributeNames(stats->attributes).find("extras"), std::string::npos);
+  const auto tileset = nlohmann::json::parse(test::readFile(dir.file("t/tileset.json")));
+  std::vector<std::string> uris;
+  checkTileset(tileset["root"], dir.file("t"), tileset["geometricError"], nullptr, uris);
+  ASSERT_GT(uris.size(), 3u);
+  for (const std::string& uri : uris) {
+    const std::string glb = dir.file("t/" + uri);
+    const auto cls = readPointAttribute(glb, "_CLASSIFICATION");
+    const auto intensity = readPointAttribute(glb, "_INTENSITY");
+    const auto height = readPointAttribute(glb, "_HEIGHT_ABOVE_GROUND");
+    const auto echo = readPointAttribute(glb, "_ECHO_WIDTH");
+    const auto range = readPointAttribute(glb, "_RANGE");
+    ASSERT_EQ(height.size(), cls.size()) << uri;
+    ASSERT_EQ(range.size(), cls.size()) << uri;
+    const nlohmann::json heightProperty = lidarProperty(glb, "height_above_ground");
+    EXPECT_EQ(heightProperty["componentType"], "FLOAT32");
+    EXPECT_EQ(heightProperty["description"], "metres above the ground");
+    const auto none = static_cast<float>(heightProperty["noData"].get<double>());
+    EXPECT_EQ(lidarProperty(glb, "echo_width")["componentType"], "UINT8");
+    for (std::size_t i = 0; i < cls.size(); ++i) {
+      const bool missing = static_cast<float>(height[i]) == none;
+      foundNoHeight += missing;
+      found.insert({int(cls[i]), int(intensity[i]),
+                    missing ? -1 : int(std::lround(height[i] * 100)), int(echo[i])});
+    }
+    foundRanges.insert(foundRanges.end(), range.begin(), range.end());
+  }
+  EXPECT_EQ(foundNoHeight, noHeight);
+  ASSERT_EQ(found.size(), expected.size());
+  EXPECT_TRUE(found == expected);
+  std::sort(expectedRanges.begin(), expectedRanges.end());
+  std::sort(foundRanges.begin(), foundRanges.end());
+  double worst = 0;
+  for (std::size_t i = 0; i < foundRanges.size(); ++i)
+    worst = std::max(worst, std::abs(foundRanges[i] - expectedRanges[i]));
+  EXPECT_LT(worst, 1e-4);  // float32 over at most ~150 m from the tile's least metre
+
+  // Not asked for: not carried.
+  options.attributes = kAttrClassification;
+  ASSERT_TRUE(writePointTiles(las, dir.file("c"), options).ok());
+  EXPECT_EQ(readPointAttribute(dir.file("c/tiles/b.glb"), "_RANGE").size(), 0u);
+}
+
+// A PLY's other vertex properties reach the tiles under their names (made identifiers, unique
+// beside the lidar properties), each with its point: segment_index i lies at x = i / 2.
+TEST(PointTiles, CarryPlyPropertiesBeyondPositionNormalAndColour) {
+  test::TempDir dir;
+  const std::string ply = dir.file("labels.ply");
+  {
+    std::ofstream out(ply);
+    out << "ply\nformat ascii 1.0\nelement vertex 6000\nproperty float x\nproperty float y\n"
+           "property float z\nproperty uchar label\nproperty int segment_index\n"
+           "property short 2nd-return\nproperty double intensity\nend_header\n";
+    Random random(4);
+    for (int i = 0; i < 6000; ++i)
+      out << i * 0.5 << ' ' << random.uniform(0, 40) << ' ' << random.uniform(0, 1) << ' ' << i % 7
+          << ' ' << i << ' ' << -(i % 300) << ' ' << i * 0.25 << '\n';
+  }
+  PointTilesOptions options;
+  options.blockSize = 1'000;
+  options.tilePoints = 800;
+  options.quantize = false;
+  Result<PointTilesStats> stats = writePointTiles(ply, dir.file("t"), options);
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  EXPECT_EQ(stats->attributes, kAttrExtras);
+  const auto tileset = nlohmann::json::parse(test::readFile(dir.file("t/tileset.json")));
+  std::vector<std::string> uris;
+  checkTileset(tileset["root"], dir.file("t"), tileset["geometricError"], nullptr, uris);
+  std::vector<int> seen(6000, 0);
+  for (const std::string& uri : uris) {
+    const std::string glb = dir.file("t/" + uri);
+    const std::vector<Vec3d> points = readPointGlb(glb);
+    const auto label = readPointAttribute(glb, "_LABEL");
+    const auto segment = readPointAttribute(glb, "_SEGMENT_INDEX");
+    const auto second = readPointAttribute(glb, "__2ND_RETURN");
+    const auto intensity = readPointAttribute(glb, "_INTENSITY_2");
+    ASSERT_EQ(label.size(), points.size()) << uri;
+    ASSERT_EQ(second.size(), points.size()) << uri;
+    ASSERT_EQ(intensity.size(), points.size()) << uri;
+    EXPECT_EQ(lidarProperty(glb, "label")["componentType"], "UINT8");
+    EXPECT_EQ(lidarProperty(glb, "_2nd_return")["componentType"], "INT16");
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const auto index = static_cast<int>(std::lround(points[i].x * 2));
+      ASSERT_TRUE(index >= 0 && index < 6000) << points[i].x;
+      ++seen[static_cast<std::size_t>(index)];
+      EXPECT_EQ(int(segment[i]), index);  // an int32: as a float, exact below 2^24
+      EXPECT_EQ(int(label[i]), index % 7);
+      EXPECT_EQ(int(second[i]), -(index % 300));
+      EXPECT_DOUBLE_EQ(intensity[i], index * 0.25);
+    }
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 6000);
+}
+
+TEST(PointTiles, ExtraPropertyNamesAreUniqueIdentifiers) {
+  PointExtras extras;
+  for (const char* name : {"Amplitude", "amplitude", "9 lives", "", "intensity", "a-b"})
+    extras.fields.push_back({name, "", ExtraType::kUint8, 0, 1, 0, std::nullopt});
+  EXPECT_EQ(extraPropertyNames(extras),
+            (std::vector<std::string>{"Amplitude", "amplitude_2", "_9_lives", "extra",
+                                      "intensity_2", "a_b"}));
+}
+
 TEST(PointTiles, AttributeNamesParse) {
   EXPECT_EQ(*parsePointAttributes("classification,intensity"),
             kAttrClassification | kAttrIntensity);
   EXPECT_EQ(*parsePointAttributes("none"), 0u);
+  EXPECT_EQ(*parsePointAttributes("extras,nir"), kAttrExtras | kAttrNir);
   EXPECT_EQ(*parsePointAttributes("all"), ~0u);
   Result<std::uint32_t> bad = parsePointAttributes("classification,colour");
   ASSERT_FALSE(bad.ok());

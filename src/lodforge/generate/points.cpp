@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <vector>
 
@@ -26,8 +27,41 @@ constexpr double kFlightSpeed = 60.0;  // metres per second along it
 struct PointBatch {
   std::vector<Vec3f> positions, normals;
   std::vector<Rgba8> colors;
-  std::vector<LasPoint3> lidar;  // for LAS output
+  std::vector<LasPoint3> lidar;   // for LAS output
+  std::vector<std::byte> extras;  // generatedExtraBytes().stride a point, when asked for
 };
+
+// The extra bytes of a lidar point: height above ground by class (none known for noise), the
+// echo's width (wider in vegetation), the range from the aircraft flying 1,000 m above the
+// terrain's base, and the amplitude in dB from the intensity.
+void lidarExtras(const LasPoint3& point, Vec3d ground, Random& random, std::byte* out) {
+  static const PointExtras layout = generatedExtraBytes();
+  double height = 0;
+  switch (point.classification) {
+    case 3:
+      height = random.uniform(0.1, 0.5);
+      break;
+    case 4:
+      height = random.uniform(0.5, 2);
+      break;
+    case 5:
+      height = random.uniform(2, 25);
+      break;
+    default:
+      height = random.uniform(0, 0.05);
+  }
+  const auto heightCm =
+      static_cast<std::uint16_t>(point.classification == 7 ? 65535 : std::lround(height * 100));
+  const auto echo = static_cast<std::uint8_t>(point.classification >= 3 && point.classification <= 5
+                                                  ? random.uniform(40, 90)
+                                                  : random.uniform(25, 35));
+  const double range = 1000.0 - ground.z + random.uniform(-0.02, 0.02);
+  const auto amplitude = static_cast<float>(20 * std::log10(1 + point.intensity / 655.35));
+  std::memcpy(out + layout.fields[0].offset, &heightCm, 2);
+  std::memcpy(out + layout.fields[1].offset, &echo, 1);
+  std::memcpy(out + layout.fields[2].offset, &range, 8);
+  std::memcpy(out + layout.fields[3].offset, &amplitude, 4);
+}
 
 // What an airborne scanner would record at a point: the ASPRS class (ground, low, medium and
 // high vegetation where the surface is green, water in the lowest hollows, rare noise above),
@@ -77,6 +111,9 @@ void sampleBatch(const Terrain& terrain, const PointsOptions& options, std::uint
                  std::uint64_t count, bool lidar, PointBatch& out) {
   Random random = Random::forItem(options.seed, batch);
   Random attributes = Random::forItem(options.seed ^ 0x4C4153ull, batch);  // "LAS"
+  Random extra = Random::forItem(options.seed ^ 0x455842ull, batch);       // "EXB"
+  const std::size_t stride = lidar && options.extraBytes ? generatedExtraBytes().stride : 0;
+  out.extras.clear();
   out.positions.clear();
   out.normals.clear();
   out.colors.clear();
@@ -92,7 +129,11 @@ void sampleBatch(const Terrain& terrain, const PointsOptions& options, std::uint
     out.positions.push_back(toFloat(p));
     out.normals.push_back(toFloat(n));
     out.colors.push_back(color);
-    if (lidar) out.lidar.push_back(lidarPoint(p, n, color, u, v, attributes));
+    if (!lidar) continue;
+    out.lidar.push_back(lidarPoint(p, n, color, u, v, attributes));
+    if (stride == 0) continue;
+    out.extras.resize(out.extras.size() + stride);
+    lidarExtras(out.lidar.back(), p, extra, out.extras.data() + out.extras.size() - stride);
   }
 }
 
@@ -101,7 +142,7 @@ struct PointSink {
   std::optional<PlyWriter> ply;
   std::optional<LasWriter> las;
   Status write(const PointBatch& batch) {
-    if (las) return las->write(batch.lidar);
+    if (las) return las->write(batch.lidar, batch.extras);
     return ply->writeVertices(batch.positions, batch.normals, batch.colors);
   }
   std::uint64_t fileBytes() const { return las ? las->fileBytes() : ply->fileBytes(); }
@@ -115,7 +156,8 @@ Result<PointSink> openSink(const PointsOptions& options, const std::string& path
   if (fileExtension(path) == "las") {
     // Millimetres: the terrain spans kilometres at most, far inside 32-bit integers.
     Result<LasWriter> las =
-        LasWriter::create(path, {0.001, 0.001, 0.001}, {0, 0, 0}, "lodforge generate points");
+        LasWriter::create(path, {0.001, 0.001, 0.001}, {0, 0, 0}, "lodforge generate points",
+                          options.extraBytes ? generatedExtraBytes() : PointExtras{});
     if (!las) return las.status();
     sink.las.emplace(std::move(*las));
     return sink;
@@ -133,6 +175,21 @@ Result<PointSink> openSink(const PointsOptions& options, const std::string& path
 
 }  // namespace
 
+PointExtras generatedExtraBytes() {
+  PointExtras extras;
+  const auto add = [&](std::string name, std::string description, ExtraType type, double scale,
+                       std::optional<double> noData) {
+    extras.fields.push_back(
+        {std::move(name), std::move(description), type, extras.stride, scale, 0, noData});
+    extras.stride += static_cast<std::uint32_t>(extraTypeSize(type));
+  };
+  add("height_above_ground", "metres above the ground", ExtraType::kUint16, 0.01, 65535);
+  add("echo_width", "pulse width, 0.1 ns", ExtraType::kUint8, 1, std::nullopt);
+  add("range", "metres from the scanner", ExtraType::kFloat64, 1, std::nullopt);
+  add("amplitude", "dB", ExtraType::kFloat32, 1, std::nullopt);
+  return extras;
+}
+
 Result<GenerateStats> generatePoints(const PointsOptions& options, const std::string& path) {
   if (options.points == 0)
     return Error{ErrorKind::kUsage, "a point cloud needs at least one point"};
@@ -140,6 +197,8 @@ Result<GenerateStats> generatePoints(const PointsOptions& options, const std::st
   if (ext != "ply" && ext != "las")
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: the points generator writes .ply or .las", path)};
+  if (options.extraBytes && ext != "las")
+    return Error{ErrorKind::kUsage, fmt::format("{}: --extra-bytes needs a .las output", path)};
   const double depth = options.width * 2.0 / 3.0;
   const double spacing = std::sqrt(options.width * depth / static_cast<double>(options.points));
   const Terrain terrain(options.seed, options.width, depth, spacing);

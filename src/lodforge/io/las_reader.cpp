@@ -16,7 +16,7 @@ namespace {
 // prefixes of it).
 constexpr std::size_t kHeader12 = 227, kHeader13 = 235, kHeader14 = 375;
 constexpr std::size_t kVlrHeader = 54, kEvlrHeader = 60;
-constexpr std::uint16_t kWktRecord = 2112, kGeoKeyRecord = 34735;
+constexpr std::uint16_t kWktRecord = 2112, kGeoKeyRecord = 34735, kExtraBytesRecord = 4;
 constexpr std::uint16_t kProjectedCsKey = 3072, kGeographicKey = 2048, kUserDefined = 32767;
 constexpr std::size_t kColorProbe = 1 << 16;  // points looked at to tell 8- from 16-bit colours
 
@@ -120,6 +120,7 @@ struct LasReader::State {
   Status checkPointData() const;
   Status readRecords(CrsRecords& crs);
   Status readExtendedRecords(CrsRecords& crs);
+  Status readExtraBytes(std::span<const std::byte> record, std::uint64_t at);
   Status probeColorDepth();
   Status readLazRecord();
   Result<LazPointStream> openLazPoints() const;
@@ -301,7 +302,19 @@ Status LasReader::State::readRecords(CrsRecords& crs) {
       lazAt = at + kVlrHeader;
     }
     if (user == "copc" && id == 1) header.copc = true;
+    if (user == "LASF_Spec" && id == kExtraBytesRecord)
+      LODFORGE_TRY(readExtraBytes(record, at + kVlrHeader));
   }
+  return {};
+}
+
+// The Extra Bytes record: what the bytes past the point format's hold.
+Status LasReader::State::readExtraBytes(std::span<const std::byte> record, std::uint64_t at) {
+  LasHeader& h = header;
+  const auto available = static_cast<std::uint32_t>(h.recordLength - lasRecordSize(h.pointFormat));
+  Result<PointExtras> extras = parseLasExtraBytes(record, available, source->name(), at);
+  if (!extras) return extras.status();
+  h.extras = extras->fields.empty() ? PointExtras{} : std::move(*extras);
   return {};
 }
 
@@ -336,6 +349,11 @@ Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
       record.resize(length);
       extra->read(record.data(), record.size());
       crs.take(id, user, record);
+    } else if (user == "LASF_Spec" && id == kExtraBytesRecord &&
+               length < (std::uint64_t{1} << 24)) {
+      record.resize(length);
+      extra->read(record.data(), record.size());
+      LODFORGE_TRY(readExtraBytes(record, at + kEvlrHeader));
     } else {
       extra->skip(length);
     }
@@ -467,8 +485,11 @@ Result<bool> LasReader::next(PointBatch& batch) {
   batch.positions.resize(count);
   batch.attributes.resize(count);
   if (h.hasColors) batch.colors.resize(count);
+  const std::size_t stride = h.extras.stride, extrasAt = lasRecordSize(h.pointFormat);
+  batch.extras.resize(count * stride);
   for (std::size_t i = 0; i < count; ++i) {
     const std::byte* r = s.records.data() + i * h.recordLength;
+    if (stride != 0) std::memcpy(batch.extras.data() + i * stride, r + extrasAt, stride);
     batch.attributes[i] = recordAttributes(r, h.pointFormat);
     Vec3d& p = batch.positions[i];
     for (int k = 0; k < 3; ++k) {

@@ -16,6 +16,7 @@
 #include "lodforge/core/status.h"
 #include "lodforge/io/laz_vlr.h"
 #include "lodforge/io/point_batch.h"
+#include "lodforge/io/point_extras.h"
 
 namespace lodforge {
 
@@ -43,6 +44,9 @@ struct LasHeader {
   std::optional<LazInfo> laz;
   bool copc = false;
   std::uint32_t attributes = 0;  // PointAttributeBit: the lidar fields of the point format
+  // The record's bytes past its format's, as the Extra Bytes record describes them (none
+  // carried when no record describes them).
+  PointExtras extras;
 };
 
 // The smallest record of a point format (0–10), 0 for an unknown format.
@@ -60,8 +64,8 @@ class LasReader {
   ~LasReader();
 
   const LasHeader& header() const;
-  // The next batch of points (positions, the lidar attributes, and colours when the format has
-  // them); false at the end of the point records.
+  // The next batch of points (positions, the lidar attributes, colours when the format has
+  // them, and the extra bytes the header describes); false at the end of the point records.
   Result<bool> next(PointBatch& batch);
   // Or the next batch as the point records themselves (record length bytes each, decoded when
   // the file is LAZ); false at the end.

@@ -16,20 +16,47 @@ void put(std::array<std::byte, 227>& bytes, std::size_t at, T value) {
 
 }  // namespace
 
-LasWriter::LasWriter(OutputFile out, Vec3d scale, Vec3d offset, std::string software)
-    : out_(std::move(out)), scale_(scale), offset_(offset), software_(std::move(software)) {}
+constexpr std::size_t kVlrHeader = 54, kDescriptor = 192;
+
+LasWriter::LasWriter(OutputFile out, Vec3d scale, Vec3d offset, std::string software,
+                     PointExtras extras)
+    : out_(std::move(out)),
+      scale_(scale),
+      offset_(offset),
+      software_(std::move(software)),
+      extras_(std::move(extras)) {}
 
 Result<LasWriter> LasWriter::create(const std::string& path, Vec3d scale, Vec3d offset,
-                                    std::string generatingSoftware) {
+                                    std::string generatingSoftware, PointExtras extras) {
   Result<OutputFile> out = OutputFile::create(path);
   if (!out) return out.status();
-  LasWriter writer(std::move(*out), scale, offset, std::move(generatingSoftware));
+  LasWriter writer(std::move(*out), scale, offset, std::move(generatingSoftware),
+                   std::move(extras));
   const auto placeholder = writer.header();  // counts and bounds come with finish()
   LODFORGE_TRY(writer.out_.write(placeholder.data(), placeholder.size()));
+  if (writer.extras_.stride == 0) return writer;
+  // The Extra Bytes record ("LASF_Spec", 4): one descriptor a field.
+  std::vector<std::byte> record(kVlrHeader);
+  std::memcpy(record.data() + 2, "LASF_Spec", 9);
+  const std::uint16_t id = 4;
+  const auto length = static_cast<std::uint16_t>(kDescriptor * writer.extras_.fields.size());
+  std::memcpy(record.data() + 18, &id, 2);
+  std::memcpy(record.data() + 20, &length, 2);
+  std::memcpy(record.data() + 22, "extra bytes", 11);
+  for (const ExtraField& field : writer.extras_.fields) {
+    const std::vector<std::byte> descriptor = lasExtraBytesDescriptor(field);
+    record.insert(record.end(), descriptor.begin(), descriptor.end());
+  }
+  LODFORGE_TRY(writer.out_.write(record.data(), record.size()));
   return writer;
 }
 
-// The public header block of LAS 1.2 (227 bytes, no VLRs: the points follow it).
+std::uint32_t LasWriter::pointOffset() const {
+  if (extras_.stride == 0) return 227;
+  return static_cast<std::uint32_t>(227 + kVlrHeader + kDescriptor * extras_.fields.size());
+}
+
+// The public header block of LAS 1.2 (227 bytes; the Extra Bytes record, if any, follows).
 std::array<std::byte, 227> LasWriter::header() const {
   std::array<std::byte, 227> h{};
   std::memcpy(h.data(), "LASF", 4);
@@ -38,9 +65,10 @@ std::array<std::byte, 227> LasWriter::header() const {
   std::memcpy(h.data() + 26, "lodforge", 8);
   std::memcpy(h.data() + 58, software_.data(), std::min<std::size_t>(software_.size(), 31));
   put<std::uint16_t>(h, 94, 227);
-  put<std::uint32_t>(h, 96, 227);
+  put<std::uint32_t>(h, 96, pointOffset());
+  put<std::uint32_t>(h, 100, extras_.stride == 0 ? 0u : 1u);
   put<std::uint8_t>(h, 104, 3);
-  put<std::uint16_t>(h, 105, static_cast<std::uint16_t>(kLasFormat3Size));
+  put<std::uint16_t>(h, 105, static_cast<std::uint16_t>(recordSize()));
   put<std::uint32_t>(h, 107,
                      static_cast<std::uint32_t>(std::min<std::uint64_t>(points_, 0xFFFFFFFFu)));
   for (std::size_t r = 0; r < 5; ++r) put<std::uint32_t>(h, 111 + 4 * r, byReturn_[r]);
@@ -55,11 +83,17 @@ std::array<std::byte, 227> LasWriter::header() const {
   return h;
 }
 
-Status LasWriter::write(std::span<const LasPoint3> points) {
-  std::vector<std::byte> records(points.size() * kLasFormat3Size);
+Status LasWriter::write(std::span<const LasPoint3> points, std::span<const std::byte> extras) {
+  const std::size_t stride = extras_.stride;
+  if (extras.size() != points.size() * stride)
+    return Error{ErrorKind::kInternal,
+                 fmt::format("{}: {} extra bytes for {} points of {}", out_.path(), extras.size(),
+                             points.size(), stride)};
+  std::vector<std::byte> records(points.size() * recordSize());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const LasPoint3& p = points[i];
-    std::byte* r = records.data() + i * kLasFormat3Size;
+    std::byte* r = records.data() + i * recordSize();
+    if (stride != 0) std::memcpy(r + kLasFormat3Size, extras.data() + i * stride, stride);
     Vec3d stored;
     for (int k = 0; k < 3; ++k) {
       const double v = std::round((p.position[k] - offset_[k]) / scale_[k]);

@@ -1,6 +1,7 @@
 #include "lodforge/io/ply_reader.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -85,7 +86,53 @@ struct Roles {
   int red = -1, green = -1, blue = -1, alpha = -1;
   int faceIndices = -1, objectId = -1;
   int stripElement = -1, stripIndices = -1;  // 'tristrips' and its index list
+  std::vector<int> extras;                   // vertex properties carried as extra fields
 };
+
+ExtraType extraTypeOf(PlyType type) {
+  switch (type) {
+    case PlyType::kInt8:
+      return ExtraType::kInt8;
+    case PlyType::kUint8:
+      return ExtraType::kUint8;
+    case PlyType::kInt16:
+      return ExtraType::kInt16;
+    case PlyType::kUint16:
+      return ExtraType::kUint16;
+    case PlyType::kInt32:
+      return ExtraType::kInt32;
+    case PlyType::kUint32:
+      return ExtraType::kUint32;
+    case PlyType::kFloat32:
+      return ExtraType::kFloat32;
+    case PlyType::kFloat64:
+      return ExtraType::kFloat64;
+  }
+  return ExtraType::kFloat64;
+}
+
+// A value of a PLY scalar (exact in a double) stored as its type.
+void storeExtra(std::byte* at, ExtraType type, double v) {
+  const auto put = [at](auto x) { std::memcpy(at, &x, sizeof x); };
+  switch (type) {
+    case ExtraType::kInt8:
+      return put(static_cast<std::int8_t>(v));
+    case ExtraType::kUint8:
+      return put(static_cast<std::uint8_t>(v));
+    case ExtraType::kInt16:
+      return put(static_cast<std::int16_t>(v));
+    case ExtraType::kUint16:
+      return put(static_cast<std::uint16_t>(v));
+    case ExtraType::kInt32:
+      return put(static_cast<std::int32_t>(v));
+    case ExtraType::kUint32:
+      return put(static_cast<std::uint32_t>(v));
+    case ExtraType::kFloat32:
+      return put(static_cast<float>(v));
+    default:
+      return put(v);
+  }
+}
 
 int findProperty(const PlyElement& e, std::initializer_list<std::string_view> names) {
   for (std::string_view name : names) {
@@ -272,6 +319,7 @@ struct PlyReader::State {
   std::vector<std::byte> record;       // one element's bytes
   std::vector<std::byte> cornerBytes;  // a binary face's corners
   void planRecord(const PlyElement& e);
+  void planExtras(const PlyElement& vertex);
   template <class T>
   double decode(const std::byte* at) const {
     T value;
@@ -451,6 +499,7 @@ void PlyReader::State::assignRoles() {
   header.vertexCount = v.count;
   header.hasNormals = roles.nx >= 0 && roles.ny >= 0 && roles.nz >= 0;
   header.hasColors = roles.red >= 0 && roles.green >= 0 && roles.blue >= 0;
+  if (options.readExtras) planExtras(v);
   header.doublePositions =
       v.properties[static_cast<std::size_t>(roles.x)].type == PlyType::kFloat64;
   if (header.vertexCount > std::numeric_limits<std::uint32_t>::max()) {
@@ -527,6 +576,25 @@ void PlyReader::State::planRecord(const PlyElement& e) {
   record.resize(offset);
 }
 
+// The vertex's scalar properties that are not a position, normal or colour, packed one after
+// the other in their own types.
+void PlyReader::State::planExtras(const PlyElement& vertex) {
+  const std::array<int, 10> known = {roles.x,  roles.y,   roles.z,     roles.nx,   roles.ny,
+                                     roles.nz, roles.red, roles.green, roles.blue, roles.alpha};
+  for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
+    const PlyProperty& p = vertex.properties[i];
+    if (p.isList || std::find(known.begin(), known.end(), static_cast<int>(i)) != known.end())
+      continue;
+    ExtraField field;
+    field.name = p.name;
+    field.type = extraTypeOf(p.type);
+    field.offset = header.extras.stride;
+    header.extras.stride += static_cast<std::uint32_t>(extraTypeSize(field.type));
+    header.extras.fields.push_back(std::move(field));
+    roles.extras.push_back(static_cast<int>(i));
+  }
+}
+
 void PlyReader::State::readVertex(PlyBatch& batch) {
   const PlyElement& e = header.elements[element];
   values.resize(e.properties.size());
@@ -583,6 +651,14 @@ void PlyReader::State::readVertex(PlyBatch& batch) {
     };
     batch.colors.push_back(
         {channel(roles.red), channel(roles.green), channel(roles.blue), channel(roles.alpha)});
+  }
+  if (!roles.extras.empty()) {
+    const std::size_t at = batch.extras.size();
+    batch.extras.resize(at + header.extras.stride);
+    for (std::size_t k = 0; k < roles.extras.size(); ++k) {
+      const ExtraField& field = header.extras.fields[k];
+      storeExtra(batch.extras.data() + at + field.offset, field.type, value(roles.extras[k]));
+    }
   }
 }
 
@@ -765,6 +841,7 @@ bool PlyReader::State::next(PlyBatch& batch) {
   batch.positions.clear();
   batch.normals.clear();
   batch.colors.clear();
+  batch.extras.clear();
   batch.triangles.clear();
   batch.triangleObjects.clear();
   batch.count = 0;

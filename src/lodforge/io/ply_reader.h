@@ -15,6 +15,7 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/model.h"
 #include "lodforge/core/status.h"
+#include "lodforge/io/point_extras.h"
 
 namespace lodforge {
 
@@ -60,6 +61,8 @@ struct PlyHeader {
   bool hasColors = false;
   bool hasObjectIds = false;
   bool doublePositions = false;  // x y z stored as double: keep the double origin
+  // The vertex's other scalar properties (label, segment_index, …), with readExtras.
+  PointExtras extras;
 };
 
 struct PlyReadOptions {
@@ -70,6 +73,7 @@ struct PlyReadOptions {
   // Which elements to deliver; the others are skipped (binary fixed-size ones by seeking).
   bool readVertices = true;
   bool readFaces = true;
+  bool readExtras = false;  // deliver the vertices' other scalar properties (PlyBatch::extras)
   std::vector<std::string>* warnings = nullptr;  // readPly adds what it salvaged, if anything
   // Face properties recognised as an object (part) id, first match wins.
   std::vector<std::string> objectIdProperties = {"object_id", "objectid", "obj_id",
@@ -86,8 +90,9 @@ struct PlyBatch {
   std::uint64_t count = 0;
   // kVertices
   std::vector<Vec3d> positions;
-  std::vector<Vec3f> normals;  // when the header has nx ny nz
-  std::vector<Rgba8> colors;   // when the header has red green blue
+  std::vector<Vec3f> normals;     // when the header has nx ny nz
+  std::vector<Rgba8> colors;      // when the header has red green blue
+  std::vector<std::byte> extras;  // header.extras.stride bytes per vertex, with readExtras
   // kFaces: 3 indices per triangle (polygons fan-triangulated, strips with every triangle facing
   // the way the first does), global vertex indices
   std::vector<std::uint32_t> triangles;

@@ -36,6 +36,7 @@ enum PointAttributeBit : std::uint32_t {
   kAttrPointSource = 1u << 6,
   kAttrGpsTime = 1u << 7,
   kAttrNir = 1u << 8,
+  kAttrExtras = 1u << 9,  // the fields of PointCloudInfo::extras (LAS extra bytes, PLY others)
 };
 
 struct PointBatch {
@@ -44,6 +45,7 @@ struct PointBatch {
   std::vector<Vec3f> normals;               // empty, or one per point
   std::vector<Rgba8> colors;                // empty, or one per point
   std::vector<PointAttributes> attributes;  // empty, or one per point
+  std::vector<std::byte> extras;            // PointExtras::stride bytes per point, or empty
 
   std::size_t size() const { return positions.size(); }
   void clear() {
@@ -51,6 +53,7 @@ struct PointBatch {
     normals.clear();
     colors.clear();
     attributes.clear();
+    extras.clear();
   }
 };
 

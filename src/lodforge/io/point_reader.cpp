@@ -54,12 +54,15 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
     info.crs = h.crs;
     info.hasColors = h.hasColors;
     info.attributes = h.attributes;
+    info.extras = h.extras;
+    if (!info.extras.fields.empty()) info.attributes |= kAttrExtras;
     return PointReader(std::make_unique<State>(State{std::move(*las), std::move(info), {}}));
   }
   if (ext == "ply") {
     PlyReadOptions options;
     options.batchSize = batchSize;
     options.readFaces = false;
+    options.readExtras = true;
     options.salvageTruncated = salvageTruncated;
     Result<PlyReader> ply = PlyReader::open(path, options);
     if (!ply) return ply.status();
@@ -69,6 +72,8 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
     info.count = h.vertexCount;
     info.hasNormals = h.hasNormals;
     info.hasColors = h.hasColors;
+    info.extras = h.extras;
+    if (!info.extras.fields.empty()) info.attributes |= kAttrExtras;
     return PointReader(std::make_unique<State>(State{std::move(*ply), std::move(info), {}}));
   }
   if (isPointCloudPath(path)) {
@@ -101,6 +106,7 @@ Result<bool> PointReader::next(PointBatch& batch) {
     batch.positions = std::move(s.plyBatch.positions);
     batch.normals = std::move(s.plyBatch.normals);
     batch.colors = std::move(s.plyBatch.colors);
+    batch.extras = std::move(s.plyBatch.extras);
     return true;
   }
 }

@@ -9,6 +9,7 @@
 
 #include "lodforge/core/status.h"
 #include "lodforge/io/point_batch.h"
+#include "lodforge/io/point_extras.h"
 
 namespace lodforge {
 
@@ -19,6 +20,7 @@ struct PointCloudInfo {
   std::string crs;                     // WKT or "EPSG:N" from a LAS file; empty when unknown
   bool hasNormals = false, hasColors = false;
   std::uint32_t attributes = 0;  // PointAttributeBit: the lidar fields a LAS or LAZ has
+  PointExtras extras;            // documented extra bytes, other PLY vertex properties
 };
 
 // Whether `path` names a point file by its extension (las laz xyz txt csv pts); a PLY may hold

@@ -27,8 +27,9 @@ struct Separator {
 
 // Top-down splitting (§4.1, "Hierarchical clustering"), breadth-first: each node's centroid,
 // mean colour and count; splitting node i reorders only inside ranges[i].
-void splitTree(std::span<CloudPoint> points, Vec3d origin, std::vector<ClusterNode>& nodes,
-               std::vector<Range>& ranges, std::vector<Separator>& separators) {
+void splitTree(std::span<CloudPoint> points, std::span<std::uint32_t> ids, Vec3d origin,
+               std::vector<ClusterNode>& nodes, std::vector<Range>& ranges,
+               std::vector<Separator>& separators) {
   nodes.reserve(2 * points.size() - 1);
   ranges.reserve(2 * points.size() - 1);
   separators.resize(2 * points.size() - 1);
@@ -55,7 +56,8 @@ void splitTree(std::span<CloudPoint> points, Vec3d origin, std::vector<ClusterNo
     node.pointCount = static_cast<std::uint32_t>(mine.size());
     if (mine.size() == 1) continue;
     const SplitPlane plane = centroidSplit(bounds, centroid);
-    const auto below = static_cast<std::uint32_t>(splitPoints(mine, plane));
+    const auto below = static_cast<std::uint32_t>(
+        splitPoints(mine, plane, ids.empty() ? ids : ids.subspan(r.begin, r.size())));
     // When the centroid leaves every point on one side, splitPoints splits at the median.
     const bool median =
         bounds.min[plane.axis] >= plane.value || bounds.max[plane.axis] < plane.value;
@@ -250,12 +252,13 @@ void nodeErrors(std::span<const CloudPoint> points, Vec3d origin, std::span<Clus
 
 std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin, bool hasNormals,
                                       const ClusterOptions& options,
-                                      std::vector<std::uint32_t>* firstPoint) {
+                                      std::vector<std::uint32_t>* firstPoint,
+                                      std::span<std::uint32_t> ids) {
   std::vector<ClusterNode> nodes;
   if (points.empty()) return nodes;
   std::vector<Range> ranges;
   std::vector<Separator> separators;
-  splitTree(points, origin, nodes, ranges, separators);
+  splitTree(points, ids, origin, nodes, ranges, separators);
   if (!hasNormals)
     cellNormals(points, nodes, ranges, static_cast<std::uint32_t>(std::max(3, options.neighbours)));
   const std::vector<float> spacing = halfSpacing(points, nodes, ranges, separators);

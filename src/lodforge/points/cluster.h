@@ -42,10 +42,11 @@ struct ClusterOptions {
 // terms, the second scaled by the square's radius so that E is a length (see docs/points.md).
 // Leaves are single points whose radius is half the distance to their nearest neighbour.
 // With `firstPoint`, each node's first point (its range in the reordered `points` starts
-// there; a leaf's is its point).
+// there; a leaf's is its point). `ids`, if given (one per point), is reordered with the points.
 std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin, bool hasNormals,
                                       const ClusterOptions& options = {},
-                                      std::vector<std::uint32_t>* firstPoint = nullptr);
+                                      std::vector<std::uint32_t>* firstPoint = nullptr,
+                                      std::span<std::uint32_t> ids = {});
 
 // The cut of a tree at `tolerance` (Fig. 4): Part II is every node with error ≤ tolerance whose
 // parent's error is above it (or the root); Part I, their ancestors, is dropped; Part III, their

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <mutex>
+#include <numeric>
 #include <optional>
 
 #include <tbb/parallel_for.h>
@@ -47,20 +50,92 @@ constexpr std::uint64_t at(std::uint64_t record) {
   return record * sizeof(CloudPoint);
 }
 
-// Pass 0: the input into one work file, with its bounds and centroid.
+// The work files: the points and, when the input has extra fields, their bytes in step.
+struct WorkFiles {
+  const WorkFile& points;
+  const WorkFile* extras = nullptr;
+  std::size_t stride = 0;  // extra bytes a point
+};
+
+// Consecutive records in memory: the points and, in step, their extra bytes.
+struct Records {
+  std::size_t stride = 0;
+  std::vector<CloudPoint> points;
+  std::vector<std::byte> extras;
+
+  std::size_t size() const { return points.size(); }
+  void resize(std::size_t n) {
+    points.resize(n);
+    extras.resize(n * stride);
+  }
+  void push(const Records& from, std::size_t i) {
+    points.push_back(from.points[i]);
+    const auto e = from.extras.begin() + static_cast<std::ptrdiff_t>(i * stride);
+    extras.insert(extras.end(), e, e + static_cast<std::ptrdiff_t>(stride));
+  }
+  // n records from record `first` of the files.
+  Status read(const WorkFiles& files, std::uint64_t first, std::size_t n) {
+    resize(n);
+    LODFORGE_TRY(files.points.readAt(at(first), points.data(), n * sizeof(CloudPoint)));
+    if (stride == 0) return {};
+    return files.extras->readAt(first * stride, extras.data(), n * stride);
+  }
+  // Records [from, from + n) to record `first` of the files.
+  Status write(const WorkFiles& files, std::uint64_t first, std::size_t from, std::size_t n) const {
+    LODFORGE_TRY(files.points.writeAt(at(first), points.data() + from, n * sizeof(CloudPoint)));
+    if (stride == 0) return {};
+    return files.extras->writeAt(first * stride, extras.data() + from * stride, n * stride);
+  }
+};
+
+// Converts a batch into work records, checking every position (and placing it, with a transform).
+Status convertBatch(const std::string& input, const PartitionOptions& options, PointBatch& batch,
+                    std::size_t stride, Records& out, Stats& stats) {
+  out.resize(batch.size());
+  for (std::size_t i = 0; i < batch.size(); ++i) {
+    CloudPoint& p = out.points[i];
+    p.position = batch.positions[i];
+    if (!isFinite(p.position))
+      return badInput(input, fmt::format("point {}: coordinate is not finite", batch.first + i));
+    if (options.transform && !options.transform(batch.positions[i], p.position))
+      return badInput(input, fmt::format("point {} ({:.10g}, {:.10g}, {:.10g}) cannot be placed "
+                                         "on Earth from the coordinate system",
+                                         batch.first + i, batch.positions[i].x,
+                                         batch.positions[i].y, batch.positions[i].z));
+    p.normal = batch.normals.empty() ? Vec3f{} : batch.normals[i];
+    p.color = batch.colors.empty() ? Rgba8{} : batch.colors[i];
+    p.attributes = batch.attributes.empty() ? PointAttributes{} : batch.attributes[i];
+    stats.add(p);
+  }
+  if (stride != 0) {
+    assert(batch.extras.size() == batch.size() * stride);
+    std::swap(out.extras, batch.extras);
+  }
+  return {};
+}
+
+// Pass 0: the input into the work files, with its bounds and centroid.
 Result<PartNode> readInput(const std::string& input, const std::string& path,
-                           const PartitionOptions& options, Partition& partition) {
+                           const std::string& extrasPath, const PartitionOptions& options,
+                           Partition& partition) {
   PointCloudInfo& info = partition.info;
   Result<PointReader> reader = PointReader::open(input, 1 << 16, options.salvageTruncated);
   if (!reader) return reader.status();
   info = reader->info();
+  const std::size_t stride = info.extras.stride;
   Result<OutputFile> out = OutputFile::create(path, std::size_t{1} << 20);
   if (!out) return out.status();
+  std::optional<OutputFile> extrasOut;
+  if (stride != 0) {
+    Result<OutputFile> file = OutputFile::create(extrasPath, std::size_t{1} << 20);
+    if (!file) return file.status();
+    extrasOut.emplace(std::move(*file));
+  }
   Progress progress("points: reading", info.count.value_or(0));
   PointBatch batch;
   // Each batch is written (a kernel copy into new pages, as costly as the parsing) while the
   // next is converted: two buffers, one write in flight, awaited on every way out.
-  std::array<std::vector<CloudPoint>, 2> records;
+  std::array<Records, 2> records{Records{stride, {}, {}}, Records{stride, {}, {}}};
   Status written;
   tbb::task_group writing;
   struct Await {
@@ -72,28 +147,15 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
     Result<bool> more = reader->next(batch);
     if (!more) return more.status();
     if (!*more) break;
-    std::vector<CloudPoint>& mine = records[turn];
-    mine.resize(batch.size());
-    for (std::size_t i = 0; i < batch.size(); ++i) {
-      CloudPoint& p = mine[i];
-      p.position = batch.positions[i];
-      if (!isFinite(p.position))
-        return badInput(input, fmt::format("point {}: coordinate is not finite", batch.first + i));
-      if (options.transform && !options.transform(batch.positions[i], p.position))
-        return badInput(input, fmt::format("point {} ({:.10g}, {:.10g}, {:.10g}) cannot be placed "
-                                           "on Earth from the coordinate system",
-                                           batch.first + i, batch.positions[i].x,
-                                           batch.positions[i].y, batch.positions[i].z));
-      p.normal = batch.normals.empty() ? Vec3f{} : batch.normals[i];
-      p.color = batch.colors.empty() ? Rgba8{} : batch.colors[i];
-      p.attributes = batch.attributes.empty() ? PointAttributes{} : batch.attributes[i];
-      stats.add(p);
-    }
+    Records& mine = records[turn];
+    LODFORGE_TRY(convertBatch(input, options, batch, stride, mine, stats));
     writing.wait();
     LODFORGE_TRY(written);
-    writing.run([&out, &written, &mine] {
+    writing.run([&out, &extrasOut, &written, &mine] {
       try {  // nothing may escape into the waiting destructor
-        written = out->writeSpan(std::span<const CloudPoint>(mine));
+        written = out->writeSpan(std::span<const CloudPoint>(mine.points));
+        if (written.ok() && extrasOut)
+          written = extrasOut->writeSpan(std::span<const std::byte>(mine.extras));
       } catch (const std::exception& e) {
         written = ioError(out->path(), e.what());
       }
@@ -106,6 +168,7 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
   progress.finish();
   partition.truncation = reader->truncation();
   LODFORGE_TRY(out->commit());
+  if (extrasOut) LODFORGE_TRY(extrasOut->commit());
   if (stats.count == 0) return badInput(input, "the file has no points");
   return PartNode{"b", 0, stats.count, stats.bounds, stats.sum};
 }
@@ -115,29 +178,29 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
 // from the front and the others from the back, only ever over records already read; at most
 // about two chunks wait in memory. Rewriting cached pages instead of writing two new files
 // per split made the streamed levels several times faster.
-Result<std::array<PartNode, 2>> splitInPlace(const PartNode& node, const WorkFile& file,
+Result<std::array<PartNode, 2>> splitInPlace(const PartNode& node, const WorkFiles& files,
                                              Progress& progress) {
   const SplitPlane plane = centroidSplit(node.bounds, centroidOf(node.sum, node.count));
   constexpr std::uint64_t kChunk = std::uint64_t{1} << 14;
   const std::uint64_t begin = node.first, end = node.first + node.count;
   std::uint64_t front = begin, back = end;  // not read yet: [front, back)
   std::uint64_t low = begin, high = end;    // written: below in [begin, low), above in [high, end)
-  std::vector<CloudPoint> chunk;
-  std::array<std::vector<CloudPoint>, 2> waiting;  // below, above
+  Records chunk{files.stride, {}, {}};
+  std::array<Records, 2> waiting{chunk, chunk};  // below, above
   std::array<Stats, 2> stats;
   // Writes what fits into space already read: below after `low`, above before `high`.
   const auto place = [&]() -> Status {
-    std::vector<CloudPoint>& below = waiting[0];
+    Records& below = waiting[0];
     const std::size_t n =
         static_cast<std::size_t>(std::min<std::uint64_t>(below.size(), front - low));
-    LODFORGE_TRY(file.writeAt(at(low), below.data() + below.size() - n, n * sizeof(CloudPoint)));
+    LODFORGE_TRY(below.write(files, low, below.size() - n, n));
     below.resize(below.size() - n);
     low += n;
-    std::vector<CloudPoint>& above = waiting[1];
+    Records& above = waiting[1];
     const std::size_t m =
         static_cast<std::size_t>(std::min<std::uint64_t>(above.size(), high - back));
     high -= m;
-    LODFORGE_TRY(file.writeAt(at(high), above.data() + above.size() - m, m * sizeof(CloudPoint)));
+    LODFORGE_TRY(above.write(files, high, above.size() - m, m));
     above.resize(above.size() - m);
     return {};
   };
@@ -145,12 +208,12 @@ Result<std::array<PartNode, 2>> splitInPlace(const PartNode& node, const WorkFil
     // Read from the back when points above wait for room there, else from the front.
     const bool fromBack = waiting[1].size() > high - back;
     const std::uint64_t n = std::min(kChunk, back - front);
-    chunk.resize(static_cast<std::size_t>(n));
-    LODFORGE_TRY(file.readAt(at(fromBack ? back - n : front), chunk.data(), at(n)));
+    LODFORGE_TRY(chunk.read(files, fromBack ? back - n : front, static_cast<std::size_t>(n)));
     (fromBack ? back : front) = fromBack ? back - n : front + n;
-    for (const CloudPoint& p : chunk) {
+    for (std::size_t i = 0; i < chunk.size(); ++i) {
+      const CloudPoint& p = chunk.points[i];
       const std::size_t side = p.position[plane.axis] < plane.value ? 0 : 1;
-      waiting[side].push_back(p);
+      waiting[side].push(chunk, i);
       stats[side].add(p);
     }
     LODFORGE_TRY(place());
@@ -158,8 +221,8 @@ Result<std::array<PartNode, 2>> splitInPlace(const PartNode& node, const WorkFil
     LODFORGE_TRY(checkCancelled());
   }
   // Everything read: the gap [low, high) is exactly what still waits.
-  LODFORGE_TRY(file.writeAt(at(low), waiting[0].data(), at(waiting[0].size())));
-  LODFORGE_TRY(file.writeAt(at(low + waiting[0].size()), waiting[1].data(), at(waiting[1].size())));
+  LODFORGE_TRY(waiting[0].write(files, low, 0, waiting[0].size()));
+  LODFORGE_TRY(waiting[1].write(files, low + waiting[0].size(), 0, waiting[1].size()));
   if (stats[0].count == 0 || stats[1].count == 0) {
     // All on one side (the node's points share the coordinate): leave it to the in-memory
     // split, which falls back to the median.
@@ -182,34 +245,59 @@ struct Blocks {
   Status status;
 };
 
+// What every in-memory split shares: the node's extra bytes by id (its records' order as read).
+struct InMemory {
+  const PartitionOptions& options;
+  const WorkFiles& files;
+  std::span<const std::byte> extras;
+  Blocks& blocks;
+};
+
+// A finished block: handed to the sink, if any, then written back in place (its extra bytes
+// gathered by the ids the splits and the sink moved with the points).
+Status finishBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids, PointBlock& block,
+                   const InMemory& shared) {
+  if (shared.options.blockSink && !cancelRequested())
+    LODFORGE_TRY(shared.options.blockSink(points, ids, block));
+  LODFORGE_TRY(shared.files.points.writeAt(at(block.first), points.data(), points.size_bytes()));
+  const std::size_t stride = shared.files.stride;
+  if (stride == 0) return {};
+  std::vector<std::byte> extras(points.size() * stride);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    std::memcpy(extras.data() + i * stride, shared.extras.data() + ids[i] * stride, stride);
+  return shared.files.extras->writeAt(block.first * stride, extras.data(), extras.size());
+}
+
 // A node in memory (its records from `first` on in the work file), split recursively into
-// blocks (both halves in parallel); each block is handed to the sink, if any, then written
-// back in place.
-void splitInMemory(std::span<CloudPoint> points, std::uint64_t first, std::string name,
-                   const PartitionOptions& options, const WorkFile& file, Blocks& blocks) {
+// blocks (both halves in parallel).
+void splitInMemory(std::span<CloudPoint> points, std::span<std::uint32_t> ids, std::uint64_t first,
+                   std::string name, const InMemory& shared) {
   Stats stats;
   for (const CloudPoint& p : points) stats.add(p);
-  if (points.size() <= options.blockSize) {
+  if (points.size() <= shared.options.blockSize) {
     PointBlock block;
     block.name = name;
-    block.path = file.path();
+    block.path = shared.files.points.path();
     block.first = first;
     block.count = points.size();
     block.bounds = stats.bounds;
     block.centroid = centroidOf(stats.sum, stats.count);
-    Status written;
-    if (options.blockSink && !cancelRequested()) written = options.blockSink(points, block);
-    if (written.ok()) written = file.writeAt(at(first), points.data(), points.size_bytes());
-    std::lock_guard lock(blocks.mutex);
-    if (!written.ok() && blocks.status.ok()) blocks.status = written;
-    blocks.named.emplace_back(std::move(name), std::move(block));
+    const Status written = finishBlock(points, ids, block, shared);
+    std::lock_guard lock(shared.blocks.mutex);
+    if (!written.ok() && shared.blocks.status.ok()) shared.blocks.status = written;
+    shared.blocks.named.emplace_back(std::move(name), std::move(block));
     return;
   }
   const std::size_t below =
-      splitPoints(points, centroidSplit(stats.bounds, centroidOf(stats.sum, stats.count)));
+      splitPoints(points, centroidSplit(stats.bounds, centroidOf(stats.sum, stats.count)), ids);
+  const auto half = [&](std::span<std::uint32_t> s, bool low) {
+    if (s.empty()) return s;
+    return low ? s.first(below) : s.subspan(below);
+  };
   tbb::task_group group;
-  group.run([&] { splitInMemory(points.first(below), first, name + "0", options, file, blocks); });
-  splitInMemory(points.subspan(below), first + below, name + "1", options, file, blocks);
+  group.run(
+      [&] { splitInMemory(points.first(below), half(ids, true), first, name + "0", shared); });
+  splitInMemory(points.subspan(below), half(ids, false), first + below, name + "1", shared);
   group.wait();
 }
 
@@ -217,7 +305,7 @@ void splitInMemory(std::span<CloudPoint> points, std::uint64_t first, std::strin
 // level's nodes in parallel (each pass streams its own range); what is left, in split-tree
 // order, fits in memory (or could not be split by streaming: every point on one side).
 Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t inMemory,
-                                                  const WorkFile& file, Partition& partition) {
+                                                  const WorkFiles& files, Partition& partition) {
   // About one pass over every point per level: levels halve the nodes until they fit.
   int levels = 0;
   for (std::uint64_t n = root.count; n > inMemory; n = (n + 1) / 2) ++levels;
@@ -228,7 +316,7 @@ Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t i
     std::vector<std::optional<Result<std::array<PartNode, 2>>>> halves(level.size());
     tbb::parallel_for(std::size_t{0}, level.size(), [&](std::size_t i) {
       if (level[i].count > inMemory && !cancelRequested())
-        halves[i] = splitInPlace(level[i], file, progress);
+        halves[i] = splitInPlace(level[i], files, progress);
     });
     LODFORGE_TRY(checkCancelled());
     std::vector<PartNode> next;
@@ -261,19 +349,46 @@ SplitPlane centroidSplit(const Aabbd& bounds, Vec3d centroid) {
   return {axis, centroid[axis]};
 }
 
-std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane) {
-  const auto middle = std::partition(points.begin(), points.end(), [&](const CloudPoint& p) {
-    return p.position[plane.axis] < plane.value;
-  });
-  std::size_t below = static_cast<std::size_t>(middle - points.begin());
-  if ((below == 0 || below == points.size()) && points.size() >= 2) {
-    below = points.size() / 2;
-    std::nth_element(points.begin(), points.begin() + static_cast<std::ptrdiff_t>(below),
-                     points.end(), [&](const CloudPoint& a, const CloudPoint& b) {
-                       return a.position[plane.axis] < b.position[plane.axis];
-                     });
+std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
+                        std::span<std::uint32_t> ids) {
+  assert(ids.empty() || ids.size() == points.size());
+  const auto below = [&](std::size_t i) { return points[i].position[plane.axis] < plane.value; };
+  const auto swap = [&](std::size_t i, std::size_t j) {
+    std::swap(points[i], points[j]);
+    if (!ids.empty()) std::swap(ids[i], ids[j]);
+  };
+  // Hoare's partition, as std::partition does it (the same order), moving the ids too.
+  std::size_t i = 0, j = points.size();
+  while (true) {
+    while (i < j && below(i)) ++i;
+    while (i < j && !below(j - 1)) --j;
+    if (i >= j) break;
+    swap(i++, --j);
   }
-  return below;
+  std::size_t count = i;
+  if ((count == 0 || count == points.size()) && points.size() >= 2) {
+    count = points.size() / 2;
+    const auto byAxis = [&](const CloudPoint& a, const CloudPoint& b) {
+      return a.position[plane.axis] < b.position[plane.axis];
+    };
+    if (ids.empty()) {
+      std::nth_element(points.begin(), points.begin() + static_cast<std::ptrdiff_t>(count),
+                       points.end(), byAxis);
+    } else {
+      std::vector<std::uint32_t> order(points.size());
+      std::iota(order.begin(), order.end(), 0u);
+      std::nth_element(
+          order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count), order.end(),
+          [&](std::uint32_t a, std::uint32_t b) { return byAxis(points[a], points[b]); });
+      const std::vector<CloudPoint> was(points.begin(), points.end());
+      const std::vector<std::uint32_t> wasIds(ids.begin(), ids.end());
+      for (std::size_t k = 0; k < order.size(); ++k) {
+        points[k] = was[order[k]];
+        ids[k] = wasIds[order[k]];
+      }
+    }
+  }
+  return count;
 }
 
 Result<std::vector<CloudPoint>> readPointRecords(const std::string& path, std::uint64_t first,
@@ -287,33 +402,59 @@ Result<std::vector<CloudPoint>> readPointRecords(const std::string& path, std::u
   return points;
 }
 
+Result<std::vector<std::byte>> readExtraRecords(const std::string& path, std::uint32_t stride,
+                                                std::uint64_t first, std::uint64_t count) {
+  Result<ByteSource> in = ByteSource::openFile(path);
+  if (!in) return in.status();
+  std::vector<std::byte> extras(count * stride);
+  if (!in->skip(first * stride) || !in->read(extras.data(), extras.size()))
+    return ioError(path, "work file is shorter than expected");
+  return extras;
+}
+
 Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options) {
   assert(options.blockSize > 0 && !options.workDirectory.empty());
   Partition partition;
   const std::string path = options.workDirectory + "/b.points";
-  Result<PartNode> root = readInput(input, path, options, partition);
+  const std::string extrasPath = options.workDirectory + "/b.extras";
+  Result<PartNode> root = readInput(input, path, extrasPath, options, partition);
   if (!root) return root.status();
   partition.pointCount = root->count;
   partition.bounds = root->bounds;
+  const std::size_t stride = partition.info.extras.stride;
+  if (stride != 0) partition.extrasPath = extrasPath;
   Result<WorkFile> file = WorkFile::open(path);
   if (!file) return file.status();
+  std::optional<WorkFile> extrasFile;
+  if (stride != 0) {
+    Result<WorkFile> opened = WorkFile::open(extrasPath);
+    if (!opened) return opened.status();
+    extrasFile.emplace(std::move(*opened));
+  }
+  const WorkFiles files{*file, extrasFile ? &*extrasFile : nullptr, stride};
+  // A point in memory: its record, and with extras their bytes twice (read, gathered) and an id.
+  const std::uint64_t pointBytes = sizeof(CloudPoint) + (stride == 0 ? 0 : 2 * stride + 4);
   const std::uint64_t inMemory =
-      std::max<std::uint64_t>(options.blockSize, options.memoryBytes / sizeof(CloudPoint));
+      std::max<std::uint64_t>(options.blockSize, options.memoryBytes / pointBytes);
   Result<std::vector<PartNode>> nodes =
-      splitStreamedLevels(std::move(*root), inMemory, *file, partition);
+      splitStreamedLevels(std::move(*root), inMemory, files, partition);
   if (!nodes) return nodes.status();
   // Then one node at a time in memory (so that only one is held), its halves in parallel.
   Blocks blocks;
   Progress progress("points: partition", partition.pointCount);
   // One buffer for the biggest node (growing it node by node would hold two at once).
-  std::vector<CloudPoint> points;
+  Records records{stride, {}, {}};
+  std::vector<std::uint32_t> ids;
   std::uint64_t biggest = 0;
   for (const PartNode& node : *nodes) biggest = std::max(biggest, node.count);
-  points.reserve(static_cast<std::size_t>(biggest));
+  records.points.reserve(static_cast<std::size_t>(biggest));
+  records.extras.reserve(static_cast<std::size_t>(biggest) * stride);
   for (const PartNode& node : *nodes) {
-    points.resize(static_cast<std::size_t>(node.count));
-    LODFORGE_TRY(file->readAt(at(node.first), points.data(), points.size() * sizeof(CloudPoint)));
-    splitInMemory(points, node.first, node.name, options, *file, blocks);
+    LODFORGE_TRY(records.read(files, node.first, static_cast<std::size_t>(node.count)));
+    ids.resize(stride == 0 ? 0 : records.size());
+    std::iota(ids.begin(), ids.end(), 0u);
+    splitInMemory(records.points, ids, node.first, node.name,
+                  InMemory{options, files, records.extras, blocks});
     if (!blocks.status.ok()) return blocks.status;
     progress.advance(node.count);
     LODFORGE_TRY(checkCancelled());

@@ -19,7 +19,8 @@
 namespace lodforge {
 
 // One point in the work files (64 bytes): double position, normal (zero when the input has
-// none), colour (white when it has none), lidar attributes (zero when it has none).
+// none), colour (white when it has none), lidar attributes (zero when it has none). Extra fields
+// travel in a second work file, moved in step.
 struct CloudPoint {
   Vec3d position;
   Vec3f normal;
@@ -49,11 +50,16 @@ struct PartitionOptions {
   std::function<bool(Vec3d, Vec3d&)> transform;
   // Called with each finished block's points while they are in memory, from several threads
   // at once; it may reorder them, and they are written back to the work file as it left them.
-  std::function<Status(std::span<CloudPoint>, PointBlock&)> blockSink;
+  // With extra fields it gets one id per point and must reorder them with the points (so the
+  // extras can follow); without, the ids are empty.
+  std::function<Status(std::span<CloudPoint>, std::span<std::uint32_t> ids, PointBlock&)> blockSink;
 };
 
 struct Partition {
   PointCloudInfo info;
+  // The work file of the points' extra bytes (info.extras.stride each) when they have any:
+  // record i belongs to record i of the blocks' file.
+  std::string extrasPath;
   std::vector<PointBlock> blocks;  // depth-first, lower side first
   std::uint64_t pointCount = 0;
   Aabbd bounds;
@@ -70,12 +76,17 @@ SplitPlane centroidSplit(const Aabbd& bounds, Vec3d centroid);
 
 // Reorders `points` so that those below the plane come first and returns how many they are. When
 // every point falls on one side (coincident coordinates), splits at the median along the axis
-// instead, so both sides are non-empty whenever there are two points or more.
-std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane);
+// instead, so both sides are non-empty whenever there are two points or more. `ids`, if given
+// (one per point), is reordered with them.
+std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
+                        std::span<std::uint32_t> ids = {});
 
 // Records [first, first + count) of a work file of CloudPoints (a block's, say).
 Result<std::vector<CloudPoint>> readPointRecords(const std::string& path, std::uint64_t first,
                                                  std::uint64_t count);
+// The same records' extra bytes from the extras work file.
+Result<std::vector<std::byte>> readExtraRecords(const std::string& path, std::uint32_t stride,
+                                                std::uint64_t first, std::uint64_t count);
 
 Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options);
 

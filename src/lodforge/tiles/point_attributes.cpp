@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
+#include <cctype>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -21,15 +24,16 @@ struct Named {
   const char* name;
   std::uint32_t bit;
 };
-constexpr std::array<Named, 9> kNames = {{{"classification", kAttrClassification},
-                                          {"intensity", kAttrIntensity},
-                                          {"returns", kAttrReturns},
-                                          {"flags", kAttrFlags},
-                                          {"scan-angle", kAttrScanAngle},
-                                          {"user-data", kAttrUserData},
-                                          {"point-source", kAttrPointSource},
-                                          {"gps-time", kAttrGpsTime},
-                                          {"nir", kAttrNir}}};
+constexpr std::array<Named, 10> kNames = {{{"classification", kAttrClassification},
+                                           {"intensity", kAttrIntensity},
+                                           {"returns", kAttrReturns},
+                                           {"flags", kAttrFlags},
+                                           {"scan-angle", kAttrScanAngle},
+                                           {"user-data", kAttrUserData},
+                                           {"point-source", kAttrPointSource},
+                                           {"gps-time", kAttrGpsTime},
+                                           {"nir", kAttrNir},
+                                           {"extras", kAttrExtras}}};
 
 // Each value in 4 bytes (glTF aligns vertex attribute elements to 4); GPS time as a float from
 // the tile's first whole second, which the property attribute's offset adds back.
@@ -50,6 +54,73 @@ std::vector<std::byte> packField(const Field& field, std::span<const CloudPoint>
     }
   }
   return bytes;
+}
+
+// How an extra field goes into a tile: 8- and 16-bit integers as they are stored (their glTF
+// component type), the rest as FLOAT32 of value − offset.
+struct ExtraColumn {
+  int componentType = kFloat;
+  const char* metadataType = "FLOAT32";
+  double offset = 0;  // the tile's least whole value, where a float would lose digits
+};
+
+ExtraColumn extraColumn(const ExtraField& field, const PointTileExtras& extras, std::size_t count) {
+  const std::uint32_t stride = extras.layout->stride;
+  if (!field.scaled()) {
+    switch (field.type) {
+      case ExtraType::kInt8:
+        return {5120, "INT8", 0};
+      case ExtraType::kUint8:
+        return {kUnsignedByte, "UINT8", 0};
+      case ExtraType::kInt16:
+        return {5122, "INT16", 0};
+      case ExtraType::kUint16:
+        return {kUnsignedShort, "UINT16", 0};
+      case ExtraType::kFloat32:
+        return {};
+      default:
+        break;
+    }
+  }
+  double least = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::byte* point = extras.bytes.data() + i * stride;
+    if (field.noData && extraRaw(point, field) == *field.noData) continue;
+    least = std::min(least, extraValue(point, field));
+  }
+  return {kFloat, "FLOAT32", std::isfinite(least) ? std::floor(least) : 0.0};
+}
+
+std::vector<std::byte> packExtra(const ExtraField& field, const ExtraColumn& column,
+                                 const PointTileExtras& extras, std::size_t count) {
+  const std::uint32_t stride = extras.layout->stride;
+  std::vector<std::byte> bytes(4 * count);
+  const std::size_t size = column.componentType == kFloat ? 4 : extraTypeSize(field.type);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::byte* point = extras.bytes.data() + i * stride;
+    if (column.componentType != kFloat) {
+      std::memcpy(bytes.data() + 4 * i, point + field.offset, size);
+    } else {
+      const auto f = static_cast<float>(extraValue(point, field) - column.offset);
+      std::memcpy(bytes.data() + 4 * i, &f, 4);
+    }
+  }
+  return bytes;
+}
+
+// The class property of an extra field, its no-data value as the tile stores it.
+nlohmann::json extraProperty(const ExtraField& field, const ExtraColumn& column) {
+  nlohmann::json property = {{"type", "SCALAR"}, {"componentType", column.metadataType}};
+  if (!field.description.empty()) property["description"] = field.description;
+  if (field.noData) {
+    if (column.componentType == kFloat) {
+      property["noData"] =
+          static_cast<float>(*field.noData * field.scale + field.add - column.offset);
+    } else {
+      property["noData"] = *field.noData;
+    }
+  }
+  return property;
 }
 
 nlohmann::json classificationEnum(std::span<const CloudPoint> points) {
@@ -119,19 +190,19 @@ std::string asprsClassName(std::uint8_t classification) {
   return fmt::format("Class {}", classification);
 }
 
-PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std::uint32_t mask) {
+PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std::uint32_t mask,
+                                        PointTileExtras extras) {
   PointTileAttributes out;
   if (mask == 0 || points.empty()) return out;
   double firstSecond = points.front().attributes.gpsTime;
   for (const CloudPoint& p : points) firstSecond = std::min(firstSecond, p.attributes.gpsTime);
   firstSecond = std::floor(firstSecond);
-  nlohmann::json properties, mapped;
-  std::vector<const Field*> chosen;
+  nlohmann::json properties = nlohmann::json::object(), mapped = nlohmann::json::object();
   for (const Field& field : pointAttributeFields()) {
     if ((mask & field.bit) == 0) continue;
     const bool time = field.bit == kAttrGpsTime;
-    chosen.push_back(&field);
     out.data.push_back(packField(field, points, time ? firstSecond : 0));
+    out.attributes.push_back({field.semantic, field.componentType, {}});
     properties[field.property] =
         field.bit == kAttrClassification
             ? nlohmann::json{{"type", "ENUM"}, {"enumType", "classification"}}
@@ -139,9 +210,25 @@ PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std:
     mapped[field.property] = {{"attribute", field.semantic}};
     if (time) mapped[field.property]["offset"] = firstSecond;
   }
+  if ((mask & kAttrExtras) != 0 && extras.layout != nullptr) {
+    assert(extras.bytes.size() == points.size() * extras.layout->stride);
+    const std::vector<std::string> names = extraPropertyNames(*extras.layout);
+    for (std::size_t f = 0; f < names.size(); ++f) {
+      const ExtraField& field = extras.layout->fields[f];
+      const ExtraColumn column = extraColumn(field, extras, points.size());
+      std::string semantic = "_" + names[f];
+      std::transform(semantic.begin(), semantic.end(), semantic.begin(),
+                     [](char c) { return static_cast<char>(std::toupper(c)); });
+      out.data.push_back(packExtra(field, column, extras, points.size()));
+      out.attributes.push_back({semantic, column.componentType, {}});
+      properties[names[f]] = extraProperty(field, column);
+      mapped[names[f]] = {{"attribute", semantic}};
+      if (column.offset != 0) mapped[names[f]]["offset"] = column.offset;
+    }
+  }
+  if (out.attributes.empty()) return out;
   // Spans into `data`, complete now.
-  for (std::size_t i = 0; i < chosen.size(); ++i)
-    out.attributes.push_back({chosen[i]->semantic, chosen[i]->componentType, out.data[i]});
+  for (std::size_t i = 0; i < out.attributes.size(); ++i) out.attributes[i].data = out.data[i];
   nlohmann::json schema = {
       {"id", "lodforge_lidar"},
       {"classes", {{"lidar", {{"name", "Lidar point"}, {"properties", properties}}}}}};
@@ -151,6 +238,28 @@ PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std:
       {"schema", schema}, {"propertyAttributes", {{{"class", "lidar"}, {"properties", mapped}}}}};
   out.metadata = metadata.dump();
   return out;
+}
+
+std::vector<std::string> extraPropertyNames(const PointExtras& extras) {
+  std::set<std::string> taken;  // upper case
+  const auto upper = [](std::string s) {
+    std::transform(s.begin(), s.end(), s.begin(),
+                   [](char c) { return static_cast<char>(std::toupper(c)); });
+    return s;
+  };
+  for (const Field& field : pointAttributeFields()) taken.insert(upper(field.property));
+  std::vector<std::string> names;
+  for (const ExtraField& field : extras.fields) {
+    std::string name = field.name.empty() ? "extra" : field.name;
+    for (char& c : name)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') c = '_';
+    if (std::isdigit(static_cast<unsigned char>(name.front()))) name = "_" + name;
+    std::string unique = name;
+    for (int n = 2; taken.count(upper(unique)) != 0; ++n) unique = fmt::format("{}_{}", name, n);
+    taken.insert(upper(unique));
+    names.push_back(std::move(unique));
+  }
+  return names;
 }
 
 Result<std::uint32_t> parsePointAttributes(const std::string& list) {

@@ -12,6 +12,7 @@
 
 #include "lodforge/core/status.h"
 #include "lodforge/io/glb_writer.h"
+#include "lodforge/io/point_extras.h"
 #include "lodforge/points/partition.h"
 
 namespace lodforge {
@@ -34,8 +35,22 @@ struct PointTileAttributes {
   std::string metadata;  // the EXT_structural_metadata object; empty without attributes
 };
 
-// The fields `mask` (PointAttributeBit) names, of `points`.
-PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std::uint32_t mask);
+// The extra fields of the same points: their layout and `stride` bytes a point.
+struct PointTileExtras {
+  const PointExtras* layout = nullptr;
+  std::span<const std::byte> bytes;
+};
+
+// The fields `mask` (PointAttributeBit) names, of `points`; with kAttrExtras, also every extra
+// field (8- and 16-bit integers as they are, the others as FLOAT32 of their scaled value, from
+// the tile's least whole value where the type is wider than a float holds exactly).
+PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std::uint32_t mask,
+                                        PointTileExtras extras = {});
+
+// The property names extra fields take in tiles: the field's name with each character other
+// than a letter, digit or '_' made '_' (and '_' before a leading digit), unique among the lidar
+// properties and each other regardless of case (their attribute is "_" + the name upper-cased).
+std::vector<std::string> extraPropertyNames(const PointExtras& extras);
 
 // The names `--attributes` takes, as PointAttributeBits ("all" and "none" too); bad input names
 // the unknown one.

@@ -57,12 +57,12 @@ struct BlockTiles {
 
 // Sorts the block's points by key (the partition writes them back in that order) and writes
 // the keys beside.
-Status rankBlock(std::span<CloudPoint> points, const PointBlock& block, bool hasNormals,
-                 const PointTilesOptions& options, const std::string& workDirectory,
-                 BlockTiles& out) {
+Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
+                 const PointBlock& block, bool hasNormals, const PointTilesOptions& options,
+                 const std::string& workDirectory, BlockTiles& out) {
   std::vector<std::uint32_t> firstPoint;
-  const std::vector<ClusterNode> tree =
-      tileErrorTree(clusterBlock(points, block.centroid, hasNormals, options.cluster, &firstPoint));
+  const std::vector<ClusterNode> tree = tileErrorTree(
+      clusterBlock(points, block.centroid, hasNormals, options.cluster, &firstPoint, ids));
   const std::vector<std::uint32_t> reps =
       clusterRepresentatives(tree, points, firstPoint, block.centroid);
   const std::vector<float> key = pointKeys(tree, reps);
@@ -75,10 +75,12 @@ Status rankBlock(std::span<CloudPoint> points, const PointBlock& block, bool has
     order[i] = std::uint64_t{~std::bit_cast<std::uint32_t>(key[i])} << 32 | i;
   std::sort(order.begin(), order.end());
   const std::vector<CloudPoint> unsorted(points.begin(), points.end());
+  const std::vector<std::uint32_t> unsortedIds(ids.begin(), ids.end());
   std::vector<float> sortedKeys(points.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
     const auto from = static_cast<std::uint32_t>(order[i]);
     points[i] = unsorted[from];
+    if (!ids.empty()) ids[i] = unsortedIds[from];
     sortedKeys[i] = key[from];
   }
   out.path = block.path;
@@ -180,17 +182,22 @@ struct TileNode {
   std::string uri;           // empty when it has no content
 };
 
-// What a tile's GLB carries besides positions and normals: colours, and the lidar attributes.
+// What a tile's GLB carries besides positions and normals: colours, the lidar attributes and
+// the extra fields (from their work file).
 struct ContentFields {
   bool colors = false;
   std::uint32_t attributes = 0;  // PointAttributeBit
+  const PointExtras* extras = nullptr;
+  std::string extrasPath;
 };
 
 Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
                     const PointTilesOptions& options, ContentFields fields,
                     const std::string& path) {
   const bool colors = fields.colors;
+  const bool extras = (fields.attributes & kAttrExtras) != 0 && fields.extras != nullptr;
   std::vector<CloudPoint> points;
+  std::vector<std::byte> extraBytes;
   points.reserve(node.points);
   for (std::size_t b : node.blocks) {
     const BlockTiles& block = blocks[b];
@@ -200,6 +207,11 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
     Result<std::vector<CloudPoint>> section = readPointRecords(block.path, first, block.counts[d]);
     if (!section) return section.status();
     points.insert(points.end(), section->begin(), section->end());
+    if (!extras) continue;
+    Result<std::vector<std::byte>> bytes =
+        readExtraRecords(fields.extrasPath, fields.extras->stride, first, block.counts[d]);
+    if (!bytes) return bytes.status();
+    extraBytes.insert(extraBytes.end(), bytes->begin(), bytes->end());
   }
   Aabbd content;
   for (const CloudPoint& p : points) content.add(p.position);
@@ -211,7 +223,8 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
     normals[i] = toYUp(normalizeOr(points[i].normal, Vec3f{0, 0, 1}));
     if (colors) rgba[i] = points[i].color;
   }
-  const PointTileAttributes lidar = pointTileAttributes(points, fields.attributes);
+  const PointTileAttributes lidar =
+      pointTileAttributes(points, fields.attributes, {fields.extras, extraBytes});
   Result<GlbWriter> writer = GlbWriter::create(
       path,
       {.doubleSided = false, .meshoptCompression = options.meshoptCompression, .flatScene = true});
@@ -408,9 +421,10 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   // files written and read back), as many at once as the memory plan allows.
   std::mutex ranked;
   std::map<std::string, BlockTiles> byName;
-  partitionOptions.blockSink = [&](std::span<CloudPoint> points, PointBlock& block) {
+  partitionOptions.blockSink = [&](std::span<CloudPoint> points, std::span<std::uint32_t> ids,
+                                   PointBlock& block) {
     BlockTiles tiles;
-    LODFORGE_TRY(rankBlock(points, block, hasNormals, options, work.path, tiles));
+    LODFORGE_TRY(rankBlock(points, ids, block, hasNormals, options, work.path, tiles));
     std::lock_guard lock(ranked);
     byName[block.name] = std::move(tiles);
     return Status{};
@@ -432,9 +446,11 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   LODFORGE_TRY(countLevels(*partition, *taus, blocks));
 
   std::map<std::string, TileNode> nodes = tileTree(*partition, blocks);
-  Result<std::uint64_t> tiles = writeContents(
-      nodes, blocks, options,
-      {partition->info.hasColors, partition->info.attributes & options.attributes}, staging.path);
+  Result<std::uint64_t> tiles =
+      writeContents(nodes, blocks, options,
+                    {partition->info.hasColors, partition->info.attributes & options.attributes,
+                     &partition->info.extras, partition->extrasPath},
+                    staging.path);
   if (!tiles) return tiles.status();
   stats.tiles = *tiles;
   std::optional<Mat4d> rootTransform;

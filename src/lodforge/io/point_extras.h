@@ -1,0 +1,64 @@
+// A point's fields beyond the ones every stage knows (position, normal, colour, the LAS
+// attributes): a LAS file's extra bytes, as its Extra Bytes record describes them (LAS 1.4 R15,
+// §2.6, record 4 of "LASF_Spec"), or a PLY vertex's other scalar properties. Each point carries
+// them as `stride` raw little-endian bytes; the fields say what lies where.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+enum class ExtraType : std::uint8_t {
+  kInt8,
+  kUint8,
+  kInt16,
+  kUint16,
+  kInt32,
+  kUint32,
+  kInt64,
+  kUint64,
+  kFloat32,
+  kFloat64
+};
+std::size_t extraTypeSize(ExtraType type);
+const char* extraTypeName(ExtraType type);  // "uint16", …
+
+struct ExtraField {
+  std::string name;  // as the file names it
+  std::string description;
+  ExtraType type = ExtraType::kUint8;
+  std::uint32_t offset = 0;      // within a point's extra bytes
+  double scale = 1, add = 0;     // value = raw · scale + add
+  std::optional<double> noData;  // raw value that means "none"
+  bool scaled() const { return scale != 1 || add != 0; }
+};
+
+struct PointExtras {
+  std::vector<ExtraField> fields;
+  std::uint32_t stride = 0;  // bytes a point carries (0: none)
+};
+
+// A field's raw value of the point whose extra bytes start at `point`.
+double extraRaw(const std::byte* point, const ExtraField& field);
+// Its value: raw · scale + add.
+inline double extraValue(const std::byte* point, const ExtraField& field) {
+  return extraRaw(point, field) * field.scale + field.add;
+}
+
+// The fields of a LAS file's Extra Bytes record (192-byte descriptors) over the `available`
+// bytes each record has past its point format's. Undocumented bytes (type 0) are skipped over,
+// LAS 1.3's two- and three-element types become a field per element ("name[1]"); bad input
+// names the file, the byte `at` of the record and the descriptor.
+Result<PointExtras> parseLasExtraBytes(std::span<const std::byte> record, std::uint32_t available,
+                                       const std::string& file, std::uint64_t at);
+
+// One 192-byte descriptor, for writers and tests.
+std::vector<std::byte> lasExtraBytesDescriptor(const ExtraField& field);
+
+}  // namespace lodforge

@@ -5,11 +5,13 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "lodforge/core/memory.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/threads.h"
 
 int main(int argc, char** argv) {
   using namespace lodforge;
+  keepFreedMemoryForReuse();
   CLI::App app{"lodforge: level-of-detail data for massive 3D models", "lodforge"};
   app.set_version_flag("--version", "lodforge " LODFORGE_VERSION);
   app.require_subcommand(1);

@@ -1,5 +1,6 @@
 #include "lodforge/core/memory.h"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -52,6 +53,12 @@ Status MemoryBudget::reserve(std::uint64_t bytes, const char* what) {
     }
   } while (!used_.compare_exchange_weak(current, current + bytes));
   return {};
+}
+
+void keepFreedMemoryForReuse() {
+  constexpr int kKeep = 16 << 20;
+  mallopt(M_MMAP_THRESHOLD, kKeep);
+  mallopt(M_TRIM_THRESHOLD, kKeep);
 }
 
 }  // namespace lodforge

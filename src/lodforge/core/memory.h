@@ -13,6 +13,11 @@ std::uint64_t physicalMemoryBytes();
 std::uint64_t currentRssBytes();
 std::uint64_t peakRssBytes();  // VmHWM: the high-water mark since the process started
 
+// Keeps freed blocks of up to 16 MiB in the allocator instead of unmapping them (glibc's
+// thresholds; its default returns most per-block buffers to the kernel, which then faults and
+// zeroes them again for the next block). Point tiles of 20 M points: 6.9 → 4.9 s of system time.
+void keepFreedMemoryForReuse();
+
 class MemoryBudget {
  public:
   // limit 0 means unlimited.

@@ -32,14 +32,17 @@ struct Summary {
   bool normals = false, colors = false;
   Aabbd bounds;  // world coordinates
   std::uint64_t memoryBytes = 0;
+  nlohmann::json extras;  // a PLY's other vertex properties (ExtraRanges::json)
 };
 
 Result<Summary> summarizePly(const std::string& path, bool salvage) {
   PlyReadOptions options;
   options.salvageTruncated = salvage;
+  options.readExtras = true;
   Result<PlyReader> reader = PlyReader::open(path, options);
   if (!reader) return reader.status();
   const PlyHeader& header = reader->header();
+  ExtraRanges extras(header.extras);
   Summary s;
   s.format = "PLY";
   s.encoding = std::string(plyFormatName(header.format));
@@ -57,12 +60,14 @@ Result<Summary> summarizePly(const std::string& path, bool salvage) {
     s.vertices += batch.positions.size();
     s.triangles += batch.triangles.size() / 3;
     ids.insert(batch.triangleObjects.begin(), batch.triangleObjects.end());
+    extras.add(batch.extras);
     progress.advance(batch.count);
   }
   if (reader->truncation()) {
     fmt::print(stderr, "lodforge: warning: {}; counted what came before\n", *reader->truncation());
   }
   s.objects = header.hasObjectIds ? ids.size() : 1;
+  s.extras = extras.json();
   s.memoryBytes = modelMemoryBytes(s.vertices, s.triangles, s.objects, s.normals, s.colors);
   return s;
 }
@@ -92,6 +97,7 @@ nlohmann::json toJson(const std::string& path, const Summary& s) {
       {"vertices", s.vertices}, {"triangles", s.triangles}, {"objects", s.objects},
       {"normals", s.normals},   {"colors", s.colors},       {"memoryBytes", s.memoryBytes}};
   if (!s.encoding.empty()) j["encoding"] = s.encoding;
+  if (!s.extras.empty()) j["attributes"] = {{"extras", s.extras}};
   if (!s.bounds.empty()) {
     j["bounds"] = {{"min", {s.bounds.min.x, s.bounds.min.y, s.bounds.min.z}},
                    {"max", {s.bounds.max.x, s.bounds.max.y, s.bounds.max.z}}};
@@ -120,6 +126,7 @@ void print(const std::string& path, const Summary& s) {
     fmt::print("bounds     empty\n");
   }
   fmt::print("memory     {} to load\n", formatBytes(s.memoryBytes));
+  if (!s.extras.empty()) printPointAttributes({{"extras", s.extras}});
 }
 
 // A progressive package: counts, levels, and what the LOD bookkeeping costs.

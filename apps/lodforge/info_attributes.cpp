@@ -36,6 +36,51 @@ double shown(const PointAttributeField& field, const PointAttributes& a) {
 
 }  // namespace
 
+ExtraRanges::ExtraRanges(const PointExtras& extras)
+    : extras_(extras),
+      min_(extras.fields.size(), std::numeric_limits<double>::infinity()),
+      max_(extras.fields.size(), -std::numeric_limits<double>::infinity()),
+      noData_(extras.fields.size(), 0) {}
+
+void ExtraRanges::add(std::span<const std::byte> points) {
+  if (extras_.stride == 0) return;
+  for (std::size_t at = 0; at + extras_.stride <= points.size(); at += extras_.stride) {
+    for (std::size_t f = 0; f < extras_.fields.size(); ++f) {
+      const ExtraField& field = extras_.fields[f];
+      if (field.noData && extraRaw(points.data() + at, field) == *field.noData) {
+        ++noData_[f];
+        continue;
+      }
+      const double v = extraValue(points.data() + at, field);
+      min_[f] = std::min(min_[f], v);
+      max_[f] = std::max(max_[f], v);
+    }
+  }
+}
+
+nlohmann::json ExtraRanges::json() const {
+  nlohmann::json list = nlohmann::json::array();
+  for (std::size_t f = 0; f < extras_.fields.size(); ++f) {
+    const ExtraField& field = extras_.fields[f];
+    nlohmann::json entry = {{"name", field.name}, {"type", extraTypeName(field.type)}};
+    if (!field.description.empty()) entry["description"] = field.description;
+    if (field.scaled()) {
+      entry["scale"] = field.scale;
+      entry["offset"] = field.add;
+    }
+    if (min_[f] <= max_[f]) {
+      entry["min"] = min_[f];
+      entry["max"] = max_[f];
+    }
+    if (field.noData) {
+      entry["noData"] = *field.noData;
+      entry["noDataPoints"] = noData_[f];
+    }
+    list.push_back(std::move(entry));
+  }
+  return list;
+}
+
 Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_t fileBytes) {
   Result<PointReader> reader = PointReader::open(path);
   if (!reader) return reader.status();
@@ -43,9 +88,7 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
   const auto fields = pointAttributeFields();
   std::vector<Range> ranges(fields.size());
   std::array<std::uint64_t, 256> classes{};
-  const PointExtras& extras = reader->info().extras;
-  std::vector<Range> extraRanges(extras.fields.size());
-  std::vector<std::uint64_t> noData(extras.fields.size(), 0);
+  ExtraRanges extras(reader->info().extras);
   Progress progress("reading", reader->info().count.value_or(fileBytes / 20));
   PointBatch batch;
   while (true) {
@@ -58,17 +101,7 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
         if ((mask & fields[f].bit) != 0 && ranged(fields[f])) ranges[f].add(shown(fields[f], a));
       ++classes[a.classification];
     }
-    for (std::size_t i = 0; i < batch.size() && extras.stride != 0; ++i) {
-      const std::byte* point = batch.extras.data() + i * extras.stride;
-      for (std::size_t f = 0; f < extras.fields.size(); ++f) {
-        const ExtraField& field = extras.fields[f];
-        if (field.noData && extraRaw(point, field) == *field.noData) {
-          ++noData[f];
-        } else {
-          extraRanges[f].add(extraValue(point, field));
-        }
-      }
-    }
+    extras.add(batch.extras);
     progress.advance(batch.size());
   }
   progress.finish();
@@ -76,28 +109,7 @@ Result<nlohmann::json> scanPointAttributes(const std::string& path, std::uint64_
   for (std::size_t f = 0; f < fields.size(); ++f)
     if (ranges[f].min <= ranges[f].max)
       j[fields[f].property] = {{"min", ranges[f].min}, {"max", ranges[f].max}};
-  if (!extras.fields.empty()) {
-    nlohmann::json list = nlohmann::json::array();
-    for (std::size_t f = 0; f < extras.fields.size(); ++f) {
-      const ExtraField& field = extras.fields[f];
-      nlohmann::json entry = {{"name", field.name}, {"type", extraTypeName(field.type)}};
-      if (!field.description.empty()) entry["description"] = field.description;
-      if (field.scaled()) {
-        entry["scale"] = field.scale;
-        entry["offset"] = field.add;
-      }
-      if (extraRanges[f].min <= extraRanges[f].max) {
-        entry["min"] = extraRanges[f].min;
-        entry["max"] = extraRanges[f].max;
-      }
-      if (field.noData) {
-        entry["noData"] = *field.noData;
-        entry["noDataPoints"] = noData[f];
-      }
-      list.push_back(std::move(entry));
-    }
-    j["extras"] = std::move(list);
-  }
+  if (nlohmann::json list = extras.json(); !list.empty()) j["extras"] = std::move(list);
   if ((mask & kAttrClassification) != 0) {
     nlohmann::json counts = nlohmann::json::object();
     for (std::size_t c = 0; c < classes.size(); ++c)

@@ -537,6 +537,19 @@ TEST(CliPoints, ExtraBytesAreListedAndCarried) {
   o = lodforge("tiles " + dir.file("e.las") + " -o " + dir.file("n") + " --attributes none", dir);
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_EQ(test::readFile(dir.file("n/tiles/b.glb")).find("_ECHO_WIDTH"), std::string::npos);
+  // A PLY's other vertex properties likewise.
+  test::writeFile(dir.file("l.ply"),
+                  "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                  "property float z\nproperty uchar label\nproperty int segment_index\n"
+                  "end_header\n0 0 0 1 10\n1 0 0 2 11\n0 1 0 3 -12\n");
+  o = lodforge("info " + dir.file("l.ply") + " --json", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const nlohmann::json plyExtras = nlohmann::json::parse(o.out)["attributes"]["extras"];
+  ASSERT_EQ(plyExtras.size(), 2u);
+  EXPECT_EQ(plyExtras[1]["name"], "segment_index");
+  EXPECT_EQ(plyExtras[1]["type"], "int32");
+  EXPECT_EQ(plyExtras[1]["min"], -12);
+  EXPECT_EQ(plyExtras[1]["max"], 11);
   o = lodforge("generate points --points 5K --extra-bytes -o " + dir.file("e.ply"), dir);
   EXPECT_NE(o.code, 0);
   EXPECT_NE(o.err.find("--extra-bytes needs a .las output"), std::string::npos) << o.err;

@@ -7,11 +7,13 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace lodforge;
   const std::span<const std::byte> bytes(reinterpret_cast<const std::byte*>(data), size);
-  // Strict, then salvaging with tiny batches (exercises batch edges and truncation recovery).
+  // Strict, then salvaging with tiny batches (exercises batch edges and truncation recovery)
+  // and packing the other vertex properties as extra fields.
   fuzz::check(readPlyFromMemory(bytes, "fuzz.ply"), "fuzz.ply");
   PlyReadOptions options;
   options.batchSize = 3;
   options.salvageTruncated = true;
+  options.readExtras = true;
   fuzz::check(readPlyFromMemory(bytes, "fuzz.ply", options), "fuzz.ply");
   return 0;
 }

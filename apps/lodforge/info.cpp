@@ -229,6 +229,7 @@ Status describePointFile(const std::string& path, bool json, bool headerOnly) {
     j["software"] = h.generatingSoftware;
     count = h.pointCount;
     bounds = h.bounds;
+    if (!h.extrasIgnored.empty()) j["warnings"] = {h.extrasIgnored};
     if (!headerOnly) {
       Result<nlohmann::json> attributes = scanPointAttributes(path, *bytes);
       if (!attributes) return attributes.status();
@@ -288,6 +289,9 @@ Status describePointFile(const std::string& path, bool json, bool headerOnly) {
                                   : crs.size() > 100 ? crs.substr(0, 97) + "..."
                                                      : crs);
   if (j.contains("attributes")) printPointAttributes(j["attributes"]);
+  if (j.contains("warnings"))
+    for (const auto& warning : j["warnings"])
+      fmt::print("warning    {}\n", warning.get<std::string>());
   return {};
 }
 

@@ -164,6 +164,8 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
   points.attributes = *attributes;
   Result<PointTilesStats> stats = writePointTiles(options.input, options.output, points);
   if (!stats) return stats.status();
+  for (const std::string& warning : stats->warnings)
+    fmt::print(stderr, "lodforge: warning: {}\n", warning);
   warnIfNotPlaced(global, !stats->crs.empty() || points.origin.has_value());
   say(global,
       fmt::format("wrote {}: a point tileset of {} points in {} tiles ({} blocks, depth {}), "

@@ -35,7 +35,8 @@ void put(std::string& s, std::size_t at, T value) {
 // A LAS file built field by field (the layout of LAS 1.4 R15, Tables 3, 4 and 7–17).
 std::string makeLas(int minor, int format, const std::vector<LasPoint>& points,
                     const std::vector<Record>& vlrs = {}, const std::vector<Record>& evlrs = {},
-                    Vec3d scale = {0.01, 0.01, 0.01}, Vec3d offset = {1000, 2000, 0}) {
+                    Vec3d scale = {0.01, 0.01, 0.01}, Vec3d offset = {1000, 2000, 0},
+                    std::uint16_t extraBytes = 0) {
   const std::size_t headerSize = minor >= 4 ? 375 : minor == 3 ? 235 : 227;
   std::string s(headerSize, '\0');
   std::memcpy(s.data(), "LASF", 4);
@@ -48,7 +49,7 @@ std::string makeLas(int minor, int format, const std::vector<LasPoint>& points,
   put<std::uint32_t>(s, 96, static_cast<std::uint32_t>(headerSize + vlrBytes));
   put<std::uint32_t>(s, 100, static_cast<std::uint32_t>(vlrs.size()));
   s[104] = static_cast<char>(format);
-  const std::uint16_t length = lasRecordSize(format);
+  const auto length = static_cast<std::uint16_t>(lasRecordSize(format) + extraBytes);
   put<std::uint16_t>(s, 105, length);
   put<std::uint32_t>(s, 107, minor >= 4 ? 0u : static_cast<std::uint32_t>(points.size()));
   for (int k = 0; k < 3; ++k) {
@@ -466,6 +467,61 @@ TEST(LasExtraBytes, DescriptorsGiveTypesOffsetsScalesAndNoData) {
   EXPECT_NE(badType.error().message.find("data type 31"), std::string::npos);
   EXPECT_FALSE(
       parseLasExtraBytes(bytesOf(descriptor(9, 8, "zero", {0, 1, 1})), 4, "f.las", 0).ok());
+  // Arrays take each element's scale and offset; a no-data value the type cannot hold (300 for
+  // a uint8) is dropped; a float's is the float it would be stored as; names are made printable.
+  const std::string pair = descriptor(13, 8 | 16, "rg", {0.5, 0.25, 1}, {1, 2, 0}) +
+                           descriptor(1, 1, "byte", {1, 1, 1}, {0, 0, 0}, 300) +
+                           descriptor(9, 0, "f\x01\xff");
+  std::string floatNoData = descriptor(9, 1, "level");
+  put(floatNoData, 40, -9999.9);
+  Result<PointExtras> more = parseLasExtraBytes(bytesOf(pair + floatNoData), 13, "f.las", 0);
+  ASSERT_TRUE(more.ok()) << more.error().message;
+  ASSERT_EQ(more->fields.size(), 5u);
+  EXPECT_EQ(more->fields[1].name, "rg[1]");
+  EXPECT_EQ(more->fields[1].scale, 0.25);
+  EXPECT_EQ(more->fields[1].add, 2);
+  EXPECT_EQ(more->fields[1].offset, 2u);
+  EXPECT_FALSE(more->fields[2].noData.has_value());
+  EXPECT_EQ(more->fields[3].name, "f??");
+  ASSERT_TRUE(more->fields[4].noData.has_value());
+  EXPECT_EQ(*more->fields[4].noData, static_cast<double>(-9999.9f));
+}
+
+// A damaged Extra Bytes record costs the extra bytes, not the file: the points are read, and
+// the header says why the extra bytes are not. An EVLR describes them as well as a VLR.
+TEST(LasExtraBytes, ADamagedRecordIsReadPastAndAnExtendedOneIsRead) {
+  test::TempDir dir;
+  const std::vector<LasPoint> points = somePoints(10, 1);
+  const std::string bad = makeLas(2, 1, points, {{"LASF_Spec", 4, std::string(100, '\x01')}});
+  test::writeFile(dir.file("bad.las"), bad);
+  Result<LasReader> reader = LasReader::open(dir.file("bad.las"));
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  EXPECT_TRUE(reader->header().extras.fields.empty());
+  EXPECT_NE(reader->header().extrasIgnored.find("not a whole number of 192-byte descriptors"),
+            std::string::npos)
+      << reader->header().extrasIgnored;
+  EXPECT_EQ(readAll(*reader).size(), 10u);
+  Result<PointReader> common = PointReader::open(dir.file("bad.las"));
+  ASSERT_TRUE(common.ok());
+  ASSERT_EQ(common->info().warnings.size(), 1u);
+  // LAS 1.4 with 2 extra bytes a record, described by an extended record.
+  const std::string evlr = makeLas(4, 6, points, {}, {{"LASF_Spec", 4, descriptor(3, 0, "tag")}},
+                                   {0.01, 0.01, 0.01}, {1000, 2000, 0}, 2);
+  test::writeFile(dir.file("evlr.las"), evlr);
+  Result<PointReader> extended = PointReader::open(dir.file("evlr.las"));
+  ASSERT_TRUE(extended.ok()) << extended.error().message;
+  ASSERT_EQ(extended->info().extras.fields.size(), 1u);
+  EXPECT_EQ(extended->info().extras.fields[0].name, "tag");
+  EXPECT_EQ(extended->info().extras.stride, 2u);
+  PointBatch batch;
+  ASSERT_TRUE(*extended->next(batch));
+  EXPECT_EQ(batch.extras.size(), 20u);
+  // Without extras asked for, none come.
+  Result<PointReader> without = PointReader::open(dir.file("evlr.las"), 1 << 16, false, false);
+  ASSERT_TRUE(without.ok());
+  EXPECT_TRUE(without->info().extras.fields.empty());
+  ASSERT_TRUE(*without->next(batch));
+  EXPECT_TRUE(batch.extras.empty());
 }
 
 // What the writer describes, the reader reads back: the fields and each point's bytes.

@@ -271,6 +271,18 @@ TEST(PlyRead, OtherVertexPropertiesComeAsExtraFields) {
     EXPECT_EQ(extraRaw(e, extras.fields[1]), -300.0 - double(i));
     EXPECT_EQ(extraRaw(e, extras.fields[2]), 0.125 * double(i));
   }
+  // An ascii value that does not fit its property's type is bad input, with its vertex.
+  options.readExtras = true;
+  Result<PlyReader> wide = PlyReader::fromMemory(
+      test::bytesOf("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                    "property float z\nproperty uchar label\nend_header\n0 0 0 7\n1 1 1 300\n"),
+      "w.ply", options);
+  ASSERT_TRUE(wide.ok()) << wide.error().message;
+  Result<bool> bad = wide->next(batch);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("vertex 1: 300 does not fit property 'label' (uint8)"),
+            std::string::npos)
+      << bad.error().message;
   // Without the option (meshes), nothing is packed.
   Result<PlyReader> plain = PlyReader::fromMemory(test::bytesOf(ply + body), "x.ply");
   ASSERT_TRUE(plain.ok());

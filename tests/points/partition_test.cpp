@@ -219,15 +219,17 @@ TEST(Partition, ASinkSeesEveryBlockAndItsOrderIsWrittenBack) {
 }
 
 // A PLY of `points` with one extra property: each point's index in the file (an int, so that
-// the partition carries 4 extra bytes a point).
+// the partition carries 4 extra bytes a point). The index is in the normal's x too, so that
+// coincident points can be told apart.
 void writeIndexedPly(const std::string& path, const std::vector<Vec3d>& points) {
   std::ofstream out(path);
   out.precision(17);
   out << "ply\nformat ascii 1.0\nelement vertex " << points.size()
-      << "\nproperty double x\nproperty double y\nproperty double z\nproperty int index\n"
-         "end_header\n";
+      << "\nproperty double x\nproperty double y\nproperty double z\nproperty float nx\n"
+         "property float ny\nproperty float nz\nproperty int index\nend_header\n";
   for (std::size_t i = 0; i < points.size(); ++i)
-    out << points[i].x << ' ' << points[i].y << ' ' << points[i].z << ' ' << i << '\n';
+    out << points[i].x << ' ' << points[i].y << ' ' << points[i].z << ' ' << i << " 0 1 " << i
+        << '\n';
 }
 
 // Extra fields travel in step with their points through every reorder: the reading pass,
@@ -247,6 +249,7 @@ TEST(Partition, ExtraBytesFollowTheirPointsThroughEveryReorder) {
     PartitionOptions options;
     options.blockSize = 900;
     options.workDirectory = dir.file(fmt::format("w{}", memory));
+    options.carryExtras = true;
     if (memory != 0) options.memoryBytes = memory * sizeof(CloudPoint);
     std::filesystem::create_directories(options.workDirectory);
     std::mutex mutex;
@@ -286,10 +289,20 @@ TEST(Partition, ExtraBytesFollowTheirPointsThroughEveryReorder) {
         ++seen[static_cast<std::size_t>(index)];
         EXPECT_EQ(records[i].position, points[static_cast<std::size_t>(index)])
             << block.name << " record " << i;
+        EXPECT_EQ(records[i].normal.x, static_cast<float>(index)) << block.name << " record " << i;
       }
     }
     EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), static_cast<std::ptrdiff_t>(points.size()));
   }
+  // Not asked for: not read, no second work file.
+  PartitionOptions plain;
+  plain.workDirectory = dir.file("plain");
+  std::filesystem::create_directories(plain.workDirectory);
+  Result<Partition> without = partitionPoints(dir.file("cloud.ply"), plain);
+  ASSERT_TRUE(without.ok()) << without.error().message;
+  EXPECT_EQ(without->info.extras.stride, 0u);
+  EXPECT_TRUE(without->extrasPath.empty());
+  EXPECT_FALSE(std::filesystem::exists(plain.workDirectory + "/b.extras"));
 }
 
 TEST(Partition, SplitsCoincidentPointsByCount) {

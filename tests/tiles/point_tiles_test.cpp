@@ -419,6 +419,14 @@ TEST(PointTiles, CarryTheLasAttributesAsStructuralMetadata) {
   EXPECT_FALSE(gltf.contains("extensions"));
 }
 
+// The offset a tile's property attribute gives property `name` (0 when none).
+double attributeOffset(const std::string& glb, const std::string& name) {
+  nlohmann::json gltf;
+  readPointGlb(glb, &gltf);
+  return gltf["extensions"]["EXT_structural_metadata"]["propertyAttributes"][0]["properties"][name]
+      .value("offset", 0.0);
+}
+
 // The class property `name` of a tile's lidar class.
 nlohmann::json lidarProperty(const std::string& glb, const std::string& name) {
   nlohmann::json gltf;
@@ -479,10 +487,12 @@ TEST(PointTiles, CarryLasExtraBytesWithTheirPoints) {
     const nlohmann::json heightProperty = lidarProperty(glb, "height_above_ground");
     EXPECT_EQ(heightProperty["componentType"], "FLOAT32");
     EXPECT_EQ(heightProperty["description"], "metres above the ground");
+    // noData is the value as stored, before the property attribute's offset.
     const auto none = static_cast<float>(heightProperty["noData"].get<double>());
+    const double offset = attributeOffset(glb, "height_above_ground");
     EXPECT_EQ(lidarProperty(glb, "echo_width")["componentType"], "UINT8");
     for (std::size_t i = 0; i < cls.size(); ++i) {
-      const bool missing = static_cast<float>(height[i]) == none;
+      const bool missing = static_cast<float>(height[i] - offset) == none;
       foundNoHeight += missing;
       found.insert({int(cls[i]), int(intensity[i]),
                     missing ? -1 : int(std::lround(height[i] * 100)), int(echo[i])});
@@ -554,6 +564,39 @@ TEST(PointTiles, CarryPlyPropertiesBeyondPositionNormalAndColour) {
     }
   }
   EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 6000);
+}
+
+// More vertex attributes than WebGL viewers draw: written, with a warning that says what to do.
+TEST(PointTiles, WarnsWhenTilesCarryMoreAttributesThanViewersDraw) {
+  test::TempDir dir;
+  const auto write = [&](const std::string& name, int properties) {
+    std::ofstream out(dir.file(name));
+    out << "ply\nformat ascii 1.0\nelement vertex 300\nproperty float x\nproperty float y\n"
+           "property float z\n";
+    for (int k = 0; k < properties; ++k) out << "property uchar p" << k << "\n";
+    out << "end_header\n";
+    for (int i = 0; i < 300; ++i) {
+      out << i << ' ' << i % 17 << ' ' << i % 5;
+      for (int k = 0; k < properties; ++k) out << ' ' << (i + k) % 256;
+      out << '\n';
+    }
+  };
+  write("few.ply", 14);   // POSITION, NORMAL and 14: 16
+  write("many.ply", 15);  // 17
+  PointTilesOptions options;
+  options.blockSize = 100;
+  Result<PointTilesStats> few = writePointTiles(dir.file("few.ply"), dir.file("f"), options);
+  ASSERT_TRUE(few.ok()) << few.error().message;
+  EXPECT_TRUE(few->warnings.empty());
+  Result<PointTilesStats> many = writePointTiles(dir.file("many.ply"), dir.file("m"), options);
+  ASSERT_TRUE(many.ok()) << many.error().message;
+  ASSERT_EQ(many->warnings.size(), 1u);
+  EXPECT_NE(many->warnings[0].find("17 vertex attributes"), std::string::npos);
+  EXPECT_NE(many->warnings[0].find("--attributes"), std::string::npos);
+  options.attributes = 0;
+  Result<PointTilesStats> none = writePointTiles(dir.file("many.ply"), dir.file("n"), options);
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->warnings.empty());
 }
 
 TEST(PointTiles, ExtraPropertyNamesAreUniqueIdentifiers) {

@@ -139,6 +139,10 @@ LasReader::LasReader(LasReader&&) noexcept = default;
 LasReader& LasReader::operator=(LasReader&&) noexcept = default;
 LasReader::~LasReader() = default;
 
+void LasReader::skipExtraBytes() {
+  state_->header.extras = {};
+}
+
 const LasHeader& LasReader::header() const {
   return state_->header;
 }
@@ -313,7 +317,12 @@ Status LasReader::State::readExtraBytes(std::span<const std::byte> record, std::
   LasHeader& h = header;
   const auto available = static_cast<std::uint32_t>(h.recordLength - lasRecordSize(h.pointFormat));
   Result<PointExtras> extras = parseLasExtraBytes(record, available, source->name(), at);
-  if (!extras) return extras.status();
+  if (!extras) {
+    // The points themselves are fine: read them without the extra bytes, and say why.
+    h.extras = {};
+    h.extrasIgnored = extras.error().message + "; the extra bytes are not carried";
+    return {};
+  }
   h.extras = extras->fields.empty() ? PointExtras{} : std::move(*extras);
   return {};
 }

@@ -45,8 +45,10 @@ struct LasHeader {
   bool copc = false;
   std::uint32_t attributes = 0;  // PointAttributeBit: the lidar fields of the point format
   // The record's bytes past its format's, as the Extra Bytes record describes them (none
-  // carried when no record describes them).
+  // carried when no record describes them, or when the record is damaged: then
+  // `extrasIgnored` says why).
   PointExtras extras;
+  std::string extrasIgnored;
 };
 
 // The smallest record of a point format (0–10), 0 for an unknown format.
@@ -64,6 +66,8 @@ class LasReader {
   ~LasReader();
 
   const LasHeader& header() const;
+  // From now on, batches leave the extra bytes out (header().extras becomes empty).
+  void skipExtraBytes();
   // The next batch of points (positions, the lidar attributes, colours when the format has
   // them, and the extra bytes the header describes); false at the end of the point records.
   Result<bool> next(PointBatch& batch);

@@ -28,6 +28,21 @@ LasWriter::LasWriter(OutputFile out, Vec3d scale, Vec3d offset, std::string soft
 
 Result<LasWriter> LasWriter::create(const std::string& path, Vec3d scale, Vec3d offset,
                                     std::string generatingSoftware, PointExtras extras) {
+  // The descriptors say nothing of offsets: the fields must lie back to back.
+  std::uint32_t end = 0;
+  for (const ExtraField& field : extras.fields) {
+    if (field.offset != end)
+      return Error{ErrorKind::kInternal,
+                   fmt::format("{}: extra field \"{}\" at byte {} does not follow the one before "
+                               "(byte {})",
+                               path, field.name, field.offset, end)};
+    end += static_cast<std::uint32_t>(extraTypeSize(field.type));
+  }
+  if (end != extras.stride || kLasFormat3Size + extras.stride > 0xFFFF ||
+      kDescriptor * extras.fields.size() > 0xFFFF)
+    return Error{ErrorKind::kInternal,
+                 fmt::format("{}: {} extra bytes in {} fields do not make a LAS record", path,
+                             extras.stride, extras.fields.size())};
   Result<OutputFile> out = OutputFile::create(path);
   if (!out) return out.status();
   LasWriter writer(std::move(*out), scale, offset, std::move(generatingSoftware),

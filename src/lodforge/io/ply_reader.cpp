@@ -586,7 +586,7 @@ void PlyReader::State::planExtras(const PlyElement& vertex) {
     if (p.isList || std::find(known.begin(), known.end(), static_cast<int>(i)) != known.end())
       continue;
     ExtraField field;
-    field.name = p.name;
+    field.name = printableText(p.name);
     field.type = extraTypeOf(p.type);
     field.offset = header.extras.stride;
     header.extras.stride += static_cast<std::uint32_t>(extraTypeSize(field.type));
@@ -657,7 +657,12 @@ void PlyReader::State::readVertex(PlyBatch& batch) {
     batch.extras.resize(at + header.extras.stride);
     for (std::size_t k = 0; k < roles.extras.size(); ++k) {
       const ExtraField& field = header.extras.fields[k];
-      storeExtra(batch.extras.data() + at + field.offset, field.type, value(roles.extras[k]));
+      const double v = value(roles.extras[k]);
+      const bool integer = field.type != ExtraType::kFloat32 && field.type != ExtraType::kFloat64;
+      if (integer && !fitsExtraType(v, field.type))  // ascii text can say anything
+        fail(fmt::format("vertex {}: {} does not fit property '{}' ({})", elementDone, v,
+                         field.name, extraTypeName(field.type)));
+      storeExtra(batch.extras.data() + at + field.offset, field.type, v);
     }
   }
 }

@@ -66,6 +66,21 @@ const char* extraTypeName(ExtraType type) {
   return kNames[static_cast<std::size_t>(type)];
 }
 
+bool fitsExtraType(double v, ExtraType type) {
+  if (!std::isfinite(v)) return false;
+  if (isFloat(type)) return type == ExtraType::kFloat64 || std::isfinite(static_cast<float>(v));
+  if (v != std::floor(v)) return false;
+  const std::size_t bits = 8 * extraTypeSize(type);
+  const double top = std::ldexp(1.0, static_cast<int>(isSigned(type) ? bits - 1 : bits));
+  return isSigned(type) ? v >= -top && v < top : v >= 0 && v < top;
+}
+
+std::string printableText(std::string text) {
+  for (char& c : text)
+    if (c < 0x20 || c > 0x7E) c = '?';
+  return text;
+}
+
 double extraRaw(const std::byte* point, const ExtraField& field) {
   const std::byte* at = point + field.offset;
   switch (field.type) {
@@ -108,7 +123,7 @@ Result<PointExtras> parseLasExtraBytes(std::span<const std::byte> record, std::u
     const std::uint64_t where = at + d * kDescriptor;
     const auto dataType = static_cast<std::size_t>(e[kTypeAt]);
     const auto options = static_cast<std::uint8_t>(e[kOptionsAt]);
-    const std::string name = loadText(e + kNameAt, 32);
+    const std::string name = printableText(loadText(e + kNameAt, 32));
     if (dataType > 30)
       return badInputAtByte(
           file, where + kTypeAt,
@@ -127,12 +142,18 @@ Result<PointExtras> parseLasExtraBytes(std::span<const std::byte> record, std::u
     for (std::size_t k = 0; k < elements; ++k) {
       ExtraField field;
       field.name = elements == 1 ? name : fmt::format("{}[{}]", name, k);
-      field.description = loadText(e + kDescriptionAt, 32);
+      field.description = printableText(loadText(e + kDescriptionAt, 32));
       field.type = base;
       field.offset = offset + static_cast<std::uint32_t>(k * extraTypeSize(base));
       if ((options & kHasScale) != 0) field.scale = loadField<double>(e + kScaleAt + 8 * k);
       if ((options & kHasOffset) != 0) field.add = loadField<double>(e + kOffsetAt + 8 * k);
-      if ((options & kHasNoData) != 0) field.noData = anyValue(e + kNoDataAt + 8 * k, base);
+      // A no-data value the type cannot hold matches no point: dropped. A float's is taken as
+      // the float it would be stored as, so that it matches.
+      if ((options & kHasNoData) != 0) {
+        const double noData = anyValue(e + kNoDataAt + 8 * k, base);
+        if (fitsExtraType(noData, base))
+          field.noData = base == ExtraType::kFloat32 ? static_cast<float>(noData) : noData;
+      }
       if (!std::isfinite(field.scale) || field.scale == 0 || !std::isfinite(field.add))
         return badInputAtByte(file, where + kScaleAt,
                               fmt::format("extra bytes \"{}\": scale {} and offset {} are not "

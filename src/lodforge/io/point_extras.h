@@ -35,7 +35,7 @@ struct ExtraField {
   ExtraType type = ExtraType::kUint8;
   std::uint32_t offset = 0;      // within a point's extra bytes
   double scale = 1, add = 0;     // value = raw · scale + add
-  std::optional<double> noData;  // raw value that means "none"
+  std::optional<double> noData;  // raw value that means "none" (one the type can hold)
   bool scaled() const { return scale != 1 || add != 0; }
 };
 
@@ -43,6 +43,12 @@ struct PointExtras {
   std::vector<ExtraField> fields;
   std::uint32_t stride = 0;  // bytes a point carries (0: none)
 };
+
+// Whether `v` is a value of `type` (whole and in range for the integers; finite for floats).
+bool fitsExtraType(double v, ExtraType type);
+
+// A file's text made safe to name a field by (bytes outside printable ASCII become '?').
+std::string printableText(std::string text);
 
 // A field's raw value of the point whose extra bytes start at `point`.
 double extraRaw(const std::byte* point, const ExtraField& field);

@@ -37,10 +37,11 @@ std::optional<std::string> PointReader::truncation() const {
 }
 
 Result<PointReader> PointReader::open(const std::string& path, std::size_t batchSize,
-                                      bool salvageTruncated) {
+                                      bool salvageTruncated, bool extras) {
   const std::string ext = fileExtension(path);
   if (ext == "las" || ext == "laz") {
     Result<LasReader> las = LasReader::open(path, batchSize);
+    if (las && !extras) las->skipExtraBytes();
     if (!las) return las.status();
     const LasHeader& h = las->header();
     PointCloudInfo info;
@@ -56,13 +57,14 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
     info.attributes = h.attributes;
     info.extras = h.extras;
     if (!info.extras.fields.empty()) info.attributes |= kAttrExtras;
+    if (!h.extrasIgnored.empty()) info.warnings.push_back(h.extrasIgnored);
     return PointReader(std::make_unique<State>(State{std::move(*las), std::move(info), {}}));
   }
   if (ext == "ply") {
     PlyReadOptions options;
     options.batchSize = batchSize;
     options.readFaces = false;
-    options.readExtras = true;
+    options.readExtras = extras;
     options.salvageTruncated = salvageTruncated;
     Result<PlyReader> ply = PlyReader::open(path, options);
     if (!ply) return ply.status();

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lodforge/core/status.h"
 #include "lodforge/io/point_batch.h"
@@ -19,8 +20,9 @@ struct PointCloudInfo {
   std::optional<Aabbd> bounds;         // as a LAS header states it
   std::string crs;                     // WKT or "EPSG:N" from a LAS file; empty when unknown
   bool hasNormals = false, hasColors = false;
-  std::uint32_t attributes = 0;  // PointAttributeBit: the lidar fields a LAS or LAZ has
-  PointExtras extras;            // documented extra bytes, other PLY vertex properties
+  std::uint32_t attributes = 0;       // PointAttributeBit: the lidar fields a LAS or LAZ has
+  PointExtras extras;                 // documented extra bytes, other PLY vertex properties
+  std::vector<std::string> warnings;  // what is read past (a damaged Extra Bytes record, …)
 };
 
 // Whether `path` names a point file by its extension (las laz xyz txt csv pts); a PLY may hold
@@ -30,9 +32,10 @@ bool isPointCloudPath(const std::string& path);
 class PointReader {
  public:
   // With `salvageTruncated`, a PLY cut short is read up to its last whole point (truncation()
-  // then says where it was cut); otherwise it is bad input.
+  // then says where it was cut); otherwise it is bad input. Without `extras`, batches carry no
+  // extra fields (and info().extras is empty).
   static Result<PointReader> open(const std::string& path, std::size_t batchSize = 1 << 16,
-                                  bool salvageTruncated = false);
+                                  bool salvageTruncated = false, bool extras = true);
   PointReader(PointReader&&) noexcept;
   PointReader& operator=(PointReader&&) noexcept;
   ~PointReader();

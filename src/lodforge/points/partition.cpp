@@ -7,6 +7,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <limits>
 #include <mutex>
 #include <numeric>
 #include <optional>
@@ -70,6 +71,7 @@ struct Records {
   }
   void push(const Records& from, std::size_t i) {
     points.push_back(from.points[i]);
+    if (stride == 0) return;
     const auto e = from.extras.begin() + static_cast<std::ptrdiff_t>(i * stride);
     extras.insert(extras.end(), e, e + static_cast<std::ptrdiff_t>(stride));
   }
@@ -119,7 +121,8 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
                            const std::string& extrasPath, const PartitionOptions& options,
                            Partition& partition) {
   PointCloudInfo& info = partition.info;
-  Result<PointReader> reader = PointReader::open(input, 1 << 16, options.salvageTruncated);
+  Result<PointReader> reader =
+      PointReader::open(input, 1 << 16, options.salvageTruncated, options.carryExtras);
   if (!reader) return reader.status();
   info = reader->info();
   const std::size_t stride = info.extras.stride;
@@ -374,18 +377,23 @@ std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
     if (ids.empty()) {
       std::nth_element(points.begin(), points.begin() + static_cast<std::ptrdiff_t>(count),
                        points.end(), byAxis);
-    } else {
-      std::vector<std::uint32_t> order(points.size());
-      std::iota(order.begin(), order.end(), 0u);
-      std::nth_element(
-          order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count), order.end(),
-          [&](std::uint32_t a, std::uint32_t b) { return byAxis(points[a], points[b]); });
-      const std::vector<CloudPoint> was(points.begin(), points.end());
-      const std::vector<std::uint32_t> wasIds(ids.begin(), ids.end());
-      for (std::size_t k = 0; k < order.size(); ++k) {
-        points[k] = was[order[k]];
-        ids[k] = wasIds[order[k]];
-      }
+      return count;
+    }
+    const auto [least, most] = std::minmax_element(points.begin(), points.end(), byAxis);
+    if (least->position[plane.axis] == most->position[plane.axis])
+      return count;  // all on one coordinate (the usual case here): any half will do
+    // Otherwise select through an index (rare: rounding put the centroid outside), then move
+    // the points and their ids together.
+    std::vector<std::uint32_t> order(points.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::nth_element(
+        order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count), order.end(),
+        [&](std::uint32_t a, std::uint32_t b) { return byAxis(points[a], points[b]); });
+    const std::vector<CloudPoint> was(points.begin(), points.end());
+    const std::vector<std::uint32_t> wasIds(ids.begin(), ids.end());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      points[k] = was[order[k]];
+      ids[k] = wasIds[order[k]];
     }
   }
   return count;
@@ -434,8 +442,10 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
   const WorkFiles files{*file, extrasFile ? &*extrasFile : nullptr, stride};
   // A point in memory: its record, and with extras their bytes twice (read, gathered) and an id.
   const std::uint64_t pointBytes = sizeof(CloudPoint) + (stride == 0 ? 0 : 2 * stride + 4);
-  const std::uint64_t inMemory =
-      std::max<std::uint64_t>(options.blockSize, options.memoryBytes / pointBytes);
+  // Ids are 32-bit: no node is split in memory with more points than they count.
+  const std::uint64_t inMemory = std::min<std::uint64_t>(
+      std::max<std::uint64_t>(options.blockSize, options.memoryBytes / pointBytes),
+      stride == 0 ? ~std::uint64_t{0} : std::numeric_limits<std::uint32_t>::max());
   Result<std::vector<PartNode>> nodes =
       splitStreamedLevels(std::move(*root), inMemory, files, partition);
   if (!nodes) return nodes.status();
@@ -450,6 +460,11 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
   records.points.reserve(static_cast<std::size_t>(biggest));
   records.extras.reserve(static_cast<std::size_t>(biggest) * stride);
   for (const PartNode& node : *nodes) {
+    if (stride != 0 && node.count > std::numeric_limits<std::uint32_t>::max())
+      return Error{ErrorKind::kLimit,
+                   fmt::format("{}: {} points share one position, more than the 2^32 that can "
+                               "carry extra fields; leave them out with --attributes",
+                               input, node.count)};
     LODFORGE_TRY(records.read(files, node.first, static_cast<std::size_t>(node.count)));
     ids.resize(stride == 0 ? 0 : records.size());
     std::iota(ids.begin(), ids.end(), 0u);

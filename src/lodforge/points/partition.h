@@ -45,6 +45,9 @@ struct PartitionOptions {
   std::uint64_t memoryBytes = std::uint64_t{256} << 20;
   std::string workDirectory;      // must exist
   bool salvageTruncated = false;  // read a PLY cut short up to its last whole point
+  // Carry the input's extra fields (LAS extra bytes, other PLY properties) in a second work file;
+  // without, they are not read.
+  bool carryExtras = false;
   // Applied to every point as it is read (one thread): e.g. a CRS to a local frame. False
   // refuses the point.
   std::function<bool(Vec3d, Vec3d&)> transform;

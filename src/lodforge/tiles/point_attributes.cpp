@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -15,7 +16,8 @@ namespace lodforge {
 
 namespace {
 
-constexpr int kUnsignedByte = 5121, kUnsignedShort = 5123, kFloat = 5126;
+constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123,
+              kFloat = 5126;
 
 using Field = PointAttributeField;
 
@@ -57,67 +59,90 @@ std::vector<std::byte> packField(const Field& field, std::span<const CloudPoint>
 }
 
 // How an extra field goes into a tile: 8- and 16-bit integers as they are stored (their glTF
-// component type), the rest as FLOAT32 of value − offset.
+// component type), the rest as FLOAT32 of value − offset. `noData` is what the tile stores for
+// "none": the field's own no-data value, or for floats without one that are NaN or infinite
+// somewhere (which glTF accessors may not hold) the lowest float.
 struct ExtraColumn {
   int componentType = kFloat;
   const char* metadataType = "FLOAT32";
   double offset = 0;  // the tile's least whole value, where a float would lose digits
+  std::optional<double> noData;
 };
+
+bool isNoData(const std::byte* point, const ExtraField& field) {
+  return field.noData && extraRaw(point, field) == *field.noData;
+}
 
 ExtraColumn extraColumn(const ExtraField& field, const PointTileExtras& extras, std::size_t count) {
   const std::uint32_t stride = extras.layout->stride;
   if (!field.scaled()) {
+    const std::optional<double> raw = field.noData;
     switch (field.type) {
       case ExtraType::kInt8:
-        return {5120, "INT8", 0};
+        return {kByte, "INT8", 0, raw};
       case ExtraType::kUint8:
-        return {kUnsignedByte, "UINT8", 0};
+        return {kUnsignedByte, "UINT8", 0, raw};
       case ExtraType::kInt16:
-        return {5122, "INT16", 0};
+        return {kShort, "INT16", 0, raw};
       case ExtraType::kUint16:
-        return {kUnsignedShort, "UINT16", 0};
-      case ExtraType::kFloat32:
-        return {};
+        return {kUnsignedShort, "UINT16", 0, raw};
       default:
         break;
     }
   }
   double least = std::numeric_limits<double>::infinity();
+  bool nonFinite = false;
   for (std::size_t i = 0; i < count; ++i) {
     const std::byte* point = extras.bytes.data() + i * stride;
-    if (field.noData && extraRaw(point, field) == *field.noData) continue;
-    least = std::min(least, extraValue(point, field));
+    if (isNoData(point, field)) continue;
+    const double v = extraValue(point, field);
+    if (!std::isfinite(v)) {
+      nonFinite = true;
+    } else {
+      least = std::min(least, v);
+    }
   }
-  return {kFloat, "FLOAT32", std::isfinite(least) ? std::floor(least) : 0.0};
+  ExtraColumn column;
+  // A float32 holds its own values exactly; wider types lose digits far from zero.
+  const bool exact = field.type == ExtraType::kFloat32 && !field.scaled();
+  column.offset = exact || !std::isfinite(least) ? 0.0 : std::floor(least);
+  if (field.noData) {
+    column.noData = static_cast<float>(*field.noData * field.scale + field.add - column.offset);
+  } else if (nonFinite) {
+    column.noData = std::numeric_limits<float>::lowest();
+  }
+  return column;
 }
 
 std::vector<std::byte> packExtra(const ExtraField& field, const ExtraColumn& column,
                                  const PointTileExtras& extras, std::size_t count) {
   const std::uint32_t stride = extras.layout->stride;
   std::vector<std::byte> bytes(4 * count);
-  const std::size_t size = column.componentType == kFloat ? 4 : extraTypeSize(field.type);
+  const std::size_t size = extraTypeSize(field.type);
   for (std::size_t i = 0; i < count; ++i) {
     const std::byte* point = extras.bytes.data() + i * stride;
     if (column.componentType != kFloat) {
       std::memcpy(bytes.data() + 4 * i, point + field.offset, size);
-    } else {
-      const auto f = static_cast<float>(extraValue(point, field) - column.offset);
-      std::memcpy(bytes.data() + 4 * i, &f, 4);
+      continue;
     }
+    const double v = extraValue(point, field);
+    const auto f = isNoData(point, field) || !std::isfinite(v)
+                       ? static_cast<float>(*column.noData)
+                       : static_cast<float>(v - column.offset);
+    std::memcpy(bytes.data() + 4 * i, &f, 4);
   }
   return bytes;
 }
 
-// The class property of an extra field, its no-data value as the tile stores it.
+// The class property of an extra field, with its description and what means "none".
 nlohmann::json extraProperty(const ExtraField& field, const ExtraColumn& column) {
   nlohmann::json property = {{"type", "SCALAR"}, {"componentType", column.metadataType}};
   if (!field.description.empty()) property["description"] = field.description;
-  if (field.noData) {
+  if (column.noData) {
     if (column.componentType == kFloat) {
-      property["noData"] =
-          static_cast<float>(*field.noData * field.scale + field.add - column.offset);
+      property["noData"] = static_cast<float>(*column.noData);
     } else {
-      property["noData"] = *field.noData;
+      property["noData"] = static_cast<std::int64_t>(*column.noData);
     }
   }
   return property;
@@ -240,6 +265,12 @@ PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std:
   return out;
 }
 
+namespace {
+bool isAsciiAlnum(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+}
+}  // namespace
+
 std::vector<std::string> extraPropertyNames(const PointExtras& extras) {
   std::set<std::string> taken;  // upper case
   const auto upper = [](std::string s) {
@@ -252,8 +283,8 @@ std::vector<std::string> extraPropertyNames(const PointExtras& extras) {
   for (const ExtraField& field : extras.fields) {
     std::string name = field.name.empty() ? "extra" : field.name;
     for (char& c : name)
-      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') c = '_';
-    if (std::isdigit(static_cast<unsigned char>(name.front()))) name = "_" + name;
+      if (!isAsciiAlnum(c) && c != '_') c = '_';
+    if (name.front() >= '0' && name.front() <= '9') name = "_" + name;
     std::string unique = name;
     for (int n = 2; taken.count(upper(unique)) != 0; ++n) unique = fmt::format("{}_{}", name, n);
     taken.insert(upper(unique));

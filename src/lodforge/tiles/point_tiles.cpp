@@ -30,6 +30,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// WebGL's usual MAX_VERTEX_ATTRIBS: a primitive with more does not draw.
+constexpr std::size_t kViewerVertexAttributes = 16;
+
+// POSITION, NORMAL, COLOR_0 if any, one per lidar field carried and per extra field.
+std::size_t vertexAttributeCount(const PointCloudInfo& info, std::uint32_t carried) {
+  std::size_t count = 2 + (info.hasColors ? 1 : 0);
+  for (const PointAttributeField& field : pointAttributeFields())
+    count += (carried & field.bit) != 0 ? 1 : 0;
+  if ((carried & kAttrExtras) != 0) count += info.extras.fields.size();
+  return count;
+}
+
 int depthOf(const PointBlock& block) {
   return static_cast<int>(block.name.size()) - 1;
 }
@@ -412,6 +424,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   partitionOptions.blockSize = options.blockSize;
   partitionOptions.workDirectory = work.path;
   partitionOptions.salvageTruncated = options.salvageTruncated;
+  partitionOptions.carryExtras = (options.attributes & kAttrExtras) != 0;
   partitionOptions.memoryBytes = plan->partitionBytes;
   if (frame->has_value())
     partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) {
@@ -435,6 +448,13 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   if (!partition) return partition.status();
   stats.points = partition->pointCount;
   stats.attributes = partition->info.attributes & options.attributes;
+  stats.warnings = partition->info.warnings;
+  if (const std::size_t count = vertexAttributeCount(partition->info, stats.attributes);
+      count > kViewerVertexAttributes)
+    stats.warnings.push_back(fmt::format(
+        "the tiles carry {} vertex attributes; WebGL viewers (CesiumJS, three.js) draw at most "
+        "{}: choose fewer with --attributes",
+        count, kViewerVertexAttributes));
   stats.blocks = partition->blocks.size();
   std::vector<BlockTiles> blocks;
   for (const PointBlock& b : partition->blocks) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lodforge/core/status.h"
 #include "lodforge/points/cluster.h"
@@ -37,7 +38,8 @@ struct PointTilesStats {
   std::uint64_t points = 0, blocks = 0, tiles = 0;
   int depth = 0;  // of the deepest block tile
   std::string crs;
-  std::uint32_t attributes = 0;  // the lidar fields the tiles carry
+  std::uint32_t attributes = 0;       // the lidar fields the tiles carry
+  std::vector<std::string> warnings;  // what was read past, what viewers may not manage
   std::uint64_t outputBytes = 0;
   double seconds = 0;
 };

@@ -252,7 +252,8 @@ TEST(PlyRead, OtherVertexPropertiesComeAsExtraFields) {
   }
   PlyReadOptions options;
   options.readExtras = true;
-  Result<PlyReader> reader = PlyReader::fromMemory(test::bytesOf(ply + body), "x.ply", options);
+  const std::string file = ply + body;  // the reader reads it in place
+  Result<PlyReader> reader = PlyReader::fromMemory(test::bytesOf(file), "x.ply", options);
   ASSERT_TRUE(reader.ok()) << reader.error().message;
   const PointExtras& extras = reader->header().extras;
   ASSERT_EQ(extras.fields.size(), 3u);
@@ -273,10 +274,10 @@ TEST(PlyRead, OtherVertexPropertiesComeAsExtraFields) {
   }
   // An ascii value that does not fit its property's type is bad input, with its vertex.
   options.readExtras = true;
-  Result<PlyReader> wide = PlyReader::fromMemory(
-      test::bytesOf("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-                    "property float z\nproperty uchar label\nend_header\n0 0 0 7\n1 1 1 300\n"),
-      "w.ply", options);
+  const std::string wideFile =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\nproperty uchar label\nend_header\n0 0 0 7\n1 1 1 300\n";
+  Result<PlyReader> wide = PlyReader::fromMemory(test::bytesOf(wideFile), "w.ply", options);
   ASSERT_TRUE(wide.ok()) << wide.error().message;
   Result<bool> bad = wide->next(batch);
   ASSERT_FALSE(bad.ok());
@@ -284,7 +285,7 @@ TEST(PlyRead, OtherVertexPropertiesComeAsExtraFields) {
             std::string::npos)
       << bad.error().message;
   // Without the option (meshes), nothing is packed.
-  Result<PlyReader> plain = PlyReader::fromMemory(test::bytesOf(ply + body), "x.ply");
+  Result<PlyReader> plain = PlyReader::fromMemory(test::bytesOf(file), "x.ply");
   ASSERT_TRUE(plain.ok());
   EXPECT_TRUE(plain->header().extras.fields.empty());
 }

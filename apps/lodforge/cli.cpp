@@ -73,13 +73,14 @@ Status checkMemoryLimit(const CLI::App& app, const CLI::Option& option, std::uin
     return Error{ErrorKind::kUsage,
                  "--memory-limit 0 means nothing: give a size such as 512M, or leave it out for no "
                  "limit"};
-  static constexpr std::string_view kHonoured[] = {"tiles", "points", "build", "convert"};
+  static constexpr std::string_view kHonoured[] = {"tiles", "points", "build", "convert",
+                                                   "reconstruct"};
   for (const CLI::App* sub : app.get_subcommands()) {
     const std::string& name = sub->get_name();
     if (std::find(std::begin(kHonoured), std::end(kHonoured), name) == std::end(kHonoured))
       return Error{ErrorKind::kUsage,
-                   fmt::format("{} does not take --memory-limit (tiles, points, build and "
-                               "convert do)",
+                   fmt::format("{} does not take --memory-limit (tiles, points, build, "
+                               "convert and reconstruct do)",
                                name)};
   }
   return {};

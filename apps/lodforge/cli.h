@@ -56,6 +56,7 @@ void addRender(CLI::App& app, const Global& global, Run& run);
 void addView(CLI::App& app, const Global& global, Run& run);
 void addTiles(CLI::App& app, const Global& global, Run& run);
 void addPoints(CLI::App& app, const Global& global, Run& run);
+void addReconstruct(CLI::App& app, const Global& global, Run& run);
 void addServe(CLI::App& app, const Global& global, Run& run);
 
 }  // namespace lodforge::cli

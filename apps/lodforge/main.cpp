@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   cli::addExtract(app, global, run);
   cli::addTiles(app, global, run);
   cli::addPoints(app, global, run);
+  cli::addReconstruct(app, global, run);
   cli::addServe(app, global, run);
   cli::addGenerate(app, global, run);
   cli::addBench(app, global, run);

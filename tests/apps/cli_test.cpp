@@ -556,6 +556,53 @@ TEST(CliPoints, ExtraBytesAreListedAndCarried) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("e.ply")));
 }
 
+// `reconstruct`: a surface from generated points, its figures on the way; bad input is exit 2
+// with what would work, and nothing written.
+TEST(CliReconstruct, MakesASurfaceAndRefusesWhatCannotBeOne) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate points --points 30K -o " + dir.file("p.ply"), dir).code, 0);
+  Outcome o = lodforge("reconstruct " + dir.file("p.ply") + " -o " + dir.file("s.ply") +
+                           " --chunk-size 16 --min-triangles 50",
+                       dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("triangles"), std::string::npos) << o.out;
+  o = lodforge("info " + dir.file("s.ply") + " --json", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const nlohmann::json mesh = nlohmann::json::parse(o.out);
+  EXPECT_GT(mesh["triangles"].get<std::uint64_t>(), 30'000u);
+  EXPECT_TRUE(mesh["normals"].get<bool>());
+  EXPECT_TRUE(mesh["colors"].get<bool>());
+  // Bad input: too few points, all on a line, a coordinate that is not a number, a voxel too
+  // small for the cloud, a chunk too big for the memory limit.
+  test::writeFile(dir.file("few.xyz"), "0 0 0\n1 0 0\n0 1 0\n");
+  std::string line;
+  for (int i = 0; i < 50; ++i) line += fmt::format("{} 2 3\n", i);
+  test::writeFile(dir.file("line.xyz"), line);
+  test::writeFile(dir.file("nan.xyz"), "0 0 0\n1 0 nan\n0 1 0\n1 1 1\n");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"few.xyz", "too few for a surface"},
+      {"line.xyz", "on a line"},
+      {"nan.xyz", "nan.xyz"},
+      {"p.ply --voxel 0.000001", "--voxel"},
+  };
+  for (const auto& [args, says] : cases) {
+    o = lodforge("reconstruct " + dir.file(args) + " -o " + dir.file("bad.ply"), dir);
+    EXPECT_EQ(o.code, 2) << args << "\n" << o.err;
+    EXPECT_NE(o.err.find(says), std::string::npos) << args << "\n" << o.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply"))) << args;
+  }
+  o = lodforge("--memory-limit 64M reconstruct " + dir.file("p.ply") + " -o " +
+                   dir.file("bad.ply") + " --chunk-size 512",
+               dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("--chunk-size"), std::string::npos) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
+  o = lodforge(
+      "reconstruct " + dir.file("p.ply") + " -o " + dir.file("x.ply") + " --orient sideways", dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("not propagate, up or a viewpoint"), std::string::npos) << o.err;
+}
+
 TEST(CliPoints, BadInputIsExitCode2AndLeavesNothing) {
   test::TempDir dir;
   // A LAZ cut inside its last chunk: the chunk table went with the cut.

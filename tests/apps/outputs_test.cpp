@@ -75,6 +75,8 @@ std::vector<Command> writingCommands() {
       {"render", "model.lfp", "frames", true,
        [](auto& in, auto& out) { return "-q render " + in + " --frames 1 --size 32x24 -o " + out; },
        test::glSubprocess()},
+      {"reconstruct", "points.ply", "surface.ply", false,
+       [](auto& in, auto& out) { return "-q reconstruct " + in + " -o " + out; }, ""},
       {"generate", "", "made.ply", false,
        [](auto&, auto& out) { return "-q generate scan --triangles 2K -o " + out; }, ""},
   };
@@ -86,6 +88,10 @@ class WritingCommands : public ::testing::Test {
     sources_ = new test::TempDir();
     const std::string scan = sources_->file("scan.ply");
     ASSERT_EQ(lodforge("-q generate scan --triangles 20K -o " + scan, *sources_).code, 0);
+    ASSERT_EQ(
+        lodforge("-q generate points --points 5K -o " + sources_->file("points.ply"), *sources_)
+            .code,
+        0);
     fs::copy_file(test::dataPath("points/simple.las"), sources_->file("cloud.las"));
     fs::permissions(sources_->file("cloud.las"), fs::perms::owner_write, fs::perm_options::add);
     fs::copy_file(test::dataPath("points/simple-v1.laz"), sources_->file("cloud.laz"));

@@ -1,0 +1,115 @@
+// `lodforge reconstruct CLOUD -o mesh.ply`: a surface from a point cloud, chunk by chunk
+// (large-meshes paper §3.1, §3.3; docs/surface.md).
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include "cli.h"
+#include "lodforge/core/file.h"
+#include "lodforge/core/memory.h"
+#include "lodforge/core/units.h"
+#include "lodforge/io/point_reader.h"
+#include "lodforge/surface/reconstruct.h"
+#include "outputs.h"
+
+namespace lodforge::cli {
+
+namespace {
+
+// --orient: propagate, up, or a viewpoint "X,Y,Z".
+Result<NormalOptions> parseOrientation(const std::string& text) {
+  NormalOptions options;
+  if (text == "propagate") return options;
+  if (text == "up") {
+    options.orientation = NormalOrientation::kUp;
+    return options;
+  }
+  double x = 0, y = 0, z = 0;
+  char extra = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &extra) == 3) {
+    options.orientation = NormalOrientation::kViewpoint;
+    options.viewpoint = {x, y, z};
+    return options;
+  }
+  return Error{ErrorKind::kUsage,
+               fmt::format("--orient: \"{}\" is not propagate, up or a viewpoint X,Y,Z", text)};
+}
+
+}  // namespace
+
+void addReconstruct(CLI::App& app, const Global& global, Run& run) {
+  struct Options {
+    std::string input, output, orient = "propagate";
+    ReconstructOptions reconstruct;
+    bool salvage = false;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "reconstruct", "A surface (triangle mesh) from a point cloud, chunk by chunk");
+  sub->add_option("CLOUD", options->input, "A .las .laz .ply .xyz .txt .csv or .pts point cloud")
+      ->required();
+  sub->add_option("-o,--output", options->output, "The .ply mesh to write")->required();
+  sub->add_option("--voxel", options->reconstruct.voxel,
+                  "Voxel edge in the cloud's units (default: twice the median point spacing)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--chunk-size", options->reconstruct.chunkVoxels,
+                  "Voxels along a chunk's edge (default 64)")
+      ->check(CLI::Range(2, 1024));
+  sub->add_option("--radius", options->reconstruct.distance.radius,
+                  "Points within this many voxels of a corner set its distance (default 3)")
+      ->check(CLI::Range(0.5, 16.0));
+  sub->add_option("--min-points", options->reconstruct.distance.minPoints,
+                  "Fewest points near a corner for a surface there (default 3)")
+      ->check(CLI::Range(1, 1000));
+  sub->add_option("--orient", options->orient,
+                  "Points without normals: turn estimated normals by propagation (default; "
+                  "closed objects), up (+z: scans of the ground) or towards a viewpoint X,Y,Z");
+  addCountOption(*sub, "--min-triangles", options->reconstruct.minTriangles,
+                 "Drop connected pieces with fewer triangles (default 0: keep all)");
+  sub->add_flag("--salvage", options->salvage,
+                "Read a PLY cut short up to its last whole point (with a warning)");
+  sub->callback([&global, &run, options] {
+    run = [&global, options]() -> Status {
+      const auto start = std::chrono::steady_clock::now();
+      if (fileExtension(options->output) != "ply")
+        return Error{ErrorKind::kUsage,
+                     fmt::format("{}: reconstruct writes a .ply mesh", options->output)};
+      if (!isPointCloudPath(options->input) && fileExtension(options->input) != "ply")
+        return Error{ErrorKind::kUsage,
+                     fmt::format("{}: not a point cloud (.las .laz .ply .xyz .txt .csv .pts)",
+                                 options->input)};
+      Result<NormalOptions> normals = parseOrientation(options->orient);
+      if (!normals) return normals.status();
+      LODFORGE_TRY(claimOutput(options->output, modelFileOutput(options->output),
+                               std::vector<std::string>{options->input}));
+      ReconstructOptions reconstruct = options->reconstruct;
+      reconstruct.normals = *normals;
+      reconstruct.memoryLimit = global.memoryLimit;
+      reconstruct.salvageTruncated = options->salvage;
+      Result<ReconstructedMesh> mesh = reconstructSurface(options->input, reconstruct);
+      if (!mesh) return mesh.status();
+      if (mesh->indices.empty())
+        return badInput(options->input,
+                        fmt::format("no surface at voxel {:g}: the points are too sparse for it "
+                                    "(try a larger --voxel or --radius, or a smaller "
+                                    "--min-points)",
+                                    mesh->grid.voxel));
+      LODFORGE_TRY(writeReconstruction(*mesh, options->output));
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      say(global, fmt::format("wrote {}: {} triangles, {} vertices from {} points in {:.2f} s "
+                              "(voxel {:g}, {} chunks{}{})",
+                              options->output, formatCount(mesh->indices.size() / 3),
+                              formatCount(mesh->positions.size()), formatCount(mesh->points),
+                              seconds, mesh->grid.voxel, formatCount(mesh->chunks),
+                              mesh->estimatedNormals ? ", normals estimated" : "",
+                              mesh->droppedPieces > 0
+                                  ? fmt::format(", {} small pieces dropped", mesh->droppedPieces)
+                                  : ""));
+      detail(global, fmt::format("peak memory {}", formatBytes(peakRssBytes())));
+      return Status{};
+    };
+  });
+}
+
+}  // namespace lodforge::cli

@@ -1,0 +1,37 @@
+// The reconstruction's voxel grid (large-meshes paper §3.1): one global lattice of corners
+// `voxel` apart from `origin`, cut into chunks of N voxels along an edge. Every value lives at a
+// global corner, so a corner shared by two chunks is one and the same corner of both.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "lodforge/core/math.h"
+
+namespace lodforge {
+
+struct VoxelGrid {
+  Vec3d origin;  // world position of global corner (0, 0, 0)
+  double voxel = 1;
+  std::array<std::uint64_t, 3> corners{};  // global corners along each axis
+
+  Vec3d position(std::uint64_t i, std::uint64_t j, std::uint64_t k) const {
+    return origin +
+           Vec3d{static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)} * voxel;
+  }
+};
+
+// The values of a box of global corners [first, first + size) (x fastest), NaN where no point
+// is near enough to say.
+struct CornerValues {
+  std::array<std::uint64_t, 3> first{};
+  std::array<std::uint32_t, 3> size{};
+  std::vector<float> values;
+
+  std::size_t index(std::uint32_t i, std::uint32_t j, std::uint32_t k) const {
+    return (static_cast<std::size_t>(k) * size[1] + j) * size[0] + i;
+  }
+};
+
+}  // namespace lodforge

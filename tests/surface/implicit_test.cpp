@@ -1,0 +1,81 @@
+#include "lodforge/surface/implicit.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <gtest/gtest.h>
+
+#include "lodforge/core/random.h"
+
+namespace lodforge {
+namespace {
+
+struct Cloud {
+  std::vector<Vec3d> positions;
+  std::vector<Vec3f> normals;
+  std::vector<std::uint64_t> ids;
+  OrientedPoints view() const { return {positions, normals, ids}; }
+};
+
+// Points on the plane z = 0.25 over [0, 4]², facing +z.
+Cloud plane(std::size_t n, std::uint64_t seed) {
+  Random random(seed);
+  Cloud c;
+  for (std::size_t i = 0; i < n; ++i) {
+    c.positions.push_back({random.uniform(0, 4), random.uniform(0, 4), 0.25});
+    c.normals.push_back({0, 0, 1});
+    c.ids.push_back(i);
+  }
+  return c;
+}
+
+// Near the plane the value is the signed distance to it; far from every point there is none.
+TEST(SignedDistance, IsTheDistanceToAPlaneAndUnknownFarFromThePoints) {
+  const Cloud cloud = plane(4000, 3);
+  const VoxelGrid grid{{0, 0, -1}, 0.25, {17, 17, 17}};
+  CornerValues values{{0, 0, 0}, {17, 17, 17}, {}};
+  signedDistances(grid, cloud.view(), {}, values);
+  int known = 0;
+  for (std::uint32_t k = 0; k < 17; ++k) {
+    const double z = -1 + 0.25 * k;
+    for (std::uint32_t j = 2; j < 15; ++j)
+      for (std::uint32_t i = 2; i < 15; ++i) {
+        const float v = values.values[values.index(i, j, k)];
+        if (std::abs(z - 0.25) < 0.3) {
+          ASSERT_FALSE(std::isnan(v)) << i << ' ' << j << ' ' << k;
+          EXPECT_NEAR(v, z - 0.25, 1e-6);
+          ++known;
+        }
+        if (std::abs(z - 0.25) > 0.51) {
+          EXPECT_TRUE(std::isnan(v)) << k;
+        }
+      }
+  }
+  EXPECT_GT(known, 300);
+}
+
+// A corner's value is the same bits in any box that holds it, given the points near it.
+TEST(SignedDistance, ACornerHasTheSameValueInEveryBox) {
+  Cloud cloud = plane(3000, 5);
+  Random random(9);
+  for (std::size_t i = 0; i < cloud.positions.size(); ++i) {
+    cloud.positions[i].z += random.uniform(-0.05, 0.05);
+    cloud.normals[i] =
+        normalizeOr(Vec3f{static_cast<float>(random.uniform(-0.2, 0.2)), 0.1f, 1}, Vec3f{0, 0, 1});
+  }
+  const VoxelGrid grid{{0, 0, -1}, 0.2, {21, 21, 11}};
+  CornerValues whole{{0, 0, 0}, {21, 21, 11}, {}};
+  signedDistances(grid, cloud.view(), {}, whole);
+  CornerValues part{{8, 5, 3}, {6, 7, 5}, {}};
+  signedDistances(grid, cloud.view(), {}, part);
+  for (std::uint32_t k = 0; k < 5; ++k)
+    for (std::uint32_t j = 0; j < 7; ++j)
+      for (std::uint32_t i = 0; i < 6; ++i) {
+        const float a = part.values[part.index(i, j, k)];
+        const float b = whole.values[whole.index(8 + i, 5 + j, 3 + k)];
+        EXPECT_EQ(std::memcmp(&a, &b, 4), 0) << i << ' ' << j << ' ' << k;
+      }
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -1,0 +1,238 @@
+#include "lodforge/surface/reconstruct.h"
+
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "lodforge/core/distance.h"
+#include "lodforge/core/random.h"
+#include "lodforge/generate/terrain.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+std::size_t boundaryEdges(const std::vector<std::uint32_t>& indices) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (std::size_t t = 0; t < indices.size(); t += 3)
+    for (std::size_t e = 0; e < 3; ++e) {
+      const std::uint32_t a = indices[t + e], b = indices[t + (e + 1) % 3];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  std::size_t once = 0;
+  for (const auto& [edge, n] : uses) once += n == 1 ? 1 : 0;
+  return once;
+}
+
+std::vector<Vec3f> floats(const std::vector<Vec3d>& positions) {
+  std::vector<Vec3f> out(positions.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = toFloat(positions[i]);
+  return out;
+}
+
+struct Sampled {
+  std::vector<Vec3d> points;
+  std::vector<Vec3f> normals;
+  std::vector<Vec3f> truth;  // the terrain itself, finely triangulated (holes left out)
+  std::vector<std::uint32_t> truthIndices;
+};
+
+// Points sampled exactly on the terrain `generate points` and `generate scan` share (no noise),
+// and the terrain triangulated at a quarter of the point spacing as the ground truth.
+Sampled terrainSamples(std::size_t n, double width) {
+  const double depth = width * 2 / 3;
+  const double spacing = std::sqrt(width * depth / static_cast<double>(n));
+  const Terrain terrain(7, width, depth, spacing);
+  Sampled s;
+  Random random(11);
+  while (s.points.size() < n) {
+    const double u = random.uniform(0, width), v = random.uniform(0, depth);
+    if (terrain.inHole(u, v)) continue;
+    s.points.push_back(terrain.position(u, v));
+    s.normals.push_back(toFloat(terrain.normal(u, v)));
+  }
+  const double step = spacing / 4;
+  const auto columns = static_cast<std::uint32_t>(width / step) + 1;
+  const auto rows = static_cast<std::uint32_t>(depth / step) + 1;
+  for (std::uint32_t r = 0; r < rows; ++r)
+    for (std::uint32_t c = 0; c < columns; ++c)
+      s.truth.push_back(toFloat(terrain.position(c * step, r * step)));
+  for (std::uint32_t r = 0; r + 1 < rows; ++r)
+    for (std::uint32_t c = 0; c + 1 < columns; ++c) {
+      if (terrain.inHole((c + 0.5) * step, (r + 0.5) * step)) continue;
+      const std::uint32_t a = r * columns + c, b = a + 1, d = a + columns, e = d + 1;
+      s.truthIndices.insert(s.truthIndices.end(), {a, b, e, a, e, d});
+    }
+  return s;
+}
+
+// A smooth open sheet z = 2 sin(x/7) cos(y/9) over 60 × 40, points uniform and noise-free.
+Sampled sheetSamples(std::size_t count) {
+  const auto height = [](double x, double y) { return 2 * std::sin(x / 7) * std::cos(y / 9); };
+  Sampled s;
+  Random random(5);
+  for (std::size_t i = 0; i < count; ++i) {
+    const double x = random.uniform(0, 60), y = random.uniform(0, 40);
+    s.points.push_back({x, y, height(x, y)});
+    const Vec3d n{-2 / 7.0 * std::cos(x / 7) * std::cos(y / 9),
+                  2 / 9.0 * std::sin(x / 7) * std::sin(y / 9), 1};
+    s.normals.push_back(toFloat(n * (1 / length(n))));
+  }
+  const std::uint32_t columns = 601, rows = 401;
+  for (std::uint32_t r = 0; r < rows; ++r)
+    for (std::uint32_t c = 0; c < columns; ++c)
+      s.truth.push_back(toFloat(Vec3d{c * 0.1, r * 0.1, height(c * 0.1, r * 0.1)}));
+  for (std::uint32_t r = 0; r + 1 < rows; ++r)
+    for (std::uint32_t c = 0; c + 1 < columns; ++c) {
+      const std::uint32_t a = r * columns + c, b = a + 1, d = a + columns, e = d + 1;
+      s.truthIndices.insert(s.truthIndices.end(), {a, b, e, a, e, d});
+    }
+  return s;
+}
+
+SurfaceDistance distanceToTruth(const ReconstructedMesh& mesh, const Sampled& s) {
+  return surfaceDistance(floats(mesh.positions), mesh.indices, s.truth, s.truthIndices, 100'000);
+}
+
+// A smooth open sheet comes back within one voxel of itself, both ways (exact distances of the
+// vertices of each to the other surface; at the open border, where the reconstruction follows
+// the points' edge rather than the domain's, the sheet's own vertices within two voxels of it
+// are left out and the reconstruction's past it held to one and a half voxels), with its own
+// normals and with estimated ones.
+TEST(Reconstruct, ASmoothSheetComesBackWithinOneVoxel) {
+  const Sampled s = sheetSamples(30'000);
+  for (const bool given : {true, false}) {
+    ReconstructOptions options;
+    options.chunkVoxels = 24;
+    options.normals.orientation = NormalOrientation::kUp;
+    Result<ReconstructedMesh> mesh =
+        reconstructPoints(s.points, given ? s.normals : std::vector<Vec3f>{}, {}, "sheet", options);
+    ASSERT_TRUE(mesh.ok()) << mesh.error().message;
+    EXPECT_EQ(mesh->estimatedNormals, !given);
+    EXPECT_GT(mesh->chunks, 4u);
+    const double voxel = mesh->grid.voxel;
+    const std::vector<Vec3f> recon = floats(mesh->positions);
+    // Over the sheet within one voxel; past its border (the points stop there) by less than
+    // one and a half.
+    std::vector<Vec3f> over, past;
+    for (const Vec3f& p : recon)
+      (p.x >= 0 && p.x <= 60 && p.y >= 0 && p.y <= 40 ? over : past).push_back(p);
+    EXPECT_LT(farthestDistance(over, s.truth, s.truthIndices), voxel) << given;
+    EXPECT_LT(farthestDistance(past, s.truth, s.truthIndices), 1.5 * voxel) << given;
+    std::vector<Vec3f> inner;
+    for (const Vec3f& p : s.truth)
+      if (p.x > 2 * voxel && p.x < 60 - 2 * voxel && p.y > 2 * voxel && p.y < 40 - 2 * voxel)
+        inner.push_back(p);
+    EXPECT_LT(farthestDistance(inner, recon, mesh->indices), voxel) << given;
+    EXPECT_LT(distanceToTruth(*mesh, s).rms, voxel / 10) << given;
+  }
+}
+
+// The generators' terrain (fractal detail, a cliff leaning over its foot, holes): close on the
+// whole (RMS), within a few voxels at the cliff, whose edge the distance's radius rounds off.
+TEST(Reconstruct, TerrainComesBackCloseToTheGeneratorsSurface) {
+  const Sampled s = terrainSamples(20'000, 150);
+  ReconstructOptions options;
+  options.chunkVoxels = 32;
+  Result<ReconstructedMesh> mesh = reconstructPoints(s.points, s.normals, {}, "terrain", options);
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message;
+  const SurfaceDistance d = distanceToTruth(*mesh, s);
+  EXPECT_LT(d.rms, mesh->grid.voxel / 4);
+  EXPECT_LT(d.hausdorff, 4 * mesh->grid.voxel);
+}
+
+// Points on a sphere without normals: normals estimated and propagated, the surface closed and
+// facing out.
+TEST(Reconstruct, AClosedObjectWithoutNormalsComesBackClosedFacingOut) {
+  Random random(2);
+  std::vector<Vec3d> points;
+  const Vec3d centre{3, -2, 1};
+  for (int i = 0; i < 20'000; ++i) {
+    const double z = random.uniform(-1, 1), a = random.uniform(0, 2 * M_PI);
+    const double r = std::sqrt(1 - z * z);
+    points.push_back(centre + Vec3d{r * std::cos(a), r * std::sin(a), z} * 2.0);
+  }
+  ReconstructOptions options;
+  options.chunkVoxels = 16;
+  Result<ReconstructedMesh> mesh = reconstructPoints(points, {}, {}, "sphere", options);
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message;
+  ASSERT_GT(mesh->chunks, 1u);
+  EXPECT_EQ(boundaryEdges(mesh->indices), 0u);
+  std::size_t outward = 0;
+  for (std::size_t t = 0; t < mesh->indices.size(); t += 3) {
+    const Vec3d a = mesh->positions[mesh->indices[t]], b = mesh->positions[mesh->indices[t + 1]],
+                c = mesh->positions[mesh->indices[t + 2]];
+    outward += dot(cross(b - a, c - a), (a + b + c) * (1.0 / 3) - centre) > 0 ? 1 : 0;
+  }
+  EXPECT_EQ(outward, mesh->indices.size() / 3);
+  for (const Vec3d& p : mesh->positions) EXPECT_NEAR(length(p - centre), 2.0, mesh->grid.voxel);
+}
+
+// One chunk and many small ones give the same surface: no more boundary edges, and every
+// vertex on a chunk face has the same bits in both chunks that share it.
+TEST(Reconstruct, ManyChunksJoinWithoutACrack) {
+  const Sampled s = terrainSamples(20'000, 150);
+  ReconstructOptions options;
+  options.voxel = 1.2;
+  options.chunkVoxels = 1024;
+  std::vector<SurfacePiece> one, many;
+  Result<ReconstructedMesh> whole = reconstructPoints(s.points, s.normals, {}, "t", options, &one);
+  ASSERT_TRUE(whole.ok()) << whole.error().message;
+  EXPECT_EQ(whole->chunks, 1u);
+  options.chunkVoxels = 7;
+  Result<ReconstructedMesh> chunked =
+      reconstructPoints(s.points, s.normals, {}, "t", options, &many);
+  ASSERT_TRUE(chunked.ok());
+  EXPECT_GT(chunked->chunks, 100u);
+  EXPECT_LE(boundaryEdges(chunked->indices), boundaryEdges(whole->indices));
+  EXPECT_EQ(chunked->indices.size(), whole->indices.size());
+  EXPECT_EQ(chunked->positions.size(), whole->positions.size());
+  std::map<std::uint64_t, Vec3d> first;
+  std::size_t shared = 0;
+  for (const SurfacePiece& piece : many)
+    for (std::size_t v = 0; v < piece.positions.size(); ++v) {
+      const auto [at, added] = first.try_emplace(piece.edges[v], piece.positions[v]);
+      if (added) continue;
+      ++shared;
+      EXPECT_EQ(std::memcmp(&at->second, &piece.positions[v], sizeof(Vec3d)), 0);
+    }
+  EXPECT_GT(shared, 1000u);
+  // And every vertex where the one-chunk mesh has it.
+  std::map<std::uint64_t, Vec3d> single;
+  for (std::size_t v = 0; v < one[0].positions.size(); ++v)
+    single[one[0].edges[v]] = one[0].positions[v];
+  for (const auto& [edge, p] : first)
+    EXPECT_EQ(std::memcmp(&single.at(edge), &p, sizeof(Vec3d)), 0);
+}
+
+// Bad input says what would work.
+TEST(Reconstruct, BadInputSaysWhatWouldWork) {
+  ReconstructOptions options;
+  Result<ReconstructedMesh> few =
+      reconstructPoints({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {}, {}, "few.xyz", options);
+  ASSERT_FALSE(few.ok());
+  EXPECT_EQ(few.status().kind(), ErrorKind::kBadInput);
+  EXPECT_NE(few.error().message.find("too few for a surface"), std::string::npos);
+  std::vector<Vec3d> line;
+  for (int i = 0; i < 100; ++i) line.push_back({double(i), 2, 3});
+  Result<ReconstructedMesh> onLine = reconstructPoints(line, {}, {}, "line.xyz", options);
+  ASSERT_FALSE(onLine.ok());
+  EXPECT_NE(onLine.error().message.find("line"), std::string::npos);
+  const Sampled s = terrainSamples(2'000, 100);
+  options.voxel = 1e-6;
+  Result<ReconstructedMesh> tiny = reconstructPoints(s.points, s.normals, {}, "t.xyz", options);
+  ASSERT_FALSE(tiny.ok());
+  EXPECT_NE(tiny.error().message.find("too small"), std::string::npos);
+  EXPECT_NE(tiny.error().message.find("--voxel"), std::string::npos);
+  options.voxel = 1;
+  options.chunkVoxels = 512;
+  options.memoryLimit = 64 << 20;
+  Result<ReconstructedMesh> big = reconstructPoints(s.points, s.normals, {}, "t.xyz", options);
+  ASSERT_FALSE(big.ok());
+  EXPECT_NE(big.error().message.find("--chunk-size"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace lodforge

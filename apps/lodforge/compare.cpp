@@ -1,6 +1,7 @@
 // `lodforge compare A.png B.png` or `lodforge compare A/ B/`: the large-meshes paper's image
 // difference — CIE76 ΔE per pixel — as the share of pixels above the just-noticeable 2.3, the
 // mean ΔE and PSNR; `--diff` writes a heat map (for folders, one per frame pair into a folder).
+// Two meshes go to compare_meshes (surface distance).
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
+#include "compare_meshes.h"
 #include "lodforge/core/file.h"
 #include "lodforge/render/image.h"
 #include "outputs.h"
@@ -21,6 +23,7 @@ struct CompareOptions {
   std::string diff;
   double threshold = kJustNoticeableDeltaE;
   std::string json;
+  std::uint32_t samples = 200'000;  // meshes: sample points on each surface
 };
 
 struct Pair {
@@ -131,15 +134,25 @@ Status runCompare(const Global& global, const CompareOptions& o) {
 void addCompare(CLI::App& app, const Global& global, Run& run) {
   auto options = std::make_shared<CompareOptions>();
   auto* command = app.add_subcommand(
-      "compare", "Image difference (CIE76 ΔE, PSNR) of two PNG files or two folders of frames");
-  command->add_option("a", options->a, "First PNG (or folder)")->required();
-  command->add_option("b", options->b, "Second PNG (or folder)")->required();
+      "compare",
+      "Image difference (CIE76 ΔE, PSNR) of two PNG files or two folders of frames; surface "
+      "distance (Hausdorff, RMS) of two meshes");
+  command->add_option("a", options->a, "First PNG (or folder, or mesh)")->required();
+  command->add_option("b", options->b, "Second PNG (or folder, or mesh)")->required();
+  command
+      ->add_option("--samples", options->samples,
+                   "Meshes: points sampled on each surface (default 200K)")
+      ->check(CLI::Range(1000, 100'000'000));
   command->add_option("--diff", options->diff, "Write a ΔE heat map PNG (a folder for folders)");
   command->add_option("--threshold", options->threshold, "ΔE counted as visible (default 2.3)")
       ->check(CLI::PositiveNumber);
   command->add_option("--json", options->json, "Write the figures as JSON");
   command->callback([&global, &run, options] {
-    run = [&global, options] { return runCompare(global, *options); };
+    run = [&global, options] {
+      if (isMeshComparison(options->a, options->b))
+        return runCompareMeshes(global, options->a, options->b, options->samples, options->json);
+      return runCompare(global, *options);
+    };
   });
 }
 

@@ -1263,6 +1263,38 @@ TEST(CliCompare, FilesAndFoldersWithHeatMapsAndJson) {
   EXPECT_NEAR(j["frames"][1]["mean_delta_e"].get<double>(), d.meanDeltaE, 1e-9);
 }
 
+// Two meshes: their surface distance — none from a mesh to itself, the offset between a mesh
+// and a copy moved along its normal (a flat square), in the text and the JSON.
+TEST(CliCompare, MeshesGiveTheirSurfaceDistance) {
+  test::TempDir dir;
+  const auto square = [&](const std::string& name, double z) {
+    test::writeFile(dir.file(name), fmt::format("v 0 0 {0}\nv 10 0 {0}\nv 10 10 {0}\nv 0 10 {0}\n"
+                                                "f 1 2 3\nf 1 3 4\n",
+                                                z));
+  };
+  square("a.obj", 1);
+  square("b.obj", 1.25);
+  Outcome o = lodforge(
+      "compare " + dir.file("a.obj") + " " + dir.file("a.obj") + " --json " + dir.file("self.json"),
+      dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("hausdorff "), std::string::npos) << o.out;
+  EXPECT_LT(nlohmann::json::parse(test::readFile(dir.file("self.json")))["hausdorff"].get<double>(),
+            1e-9);
+  o = lodforge("compare " + dir.file("a.obj") + " " + dir.file("b.obj") +
+                   " --samples 5000 --json " + dir.file("d.json"),
+               dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const nlohmann::json d = nlohmann::json::parse(test::readFile(dir.file("d.json")));
+  EXPECT_NEAR(d["hausdorff"].get<double>(), 0.25, 1e-6);
+  EXPECT_NEAR(d["rms"].get<double>(), 0.25, 1e-6);
+  EXPECT_EQ(d["samples"], 5000);
+  test::writeFile(dir.file("points.obj"), "v 0 0 0\nv 1 0 0\n");
+  o = lodforge("compare " + dir.file("a.obj") + " " + dir.file("points.obj"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("no triangles"), std::string::npos) << o.err;
+}
+
 TEST(CliCompare, MismatchedOrBadImagesAreExitCode2) {
   test::TempDir dir;
   ASSERT_TRUE(writePng(dir.file("small.png"), gradient(8, 8, 0)).ok());

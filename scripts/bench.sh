@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -305,6 +305,73 @@ potree_section() {
 }
 if [[ ${BENCH_ONLY:-} == potree ]]; then potree_section; exit 0; fi
 
+# Surfaces beside PoissonRecon (issue 19): `POISSON=/path/to/PoissonRecon` (built from its public
+# source outside the project; skipped without it). SURFACE_SIZES (default "1M") picks the clouds:
+# `generate points` (normals, colours, 5 mm noise) and, as the ground truth, `generate scan` of
+# twice as many triangles (the same terrain at the same detail). Both tools at a comparable
+# resolution: PoissonRecon --depth 9 (512 cells over its bounding cube, 1.1× the cloud) and
+# lodforge --voxel of the same size; each mesh measured against the truth by `lodforge compare`.
+surface_once() {  # label, command...; prints "seconds peak-KiB"
+  local log=$work/time.log
+  shift
+  /usr/bin/time -v "$@" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
+  local wall
+  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
+  echo "$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")" \
+    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")"
+}
+surface_section() {
+  echo
+  echo "== surfaces beside PoissonRecon (same cloud, one run each; $(nproc) threads)"
+  if [[ -z ${POISSON:-} || ! -x ${POISSON:-} ]]; then
+    echo "POISSON is not set to a PoissonRecon binary: nothing to compare against (skipped)"
+    return
+  fi
+  printf '| %-5s | %-12s | %8s | %10s | %10s | %9s | %9s |\n' cloud tool wall "peak RSS" triangles hausdorff rms
+  printf '|%s|%s|%s|%s|%s|%s|%s|\n' ------- -------------- ---------- ------------ ------------ ----------- -----------
+  for n in ${SURFACE_SIZES:-1M}; do
+    local cloud=$work/surface-$n.ply truth=$work/surface-truth-$n.ply
+    [[ -f $cloud ]] || "$lodforge" -q generate points --points "$n" -o "$cloud"
+    local count
+    count=$("$lodforge" info "$cloud" --json | sed -n 's/.*"vertices": \([0-9]*\).*/\1/p')
+    [[ -f $truth ]] || "$lodforge" -q generate scan --triangles $((2 * count)) -o "$truth"
+    local voxel
+    voxel=$("$lodforge" info "$cloud" --json | awk '/"max"/ {m = 1} /"min"/ {m = 0} 
+      /^ *-?[0-9.e+-]+,?$/ { v = $1 + 0; if (m) max[++a] = v; else min[++b] = v }
+      END { s = 0; for (i = 1; i <= 3; ++i) if (max[i] - min[i] > s) s = max[i] - min[i]; print s * 1.1 / 512 }')
+    # PoissonRecon closes the surface over its whole cube; users trim it by sampling density
+    # (SurfaceTrimmer --trim 7 on a --density run, as its documentation shows): both rows.
+    local trimmer=${POISSON_TRIMMER:-$(dirname "$POISSON")/SurfaceTrimmer}
+    local tools=(lodforge poisson)
+    [[ -x $trimmer ]] && tools+=(poisson+trim)
+    for tool in "${tools[@]}"; do
+      local out=$work/surface-$tool-$n.ply
+      rm -f "$out"
+      if [[ $tool == lodforge ]]; then
+        read -r seconds kib < <(surface_once "$tool" "$lodforge" -q reconstruct "$cloud" -o "$out" --voxel "$voxel")
+      elif [[ $tool == poisson ]]; then
+        read -r seconds kib < <(surface_once "$tool" "$POISSON" --in "$cloud" --out "$out" --depth 9)
+      else
+        read -r s1 k1 < <(surface_once "$tool" "$POISSON" --in "$cloud" --out "$out.dense.ply" --depth 9 --density)
+        read -r s2 k2 < <(surface_once "$tool" "$trimmer" --in "$out.dense.ply" --out "$out" --trim 7)
+        seconds=$(awk -v a="$s1" -v b="$s2" 'BEGIN { print a + b }')
+        kib=$(( k1 > k2 ? k1 : k2 ))
+        rm -f "$out.dense.ply"
+      fi
+      local triangles
+      triangles=$("$lodforge" info "$out" --json | sed -n 's/.*"triangles": \([0-9]*\).*/\1/p')
+      "$lodforge" -q compare "$out" "$truth" --json "$work/surface-$tool.json"
+      local h r
+      h=$(sed -n 's/.*"hausdorff": \([0-9.e+-]*\).*/\1/p' "$work/surface-$tool.json")
+      r=$(sed -n 's/.*"rms": \([0-9.e+-]*\).*/\1/p' "$work/surface-$tool.json")
+      printf '| %-5s | %-12s | %7ss | %6d MiB | %10s | %9.3f | %9.4f |\n' "$n" "$tool" "$seconds" \
+        $((kib / 1024)) "$triangles" "$h" "$r"
+    done
+    echo "(voxel $voxel for lodforge; ground truth: generate scan --triangles $((2 * count)))"
+  done
+}
+if [[ ${BENCH_ONLY:-} == surface ]]; then surface_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -328,5 +395,6 @@ points_section
 serve_section
 laz_section
 potree_section
+surface_section
 render_section
 runtime_section

@@ -2,7 +2,8 @@
 # Every kind of GLB lodforge writes, checked by the Khronos glTF validator: conversions of the
 # real models in ../shared/data, the generated CAD assembly, a generated scan, levels extracted
 # from a progressive package, 3D Tiles contents (the horse, a scan, an assembly's package, point
-# clouds from a LAS, a LAZ, a COPC, a LAS with extra bytes and a PLY).
+# clouds from a LAS, a LAZ, a COPC, a LAS with extra bytes and a PLY, and a surface
+# reconstructed from points).
 # Fails on any error.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
@@ -36,9 +37,11 @@ want=$(( $(ls "$data"/meshes | wc -l) + 6 ))
 "$lodforge" -q generate points --points 30K --extra-bytes -o "$out/extra.las"
 "$lodforge" -q tiles "$out/extra.las" -o "$out/extra-tiles" --block-size 10K
 "$lodforge" -q generate points --points 60K -o "$out/points.ply"
+"$lodforge" -q tiles "$out/points.ply" --surface -o "$out/surface-tiles" --chunk-size 100
 "$lodforge" -q tiles "$out/points.ply" -o "$out/points-tiles" --block-size 10K --no-quantization --compress meshopt
 tiles=$(ls "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb | wc -l)
 [[ $tiles -ge 20 ]] || { echo "expected at least 20 tile GLBs, found $tiles" >&2; exit 1; }
 node "$here/js/validate-gltf.mjs" "$out"/*.glb "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb \
   "$out"/cad-tiles/tiles/*.glb "$out"/autzen-tiles/tiles/*.glb "$out"/points-tiles/tiles/*.glb \
-  "$out"/autzen-laz-tiles/tiles/*.glb "$out"/copc-tiles/tiles/*.glb "$out"/extra-tiles/tiles/*.glb
+  "$out"/autzen-laz-tiles/tiles/*.glb "$out"/copc-tiles/tiles/*.glb "$out"/extra-tiles/tiles/*.glb \
+  "$out"/surface-tiles/tiles/*.glb

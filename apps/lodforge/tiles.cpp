@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
 #include "lodforge/core/output_claim.h"
@@ -13,9 +14,11 @@
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/ply_reader.h"
 #include "lodforge/io/point_reader.h"
+#include "lodforge/surface/reconstruct.h"
 #include "lodforge/tiles/point_attributes.h"
 #include "lodforge/tiles/point_tiles.h"
 #include "lodforge/tiles/tileset.h"
+#include "lodforge/tiles/tileset_output.h"
 #include "lodforge/tiling/resume.h"
 
 namespace lodforge::cli {
@@ -63,6 +66,8 @@ struct TilesCommand {
   std::uint64_t tilePoints = 50'000;
   std::string attributes = "all";
   bool salvage = false;
+  bool surface = false;  // point clouds: reconstruct a surface and tile it as a mesh
+  double voxel = 0;
 };
 
 void addTilesOptions(CLI::App& sub, TilesCommand& options) {
@@ -110,6 +115,12 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
                  "intensity, returns, flags, scan-angle, user-data, point-source, gps-time, nir, "
                  "extras (LAS extra bytes, other PLY properties); or all (default: all the input "
                  "has) or none");
+  sub.add_flag("--surface", options.surface,
+               "Point clouds: reconstruct a surface (as `lodforge reconstruct`) and tile it as a "
+               "mesh");
+  sub.add_option("--voxel", options.voxel,
+                 "With --surface: voxel edge (default: twice the median point spacing)")
+      ->check(CLI::NonNegativeNumber);
   sub.add_flag("--salvage", options.salvage,
                "Read a PLY cut short up to its last whole element (with a warning)");
   sub.add_flag("--resume", options.resume,
@@ -224,11 +235,50 @@ Status runMeshTiles(const Global& global, const TilesCommand& options, const Til
   return {};
 }
 
+// --surface: the cloud reconstructed (docs/surface.md) into a PLY in a work folder of ours beside
+// the output, removed on every way out, then tiled as a mesh (crack-free as any mesh is). The
+// CRS a LAS file names places the tileset unless --crs or --origin does.
+Status runSurfaceTiles(const Global& global, const TilesCommand& options, TilesOptions tiles) {
+  if (options.resume)
+    return Error{ErrorKind::kUsage, "--resume does not go with --surface (it starts over)"};
+  LODFORGE_TRY(claimTilesetOutput(options.input, options.output));
+  ReconstructOptions reconstruct;
+  reconstruct.voxel = options.voxel;
+  reconstruct.memoryLimit = global.memoryLimit;
+  reconstruct.salvageTruncated = options.salvage;
+  Result<ReconstructedMesh> mesh = reconstructSurface(options.input, reconstruct);
+  if (!mesh) return mesh.status();
+  if (mesh->indices.empty())
+    return badInput(options.input, fmt::format("no surface at voxel {:g}: the points are too "
+                                               "sparse for it (try a larger --voxel)",
+                                               mesh->grid.voxel));
+  ScopedDirectory work(temporaryPathFor(options.output + ".surface"));
+  std::error_code error;
+  std::filesystem::create_directories(work.path, error);
+  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
+  TilesCommand surface = options;
+  surface.input = work.path + "/surface.ply";
+  LODFORGE_TRY(writeReconstruction(*mesh, surface.input));
+  say(global, fmt::format("reconstructed {} triangles from {} points (voxel {:g})",
+                          formatCount(mesh->indices.size() / 3), formatCount(mesh->points),
+                          mesh->grid.voxel));
+  if (tiles.crs.empty() && !tiles.origin) {
+    Result<PointReader> reader = PointReader::open(options.input, 1, options.salvage, false);
+    if (reader) tiles.crs = reader->info().crs;
+  }
+  return runMeshTiles(global, surface, tiles);
+}
+
 Status runTiles(const Global& global, const TilesCommand& options) {
   LODFORGE_TRY(checkTilesInput(options.input));
   Result<TilesOptions> tiles = meshTilesOptions(global, options);
   if (!tiles) return tiles.status();
-  if (isPointInput(options.input)) return runPointTiles(global, options, *tiles);
+  const bool points = isPointInput(options.input);
+  if (options.surface && !points)
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: --surface is for point clouds (this is a mesh)", options.input)};
+  if (options.surface) return runSurfaceTiles(global, options, *tiles);
+  if (points) return runPointTiles(global, options, *tiles);
   return runMeshTiles(global, options, *tiles);
 }
 

@@ -597,6 +597,17 @@ TEST(CliReconstruct, MakesASurfaceAndRefusesWhatCannotBeOne) {
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("--chunk-size"), std::string::npos) << o.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
+  // tiles --surface: the reconstruction tiled as a mesh, its work folder gone afterwards.
+  o = lodforge(
+      "tiles " + dir.file("p.ply") + " --surface -o " + dir.file("t") + " --chunk-size 200", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("reconstructed"), std::string::npos) << o.out;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("t/tileset.json")));
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_EQ(entry.path().filename().string().find(".surface"), std::string::npos) << entry.path();
+  o = lodforge("tiles " + dir.file("s.ply") + " --surface -o " + dir.file("u"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("--surface is for point clouds"), std::string::npos) << o.err;
   o = lodforge(
       "reconstruct " + dir.file("p.ply") + " -o " + dir.file("x.ply") + " --orient sideways", dir);
   EXPECT_EQ(o.code, 2);

@@ -17,6 +17,7 @@
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
 #include "lodforge/io/model_io.h"
+#include "lodforge/surface/reconstruct.h"
 
 namespace lodforge {
 namespace {
@@ -249,6 +250,32 @@ TEST(Octree, AnyMixOfLevelsHasNoBoundaryTheInputDidNotHave) {
       EXPECT_EQ(rootRim, 0u);
     }
   }
+}
+
+// A surface reconstructed from points (surface/reconstruct: an open wavy sheet with its own
+// edge) tiles like any mesh: no mix of levels opens a crack.
+TEST(Octree, AReconstructedScanHasNoCrackInAnyMix) {
+  Random random(3);
+  std::vector<Vec3d> points;
+  for (int i = 0; i < 12'000; ++i) {
+    const double x = random.uniform(0, 80), y = random.uniform(0, 50);
+    points.push_back({1000 + x, 2000 + y, 3 * std::sin(x / 9) * std::cos(y / 7)});
+  }
+  ReconstructOptions reconstruct;
+  reconstruct.normals.orientation = NormalOrientation::kUp;
+  Result<ReconstructedMesh> surface = reconstructPoints(points, {}, {}, "sheet", reconstruct);
+  ASSERT_TRUE(surface.ok()) << surface.error().message;
+  MeshPart input;
+  input.positions = surface->positions;
+  input.indices = surface->indices;
+  OctreeOptions options;
+  options.errorSamples = 2000;
+  const Built built = build(input, 10, options, ::testing::TempDir() + "/octree-surface");
+  ASSERT_GE(built.tree.levels, 2);
+  std::vector<MeshPart> leaves;
+  for (const auto& [index, mesh] : built.meshes)
+    if (built.tree.nodes[index].level == 0) leaves.push_back(mesh);
+  expectNoCracks(built, endsOf(boundaryEdges(concatenate(leaves))), 9, "reconstructed sheet");
 }
 
 TEST(Octree, ParentsAreSimplerAndTheirErrorBoundsTheirChildren) {

@@ -14,7 +14,7 @@ void signedDistances(const VoxelGrid& grid, const OrientedPoints& points,
   const auto& size = values.size;
   const std::size_t count = static_cast<std::size_t>(size[0]) * size[1] * size[2];
   std::vector<double> weights(count, 0), sums(count, 0);
-  std::vector<Vec3d> offsets(count), directions(count);  // Σ w (p − c), Σ w n
+  std::vector<Vec3f> offsets(count), directions(count);  // Σ w (p − c), Σ w n (only compared)
   std::vector<std::uint32_t> near(count, 0);
   const double radius = options.radius * grid.voxel, radius2 = radius * radius;
   // Each point adds to the corners within the radius, points in id order: every corner sums
@@ -51,8 +51,8 @@ void signedDistances(const VoxelGrid& grid, const OrientedPoints& points,
               static_cast<std::uint32_t>(k - static_cast<std::int64_t>(values.first[2])));
           weights[at3] += w;
           sums[at3] += w * dot(n, d);
-          offsets[at3] = offsets[at3] - d * w;
-          directions[at3] = directions[at3] + n * w;
+          offsets[at3] = offsets[at3] - toFloat(d * w);
+          directions[at3] = directions[at3] + toFloat(n * w);
           ++near[at3];
         }
       }
@@ -63,8 +63,8 @@ void signedDistances(const VoxelGrid& grid, const OrientedPoints& points,
   for (std::size_t c = 0; c < count; ++c) {
     if (near[c] < options.minPoints) continue;
     // The near points' centroid seen from the corner, along their mean plane.
-    const Vec3d offset = offsets[c] * (1 / weights[c]);
-    const Vec3d normal = normalizeOr(directions[c], Vec3d{0, 0, 1});
+    const Vec3d offset = toDouble(offsets[c]) * (1 / weights[c]);
+    const Vec3d normal = normalizeOr(toDouble(directions[c]), Vec3d{0, 0, 1});
     const Vec3d along = offset - normal * dot(offset, normal);
     if (dot(along, along) > edge2) continue;
     values.values[c] = static_cast<float>(sums[c] / weights[c]);

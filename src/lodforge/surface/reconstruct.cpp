@@ -1,13 +1,13 @@
 #include "lodforge/surface/reconstruct.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <numeric>
 #include <unordered_map>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
@@ -126,20 +126,46 @@ SurfacePiece chunkPiece(const Layout& layout, std::uint64_t c,
   return polygonize(layout.grid, values);
 }
 
-// Pieces joined by vertex name, in chunk order.
-void join(std::span<const SurfacePiece> pieces, ReconstructedMesh& mesh) {
-  std::unordered_map<std::uint64_t, std::uint32_t> index;
-  for (const SurfacePiece& piece : pieces) {
-    std::vector<std::uint32_t> local(piece.positions.size());
-    for (std::size_t v = 0; v < piece.positions.size(); ++v) {
-      const auto [at, added] =
-          index.try_emplace(piece.edges[v], static_cast<std::uint32_t>(mesh.positions.size()));
-      if (added) mesh.positions.push_back(piece.positions[v]);
-      local[v] = at->second;
-    }
-    for (std::uint32_t i : piece.indices) mesh.indices.push_back(local[i]);
+// Whether a vertex's lattice edge lies in a chunk face (in a plane of corners a multiple of N
+// along an axis it does not run along): only those can be in two chunks.
+bool onChunkFace(std::uint64_t key, const Layout& layout) {
+  const int direction = static_cast<int>(key % 7) + 1;
+  std::uint64_t corner = key / 7;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const std::uint64_t at = corner % layout.grid.corners[a];
+    corner /= layout.grid.corners[a];
+    if ((direction & (1 << a)) == 0 && at % layout.n == 0) return true;
   }
+  return false;
 }
+
+// Pieces joined by vertex name as they come, in chunk order.
+class Joiner {
+ public:
+  Joiner(const Layout& layout, ReconstructedMesh& mesh) : layout_(layout), mesh_(mesh) {}
+
+  void add(const SurfacePiece& piece) {
+    local_.resize(piece.positions.size());
+    for (std::size_t v = 0; v < piece.positions.size(); ++v) {
+      const auto next = static_cast<std::uint32_t>(mesh_.positions.size());
+      if (!onChunkFace(piece.edges[v], layout_)) {
+        local_[v] = next;
+        mesh_.positions.push_back(piece.positions[v]);
+        continue;
+      }
+      const auto [at, added] = shared_.try_emplace(piece.edges[v], next);
+      if (added) mesh_.positions.push_back(piece.positions[v]);
+      local_[v] = at->second;
+    }
+    for (std::uint32_t i : piece.indices) mesh_.indices.push_back(local_[i]);
+  }
+
+ private:
+  const Layout& layout_;
+  ReconstructedMesh& mesh_;
+  std::unordered_map<std::uint64_t, std::uint32_t> shared_;  // face vertices only
+  std::vector<std::uint32_t> local_;
+};
 
 // Drops connected pieces of fewer than `least` triangles (and the vertices only they used).
 std::uint64_t dropSmallPieces(ReconstructedMesh& mesh, std::uint64_t least) {
@@ -220,24 +246,31 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
   LODFORGE_TRY(checkCancelled());
   const std::vector<std::vector<std::uint32_t>> members =
       bucket(positions, *layout, options.distance.radius);
-  std::vector<SurfacePiece> made(members.size());
+  // A few chunks per thread at a time, joined in chunk order and freed: only those pieces are
+  // held besides the mesh.
+  const auto batch =
+      static_cast<std::size_t>(4 * std::max(1, tbb::this_task_arena::max_concurrency()));
+  std::vector<SurfacePiece> made(batch);
+  Joiner joiner(*layout, mesh);
   Progress progress("reconstruct: chunks", members.size());
-  std::atomic<bool> cancelled{false};
-  tbb::parallel_for(std::size_t{0}, members.size(), [&](std::size_t c) {
-    if (cancelled || members[c].empty()) return;
-    if (cancelRequested()) {
-      cancelled = true;
-      return;
+  for (std::size_t first = 0; first < members.size(); first += batch) {
+    const std::size_t last = std::min(members.size(), first + batch);
+    tbb::parallel_for(first, last, [&](std::size_t c) {
+      made[c - first] = members[c].empty() ? SurfacePiece{}
+                                           : chunkPiece(*layout, c, members[c], positions, normals,
+                                                        options.distance);
+    });
+    for (std::size_t c = first; c < last; ++c) {
+      joiner.add(made[c - first]);
+      if (pieces) pieces->push_back(std::move(made[c - first]));
+      made[c - first] = SurfacePiece{};
     }
-    made[c] = chunkPiece(*layout, c, members[c], positions, normals, options.distance);
-    progress.advance(1);
-  });
-  LODFORGE_TRY(checkCancelled());
+    progress.advance(last - first);
+    LODFORGE_TRY(checkCancelled());
+  }
   progress.finish();
-  join(made, mesh);
   mesh.droppedPieces = dropSmallPieces(mesh, options.minTriangles);
   if (!colors.empty()) colourVertices(positions, colors, mesh);
-  if (pieces) *pieces = std::move(made);
   return mesh;
 }
 
@@ -254,6 +287,11 @@ Result<ReconstructedMesh> reconstructSurface(const std::string& input,
   std::vector<Vec3d> positions;
   std::vector<Vec3f> normals;
   std::vector<Rgba8> colors;
+  // Reserved when the count is known: growing by doubling would hold half as much again.
+  const auto count = static_cast<std::size_t>(info.count.value_or(0));
+  positions.reserve(count);
+  if (info.hasNormals) normals.reserve(count);
+  if (info.hasColors) colors.reserve(count);
   Progress progress("reconstruct: reading", info.count.value_or(0));
   PointBatch batch;
   while (true) {

@@ -251,16 +251,20 @@ if [[ ${BENCH_ONLY:-} == laz ]]; then laz_section; exit 0; fi
 # e.g. a LASzip-based compressor). POTREE_SIZES (default "1M 20M") picks the clouds, kept in
 # the bench folder as cloud-N.las/.laz for the next run; POTREE_RUNS (default 3) runs of each
 # tool alternate and the median wall time is shown (this machine is shared and noisy).
-potree_once() {  # tool, input; prints "seconds peak-KiB output-size"
-  local tool=$1 input=$2 log=$work/time.log out=$work/potree-out
-  rm -rf "$out"
-  local cmd
-  if [[ $tool == lodforge ]]; then cmd=("$lodforge" -q tiles "$input" -o "$out"); else cmd=("$POTREE" "$input" -o "$out"); fi
-  /usr/bin/time -v "${cmd[@]}" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
+timed() {  # command...; prints "seconds peak-KiB" from /usr/bin/time -v
+  local log=$work/time.log
+  /usr/bin/time -v "$@" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
   local wall
   wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
   echo "$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")" \
-    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")" "$(du -sh "$out" | cut -f1)"
+    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")"
+}
+potree_once() {  # tool, input; prints "seconds peak-KiB output-size"
+  local tool=$1 input=$2 out=$work/potree-out
+  rm -rf "$out"
+  local cmd
+  if [[ $tool == lodforge ]]; then cmd=("$lodforge" -q tiles "$input" -o "$out"); else cmd=("$POTREE" "$input" -o "$out"); fi
+  echo "$(timed "${cmd[@]}")" "$(du -sh "$out" | cut -f1)"
   rm -rf "$out"
 }
 potree_section() {
@@ -311,15 +315,6 @@ if [[ ${BENCH_ONLY:-} == potree ]]; then potree_section; exit 0; fi
 # twice as many triangles (the same terrain at the same detail). Both tools at a comparable
 # resolution: PoissonRecon --depth 9 (512 cells over its bounding cube, 1.1× the cloud) and
 # lodforge --voxel of the same size; each mesh measured against the truth by `lodforge compare`.
-surface_once() {  # label, command...; prints "seconds peak-KiB"
-  local log=$work/time.log
-  shift
-  /usr/bin/time -v "$@" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
-  local wall
-  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
-  echo "$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")" \
-    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")"
-}
 surface_section() {
   echo
   echo "== surfaces beside PoissonRecon (same cloud, one run each; $(nproc) threads)"
@@ -348,12 +343,12 @@ surface_section() {
       local out=$work/surface-$tool-$n.ply
       rm -f "$out"
       if [[ $tool == lodforge ]]; then
-        read -r seconds kib < <(surface_once "$tool" "$lodforge" -q reconstruct "$cloud" -o "$out" --voxel "$voxel")
+        read -r seconds kib < <(timed "$lodforge" -q reconstruct "$cloud" -o "$out" --voxel "$voxel")
       elif [[ $tool == poisson ]]; then
-        read -r seconds kib < <(surface_once "$tool" "$POISSON" --in "$cloud" --out "$out" --depth 9)
+        read -r seconds kib < <(timed "$POISSON" --in "$cloud" --out "$out" --depth 9)
       else
-        read -r s1 k1 < <(surface_once "$tool" "$POISSON" --in "$cloud" --out "$out.dense.ply" --depth 9 --density)
-        read -r s2 k2 < <(surface_once "$tool" "$trimmer" --in "$out.dense.ply" --out "$out" --trim 7)
+        read -r s1 k1 < <(timed "$POISSON" --in "$cloud" --out "$out.dense.ply" --depth 9 --density)
+        read -r s2 k2 < <(timed "$trimmer" --in "$out.dense.ply" --out "$out" --trim 7)
         seconds=$(awk -v a="$s1" -v b="$s2" 'BEGIN { print a + b }')
         kib=$(( k1 > k2 ? k1 : k2 ))
         rm -f "$out.dense.ply"

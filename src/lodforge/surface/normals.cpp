@@ -91,10 +91,10 @@ void propagate(std::span<const Vec3d> points, std::span<const std::uint32_t> knn
 
 }  // namespace
 
-std::vector<Vec3f> estimateNormals(std::span<const Vec3d> positions, const NormalOptions& options) {
+std::vector<Vec3f> estimateNormals(std::span<const Vec3d> positions, const PointIndex& tree,
+                                   const NormalOptions& options) {
   std::vector<Vec3f> normals(positions.size(), Vec3f{0, 0, 1});
   if (positions.size() < 3) return normals;
-  const PointIndex tree(positions);
   const std::size_t k = std::min<std::size_t>(
       positions.size(), static_cast<std::size_t>(std::max(3, options.neighbours)));
   const std::vector<std::uint32_t> knn = nearest(tree, positions, k);
@@ -118,9 +118,9 @@ std::vector<Vec3f> estimateNormals(std::span<const Vec3d> positions, const Norma
   return normals;
 }
 
-double medianSpacing(std::span<const Vec3d> positions, std::size_t samples) {
+double medianSpacing(std::span<const Vec3d> positions, const PointIndex& tree,
+                     std::size_t samples) {
   if (positions.size() < 2) return 0;
-  const PointIndex tree(positions);
   const std::size_t step = std::max<std::size_t>(1, positions.size() / samples);
   std::vector<double> gaps;
   for (std::size_t i = 0; i < positions.size(); i += step) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lodforge/core/math.h"
+#include "lodforge/surface/point_index.h"
 
 namespace lodforge {
 
@@ -21,10 +22,13 @@ struct NormalOptions {
   Vec3d viewpoint;  // with kViewpoint
 };
 
-std::vector<Vec3f> estimateNormals(std::span<const Vec3d> positions, const NormalOptions& options);
+// `index` is over `positions` (one k-d tree serves the normals, the spacing and the colours).
+std::vector<Vec3f> estimateNormals(std::span<const Vec3d> positions, const PointIndex& index,
+                                   const NormalOptions& options);
 
 // The median distance from a point to its nearest neighbour, over up to `samples` points spread
 // through the cloud (0 for fewer than two distinct points).
-double medianSpacing(std::span<const Vec3d> positions, std::size_t samples = 10'000);
+double medianSpacing(std::span<const Vec3d> positions, const PointIndex& index,
+                     std::size_t samples = 10'000);
 
 }  // namespace lodforge

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -24,7 +25,7 @@ namespace {
 // search of the normal estimate (k indices and the graph).
 constexpr std::uint64_t kBytesPerPoint = 24 + 12 + 4 + 8 + 12 * 4 * 3;
 // Bytes of one chunk in flight per corner: the weight and sum (doubles), count and value.
-constexpr std::uint64_t kBytesPerCorner = 8 + 8 + 4 + 4;
+constexpr std::uint64_t kBytesPerCorner = 8 + 8 + 12 + 12 + 4 + 4;
 
 struct Layout {
   VoxelGrid grid;
@@ -33,8 +34,8 @@ struct Layout {
   std::uint64_t chunkCount() const { return chunks[0] * chunks[1] * chunks[2]; }
 };
 
-Result<Layout> layOut(std::span<const Vec3d> positions, const std::string& name,
-                      const ReconstructOptions& options) {
+Result<Layout> layOut(std::span<const Vec3d> positions, const PointIndex* index,
+                      const std::string& name, const ReconstructOptions& options) {
   if (positions.size() < 4)
     return badInput(name, fmt::format("{} points are too few for a surface: it takes at least 4, "
                                       "and enough to cover the surface at the voxel size",
@@ -48,7 +49,7 @@ Result<Layout> layOut(std::span<const Vec3d> positions, const std::string& name,
                     "all points lie on a line or at one position: a surface needs points "
                     "spread in two directions at least");
   double voxel = options.voxel;
-  if (voxel <= 0) voxel = 2 * medianSpacing(positions);
+  if (voxel <= 0) voxel = 2 * medianSpacing(positions, *index);
   if (!(voxel > 0) || !std::isfinite(voxel))
     return badInput(name, "the points have no spacing to size voxels by: give --voxel");
   Layout layout;
@@ -206,9 +207,8 @@ std::uint64_t dropSmallPieces(ReconstructedMesh& mesh, std::uint64_t least) {
 }
 
 // Each vertex takes the colour of the nearest input point.
-void colourVertices(std::span<const Vec3d> points, std::span<const Rgba8> colors,
+void colourVertices(const PointIndex& tree, std::span<const Rgba8> colors,
                     ReconstructedMesh& mesh) {
-  const PointIndex tree(points);
   mesh.colors.resize(mesh.positions.size());
   tbb::parallel_for(std::size_t{0}, mesh.positions.size(), [&](std::size_t v) {
     std::uint32_t nearest = 0;
@@ -225,7 +225,10 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
                                             const std::string& name,
                                             const ReconstructOptions& options,
                                             std::vector<SurfacePiece>* pieces) {
-  Result<Layout> layout = layOut(positions, name, options);
+  // One k-d tree over the points, if the spacing, the normals or the colours need it.
+  std::optional<PointIndex> index;
+  if (options.voxel <= 0 || normals.empty() || !colors.empty()) index.emplace(positions);
+  Result<Layout> layout = layOut(positions, index ? &*index : nullptr, name, options);
   if (!layout) return layout.status();
   const std::uint64_t corners = std::uint64_t{layout->n + 1} * (layout->n + 1) * (layout->n + 1);
   if (options.memoryLimit > 0 && corners * kBytesPerCorner > options.memoryLimit / 2)
@@ -240,7 +243,7 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
   mesh.points = positions.size();
   mesh.chunks = layout->chunkCount();
   if (normals.empty()) {
-    normals = estimateNormals(positions, options.normals);
+    normals = estimateNormals(positions, *index, options.normals);
     mesh.estimatedNormals = true;
   }
   LODFORGE_TRY(checkCancelled());
@@ -270,7 +273,7 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
   }
   progress.finish();
   mesh.droppedPieces = dropSmallPieces(mesh, options.minTriangles);
-  if (!colors.empty()) colourVertices(positions, colors, mesh);
+  if (!colors.empty()) colourVertices(*index, colors, mesh);
   return mesh;
 }
 

@@ -21,6 +21,17 @@ constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort 
 
 using Field = PointAttributeField;
 
+bool isAsciiAlnum(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+}
+
+// Property names are ASCII identifiers: their attribute (and clash test) is "_" + upper case.
+std::string upper(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](char c) { return static_cast<char>(std::toupper(c)); });
+  return s;
+}
+
 // The names `--attributes` takes: one per bit (returns covers both return fields).
 struct Named {
   const char* name;
@@ -241,9 +252,7 @@ PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std:
     for (std::size_t f = 0; f < names.size(); ++f) {
       const ExtraField& field = extras.layout->fields[f];
       const ExtraColumn column = extraColumn(field, extras, points.size());
-      std::string semantic = "_" + names[f];
-      std::transform(semantic.begin(), semantic.end(), semantic.begin(),
-                     [](char c) { return static_cast<char>(std::toupper(c)); });
+      const std::string semantic = "_" + upper(names[f]);
       out.data.push_back(packExtra(field, column, extras, points.size()));
       out.attributes.push_back({semantic, column.componentType, {}});
       properties[names[f]] = extraProperty(field, column);
@@ -265,19 +274,8 @@ PointTileAttributes pointTileAttributes(std::span<const CloudPoint> points, std:
   return out;
 }
 
-namespace {
-bool isAsciiAlnum(char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
-}
-}  // namespace
-
 std::vector<std::string> extraPropertyNames(const PointExtras& extras) {
   std::set<std::string> taken;  // upper case
-  const auto upper = [](std::string s) {
-    std::transform(s.begin(), s.end(), s.begin(),
-                   [](char c) { return static_cast<char>(std::toupper(c)); });
-    return s;
-  };
   for (const Field& field : pointAttributeFields()) taken.insert(upper(field.property));
   std::vector<std::string> names;
   for (const ExtraField& field : extras.fields) {

@@ -120,7 +120,7 @@ struct LasReader::State {
   Status checkPointData() const;
   Status readRecords(CrsRecords& crs);
   Status readExtendedRecords(CrsRecords& crs);
-  Status readExtraBytes(std::span<const std::byte> record, std::uint64_t at);
+  void readExtraBytes(std::span<const std::byte> record, std::uint64_t at);
   Status probeColorDepth();
   Status readLazRecord();
   Result<LazPointStream> openLazPoints() const;
@@ -306,14 +306,14 @@ Status LasReader::State::readRecords(CrsRecords& crs) {
       lazAt = at + kVlrHeader;
     }
     if (user == "copc" && id == 1) header.copc = true;
-    if (user == "LASF_Spec" && id == kExtraBytesRecord)
-      LODFORGE_TRY(readExtraBytes(record, at + kVlrHeader));
+    if (user == "LASF_Spec" && id == kExtraBytesRecord) readExtraBytes(record, at + kVlrHeader);
   }
   return {};
 }
 
-// The Extra Bytes record: what the bytes past the point format's hold.
-Status LasReader::State::readExtraBytes(std::span<const std::byte> record, std::uint64_t at) {
+// The Extra Bytes record: what the bytes past the point format's hold. A damaged one never
+// fails the file: its extra bytes are then not carried, and extrasIgnored says why.
+void LasReader::State::readExtraBytes(std::span<const std::byte> record, std::uint64_t at) {
   LasHeader& h = header;
   const auto available = static_cast<std::uint32_t>(h.recordLength - lasRecordSize(h.pointFormat));
   Result<PointExtras> extras = parseLasExtraBytes(record, available, source->name(), at);
@@ -321,10 +321,9 @@ Status LasReader::State::readExtraBytes(std::span<const std::byte> record, std::
     // The points themselves are fine: read them without the extra bytes, and say why.
     h.extras = {};
     h.extrasIgnored = extras.error().message + "; the extra bytes are not carried";
-    return {};
+    return;
   }
   h.extras = extras->fields.empty() ? PointExtras{} : std::move(*extras);
-  return {};
 }
 
 // Extended records (LAS 1.4) follow the points; a second reader fetches them.
@@ -362,7 +361,7 @@ Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
                length < (std::uint64_t{1} << 24)) {
       record.resize(length);
       extra->read(record.data(), record.size());
-      LODFORGE_TRY(readExtraBytes(record, at + kEvlrHeader));
+      readExtraBytes(record, at + kEvlrHeader);
     } else {
       extra->skip(length);
     }

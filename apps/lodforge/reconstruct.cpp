@@ -86,22 +86,16 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
       reconstruct.normals = *normals;
       reconstruct.memoryLimit = global.memoryLimit;
       reconstruct.salvageTruncated = options->salvage;
-      Result<ReconstructedMesh> mesh = reconstructSurface(options->input, reconstruct);
+      Result<ReconstructStats> mesh =
+          reconstructToFile(options->input, options->output, reconstruct);
       if (!mesh) return mesh.status();
-      if (mesh->indices.empty())
-        return badInput(options->input,
-                        fmt::format("no surface at voxel {:g}: the points are too sparse for it "
-                                    "(try a larger --voxel or --radius, or a smaller "
-                                    "--min-points)",
-                                    mesh->grid.voxel));
-      LODFORGE_TRY(writeReconstruction(*mesh, options->output));
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       say(global, fmt::format("wrote {}: {} triangles, {} vertices from {} points in {:.2f} s "
-                              "(voxel {:g}, {} chunks{}{})",
-                              options->output, formatCount(mesh->indices.size() / 3),
-                              formatCount(mesh->positions.size()), formatCount(mesh->points),
-                              seconds, mesh->grid.voxel, formatCount(mesh->chunks),
+                              "(voxel {:g}, {} chunks in {} runs{}{})",
+                              options->output, formatCount(mesh->triangles),
+                              formatCount(mesh->vertices), formatCount(mesh->points), seconds,
+                              mesh->grid.voxel, formatCount(mesh->chunks), mesh->runs,
                               mesh->estimatedNormals ? ", normals estimated" : "",
                               mesh->droppedPieces > 0
                                   ? fmt::format(", {} small pieces dropped", mesh->droppedPieces)

@@ -246,22 +246,17 @@ Status runSurfaceTiles(const Global& global, const TilesCommand& options, TilesO
   reconstruct.voxel = options.voxel;
   reconstruct.memoryLimit = global.memoryLimit;
   reconstruct.salvageTruncated = options.salvage;
-  Result<ReconstructedMesh> mesh = reconstructSurface(options.input, reconstruct);
-  if (!mesh) return mesh.status();
-  if (mesh->indices.empty())
-    return badInput(options.input, fmt::format("no surface at voxel {:g}: the points are too "
-                                               "sparse for it (try a larger --voxel)",
-                                               mesh->grid.voxel));
   ScopedDirectory work(temporaryPathFor(options.output + ".surface"));
   std::error_code error;
   std::filesystem::create_directories(work.path, error);
   if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
   TilesCommand surface = options;
   surface.input = work.path + "/surface.ply";
-  LODFORGE_TRY(writeReconstruction(*mesh, surface.input));
-  say(global, fmt::format("reconstructed {} triangles from {} points (voxel {:g})",
-                          formatCount(mesh->indices.size() / 3), formatCount(mesh->points),
-                          mesh->grid.voxel));
+  Result<ReconstructStats> mesh = reconstructToFile(options.input, surface.input, reconstruct);
+  if (!mesh) return mesh.status();
+  say(global,
+      fmt::format("reconstructed {} triangles from {} points (voxel {:g})",
+                  formatCount(mesh->triangles), formatCount(mesh->points), mesh->grid.voxel));
   if (tiles.crs.empty() && !tiles.origin) {
     Result<PointReader> reader = PointReader::open(options.input, 1, options.salvage, false);
     if (reader) tiles.crs = reader->info().crs;

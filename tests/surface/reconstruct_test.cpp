@@ -9,6 +9,10 @@
 #include "lodforge/core/distance.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/terrain.h"
+#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/ply_writer.h"
+#include "lodforge/surface/cloud_file.h"
+#include "lodforge/surface/point_index.h"
 #include "test_support.h"
 
 namespace lodforge {
@@ -205,6 +209,97 @@ TEST(Reconstruct, ManyChunksJoinWithoutACrack) {
     single[one[0].edges[v]] = one[0].positions[v];
   for (const auto& [edge, p] : first)
     EXPECT_EQ(std::memcmp(&single.at(edge), &p, sizeof(Vec3d)), 0);
+}
+
+// Points (and normals, when given) as a binary PLY point cloud.
+std::string writeCloud(const test::TempDir& dir, const std::string& name, const Sampled& s,
+                       bool normals) {
+  PlyLayout layout;
+  layout.vertexCount = s.points.size();
+  layout.normals = normals;
+  const std::string path = dir.file(name);
+  Result<PlyWriter> writer = PlyWriter::create(path, layout);
+  EXPECT_TRUE(writer.ok());
+  EXPECT_TRUE(
+      writer->writeVertices(floats(s.points), normals ? s.normals : std::vector<Vec3f>{}, {}).ok());
+  EXPECT_TRUE(writer->finish().ok());
+  return path;
+}
+
+// Out of core, the chunks are worked in runs that fit the memory budget: any number of runs
+// writes the same bytes, the same mesh as in memory, and leaves nothing but the output.
+TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
+  test::TempDir dir;
+  Sampled s = terrainSamples(30'000, 150);
+  for (Vec3d& p : s.points) p = toDouble(toFloat(p));  // as the PLY holds them
+  const std::string cloud = writeCloud(dir, "cloud.ply", s, true);
+  ReconstructOptions options;
+  options.voxel = 1.1;
+  options.chunkVoxels = 9;
+  Result<ReconstructStats> one = reconstructToFile(cloud, dir.file("one.ply"), options);
+  ASSERT_TRUE(one.ok()) << one.error().message;
+  EXPECT_EQ(one->runs, 1u);
+  options.runPoints = 2'000;
+  Result<ReconstructStats> many = reconstructToFile(cloud, dir.file("many.ply"), options);
+  ASSERT_TRUE(many.ok());
+  EXPECT_GT(many->runs, 20u);
+  EXPECT_EQ(test::readFile(dir.file("one.ply")), test::readFile(dir.file("many.ply")));
+  std::vector<Vec3f> normals;
+  for (const Vec3f& n : s.normals) normals.push_back(normalizeOr(n, Vec3f{0, 0, 1}));
+  Result<ReconstructedMesh> memory = reconstructPoints(s.points, normals, {}, "t", options);
+  ASSERT_TRUE(memory.ok());
+  Result<Model> back = readPly(dir.file("many.ply"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->triangleCount(), memory->indices.size() / 3);
+  EXPECT_EQ(back->vertexCount(), memory->positions.size());
+  EXPECT_EQ(many->triangles, memory->indices.size() / 3);
+  ASSERT_EQ(back->positions.size(), memory->positions.size());
+  for (std::size_t v = 0; v < back->positions.size(); v += 97)
+    EXPECT_EQ(back->positions[v], toFloat(memory->positions[v] - back->origin)) << v;
+  EXPECT_EQ(back->indices, memory->indices);
+  EXPECT_EQ(test::listFolder(dir.path()).size(), 3u);  // the cloud and two meshes
+}
+
+// Without normals, `--orient up` estimates each normal in the run that owns its point: many
+// runs still join without a crack and stay on the surface.
+TEST(Reconstruct, NormalsEstimatedRunByRunJoinWithoutACrack) {
+  test::TempDir dir;
+  const Sampled s = terrainSamples(30'000, 150);
+  const std::string cloud = writeCloud(dir, "cloud.ply", s, false);
+  ReconstructOptions options;
+  options.voxel = 1.1;
+  options.chunkVoxels = 9;
+  options.normals.orientation = NormalOrientation::kUp;
+  ASSERT_TRUE(reconstructToFile(cloud, dir.file("one.ply"), options).ok());
+  options.runPoints = 2'000;
+  Result<ReconstructStats> many = reconstructToFile(cloud, dir.file("many.ply"), options);
+  ASSERT_TRUE(many.ok()) << many.error().message;
+  EXPECT_TRUE(many->estimatedNormals);
+  EXPECT_GT(many->runs, 20u);
+  Result<Model> a = readPly(dir.file("one.ply")), b = readPly(dir.file("many.ply"));
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_LE(boundaryEdges(b->indices), boundaryEdges(a->indices));
+  EXPECT_NEAR(static_cast<double>(b->triangleCount()), static_cast<double>(a->triangleCount()),
+              0.001 * static_cast<double>(a->triangleCount()));
+}
+
+// The voxel's default from the file (a sample of points, their nearest neighbours found in
+// passes over the file) is the in-memory estimate's value.
+TEST(Reconstruct, SpacingFromTheFileIsTheSpacingInMemory) {
+  test::TempDir dir;
+  Sampled s = terrainSamples(50'000, 400);
+  for (Vec3d& p : s.points) p = toDouble(toFloat(p));
+  const std::string cloud = writeCloud(dir, "cloud.ply", s, true);
+  Result<CloudSummary> summary = copyCloud(cloud, dir.file("cloud.points"), false);
+  ASSERT_TRUE(summary.ok());
+  EXPECT_EQ(summary->count, s.points.size());
+  for (std::size_t samples : {100u, 10'000u}) {
+    Result<double> fromFile = medianSpacingOfFile(dir.file("cloud.points"), *summary, samples);
+    ASSERT_TRUE(fromFile.ok());
+    const PointIndex index(s.points);
+    EXPECT_EQ(*fromFile, medianSpacing(s.points, index, samples)) << samples;
+    EXPECT_GT(*fromFile, 0);
+  }
 }
 
 // Bad input says what would work.

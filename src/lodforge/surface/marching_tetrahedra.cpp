@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 #include <utility>
 
@@ -20,9 +21,40 @@ struct Cell {
   std::array<float, 8> values;
 };
 
+// The gradient of the values at a global corner: central differences, one-sided where a
+// neighbour is unknown or outside the box, 0 along an axis with neither.
+Vec3d gradientAt(const CornerValues& values, std::array<std::uint64_t, 3> at) {
+  std::array<std::uint32_t, 3> local{};
+  for (std::size_t a = 0; a < 3; ++a)
+    local[a] = static_cast<std::uint32_t>(at[a] - values.first[a]);
+  const double here = values.values[values.index(local[0], local[1], local[2])];
+  Vec3d g;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const auto valueAt = [&](int step) {
+      std::array<std::uint32_t, 3> q = local;
+      if ((step < 0 && q[a] == 0) || (step > 0 && q[a] + 1 >= values.size[a]))
+        return std::numeric_limits<double>::quiet_NaN();
+      q[a] = static_cast<std::uint32_t>(static_cast<std::int64_t>(q[a]) + step);
+      return static_cast<double>(values.values[values.index(q[0], q[1], q[2])]);
+    };
+    const double below = valueAt(-1), above = valueAt(1);
+    double d = 0;
+    if (!std::isnan(below) && !std::isnan(above)) {
+      d = (above - below) / 2;
+    } else if (!std::isnan(above)) {
+      d = above - here;
+    } else if (!std::isnan(below)) {
+      d = here - below;
+    }
+    g[static_cast<int>(a)] = d;
+  }
+  return g;
+}
+
 class Polygonizer {
  public:
-  Polygonizer(const VoxelGrid& grid, SurfacePiece& out) : grid_(grid), out_(out) {}
+  Polygonizer(const VoxelGrid& grid, const CornerValues& values, SurfacePiece& out)
+      : grid_(grid), values_(values), out_(out) {}
 
   void cell(const Cell& c) {
     for (const auto& tet : kTetrahedra) tetrahedron(c, tet);
@@ -41,10 +73,14 @@ class Polygonizer {
                  vb = c.values[static_cast<std::size_t>(b)];
     const double t = va / (va - vb);
     const Vec3d p = grid_.position(i, j, k);
-    const Vec3d q = grid_.position(c.corner[0] + (b & 1), c.corner[1] + ((b >> 1) & 1),
-                                   c.corner[2] + ((b >> 2) & 1));
+    const std::array<std::uint64_t, 3> upper = {c.corner[0] + (b & 1), c.corner[1] + ((b >> 1) & 1),
+                                                c.corner[2] + ((b >> 2) & 1)};
+    const Vec3d q = grid_.position(upper[0], upper[1], upper[2]);
     at->second = static_cast<std::uint32_t>(out_.positions.size());
     out_.positions.push_back(p + (q - p) * t);
+    const Vec3d gradient =
+        gradientAt(values_, {i, j, k}) * (1 - t) + gradientAt(values_, upper) * t;
+    out_.normals.push_back(toFloat(normalizeOr(gradient, Vec3d{0, 0, 1})));
     out_.edges.push_back(key);
     return at->second;
   }
@@ -100,6 +136,7 @@ class Polygonizer {
   }
 
   const VoxelGrid& grid_;
+  const CornerValues& values_;
   SurfacePiece& out_;
   std::unordered_map<std::uint64_t, std::uint32_t> vertexOf_;
 };
@@ -111,13 +148,22 @@ std::uint64_t edgeKey(const VoxelGrid& grid, std::uint64_t i, std::uint64_t j, s
   return ((k * grid.corners[1] + j) * grid.corners[0] + i) * 7 + static_cast<std::uint64_t>(d - 1);
 }
 
-SurfacePiece polygonize(const VoxelGrid& grid, const CornerValues& values) {
+SurfacePiece polygonize(const VoxelGrid& grid, const CornerValues& values,
+                        std::array<std::uint64_t, 3> first, std::array<std::uint32_t, 3> size) {
   SurfacePiece out;
-  Polygonizer polygonizer(grid, out);
-  const auto& size = values.size;
-  for (std::uint32_t k = 0; k + 1 < size[2]; ++k) {
-    for (std::uint32_t j = 0; j + 1 < size[1]; ++j) {
-      for (std::uint32_t i = 0; i + 1 < size[0]; ++i) {
+  Polygonizer polygonizer(grid, values, out);
+  if (size[0] == 0) {
+    first = values.first;
+    size = values.size;
+  }
+  std::array<std::uint32_t, 3> lo{}, hi{};  // the cells' corner 000, local to `values`
+  for (std::size_t a = 0; a < 3; ++a) {
+    lo[a] = static_cast<std::uint32_t>(first[a] - values.first[a]);
+    hi[a] = lo[a] + size[a] - 1;
+  }
+  for (std::uint32_t k = lo[2]; k < hi[2]; ++k) {
+    for (std::uint32_t j = lo[1]; j < hi[1]; ++j) {
+      for (std::uint32_t i = lo[0]; i < hi[0]; ++i) {
         Cell cell{{values.first[0] + i, values.first[1] + j, values.first[2] + k}, {}};
         bool known = true, negative = false, positive = false;
         for (int corner = 0; corner < 8; ++corner) {

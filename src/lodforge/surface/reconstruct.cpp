@@ -2,340 +2,421 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
 #include <optional>
-#include <unordered_map>
+#include <queue>
 
 #include <fmt/format.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include "lodforge/core/mesh.h"
+#include "lodforge/core/directory.h"
+#include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
-#include "lodforge/io/ply_writer.h"
-#include "lodforge/io/point_reader.h"
+#include "lodforge/surface/chunk_runs.h"
+#include "lodforge/surface/cloud_file.h"
+#include "lodforge/surface/layout.h"
+#include "lodforge/surface/mesh_join.h"
 #include "lodforge/surface/point_index.h"
 
 namespace lodforge {
 
 namespace {
 
-// Bytes a point costs here: position, normal, colour, its chunk lists, and the neighbour
-// search of the normal estimate (k indices and the graph).
-constexpr std::uint64_t kBytesPerPoint = 24 + 12 + 4 + 8 + 12 * 4 * 3;
-// Bytes of one chunk in flight per corner: the weight and sum (doubles), count and value.
+// Bytes a point costs when normals are turned by propagation over the whole cloud: position,
+// normal, the k nearest (k = 12) and the symmetric neighbour graph.
+constexpr std::uint64_t kBytesPerPropagatedPoint = 24 + 12 + 12 * 4 * 3;
+// Bytes of one chunk in flight per corner: the weight and sum (doubles), offsets and
+// directions (floats), count and value.
 constexpr std::uint64_t kBytesPerCorner = 8 + 8 + 12 + 12 + 4 + 4;
+// Bytes a point of a run costs: its record, its places in the chunks' lists, the gathered
+// copies of the chunks in flight, and the k-d tree for colours.
+constexpr std::uint64_t kBytesPerRunPoint = 48 + 8 + 44 + 40;
+// What the rest holds besides the runs and the grids (the join's wavefront, buffers).
+constexpr std::uint64_t kOtherBytes = std::uint64_t{48} << 20;
 
-struct Layout {
-  VoxelGrid grid;
-  std::uint32_t n = 64;  // voxels along a chunk's edge
-  std::array<std::uint64_t, 3> chunks{};
-  std::uint64_t chunkCount() const { return chunks[0] * chunks[1] * chunks[2]; }
-};
-
-Result<Layout> layOut(std::span<const Vec3d> positions, const PointIndex* index,
-                      const std::string& name, const ReconstructOptions& options) {
-  if (positions.size() < 4)
-    return badInput(name, fmt::format("{} points are too few for a surface: it takes at least 4, "
-                                      "and enough to cover the surface at the voxel size",
-                                      positions.size()));
-  Aabbd bounds;
-  for (const Vec3d& p : positions) bounds.add(p);
-  int spread = 0;
-  for (int a = 0; a < 3; ++a) spread += bounds.max[a] > bounds.min[a] ? 1 : 0;
-  if (spread < 2)
-    return badInput(name,
-                    "all points lie on a line or at one position: a surface needs points "
-                    "spread in two directions at least");
-  double voxel = options.voxel;
-  if (voxel <= 0) voxel = 2 * medianSpacing(positions, *index);
-  if (!(voxel > 0) || !std::isfinite(voxel))
-    return badInput(name, "the points have no spacing to size voxels by: give --voxel");
-  Layout layout;
-  layout.n = std::max<std::uint32_t>(2, options.chunkVoxels);
-  const auto margin = static_cast<std::uint64_t>(std::ceil(options.distance.radius)) + 1;
-  layout.grid.voxel = voxel;
-  double corners = 1;
-  for (int a = 0; a < 3; ++a) {
-    layout.grid.origin[a] = bounds.min[a] - static_cast<double>(margin) * voxel;
-    const double along =
-        std::ceil((bounds.max[a] - bounds.min[a]) / voxel) + 2.0 * static_cast<double>(margin) + 1;
-    corners *= along;
-    layout.grid.corners[static_cast<std::size_t>(a)] = static_cast<std::uint64_t>(along);
-  }
-  // Edge names count corners × 7 in 64 bits; far below that, the mesh would not fit anywhere.
-  if (corners > 1e15)
-    return Error{ErrorKind::kUsage,
-                 fmt::format("{}: voxel {:g} is too small for a cloud {:g} across ({:.3g} grid "
-                             "corners); try --voxel {:g} or larger",
-                             name, voxel, length(bounds.max - bounds.min), corners,
-                             length(bounds.max - bounds.min) / 10'000)};
-  for (std::size_t a = 0; a < 3; ++a)
-    layout.chunks[a] =
-        std::max<std::uint64_t>(1, (layout.grid.corners[a] - 1 + layout.n - 1) / layout.n);
-  return layout;
+// A chunk is computed with one corner of margin round it, for the gradient at its faces.
+std::uint64_t gridBytes(std::uint32_t n) {
+  const std::uint64_t side = std::uint64_t{n} + 3;
+  return side * side * side * kBytesPerCorner;
 }
 
-// The chunks each point reaches (those holding a corner within the radius), points in order.
-std::vector<std::vector<std::uint32_t>> bucket(std::span<const Vec3d> positions,
-                                               const Layout& layout, double radius) {
-  std::vector<std::vector<std::uint32_t>> members(static_cast<std::size_t>(layout.chunkCount()));
-  const std::uint64_t n = layout.n;
-  for (std::uint32_t i = 0; i < positions.size(); ++i) {
-    std::array<std::uint64_t, 3> lo{}, hi{};
-    for (std::size_t a = 0; a < 3; ++a) {
-      const double g =
-          (positions[i][static_cast<int>(a)] - layout.grid.origin[static_cast<int>(a)]) /
-          layout.grid.voxel;
-      const auto first = static_cast<std::uint64_t>(std::max(0.0, std::ceil(g - radius)));
-      const auto last = static_cast<std::uint64_t>(std::max(0.0, std::floor(g + radius)));
-      // Corner x lies in chunks ceil(x / n) − 1 … floor(x / n).
-      lo[a] = first == 0 ? 0 : (first + n - 1) / n - 1;
-      hi[a] = std::min(layout.chunks[a] - 1, last / n);
-    }
-    for (std::uint64_t z = lo[2]; z <= hi[2]; ++z)
-      for (std::uint64_t y = lo[1]; y <= hi[1]; ++y)
-        for (std::uint64_t x = lo[0]; x <= hi[0]; ++x)
-          members[static_cast<std::size_t>((z * layout.chunks[1] + y) * layout.chunks[0] + x)]
-              .push_back(i);
+int threads() {
+  return std::max(1, tbb::this_task_arena::max_concurrency());
+}
+
+Status checkChunkFits(const ChunkLayout& layout, const ReconstructOptions& options,
+                      const std::string& name) {
+  const std::uint64_t grids = gridBytes(layout.n) * static_cast<std::uint64_t>(threads());
+  if (options.memoryLimit > 0 && grids > options.memoryLimit / 2)
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: {} chunks of {}³ voxels in flight need {} of grid, more than "
+                             "half of --memory-limit {}: use a smaller --chunk-size",
+                             name, threads(), layout.n, formatBytes(grids),
+                             formatBytes(options.memoryLimit))};
+  return {};
+}
+
+std::uint64_t runBudget(const ChunkLayout& layout, const ReconstructOptions& options) {
+  if (options.runPoints > 0) return options.runPoints;
+  if (options.memoryLimit == 0) return kDefaultRunPoints;
+  const std::uint64_t grids = gridBytes(layout.n) * static_cast<std::uint64_t>(threads());
+  const std::uint64_t left =
+      options.memoryLimit > grids + kOtherBytes ? options.memoryLimit - grids - kOtherBytes : 0;
+  return std::max<std::uint64_t>(10'000, left / kBytesPerRunPoint);
+}
+
+double voxelFor(const ReconstructOptions& options, double spacing) {
+  return options.voxel > 0 ? options.voxel : 2 * spacing;
+}
+
+// The members of each of the run's chunks (ascending), by index into `records`, in input order.
+// The reach is a voxel more than the radius: the corners of a chunk's margin need their points.
+std::vector<std::vector<std::uint32_t>> membersOf(const ChunkLayout& layout,
+                                                  std::span<const CloudRecord> records,
+                                                  std::span<const std::uint64_t> chunks,
+                                                  double radius) {
+  std::vector<std::vector<std::uint32_t>> members(chunks.size());
+  for (std::uint32_t i = 0; i < records.size(); ++i) {
+    const ChunkBox box = layout.reach(records[i].position, radius + 1);
+    for (std::uint64_t z = box.lo[2]; z <= box.hi[2]; ++z)
+      for (std::uint64_t y = box.lo[1]; y <= box.hi[1]; ++y)
+        for (std::uint64_t x = box.lo[0]; x <= box.hi[0]; ++x) {
+          const std::uint64_t c = layout.chunkIndex(x, y, z);
+          const auto at = std::lower_bound(chunks.begin(), chunks.end(), c);
+          if (at != chunks.end() && *at == c)
+            members[static_cast<std::size_t>(at - chunks.begin())].push_back(i);
+        }
   }
   return members;
 }
 
-SurfacePiece chunkPiece(const Layout& layout, std::uint64_t c,
-                        std::span<const std::uint32_t> members, std::span<const Vec3d> positions,
-                        std::span<const Vec3f> normals, const DistanceOptions& distance) {
+// One chunk's piece: distances at its corners and a corner of margin, polygonized within its
+// own corners; colours from the nearest point of the run.
+SurfacePiece chunkPiece(const ChunkLayout& layout, std::uint64_t c,
+                        std::span<const std::uint32_t> members,
+                        std::span<const CloudRecord> records, const DistanceOptions& distance,
+                        const PointIndex* colourIndex) {
   std::vector<Vec3d> p(members.size());
   std::vector<Vec3f> nrm(members.size());
   std::vector<std::uint64_t> ids(members.size());
   for (std::size_t m = 0; m < members.size(); ++m) {
-    p[m] = positions[members[m]];
-    nrm[m] = normals[members[m]];
-    ids[m] = members[m];
+    const CloudRecord& r = records[members[m]];
+    p[m] = r.position;
+    nrm[m] = r.normal;
+    ids[m] = r.id;
   }
-  const std::array<std::uint64_t, 3> at = {c % layout.chunks[0],
-                                           (c / layout.chunks[0]) % layout.chunks[1],
-                                           c / (layout.chunks[0] * layout.chunks[1])};
+  const std::array<std::uint64_t, 3> at = layout.chunkAt(c);
+  std::array<std::uint64_t, 3> first{};
+  std::array<std::uint32_t, 3> size{};
   CornerValues values;
   for (std::size_t a = 0; a < 3; ++a) {
-    values.first[a] = at[a] * layout.n;
+    first[a] = at[a] * layout.n;
+    size[a] = static_cast<std::uint32_t>(
+        std::min<std::uint64_t>(layout.n + 1, layout.grid.corners[a] - first[a]));
+    values.first[a] = first[a] > 0 ? first[a] - 1 : 0;
     values.size[a] = static_cast<std::uint32_t>(
-        std::min<std::uint64_t>(layout.n + 1, layout.grid.corners[a] - values.first[a]));
+        std::min<std::uint64_t>(first[a] + size[a] + 1, layout.grid.corners[a]) - values.first[a]);
   }
   signedDistances(layout.grid, {p, nrm, ids}, distance, values);
-  return polygonize(layout.grid, values);
-}
-
-// Whether a vertex's lattice edge lies in a chunk face (in a plane of corners a multiple of N
-// along an axis it does not run along): only those can be in two chunks.
-bool onChunkFace(std::uint64_t key, const Layout& layout) {
-  const int direction = static_cast<int>(key % 7) + 1;
-  std::uint64_t corner = key / 7;
-  for (std::size_t a = 0; a < 3; ++a) {
-    const std::uint64_t at = corner % layout.grid.corners[a];
-    corner /= layout.grid.corners[a];
-    if ((direction & (1 << a)) == 0 && at % layout.n == 0) return true;
-  }
-  return false;
-}
-
-// Pieces joined by vertex name as they come, in chunk order.
-class Joiner {
- public:
-  Joiner(const Layout& layout, ReconstructedMesh& mesh) : layout_(layout), mesh_(mesh) {}
-
-  void add(const SurfacePiece& piece) {
-    local_.resize(piece.positions.size());
+  SurfacePiece piece = polygonize(layout.grid, values, first, size);
+  if (colourIndex) {
+    piece.colors.resize(piece.positions.size());
     for (std::size_t v = 0; v < piece.positions.size(); ++v) {
-      const auto next = static_cast<std::uint32_t>(mesh_.positions.size());
-      if (!onChunkFace(piece.edges[v], layout_)) {
-        local_[v] = next;
-        mesh_.positions.push_back(piece.positions[v]);
-        continue;
-      }
-      const auto [at, added] = shared_.try_emplace(piece.edges[v], next);
-      if (added) mesh_.positions.push_back(piece.positions[v]);
-      local_[v] = at->second;
+      std::uint32_t nearest = 0;
+      double d2 = 0;
+      colourIndex->nearest(piece.positions[v], 1, &nearest, &d2);
+      piece.colors[v] = records[nearest].color;
     }
-    for (std::uint32_t i : piece.indices) mesh_.indices.push_back(local_[i]);
   }
-
- private:
-  const Layout& layout_;
-  ReconstructedMesh& mesh_;
-  std::unordered_map<std::uint64_t, std::uint32_t> shared_;  // face vertices only
-  std::vector<std::uint32_t> local_;
-};
-
-// Drops connected pieces of fewer than `least` triangles (and the vertices only they used).
-std::uint64_t dropSmallPieces(ReconstructedMesh& mesh, std::uint64_t least) {
-  if (least == 0 || mesh.indices.empty()) return 0;
-  std::vector<std::uint32_t> parent(mesh.positions.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  const auto find = [&](std::uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
-    const std::uint32_t a = find(mesh.indices[t]);
-    parent[find(mesh.indices[t + 1])] = a;
-    parent[find(mesh.indices[t + 2])] = a;
-  }
-  std::unordered_map<std::uint32_t, std::uint64_t> triangles;
-  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) ++triangles[find(mesh.indices[t])];
-  std::uint64_t dropped = 0;
-  for (const auto& [root, count] : triangles) dropped += count < least ? 1 : 0;
-  if (dropped == 0) return 0;
-  std::vector<std::uint32_t> kept;
-  for (std::size_t t = 0; t < mesh.indices.size(); t += 3)
-    if (triangles[find(mesh.indices[t])] >= least)
-      kept.insert(kept.end(), mesh.indices.begin() + static_cast<std::ptrdiff_t>(t),
-                  mesh.indices.begin() + static_cast<std::ptrdiff_t>(t + 3));
-  std::vector<std::uint32_t> renumber(mesh.positions.size(), ~0u);
-  std::vector<Vec3d> positions;
-  for (std::uint32_t& i : kept) {
-    if (renumber[i] == ~0u) {
-      renumber[i] = static_cast<std::uint32_t>(positions.size());
-      positions.push_back(mesh.positions[i]);
-    }
-    i = renumber[i];
-  }
-  mesh.positions = std::move(positions);
-  mesh.indices = std::move(kept);
-  return dropped;
+  return piece;
 }
 
-// Each vertex takes the colour of the nearest input point.
-void colourVertices(const PointIndex& tree, std::span<const Rgba8> colors,
-                    ReconstructedMesh& mesh) {
-  mesh.colors.resize(mesh.positions.size());
-  tbb::parallel_for(std::size_t{0}, mesh.positions.size(), [&](std::size_t v) {
-    std::uint32_t nearest = 0;
-    double d2 = 0;
-    tree.nearest(mesh.positions[v], 1, &nearest, &d2);
-    mesh.colors[v] = colors[nearest];
+// The run's chunks made a few per thread at a time and joined in chunk order.
+Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> records,
+                  std::span<const std::uint64_t> chunks, const ReconstructOptions& options,
+                  bool colors, PieceJoiner& joiner, Progress& progress,
+                  std::vector<SurfacePiece>* pieces) {
+  const std::vector<std::vector<std::uint32_t>> members =
+      membersOf(layout, records, chunks, options.distance.radius);
+  std::optional<PointIndex> colourIndex;
+  std::vector<Vec3d> positions;
+  if (colors) {
+    positions.resize(records.size());
+    for (std::size_t i = 0; i < records.size(); ++i) positions[i] = records[i].position;
+    colourIndex.emplace(positions);
+  }
+  const auto batch = static_cast<std::size_t>(4 * threads());
+  std::vector<SurfacePiece> made(batch);
+  for (std::size_t first = 0; first < chunks.size(); first += batch) {
+    const std::size_t last = std::min(chunks.size(), first + batch);
+    tbb::parallel_for(first, last, [&](std::size_t i) {
+      made[i - first] = members[i].empty()
+                            ? SurfacePiece{}
+                            : chunkPiece(layout, chunks[i], members[i], records, options.distance,
+                                         colourIndex ? &*colourIndex : nullptr);
+    });
+    for (std::size_t i = first; i < last; ++i) {
+      LODFORGE_TRY(joiner.add(chunks[i], made[i - first]));
+      if (pieces) pieces->push_back(std::move(made[i - first]));
+      made[i - first] = SurfacePiece{};
+    }
+    progress.advance(last - first);
+    LODFORGE_TRY(checkCancelled());
+  }
+  return {};
+}
+
+// Normals turned by propagation need the whole cloud's neighbour graph at once.
+Status checkPropagationFits(std::uint64_t points, const ReconstructOptions& options,
+                            const std::string& name) {
+  if (options.memoryLimit > 0 && points * kBytesPerPropagatedPoint > options.memoryLimit)
+    return Error{
+        ErrorKind::kLimit,
+        fmt::format("{}: turning the normals of {} points by propagation needs about {}, "
+                    "more than --memory-limit {}: give --orient up or --orient X,Y,Z "
+                    "(estimated chunk by chunk), or points with normals",
+                    name, formatCount(points), formatBytes(points * kBytesPerPropagatedPoint),
+                    formatBytes(options.memoryLimit))};
+  return {};
+}
+
+// Propagation: the positions in memory, the normals written back into the record file.
+Status estimateNormalsWhole(const std::string& cloudPath, const CloudSummary& cloud,
+                            const NormalOptions& options) {
+  std::vector<Vec3d> positions;
+  positions.reserve(static_cast<std::size_t>(cloud.count));
+  LODFORGE_TRY(forEachRecordBlock(cloudPath, [&](std::span<const CloudRecord> block) {
+    for (const CloudRecord& r : block) positions.push_back(r.position);
+    return Status{};
+  }));
+  std::vector<Vec3f> normals;
+  {
+    const PointIndex index(positions);
+    normals = estimateNormals(positions, index, options);
+  }
+  return rewriteNormals(cloudPath, [&](std::span<CloudRecord> block) {
+    for (CloudRecord& r : block) r.normal = normals[static_cast<std::size_t>(r.id)];
+    return Status{};
   });
 }
 
+struct OwnedNormal {
+  std::uint64_t id;
+  Vec3f normal;
+  std::uint32_t unused = 0;
+};
+
+// A run's owned normals, read back in id order.
+class NormalStream {
+ public:
+  explicit NormalStream(std::FILE* file) : file_(file) { refill(); }
+  NormalStream(const NormalStream&) = delete;
+  NormalStream& operator=(const NormalStream&) = delete;
+  ~NormalStream() { std::fclose(file_); }
+  bool done() const { return at_ == got_; }
+  const OwnedNormal& head() const { return block_[at_]; }
+  void pop() {
+    if (++at_ == got_) refill();
+  }
+
+ private:
+  void refill() {
+    got_ = std::fread(block_.data(), sizeof(OwnedNormal), block_.size(), file_);
+    at_ = 0;
+  }
+  std::FILE* file_;
+  std::vector<OwnedNormal> block_ = std::vector<OwnedNormal>(4096);
+  std::size_t at_ = 0, got_ = 0;
+};
+
+std::string normalsPath(const std::string& directory, std::size_t run) {
+  return fmt::format("{}/run-{}.normals", directory, run);
+}
+
+// Up or towards a viewpoint: each point's normal from its neighbours in the run that owns it
+// (the run of the chunk it lies in), so a normal is computed once; then merged into the record
+// file in id order.
+Status estimateNormalsByRun(const std::string& cloudPath, const ChunkLayout& layout,
+                            const ChunkRuns& runs, const ReconstructOptions& options,
+                            const std::string& directory) {
+  LODFORGE_TRY(writeRuns(cloudPath, layout, options.distance.radius + 1, runs, directory));
+  Progress progress("reconstruct: normals", runs.runCount());
+  for (std::size_t r = 0; r < runs.runCount(); ++r) {
+    Result<std::vector<CloudRecord>> records = readRecords(runPath(directory, r));
+    if (!records) return records.status();
+    std::remove(runPath(directory, r).c_str());
+    std::vector<Vec3d> positions(records->size());
+    for (std::size_t i = 0; i < positions.size(); ++i) positions[i] = (*records)[i].position;
+    std::vector<Vec3f> normals;
+    {
+      const PointIndex index(positions);
+      normals = estimateNormals(positions, index, options.normals);
+    }
+    Result<OutputFile> out = OutputFile::create(normalsPath(directory, r), 1 << 20);
+    if (!out) return out.status();
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+      if (runs.runOf(layout.owner(positions[i])) != r) continue;
+      const OwnedNormal owned{(*records)[i].id, normals[i]};
+      LODFORGE_TRY(out->write(&owned, sizeof owned));
+    }
+    LODFORGE_TRY(out->commit());
+    progress.advance(1);
+    LODFORGE_TRY(checkCancelled());
+  }
+  progress.finish();
+  std::vector<std::unique_ptr<NormalStream>> streams;
+  for (std::size_t r = 0; r < runs.runCount(); ++r) {
+    std::FILE* file = std::fopen(normalsPath(directory, r).c_str(), "rb");
+    if (!file) return ioErrorFromErrno(normalsPath(directory, r), "open");
+    streams.push_back(std::make_unique<NormalStream>(file));
+  }
+  using Head = std::pair<std::uint64_t, std::size_t>;  // (id, run)
+  std::priority_queue<Head, std::vector<Head>, std::greater<>> heads;
+  for (std::size_t r = 0; r < streams.size(); ++r)
+    if (!streams[r]->done()) heads.emplace(streams[r]->head().id, r);
+  LODFORGE_TRY(rewriteNormals(cloudPath, [&](std::span<CloudRecord> block) -> Status {
+    for (CloudRecord& record : block) {
+      if (heads.empty() || heads.top().first != record.id)
+        return Error{ErrorKind::kInternal,
+                     fmt::format("{}: point {} has no normal", cloudPath, record.id)};
+      const std::size_t run = heads.top().second;
+      heads.pop();
+      NormalStream& s = *streams[run];
+      record.normal = s.head().normal;
+      s.pop();
+      if (!s.done()) heads.emplace(s.head().id, run);
+    }
+    return Status{};
+  }));
+  return {};
+}
+
 }  // namespace
+
+Result<ReconstructStats> reconstructToFile(const std::string& input, const std::string& output,
+                                           const ReconstructOptions& options) {
+  ScopedDirectory work(temporaryPathFor(output + ".work"));
+  std::error_code error;
+  std::filesystem::create_directories(work.path, error);
+  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
+  const std::string cloudPath = work.path + "/cloud.points";
+  Result<CloudSummary> cloud = copyCloud(input, cloudPath, options.salvageTruncated);
+  if (!cloud) return cloud.status();
+  LODFORGE_TRY(checkSurfaceExtent(cloud->count, cloud->bounds, input));
+  double spacing = 0;
+  if (options.voxel <= 0) {
+    Result<double> measured = medianSpacingOfFile(cloudPath, *cloud);
+    if (!measured) return measured.status();
+    spacing = *measured;
+  }
+  Result<ChunkLayout> layout = layOutChunks(cloud->bounds, voxelFor(options, spacing),
+                                            options.chunkVoxels, options.distance.radius, input);
+  if (!layout) return layout.status();
+  LODFORGE_TRY(checkChunkFits(*layout, options, input));
+  ReconstructStats stats;
+  stats.grid = layout->grid;
+  stats.chunkVoxels = layout->n;
+  stats.points = cloud->count;
+  stats.chunks = layout->chunkCount();
+  const double reach = options.distance.radius + 1;
+  Result<ChunkRuns> runs = planRuns(cloudPath, *layout, reach, runBudget(*layout, options));
+  if (!runs) return runs.status();
+  stats.runs = runs->runCount();
+  if (!cloud->hasNormals) {
+    stats.estimatedNormals = true;
+    if (options.normals.orientation == NormalOrientation::kPropagate) {
+      LODFORGE_TRY(checkPropagationFits(cloud->count, options, input));
+      LODFORGE_TRY(estimateNormalsWhole(cloudPath, *cloud, options.normals));
+    } else {
+      LODFORGE_TRY(estimateNormalsByRun(cloudPath, *layout, *runs, options, work.path));
+    }
+  }
+  LODFORGE_TRY(writeRuns(cloudPath, *layout, reach, *runs, work.path));
+  std::filesystem::remove(cloudPath, error);
+  Result<std::unique_ptr<PlyMeshOutput>> mesh = PlyMeshOutput::create(work.path);
+  if (!mesh) return mesh.status();
+  PieceJoiner joiner(*layout, options.minTriangles, **mesh);
+  Progress progress("reconstruct: chunks", runs->chunks.size());
+  for (std::size_t r = 0; r < runs->runCount(); ++r) {
+    Result<std::vector<CloudRecord>> records = readRecords(runPath(work.path, r));
+    if (!records) return records.status();
+    std::filesystem::remove(runPath(work.path, r), error);
+    const std::span<const std::uint64_t> chunks(runs->chunks.data() + runs->firstChunk[r],
+                                                runs->firstChunk[r + 1] - runs->firstChunk[r]);
+    LODFORGE_TRY(makeChunks(*layout, *records, chunks, options, cloud->hasColors, joiner, progress,
+                            nullptr));
+  }
+  progress.finish();
+  stats.vertices = joiner.vertices();
+  stats.triangles = joiner.triangles();
+  stats.droppedPieces = joiner.droppedPieces();
+  if (stats.triangles == 0)
+    return badInput(input, fmt::format("no surface at voxel {:g}: the points are too sparse for it "
+                                       "(try a larger --voxel or --radius, or a smaller "
+                                       "--min-points)",
+                                       layout->grid.voxel));
+  LODFORGE_TRY((*mesh)->finish(output, cloud->hasColors, "lodforge reconstruct"));
+  return stats;
+}
 
 Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
                                             std::vector<Vec3f> normals, std::vector<Rgba8> colors,
                                             const std::string& name,
                                             const ReconstructOptions& options,
                                             std::vector<SurfacePiece>* pieces) {
-  // One k-d tree over the points, if the spacing, the normals or the colours need it.
+  Aabbd bounds;
+  for (const Vec3d& p : positions) bounds.add(p);
+  LODFORGE_TRY(checkSurfaceExtent(positions.size(), bounds, name));
   std::optional<PointIndex> index;
-  if (options.voxel <= 0 || normals.empty() || !colors.empty()) index.emplace(positions);
-  Result<Layout> layout = layOut(positions, index ? &*index : nullptr, name, options);
+  if (options.voxel <= 0 || normals.empty()) index.emplace(positions);
+  const double spacing = options.voxel > 0 ? 0 : medianSpacing(positions, *index);
+  Result<ChunkLayout> layout = layOutChunks(bounds, voxelFor(options, spacing), options.chunkVoxels,
+                                            options.distance.radius, name);
   if (!layout) return layout.status();
-  const std::uint64_t corners = std::uint64_t{layout->n + 1} * (layout->n + 1) * (layout->n + 1);
-  if (options.memoryLimit > 0 && corners * kBytesPerCorner > options.memoryLimit / 2)
-    return Error{ErrorKind::kUsage,
-                 fmt::format("{}: a chunk of {}³ voxels needs {} of grid, more than half of "
-                             "--memory-limit {}: use a smaller --chunk-size",
-                             name, layout->n, formatBytes(corners * kBytesPerCorner),
-                             formatBytes(options.memoryLimit))};
+  LODFORGE_TRY(checkChunkFits(*layout, options, name));
   ReconstructedMesh mesh;
   mesh.grid = layout->grid;
   mesh.chunkVoxels = layout->n;
   mesh.points = positions.size();
   mesh.chunks = layout->chunkCount();
+  mesh.runs = 1;
   if (normals.empty()) {
     normals = estimateNormals(positions, *index, options.normals);
     mesh.estimatedNormals = true;
   }
-  LODFORGE_TRY(checkCancelled());
-  const std::vector<std::vector<std::uint32_t>> members =
-      bucket(positions, *layout, options.distance.radius);
-  // A few chunks per thread at a time, joined in chunk order and freed: only those pieces are
-  // held besides the mesh.
-  const auto batch =
-      static_cast<std::size_t>(4 * std::max(1, tbb::this_task_arena::max_concurrency()));
-  std::vector<SurfacePiece> made(batch);
-  Joiner joiner(*layout, mesh);
-  Progress progress("reconstruct: chunks", members.size());
-  for (std::size_t first = 0; first < members.size(); first += batch) {
-    const std::size_t last = std::min(members.size(), first + batch);
-    tbb::parallel_for(first, last, [&](std::size_t c) {
-      made[c - first] = members[c].empty() ? SurfacePiece{}
-                                           : chunkPiece(*layout, c, members[c], positions, normals,
-                                                        options.distance);
-    });
-    for (std::size_t c = first; c < last; ++c) {
-      joiner.add(made[c - first]);
-      if (pieces) pieces->push_back(std::move(made[c - first]));
-      made[c - first] = SurfacePiece{};
-    }
-    progress.advance(last - first);
-    LODFORGE_TRY(checkCancelled());
+  index.reset();
+  std::vector<CloudRecord> records(positions.size());
+  for (std::size_t i = 0; i < records.size(); ++i)
+    records[i] = {i, positions[i], normalizeOr(normals[i], Vec3f{0, 0, 1}),
+                  colors.empty() ? Rgba8{} : colors[i]};
+  std::vector<std::uint64_t> chunks;
+  for (const CloudRecord& r : records) {
+    const ChunkBox box = layout->reach(r.position, options.distance.radius + 1);
+    for (std::uint64_t z = box.lo[2]; z <= box.hi[2]; ++z)
+      for (std::uint64_t y = box.lo[1]; y <= box.hi[1]; ++y)
+        for (std::uint64_t x = box.lo[0]; x <= box.hi[0]; ++x)
+          chunks.push_back(layout->chunkIndex(x, y, z));
   }
+  std::sort(chunks.begin(), chunks.end());
+  chunks.erase(std::unique(chunks.begin(), chunks.end()), chunks.end());
+  MemoryMeshOutput out;
+  PieceJoiner joiner(*layout, options.minTriangles, out);
+  Progress progress("reconstruct: chunks", chunks.size());
+  LODFORGE_TRY(
+      makeChunks(*layout, records, chunks, options, !colors.empty(), joiner, progress, pieces));
   progress.finish();
-  mesh.droppedPieces = dropSmallPieces(mesh, options.minTriangles);
-  if (!colors.empty()) colourVertices(*index, colors, mesh);
+  mesh.vertices = joiner.vertices();
+  mesh.triangles = joiner.triangles();
+  mesh.droppedPieces = joiner.droppedPieces();
+  mesh.positions = std::move(out.positions);
+  mesh.normals = std::move(out.normals);
+  if (!colors.empty()) mesh.colors = std::move(out.colors);
+  mesh.indices = std::move(out.indices);
   return mesh;
-}
-
-Result<ReconstructedMesh> reconstructSurface(const std::string& input,
-                                             const ReconstructOptions& options) {
-  Result<PointReader> reader = PointReader::open(input, 1 << 16, options.salvageTruncated, false);
-  if (!reader) return reader.status();
-  const PointCloudInfo& info = reader->info();
-  if (options.memoryLimit > 0 && info.count && *info.count * kBytesPerPoint > options.memoryLimit)
-    return Error{ErrorKind::kLimit,
-                 fmt::format("{}: {} points need about {} here, more than --memory-limit {}", input,
-                             formatCount(*info.count), formatBytes(*info.count * kBytesPerPoint),
-                             formatBytes(options.memoryLimit))};
-  std::vector<Vec3d> positions;
-  std::vector<Vec3f> normals;
-  std::vector<Rgba8> colors;
-  // Reserved when the count is known: growing by doubling would hold half as much again.
-  const auto count = static_cast<std::size_t>(info.count.value_or(0));
-  positions.reserve(count);
-  if (info.hasNormals) normals.reserve(count);
-  if (info.hasColors) colors.reserve(count);
-  Progress progress("reconstruct: reading", info.count.value_or(0));
-  PointBatch batch;
-  while (true) {
-    Result<bool> more = reader->next(batch);
-    if (!more) return more.status();
-    if (!*more) break;
-    positions.insert(positions.end(), batch.positions.begin(), batch.positions.end());
-    normals.insert(normals.end(), batch.normals.begin(), batch.normals.end());
-    colors.insert(colors.end(), batch.colors.begin(), batch.colors.end());
-    progress.advance(batch.size());
-    LODFORGE_TRY(checkCancelled());
-  }
-  progress.finish();
-  for (Vec3f& n : normals) n = normalizeOr(n, Vec3f{0, 0, 1});
-  return reconstructPoints(std::move(positions), std::move(normals), std::move(colors), input,
-                           options);
-}
-
-Status writeReconstruction(const ReconstructedMesh& mesh, const std::string& path) {
-  Aabbd bounds;
-  for (const Vec3d& p : mesh.positions) bounds.add(p);
-  // Geo-scale coordinates keep their millimetres as doubles around the centre.
-  const bool far = !bounds.empty() && length(bounds.center()) > 1e4;
-  const Vec3d origin = far ? bounds.center() : Vec3d{};
-  std::vector<Vec3f> positions(mesh.positions.size());
-  for (std::size_t v = 0; v < positions.size(); ++v)
-    positions[v] = toFloat(mesh.positions[v] - origin);
-  std::vector<Vec3f> normals(positions.size());
-  computeVertexNormals(positions, mesh.indices, normals);
-  PlyLayout layout;
-  layout.vertexCount = positions.size();
-  layout.faceCount = mesh.indices.size() / 3;
-  layout.normals = true;
-  layout.colors = !mesh.colors.empty();
-  layout.doublePositions = far;
-  layout.comments = {"lodforge reconstruct"};
-  Result<PlyWriter> writer = PlyWriter::create(path, layout);
-  if (!writer) return writer.status();
-  LODFORGE_TRY(writer->writeVertices(positions, normals, mesh.colors, origin));
-  LODFORGE_TRY(writer->writeTriangles(mesh.indices));
-  return writer->finish();
 }
 
 }  // namespace lodforge

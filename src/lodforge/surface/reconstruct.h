@@ -1,10 +1,15 @@
 // `lodforge reconstruct`: a surface from a point cloud, chunk by chunk (large-meshes paper §3.1):
-// a meta grid of chunks of N voxels along an edge over one global lattice; each chunk takes the
-// points within the distance radius of its corners (its overlap), computes the signed distance
-// at its corners (surface/implicit) and polygonizes its cells (surface/marching_tetrahedra).
-// Chunks that share a face compute its corners' values and vertices bit for bit alike, so the
-// pieces join by vertex name into one mesh without a crack (§3.3's unification, by
-// construction). Deterministic for any thread count.
+// a meta grid of chunks of N voxels along an edge over one global lattice (surface/layout); each
+// chunk takes the points within the distance radius of its corners (its overlap), computes the
+// signed distance at its corners (surface/implicit) and polygonizes its cells
+// (surface/marching_tetrahedra). Chunks that share a face compute its corners' values and
+// vertices bit for bit alike, so the pieces join by vertex name into one mesh without a crack
+// (§3.3's unification, by construction; surface/mesh_join).
+//
+// Out of core (reconstructToFile): the cloud is copied into a record file, chunks are worked in
+// runs that fit the memory budget (surface/chunk_runs), and the joined mesh streams to work
+// files made one PLY at the end: memory holds one run, the chunks in flight and a wavefront of
+// chunk-face vertices, whatever the cloud's size. Deterministic for any thread count.
 #pragma once
 
 #include <cstdint>
@@ -25,35 +30,42 @@ struct ReconstructOptions {
   std::uint32_t chunkVoxels = 64;  // N: voxels along a chunk's edge
   DistanceOptions distance;        // radius in voxels, fewest points near a corner
   NormalOptions normals;           // for points without normals
-  std::uint64_t memoryLimit = 0;   // bytes, 0: unlimited
+  std::uint64_t memoryLimit = 0;   // bytes, 0: the default budget (kDefaultRunPoints a run)
+  std::uint64_t runPoints = 0;     // points a run of chunks holds; 0: from the memory limit
   std::uint64_t minTriangles = 0;  // connected pieces with fewer triangles are dropped
   bool salvageTruncated = false;
 };
 
-// The mesh as chunks made it: pieces joined by vertex name.
-struct ReconstructedMesh {
+// Points a run holds when no memory limit says otherwise (≈ 80 MB with its chunks).
+constexpr std::uint64_t kDefaultRunPoints = 500'000;
+
+struct ReconstructStats {
   VoxelGrid grid;
   std::uint32_t chunkVoxels = 0;
-  std::vector<Vec3d> positions;
-  std::vector<Rgba8> colors;  // empty when the points have none
-  std::vector<std::uint32_t> indices;
-  std::uint64_t points = 0, chunks = 0, droppedPieces = 0;
+  std::uint64_t points = 0, chunks = 0, runs = 0, vertices = 0, triangles = 0;
+  std::uint64_t droppedPieces = 0;
   bool estimatedNormals = false;
 };
 
-// Reads `input` (any point format) and reconstructs it in memory-bounded chunks.
-Result<ReconstructedMesh> reconstructSurface(const std::string& input,
-                                             const ReconstructOptions& options);
+// The mesh in memory (tests, small clouds): pieces joined by vertex name.
+struct ReconstructedMesh : ReconstructStats {
+  std::vector<Vec3d> positions;
+  std::vector<Vec3f> normals;  // the distance's gradient at each vertex
+  std::vector<Rgba8> colors;   // empty when the points have none
+  std::vector<std::uint32_t> indices;
+};
 
-// The same from points in memory (normals may be empty: estimated then).
+// Reads `input` (any point format) and writes the surface to `output` as binary PLY, out of
+// core. No surface at all is bad input (nothing written).
+Result<ReconstructStats> reconstructToFile(const std::string& input, const std::string& output,
+                                           const ReconstructOptions& options);
+
+// The same from points in memory, as one run (normals may be empty: estimated then). `pieces`,
+// when given, receives every chunk's piece as made.
 Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
                                             std::vector<Vec3f> normals, std::vector<Rgba8> colors,
                                             const std::string& name,
                                             const ReconstructOptions& options,
                                             std::vector<SurfacePiece>* pieces = nullptr);
-
-// Writes the mesh as binary PLY (double positions when far from the origin; vertex normals from
-// the triangles; colours when it has them), under a temporary name renamed when complete.
-Status writeReconstruction(const ReconstructedMesh& mesh, const std::string& path);
 
 }  // namespace lodforge

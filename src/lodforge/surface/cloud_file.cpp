@@ -1,0 +1,190 @@
+#include "lodforge/surface/cloud_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <unordered_map>
+
+#include <fmt/format.h>
+
+#include "lodforge/core/progress.h"
+#include "lodforge/io/point_reader.h"
+
+namespace lodforge {
+
+namespace {
+
+constexpr std::size_t kBlockRecords = 1 << 15;
+
+}  // namespace
+
+Result<RecordWriter> RecordWriter::create(const std::string& path, std::size_t bufferBytes) {
+  Result<OutputFile> file = OutputFile::create(path, bufferBytes);
+  if (!file) return file.status();
+  return RecordWriter(std::move(*file));
+}
+
+Result<CloudSummary> copyCloud(const std::string& input, const std::string& path,
+                               bool salvageTruncated) {
+  Result<PointReader> reader = PointReader::open(input, 1 << 16, salvageTruncated, false);
+  if (!reader) return reader.status();
+  Result<RecordWriter> out = RecordWriter::create(path, std::size_t{4} << 20);
+  if (!out) return out.status();
+  CloudSummary cloud;
+  cloud.hasNormals = reader->info().hasNormals;
+  cloud.hasColors = reader->info().hasColors;
+  Progress progress("reconstruct: reading", reader->info().count.value_or(0));
+  PointBatch batch;
+  while (true) {
+    Result<bool> more = reader->next(batch);
+    if (!more) return more.status();
+    if (!*more) break;
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      CloudRecord r;
+      r.id = cloud.count++;
+      r.position = batch.positions[i];
+      cloud.bounds.add(r.position);
+      if (!batch.normals.empty()) r.normal = normalizeOr(batch.normals[i], Vec3f{0, 0, 1});
+      if (!batch.colors.empty()) r.color = batch.colors[i];
+      LODFORGE_TRY(out->add(r));
+    }
+    progress.advance(batch.size());
+    LODFORGE_TRY(checkCancelled());
+  }
+  progress.finish();
+  LODFORGE_TRY(out->finish());
+  return cloud;
+}
+
+Status forEachRecordBlock(const std::string& path,
+                          const std::function<Status(std::span<const CloudRecord>)>& each) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) return ioErrorFromErrno(path, "open");
+  std::vector<CloudRecord> block(kBlockRecords);
+  Status status;
+  while (status.ok()) {
+    const std::size_t got = std::fread(block.data(), sizeof(CloudRecord), block.size(), file);
+    if (got == 0) {
+      if (std::ferror(file)) status = ioError(path, "read failed");
+      break;
+    }
+    status = each(std::span<const CloudRecord>(block.data(), got));
+    if (status.ok()) status = checkCancelled();
+  }
+  std::fclose(file);
+  return status;
+}
+
+Result<std::vector<CloudRecord>> readRecords(const std::string& path) {
+  std::vector<CloudRecord> records;
+  LODFORGE_TRY(forEachRecordBlock(path, [&](std::span<const CloudRecord> block) {
+    records.insert(records.end(), block.begin(), block.end());
+    return Status{};
+  }));
+  return records;
+}
+
+Status rewriteNormals(const std::string& path,
+                      const std::function<Status(std::span<CloudRecord>)>& change) {
+  Result<WorkFile> file = WorkFile::open(path);
+  if (!file) return file.status();
+  Result<std::uint64_t> bytes = fileSize(path);
+  if (!bytes) return bytes.status();
+  std::vector<CloudRecord> block(kBlockRecords);
+  for (std::uint64_t at = 0; at < *bytes;) {
+    const std::size_t n = static_cast<std::size_t>(
+        std::min<std::uint64_t>(block.size(), (*bytes - at) / sizeof(CloudRecord)));
+    if (n == 0) break;
+    LODFORGE_TRY(file->readAt(at, block.data(), n * sizeof(CloudRecord)));
+    LODFORGE_TRY(change(std::span<CloudRecord>(block.data(), n)));
+    LODFORGE_TRY(file->writeAt(at, block.data(), n * sizeof(CloudRecord)));
+    at += n * sizeof(CloudRecord);
+    LODFORGE_TRY(checkCancelled());
+  }
+  return {};
+}
+
+namespace {
+
+// Samples hashed into every cell of a coarse grid within one cell of them: a point then finds
+// every sample within `cell` of it with one look-up.
+class SampleGrid {
+ public:
+  SampleGrid(std::span<const CloudRecord> samples, const Aabbd& bounds, double cell)
+      : origin_(bounds.min), cell_(cell) {
+    for (std::uint32_t s = 0; s < samples.size(); ++s) {
+      const std::array<std::int64_t, 3> c = cellOf(samples[s].position);
+      for (std::int64_t dz = -1; dz <= 1; ++dz)
+        for (std::int64_t dy = -1; dy <= 1; ++dy)
+          for (std::int64_t dx = -1; dx <= 1; ++dx)
+            cells_[key({c[0] + dx, c[1] + dy, c[2] + dz})].push_back(s);
+    }
+  }
+  const std::vector<std::uint32_t>* near(const Vec3d& p) const {
+    const auto at = cells_.find(key(cellOf(p)));
+    return at == cells_.end() ? nullptr : &at->second;
+  }
+
+ private:
+  std::array<std::int64_t, 3> cellOf(const Vec3d& p) const {
+    return {static_cast<std::int64_t>(std::floor((p.x - origin_.x) / cell_)),
+            static_cast<std::int64_t>(std::floor((p.y - origin_.y) / cell_)),
+            static_cast<std::int64_t>(std::floor((p.z - origin_.z) / cell_))};
+  }
+  static std::uint64_t key(std::array<std::int64_t, 3> c) {
+    // 21 bits an axis: the cell is never smaller than a millionth of the extent.
+    const auto part = [](std::int64_t v) {
+      return static_cast<std::uint64_t>(v + (std::int64_t{1} << 20)) & ((1u << 21) - 1);
+    };
+    return part(c[0]) | part(c[1]) << 21 | part(c[2]) << 42;
+  }
+  Vec3d origin_;
+  double cell_;
+  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> cells_;
+};
+
+}  // namespace
+
+Result<double> medianSpacingOfFile(const std::string& path, const CloudSummary& cloud,
+                                   std::size_t samples) {
+  if (cloud.count < 2) return 0.0;
+  const std::uint64_t step = std::max<std::uint64_t>(1, cloud.count / samples);
+  std::vector<CloudRecord> picked;
+  LODFORGE_TRY(forEachRecordBlock(path, [&](std::span<const CloudRecord> block) {
+    for (const CloudRecord& r : block)
+      if (r.id % step == 0) picked.push_back(r);
+    return Status{};
+  }));
+  const Vec3d extent = cloud.bounds.max - cloud.bounds.min;
+  const double diagonal = length(extent);
+  // A first cell of a few mean spacings of points spread over the largest face of the bounds;
+  // four times larger each time the median is not within a cell yet.
+  const double face = std::max({extent.x * extent.y, extent.y * extent.z, extent.x * extent.z});
+  double cell = std::max(diagonal * 1e-6, 4 * std::sqrt(face / static_cast<double>(cloud.count)));
+  while (true) {
+    const SampleGrid grid(picked, cloud.bounds, cell);
+    std::vector<double> best(picked.size(), std::numeric_limits<double>::infinity());
+    LODFORGE_TRY(forEachRecordBlock(path, [&](std::span<const CloudRecord> block) {
+      for (const CloudRecord& r : block) {
+        const std::vector<std::uint32_t>* near = grid.near(r.position);
+        if (!near) continue;
+        for (std::uint32_t s : *near) {
+          const Vec3d d = r.position - picked[s].position;
+          const double d2 = dot(d, d);
+          if (d2 > 0 && d2 < best[s]) best[s] = d2;
+        }
+      }
+      return Status{};
+    }));
+    std::nth_element(best.begin(), best.begin() + static_cast<std::ptrdiff_t>(best.size() / 2),
+                     best.end());
+    const double median = best[best.size() / 2];
+    // Within a cell, every nearer point was seen: the median is exact.
+    if (median <= cell * cell) return std::sqrt(median);
+    if (cell > diagonal) return std::isfinite(median) ? std::sqrt(median) : 0.0;
+    cell *= 4;
+  }
+}
+
+}  // namespace lodforge

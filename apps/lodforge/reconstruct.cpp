@@ -11,36 +11,14 @@
 #include "lodforge/io/point_reader.h"
 #include "lodforge/surface/reconstruct.h"
 #include "outputs.h"
+#include "surface_options.h"
 
 namespace lodforge::cli {
 
-namespace {
-
-// --orient: propagate, up, or a viewpoint "X,Y,Z".
-Result<NormalOptions> parseOrientation(const std::string& text) {
-  NormalOptions options;
-  if (text == "propagate") return options;
-  if (text == "up") {
-    options.orientation = NormalOrientation::kUp;
-    return options;
-  }
-  double x = 0, y = 0, z = 0;
-  char extra = 0;
-  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &extra) == 3) {
-    options.orientation = NormalOrientation::kViewpoint;
-    options.viewpoint = {x, y, z};
-    return options;
-  }
-  return Error{ErrorKind::kUsage,
-               fmt::format("--orient: \"{}\" is not propagate, up or a viewpoint X,Y,Z", text)};
-}
-
-}  // namespace
-
 void addReconstruct(CLI::App& app, const Global& global, Run& run) {
   struct Options {
-    std::string input, output, orient = "propagate";
-    ReconstructOptions reconstruct;
+    std::string input, output;
+    SurfaceCommand surface;
     bool salvage = false;
   };
   auto options = std::make_shared<Options>();
@@ -49,23 +27,10 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("CLOUD", options->input, "A .las .laz .ply .xyz .txt .csv or .pts point cloud")
       ->required();
   sub->add_option("-o,--output", options->output, "The .ply mesh to write")->required();
-  sub->add_option("--voxel", options->reconstruct.voxel,
-                  "Voxel edge in the cloud's units (default: twice the median point spacing)")
-      ->check(CLI::NonNegativeNumber);
-  sub->add_option("--chunk-size", options->reconstruct.chunkVoxels,
+  addSurfaceOptions(*sub, options->surface);
+  sub->add_option("--chunk-size", options->surface.reconstruct.chunkVoxels,
                   "Voxels along a chunk's edge (default 64)")
       ->check(CLI::Range(2, 1024));
-  sub->add_option("--radius", options->reconstruct.distance.radius,
-                  "Points within this many voxels of a corner set its distance (default 3)")
-      ->check(CLI::Range(0.5, 16.0));
-  sub->add_option("--min-points", options->reconstruct.distance.minPoints,
-                  "Fewest points near a corner for a surface there (default 3)")
-      ->check(CLI::Range(1, 1000));
-  sub->add_option("--orient", options->orient,
-                  "Points without normals: turn estimated normals by propagation (default; "
-                  "closed objects), up (+z: scans of the ground) or towards a viewpoint X,Y,Z");
-  addCountOption(*sub, "--min-triangles", options->reconstruct.minTriangles,
-                 "Drop connected pieces with fewer triangles (default 0: keep all)");
   sub->add_flag("--salvage", options->salvage,
                 "Read a PLY cut short up to its last whole point (with a warning)");
   sub->callback([&global, &run, options] {
@@ -78,16 +43,14 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
         return Error{ErrorKind::kUsage,
                      fmt::format("{}: not a point cloud (.las .laz .ply .xyz .txt .csv .pts)",
                                  options->input)};
-      Result<NormalOptions> normals = parseOrientation(options->orient);
-      if (!normals) return normals.status();
+      Result<ReconstructOptions> reconstruct = surfaceOptions(options->surface, options->input);
+      if (!reconstruct) return reconstruct.status();
       LODFORGE_TRY(claimOutput(options->output, modelFileOutput(options->output),
                                std::vector<std::string>{options->input}));
-      ReconstructOptions reconstruct = options->reconstruct;
-      reconstruct.normals = *normals;
-      reconstruct.memoryLimit = global.memoryLimit;
-      reconstruct.salvageTruncated = options->salvage;
+      reconstruct->memoryLimit = global.memoryLimit;
+      reconstruct->salvageTruncated = options->salvage;
       Result<ReconstructStats> mesh =
-          reconstructToFile(options->input, options->output, reconstruct);
+          reconstructToFile(options->input, options->output, *reconstruct);
       if (!mesh) return mesh.status();
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

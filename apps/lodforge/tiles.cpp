@@ -20,6 +20,7 @@
 #include "lodforge/tiles/tileset.h"
 #include "lodforge/tiles/tileset_output.h"
 #include "lodforge/tiling/resume.h"
+#include "surface_options.h"
 
 namespace lodforge::cli {
 
@@ -67,7 +68,7 @@ struct TilesCommand {
   std::string attributes = "all";
   bool salvage = false;
   bool surface = false;  // point clouds: reconstruct a surface and tile it as a mesh
-  double voxel = 0;
+  SurfaceCommand surfaceOptions;
 };
 
 void addTilesOptions(CLI::App& sub, TilesCommand& options) {
@@ -116,11 +117,10 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
                  "extras (LAS extra bytes, other PLY properties); or all (default: all the input "
                  "has) or none");
   sub.add_flag("--surface", options.surface,
-               "Point clouds: reconstruct a surface (as `lodforge reconstruct`) and tile it as a "
-               "mesh");
-  sub.add_option("--voxel", options.voxel,
-                 "With --surface: voxel edge (default: twice the median point spacing)")
-      ->check(CLI::NonNegativeNumber);
+               "Point clouds: reconstruct a surface (as `lodforge reconstruct`), its chunks the "
+               "leaves (--chunk-size: their edge, default 64 voxels); the options marked "
+               "Surface go with it");
+  addSurfaceOptions(sub, options.surfaceOptions);
   sub.add_flag("--salvage", options.salvage,
                "Read a PLY cut short up to its last whole element (with a warning)");
   sub.add_flag("--resume", options.resume,
@@ -193,6 +193,18 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
 }
 
 void reportMeshTiles(const Global& global, const TilesCommand& options, const TilesStats& stats) {
+  if (stats.surface) {
+    const ReconstructStats& surface = *stats.surface;
+    say(global,
+        fmt::format("reconstructed {} triangles from {} points (voxel {:g}, chunks of {} voxels, "
+                    "{} runs{}{})",
+                    formatCount(surface.triangles), formatCount(surface.points), surface.grid.voxel,
+                    surface.chunkVoxels, surface.runs,
+                    surface.estimatedNormals ? ", normals estimated" : "",
+                    surface.droppedPieces > 0
+                        ? fmt::format(", {} small pieces dropped", surface.droppedPieces)
+                        : ""));
+  }
   say(global,
       fmt::format("wrote {}: {} tiles ({} leaves, {} levels above them), {} in {:.1f} s ({} "
                   "input triangles/s)",
@@ -235,33 +247,32 @@ Status runMeshTiles(const Global& global, const TilesCommand& options, const Til
   return {};
 }
 
-// --surface: the cloud reconstructed (docs/surface.md) into a PLY in a work folder of ours beside
-// the output, removed on every way out, then tiled as a mesh (crack-free as any mesh is). The
-// CRS a LAS file names places the tileset unless --crs or --origin does.
+bool usesSurfaceOptions(const SurfaceCommand& given) {
+  const SurfaceCommand none;
+  return given.orient != none.orient || given.reconstruct.voxel != none.reconstruct.voxel ||
+         given.reconstruct.distance.radius != none.reconstruct.distance.radius ||
+         given.reconstruct.distance.minPoints != none.reconstruct.distance.minPoints ||
+         given.reconstruct.minTriangles != none.reconstruct.minTriangles;
+}
+
+// --surface: the cloud reconstructed chunk by chunk into the leaves (docs/surface.md), then
+// tiled as a mesh. The CRS a LAS file names places the tileset unless --crs or --origin does.
 Status runSurfaceTiles(const Global& global, const TilesCommand& options, TilesOptions tiles) {
-  if (options.resume)
-    return Error{ErrorKind::kUsage, "--resume does not go with --surface (it starts over)"};
-  LODFORGE_TRY(claimTilesetOutput(options.input, options.output));
-  ReconstructOptions reconstruct;
-  reconstruct.voxel = options.voxel;
-  reconstruct.memoryLimit = global.memoryLimit;
-  reconstruct.salvageTruncated = options.salvage;
-  ScopedDirectory work(temporaryPathFor(options.output + ".surface"));
-  std::error_code error;
-  std::filesystem::create_directories(work.path, error);
-  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
-  TilesCommand surface = options;
-  surface.input = work.path + "/surface.ply";
-  Result<ReconstructStats> mesh = reconstructToFile(options.input, surface.input, reconstruct);
-  if (!mesh) return mesh.status();
-  say(global,
-      fmt::format("reconstructed {} triangles from {} points (voxel {:g})",
-                  formatCount(mesh->triangles), formatCount(mesh->points), mesh->grid.voxel));
+  if (options.levels > 0)
+    return Error{ErrorKind::kUsage,
+                 "--levels does not go with --surface: the leaves are the reconstruction's "
+                 "chunks (set their edge with --chunk-size)"};
+  Result<ReconstructOptions> reconstruct = surfaceOptions(options.surfaceOptions, options.input);
+  if (!reconstruct) return reconstruct.status();
+  reconstruct->chunkLength = options.chunkSize;
+  reconstruct->memoryLimit = global.memoryLimit;
+  tiles.input.chunkSize = 0;
+  tiles.surface = *reconstruct;
   if (tiles.crs.empty() && !tiles.origin) {
     Result<PointReader> reader = PointReader::open(options.input, 1, options.salvage, false);
     if (reader) tiles.crs = reader->info().crs;
   }
-  return runMeshTiles(global, surface, tiles);
+  return runMeshTiles(global, options, tiles);
 }
 
 Status runTiles(const Global& global, const TilesCommand& options) {
@@ -273,6 +284,9 @@ Status runTiles(const Global& global, const TilesCommand& options) {
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: --surface is for point clouds (this is a mesh)", options.input)};
   if (options.surface) return runSurfaceTiles(global, options, *tiles);
+  if (usesSurfaceOptions(options.surfaceOptions))
+    return Error{ErrorKind::kUsage,
+                 "--voxel, --radius, --min-points, --orient and --min-triangles go with --surface"};
   if (points) return runPointTiles(global, options, *tiles);
   return runMeshTiles(global, options, *tiles);
 }

@@ -597,21 +597,30 @@ TEST(CliReconstruct, MakesASurfaceAndRefusesWhatCannotBeOne) {
   EXPECT_EQ(o.code, 2);
   EXPECT_NE(o.err.find("--chunk-size"), std::string::npos) << o.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
-  // tiles --surface: the reconstruction tiled as a mesh, its work folder gone afterwards.
-  o = lodforge(
-      "tiles " + dir.file("p.ply") + " --surface -o " + dir.file("t") + " --chunk-size 200", dir);
+  // tiles --surface: the reconstruction's chunks tiled as the leaves, its work folder gone
+  // afterwards.
+  o = lodforge("tiles " + dir.file("p.ply") + " --surface -o " + dir.file("t") + " --chunk-size 30",
+               dir);
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_NE(o.out.find("reconstructed"), std::string::npos) << o.out;
   EXPECT_TRUE(std::filesystem::exists(dir.file("t/tileset.json")));
-  for (const auto& entry : std::filesystem::directory_iterator(dir.path()))
-    EXPECT_EQ(entry.path().filename().string().find(".surface"), std::string::npos) << entry.path();
-  o = lodforge("tiles " + dir.file("s.ply") + " --surface -o " + dir.file("u"), dir);
-  EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.err.find("--surface is for point clouds"), std::string::npos) << o.err;
-  o = lodforge(
-      "reconstruct " + dir.file("p.ply") + " -o " + dir.file("x.ply") + " --orient sideways", dir);
-  EXPECT_EQ(o.code, 2);
-  EXPECT_NE(o.err.find("not propagate, up or a viewpoint"), std::string::npos) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("t.work")));
+  // Options that do not go together, or do not go without --surface.
+  const std::vector<std::pair<std::string, std::string>> usage = {
+      {"tiles " + dir.file("s.ply") + " --surface -o " + dir.file("u"),
+       "--surface is for point clouds"},
+      {"tiles " + dir.file("p.ply") + " --surface --levels 2 -o " + dir.file("u"),
+       "--levels does not go with --surface"},
+      {"tiles " + dir.file("p.ply") + " --voxel 2 -o " + dir.file("u"), "go with --surface"},
+      {"reconstruct " + dir.file("p.ply") + " -o " + dir.file("x.ply") + " --orient sideways",
+       "not auto, propagate, up or a viewpoint"},
+  };
+  for (const auto& [args, says] : usage) {
+    o = lodforge(args, dir);
+    EXPECT_EQ(o.code, 2) << args;
+    EXPECT_NE(o.err.find(says), std::string::npos) << args << "\n" << o.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("u"))) << args;
+  }
 }
 
 TEST(CliPoints, BadInputIsExitCode2AndLeavesNothing) {
@@ -1123,19 +1132,20 @@ TEST(CliTiles, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {
   EXPECT_NE(small.err.find("too small"), std::string::npos) << small.err;
 }
 
-TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
-  test::TempDir dir;
-  ASSERT_EQ(lodforge("-q generate scan --triangles 1M -o " + dir.file("scan.ply"), dir).code, 0);
-  const std::vector<std::string> args = {"-q", "--threads",  "1", "tiles", dir.file("scan.ply"),
-                                         "-o", dir.file("b")};
-  ASSERT_EQ(
-      lodforge("-q --threads 1 tiles " + dir.file("scan.ply") + " -o " + dir.file("a"), dir).code,
-      0);
+// `tiles INPUT -o b ARGS…` stopped by Ctrl-C once its chunks are done and a few tiles written,
+// then run again with --resume: the chunks are reused and the tileset is byte for byte the one
+// an uninterrupted run (into a) writes.
+void expectResumesToTheSameTileset(const test::TempDir& dir, const std::string& input,
+                                   const std::vector<std::string>& more) {
+  std::vector<std::string> args = {"-q", "--threads", "1", "tiles", input, "-o", dir.file("b")};
+  args.insert(args.end(), more.begin(), more.end());
+  std::string whole = "-q --threads 1 tiles " + input + " -o " + dir.file("a");
+  for (const std::string& a : more) whole += " " + a;
+  ASSERT_EQ(lodforge(whole, dir).code, 0);
   const pid_t pid = spawnLodforge(args, dir.file(".stderr"));
-  // Stop it once the chunks are done and a few tiles are written.
   const std::filesystem::path nodes = dir.file("b.work/nodes");
   bool started = false;
-  for (int i = 0; i < 600 && !started; ++i) {
+  for (int i = 0; i < 3000 && !started; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     std::error_code ignored;
     started = std::filesystem::exists(dir.file("b.work/state.json")) &&
@@ -1170,7 +1180,21 @@ TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
     ASSERT_EQ(test::readFile(dir.file("a/tiles/" + f)), test::readFile(dir.file("b/tiles/" + f)))
         << f;
   EXPECT_EQ(test::readFile(dir.file("a/tileset.json")), test::readFile(dir.file("b/tileset.json")));
-  EXPECT_EQ(test::listFolder(dir.path()), (std::vector<std::string>{"a", "b", "scan.ply"}));
+  const std::string name = std::filesystem::path(input).filename().string();
+  EXPECT_EQ(test::listFolder(dir.path()), (std::vector<std::string>{"a", "b", name}));
+}
+
+TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate scan --triangles 1M -o " + dir.file("scan.ply"), dir).code, 0);
+  expectResumesToTheSameTileset(dir, dir.file("scan.ply"), {});
+}
+
+// tiles --surface resumes like any tileset: the reconstructed chunks are kept.
+TEST(CliTiles, AnInterruptedSurfaceResumesToTheSameTileset) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate points --points 200K -o " + dir.file("p.ply"), dir).code, 0);
+  expectResumesToTheSameTileset(dir, dir.file("p.ply"), {"--surface", "--voxel", "2"});
 }
 
 TEST(CliBench, RunsEveryBudgetAndHitsItExactly) {

@@ -4,7 +4,9 @@
 #include <cstring>
 #include <map>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "lodforge/core/distance.h"
 #include "lodforge/core/random.h"
@@ -258,6 +260,27 @@ TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
     EXPECT_EQ(back->positions[v], toFloat(memory->positions[v] - back->origin)) << v;
   EXPECT_EQ(back->indices, memory->indices);
   EXPECT_EQ(test::listFolder(dir.path()).size(), 3u);  // the cloud and two meshes
+}
+
+// Deterministic: one thread and four write the same bytes (normals estimated run by run too).
+TEST(Reconstruct, TheSameMeshForAnyThreadCount) {
+  test::TempDir dir;
+  const Sampled s = terrainSamples(20'000, 150);
+  const std::string cloud = writeCloud(dir, "cloud.ply", s, false);
+  ReconstructOptions options;
+  options.voxel = 1.1;
+  options.chunkVoxels = 9;
+  options.runPoints = 4'000;
+  options.normals.orientation = NormalOrientation::kUp;
+  for (const int threads : {1, 4}) {
+    tbb::task_arena arena(threads);
+    const Result<ReconstructStats> made = arena.execute([&] {
+      return reconstructToFile(cloud, dir.file(fmt::format("t{}.ply", threads)), options);
+    });
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    EXPECT_GT(made->runs, 3u);
+  }
+  EXPECT_EQ(test::readFile(dir.file("t1.ply")), test::readFile(dir.file("t4.ply")));
 }
 
 // Without normals, `--orient up` estimates each normal in the run that owns its point: many

@@ -17,7 +17,8 @@
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
 #include "lodforge/io/model_io.h"
-#include "lodforge/surface/reconstruct.h"
+#include "lodforge/io/ply_writer.h"
+#include "lodforge/tiles/surface_input.h"
 
 namespace lodforge {
 namespace {
@@ -130,6 +131,8 @@ std::unique_ptr<ChunkWriter> chunksOf(const MeshPart& input, double chunkSize,
   return chunks;
 }
 
+Built buildOver(const ChunkWriter& chunks, const OctreeOptions& base, const std::string& work);
+
 // Cuts `input` into a grid and builds the octree, keeping every node's mesh. With `segments`,
 // the input's connected components smaller than a chunk go in whole, as chunkInput does.
 Built build(const MeshPart& input, double chunkSize, const OctreeOptions& base,
@@ -155,6 +158,12 @@ Built build(const MeshPart& input, double chunkSize, const OctreeOptions& base,
                     .ok());
   }
   EXPECT_TRUE(chunks.flush().ok());
+  return buildOver(chunks, base, work);
+}
+
+// The octree over chunks already made, keeping every node's mesh.
+Built buildOver(const ChunkWriter& chunks, const OctreeOptions& base, const std::string& work) {
+  fs::create_directories(work + "/nodes");
   OctreeOptions options = base;
   options.workDirectory = work + "/nodes";
   std::mutex mutex;
@@ -252,29 +261,41 @@ TEST(Octree, AnyMixOfLevelsHasNoBoundaryTheInputDidNotHave) {
   }
 }
 
-// A surface reconstructed from points (surface/reconstruct: an open wavy sheet with its own
-// edge) tiles like any mesh: no mix of levels opens a crack.
+// A surface reconstructed from points straight into the leaves (tiles/surface_input, the
+// paper's "Chunk" path: an open wavy sheet with its own edge, chunks of 11 voxels, near the
+// origin where chunk planes and lattice corners round apart): no mix of levels opens a crack.
 TEST(Octree, AReconstructedScanHasNoCrackInAnyMix) {
   Random random(3);
-  std::vector<Vec3d> points;
-  for (int i = 0; i < 12'000; ++i) {
+  PlyLayout layout;
+  layout.vertexCount = 12'000;
+  std::vector<Vec3f> points;
+  for (std::size_t i = 0; i < layout.vertexCount; ++i) {
     const double x = random.uniform(0, 80), y = random.uniform(0, 50);
-    points.push_back({1000 + x, 2000 + y, 3 * std::sin(x / 9) * std::cos(y / 7)});
+    points.push_back(toFloat(Vec3d{x, y, 3 * std::sin(x / 9) * std::cos(y / 7)}));
   }
+  const std::string work = ::testing::TempDir() + "/octree-surface";
+  fs::remove_all(work);
+  fs::create_directories(work);
+  Result<PlyWriter> writer = PlyWriter::create(work + "/cloud.ply", layout);
+  ASSERT_TRUE(writer.ok());
+  ASSERT_TRUE(writer->writeVertices(points, {}, {}).ok());
+  ASSERT_TRUE(writer->finish().ok());
   ReconstructOptions reconstruct;
   reconstruct.normals.orientation = NormalOrientation::kUp;
-  Result<ReconstructedMesh> surface = reconstructPoints(points, {}, {}, "sheet", reconstruct);
-  ASSERT_TRUE(surface.ok()) << surface.error().message;
-  MeshPart input;
-  input.positions = surface->positions;
-  input.indices = surface->indices;
+  reconstruct.chunkVoxels = 11;
+  ChunkInputOptions input;
+  input.workDirectory = work;
+  ReconstructStats stats;
+  Result<ChunkInput> chunks = surfaceChunkInput(work + "/cloud.ply", input, reconstruct, stats);
+  ASSERT_TRUE(chunks.ok()) << chunks.error().message;
   OctreeOptions options;
   options.errorSamples = 2000;
-  const Built built = build(input, 10, options, ::testing::TempDir() + "/octree-surface");
+  const Built built = buildOver(*chunks->chunks, options, work);
   ASSERT_GE(built.tree.levels, 2);
   std::vector<MeshPart> leaves;
   for (const auto& [index, mesh] : built.meshes)
     if (built.tree.nodes[index].level == 0) leaves.push_back(mesh);
+  EXPECT_EQ(concatenate(leaves).triangleCount(), stats.triangles);
   expectNoCracks(built, endsOf(boundaryEdges(concatenate(leaves))), 9, "reconstructed sheet");
 }
 

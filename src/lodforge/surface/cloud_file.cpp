@@ -17,6 +17,15 @@ namespace {
 
 constexpr std::size_t kBlockRecords = 1 << 15;
 
+// A normal carried through `transform`: the image of a short step along it (the transforms are
+// CRS to local metres, smooth at the scale of a metre).
+Vec3f transformedNormal(const std::function<bool(Vec3d, Vec3d&)>& transform, Vec3d from, Vec3d to,
+                        Vec3f normal) {
+  Vec3d tip;
+  if (!transform(from + toDouble(normal), tip)) return normal;
+  return normalizeOr(toFloat(tip - to), normal);
+}
+
 }  // namespace
 
 Result<RecordWriter> RecordWriter::create(const std::string& path, std::size_t bufferBytes) {
@@ -26,7 +35,8 @@ Result<RecordWriter> RecordWriter::create(const std::string& path, std::size_t b
 }
 
 Result<CloudSummary> copyCloud(const std::string& input, const std::string& path,
-                               bool salvageTruncated) {
+                               bool salvageTruncated,
+                               const std::function<bool(Vec3d, Vec3d&)>& transform) {
   Result<PointReader> reader = PointReader::open(input, 1 << 16, salvageTruncated, false);
   if (!reader) return reader.status();
   Result<RecordWriter> out = RecordWriter::create(path, std::size_t{4} << 20);
@@ -44,8 +54,17 @@ Result<CloudSummary> copyCloud(const std::string& input, const std::string& path
       CloudRecord r;
       r.id = cloud.count++;
       r.position = batch.positions[i];
-      cloud.bounds.add(r.position);
       if (!batch.normals.empty()) r.normal = normalizeOr(batch.normals[i], Vec3f{0, 0, 1});
+      if (transform) {
+        if (!transform(batch.positions[i], r.position))
+          return badInput(input, fmt::format("point {} ({:.3f}, {:.3f}, {:.3f}) cannot be placed "
+                                             "in the local frame",
+                                             r.id, batch.positions[i].x, batch.positions[i].y,
+                                             batch.positions[i].z));
+        if (!batch.normals.empty())
+          r.normal = transformedNormal(transform, batch.positions[i], r.position, r.normal);
+      }
+      cloud.bounds.add(r.position);
       if (!batch.colors.empty()) r.color = batch.colors[i];
       LODFORGE_TRY(out->add(r));
     }

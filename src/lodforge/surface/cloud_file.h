@@ -32,7 +32,8 @@ struct CloudSummary {
 // Reads `input` (any point format) into the record file `path`, normals made unit (+z where the
 // input has none), colours white where it has none.
 Result<CloudSummary> copyCloud(const std::string& input, const std::string& path,
-                               bool salvageTruncated);
+                               bool salvageTruncated,
+                               const std::function<bool(Vec3d, Vec3d&)>& transform = {});
 
 // Records appended in blocks; the file appears under its name at finish().
 class RecordWriter {

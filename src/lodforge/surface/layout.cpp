@@ -55,6 +55,16 @@ bool ChunkLayout::onChunkFace(std::uint64_t key) const {
   return false;
 }
 
+std::array<std::int64_t, 3> ChunkLayout::chunkPlanesOf(std::uint64_t key) const {
+  int direction = 0;
+  const std::array<std::uint64_t, 3> at = edgeCorner(key, grid, direction);
+  std::array<std::int64_t, 3> planes{-1, -1, -1};
+  for (std::size_t a = 0; a < 3; ++a)
+    if ((direction & (1 << a)) == 0 && at[a] % n == 0)
+      planes[a] = static_cast<std::int64_t>(at[a] / n);
+  return planes;
+}
+
 std::uint64_t ChunkLayout::lastChunkHolding(std::uint64_t key) const {
   int direction = 0;
   const std::array<std::uint64_t, 3> at = edgeCorner(key, grid, direction);

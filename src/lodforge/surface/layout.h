@@ -37,6 +37,9 @@ struct ChunkLayout {
   // Whether the vertex on lattice edge `key` (edgeKey) lies in a chunk face, i.e. in a plane of
   // corners a multiple of N along an axis it does not run along: only those are in two chunks.
   bool onChunkFace(std::uint64_t key) const;
+  // Per axis, the chunk plane (corners k·N along it) a vertex on lattice edge `key` lies in, or
+  // -1 where it lies in none.
+  std::array<std::int64_t, 3> chunkPlanesOf(std::uint64_t key) const;
   // The last chunk (in chunk order) that holds lattice edge `key`: after it, nobody asks again.
   std::uint64_t lastChunkHolding(std::uint64_t key) const;
 };

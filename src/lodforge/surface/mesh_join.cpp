@@ -10,10 +10,11 @@ namespace lodforge {
 
 // Union-find over the piece's vertices: a component is small when it has fewer triangles than
 // asked and no vertex on a chunk face (one that crosses a face may go on in the next chunk).
-std::vector<char> PieceJoiner::keptTriangles(const SurfacePiece& piece) {
+std::vector<char> keptTriangles(const ChunkLayout& layout, const SurfacePiece& piece,
+                                std::uint64_t minTriangles, std::uint64_t& dropped) {
   const std::size_t triangles = piece.indices.size() / 3;
   std::vector<char> kept(triangles, 1);
-  if (minTriangles_ == 0) return kept;
+  if (minTriangles == 0) return kept;
   std::vector<std::uint32_t> parent(piece.positions.size());
   std::iota(parent.begin(), parent.end(), 0u);
   const auto find = [&](std::uint32_t v) {
@@ -29,18 +30,23 @@ std::vector<char> PieceJoiner::keptTriangles(const SurfacePiece& piece) {
   std::vector<char> crosses(parent.size(), 0);
   for (std::size_t t = 0; t < triangles; ++t) ++size[find(piece.indices[3 * t])];
   for (std::uint32_t v = 0; v < parent.size(); ++v)
-    if (layout_.onChunkFace(piece.edges[v])) crosses[find(v)] = 1;
+    if (layout.onChunkFace(piece.edges[v])) crosses[find(v)] = 1;
   for (std::uint32_t v = 0; v < parent.size(); ++v)
-    if (parent[v] == v && size[v] > 0 && size[v] < minTriangles_ && !crosses[v]) ++dropped_;
+    if (parent[v] == v && size[v] > 0 && size[v] < minTriangles && !crosses[v]) ++dropped;
   for (std::size_t t = 0; t < triangles; ++t) {
     const std::uint32_t root = find(piece.indices[3 * t]);
-    kept[t] = size[root] >= minTriangles_ || crosses[root] ? 1 : 0;
+    kept[t] = size[root] >= minTriangles || crosses[root] ? 1 : 0;
   }
   return kept;
 }
 
+Status PieceJoiner::begin(const ChunkLayout& layout, bool) {
+  layout_ = layout;
+  return {};
+}
+
 Status PieceJoiner::add(std::uint64_t chunk, const SurfacePiece& piece) {
-  const std::vector<char> kept = keptTriangles(piece);
+  const std::vector<char> kept = keptTriangles(layout_, piece, minTriangles_, dropped_);
   constexpr std::uint32_t kNone = ~0u;
   local_.assign(piece.positions.size(), kNone);
   triangleBuffer_.clear();

@@ -34,15 +34,30 @@ class MeshOutput {
   virtual Status triangles(std::span<const std::uint32_t> indices) = 0;
 };
 
-class PieceJoiner {
+// Where a reconstruction hands its chunks' pieces: a joined mesh (PieceJoiner) or the chunks of
+// a tileset (tiles/surface_input).
+class PieceSink {
  public:
-  // Connected pieces with fewer than `minTriangles` triangles that touch no chunk face are
-  // dropped (a piece that crosses a face is kept: its size is only known globally).
-  PieceJoiner(const ChunkLayout& layout, std::uint64_t minTriangles, MeshOutput& out)
-      : layout_(layout), minTriangles_(minTriangles), out_(out) {}
-
+  virtual ~PieceSink() = default;
+  // Once, before the first piece: the lattice and whether the points have colours.
+  virtual Status begin(const ChunkLayout& layout, bool colors) = 0;
   // Chunks in ascending order.
-  Status add(std::uint64_t chunk, const SurfacePiece& piece);
+  virtual Status add(std::uint64_t chunk, const SurfacePiece& piece) = 0;
+};
+
+// Which of a piece's triangles stay when connected pieces with fewer than `minTriangles`
+// triangles that touch no chunk face are dropped (a piece that crosses a face is kept: its size
+// is only known globally); `dropped` counts the pieces dropped.
+std::vector<char> keptTriangles(const ChunkLayout& layout, const SurfacePiece& piece,
+                                std::uint64_t minTriangles, std::uint64_t& dropped);
+
+class PieceJoiner : public PieceSink {
+ public:
+  PieceJoiner(std::uint64_t minTriangles, MeshOutput& out)
+      : minTriangles_(minTriangles), out_(out) {}
+
+  Status begin(const ChunkLayout& layout, bool colors) override;
+  Status add(std::uint64_t chunk, const SurfacePiece& piece) override;
 
   std::uint64_t vertices() const { return vertices_; }
   std::uint64_t triangles() const { return triangles_; }
@@ -50,9 +65,7 @@ class PieceJoiner {
   std::size_t faceVerticesHeld() const { return shared_.size(); }
 
  private:
-  std::vector<char> keptTriangles(const SurfacePiece& piece);
-
-  const ChunkLayout& layout_;
+  ChunkLayout layout_;
   std::uint64_t minTriangles_;
   MeshOutput& out_;
   std::unordered_map<std::uint64_t, std::uint32_t> shared_;  // face vertices still wanted

@@ -73,6 +73,12 @@ double voxelFor(const ReconstructOptions& options, double spacing) {
   return options.voxel > 0 ? options.voxel : 2 * spacing;
 }
 
+std::uint32_t chunkVoxelsFor(const ReconstructOptions& options, double voxel) {
+  if (options.chunkLength <= 0) return options.chunkVoxels;
+  const double n = std::round(options.chunkLength / voxel);
+  return static_cast<std::uint32_t>(std::clamp(n, 4.0, 4096.0));
+}
+
 // The members of each of the run's chunks (ascending), by index into `records`, in input order.
 // The reach is a voxel more than the radius: the corners of a chunk's margin need their points.
 std::vector<std::vector<std::uint32_t>> membersOf(const ChunkLayout& layout,
@@ -138,7 +144,7 @@ SurfacePiece chunkPiece(const ChunkLayout& layout, std::uint64_t c,
 // The run's chunks made a few per thread at a time and joined in chunk order.
 Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> records,
                   std::span<const std::uint64_t> chunks, const ReconstructOptions& options,
-                  bool colors, PieceJoiner& joiner, Progress& progress,
+                  bool colors, PieceSink& sink, Progress& progress,
                   std::vector<SurfacePiece>* pieces) {
   const std::vector<std::vector<std::uint32_t>> members =
       membersOf(layout, records, chunks, options.distance.radius);
@@ -160,7 +166,7 @@ Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> record
                                          colourIndex ? &*colourIndex : nullptr);
     });
     for (std::size_t i = first; i < last; ++i) {
-      LODFORGE_TRY(joiner.add(chunks[i], made[i - first]));
+      LODFORGE_TRY(sink.add(chunks[i], made[i - first]));
       if (pieces) pieces->push_back(std::move(made[i - first]));
       made[i - first] = SurfacePiece{};
     }
@@ -297,14 +303,12 @@ Status estimateNormalsByRun(const std::string& cloudPath, const ChunkLayout& lay
 
 }  // namespace
 
-Result<ReconstructStats> reconstructToFile(const std::string& input, const std::string& output,
-                                           const ReconstructOptions& options) {
-  ScopedDirectory work(temporaryPathFor(output + ".work"));
-  std::error_code error;
-  std::filesystem::create_directories(work.path, error);
-  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
-  const std::string cloudPath = work.path + "/cloud.points";
-  Result<CloudSummary> cloud = copyCloud(input, cloudPath, options.salvageTruncated);
+Result<ReconstructStats> reconstructPieces(const std::string& input,
+                                           const std::string& workDirectory,
+                                           const ReconstructOptions& options, PieceSink& sink) {
+  const std::string cloudPath = workDirectory + "/cloud.points";
+  Result<CloudSummary> cloud =
+      copyCloud(input, cloudPath, options.salvageTruncated, options.transform);
   if (!cloud) return cloud.status();
   LODFORGE_TRY(checkSurfaceExtent(cloud->count, cloud->bounds, input));
   double spacing = 0;
@@ -313,8 +317,9 @@ Result<ReconstructStats> reconstructToFile(const std::string& input, const std::
     if (!measured) return measured.status();
     spacing = *measured;
   }
-  Result<ChunkLayout> layout = layOutChunks(cloud->bounds, voxelFor(options, spacing),
-                                            options.chunkVoxels, options.distance.radius, input);
+  const double voxel = voxelFor(options, spacing);
+  Result<ChunkLayout> layout = layOutChunks(cloud->bounds, voxel, chunkVoxelsFor(options, voxel),
+                                            options.distance.radius, input);
   if (!layout) return layout.status();
   LODFORGE_TRY(checkChunkFits(*layout, options, input));
   ReconstructStats stats;
@@ -322,6 +327,7 @@ Result<ReconstructStats> reconstructToFile(const std::string& input, const std::
   stats.chunkVoxels = layout->n;
   stats.points = cloud->count;
   stats.chunks = layout->chunkCount();
+  stats.hasColors = cloud->hasColors;
   const double reach = options.distance.radius + 1;
   Result<ChunkRuns> runs = planRuns(cloudPath, *layout, reach, runBudget(*layout, options));
   if (!runs) return runs.status();
@@ -332,34 +338,50 @@ Result<ReconstructStats> reconstructToFile(const std::string& input, const std::
       LODFORGE_TRY(checkPropagationFits(cloud->count, options, input));
       LODFORGE_TRY(estimateNormalsWhole(cloudPath, *cloud, options.normals));
     } else {
-      LODFORGE_TRY(estimateNormalsByRun(cloudPath, *layout, *runs, options, work.path));
+      LODFORGE_TRY(estimateNormalsByRun(cloudPath, *layout, *runs, options, workDirectory));
     }
   }
-  LODFORGE_TRY(writeRuns(cloudPath, *layout, reach, *runs, work.path));
+  LODFORGE_TRY(writeRuns(cloudPath, *layout, reach, *runs, workDirectory));
+  std::error_code error;
   std::filesystem::remove(cloudPath, error);
-  Result<std::unique_ptr<PlyMeshOutput>> mesh = PlyMeshOutput::create(work.path);
-  if (!mesh) return mesh.status();
-  PieceJoiner joiner(*layout, options.minTriangles, **mesh);
+  LODFORGE_TRY(sink.begin(*layout, cloud->hasColors));
   Progress progress("reconstruct: chunks", runs->chunks.size());
   for (std::size_t r = 0; r < runs->runCount(); ++r) {
-    Result<std::vector<CloudRecord>> records = readRecords(runPath(work.path, r));
+    Result<std::vector<CloudRecord>> records = readRecords(runPath(workDirectory, r));
     if (!records) return records.status();
-    std::filesystem::remove(runPath(work.path, r), error);
+    std::filesystem::remove(runPath(workDirectory, r), error);
     const std::span<const std::uint64_t> chunks(runs->chunks.data() + runs->firstChunk[r],
                                                 runs->firstChunk[r + 1] - runs->firstChunk[r]);
-    LODFORGE_TRY(makeChunks(*layout, *records, chunks, options, cloud->hasColors, joiner, progress,
-                            nullptr));
+    LODFORGE_TRY(
+        makeChunks(*layout, *records, chunks, options, cloud->hasColors, sink, progress, nullptr));
   }
   progress.finish();
-  stats.vertices = joiner.vertices();
-  stats.triangles = joiner.triangles();
-  stats.droppedPieces = joiner.droppedPieces();
-  if (stats.triangles == 0)
-    return badInput(input, fmt::format("no surface at voxel {:g}: the points are too sparse for it "
-                                       "(try a larger --voxel or --radius, or a smaller "
-                                       "--min-points)",
-                                       layout->grid.voxel));
-  LODFORGE_TRY((*mesh)->finish(output, cloud->hasColors, "lodforge reconstruct"));
+  return stats;
+}
+
+Status noSurface(const std::string& input, double voxel) {
+  return badInput(input, fmt::format("no surface at voxel {:g}: the points are too sparse for it "
+                                     "(try a larger --voxel or --radius, or a smaller "
+                                     "--min-points)",
+                                     voxel));
+}
+
+Result<ReconstructStats> reconstructToFile(const std::string& input, const std::string& output,
+                                           const ReconstructOptions& options) {
+  ScopedDirectory work(temporaryPathFor(output + ".work"));
+  std::error_code error;
+  std::filesystem::create_directories(work.path, error);
+  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
+  Result<std::unique_ptr<PlyMeshOutput>> mesh = PlyMeshOutput::create(work.path);
+  if (!mesh) return mesh.status();
+  PieceJoiner joiner(options.minTriangles, **mesh);
+  Result<ReconstructStats> stats = reconstructPieces(input, work.path, options, joiner);
+  if (!stats) return stats;
+  stats->vertices = joiner.vertices();
+  stats->triangles = joiner.triangles();
+  stats->droppedPieces = joiner.droppedPieces();
+  if (stats->triangles == 0) return noSurface(input, stats->grid.voxel);
+  LODFORGE_TRY((*mesh)->finish(output, stats->hasColors, "lodforge reconstruct"));
   return stats;
 }
 
@@ -374,8 +396,9 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
   std::optional<PointIndex> index;
   if (options.voxel <= 0 || normals.empty()) index.emplace(positions);
   const double spacing = options.voxel > 0 ? 0 : medianSpacing(positions, *index);
-  Result<ChunkLayout> layout = layOutChunks(bounds, voxelFor(options, spacing), options.chunkVoxels,
-                                            options.distance.radius, name);
+  const double voxel = voxelFor(options, spacing);
+  Result<ChunkLayout> layout =
+      layOutChunks(bounds, voxel, chunkVoxelsFor(options, voxel), options.distance.radius, name);
   if (!layout) return layout.status();
   LODFORGE_TRY(checkChunkFits(*layout, options, name));
   ReconstructedMesh mesh;
@@ -384,6 +407,7 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
   mesh.points = positions.size();
   mesh.chunks = layout->chunkCount();
   mesh.runs = 1;
+  mesh.hasColors = !colors.empty();
   if (normals.empty()) {
     normals = estimateNormals(positions, *index, options.normals);
     mesh.estimatedNormals = true;
@@ -404,7 +428,8 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
   std::sort(chunks.begin(), chunks.end());
   chunks.erase(std::unique(chunks.begin(), chunks.end()), chunks.end());
   MemoryMeshOutput out;
-  PieceJoiner joiner(*layout, options.minTriangles, out);
+  PieceJoiner joiner(options.minTriangles, out);
+  LODFORGE_TRY(joiner.begin(*layout, !colors.empty()));
   Progress progress("reconstruct: chunks", chunks.size());
   LODFORGE_TRY(
       makeChunks(*layout, records, chunks, options, !colors.empty(), joiner, progress, pieces));

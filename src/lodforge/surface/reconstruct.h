@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,6 +22,7 @@
 #include "lodforge/core/status.h"
 #include "lodforge/surface/implicit.h"
 #include "lodforge/surface/marching_tetrahedra.h"
+#include "lodforge/surface/mesh_join.h"
 #include "lodforge/surface/normals.h"
 
 namespace lodforge {
@@ -28,12 +30,16 @@ namespace lodforge {
 struct ReconstructOptions {
   double voxel = 0;                // metres; 0: twice the median spacing of the points
   std::uint32_t chunkVoxels = 64;  // N: voxels along a chunk's edge
+  double chunkLength = 0;          // metres; when > 0, N is this over the voxel (at least 4)
   DistanceOptions distance;        // radius in voxels, fewest points near a corner
   NormalOptions normals;           // for points without normals
   std::uint64_t memoryLimit = 0;   // bytes, 0: the default budget (kDefaultRunPoints a run)
   std::uint64_t runPoints = 0;     // points a run of chunks holds; 0: from the memory limit
   std::uint64_t minTriangles = 0;  // connected pieces with fewer triangles are dropped
   bool salvageTruncated = false;
+  // Applied to every input point before anything else (a CRS to a local frame, in metres);
+  // false: the point cannot be placed, which is bad input. Given normals turn with it.
+  std::function<bool(Vec3d, Vec3d&)> transform;
 };
 
 // Points a run holds when no memory limit says otherwise (≈ 80 MB with its chunks).
@@ -45,6 +51,7 @@ struct ReconstructStats {
   std::uint64_t points = 0, chunks = 0, runs = 0, vertices = 0, triangles = 0;
   std::uint64_t droppedPieces = 0;
   bool estimatedNormals = false;
+  bool hasColors = false;  // the points had colours, and so do the vertices
 };
 
 // The mesh in memory (tests, small clouds): pieces joined by vertex name.
@@ -55,8 +62,18 @@ struct ReconstructedMesh : ReconstructStats {
   std::vector<std::uint32_t> indices;
 };
 
+// Reads `input` (any point format) and hands every chunk's piece to `sink` in chunk order, out
+// of core, with its work files in `workDirectory` (which must exist; they are removed as they
+// are used). Fills the layout's figures; the sink counts what it keeps.
+Result<ReconstructStats> reconstructPieces(const std::string& input,
+                                           const std::string& workDirectory,
+                                           const ReconstructOptions& options, PieceSink& sink);
+
+// Bad input: no surface came out of `input` at `voxel`, and what might make one.
+Status noSurface(const std::string& input, double voxel);
+
 // Reads `input` (any point format) and writes the surface to `output` as binary PLY, out of
-// core. No surface at all is bad input (nothing written).
+// core: the pieces joined by vertex name. No surface at all is bad input (nothing written).
 Result<ReconstructStats> reconstructToFile(const std::string& input, const std::string& output,
                                            const ReconstructOptions& options);
 

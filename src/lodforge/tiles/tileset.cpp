@@ -12,6 +12,7 @@
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/tiles/surface_input.h"
 #include "lodforge/tiles/tileset_output.h"
 #include "lodforge/tiling/resume.h"
 
@@ -82,6 +83,20 @@ std::shared_ptr<LazyCrs> attachCrs(const std::string& crs, ChunkInputOptions& in
   return lazy;
 }
 
+// What a reconstructed surface's chunks depend on (null: not a surface).
+nlohmann::json surfaceIdentity(const std::optional<ReconstructOptions>& surface) {
+  if (!surface) return nullptr;
+  const Vec3d& view = surface->normals.viewpoint;
+  return {{"voxel", surface->voxel},
+          {"chunkVoxels", surface->chunkVoxels},
+          {"chunkLength", surface->chunkLength},
+          {"radius", surface->distance.radius},
+          {"minPoints", surface->distance.minPoints},
+          {"orientation", static_cast<int>(surface->normals.orientation)},
+          {"viewpoint", {view.x, view.y, view.z}},
+          {"minTriangles", surface->minTriangles}};
+}
+
 // Everything the chunks depend on: a resumed run takes them only when this is unchanged.
 nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
                            const ChunkInputOptions& input, const OctreeOptions& octree) {
@@ -102,13 +117,15 @@ nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
           {"quantize", options.quantize},
           {"origin", options.origin ? fmt::format("{},{},{}", options.origin->longitude,
                                                   options.origin->latitude, options.origin->height)
-                                    : ""}};
+                                    : ""},
+          {"surface", surfaceIdentity(options.surface)}};
 }
 
 // Streams the input into the chunk grid, or takes the chunks of an interrupted run.
 Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& options,
                                  const ChunkInputOptions& input, const OctreeOptions& octree,
-                                 const WorkPlace& place, const LazyCrs& crs, bool& resumed) {
+                                 const WorkPlace& place, const LazyCrs& crs, bool& resumed,
+                                 std::optional<ReconstructStats>& surface) {
   const std::string statePath = workStatePath(place.work.path);
   const nlohmann::json identity = runIdentity(path, options, input, octree);
   if (options.resume) {
@@ -118,7 +135,9 @@ Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& op
     if (earlier) return std::move(*earlier);
   }
   LODFORGE_TRY(prepareWorkPlace(place, false));
-  Result<ChunkInput> fresh = chunkInput(path, input);
+  Result<ChunkInput> fresh =
+      options.surface ? surfaceChunkInput(path, input, *options.surface, surface.emplace())
+                      : chunkInput(path, input);
   if (!fresh) return crs.error.ok() ? fresh.status() : crs.error;
   if (options.origin) fresh->frame = eastNorthUpToEcef(*options.origin);
   if (crs.transform) fresh->frame = crs.transform->localToEcef();
@@ -188,7 +207,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   const std::shared_ptr<const LazyCrs> crs = attachCrs(options.crs, input);
 
   Result<ChunkInput> chunked =
-      chunkOrResume(path, options, input, octree, place, *crs, stats.resumed);
+      chunkOrResume(path, options, input, octree, place, *crs, stats.resumed, stats.surface);
   if (!chunked) return chunked.status();
   countChunks(*chunked, stats);
   stats.chunkSeconds = secondsSince(start);

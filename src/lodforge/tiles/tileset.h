@@ -11,6 +11,7 @@
 #include <string>
 
 #include "lodforge/core/status.h"
+#include "lodforge/surface/reconstruct.h"
 #include "lodforge/tiles/georeference.h"
 #include "lodforge/tiles/memory_plan.h"
 #include "lodforge/tiles/tile_content.h"
@@ -36,6 +37,8 @@ struct TilesOptions {
   std::string crs;
   bool meshoptCompression = false;  // --compress meshopt: EXT_meshopt_compression contents
   bool quantize = true;             // KHR_mesh_quantization where it is invisible (tileQuantized)
+  // A point cloud: its surface reconstructed chunk by chunk into the leaves (surface_input.h).
+  std::optional<ReconstructOptions> surface;
 };
 
 struct TilesStats {
@@ -51,7 +54,8 @@ struct TilesStats {
   bool resumed = false;                  // chunks came from an interrupted run
   int threads = 0;
   std::uint64_t maxLockedVertices = 0, lockedVertices = 0, vertices = 0;  // over parents
-  std::uint64_t droppedSegments = 0;  // small whole segments parents left out (over parents)
+  std::uint64_t droppedSegments = 0;        // small whole segments parents left out (over parents)
+  std::optional<ReconstructStats> surface;  // --surface, when not resumed
 };
 
 // Where `lodforge tiles -o OUT` works: OUT.work holds the work files and the tileset being

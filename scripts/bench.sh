@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -367,6 +367,42 @@ surface_section() {
 }
 if [[ ${BENCH_ONLY:-} == surface ]]; then surface_section; exit 0; fi
 
+# `tiles --surface` (the paper's Chunk path) on generated clouds (issue 19): points/s and peak
+# RSS at 1 M and 10 M points (SURFACE_TILES_SIZES; add 100M for the large run), each at the
+# default voxel (the points' own resolution: about 10 triangles a point) and at a fixed voxel of
+# SURFACE_TILES_VOXEL metres (default 1: the mesh the same size for every cloud, so the figure is
+# the pipeline's cost per point). The table beside the paper's Table 2 is in docs/BENCHMARKS.md.
+surface_tiles_section() {
+  echo
+  echo "== tiles --surface, the Chunk path ($(nproc) threads)"
+  printf '| %-5s | %-8s | %9s | %11s | %9s | %12s | %7s |\n' points voxel wall "points/s" "peak RSS" triangles tiles
+  printf '|%s|%s|%s|%s|%s|%s|%s|\n' ------- ---------- ----------- ------------- ----------- -------------- ---------
+  for n in ${SURFACE_TILES_SIZES:-1M 10M}; do
+    local cloud=$work/surface-$n.ply out=$work/surface-tiles
+    [[ -f $cloud ]] || "$lodforge" -q generate points --points "$n" -o "$cloud"
+    local count
+    count=$("$lodforge" info "$cloud" --json | sed -n 's/.*"vertices": \([0-9]*\).*/\1/p')
+    for voxel in default "${SURFACE_TILES_VOXEL:-1}"; do
+      local args=()
+      [[ $voxel != default ]] && args=(--voxel "$voxel")
+      rm -rf "$out"
+      /usr/bin/time -v "$lodforge" tiles "$cloud" --surface -o "$out" "${args[@]}" > "$work/surface-tiles.log" 2> "$work/time.log" ||
+        { tail -20 "$work/time.log"; exit 1; }
+      local wall seconds kib triangles tiles
+      wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$work/time.log")
+      seconds=$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")
+      kib=$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$work/time.log")
+      triangles=$(sed -n 's/^reconstructed \([0-9,]*\) triangles.*/\1/p' "$work/surface-tiles.log")
+      tiles=$(sed -n 's/^wrote [^:]*: \([0-9,]*\) tiles.*/\1/p' "$work/surface-tiles.log")
+      [[ $voxel == default ]] && voxel=$(sed -n 's/.*(voxel \([0-9.e+-]*\),.*/\1/p' "$work/surface-tiles.log")
+      printf '| %-5s | %-8s | %8ss | %11s | %6d MiB | %12s | %7s |\n' "$n" "$voxel" "$seconds" \
+        "$(awk -v n="$count" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')" $((kib / 1024)) "$triangles" "$tiles"
+      rm -rf "$out"
+    done
+  done
+}
+if [[ ${BENCH_ONLY:-} == surface-tiles ]]; then surface_tiles_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -391,5 +427,6 @@ serve_section
 laz_section
 potree_section
 surface_section
+surface_tiles_section
 render_section
 runtime_section

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The browser viewers end to end (tests/js/web-viewers.mjs): `lodforge serve` on a free loopback
 # port, the CesiumJS and the three.js page in headless chromium, for a mesh tileset (the horse,
-# georeferenced, meshopt-compressed) and a point tileset (a LAS placed from its own CRS).
+# georeferenced, meshopt-compressed), a point tileset (a LAS placed from its own CRS) and the
+# surface reconstructed from a LAZ scan (tiles --surface, placed from the file's CRS).
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -9,9 +10,11 @@ here=$(cd "$(dirname "$0")" && pwd)
   { echo "the viewers are not built: run scripts/build-web.sh (make does)" >&2; exit 1; }
 [[ -d $here/js/node_modules/playwright-core ]] ||
   { echo "playwright-core is not installed: run scripts/install-deps.sh" >&2; exit 1; }
-rm -rf "$out" && mkdir -p "$out/horse-shots" "$out/autzen-shots"
+rm -rf "$out" && mkdir -p "$out/horse-shots" "$out/autzen-shots" "$out/surface-shots"
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse" --chunk-size 0.05 \
   --origin 8.5417,47.3769,408 --compress meshopt
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/horse" "$out/horse-shots" --min-coverage 0.03
 "$lodforge" -q tiles "$data/points/autzen_trim.las" -o "$out/autzen" --block-size 20K --tile-points 10K
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/autzen" "$out/autzen-shots" --min-coverage 0.03
+"$lodforge" -q tiles "$data/points/autzen_trim.laz" --surface -o "$out/surface" --voxel 4 --chunk-size 100
+node "$here/js/web-viewers.mjs" "$lodforge" "$out/surface" "$out/surface-shots" --min-coverage 0.03

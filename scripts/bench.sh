@@ -328,7 +328,7 @@ surface_section() {
     local cloud=$work/surface-$n.ply truth=$work/surface-truth-$n.ply
     [[ -f $cloud ]] || "$lodforge" -q generate points --points "$n" -o "$cloud"
     local count
-    count=$("$lodforge" info "$cloud" --json | sed -n 's/.*"vertices": \([0-9]*\).*/\1/p')
+    count=$("$lodforge" -q info "$cloud" --json 2> /dev/null | sed -n 's/.*"vertices": \([0-9]*\).*/\1/p')
     [[ -f $truth ]] || "$lodforge" -q generate scan --triangles $((2 * count)) -o "$truth"
     local voxel
     voxel=$("$lodforge" info "$cloud" --json | awk '/"max"/ {m = 1} /"min"/ {m = 0} 
@@ -371,7 +371,8 @@ if [[ ${BENCH_ONLY:-} == surface ]]; then surface_section; exit 0; fi
 # RSS at 1 M and 10 M points (SURFACE_TILES_SIZES; add 100M for the large run), each at the
 # default voxel (the points' own resolution: about 10 triangles a point) and at a fixed voxel of
 # SURFACE_TILES_VOXEL metres (default 1: the mesh the same size for every cloud, so the figure is
-# the pipeline's cost per point). The table beside the paper's Table 2 is in docs/BENCHMARKS.md.
+# the pipeline's cost per point; SURFACE_TILES_DEFAULT=0 leaves the default voxel out). The
+# table beside the paper's Table 2 is in docs/BENCHMARKS.md.
 surface_tiles_section() {
   echo
   echo "== tiles --surface, the Chunk path ($(nproc) threads)"
@@ -381,8 +382,10 @@ surface_tiles_section() {
     local cloud=$work/surface-$n.ply out=$work/surface-tiles
     [[ -f $cloud ]] || "$lodforge" -q generate points --points "$n" -o "$cloud"
     local count
-    count=$("$lodforge" info "$cloud" --json | sed -n 's/.*"vertices": \([0-9]*\).*/\1/p')
-    for voxel in default "${SURFACE_TILES_VOXEL:-1}"; do
+    count=$("$lodforge" -q info "$cloud" --json 2> /dev/null | sed -n 's/.*"vertices": \([0-9]*\).*/\1/p')
+    local voxels=("${SURFACE_TILES_VOXEL:-1}")
+    [[ ${SURFACE_TILES_DEFAULT:-1} == 1 ]] && voxels=(default "${voxels[@]}")
+    for voxel in "${voxels[@]}"; do
       local args=()
       [[ $voxel != default ]] && args=(--voxel "$voxel")
       rm -rf "$out"

@@ -5,9 +5,9 @@
 //
 // §3.3 makes the values of overlapping chunks identical by averaging them; here they are
 // identical by construction: a corner's value depends only on the points within the radius,
-// every chunk holds all of them (its overlap is at least the radius) and adds them in the order
-// of their index in the input, so two chunks compute the same bits. No value either past the
-// edge of the points (DistanceOptions::edge).
+// every chunk holds all of them (its overlap is at least the radius) and adds them in one order
+// that is the same for every chunk (sumOrder), so two chunks compute the same bits. No value either
+// past the edge of the points (DistanceOptions::edge).
 #pragma once
 
 #include <cstdint>
@@ -21,8 +21,15 @@ namespace lodforge {
 struct OrientedPoints {
   std::span<const Vec3d> positions;
   std::span<const Vec3f> normals;      // unit, facing out
-  std::span<const std::uint64_t> ids;  // index in the input, ascending
+  std::span<const std::uint64_t> ids;  // index in the input
 };
+
+// The order in which a corner adds its points: by the Morton code of the lattice cell a point
+// lies in, then by input index. It is one total order on the input, so every box adds a
+// corner's points in the same order whichever of them it holds; and points near each other
+// come together, so the corners they reach stay in cache. Returns the permutation of `ids`.
+std::vector<std::uint32_t> sumOrder(const VoxelGrid& grid, std::span<const Vec3d> positions,
+                                    std::span<const std::uint64_t> ids);
 
 struct DistanceOptions {
   double radius = 3;  // in voxels
@@ -35,7 +42,8 @@ struct DistanceOptions {
   double edge = 0.5;
 };
 
-// Fills values.values for the box values.first/size.
+// Fills values.values for the box values.first/size, from points in an order that is the same
+// for every box (sumOrder's, or ids ascending).
 void signedDistances(const VoxelGrid& grid, const OrientedPoints& points,
                      const DistanceOptions& options, CornerValues& values);
 

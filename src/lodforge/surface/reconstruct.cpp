@@ -32,8 +32,8 @@ constexpr std::uint64_t kBytesPerPropagatedPoint = 24 + 12 + 12 * 4 * 3;
 // Bytes of one chunk in flight per corner: the weight and sum (doubles), offsets and
 // directions (floats), count and value.
 constexpr std::uint64_t kBytesPerCorner = 8 + 8 + 12 + 12 + 4 + 4;
-// Bytes a point of a run costs: its record, its places in the chunks' lists, the gathered
-// copies of the chunks in flight, and the k-d tree for colours.
+// Bytes a point of a run costs: its record, its places in the chunks' lists, and the gathered
+// copies of the chunks in flight with their k-d trees for colours.
 constexpr std::uint64_t kBytesPerRunPoint = 48 + 8 + 44 + 40;
 // What the rest holds besides the runs and the grids (the join's wavefront, buffers).
 constexpr std::uint64_t kOtherBytes = std::uint64_t{48} << 20;
@@ -101,16 +101,25 @@ std::vector<std::vector<std::uint32_t>> membersOf(const ChunkLayout& layout,
 }
 
 // One chunk's piece: distances at its corners and a corner of margin, polygonized within its
-// own corners; colours from the nearest point of the run.
+// own corners; a vertex's colour is its nearest member's (the chunk's members do not depend on
+// how chunks are cut into runs, so neither do the colours).
 SurfacePiece chunkPiece(const ChunkLayout& layout, std::uint64_t c,
                         std::span<const std::uint32_t> members,
                         std::span<const CloudRecord> records, const DistanceOptions& distance,
-                        const PointIndex* colourIndex) {
+                        bool colors) {
   std::vector<Vec3d> p(members.size());
   std::vector<Vec3f> nrm(members.size());
   std::vector<std::uint64_t> ids(members.size());
   for (std::size_t m = 0; m < members.size(); ++m) {
-    const CloudRecord& r = records[members[m]];
+    p[m] = records[members[m]].position;
+    ids[m] = records[members[m]].id;
+  }
+  // In the order every chunk adds a corner's points (implicit.h), nearby points together.
+  const std::vector<std::uint32_t> order = sumOrder(layout.grid, p, ids);
+  std::vector<std::uint32_t> sorted(members.size());
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    sorted[m] = members[order[m]];
+    const CloudRecord& r = records[sorted[m]];
     p[m] = r.position;
     nrm[m] = r.normal;
     ids[m] = r.id;
@@ -129,41 +138,34 @@ SurfacePiece chunkPiece(const ChunkLayout& layout, std::uint64_t c,
   }
   signedDistances(layout.grid, {p, nrm, ids}, distance, values);
   SurfacePiece piece = polygonize(layout.grid, values, first, size);
-  if (colourIndex) {
+  if (colors && !piece.positions.empty()) {
+    const PointIndex index(p);
     piece.colors.resize(piece.positions.size());
     for (std::size_t v = 0; v < piece.positions.size(); ++v) {
       std::uint32_t nearest = 0;
       double d2 = 0;
-      colourIndex->nearest(piece.positions[v], 1, &nearest, &d2);
-      piece.colors[v] = records[nearest].color;
+      index.nearest(piece.positions[v], 1, &nearest, &d2);
+      piece.colors[v] = records[sorted[nearest]].color;
     }
   }
   return piece;
 }
 
-// The run's chunks made a few per thread at a time and joined in chunk order.
+// The run's chunks made a few per thread at a time and handed on in chunk order.
 Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> records,
                   std::span<const std::uint64_t> chunks, const ReconstructOptions& options,
                   bool colors, PieceSink& sink, Progress& progress,
                   std::vector<SurfacePiece>* pieces) {
   const std::vector<std::vector<std::uint32_t>> members =
       membersOf(layout, records, chunks, options.distance.radius);
-  std::optional<PointIndex> colourIndex;
-  std::vector<Vec3d> positions;
-  if (colors) {
-    positions.resize(records.size());
-    for (std::size_t i = 0; i < records.size(); ++i) positions[i] = records[i].position;
-    colourIndex.emplace(positions);
-  }
   const auto batch = static_cast<std::size_t>(4 * threads());
   std::vector<SurfacePiece> made(batch);
   for (std::size_t first = 0; first < chunks.size(); first += batch) {
     const std::size_t last = std::min(chunks.size(), first + batch);
     tbb::parallel_for(first, last, [&](std::size_t i) {
-      made[i - first] = members[i].empty()
-                            ? SurfacePiece{}
-                            : chunkPiece(layout, chunks[i], members[i], records, options.distance,
-                                         colourIndex ? &*colourIndex : nullptr);
+      made[i - first] = members[i].empty() ? SurfacePiece{}
+                                           : chunkPiece(layout, chunks[i], members[i], records,
+                                                        options.distance, colors);
     });
     for (std::size_t i = first; i < last; ++i) {
       LODFORGE_TRY(sink.add(chunks[i], made[i - first]));

@@ -42,8 +42,8 @@ struct ReconstructOptions {
   std::function<bool(Vec3d, Vec3d&)> transform;
 };
 
-// Points a run holds when no memory limit says otherwise (≈ 80 MB with its chunks).
-constexpr std::uint64_t kDefaultRunPoints = 500'000;
+// Points a run holds when no memory limit says otherwise (≈ 30 MB with its chunks).
+constexpr std::uint64_t kDefaultRunPoints = 200'000;
 
 struct ReconstructStats {
   VoxelGrid grid;

@@ -215,27 +215,36 @@ TEST(Reconstruct, ManyChunksJoinWithoutACrack) {
 }
 
 // Points (and normals, when given) as a binary PLY point cloud.
+// With `colors`, each point gets a colour of its own (from its index), so a vertex's colour
+// shows which point it was taken from.
 std::string writeCloud(const test::TempDir& dir, const std::string& name, const Sampled& s,
-                       bool normals) {
+                       bool normals, bool colors = false) {
   PlyLayout layout;
   layout.vertexCount = s.points.size();
   layout.normals = normals;
+  layout.colors = colors;
+  std::vector<Rgba8> palette;
+  for (std::size_t i = 0; colors && i < s.points.size(); ++i)
+    palette.push_back({static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8),
+                       static_cast<std::uint8_t>(i >> 16), 255});
   const std::string path = dir.file(name);
   Result<PlyWriter> writer = PlyWriter::create(path, layout);
   EXPECT_TRUE(writer.ok());
   EXPECT_TRUE(
-      writer->writeVertices(floats(s.points), normals ? s.normals : std::vector<Vec3f>{}, {}).ok());
+      writer->writeVertices(floats(s.points), normals ? s.normals : std::vector<Vec3f>{}, palette)
+          .ok());
   EXPECT_TRUE(writer->finish().ok());
   return path;
 }
 
 // Out of core, the chunks are worked in runs that fit the memory budget: any number of runs
-// writes the same bytes, the same mesh as in memory, and leaves nothing but the output.
+// writes the same bytes (colours included), the same mesh as in memory, and leaves nothing but
+// the output.
 TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
   test::TempDir dir;
   Sampled s = terrainSamples(30'000, 150);
   for (Vec3d& p : s.points) p = toDouble(toFloat(p));  // as the PLY holds them
-  const std::string cloud = writeCloud(dir, "cloud.ply", s, true);
+  const std::string cloud = writeCloud(dir, "cloud.ply", s, true, true);
   ReconstructOptions options;
   options.voxel = 1.1;
   options.chunkVoxels = 9;
@@ -253,6 +262,7 @@ TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
   ASSERT_TRUE(memory.ok());
   Result<Model> back = readPly(dir.file("many.ply"));
   ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->colors.size(), back->positions.size());
   EXPECT_EQ(back->triangleCount(), memory->indices.size() / 3);
   EXPECT_EQ(back->vertexCount(), memory->positions.size());
   EXPECT_EQ(many->triangles, memory->indices.size() / 3);

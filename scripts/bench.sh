@@ -328,7 +328,7 @@ surface_section() {
     local cloud=$work/surface-$n.ply truth=$work/surface-truth-$n.ply
     [[ -f $cloud ]] || "$lodforge" -q generate points --points "$n" -o "$cloud"
     local count
-    count=$("$lodforge" -q info "$cloud" --json 2> /dev/null | sed -n 's/.*"vertices": \([0-9]*\).*/\1/p')
+    count=$("$lodforge" -q info "$cloud" --json 2> /dev/null | sed -n 's/^  "\(vertices\|points\)": \([0-9]*\).*/\2/p' | tail -1)
     [[ -f $truth ]] || "$lodforge" -q generate scan --triangles $((2 * count)) -o "$truth"
     local voxel
     voxel=$("$lodforge" info "$cloud" --json | awk '/"max"/ {m = 1} /"min"/ {m = 0} 
@@ -379,10 +379,11 @@ surface_tiles_section() {
   printf '| %-5s | %-8s | %9s | %11s | %9s | %12s | %7s |\n' points voxel wall "points/s" "peak RSS" triangles tiles
   printf '|%s|%s|%s|%s|%s|%s|%s|\n' ------- ---------- ----------- ------------- ----------- -------------- ---------
   for n in ${SURFACE_TILES_SIZES:-1M 10M}; do
-    local cloud=$work/surface-$n.ply out=$work/surface-tiles
+    # SURFACE_TILES_FORMAT=las: LAS without normals (estimated, up), as airborne lidar comes.
+    local cloud=$work/surface-$n.${SURFACE_TILES_FORMAT:-ply} out=$work/surface-tiles
     [[ -f $cloud ]] || "$lodforge" -q generate points --points "$n" -o "$cloud"
     local count
-    count=$("$lodforge" -q info "$cloud" --json 2> /dev/null | sed -n 's/.*"vertices": \([0-9]*\).*/\1/p')
+    count=$("$lodforge" -q info "$cloud" --json 2> /dev/null | sed -n 's/^  "\(vertices\|points\)": \([0-9]*\).*/\2/p' | tail -1)
     local voxels=("${SURFACE_TILES_VOXEL:-1}")
     [[ ${SURFACE_TILES_DEFAULT:-1} == 1 ]] && voxels=(default "${voxels[@]}")
     for voxel in "${voxels[@]}"; do

@@ -1,6 +1,7 @@
 // `lodforge reconstruct CLOUD -o mesh.ply`: a surface from a point cloud, chunk by chunk
 // (large-meshes paper §3.1, §3.3; docs/surface.md).
 #include <chrono>
+#include <filesystem>
 
 #include <fmt/format.h>
 
@@ -10,6 +11,7 @@
 #include "lodforge/core/units.h"
 #include "lodforge/io/point_reader.h"
 #include "lodforge/surface/reconstruct.h"
+#include "lodforge/surface/resume_state.h"
 #include "outputs.h"
 #include "surface_options.h"
 
@@ -20,6 +22,7 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
     std::string input, output;
     SurfaceCommand surface;
     bool salvage = false;
+    bool resume = false;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
@@ -33,6 +36,9 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
       ->check(CLI::Range(2, 1024));
   sub->add_flag("--salvage", options->salvage,
                 "Read a PLY cut short up to its last whole point (with a warning)");
+  sub->add_flag("--resume", options->resume,
+                "Go on from an interrupted run with the same input and options: the runs of "
+                "chunks it finished are kept in OUTPUT.work");
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
       const auto start = std::chrono::steady_clock::now();
@@ -49,20 +55,33 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
                                std::vector<std::string>{options->input}));
       reconstruct->memoryLimit = global.memoryLimit;
       reconstruct->salvageTruncated = options->salvage;
+      reconstruct->resumable = true;
+      reconstruct->resume = options->resume;
       Result<ReconstructStats> mesh =
           reconstructToFile(options->input, options->output, *reconstruct);
-      if (!mesh) return mesh.status();
+      if (!mesh) {
+        std::error_code ignored;
+        const std::string work = reconstructWorkDirectory(options->output);
+        if (std::filesystem::exists(reconstructStatePath(work), ignored))
+          fmt::print(stderr,
+                     "lodforge: the finished runs of chunks are kept in {}: run again with "
+                     "--resume to continue, or delete it\n",
+                     work);
+        return mesh.status();
+      }
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      say(global, fmt::format("wrote {}: {} triangles, {} vertices from {} points in {:.2f} s "
-                              "(voxel {:g}, {} chunks in {} runs{}{})",
-                              options->output, formatCount(mesh->triangles),
-                              formatCount(mesh->vertices), formatCount(mesh->points), seconds,
-                              mesh->grid.voxel, formatCount(mesh->chunks), mesh->runs,
-                              mesh->estimatedNormals ? ", normals estimated" : "",
-                              mesh->droppedPieces > 0
-                                  ? fmt::format(", {} small pieces dropped", mesh->droppedPieces)
-                                  : ""));
+      say(global,
+          fmt::format("wrote {}: {} triangles, {} vertices from {} points in {:.2f} s "
+                      "(voxel {:g}, {} chunks in {} runs{}{}{})",
+                      options->output, formatCount(mesh->triangles), formatCount(mesh->vertices),
+                      formatCount(mesh->points), seconds, mesh->grid.voxel,
+                      formatCount(mesh->chunks), mesh->runs,
+                      mesh->resumedRuns > 0 ? fmt::format(", {} resumed", mesh->resumedRuns) : "",
+                      mesh->estimatedNormals ? ", normals estimated" : "",
+                      mesh->droppedPieces > 0
+                          ? fmt::format(", {} small pieces dropped", mesh->droppedPieces)
+                          : ""));
       detail(global, fmt::format("peak memory {}", formatBytes(peakRssBytes())));
       return Status{};
     };

@@ -197,9 +197,10 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
     const ReconstructStats& surface = *stats.surface;
     say(global,
         fmt::format("reconstructed {} triangles from {} points (voxel {:g}, chunks of {} voxels, "
-                    "{} runs{}{})",
+                    "{} runs{}{}{})",
                     formatCount(surface.triangles), formatCount(surface.points), surface.grid.voxel,
                     surface.chunkVoxels, surface.runs,
+                    surface.resumedRuns > 0 ? fmt::format(", {} resumed", surface.resumedRuns) : "",
                     surface.estimatedNormals ? ", normals estimated" : "",
                     surface.droppedPieces > 0
                         ? fmt::format(", {} small pieces dropped", surface.droppedPieces)
@@ -231,12 +232,11 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
 Status runMeshTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
   Result<TilesStats> stats = writeTiles(options.input, options.output, tiles);
   if (!stats) {
-    std::error_code ignored;
     const std::string work = tilesWorkDirectory(options.output);
-    if (std::filesystem::exists(workStatePath(work), ignored))
+    if (tilesWorkKept(work))
       fmt::print(stderr,
-                 "lodforge: the finished chunks and tiles are kept in {}: run again with "
-                 "--resume to continue, or delete it\n",
+                 "lodforge: the finished work is kept in {}: run again with --resume to "
+                 "continue, or delete it\n",
                  work);
     return stats.status();
   }

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <thread>
 
@@ -1132,37 +1133,61 @@ TEST(CliTiles, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {
   EXPECT_NE(small.err.find("too small"), std::string::npos) << small.err;
 }
 
-// `tiles INPUT -o b ARGS…` stopped by Ctrl-C once its chunks are done and a few tiles written,
-// then run again with --resume: the chunks are reused and the tileset is byte for byte the one
+// Starts lodforge with `args`, sends it Ctrl-C once `ready()` holds and checks that it stopped
+// with exit 1, naming --resume. False when it finished before it could be stopped.
+bool interruptWhen(const test::TempDir& dir, const std::vector<std::string>& args,
+                   const std::function<bool()>& ready) {
+  const pid_t pid = spawnLodforge(args, dir.file(".stderr"));
+  bool started = false;
+  for (int i = 0; i < 3000 && !started; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    started = ready();
+  }
+  EXPECT_TRUE(started);
+  ::kill(pid, SIGINT);
+  const Finished stopped = waitFor(pid);
+  const std::string err = test::readFile(dir.file(".stderr"));
+  std::remove(dir.file(".stderr").c_str());
+  if (stopped.code == 0) return false;
+  EXPECT_EQ(stopped.code, 1);
+  EXPECT_NE(err.find("--resume"), std::string::npos) << err;
+  return true;
+}
+
+// `tiles INPUT -o b ARGS…` stopped by Ctrl-C once its chunks are done and a few tiles written
+// (or, given `stopAt`, once that file exists in b.work), then run again with --resume: the
+// earlier work is reused (the output says `resumed`) and the tileset is byte for byte the one
 // an uninterrupted run (into a) writes.
 void expectResumesToTheSameTileset(const test::TempDir& dir, const std::string& input,
-                                   const std::vector<std::string>& more) {
+                                   const std::vector<std::string>& more,
+                                   const std::string& stopAt = "",
+                                   const std::string& resumed = "chunks resumed") {
   std::vector<std::string> args = {"-q", "--threads", "1", "tiles", input, "-o", dir.file("b")};
   args.insert(args.end(), more.begin(), more.end());
   std::string whole = "-q --threads 1 tiles " + input + " -o " + dir.file("a");
   for (const std::string& a : more) whole += " " + a;
   ASSERT_EQ(lodforge(whole, dir).code, 0);
-  const pid_t pid = spawnLodforge(args, dir.file(".stderr"));
   const std::filesystem::path nodes = dir.file("b.work/nodes");
-  bool started = false;
-  for (int i = 0; i < 3000 && !started; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const bool stopped = interruptWhen(dir, args, [&] {
     std::error_code ignored;
-    started = std::filesystem::exists(dir.file("b.work/state.json")) &&
-              std::distance(std::filesystem::directory_iterator(nodes, ignored),
-                            std::filesystem::directory_iterator{}) >= 6;
-  }
-  ASSERT_TRUE(started);
-  ::kill(pid, SIGINT);
-  const Finished stopped = waitFor(pid);
-  const std::string err = test::readFile(dir.file(".stderr"));
-  std::remove(dir.file(".stderr").c_str());
-  if (stopped.code == 0) GTEST_SKIP() << "the run finished before it could be interrupted";
-  EXPECT_EQ(stopped.code, 1);
-  EXPECT_NE(err.find("--resume"), std::string::npos) << err;
+    return stopAt.empty() ? std::filesystem::exists(dir.file("b.work/state.json")) &&
+                                std::distance(std::filesystem::directory_iterator(nodes, ignored),
+                                              std::filesystem::directory_iterator{}) >= 6
+                          : std::filesystem::exists(dir.file("b.work/" + stopAt));
+  });
+  if (!stopped) GTEST_SKIP() << "the run finished before it could be interrupted";
   EXPECT_FALSE(std::filesystem::exists(dir.file("b")));
-  const std::size_t kept = test::listFolder(dir.file("b.work/tileset/tiles")).size();
-  EXPECT_GT(kept, 0u);
+  if (stopAt.empty()) {
+    EXPECT_GT(test::listFolder(dir.file("b.work/tileset/tiles")).size(), 0u);
+  } else {
+    // What a stopped run that had flushed its chunk buffers leaves: chunk files that later
+    // chunks are appended to. The resumed run must not build on them.
+    std::filesystem::create_directories(dir.file("b.work/chunks"));
+    for (int x = 0; x < 8; ++x)
+      for (int y = 0; y < 8; ++y)
+        for (int z = 0; z < 4; ++z)
+          test::writeFile(dir.file(fmt::format("b.work/chunks/{}_{}_{}.tri", x, y, z)), "stale");
+  }
 
   std::vector<std::string> resume = args;
   resume.push_back("--resume");
@@ -1172,7 +1197,7 @@ void expectResumesToTheSameTileset(const test::TempDir& dir, const std::string& 
   for (const std::string& a : resume) line += a + " ";
   const Outcome o = lodforge(line, dir);
   ASSERT_EQ(o.code, 0) << o.err;
-  EXPECT_NE((o.out + o.err).find("chunks resumed"), std::string::npos) << o.out << o.err;
+  EXPECT_NE((o.out + o.err).find(resumed), std::string::npos) << o.out << o.err;
   // Byte for byte the tileset of an uninterrupted run, and nothing left over.
   const std::vector<std::string> files = test::listFolder(dir.file("a/tiles"));
   ASSERT_EQ(test::listFolder(dir.file("b/tiles")), files);
@@ -1195,6 +1220,48 @@ TEST(CliTiles, AnInterruptedSurfaceResumesToTheSameTileset) {
   test::TempDir dir;
   ASSERT_EQ(lodforge("-q generate points --points 200K -o " + dir.file("p.ply"), dir).code, 0);
   expectResumesToTheSameTileset(dir, dir.file("p.ply"), {"--surface", "--voxel", "2"});
+}
+
+// Stopped during the reconstruction itself, tiles --surface --resume takes the runs of chunks
+// it finished (and not the leaf chunk files the stopped run had begun: see the helper).
+TEST(CliTiles, AReconstructionStoppedHalfwayResumesToTheSameTileset) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate points --points 300K -o " + dir.file("p.ply"), dir).code, 0);
+  expectResumesToTheSameTileset(dir, dir.file("p.ply"),
+                                {"--surface", "--voxel", "2", "--chunk-size", "24"},
+                                "surface/run-1.pieces", " resumed)");
+}
+
+// reconstruct: Ctrl-C after some runs of chunks keeps OUTPUT.work and says so; --resume takes
+// the finished runs and writes the bytes of an unbroken run, leaving nothing else behind.
+TEST(CliReconstruct, AnInterruptedReconstructionResumesToTheSameMesh) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate points --points 300K -o " + dir.file("p.ply"), dir).code, 0);
+  const std::vector<std::string> args = {"-q",
+                                         "--threads",
+                                         "1",
+                                         "--memory-limit",
+                                         "64M",
+                                         "reconstruct",
+                                         dir.file("p.ply"),
+                                         "-o",
+                                         dir.file("b.ply"),
+                                         "--voxel",
+                                         "1"};
+  std::string whole;
+  for (const std::string& a : args) whole += (a == dir.file("b.ply") ? dir.file("a.ply") : a) + " ";
+  ASSERT_EQ(lodforge(whole, dir).code, 0);
+  if (!interruptWhen(dir, args,
+                     [&] { return std::filesystem::exists(dir.file("b.ply.work/run-2.pieces")); }))
+    GTEST_SKIP() << "the run finished before it could be interrupted";
+  EXPECT_FALSE(std::filesystem::exists(dir.file("b.ply")));
+  std::string resume = "-v";
+  for (std::size_t a = 1; a < args.size(); ++a) resume += " " + args[a];
+  const Outcome o = lodforge(resume + " --resume", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE((o.out + o.err).find(" resumed"), std::string::npos) << o.out << o.err;
+  EXPECT_EQ(test::readFile(dir.file("a.ply")), test::readFile(dir.file("b.ply")));
+  EXPECT_EQ(test::listFolder(dir.path()), (std::vector<std::string>{"a.ply", "b.ply", "p.ply"}));
 }
 
 TEST(CliBench, RunsEveryBudgetAndHitsItExactly) {

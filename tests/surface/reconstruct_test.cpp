@@ -16,6 +16,7 @@
 #include "lodforge/io/ply_writer.h"
 #include "lodforge/surface/cloud_file.h"
 #include "lodforge/surface/point_index.h"
+#include "lodforge/surface/resume_state.h"
 #include "test_support.h"
 
 namespace lodforge {
@@ -237,9 +238,9 @@ std::string writeCloud(const test::TempDir& dir, const std::string& name, const 
   return path;
 }
 
-// Out of core, the chunks are worked in runs that fit the memory budget: any number of runs
-// writes the same bytes (colours included), the same mesh as in memory, and leaves nothing but
-// the output.
+// Out of core, the chunks are worked in runs that fit the memory budget: any number of runs, or
+// every chunk streamed from its own file, writes the same bytes (colours included), the same mesh
+// as in memory, and leaves nothing but the output.
 TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
   test::TempDir dir;
   Sampled s = terrainSamples(30'000, 150);
@@ -255,7 +256,16 @@ TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
   Result<ReconstructStats> many = reconstructToFile(cloud, dir.file("many.ply"), options);
   ASSERT_TRUE(many.ok());
   EXPECT_GT(many->runs, 20u);
+  EXPECT_EQ(many->streamedChunks, 0u);
   EXPECT_EQ(test::readFile(dir.file("one.ply")), test::readFile(dir.file("many.ply")));
+  // Every chunk more than a run may hold: each streamed from its file, the same bytes again.
+  options.runPoints = 1;
+  Result<ReconstructStats> streamed = reconstructToFile(cloud, dir.file("streamed.ply"), options);
+  ASSERT_TRUE(streamed.ok());
+  EXPECT_GT(streamed->streamedChunks, 40u);  // (a chunk of a single point is still held)
+  EXPECT_GT(streamed->streamedChunks * 10, streamed->runs * 9);
+  EXPECT_EQ(test::readFile(dir.file("one.ply")), test::readFile(dir.file("streamed.ply")));
+  std::filesystem::remove(dir.file("streamed.ply"));
   std::vector<Vec3f> normals;
   for (const Vec3f& n : s.normals) normals.push_back(normalizeOr(n, Vec3f{0, 0, 1}));
   Result<ReconstructedMesh> memory = reconstructPoints(s.points, normals, {}, "t", options);
@@ -271,6 +281,73 @@ TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
     EXPECT_EQ(back->positions[v], toFloat(memory->positions[v] - back->origin)) << v;
   EXPECT_EQ(back->indices, memory->indices);
   EXPECT_EQ(test::listFolder(dir.path()).size(), 3u);  // the cloud and two meshes
+}
+
+// Stops a reconstruction at its n-th piece, as Ctrl-C would; counts the pieces until then.
+class StoppingSink : public PieceSink {
+ public:
+  StoppingSink(PieceSink& sink, std::size_t stopAt) : sink_(sink), stopAt_(stopAt) {}
+  Status begin(const ChunkLayout& layout, bool colors) override {
+    return sink_.begin(layout, colors);
+  }
+  Status add(std::uint64_t chunk, const SurfacePiece& piece) override {
+    if (added == stopAt_) return Error{ErrorKind::kCancelled, "stopped"};
+    ++added;
+    return sink_.add(chunk, piece);
+  }
+  std::size_t added = 0;
+
+ private:
+  PieceSink& sink_;
+  std::size_t stopAt_;
+};
+
+// An interrupted reconstruction goes on with `resume`: the runs it finished are replayed from
+// their kept pieces, the others made, and the mesh is the one made without a break. Other
+// options start over.
+TEST(Reconstruct, AnInterruptedReconstructionResumesToTheSameMesh) {
+  test::TempDir dir;
+  const std::string cloud = writeCloud(dir, "cloud.ply", terrainSamples(30'000, 150), false, true);
+  ReconstructOptions options;
+  options.voxel = 1.1;
+  options.chunkVoxels = 9;
+  options.runPoints = 2'000;
+  options.normals.orientation = NormalOrientation::kUp;
+  options.resumable = true;
+  const auto reconstruct = [&](const std::string& work, MemoryMeshOutput& out, std::size_t stopAt) {
+    std::filesystem::create_directories(work);
+    PieceJoiner joiner(0, out);
+    StoppingSink stopping(joiner, stopAt);
+    Result<ReconstructStats> stats = reconstructPieces(cloud, work, options, stopping);
+    return std::pair{stats, stopping.added};
+  };
+  MemoryMeshOutput whole;
+  const auto [unbroken, pieces] = reconstruct(dir.file("a"), whole, SIZE_MAX);
+  ASSERT_TRUE(unbroken.ok()) << unbroken.error().message;
+  ASSERT_GT(unbroken->runs, 10u);
+  MemoryMeshOutput partial;
+  const auto [stopped, before] = reconstruct(dir.file("b"), partial, pieces / 2);
+  ASSERT_FALSE(stopped.ok());
+  EXPECT_EQ(stopped.error().kind, ErrorKind::kCancelled);
+  EXPECT_TRUE(std::filesystem::exists(reconstructStatePath(dir.file("b"))));
+  options.resume = true;
+  MemoryMeshOutput resumed;
+  const auto [again, all] = reconstruct(dir.file("b"), resumed, SIZE_MAX);
+  ASSERT_TRUE(again.ok()) << again.error().message;
+  EXPECT_EQ(all, pieces);
+  EXPECT_GT(again->resumedRuns, 2u);
+  EXPECT_LT(again->resumedRuns, again->runs);
+  EXPECT_TRUE(again->estimatedNormals);
+  EXPECT_EQ(resumed.positions, whole.positions);
+  EXPECT_EQ(resumed.normals, whole.normals);
+  EXPECT_EQ(resumed.colors, whole.colors);
+  EXPECT_EQ(resumed.indices, whole.indices);
+  options.distance.radius = 2.5;  // another surface: nothing earlier is taken
+  MemoryMeshOutput other;
+  const auto [fresh, count] = reconstruct(dir.file("b"), other, SIZE_MAX);
+  ASSERT_TRUE(fresh.ok());
+  EXPECT_EQ(fresh->resumedRuns, 0u);
+  EXPECT_NE(other.indices, whole.indices);
 }
 
 // Real scans: the Cyberware horse's vertices with their normals and the Stanford bunny's without
@@ -337,6 +414,16 @@ TEST(Reconstruct, NormalsEstimatedRunByRunJoinWithoutACrack) {
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_LE(boundaryEdges(b->indices), boundaryEdges(a->indices));
   EXPECT_NEAR(static_cast<double>(b->triangleCount()), static_cast<double>(a->triangleCount()),
+              0.001 * static_cast<double>(a->triangleCount()));
+  // Chunks denser than a run: their normals in parts, their distances streamed.
+  options.runPoints = 150;
+  Result<ReconstructStats> dense = reconstructToFile(cloud, dir.file("dense.ply"), options);
+  ASSERT_TRUE(dense.ok()) << dense.error().message;
+  EXPECT_GT(dense->streamedChunks, dense->runs / 2);
+  Result<Model> c = readPly(dir.file("dense.ply"));
+  ASSERT_TRUE(c.ok());
+  EXPECT_LE(boundaryEdges(c->indices), boundaryEdges(a->indices));
+  EXPECT_NEAR(static_cast<double>(c->triangleCount()), static_cast<double>(a->triangleCount()),
               0.001 * static_cast<double>(a->triangleCount()));
 }
 

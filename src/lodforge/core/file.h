@@ -4,11 +4,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "lodforge/core/progress.h"
 #include "lodforge/core/status.h"
 
 namespace lodforge {
@@ -150,5 +152,26 @@ std::string fileExtension(const std::string& path);
 // A temporary name beside `path` that no file holds now ("<path>.tmp-<pid>-<n>"), for the
 // rename-on-complete pattern.
 std::string temporaryPathFor(const std::string& path);
+
+// Calls `each` with the file's records of type T, `block` at a time in file order, and checks
+// for cancellation between blocks (work files of fixed records read back).
+template <class T, class F>
+Status forEachFileBlock(const std::string& path, std::size_t block, F&& each) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) return ioErrorFromErrno(path, "open");
+  std::vector<T> values(block);
+  Status status;
+  while (status.ok()) {
+    const std::size_t got = std::fread(values.data(), sizeof(T), values.size(), file);
+    if (got == 0) {
+      if (std::ferror(file)) status = ioError(path, "read failed");
+      break;
+    }
+    status = each(std::span<const T>(values.data(), got));
+    if (status.ok()) status = checkCancelled();
+  }
+  std::fclose(file);
+  return status;
+}
 
 }  // namespace lodforge

@@ -78,21 +78,7 @@ Result<CloudSummary> copyCloud(const std::string& input, const std::string& path
 
 Status forEachRecordBlock(const std::string& path,
                           const std::function<Status(std::span<const CloudRecord>)>& each) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) return ioErrorFromErrno(path, "open");
-  std::vector<CloudRecord> block(kBlockRecords);
-  Status status;
-  while (status.ok()) {
-    const std::size_t got = std::fread(block.data(), sizeof(CloudRecord), block.size(), file);
-    if (got == 0) {
-      if (std::ferror(file)) status = ioError(path, "read failed");
-      break;
-    }
-    status = each(std::span<const CloudRecord>(block.data(), got));
-    if (status.ok()) status = checkCancelled();
-  }
-  std::fclose(file);
-  return status;
+  return forEachFileBlock<CloudRecord>(path, kBlockRecords, each);
 }
 
 Result<std::vector<CloudRecord>> readRecords(const std::string& path) {

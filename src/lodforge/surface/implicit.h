@@ -6,12 +6,14 @@
 // §3.3 makes the values of overlapping chunks identical by averaging them; here they are
 // identical by construction: a corner's value depends only on the points within the radius,
 // every chunk holds all of them (its overlap is at least the radius) and adds them in one order
-// that is the same for every chunk (sumOrder), so two chunks compute the same bits. No value either
-// past the edge of the points (DistanceOptions::edge).
+// that is the same for every chunk (input order), so two chunks compute the same bits. No value
+// either past the edge of the points (DistanceOptions::edge).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "lodforge/core/math.h"
 #include "lodforge/surface/grid.h"
@@ -19,17 +21,9 @@
 namespace lodforge {
 
 struct OrientedPoints {
-  std::span<const Vec3d> positions;
-  std::span<const Vec3f> normals;      // unit, facing out
-  std::span<const std::uint64_t> ids;  // index in the input
+  std::span<const Vec3d> positions;  // in input order: the order every box adds them in
+  std::span<const Vec3f> normals;    // unit, facing out
 };
-
-// The order in which a corner adds its points: by the Morton code of the lattice cell a point
-// lies in, then by input index. It is one total order on the input, so every box adds a
-// corner's points in the same order whichever of them it holds; and points near each other
-// come together, so the corners they reach stay in cache. Returns the permutation of `ids`.
-std::vector<std::uint32_t> sumOrder(const VoxelGrid& grid, std::span<const Vec3d> positions,
-                                    std::span<const std::uint64_t> ids);
 
 struct DistanceOptions {
   double radius = 3;  // in voxels
@@ -42,8 +36,36 @@ struct DistanceOptions {
   double edge = 0.5;
 };
 
-// Fills values.values for the box values.first/size, from points in an order that is the same
-// for every box (sumOrder's, or ids ascending).
+// The sums behind a box's corner values, filled a point at a time: a chunk's points can be
+// streamed through it from a file, and split by rows of corners between threads (each row adds
+// the same points in the same order whichever thread owns it).
+class CornerSums {
+ public:
+  CornerSums(const VoxelGrid& grid, const DistanceOptions& options,
+             std::array<std::uint64_t, 3> first, std::array<std::uint32_t, 3> size);
+  // Adds a point (in input order) to the box's corners within the radius whose row (y index in
+  // the box) is in [rowFirst, rowEnd).
+  void add(Vec3d at, Vec3f normal, std::uint32_t rowFirst, std::uint32_t rowEnd);
+  void add(Vec3d at, Vec3f normal) { add(at, normal, 0, size_[1]); }
+  std::uint32_t rows() const { return size_[1]; }
+  // The values: NaN where fewer than minPoints points are near or past the edge of the points.
+  CornerValues values() const;
+
+ private:
+  // One corner's sums side by side: a point's update touches one cache line per corner.
+  struct Sums {
+    double weight = 0, sum = 0;
+    Vec3f offset, direction;  // Σ w (p − c), Σ w n (only compared)
+    std::uint32_t near = 0;
+  };
+  const VoxelGrid& grid_;
+  DistanceOptions options_;
+  std::array<std::uint64_t, 3> first_;
+  std::array<std::uint32_t, 3> size_;
+  std::vector<Sums> corners_;
+};
+
+// Fills values.values for the box values.first/size from the points (CornerSums in one go).
 void signedDistances(const VoxelGrid& grid, const OrientedPoints& points,
                      const DistanceOptions& options, CornerValues& values);
 

@@ -121,29 +121,6 @@ Status PlyMeshOutput::triangles(std::span<const std::uint32_t> indices) {
   return triangleFile_.writeSpan(indices);
 }
 
-namespace {
-
-// Calls `each` with blocks of the file's T records.
-template <class T, class F>
-Status forEachBlock(const std::string& path, std::size_t block, F&& each) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) return ioErrorFromErrno(path, "open");
-  std::vector<T> values(block);
-  Status status;
-  while (status.ok()) {
-    const std::size_t got = std::fread(values.data(), sizeof(T), values.size(), file);
-    if (got == 0) {
-      if (std::ferror(file)) status = ioError(path, "read failed");
-      break;
-    }
-    status = each(std::span<const T>(values.data(), got));
-  }
-  std::fclose(file);
-  return status;
-}
-
-}  // namespace
-
 Status PlyMeshOutput::finish(const std::string& path, bool colors, const std::string& comment) {
   const std::string vertexPath = vertexFile_.path(), trianglePath = triangleFile_.path();
   LODFORGE_TRY(vertexFile_.commit());
@@ -163,7 +140,7 @@ Status PlyMeshOutput::finish(const std::string& path, bool colors, const std::st
   Progress progress("reconstruct: writing", vertices_ + indices_ / 3);
   std::vector<Vec3f> positions, normals;
   std::vector<Rgba8> rgba;
-  LODFORGE_TRY(forEachBlock<JoinedVertex>(
+  LODFORGE_TRY(forEachFileBlock<JoinedVertex>(
       vertexPath, 1 << 15, [&](std::span<const JoinedVertex> block) -> Status {
         positions.resize(block.size());
         normals.resize(block.size());
@@ -177,12 +154,12 @@ Status PlyMeshOutput::finish(const std::string& path, bool colors, const std::st
         LODFORGE_TRY(writer->writeVertices(positions, normals, rgba, origin));
         return checkCancelled();
       }));
-  LODFORGE_TRY(forEachBlock<std::uint32_t>(trianglePath, 3 << 16,
-                                           [&](std::span<const std::uint32_t> block) -> Status {
-                                             progress.advance(block.size() / 3);
-                                             LODFORGE_TRY(writer->writeTriangles(block));
-                                             return checkCancelled();
-                                           }));
+  LODFORGE_TRY(forEachFileBlock<std::uint32_t>(trianglePath, 3 << 16,
+                                               [&](std::span<const std::uint32_t> block) -> Status {
+                                                 progress.advance(block.size() / 3);
+                                                 LODFORGE_TRY(writer->writeTriangles(block));
+                                                 return checkCancelled();
+                                               }));
   std::remove(vertexPath.c_str());
   std::remove(trianglePath.c_str());
   progress.finish();

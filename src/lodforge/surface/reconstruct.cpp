@@ -14,13 +14,16 @@
 
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
+#include "lodforge/core/output_claim.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
+#include "lodforge/surface/chunk_piece.h"
 #include "lodforge/surface/chunk_runs.h"
 #include "lodforge/surface/cloud_file.h"
 #include "lodforge/surface/layout.h"
 #include "lodforge/surface/mesh_join.h"
 #include "lodforge/surface/point_index.h"
+#include "lodforge/surface/resume_state.h"
 
 namespace lodforge {
 
@@ -100,57 +103,6 @@ std::vector<std::vector<std::uint32_t>> membersOf(const ChunkLayout& layout,
   return members;
 }
 
-// One chunk's piece: distances at its corners and a corner of margin, polygonized within its
-// own corners; a vertex's colour is its nearest member's (the chunk's members do not depend on
-// how chunks are cut into runs, so neither do the colours).
-SurfacePiece chunkPiece(const ChunkLayout& layout, std::uint64_t c,
-                        std::span<const std::uint32_t> members,
-                        std::span<const CloudRecord> records, const DistanceOptions& distance,
-                        bool colors) {
-  std::vector<Vec3d> p(members.size());
-  std::vector<Vec3f> nrm(members.size());
-  std::vector<std::uint64_t> ids(members.size());
-  for (std::size_t m = 0; m < members.size(); ++m) {
-    p[m] = records[members[m]].position;
-    ids[m] = records[members[m]].id;
-  }
-  // In the order every chunk adds a corner's points (implicit.h), nearby points together.
-  const std::vector<std::uint32_t> order = sumOrder(layout.grid, p, ids);
-  std::vector<std::uint32_t> sorted(members.size());
-  for (std::size_t m = 0; m < members.size(); ++m) {
-    sorted[m] = members[order[m]];
-    const CloudRecord& r = records[sorted[m]];
-    p[m] = r.position;
-    nrm[m] = r.normal;
-    ids[m] = r.id;
-  }
-  const std::array<std::uint64_t, 3> at = layout.chunkAt(c);
-  std::array<std::uint64_t, 3> first{};
-  std::array<std::uint32_t, 3> size{};
-  CornerValues values;
-  for (std::size_t a = 0; a < 3; ++a) {
-    first[a] = at[a] * layout.n;
-    size[a] = static_cast<std::uint32_t>(
-        std::min<std::uint64_t>(layout.n + 1, layout.grid.corners[a] - first[a]));
-    values.first[a] = first[a] > 0 ? first[a] - 1 : 0;
-    values.size[a] = static_cast<std::uint32_t>(
-        std::min<std::uint64_t>(first[a] + size[a] + 1, layout.grid.corners[a]) - values.first[a]);
-  }
-  signedDistances(layout.grid, {p, nrm, ids}, distance, values);
-  SurfacePiece piece = polygonize(layout.grid, values, first, size);
-  if (colors && !piece.positions.empty()) {
-    const PointIndex index(p);
-    piece.colors.resize(piece.positions.size());
-    for (std::size_t v = 0; v < piece.positions.size(); ++v) {
-      std::uint32_t nearest = 0;
-      double d2 = 0;
-      index.nearest(piece.positions[v], 1, &nearest, &d2);
-      piece.colors[v] = records[sorted[nearest]].color;
-    }
-  }
-  return piece;
-}
-
 // The run's chunks made a few per thread at a time and handed on in chunk order.
 Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> records,
                   std::span<const std::uint64_t> chunks, const ReconstructOptions& options,
@@ -164,8 +116,8 @@ Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> record
     const std::size_t last = std::min(chunks.size(), first + batch);
     tbb::parallel_for(first, last, [&](std::size_t i) {
       made[i - first] = members[i].empty() ? SurfacePiece{}
-                                           : chunkPiece(layout, chunks[i], members[i], records,
-                                                        options.distance, colors);
+                                           : heldChunkPiece(layout, chunks[i], members[i], records,
+                                                            options.distance, colors);
     });
     for (std::size_t i = first; i < last; ++i) {
       LODFORGE_TRY(sink.add(chunks[i], made[i - first]));
@@ -176,6 +128,17 @@ Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> record
     LODFORGE_TRY(checkCancelled());
   }
   return {};
+}
+
+// A chunk streamed from its run file (chunk_piece.h).
+Status streamDenseChunk(const ChunkLayout& layout, std::uint64_t chunk, const std::string& runFile,
+                        const ReconstructOptions& options, bool colors, PieceSink& sink,
+                        Progress& progress) {
+  Result<SurfacePiece> piece = streamedChunkPiece(layout, chunk, runFile, options.distance, colors);
+  if (!piece) return piece.status();
+  LODFORGE_TRY(sink.add(chunk, *piece));
+  progress.advance(1);
+  return checkCancelled();
 }
 
 // Normals turned by propagation need the whole cloud's neighbour graph at once.
@@ -245,69 +208,181 @@ std::string normalsPath(const std::string& directory, std::size_t run) {
   return fmt::format("{}/run-{}.normals", directory, run);
 }
 
-// Up or towards a viewpoint: each point's normal from its neighbours in the run that owns it
-// (the run of the chunk it lies in), so a normal is computed once; then merged into the record
-// file in id order.
-Status estimateNormalsByRun(const std::string& cloudPath, const ChunkLayout& layout,
-                            const ChunkRuns& runs, const ReconstructOptions& options,
-                            const std::string& directory) {
-  LODFORGE_TRY(writeRuns(cloudPath, layout, options.distance.radius + 1, runs, directory));
-  Progress progress("reconstruct: normals", runs.runCount());
-  for (std::size_t r = 0; r < runs.runCount(); ++r) {
-    Result<std::vector<CloudRecord>> records = readRecords(runPath(directory, r));
-    if (!records) return records.status();
-    std::remove(runPath(directory, r).c_str());
-    std::vector<Vec3d> positions(records->size());
-    for (std::size_t i = 0; i < positions.size(); ++i) positions[i] = (*records)[i].position;
-    std::vector<Vec3f> normals;
-    {
-      const PointIndex index(positions);
-      normals = estimateNormals(positions, index, options.normals);
-    }
-    Result<OutputFile> out = OutputFile::create(normalsPath(directory, r), 1 << 20);
-    if (!out) return out.status();
-    for (std::size_t i = 0; i < positions.size(); ++i) {
-      if (runs.runOf(layout.owner(positions[i])) != r) continue;
-      const OwnedNormal owned{(*records)[i].id, normals[i]};
-      LODFORGE_TRY(out->write(&owned, sizeof owned));
-    }
-    LODFORGE_TRY(out->commit());
-    progress.advance(1);
-    LODFORGE_TRY(checkCancelled());
+// The normals of `records` from their neighbours among them; those of the points `owns` accepts
+// written to `path` in input order.
+template <class Owns>
+Status writeOwnedNormals(std::span<const CloudRecord> records, const NormalOptions& options,
+                         Owns&& owns, const std::string& path) {
+  std::vector<Vec3d> positions(records.size());
+  for (std::size_t i = 0; i < positions.size(); ++i) positions[i] = records[i].position;
+  std::vector<Vec3f> normals;
+  {
+    const PointIndex index(positions);
+    normals = estimateNormals(positions, index, options);
   }
-  progress.finish();
+  Result<OutputFile> out = OutputFile::create(path, 1 << 20);
+  if (!out) return out.status();
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    if (!owns(positions[i])) continue;
+    const OwnedNormal owned{records[i].id, normals[i]};
+    LODFORGE_TRY(out->write(&owned, sizeof owned));
+  }
+  return out->commit();
+}
+
+// A chunk denser than a run may hold, its normals in parts: its columns cut in a × b across x
+// and y, each part read from the run file with the overlap round it (the runs' own, radius and a
+// voxel) and its owned points' normals written to a file of its own.
+Status denseChunkNormals(const std::string& runFile, const ChunkLayout& layout, std::uint64_t chunk,
+                         std::uint64_t points, std::uint64_t budget,
+                         const ReconstructOptions& options, const std::string& partPath,
+                         std::vector<std::string>& paths) {
+  const std::uint64_t parts = (2 * points + budget - 1) / budget;
+  // (At most a voxel's column a part.)
+  const std::uint64_t across = std::min<std::uint64_t>(
+      layout.n, static_cast<std::uint64_t>(std::ceil(std::sqrt(static_cast<double>(parts)))));
+  const std::array<std::uint64_t, 2> cuts{
+      across, std::min<std::uint64_t>(layout.n, (parts + across - 1) / across)};
+  const std::array<std::uint64_t, 3> at = layout.chunkAt(chunk);
+  const double margin = options.distance.radius + 1;
+  // The part a point lies in along x (a = 0) or y, by its lattice coordinate in the chunk.
+  const auto partOf = [&](const Vec3d& p, std::size_t a) {
+    const int axis = static_cast<int>(a);
+    const double g = (p[axis] - layout.grid.origin[axis]) / layout.grid.voxel -
+                     static_cast<double>(at[a] * layout.n);
+    const double part = std::floor(g * static_cast<double>(cuts[a]) / layout.n);
+    return static_cast<std::uint64_t>(std::clamp(part, 0.0, static_cast<double>(cuts[a] - 1)));
+  };
+  const auto near = [&](const Vec3d& p, std::size_t a, std::uint64_t part) {
+    const int axis = static_cast<int>(a);
+    const double g = (p[axis] - layout.grid.origin[axis]) / layout.grid.voxel -
+                     static_cast<double>(at[a] * layout.n);
+    const double width = static_cast<double>(layout.n) / static_cast<double>(cuts[a]);
+    return g >= static_cast<double>(part) * width - margin &&
+           g <= static_cast<double>(part + 1) * width + margin;
+  };
+  for (std::uint64_t i = 0; i < cuts[0]; ++i)
+    for (std::uint64_t j = 0; j < cuts[1]; ++j) {
+      std::vector<CloudRecord> records;
+      LODFORGE_TRY(forEachRecordBlock(runFile, [&](std::span<const CloudRecord> block) {
+        for (const CloudRecord& r : block)
+          if (near(r.position, 0, i) && near(r.position, 1, j)) records.push_back(r);
+        return Status{};
+      }));
+      paths.push_back(fmt::format("{}-{}-{}", partPath, i, j));
+      LODFORGE_TRY(writeOwnedNormals(
+          records, options.normals,
+          [&](const Vec3d& p) {
+            return layout.owner(p) == chunk && partOf(p, 0) == i && partOf(p, 1) == j;
+          },
+          paths.back()));
+    }
+  return {};
+}
+
+// The owned normals' files merged into the record file in id order.
+Status mergeNormals(const std::string& cloudPath, const std::vector<std::string>& paths) {
   std::vector<std::unique_ptr<NormalStream>> streams;
-  for (std::size_t r = 0; r < runs.runCount(); ++r) {
-    std::FILE* file = std::fopen(normalsPath(directory, r).c_str(), "rb");
-    if (!file) return ioErrorFromErrno(normalsPath(directory, r), "open");
+  for (const std::string& path : paths) {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    if (!file) return ioErrorFromErrno(path, "open");
     streams.push_back(std::make_unique<NormalStream>(file));
   }
-  using Head = std::pair<std::uint64_t, std::size_t>;  // (id, run)
+  using Head = std::pair<std::uint64_t, std::size_t>;  // (id, stream)
   std::priority_queue<Head, std::vector<Head>, std::greater<>> heads;
-  for (std::size_t r = 0; r < streams.size(); ++r)
-    if (!streams[r]->done()) heads.emplace(streams[r]->head().id, r);
+  for (std::size_t s = 0; s < streams.size(); ++s)
+    if (!streams[s]->done()) heads.emplace(streams[s]->head().id, s);
   LODFORGE_TRY(rewriteNormals(cloudPath, [&](std::span<CloudRecord> block) -> Status {
     for (CloudRecord& record : block) {
       if (heads.empty() || heads.top().first != record.id)
         return Error{ErrorKind::kInternal,
                      fmt::format("{}: point {} has no normal", cloudPath, record.id)};
-      const std::size_t run = heads.top().second;
+      const std::size_t from = heads.top().second;
       heads.pop();
-      NormalStream& s = *streams[run];
+      NormalStream& s = *streams[from];
       record.normal = s.head().normal;
       s.pop();
-      if (!s.done()) heads.emplace(s.head().id, run);
+      if (!s.done()) heads.emplace(s.head().id, from);
     }
     return Status{};
   }));
+  std::error_code ignored;
+  for (const std::string& path : paths) std::filesystem::remove(path, ignored);
   return {};
 }
 
-}  // namespace
+// Up or towards a viewpoint: each point's normal from its neighbours in the run that owns it
+// (the run of the chunk it lies in), so a normal is computed once; then merged into the record
+// file in id order. A run of one chunk denser than a run may hold is done in parts.
+Status estimateNormalsByRun(const std::string& cloudPath, const ChunkLayout& layout,
+                            const ChunkRuns& runs, const ReconstructOptions& options,
+                            const std::string& directory) {
+  LODFORGE_TRY(writeRuns(cloudPath, layout, options.distance.radius + 1, runs, directory));
+  const std::uint64_t budget = runBudget(layout, options);
+  std::vector<std::string> paths;
+  Progress progress("reconstruct: normals", runs.runCount());
+  for (std::size_t r = 0; r < runs.runCount(); ++r) {
+    const std::string runFile = runPath(directory, r);
+    const std::uint64_t first = runs.points[runs.firstChunk[r]];
+    if (first > budget) {
+      LODFORGE_TRY(denseChunkNormals(runFile, layout, runs.chunks[runs.firstChunk[r]], first,
+                                     budget, options, normalsPath(directory, r), paths));
+    } else {
+      Result<std::vector<CloudRecord>> records = readRecords(runFile);
+      if (!records) return records.status();
+      paths.push_back(normalsPath(directory, r));
+      LODFORGE_TRY(writeOwnedNormals(
+          *records, options.normals,
+          [&](const Vec3d& p) { return runs.runOf(layout.owner(p)) == r; }, paths.back()));
+    }
+    std::remove(runFile.c_str());
+    progress.advance(1);
+    LODFORGE_TRY(checkCancelled());
+  }
+  progress.finish();
+  return mergeNormals(cloudPath, paths);
+}
 
-Result<ReconstructStats> reconstructPieces(const std::string& input,
-                                           const std::string& workDirectory,
-                                           const ReconstructOptions& options, PieceSink& sink) {
+// What the runs depend on: a resumed reconstruction takes earlier work only when this is
+// unchanged (the memory budget is not in it: a chunk held or streamed makes the same bits).
+nlohmann::json reconstructIdentity(const std::string& input, const ReconstructOptions& options) {
+  std::error_code error, unknown;
+  const auto modified = std::filesystem::last_write_time(input, unknown);
+  const Vec3d& view = options.normals.viewpoint;
+  const Result<std::uint64_t> bytes = fileSize(input);
+  return {
+      {"input", std::filesystem::absolute(input, error).string()},
+      {"bytes", bytes ? *bytes : 0},
+      {"modified", unknown ? 0 : static_cast<std::int64_t>(modified.time_since_epoch().count())},
+      {"voxel", options.voxel},
+      {"chunkVoxels", options.chunkVoxels},
+      {"chunkLength", options.chunkLength},
+      {"radius", options.distance.radius},
+      {"minPoints", options.distance.minPoints},
+      {"edge", options.distance.edge},
+      {"neighbours", options.normals.neighbours},
+      {"orientation", static_cast<int>(options.normals.orientation)},
+      {"viewpoint", {view.x, view.y, view.z}},
+      {"salvage", options.salvageTruncated},
+      {"placement", options.placement}};
+}
+
+// Removes an earlier reconstruction's state and pieces from the work directory (its run files
+// are written again).
+Status forgetEarlierRuns(const std::string& workDirectory) {
+  std::error_code error;
+  std::filesystem::remove(reconstructStatePath(workDirectory), error);
+  for (std::size_t r = 0; !error && std::filesystem::exists(piecesPath(workDirectory, r), error);
+       ++r)
+    std::filesystem::remove(piecesPath(workDirectory, r), error);
+  if (error) return ioError(workDirectory, fmt::format("cannot clear: {}", error.message()));
+  return {};
+}
+
+// The input read into a record file, the lattice laid over it, normals estimated where missing,
+// and the points written into the files of the runs of chunks.
+Result<ReconstructState> sortIntoRuns(const std::string& input, const std::string& workDirectory,
+                                      const ReconstructOptions& options) {
   const std::string cloudPath = workDirectory + "/cloud.points";
   Result<CloudSummary> cloud =
       copyCloud(input, cloudPath, options.salvageTruncated, options.transform);
@@ -324,18 +399,10 @@ Result<ReconstructStats> reconstructPieces(const std::string& input,
                                             options.distance.radius, input);
   if (!layout) return layout.status();
   LODFORGE_TRY(checkChunkFits(*layout, options, input));
-  ReconstructStats stats;
-  stats.grid = layout->grid;
-  stats.chunkVoxels = layout->n;
-  stats.points = cloud->count;
-  stats.chunks = layout->chunkCount();
-  stats.hasColors = cloud->hasColors;
   const double reach = options.distance.radius + 1;
   Result<ChunkRuns> runs = planRuns(cloudPath, *layout, reach, runBudget(*layout, options));
   if (!runs) return runs.status();
-  stats.runs = runs->runCount();
   if (!cloud->hasNormals) {
-    stats.estimatedNormals = true;
     if (options.normals.orientation == NormalOrientation::kPropagate) {
       LODFORGE_TRY(checkPropagationFits(cloud->count, options, input));
       LODFORGE_TRY(estimateNormalsWhole(cloudPath, *cloud, options.normals));
@@ -346,18 +413,99 @@ Result<ReconstructStats> reconstructPieces(const std::string& input,
   LODFORGE_TRY(writeRuns(cloudPath, *layout, reach, *runs, workDirectory));
   std::error_code error;
   std::filesystem::remove(cloudPath, error);
-  LODFORGE_TRY(sink.begin(*layout, cloud->hasColors));
-  Progress progress("reconstruct: chunks", runs->chunks.size());
-  for (std::size_t r = 0; r < runs->runCount(); ++r) {
-    Result<std::vector<CloudRecord>> records = readRecords(runPath(workDirectory, r));
-    if (!records) return records.status();
+  return ReconstructState{*layout, std::move(*runs), cloud->count, cloud->hasColors,
+                          !cloud->hasNormals};
+}
+
+// Passes each piece on and keeps it in the run's pieces file.
+class KeptPieces : public PieceSink {
+ public:
+  KeptPieces(PieceSink& sink, PieceWriter* writer) : sink_(sink), writer_(writer) {}
+  Status begin(const ChunkLayout&, bool) override { return {}; }
+  Status add(std::uint64_t chunk, const SurfacePiece& piece) override {
+    if (writer_) LODFORGE_TRY(writer_->add(chunk, piece));
+    return sink_.add(chunk, piece);
+  }
+
+ private:
+  PieceSink& sink_;
+  PieceWriter* writer_;
+};
+
+// One run's chunks: held in memory, or the one chunk of a run denser than a run may hold streamed
+// from its file.
+Status makeRun(const ReconstructState& state, std::size_t r, const std::string& workDirectory,
+               const ReconstructOptions& options, PieceSink& sink, Progress& progress,
+               ReconstructStats& stats) {
+  const ChunkRuns& runs = state.runs;
+  const std::span<const std::uint64_t> chunks(runs.chunks.data() + runs.firstChunk[r],
+                                              runs.firstChunk[r + 1] - runs.firstChunk[r]);
+  if (runs.points[runs.firstChunk[r]] > runBudget(state.layout, options)) {
+    stats.streamedChunks += 1;
+    return streamDenseChunk(state.layout, chunks.front(), runPath(workDirectory, r), options,
+                            state.hasColors, sink, progress);
+  }
+  Result<std::vector<CloudRecord>> records = readRecords(runPath(workDirectory, r));
+  if (!records) return records.status();
+  return makeChunks(state.layout, *records, chunks, options, state.hasColors, sink, progress,
+                    nullptr);
+}
+
+// Every run in chunk order: a run whose pieces an earlier reconstruction kept is replayed, the
+// others are made (and their pieces kept when the reconstruction can be resumed).
+Status makeRuns(const ReconstructState& state, const std::string& workDirectory,
+                const ReconstructOptions& options, PieceSink& sink, ReconstructStats& stats) {
+  Progress progress("reconstruct: chunks", state.runs.chunks.size());
+  std::error_code error;
+  for (std::size_t r = 0; r < state.runs.runCount(); ++r) {
+    const std::string kept = piecesPath(workDirectory, r);
+    if (options.resume && std::filesystem::exists(kept, error)) {
+      LODFORGE_TRY(replayPieces(kept, sink));
+      stats.resumedRuns += 1;
+      progress.advance(state.runs.firstChunk[r + 1] - state.runs.firstChunk[r]);
+      continue;
+    }
+    std::optional<PieceWriter> writer;
+    if (options.resumable) {
+      Result<PieceWriter> created = PieceWriter::create(kept);
+      if (!created) return created.status();
+      writer.emplace(std::move(*created));
+    }
+    KeptPieces tee(sink, writer ? &*writer : nullptr);
+    LODFORGE_TRY(makeRun(state, r, workDirectory, options, tee, progress, stats));
+    if (writer) LODFORGE_TRY(writer->finish());
     std::filesystem::remove(runPath(workDirectory, r), error);
-    const std::span<const std::uint64_t> chunks(runs->chunks.data() + runs->firstChunk[r],
-                                                runs->firstChunk[r + 1] - runs->firstChunk[r]);
-    LODFORGE_TRY(
-        makeChunks(*layout, *records, chunks, options, cloud->hasColors, sink, progress, nullptr));
   }
   progress.finish();
+  return {};
+}
+
+}  // namespace
+
+Result<ReconstructStats> reconstructPieces(const std::string& input,
+                                           const std::string& workDirectory,
+                                           const ReconstructOptions& options, PieceSink& sink) {
+  const std::string statePath = reconstructStatePath(workDirectory);
+  const nlohmann::json identity = reconstructIdentity(input, options);
+  std::optional<ReconstructState> state;
+  if (options.resume) state = loadReconstructState(statePath, identity);
+  if (!state) {
+    LODFORGE_TRY(forgetEarlierRuns(workDirectory));
+    Result<ReconstructState> sorted = sortIntoRuns(input, workDirectory, options);
+    if (!sorted) return sorted.status();
+    if (options.resumable) LODFORGE_TRY(saveReconstructState(statePath, identity, *sorted));
+    state = std::move(*sorted);
+  }
+  ReconstructStats stats;
+  stats.grid = state->layout.grid;
+  stats.chunkVoxels = state->layout.n;
+  stats.points = state->points;
+  stats.chunks = state->layout.chunkCount();
+  stats.runs = state->runs.runCount();
+  stats.hasColors = state->hasColors;
+  stats.estimatedNormals = state->estimatedNormals;
+  LODFORGE_TRY(sink.begin(state->layout, state->hasColors));
+  LODFORGE_TRY(makeRuns(*state, workDirectory, options, sink, stats));
   return stats;
 }
 
@@ -368,9 +516,17 @@ Status noSurface(const std::string& input, double voxel) {
                                      voxel));
 }
 
+std::string reconstructWorkDirectory(const std::string& output) {
+  return output + ".work";
+}
+
 Result<ReconstructStats> reconstructToFile(const std::string& input, const std::string& output,
                                            const ReconstructOptions& options) {
-  ScopedDirectory work(temporaryPathFor(output + ".work"));
+  // A resumable reconstruction's work has a stable name, claimed before it is ours to remove.
+  const std::string workPath =
+      options.resumable ? reconstructWorkDirectory(output) : temporaryPathFor(output + ".work");
+  if (options.resumable) LODFORGE_TRY(claimWorkDirectory(workPath));
+  ScopedDirectory work(workPath);
   std::error_code error;
   std::filesystem::create_directories(work.path, error);
   if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
@@ -378,7 +534,11 @@ Result<ReconstructStats> reconstructToFile(const std::string& input, const std::
   if (!mesh) return mesh.status();
   PieceJoiner joiner(options.minTriangles, **mesh);
   Result<ReconstructStats> stats = reconstructPieces(input, work.path, options, joiner);
-  if (!stats) return stats;
+  if (!stats) {
+    // Interrupted or failed once the points were sorted: the work stays for --resume.
+    if (std::filesystem::exists(reconstructStatePath(work.path), error)) work.path.clear();
+    return stats;
+  }
   stats->vertices = joiner.vertices();
   stats->triangles = joiner.triangles();
   stats->droppedPieces = joiner.droppedPieces();

@@ -37,6 +37,13 @@ struct ReconstructOptions {
   std::uint64_t runPoints = 0;     // points a run of chunks holds; 0: from the memory limit
   std::uint64_t minTriangles = 0;  // connected pieces with fewer triangles are dropped
   bool salvageTruncated = false;
+  // Keep in the work directory what lets an interrupted reconstruction go on (resume_state.h):
+  // the state after the points are sorted into runs, and each finished run's pieces.
+  bool resumable = false;
+  // Go on from such work when it was made from the same input and options.
+  bool resume = false;
+  // Names what `transform` does (a CRS), for the resume identity.
+  std::string placement;
   // Applied to every input point before anything else (a CRS to a local frame, in metres);
   // false: the point cannot be placed, which is bad input. Given normals turn with it.
   std::function<bool(Vec3d, Vec3d&)> transform;
@@ -50,6 +57,8 @@ struct ReconstructStats {
   std::uint32_t chunkVoxels = 0;
   std::uint64_t points = 0, chunks = 0, runs = 0, vertices = 0, triangles = 0;
   std::uint64_t droppedPieces = 0;
+  std::uint64_t streamedChunks = 0;  // chunks denser than a run, streamed from their run file
+  std::uint64_t resumedRuns = 0;     // runs whose pieces an interrupted reconstruction kept
   bool estimatedNormals = false;
   bool hasColors = false;  // the points had colours, and so do the vertices
 };
@@ -72,8 +81,13 @@ Result<ReconstructStats> reconstructPieces(const std::string& input,
 // Bad input: no surface came out of `input` at `voxel`, and what might make one.
 Status noSurface(const std::string& input, double voxel);
 
+// Where a resumable reconstructToFile keeps its work: beside the output, a stable name.
+std::string reconstructWorkDirectory(const std::string& output);
+
 // Reads `input` (any point format) and writes the surface to `output` as binary PLY, out of
 // core: the pieces joined by vertex name. No surface at all is bad input (nothing written).
+// With options.resumable, an interruption after the points are sorted keeps the work directory
+// (reconstructWorkDirectory) for options.resume.
 Result<ReconstructStats> reconstructToFile(const std::string& input, const std::string& output,
                                            const ReconstructOptions& options);
 

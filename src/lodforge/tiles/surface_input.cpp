@@ -8,6 +8,7 @@
 
 #include "lodforge/core/directory.h"
 #include "lodforge/surface/layout.h"
+#include "lodforge/surface/resume_state.h"
 
 namespace lodforge {
 
@@ -95,6 +96,16 @@ class LeafChunkSink : public PieceSink {
 
 }  // namespace
 
+std::string surfaceWorkDirectory(const std::string& tilesWorkDirectory) {
+  return tilesWorkDirectory + "/surface";
+}
+
+bool surfaceWorkKept(const std::string& tilesWorkDirectory) {
+  std::error_code ignored;
+  return std::filesystem::exists(reconstructStatePath(surfaceWorkDirectory(tilesWorkDirectory)),
+                                 ignored);
+}
+
 Result<ChunkInput> surfaceChunkInput(const std::string& path, const ChunkInputOptions& options,
                                      ReconstructOptions reconstruct, ReconstructStats& stats) {
   reconstruct.transform = options.transform;
@@ -102,13 +113,16 @@ Result<ChunkInput> surfaceChunkInput(const std::string& path, const ChunkInputOp
   // The chunk store's buffer is held beside the reconstruction.
   if (reconstruct.memoryLimit > 0)
     reconstruct.memoryLimit -= std::min(reconstruct.memoryLimit / 2, options.chunkBufferBytes);
-  ScopedDirectory work(options.workDirectory + "/surface");
+  ScopedDirectory work(surfaceWorkDirectory(options.workDirectory));
   std::error_code error;
   std::filesystem::create_directories(work.path, error);
   if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
   LeafChunkSink sink(options, reconstruct.minTriangles);
   Result<ReconstructStats> made = reconstructPieces(path, work.path, reconstruct, sink);
-  if (!made) return made.status();
+  if (!made) {
+    if (surfaceWorkKept(options.workDirectory)) work.path.clear();
+    return made.status();
+  }
   stats = *made;
   stats.triangles = sink.triangles();
   stats.droppedPieces = sink.droppedPieces();

@@ -13,6 +13,12 @@
 
 namespace lodforge {
 
+// Where the reconstruction keeps its work in the tiles' work directory: kept when it is
+// interrupted after the points are sorted, for --resume (reconstruct.resume).
+std::string surfaceWorkDirectory(const std::string& tilesWorkDirectory);
+// Whether that holds an interrupted reconstruction's work.
+bool surfaceWorkKept(const std::string& tilesWorkDirectory);
+
 // The chunks of `path`'s surface (work files under options.workDirectory). options.transform
 // places the points; options.chunkBufferBytes and keepInMemory are the chunk store's.
 // `stats` receives the reconstruction's figures. No surface at all is bad input.

@@ -41,8 +41,7 @@ struct WorkPlace {
   bool done = false;
   ~WorkPlace() {
     std::error_code ignored;
-    if (!done && fs::exists(workStatePath(work.path), ignored))
-      staging.path.clear(), work.path.clear();
+    if (!done && tilesWorkKept(work.path)) staging.path.clear(), work.path.clear();
   }
 };
 
@@ -52,6 +51,7 @@ Status prepareWorkPlace(const WorkPlace& place, bool keepEarlierWork) {
   if (!keepEarlierWork) {
     fs::remove_all(place.staging.path, error);
     fs::remove_all(place.work.path + "/nodes", error);
+    fs::remove_all(place.work.path + "/chunks", error);  // chunk files are appended to
     fs::remove(workStatePath(place.work.path), error);
   }
   fs::create_directories(fs::path(place.staging.path) / "tiles", error);
@@ -121,6 +121,16 @@ nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
           {"surface", surfaceIdentity(options.surface)}};
 }
 
+// The reconstruction's options for --surface: it keeps its work for --resume too (the CRS that
+// places the points is part of what it depends on).
+ReconstructOptions resumableSurface(const TilesOptions& options, const ChunkInputOptions& input) {
+  ReconstructOptions surface = *options.surface;
+  surface.resumable = !input.keepInMemory;
+  surface.resume = options.resume;
+  surface.placement = options.crs;
+  return surface;
+}
+
 // Streams the input into the chunk grid, or takes the chunks of an interrupted run.
 Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& options,
                                  const ChunkInputOptions& input, const OctreeOptions& octree,
@@ -136,8 +146,9 @@ Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& op
   }
   LODFORGE_TRY(prepareWorkPlace(place, false));
   Result<ChunkInput> fresh =
-      options.surface ? surfaceChunkInput(path, input, *options.surface, surface.emplace())
-                      : chunkInput(path, input);
+      options.surface
+          ? surfaceChunkInput(path, input, resumableSurface(options, input), surface.emplace())
+          : chunkInput(path, input);
   if (!fresh) return crs.error.ok() ? fresh.status() : crs.error;
   if (options.origin) fresh->frame = eastNorthUpToEcef(*options.origin);
   if (crs.transform) fresh->frame = crs.transform->localToEcef();
@@ -181,6 +192,11 @@ void countTiles(const OctreeResult& tree, TilesStats& stats) {
 }
 
 }  // namespace
+
+bool tilesWorkKept(const std::string& workDirectory) {
+  std::error_code ignored;
+  return fs::exists(workStatePath(workDirectory), ignored) || surfaceWorkKept(workDirectory);
+}
 
 std::string tilesWorkDirectory(const std::string& outputDirectory) {
   return outputDirectory + ".work";

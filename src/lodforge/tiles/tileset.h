@@ -61,6 +61,9 @@ struct TilesStats {
 // Where `lodforge tiles -o OUT` works: OUT.work holds the work files and the tileset being
 // staged, under a stable name so that --resume finds it.
 std::string tilesWorkDirectory(const std::string& outputDirectory);
+// Whether that work directory holds what --resume goes on from (finished chunks, or an
+// interrupted surface reconstruction's runs).
+bool tilesWorkKept(const std::string& workDirectory);
 
 // `lodforge tiles`: the whole pipeline into `outputDirectory` (written under a temporary name
 // and renamed when complete).

@@ -1,0 +1,125 @@
+#include "lodforge/surface/resume_state.h"
+
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "lodforge/core/progress.h"
+
+namespace lodforge {
+
+namespace {
+
+constexpr int kStateFormat = 1;
+
+struct PieceHeader {
+  std::uint64_t chunk = 0, vertices = 0, indices = 0, colors = 0;
+};
+
+template <class T>
+bool readArray(std::FILE* file, std::vector<T>& values, std::uint64_t count) {
+  values.resize(static_cast<std::size_t>(count));
+  return std::fread(values.data(), sizeof(T), values.size(), file) == values.size();
+}
+
+}  // namespace
+
+std::string reconstructStatePath(const std::string& workDirectory) {
+  return workDirectory + "/reconstruct.json";
+}
+
+Status saveReconstructState(const std::string& path, const nlohmann::json& identity,
+                            const ReconstructState& state) {
+  const VoxelGrid& grid = state.layout.grid;
+  const nlohmann::json json = {{"format", kStateFormat},
+                               {"identity", identity},
+                               {"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
+                               {"voxel", grid.voxel},
+                               {"corners", grid.corners},
+                               {"chunkVoxels", state.layout.n},
+                               {"chunks", state.layout.chunks},
+                               {"runChunks", state.runs.chunks},
+                               {"runPoints", state.runs.points},
+                               {"firstChunk", state.runs.firstChunk},
+                               {"points", state.points},
+                               {"hasColors", state.hasColors},
+                               {"estimatedNormals", state.estimatedNormals}};
+  return OutputFile::writeWhole(path, json.dump());
+}
+
+std::optional<ReconstructState> loadReconstructState(const std::string& path,
+                                                     const nlohmann::json& identity) {
+  Result<std::string> text = readFileToString(path, std::uint64_t{1} << 30);
+  if (!text) return std::nullopt;
+  try {
+    const nlohmann::json json = nlohmann::json::parse(*text);
+    if (json.at("format") != kStateFormat || json.at("identity") != identity) return std::nullopt;
+    ReconstructState state;
+    const auto& origin = json.at("origin");
+    state.layout.grid.origin = {origin.at(0).get<double>(), origin.at(1).get<double>(),
+                                origin.at(2).get<double>()};
+    state.layout.grid.voxel = json.at("voxel").get<double>();
+    state.layout.grid.corners = json.at("corners").get<std::array<std::uint64_t, 3>>();
+    state.layout.n = json.at("chunkVoxels").get<std::uint32_t>();
+    state.layout.chunks = json.at("chunks").get<std::array<std::uint64_t, 3>>();
+    state.runs.chunks = json.at("runChunks").get<std::vector<std::uint64_t>>();
+    state.runs.points = json.at("runPoints").get<std::vector<std::uint64_t>>();
+    state.runs.firstChunk = json.at("firstChunk").get<std::vector<std::size_t>>();
+    state.points = json.at("points").get<std::uint64_t>();
+    state.hasColors = json.at("hasColors").get<bool>();
+    state.estimatedNormals = json.at("estimatedNormals").get<bool>();
+    if (state.runs.firstChunk.empty() || state.runs.firstChunk.back() != state.runs.chunks.size() ||
+        state.runs.points.size() != state.runs.chunks.size())
+      return std::nullopt;
+    return state;
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;
+  }
+}
+
+std::string piecesPath(const std::string& workDirectory, std::size_t run) {
+  return fmt::format("{}/run-{}.pieces", workDirectory, run);
+}
+
+Result<PieceWriter> PieceWriter::create(const std::string& path) {
+  Result<OutputFile> file = OutputFile::create(path, 1 << 20);
+  if (!file) return file.status();
+  return PieceWriter(std::move(*file));
+}
+
+Status PieceWriter::add(std::uint64_t chunk, const SurfacePiece& piece) {
+  const PieceHeader header{chunk, piece.positions.size(), piece.indices.size(),
+                           piece.colors.empty() ? 0u : 1u};
+  LODFORGE_TRY(file_.write(&header, sizeof header));
+  LODFORGE_TRY(file_.writeSpan(std::span<const Vec3d>(piece.positions)));
+  LODFORGE_TRY(file_.writeSpan(std::span<const Vec3f>(piece.normals)));
+  LODFORGE_TRY(file_.writeSpan(std::span<const Rgba8>(piece.colors)));
+  LODFORGE_TRY(file_.writeSpan(std::span<const std::uint64_t>(piece.edges)));
+  return file_.writeSpan(std::span<const std::uint32_t>(piece.indices));
+}
+
+Status replayPieces(const std::string& path, PieceSink& sink) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) return ioErrorFromErrno(path, "open");
+  Status status;
+  SurfacePiece piece;
+  for (PieceHeader header; status.ok() && std::fread(&header, sizeof header, 1, file) == 1;) {
+    const bool whole = header.vertices < (std::uint64_t{1} << 32) &&
+                       header.indices < (std::uint64_t{1} << 34) &&
+                       readArray(file, piece.positions, header.vertices) &&
+                       readArray(file, piece.normals, header.vertices) &&
+                       readArray(file, piece.colors, header.colors ? header.vertices : 0) &&
+                       readArray(file, piece.edges, header.vertices) &&
+                       readArray(file, piece.indices, header.indices);
+    status = whole ? sink.add(header.chunk, piece)
+                   : Error{ErrorKind::kIo, fmt::format("{}: damaged (delete the work directory "
+                                                       "and start again)",
+                                                       path)};
+    if (status.ok()) status = checkCancelled();
+  }
+  if (status.ok() && std::ferror(file)) status = ioError(path, "read failed");
+  std::fclose(file);
+  return status;
+}
+
+}  // namespace lodforge

@@ -1,5 +1,6 @@
 #include "lodforge/surface/chunk_piece.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -37,10 +38,11 @@ std::vector<CloudRecord> wavySheet(std::size_t n, std::uint64_t seed) {
   return records;
 }
 
-ChunkLayout layoutOf(const std::vector<CloudRecord>& records, const DistanceOptions& distance) {
+ChunkLayout layoutOf(const std::vector<CloudRecord>& records, const DistanceOptions& distance,
+                     std::uint32_t chunkVoxels) {
   Aabbd bounds;
   for (const CloudRecord& r : records) bounds.add(r.position);
-  Result<ChunkLayout> layout = layOutChunks(bounds, 0.25, 12, distance.radius, "sheet");
+  Result<ChunkLayout> layout = layOutChunks(bounds, 0.25, chunkVoxels, distance.radius, "sheet");
   EXPECT_TRUE(layout.ok());
   return *layout;
 }
@@ -76,39 +78,46 @@ TEST(ChunkPiece, StreamedFromItsFileIsTheSameAsHeldInMemory) {
   test::TempDir dir;
   const std::vector<CloudRecord> records = wavySheet(60'000, 3);
   const DistanceOptions distance;
-  const ChunkLayout layout = layoutOf(records, distance);
-  ASSERT_GT(layout.chunkCount(), 8u);
-  std::size_t checked = 0, vertices = 0;
-  for (std::uint64_t chunk = 0; chunk < layout.chunkCount(); ++chunk) {
-    const std::vector<std::uint32_t> members = membersOf(layout, chunk, records, distance.radius);
-    if (members.empty()) continue;
-    const SurfacePiece held = heldChunkPiece(layout, chunk, members, records, distance, true);
-    const std::string file = dir.file(fmt::format("chunk-{}.points", chunk));
-    Result<RecordWriter> writer = RecordWriter::create(file);
-    ASSERT_TRUE(writer.ok());
-    for (const std::uint32_t m : members) ASSERT_TRUE(writer->add(records[m]).ok());
-    ASSERT_TRUE(writer->finish().ok());
-    for (const int threads : {1, 3}) {
-      tbb::task_arena arena(threads);
-      Result<SurfacePiece> streamed =
-          arena.execute([&] { return streamedChunkPiece(layout, chunk, file, distance, true); });
-      ASSERT_TRUE(streamed.ok()) << streamed.error().message;
-      expectSamePiece(held, *streamed);
-    }
-    for (std::size_t v = 0; v < held.positions.size(); v += 7) {
-      std::uint32_t best = 0;
-      double best2 = std::numeric_limits<double>::infinity();
-      for (const std::uint32_t m : members) {
-        const Vec3d d = records[m].position - held.positions[v];
-        if (dot(d, d) < best2) best = m, best2 = dot(d, d);
+  // Chunks of 12 voxels (many chunks, each file one block) and of 64 (the sheet in a few
+  // chunks, files of several blocks).
+  for (const std::uint32_t n : {12u, 64u}) {
+    const ChunkLayout layout = layoutOf(records, distance, n);
+    std::size_t checked = 0, vertices = 0, largest = 0;
+    for (std::uint64_t chunk = 0; chunk < layout.chunkCount(); ++chunk) {
+      const std::vector<std::uint32_t> members = membersOf(layout, chunk, records, distance.radius);
+      if (members.empty()) continue;
+      largest = std::max(largest, members.size());
+      const SurfacePiece held = heldChunkPiece(layout, chunk, members, records, distance, true);
+      const std::string file = dir.file(fmt::format("chunk-{}-{}.points", n, chunk));
+      Result<RecordWriter> writer = RecordWriter::create(file);
+      ASSERT_TRUE(writer.ok());
+      for (const std::uint32_t m : members) ASSERT_TRUE(writer->add(records[m]).ok());
+      ASSERT_TRUE(writer->finish().ok());
+      for (const int threads : {1, 3}) {
+        tbb::task_arena arena(threads);
+        Result<SurfacePiece> streamed =
+            arena.execute([&] { return streamedChunkPiece(layout, chunk, file, distance, true); });
+        ASSERT_TRUE(streamed.ok()) << streamed.error().message;
+        expectSamePiece(held, *streamed);
       }
-      ASSERT_EQ(held.colors[v], records[best].color) << chunk << ' ' << v;
+      for (std::size_t v = 0; v < held.positions.size(); v += 7) {
+        std::uint32_t best = 0;
+        double best2 = std::numeric_limits<double>::infinity();
+        for (const std::uint32_t m : members) {
+          const Vec3d d = records[m].position - held.positions[v];
+          if (dot(d, d) < best2) best = m, best2 = dot(d, d);
+        }
+        ASSERT_EQ(held.colors[v], records[best].color) << chunk << ' ' << v;
+      }
+      vertices += held.positions.size();
+      ++checked;
     }
-    vertices += held.positions.size();
-    ++checked;
+    EXPECT_GT(checked, n == 12 ? 8u : 0u);
+    EXPECT_GT(vertices, 10'000u);
+    if (n == 64) {
+      EXPECT_GT(largest, 40'000u);  // more than a block of the file (32 K records)
+    }
   }
-  EXPECT_GT(checked, 8u);
-  EXPECT_GT(vertices, 10'000u);
 }
 
 }  // namespace

@@ -60,6 +60,13 @@ TEST(ResumeState, PiecesComeBackAsWrittenAndACutFileIsAnError) {
     EXPECT_EQ(back.pieces[i].edges, written[i].edges);
     EXPECT_EQ(back.pieces[i].indices, written[i].indices);
   }
+  // A header whose counts the file cannot hold allocates nothing and is an error.
+  const std::uint64_t huge[4] = {0, std::uint64_t{1} << 40, std::uint64_t{1} << 40, 1};
+  test::writeFile(dir.file("huge.pieces"),
+                  std::string_view(reinterpret_cast<const char*>(huge), sizeof huge));
+  Recorder none;
+  EXPECT_FALSE(replayPieces(dir.file("huge.pieces"), none).ok());
+  EXPECT_TRUE(none.pieces.empty());
   std::filesystem::resize_file(path, std::filesystem::file_size(path) - 5);
   Recorder cut;
   const Status status = replayPieces(path, cut);
@@ -97,6 +104,15 @@ TEST(ResumeState, TheStateComesBackOnlyForTheSameIdentity) {
   EXPECT_TRUE(back->hasColors);
   EXPECT_FALSE(back->estimatedNormals);
   EXPECT_FALSE(loadReconstructState(path, {{"input", "/a/b.laz"}, {"voxel", 0.8}}).has_value());
+  ReconstructState odd = state;  // runs that do not start at the first chunk
+  odd.runs.firstChunk = {1, 2, 4};
+  ASSERT_TRUE(saveReconstructState(path, identity, odd).ok());
+  EXPECT_FALSE(loadReconstructState(path, identity).has_value());
+  odd = state;  // a chunk outside the lattice
+  odd.runs.chunks.back() = 5 * 6 * 7;
+  ASSERT_TRUE(saveReconstructState(path, identity, odd).ok());
+  EXPECT_FALSE(loadReconstructState(path, identity).has_value());
+  ASSERT_TRUE(saveReconstructState(path, identity, state).ok());
   test::writeFile(path, test::readFile(path).substr(0, 40));
   EXPECT_FALSE(loadReconstructState(path, identity).has_value());
 }

@@ -372,9 +372,15 @@ nlohmann::json reconstructIdentity(const std::string& input, const ReconstructOp
 Status forgetEarlierRuns(const std::string& workDirectory) {
   std::error_code error;
   std::filesystem::remove(reconstructStatePath(workDirectory), error);
-  for (std::size_t r = 0; !error && std::filesystem::exists(piecesPath(workDirectory, r), error);
-       ++r)
-    std::filesystem::remove(piecesPath(workDirectory, r), error);
+  std::vector<std::filesystem::path> pieces;  // run-R.pieces and their temporaries
+  for (std::filesystem::directory_iterator at(workDirectory, error), end; !error && at != end;
+       at.increment(error)) {
+    const std::string name = at->path().filename().string();
+    if (name.starts_with("run-") && name.find(".pieces") != std::string::npos)
+      pieces.push_back(at->path());
+  }
+  for (const std::filesystem::path& path : pieces)
+    if (!error) std::filesystem::remove(path, error);
   if (error) return ioError(workDirectory, fmt::format("cannot clear: {}", error.message()));
   return {};
 }
@@ -432,7 +438,7 @@ class KeptPieces : public PieceSink {
   PieceWriter* writer_;
 };
 
-// One run's chunks: held in memory, or the one chunk of a run denser than a run may hold streamed
+// One run's chunks: held in memory, or a run's single chunk denser than a run may hold streamed
 // from its file.
 Status makeRun(const ReconstructState& state, std::size_t r, const std::string& workDirectory,
                const ReconstructOptions& options, PieceSink& sink, Progress& progress,
@@ -440,7 +446,8 @@ Status makeRun(const ReconstructState& state, std::size_t r, const std::string& 
   const ChunkRuns& runs = state.runs;
   const std::span<const std::uint64_t> chunks(runs.chunks.data() + runs.firstChunk[r],
                                               runs.firstChunk[r + 1] - runs.firstChunk[r]);
-  if (runs.points[runs.firstChunk[r]] > runBudget(state.layout, options)) {
+  // (The runs may have been cut with another budget, by an earlier run this one resumes.)
+  if (chunks.size() == 1 && runs.points[runs.firstChunk[r]] > runBudget(state.layout, options)) {
     stats.streamedChunks += 1;
     return streamDenseChunk(state.layout, chunks.front(), runPath(workDirectory, r), options,
                             state.hasColors, sink, progress);
@@ -488,7 +495,8 @@ Result<ReconstructStats> reconstructPieces(const std::string& input,
   const std::string statePath = reconstructStatePath(workDirectory);
   const nlohmann::json identity = reconstructIdentity(input, options);
   std::optional<ReconstructState> state;
-  if (options.resume) state = loadReconstructState(statePath, identity);
+  // (Only work kept for resuming has its pieces: without them, the run files are gone.)
+  if (options.resume && options.resumable) state = loadReconstructState(statePath, identity);
   if (!state) {
     LODFORGE_TRY(forgetEarlierRuns(workDirectory));
     Result<ReconstructState> sorted = sortIntoRuns(input, workDirectory, options);
@@ -534,17 +542,22 @@ Result<ReconstructStats> reconstructToFile(const std::string& input, const std::
   if (!mesh) return mesh.status();
   PieceJoiner joiner(options.minTriangles, **mesh);
   Result<ReconstructStats> stats = reconstructPieces(input, work.path, options, joiner);
-  if (!stats) {
-    // Interrupted or failed once the points were sorted: the work stays for --resume.
-    if (std::filesystem::exists(reconstructStatePath(work.path), error)) work.path.clear();
-    return stats;
+  Status finished = stats.status();
+  if (stats) {
+    stats->vertices = joiner.vertices();
+    stats->triangles = joiner.triangles();
+    stats->droppedPieces = joiner.droppedPieces();
+    finished = stats->triangles == 0
+                   ? noSurface(input, stats->grid.voxel)
+                   : (*mesh)->finish(output, stats->hasColors, "lodforge reconstruct");
   }
-  stats->vertices = joiner.vertices();
-  stats->triangles = joiner.triangles();
-  stats->droppedPieces = joiner.droppedPieces();
-  if (stats->triangles == 0) return noSurface(input, stats->grid.voxel);
-  LODFORGE_TRY((*mesh)->finish(output, stats->hasColors, "lodforge reconstruct"));
-  return stats;
+  if (finished.ok()) return stats;
+  // Stopped or failed once the points were sorted (the last pass included): the work stays for
+  // --resume, unless the input itself makes no surface.
+  if (finished.error().kind != ErrorKind::kBadInput &&
+      std::filesystem::exists(reconstructStatePath(work.path), error))
+    work.path.clear();
+  return finished.error();
 }
 
 Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,

@@ -1,5 +1,6 @@
 #include "lodforge/surface/resume_state.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -20,6 +21,23 @@ template <class T>
 bool readArray(std::FILE* file, std::vector<T>& values, std::uint64_t count) {
   values.resize(static_cast<std::size_t>(count));
   return std::fread(values.data(), sizeof(T), values.size(), file) == values.size();
+}
+
+// What the reconstruction relies on in a state read back (a damaged or edited file is not
+// taken).
+bool wellFormed(const ReconstructState& state) {
+  const ChunkRuns& runs = state.runs;
+  bool ok = state.layout.n > 0 && state.layout.grid.voxel > 0 && !runs.firstChunk.empty() &&
+            runs.firstChunk.front() == 0 && runs.firstChunk.back() == runs.chunks.size() &&
+            runs.points.size() == runs.chunks.size();
+  for (std::size_t a = 0; a < 3; ++a)
+    ok = ok && state.layout.chunks[a] > 0 && state.layout.grid.corners[a] > 0;
+  for (std::size_t r = 1; ok && r < runs.firstChunk.size(); ++r)
+    ok = runs.firstChunk[r] > runs.firstChunk[r - 1];
+  for (std::size_t c = 0; ok && c < runs.chunks.size(); ++c)
+    ok = runs.chunks[c] < state.layout.chunkCount() &&
+         (c == 0 || runs.chunks[c] > runs.chunks[c - 1]);
+  return ok;
 }
 
 }  // namespace
@@ -44,7 +62,9 @@ Status saveReconstructState(const std::string& path, const nlohmann::json& ident
                                {"points", state.points},
                                {"hasColors", state.hasColors},
                                {"estimatedNormals", state.estimatedNormals}};
-  return OutputFile::writeWhole(path, json.dump());
+  // (A path that is not UTF-8 is kept with its bad bytes replaced: it then resumes nothing.)
+  return OutputFile::writeWhole(
+      path, json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 std::optional<ReconstructState> loadReconstructState(const std::string& path,
@@ -68,10 +88,7 @@ std::optional<ReconstructState> loadReconstructState(const std::string& path,
     state.points = json.at("points").get<std::uint64_t>();
     state.hasColors = json.at("hasColors").get<bool>();
     state.estimatedNormals = json.at("estimatedNormals").get<bool>();
-    if (state.runs.firstChunk.empty() || state.runs.firstChunk.back() != state.runs.chunks.size() ||
-        state.runs.points.size() != state.runs.chunks.size())
-      return std::nullopt;
-    return state;
+    return wellFormed(state) ? std::optional(std::move(state)) : std::nullopt;
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }
@@ -103,14 +120,25 @@ Status replayPieces(const std::string& path, PieceSink& sink) {
   if (!file) return ioErrorFromErrno(path, "open");
   Status status;
   SurfacePiece piece;
+  Result<std::uint64_t> bytes = fileSize(path);
+  std::uint64_t left = bytes ? *bytes : 0;
   for (PieceHeader header; status.ok() && std::fread(&header, sizeof header, 1, file) == 1;) {
-    const bool whole = header.vertices < (std::uint64_t{1} << 32) &&
-                       header.indices < (std::uint64_t{1} << 34) &&
-                       readArray(file, piece.positions, header.vertices) &&
+    // The counts fit the bytes left (a damaged header allocates nothing), the indices their
+    // vertices.
+    constexpr std::uint64_t kVertexBytes = sizeof(Vec3d) + sizeof(Vec3f) + sizeof(std::uint64_t);
+    left = left >= sizeof header ? left - sizeof header : 0;
+    const bool fits =
+        header.vertices <= left / kVertexBytes && header.indices <= left / 4 &&
+        header.vertices * (kVertexBytes + (header.colors ? 4 : 0)) + header.indices * 4 <= left;
+    if (fits)
+      left -= header.vertices * (kVertexBytes + (header.colors ? 4 : 0)) + header.indices * 4;
+    const bool whole = fits && readArray(file, piece.positions, header.vertices) &&
                        readArray(file, piece.normals, header.vertices) &&
                        readArray(file, piece.colors, header.colors ? header.vertices : 0) &&
                        readArray(file, piece.edges, header.vertices) &&
-                       readArray(file, piece.indices, header.indices);
+                       readArray(file, piece.indices, header.indices) &&
+                       std::all_of(piece.indices.begin(), piece.indices.end(),
+                                   [&](std::uint32_t i) { return i < header.vertices; });
     status = whole ? sink.add(header.chunk, piece)
                    : Error{ErrorKind::kIo, fmt::format("{}: damaged (delete the work directory "
                                                        "and start again)",

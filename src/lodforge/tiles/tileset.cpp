@@ -121,11 +121,12 @@ nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
           {"surface", surfaceIdentity(options.surface)}};
 }
 
-// The reconstruction's options for --surface: it keeps its work for --resume too (the CRS that
-// places the points is part of what it depends on).
+// The reconstruction's options for --surface: it keeps its work for --resume too, unless a CRS
+// places the points (its local frame is set up from the first point read, which a resumed
+// reconstruction does not read again).
 ReconstructOptions resumableSurface(const TilesOptions& options, const ChunkInputOptions& input) {
   ReconstructOptions surface = *options.surface;
-  surface.resumable = !input.keepInMemory;
+  surface.resumable = !input.keepInMemory && options.crs.empty();
   surface.resume = options.resume;
   surface.placement = options.crs;
   return surface;

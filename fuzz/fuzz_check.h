@@ -14,9 +14,11 @@
 
 namespace lodforge::fuzz {
 
-// A reader's error must be bad input whose message starts with `prefix` (the file's name).
+// A reader's error must be bad input, or valid input it cannot take (both exit 2), whose message
+// starts with `prefix` (the file's name).
 inline void checkError(const Error& error, const std::string& prefix) {
-  if (error.kind != ErrorKind::kBadInput || error.message.rfind(prefix, 0) != 0) {
+  const bool refused = error.kind == ErrorKind::kBadInput || error.kind == ErrorKind::kUnsupported;
+  if (!refused || error.message.rfind(prefix, 0) != 0) {
     std::fprintf(stderr, "unexpected error (kind %d): %s\n", static_cast<int>(error.kind),
                  error.message.c_str());
     std::abort();

@@ -41,6 +41,13 @@ constexpr std::uint64_t kBytesPerRunPoint = 48 + 8 + 44 + 40;
 // What the rest holds besides the runs and the grids (the join's wavefront, buffers).
 constexpr std::uint64_t kOtherBytes = std::uint64_t{48} << 20;
 
+// A run of one chunk with more points than `budget`: streamed, not read whole. (The runs may
+// have been cut with another budget, by an earlier run a resumed one takes.)
+bool isDenseRun(const ChunkRuns& runs, std::size_t r, std::uint64_t budget) {
+  return runs.firstChunk[r + 1] - runs.firstChunk[r] == 1 &&
+         runs.points[runs.firstChunk[r]] > budget;
+}
+
 // A chunk is computed with one corner of margin round it, for the gradient at its faces.
 std::uint64_t gridBytes(std::uint32_t n) {
   const std::uint64_t side = std::uint64_t{n} + 3;
@@ -323,10 +330,10 @@ Status estimateNormalsByRun(const std::string& cloudPath, const ChunkLayout& lay
   Progress progress("reconstruct: normals", runs.runCount());
   for (std::size_t r = 0; r < runs.runCount(); ++r) {
     const std::string runFile = runPath(directory, r);
-    const std::uint64_t first = runs.points[runs.firstChunk[r]];
-    if (first > budget) {
-      LODFORGE_TRY(denseChunkNormals(runFile, layout, runs.chunks[runs.firstChunk[r]], first,
-                                     budget, options, normalsPath(directory, r), paths));
+    if (isDenseRun(runs, r, budget)) {
+      LODFORGE_TRY(denseChunkNormals(runFile, layout, runs.chunks[runs.firstChunk[r]],
+                                     runs.points[runs.firstChunk[r]], budget, options,
+                                     normalsPath(directory, r), paths));
     } else {
       Result<std::vector<CloudRecord>> records = readRecords(runFile);
       if (!records) return records.status();
@@ -446,8 +453,7 @@ Status makeRun(const ReconstructState& state, std::size_t r, const std::string& 
   const ChunkRuns& runs = state.runs;
   const std::span<const std::uint64_t> chunks(runs.chunks.data() + runs.firstChunk[r],
                                               runs.firstChunk[r + 1] - runs.firstChunk[r]);
-  // (The runs may have been cut with another budget, by an earlier run this one resumes.)
-  if (chunks.size() == 1 && runs.points[runs.firstChunk[r]] > runBudget(state.layout, options)) {
+  if (isDenseRun(runs, r, runBudget(state.layout, options))) {
     stats.streamedChunks += 1;
     return streamDenseChunk(state.layout, chunks.front(), runPath(workDirectory, r), options,
                             state.hasColors, sink, progress);

@@ -237,9 +237,13 @@ Status writeOwnedNormals(std::span<const CloudRecord> records, const NormalOptio
   return out->commit();
 }
 
+// How many part files one pass over a dense run file writes (buffers of 64 KiB each: 4 MiB).
+constexpr std::uint64_t kPartFilesAtOnce = 64;
+
 // A chunk denser than a run may hold, its normals in parts: its columns cut in a × b across x
-// and y, each part read from the run file with the overlap round it (the runs' own, radius and a
-// voxel) and its owned points' normals written to a file of its own.
+// and y. The run file is split once (per kPartFilesAtOnce parts) into a file per part holding
+// the part with the overlap round it (the runs' own, radius and a voxel); then each part's
+// owned points' normals are written to a file of its own.
 Status denseChunkNormals(const std::string& runFile, const ChunkLayout& layout, std::uint64_t chunk,
                          std::uint64_t points, std::uint64_t budget,
                          const ReconstructOptions& options, const std::string& partPath,
@@ -252,38 +256,62 @@ Status denseChunkNormals(const std::string& runFile, const ChunkLayout& layout, 
       across, std::min<std::uint64_t>(layout.n, (parts + across - 1) / across)};
   const std::array<std::uint64_t, 3> at = layout.chunkAt(chunk);
   const double margin = options.distance.radius + 1;
-  // The part a point lies in along x (a = 0) or y, by its lattice coordinate in the chunk.
-  const auto partOf = [&](const Vec3d& p, std::size_t a) {
+  // A point's lattice coordinate along x (a = 0) or y, in the chunk.
+  const auto inChunk = [&](const Vec3d& p, std::size_t a) {
     const int axis = static_cast<int>(a);
-    const double g = (p[axis] - layout.grid.origin[axis]) / layout.grid.voxel -
-                     static_cast<double>(at[a] * layout.n);
+    return (p[axis] - layout.grid.origin[axis]) / layout.grid.voxel -
+           static_cast<double>(at[a] * layout.n);
+  };
+  const auto partAt = [&](double g, std::size_t a) {
     const double part = std::floor(g * static_cast<double>(cuts[a]) / layout.n);
     return static_cast<std::uint64_t>(std::clamp(part, 0.0, static_cast<double>(cuts[a] - 1)));
   };
-  const auto near = [&](const Vec3d& p, std::size_t a, std::uint64_t part) {
-    const int axis = static_cast<int>(a);
-    const double g = (p[axis] - layout.grid.origin[axis]) / layout.grid.voxel -
-                     static_cast<double>(at[a] * layout.n);
+  const auto near = [&](double g, std::size_t a, std::uint64_t part) {
     const double width = static_cast<double>(layout.n) / static_cast<double>(cuts[a]);
     return g >= static_cast<double>(part) * width - margin &&
            g <= static_cast<double>(part + 1) * width + margin;
   };
-  for (std::uint64_t i = 0; i < cuts[0]; ++i)
-    for (std::uint64_t j = 0; j < cuts[1]; ++j) {
-      std::vector<CloudRecord> records;
-      LODFORGE_TRY(forEachRecordBlock(runFile, [&](std::span<const CloudRecord> block) {
-        for (const CloudRecord& r : block)
-          if (near(r.position, 0, i) && near(r.position, 1, j)) records.push_back(r);
-        return Status{};
-      }));
-      paths.push_back(fmt::format("{}-{}-{}", partPath, i, j));
-      LODFORGE_TRY(writeOwnedNormals(
-          records, options.normals,
-          [&](const Vec3d& p) {
-            return layout.owner(p) == chunk && partOf(p, 0) == i && partOf(p, 1) == j;
-          },
-          paths.back()));
+  const std::uint64_t total = cuts[0] * cuts[1];
+  const auto recordsPath = [&](std::uint64_t part) {
+    return fmt::format("{}-{}-{}.records", partPath, part / cuts[1], part % cuts[1]);
+  };
+  for (std::uint64_t first = 0; first < total; first += kPartFilesAtOnce) {
+    const std::uint64_t last = std::min(total, first + kPartFilesAtOnce);
+    std::vector<RecordWriter> writers;
+    for (std::uint64_t part = first; part < last; ++part) {
+      Result<RecordWriter> writer = RecordWriter::create(recordsPath(part), 64 << 10);
+      if (!writer) return writer.status();
+      writers.push_back(std::move(*writer));
     }
+    LODFORGE_TRY(forEachRecordBlock(runFile, [&](std::span<const CloudRecord> block) {
+      for (const CloudRecord& r : block) {
+        const double gx = inChunk(r.position, 0), gy = inChunk(r.position, 1);
+        for (std::uint64_t i = partAt(gx - margin, 0); i <= partAt(gx + margin, 0); ++i)
+          for (std::uint64_t j = partAt(gy - margin, 1); j <= partAt(gy + margin, 1); ++j) {
+            const std::uint64_t part = i * cuts[1] + j;
+            if (part < first || part >= last || !near(gx, 0, i) || !near(gy, 1, j)) continue;
+            LODFORGE_TRY(writers[part - first].add(r));
+          }
+      }
+      return Status{};
+    }));
+    for (RecordWriter& writer : writers) LODFORGE_TRY(writer.finish());
+  }
+  for (std::uint64_t part = 0; part < total; ++part) {
+    const std::uint64_t i = part / cuts[1], j = part % cuts[1];
+    Result<std::vector<CloudRecord>> records = readRecords(recordsPath(part));
+    if (!records) return records.status();
+    std::remove(recordsPath(part).c_str());
+    paths.push_back(fmt::format("{}-{}-{}", partPath, i, j));
+    LODFORGE_TRY(writeOwnedNormals(
+        *records, options.normals,
+        [&](const Vec3d& p) {
+          return layout.owner(p) == chunk && partAt(inChunk(p, 0), 0) == i &&
+                 partAt(inChunk(p, 1), 1) == j;
+        },
+        paths.back()));
+    LODFORGE_TRY(checkCancelled());
+  }
   return {};
 }
 

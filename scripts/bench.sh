@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -407,6 +407,35 @@ surface_tiles_section() {
 }
 if [[ ${BENCH_ONLY:-} == surface-tiles ]]; then surface_tiles_section; exit 0; fi
 
+# CAD files through OpenCASCADE (issue 20): read and tessellate (`info`, which reads the whole
+# file at the default deflection) for the real samples: ../shared/data/cad and Debian's
+# occt-misc; wall time, peak RSS, parts (placed instances) and triangles per second.
+cad_section() {
+  echo
+  echo "== CAD read + tessellate ($(nproc) threads, default --deflection 0.001 of each part)"
+  printf '| %-16s | %8s | %8s | %9s | %6s | %9s | %10s | %9s | %12s |\n' file size wall "peak RSS" shapes instances triangles "parts/s" "triangles/s"
+  printf '|%s|%s|%s|%s|%s|%s|%s|%s|%s|\n' ------------------ ---------- ---------- ----------- -------- ----------- ------------ ----------- --------------
+  local samples=/usr/share/opencascade/data data=${LODFORGE_DATA:-../shared/data}
+  [[ -d $data ]] || data=/work/shared/data
+  for file in "$data/cad/as1_motor.step" "$samples/step/screw.step" "$samples/step/linkrods.step" \
+              "$samples/iges/bearing.iges" "$samples/iges/hammer.iges" "$samples/occ/Ball.brep" \
+              "$samples/occ/CrankArm.brep"; do
+    local result seconds kib
+    result=$(timed "$lodforge" -q info "$file" --json)
+    seconds=${result% *} kib=${result#* }
+    "$lodforge" -q info "$file" --json > "$work/cad-info.json"
+    local shapes instances triangles
+    shapes=$(sed -n 's/^    "shapes": \([0-9]*\).*/\1/p' "$work/cad-info.json")
+    instances=$(sed -n 's/^    "instances": \([0-9]*\).*/\1/p' "$work/cad-info.json")
+    triangles=$(sed -n 's/^  "triangles": \([0-9]*\).*/\1/p' "$work/cad-info.json")
+    printf '| %-16s | %8s | %7ss | %6d MiB | %6s | %9s | %10s | %9s | %12s |\n' "$(basename "$file")" \
+      "$(du -h "$file" | cut -f1)" "$seconds" $((kib / 1024)) "$shapes" "$instances" "$triangles" \
+      "$(awk -v n="$instances" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')" \
+      "$(awk -v n="$triangles" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')"
+  done
+}
+if [[ ${BENCH_ONLY:-} == cad ]]; then cad_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -432,5 +461,6 @@ laz_section
 potree_section
 surface_section
 surface_tiles_section
+cad_section
 render_section
 runtime_section

@@ -17,6 +17,7 @@ step "sanitizer build (ASan + UBSan)"
 scripts/build.sh asan
 step "tests (ASan + UBSan)"
 ASAN_OPTIONS=abort_on_error=1:detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  LSAN_OPTIONS=suppressions=$PWD/tests/lsan-suppressions.txt:print_suppressions=0 \
   ctest --test-dir build/asan -j"$jobs" --output-on-failure
 
 step "fuzzers (${fuzz_seconds} s each)"

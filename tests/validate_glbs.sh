@@ -3,7 +3,7 @@
 # real models in ../shared/data, the generated CAD assembly, a generated scan, levels extracted
 # from a progressive package, 3D Tiles contents (the horse, a scan, an assembly's package, point
 # clouds from a LAS, a LAZ, a COPC, a LAS with extra bytes and a PLY, and a surface
-# reconstructed from points).
+# reconstructed from points), and CAD files read through OpenCASCADE.
 # Fails on any error.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
@@ -24,12 +24,17 @@ done
 "$lodforge" -q build "$out/cad.glb" -o "$out/cad.lfp"
 "$lodforge" -q extract "$out/cad.lfp" --ratio 0.25 -o "$out/cad-lod25.glb"
 "$lodforge" -q extract "$out/cad.lfp" --ratio 0 -o "$out/cad-lod0.glb"
+# CAD files through OpenCASCADE: a coloured STEP assembly and OCCT's IGES and BREP samples.
+"$lodforge" -q convert "$data/cad/as1_motor.step" -o "$out/motor-step.glb"
+"$lodforge" -q convert /usr/share/opencascade/data/iges/bearing.iges -o "$out/bearing-iges.glb"
+"$lodforge" -q convert /usr/share/opencascade/data/occ/Ball.brep -o "$out/ball-brep.glb"
 count=$(ls "$out"/*.glb | wc -l)
-want=$(( $(ls "$data"/meshes | wc -l) + 6 ))
+want=$(( $(ls "$data"/meshes | wc -l) + 9 ))
 [[ $count -eq $want ]] || { echo "expected $want GLBs, found $count" >&2; exit 1; }
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse-tiles" --chunk-size 0.05 --no-quantization
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan-tiles" --chunk-size 60 --compress meshopt
 "$lodforge" -q tiles "$out/cad.lfp" -o "$out/cad-tiles"
+"$lodforge" -q tiles "$data/cad/as1_motor.step" -o "$out/step-tiles" --chunk-size 20
 # Point tiles: a real LAS (quantised, georeferenced) and generated points, float and meshopt.
 "$lodforge" -q tiles "$data/points/autzen_trim.las" -o "$out/autzen-tiles" --block-size 20K --tile-points 10K
 "$lodforge" -q tiles "$data/points/autzen_trim.laz" -o "$out/autzen-laz-tiles" --block-size 20K --tile-points 10K
@@ -44,4 +49,4 @@ tiles=$(ls "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb | wc -l)
 node "$here/js/validate-gltf.mjs" "$out"/*.glb "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb \
   "$out"/cad-tiles/tiles/*.glb "$out"/autzen-tiles/tiles/*.glb "$out"/points-tiles/tiles/*.glb \
   "$out"/autzen-laz-tiles/tiles/*.glb "$out"/copc-tiles/tiles/*.glb "$out"/extra-tiles/tiles/*.glb \
-  "$out"/surface-tiles/tiles/*.glb
+  "$out"/surface-tiles/tiles/*.glb "$out"/step-tiles/tiles/*.glb

@@ -1,6 +1,7 @@
 // `lodforge build INPUT -o model.lfp`: progressive meshes for every object (CAD paper §3.1).
 #include <fmt/format.h>
 
+#include "cad_options.h"
 #include "cli.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
@@ -16,10 +17,13 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
     std::string cost = "quadric";
     std::string direction = "cheaper";
     bool salvage = false;
+    CadCommand cad;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("build", "Build the progressive package (.lfp) of a model");
-  sub->add_option("INPUT", options->input, "A .ply .obj .stl .gltf or .glb model")->required();
+  sub->add_option("INPUT", options->input,
+                  "A .ply .obj .stl .gltf .glb model or a .step .iges .brep CAD file")
+      ->required();
   sub->add_option("-o,--output", options->output, "The package to write (.lfp)")->required();
   sub->add_option("--cost", options->cost,
                   "Collapse cost: quadric (Garland-Heckbert) or melax (the paper's)")
@@ -29,6 +33,7 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
                   "into higher)")
       ->check(CLI::IsMember({"cheaper", "paper"}));
   sub->add_flag("--salvage", options->salvage, "Keep what a truncated PLY holds up to the cut");
+  addCadOptions(*sub, options->cad);
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
       if (fileExtension(options->output) != "lfp")
@@ -44,6 +49,9 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
           options->direction == "paper" ? CollapseDirection::kPaper : CollapseDirection::kCheaper;
       build.memoryLimit = global.memoryLimit;
       build.read.salvageTruncated = options->salvage;
+      Result<CadReadOptions> cad = cadOptions(options->cad);
+      if (!cad) return cad.status();
+      build.read.cad = *cad;
       std::vector<std::string> warnings;
       build.read.warnings = &warnings;
       Result<BuildStats> stats = buildPackage(options->input, options->output, build);

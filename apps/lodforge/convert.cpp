@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "cad_options.h"
 #include "cli.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/mesh.h"
@@ -71,10 +72,12 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
     float weldEpsilon = 0;
     bool stlAscii = false;
     bool salvage = false;
+    CadCommand cad;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("convert", "Convert a model between formats (by extension)");
-  sub->add_option("INPUT", options->input, "A .ply .obj .stl .gltf or .glb file (or .laz/.las)")
+  sub->add_option("INPUT", options->input,
+                  "A .ply .obj .stl .gltf .glb model, a .step .iges .brep CAD file (or .laz/.las)")
       ->required();
   sub->add_option("-o,--output", options->output,
                   "A .ply .glb .obj or .stl file (or .las from .laz/.las)")
@@ -87,6 +90,7 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
   sub->add_flag("--stl-ascii", options->stlAscii, "Write ascii STL instead of binary");
   sub->add_flag("--salvage", options->salvage,
                 "Keep what a truncated PLY holds up to the cut (with a warning)");
+  addCadOptions(*sub, options->cad);
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
       const auto start = std::chrono::steady_clock::now();
@@ -101,9 +105,12 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
       LODFORGE_TRY(claimOutput(options->output, modelFileOutput(options->output),
                                std::vector<std::string>{options->input}));
       LODFORGE_TRY(checkMemory(options->input, global.memoryLimit));
+      Result<CadReadOptions> cad = cadOptions(options->cad);
+      if (!cad) return cad.status();
       std::vector<std::string> warnings;
       Result<Model> model =
-          readModel(options->input, {.salvageTruncated = options->salvage, .warnings = &warnings});
+          readModel(options->input,
+                    {.salvageTruncated = options->salvage, .warnings = &warnings, .cad = *cad});
       for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
       if (!model) return model.status();
       if (options->weld) {

@@ -1,11 +1,13 @@
 // `lodforge info FILE`: format, counts, bounds and what loading the file would cost. PLY files
 // are streamed (constant memory, any size); other formats are loaded.
 #include <chrono>
+#include <unordered_map>
 #include <unordered_set>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cad_options.h"
 #include "cli.h"
 #include "info_attributes.h"
 #include "lodforge/core/file.h"
@@ -33,6 +35,7 @@ struct Summary {
   Aabbd bounds;  // world coordinates
   std::uint64_t memoryBytes = 0;
   nlohmann::json extras;  // a PLY's other vertex properties (ExtraRanges::json)
+  nlohmann::json cad;     // a CAD file's part tree: shapes, instances, depth, names
 };
 
 Result<Summary> summarizePly(const std::string& path, bool salvage) {
@@ -72,10 +75,33 @@ Result<Summary> summarizePly(const std::string& path, bool salvage) {
   return s;
 }
 
-Result<Summary> summarizeLoaded(const std::string& path, FileFormat format) {
-  Result<Model> model = readModel(path);
+// The distinct part names in the order the tree lists them, with how often each is placed.
+nlohmann::json partNames(const Model& model) {
+  std::vector<std::string> order;
+  std::unordered_map<std::string, std::uint64_t> count;
+  for (std::size_t o = 0; o < model.objectCount(); ++o) {
+    const std::string name(model.objectName(o));
+    if (count[name]++ == 0) order.push_back(name);
+  }
+  nlohmann::json names = nlohmann::json::array();
+  for (const std::string& name : order) names.push_back({{"name", name}, {"count", count[name]}});
+  return names;
+}
+
+Result<Summary> summarizeLoaded(const std::string& path, FileFormat format,
+                                const CadReadOptions& cadOptions) {
+  std::vector<std::string> warnings;
+  CadReadStats cad;
+  Result<Model> model =
+      format == FileFormat::kCad ? readCad(path, cadOptions, &warnings, &cad) : readModel(path);
+  for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
   if (!model) return model.status();
   Summary s;
+  if (format == FileFormat::kCad)
+    s.cad = {{"shapes", cad.shapes},
+             {"instances", cad.instances},
+             {"depth", cad.depth},
+             {"parts", partNames(*model)}};
   s.format = std::string(formatName(format));
   s.vertices = model->vertexCount();
   s.triangles = model->triangleCount();
@@ -98,6 +124,7 @@ nlohmann::json toJson(const std::string& path, const Summary& s) {
       {"normals", s.normals},   {"colors", s.colors},       {"memoryBytes", s.memoryBytes}};
   if (!s.encoding.empty()) j["encoding"] = s.encoding;
   if (!s.extras.empty()) j["attributes"] = {{"extras", s.extras}};
+  if (!s.cad.empty()) j["cad"] = s.cad;
   if (!s.bounds.empty()) {
     j["bounds"] = {{"min", {s.bounds.min.x, s.bounds.min.y, s.bounds.min.z}},
                    {"max", {s.bounds.max.x, s.bounds.max.y, s.bounds.max.z}}};
@@ -127,6 +154,18 @@ void print(const std::string& path, const Summary& s) {
   }
   fmt::print("memory     {} to load\n", formatBytes(s.memoryBytes));
   if (!s.extras.empty()) printPointAttributes({{"extras", s.extras}});
+  if (s.cad.empty()) return;
+  fmt::print("parts      {} shapes placed {} times, assembly depth {}\n",
+             formatCount(s.cad["shapes"].get<std::uint64_t>()),
+             formatCount(s.cad["instances"].get<std::uint64_t>()),
+             s.cad["depth"].get<std::uint32_t>());
+  const nlohmann::json& parts = s.cad["parts"];
+  constexpr std::size_t kShown = 12;
+  for (std::size_t i = 0; i < std::min(parts.size(), kShown); ++i)
+    fmt::print("  {} x{}\n", parts[i]["name"].get<std::string>(),
+               parts[i]["count"].get<std::uint64_t>());
+  if (parts.size() > kShown)
+    fmt::print("  ... and {} more names (--json lists them all)\n", parts.size() - kShown);
 }
 
 // A progressive package: counts, levels, and what the LOD bookkeeping costs.
@@ -347,13 +386,14 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
     bool json = false;
     bool salvage = false;
     bool headerOnly = false;
+    CadCommand cad;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("info", "Print a file's format, counts, bounds and load cost");
   sub->add_option(
          "FILE", options->path,
-         "A .ply .obj .stl .gltf .glb model, a .las .xyz .txt .csv .pts point file, or a .lfp "
-         "or .lfc package")
+         "A .ply .obj .stl .gltf .glb model, a .step .iges .brep CAD file, a .las .xyz .txt .csv "
+         ".pts point file, or a .lfp or .lfc package")
       ->required();
   sub->add_flag("--json", options->json, "Print JSON instead of text");
   sub->add_flag("--header-only", options->headerOnly,
@@ -361,6 +401,7 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
                 "their fields");
   sub->add_flag("--salvage", options->salvage,
                 "Read a truncated PLY up to the cut (with a warning)");
+  addCadOptions(*sub, options->cad);
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
       LODFORGE_TRY(refuseDirectoryInput(options->path));
@@ -376,9 +417,11 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
       const FileFormat format = formatFromPath(options->path);
       Result<std::uint64_t> bytes = fileSize(options->path);
       if (!bytes) return bytes.status();
+      Result<CadReadOptions> cad = cadOptions(options->cad);
+      if (!cad) return cad.status();
       Result<Summary> summary = format == FileFormat::kPly
                                     ? summarizePly(options->path, options->salvage)
-                                    : summarizeLoaded(options->path, format);
+                                    : summarizeLoaded(options->path, format, *cad);
       if (!summary) return summary.status();
       summary->fileBytes = *bytes;
       if (options->json)

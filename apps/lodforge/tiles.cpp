@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "cad_options.h"
 #include "cli.h"
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
@@ -69,12 +70,14 @@ struct TilesCommand {
   bool salvage = false;
   bool surface = false;  // point clouds: reconstruct a surface and tile it as a mesh
   SurfaceCommand surfaceOptions;
+  CadCommand cad;
 };
 
 void addTilesOptions(CLI::App& sub, TilesCommand& options) {
   sub.add_option("INPUT", options.input,
-                 "A .ply .obj .stl .gltf or .glb mesh or assembly, an .lfp package, or a point "
-                 "cloud (.las .xyz .txt .csv .pts, or a PLY without faces)")
+                 "A .ply .obj .stl .gltf or .glb mesh or assembly, a .step .iges .brep CAD file, "
+                 "an .lfp package, or a point cloud (.las .xyz .txt .csv .pts, or a PLY without "
+                 "faces)")
       ->required();
   sub.add_option("-o,--output", options.output, "The tileset directory to write")->required();
   sub.add_option("--chunk-size", options.chunkSize,
@@ -121,6 +124,7 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
                "leaves (--chunk-size: their edge, default 64 voxels); the options marked "
                "Surface go with it");
   addSurfaceOptions(sub, options.surfaceOptions);
+  addCadOptions(sub, options.cad);
   sub.add_flag("--salvage", options.salvage,
                "Read a PLY cut short up to its last whole element (with a warning)");
   sub.add_flag("--resume", options.resume,
@@ -132,6 +136,9 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
   TilesOptions tiles;
   tiles.input.chunkSize = options.chunkSize;
   tiles.input.salvageTruncated = options.salvage;
+  Result<CadReadOptions> cad = cadOptions(options.cad);
+  if (!cad) return cad.status();
+  tiles.input.cad = *cad;
   tiles.octree.levels = options.levels;
   tiles.octree.reduction = options.reduction;
   tiles.octree.maxNormalDeviationDegrees = options.maxNormalDeviation;
@@ -242,6 +249,8 @@ Status runMeshTiles(const Global& global, const TilesCommand& options, const Til
   }
   if (stats->truncation)
     fmt::print(stderr, "lodforge: warning: {}; built from what came before\n", *stats->truncation);
+  for (const std::string& warning : stats->warnings)
+    fmt::print(stderr, "lodforge: warning: {}\n", warning);
   warnIfNotPlaced(global, tiles.origin.has_value() || !tiles.crs.empty());
   reportMeshTiles(global, options, *stats);
   return {};

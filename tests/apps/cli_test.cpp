@@ -155,17 +155,17 @@ TEST(Cli, ThreadsOptionSaysWhatItTakes) {
 
 TEST(Cli, UnknownFormatsSayWhatEachCommandReadsAndHowToBringThemIn) {
   test::TempDir dir;
-  for (const char* name : {"part.step", "part.igs", "house.ifc", "scan.e57", "cloud.pcd", "a.xyz3"})
+  for (const char* name : {"part.fbx", "part.x3d", "house.ifc", "scan.e57", "cloud.pcd", "a.xyz3"})
     test::writeFile(dir.file(name), "not read\n");
   struct Case {
     std::string args;
     std::vector<std::string> says;
   };
   for (const Case& c : {
-           Case{"info " + dir.file("part.step"),
-                {"a STEP CAD model", "tessellate it", ".las", ".lfp .lfc packages"}},
-           Case{"tiles " + dir.file("part.igs") + " -o " + dir.file("t"),
-                {"an IGES CAD model", ".glb meshes", ".las", ".lfp packages"}},
+           Case{"info " + dir.file("part.fbx"),
+                {"a mesh format", "assimp", ".las", ".lfp .lfc packages"}},
+           Case{"tiles " + dir.file("part.x3d") + " -o " + dir.file("t"),
+                {"a mesh format", ".glb meshes", ".step", ".las", ".lfp packages"}},
            Case{"build " + dir.file("house.ifc") + " -o " + dir.file("h.lfp"),
                 {"an IFC building model", "IfcConvert", ".ply .obj .stl .gltf .glb meshes"}},
            Case{"points " + dir.file("scan.e57") + " -o " + dir.file("s.lfc"),
@@ -1111,6 +1111,50 @@ TEST(CliTiles, BadInputAndArgumentsAreExitCode2AndLeaveNothing) {
       dir);
   EXPECT_EQ(o.code, 2);
   EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"cut.ply"});
+}
+
+// CAD files go wherever meshes go: info shows the part tree, convert and tiles tessellate it,
+// and a bad file or option is exit 2 leaving nothing.
+TEST(CliCad, AStepAssemblyIsDescribedConvertedAndTiled) {
+  test::TempDir dir;
+  const std::string motor = test::dataPath("cad/as1_motor.step");
+  const nlohmann::json j = info(motor, dir);
+  EXPECT_EQ(j["format"], "CAD (STEP, IGES, BREP)");
+  EXPECT_EQ(j["objects"], j["cad"]["instances"]);
+  EXPECT_LT(j["cad"]["shapes"].get<int>(), j["cad"]["instances"].get<int>());
+  EXPECT_GE(j["cad"]["depth"].get<int>(), 2);
+  EXPECT_TRUE(j["colors"].get<bool>());
+  std::uint64_t placed = 0;
+  for (const nlohmann::json& part : j["cad"]["parts"]) placed += part["count"].get<std::uint64_t>();
+  EXPECT_EQ(placed, j["objects"].get<std::uint64_t>());
+  const Outcome text = lodforge("info " + motor, dir);
+  EXPECT_NE(text.out.find("assembly depth"), std::string::npos) << text.out;
+
+  // A finer deflection, given as a length, makes more triangles.
+  Outcome o = lodforge("convert " + motor + " -o " + dir.file("coarse.glb"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  o = lodforge("convert " + motor + " -o " + dir.file("fine.glb") + " --deflection 0.02m", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_GT(info(dir.file("fine.glb"), dir)["triangles"].get<std::uint64_t>(),
+            info(dir.file("coarse.glb"), dir)["triangles"].get<std::uint64_t>());
+  EXPECT_EQ(info(dir.file("coarse.glb"), dir)["objects"], j["objects"]);
+
+  o = lodforge("tiles " + motor + " -o " + dir.file("tiles") + " --chunk-size 20", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("tiles/tileset.json")));
+
+  for (const std::string& args :
+       {"convert " + motor + " -o " + dir.file("x.glb") + " --deflection 2furlongs",
+        "info " + motor + " --code-page KOI9"}) {
+    o = lodforge(args, dir);
+    EXPECT_EQ(o.code, 2) << args << "\n" << o.err;
+  }
+  test::writeFile(dir.file("cut.step"), test::readFile(motor).substr(0, 5000));
+  o = lodforge("tiles " + dir.file("cut.step") + " -o " + dir.file("cut-tiles"), dir);
+  EXPECT_EQ(o.code, 2) << o.err;
+  EXPECT_NE(o.err.find("cut.step"), std::string::npos) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("cut-tiles")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.glb")));
 }
 
 TEST(CliTiles, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {

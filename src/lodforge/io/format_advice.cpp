@@ -14,17 +14,11 @@ struct Advice {
   std::string_view how;
 };
 
-constexpr std::string_view kCadHow =
-    "tessellate it to glTF (.glb) or STL first, e.g. with FreeCAD (File > Export) or OCCT's "
-    "DRAW, then give lodforge that file";
 constexpr std::string_view kMeshHow =
     "convert it to .ply, .obj or .glb first, e.g. with MeshLab, Blender or assimp "
     "(`assimp export IN OUT.glb`)";
 
-constexpr std::array<Advice, 9> kAdvice = {{
-    {" step stp ", "a STEP CAD model", kCadHow},
-    {" iges igs ", "an IGES CAD model", kCadHow},
-    {" brep brp ", "an OpenCASCADE B-rep", kCadHow},
+constexpr std::array<Advice, 6> kAdvice = {{
     {" ifc ", "an IFC building model",
      "convert it to glTF first, e.g. with IfcConvert (IfcOpenShell): `IfcConvert IN.ifc OUT.glb`"},
     {" off fbx dae 3ds wrl vrml x3d dxf 3mf vtk vtp ", "a mesh format", kMeshHow},

@@ -22,6 +22,7 @@ FileFormat formatFromPath(const std::string& path) {
   if (ext == "stl") return FileFormat::kStl;
   if (ext == "gltf") return FileFormat::kGltf;
   if (ext == "glb") return FileFormat::kGlb;
+  if (isCadPath(path)) return FileFormat::kCad;
   return FileFormat::kUnknown;
 }
 
@@ -37,6 +38,8 @@ std::string_view formatName(FileFormat format) {
       return "glTF";
     case FileFormat::kGlb:
       return "GLB";
+    case FileFormat::kCad:
+      return "CAD (STEP, IGES, BREP)";
     case FileFormat::kUnknown:
       break;
   }
@@ -66,6 +69,8 @@ Result<Model> readModel(const std::string& path, const ReadOptions& options) {
     case FileFormat::kGltf:
     case FileFormat::kGlb:
       return readGltf(path);
+    case FileFormat::kCad:
+      return readCad(path, options.cad, options.warnings);
     case FileFormat::kUnknown:
       break;
   }

@@ -8,10 +8,12 @@
 
 #include "lodforge/core/model.h"
 #include "lodforge/core/status.h"
+#include "lodforge/io/cad_reader.h"
 
 namespace lodforge {
 
-enum class FileFormat : std::uint8_t { kUnknown, kPly, kObj, kStl, kGltf, kGlb };
+// kCad: STEP, IGES or BREP, read through OpenCASCADE (io/cad_reader.h); never written.
+enum class FileFormat : std::uint8_t { kUnknown, kPly, kObj, kStl, kGltf, kGlb, kCad };
 
 FileFormat formatFromPath(const std::string& path);
 std::string_view formatName(FileFormat format);
@@ -22,6 +24,7 @@ struct ReadOptions {
   // Keep what a truncated PLY holds up to the cut instead of refusing it (adds a warning).
   bool salvageTruncated = false;
   std::vector<std::string>* warnings = nullptr;
+  CadReadOptions cad;  // tessellation of CAD files
 };
 
 Result<Model> readModel(const std::string& path, const ReadOptions& options = {});

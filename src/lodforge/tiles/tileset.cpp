@@ -118,7 +118,10 @@ nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
           {"origin", options.origin ? fmt::format("{},{},{}", options.origin->longitude,
                                                   options.origin->latitude, options.origin->height)
                                     : ""},
-          {"surface", surfaceIdentity(options.surface)}};
+          {"surface", surfaceIdentity(options.surface)},
+          {"cad",
+           {input.cad.deflection, input.cad.absoluteDeflection, input.cad.angleDegrees,
+            input.cad.codePage}}};
 }
 
 // The reconstruction's options for --surface: it keeps its work for --resume too, unless a CRS
@@ -173,6 +176,7 @@ Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& o
 void countChunks(const ChunkInput& chunked, TilesStats& stats) {
   stats.inputTriangles = chunked.inputTriangles;
   stats.truncation = chunked.truncation;
+  stats.warnings = chunked.warnings;
   stats.streamed = chunked.streamed;
   stats.chunkSize = chunked.chunks->grid().size;
   stats.leafTriangles = chunked.chunks->triangleCount();

@@ -43,6 +43,7 @@ struct TilesOptions {
 
 struct TilesStats {
   std::optional<std::string> truncation;  // where a salvaged input was cut short
+  std::vector<std::string> warnings;      // the reader's (a CAD part that did not mesh)
   std::uint64_t inputTriangles = 0;
   std::uint64_t leafTriangles = 0;  // after cutting at the chunk planes
   std::uint64_t tiles = 0, leaves = 0;

@@ -19,8 +19,9 @@ namespace {
 
 // A model file, or a progressive package (.lfp) at full detail: every object's mesh as it was
 // before simplification.
-Result<Model> readInputModel(const std::string& path) {
-  if (fileExtension(path) != "lfp") return readModel(path);
+Result<Model> readInputModel(const std::string& path, const CadReadOptions& cad,
+                             std::vector<std::string>& warnings) {
+  if (fileExtension(path) != "lfp") return readModel(path, {.warnings = &warnings, .cad = cad});
   Result<Package> package = Package::open(path);
   if (!package) return package.status();
   return extractModel(*package, vertexCountsForRatio(*package, 1.0));
@@ -28,7 +29,7 @@ Result<Model> readInputModel(const std::string& path) {
 
 Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& options) {
   ChunkInput input;
-  Result<Model> model = readInputModel(path);
+  Result<Model> model = readInputModel(path, options.cad, input.warnings);
   if (!model) return model.status();
   input.inputTriangles = model->triangleCount();
   if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");

@@ -15,6 +15,7 @@
 
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
+#include "lodforge/io/cad_reader.h"
 #include "lodforge/tiling/chunk_store.h"
 
 namespace lodforge {
@@ -31,6 +32,7 @@ struct ChunkInputOptions {
   // the point cannot be transformed, which is bad input.
   std::function<bool(Vec3d, Vec3d&)> transform;
   bool salvageTruncated = false;  // a PLY cut short: read up to its last whole element
+  CadReadOptions cad;             // tessellation of a CAD input
   int levels = 0;  // levels the octree must be able to build above the leaves (0: any)
 };
 
@@ -42,6 +44,7 @@ struct ChunkInput {
   bool streamed = false;       // a PLY read in two passes, never whole
   std::optional<Mat4d> frame;  // the local frame's place on Earth (ECEF), when georeferenced
   std::optional<std::string> truncation;  // where a salvaged PLY was cut short
+  std::vector<std::string> warnings;      // the reader's (a CAD part that did not mesh)
 };
 
 Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options);

@@ -1,0 +1,56 @@
+// The boundary between lodforge and its OpenCASCADE module (liblodforge_cad.so). Linking OCCT's
+// thirty libraries into every command would cost each run ~30 MiB of memory at start, so
+// cad_reader.cpp loads the module (dlopen) only when a CAD file is read. Plain standard types
+// only, no lodforge code on the module's side: it and the command are built by one compiler.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace lodforge::cad {
+
+inline constexpr int kModuleVersion = 2;  // bumped when these structs change
+inline constexpr const char* kReadSymbol = "lodforge_cad_read";
+
+struct Request {
+  std::string path;
+  double deflection = 0.001;
+  bool absoluteDeflection = false;  // metres, else a fraction of each shape's diagonal
+  double angleDegrees = 20;
+  std::string codePage;  // OCCT's read.step.codepage; empty: UTF-8
+  // Asked between shapes and inside OCCT's mesher (its user break): true stops the read.
+  bool (*cancelled)() = nullptr;
+  // Told the number of distinct shapes once, then each shape meshed (from any thread).
+  void (*shapes)(void* context, std::uint64_t total) = nullptr;
+  void (*meshed)(void* context) = nullptr;
+  void* context = nullptr;
+};
+
+struct Instance {
+  std::string name;
+  std::uint64_t firstVertex = 0, vertexCount = 0;
+  std::uint64_t firstTriangle = 0, triangleCount = 0;
+  std::uint64_t shape = 0;  // which distinct shape
+};
+
+struct Result {
+  // 0 ok; otherwise 1: bad input, 2: a bad option (usage), 3: cancelled; `error` says what
+  // (without the path)
+  int status = 0;
+  std::string error;
+  std::vector<std::string> warnings;  // without the path
+  std::vector<double> positions;      // xyz per vertex, metres (STEP, IGES) or the file's unit
+  std::vector<float> normals;         // xyz per vertex
+  std::vector<std::uint8_t> colors;   // rgba per vertex (sRGB), when `coloured`
+  bool coloured = false;
+  std::vector<std::uint32_t> indices;  // 3 per triangle, local to the instance
+  std::vector<Instance> instances;
+  std::uint64_t shapes = 0;
+  std::uint32_t depth = 0;
+};
+
+// The module's one entry point; `version` must equal kModuleVersion.
+using ReadFunction = void (*)(int version, const Request& request, Result& result);
+
+}  // namespace lodforge::cad

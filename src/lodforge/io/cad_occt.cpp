@@ -1,0 +1,433 @@
+// The OpenCASCADE module (liblodforge_cad.so, see cad_module.h): a STEP, IGES or BREP file read
+// into an XDE document, its distinct shapes tessellated once each, every placed instance's
+// triangles written out in plain arrays. Loaded by cad_reader.cpp only when a CAD file is read.
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+#include <BRepBndLib.hxx>
+#include <BRepMesh_IncrementalMesh.hxx>
+#include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
+#include <IGESCAFControl_Reader.hxx>
+#include <IGESControl_Controller.hxx>
+#include <Interface_Static.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <Message_Printer.hxx>
+#include <Message_PrinterOStream.hxx>
+#include <Message_ProgressIndicator.hxx>
+#include <Message_ProgressScope.hxx>
+#include <IMeshTools_Parameters.hxx>
+#include <RWMesh_FaceIterator.hxx>
+#include <STEPCAFControl_Reader.hxx>
+#include <STEPControl_Controller.hxx>
+#include <Standard_Failure.hxx>
+#include <TDF_Tool.hxx>
+#include <TDataStd_Name.hxx>
+#include <TDocStd_Document.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Face.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+#include <XCAFPrs_DocumentExplorer.hxx>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <sstream>
+
+#include "lodforge/io/cad_module.h"
+
+namespace lodforge::cad {
+namespace {
+
+enum class CadFormat : std::uint8_t { kNone, kStep, kIges, kBrep };
+
+// Lower-case extension without the dot.
+std::string extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  if (!ext.empty()) ext.erase(0, 1);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+CadFormat cadFormat(const std::string& path) {
+  const std::string ext = extension(path);
+  if (ext == "step" || ext == "stp") return CadFormat::kStep;
+  if (ext == "iges" || ext == "igs") return CadFormat::kIges;
+  if (ext == "brep" || ext == "brp") return CadFormat::kBrep;
+  return CadFormat::kNone;
+}
+
+// OCCT reports through its default messenger, which prints to stdout. One printer that keeps
+// the failures (and the warnings, for a reader that fails without a failure) replaces it; the
+// readers run one at a time (their statics are shared), so it is read after each.
+class KeptMessages : public Message_Printer {
+ public:
+  std::vector<std::string> take() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(kept_, {});
+  }
+
+ protected:
+  void send(const TCollection_AsciiString& text, const Message_Gravity gravity) const override {
+    if (gravity < Message_Warning) return;
+    std::lock_guard lock(mutex_);
+    if (kept_.size() < 20) kept_.emplace_back(text.ToCString());
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::vector<std::string> kept_;
+};
+
+struct Occt {
+  std::mutex reading;  // OCCT's reader statics are process-wide
+  Handle(KeptMessages) messages = new KeptMessages;
+  Occt() {
+    const Handle(Message_Messenger)& messenger = Message::DefaultMessenger();
+    messenger->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+    messenger->AddPrinter(messages);
+    STEPControl_Controller::Init();
+    IGESControl_Controller::Init();
+  }
+};
+
+Occt& occt() {
+  static Occt instance;
+  return instance;
+}
+
+std::string utf8(const TCollection_ExtendedString& text) {
+  std::string out(static_cast<std::size_t>(text.LengthOfCString()), '\0');
+  Standard_PCharacter at = out.data();
+  out.resize(static_cast<std::size_t>(text.ToUTF8CString(at)));
+  return out;
+}
+
+std::string labelName(const TDF_Label& label) {
+  Handle(TDataStd_Name) name;
+  if (label.IsNull() || !label.FindAttribute(TDataStd_Name::GetID(), name)) return {};
+  return utf8(name->Get());
+}
+
+std::string reason(std::vector<std::string> messages, std::string_view fallback) {
+  if (messages.empty()) return std::string(fallback);
+  for (std::string& m : messages) std::replace(m.begin(), m.end(), '\n', ' ');
+  return fmt::format("{} (OCCT: {})", fallback, fmt::join(messages, "; "));
+}
+
+// A failure of the read, carried to the entry point: bad input (1) or a bad option (2).
+struct Failure {
+  int status = 1;
+  std::string message;
+};
+
+Failure badFile(std::string_view what) {
+  return {1, reason(occt().messages->take(), what)};
+}
+
+// The STEP or IGES file into `doc`, lengths in metres; a failure's message, or nothing.
+std::optional<Failure> readStepOrIges(const std::string& path, CadFormat format,
+                                      const Request& request, Handle(TDocStd_Document) & doc) {
+  if (format == CadFormat::kStep) {
+    const std::string page = request.codePage.empty() ? "UTF8" : request.codePage;
+    if (!Interface_Static::SetCVal("read.step.codepage", page.c_str()))
+      return Failure{2, fmt::format("--code-page {}: not a code page OCCT knows (e.g. UTF8, "
+                                    "CP1251, CP1252, SJIS, GB)",
+                                    page)};
+    STEPCAFControl_Reader reader;
+    reader.SetColorMode(true);
+    reader.SetNameMode(true);
+    reader.SetLayerMode(true);
+    if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
+      return badFile("not a STEP file OCCT can read");
+    if (reader.NbRootsForTransfer() == 0) return badFile("a STEP file with no shape in it");
+    XCAFDoc_DocumentTool::SetLengthUnit(doc, 1.0);  // shapes in metres
+    if (!reader.Transfer(doc)) return badFile("OCCT could not transfer its shapes");
+    return {};
+  }
+  IGESCAFControl_Reader reader;
+  reader.SetColorMode(true);
+  reader.SetNameMode(true);
+  reader.SetLayerMode(true);
+  if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
+    return badFile("not an IGES file OCCT can read");
+  if (reader.NbRootsForTransfer() == 0) return badFile("an IGES file with no shape in it");
+  XCAFDoc_DocumentTool::SetLengthUnit(doc, 1.0);  // shapes in metres
+  if (!reader.Transfer(doc)) return badFile("OCCT could not transfer its shapes");
+  return {};
+}
+
+std::optional<Failure> readBrep(const std::string& path, Handle(TDocStd_Document) & doc) {
+  TopoDS_Shape shape;
+  BRep_Builder builder;
+  // BRepTools reports on std::cout, not through the messenger: kept for the error instead.
+  std::ostringstream said;
+  std::streambuf* const out = std::cout.rdbuf(said.rdbuf());
+  bool read = false;
+  try {
+    read = BRepTools::Read(shape, path.c_str(), builder);
+  } catch (...) {
+    std::cout.rdbuf(out);
+    throw;
+  }
+  std::cout.rdbuf(out);
+  if (!read || shape.IsNull()) {
+    std::string why = said.str();
+    while (!why.empty() && std::isspace(static_cast<unsigned char>(why.back()))) why.pop_back();
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    return why.empty() ? badFile("not a BREP file OCCT can read")
+                       : Failure{1, fmt::format("not a BREP file OCCT can read (OCCT: {})", why)};
+  }
+  const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+  const TDF_Label label = shapes->AddShape(shape, false);
+  TDataStd_Name::Set(
+      label, TCollection_ExtendedString(std::filesystem::path(path).stem().string().c_str(), true));
+  return {};
+}
+
+// The file into an XDE document (assembly tree, names, colours, layers).
+std::optional<Failure> readDocument(const Request& request, Handle(TDocStd_Document) & doc) {
+  const CadFormat format = cadFormat(request.path);
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+  occt().messages->take();
+  std::optional<Failure> failed = format == CadFormat::kBrep
+                                      ? readBrep(request.path, doc)
+                                      : readStepOrIges(request.path, format, request, doc);
+  if (failed) return failed;
+  TDF_LabelSequence roots;
+  XCAFDoc_DocumentTool::ShapeTool(doc->Main())->GetFreeShapes(roots);
+  if (roots.IsEmpty()) return Failure{1, "no shape in the file"};
+  return {};
+}
+
+// A placed leaf of the assembly: which shape, where, in what style, under which name.
+struct Placed {
+  std::size_t shape;  // into the distinct shapes
+  TDF_Label label;    // the shape's label (its product)
+  TopLoc_Location location;
+  XCAFPrs_Style style;
+  std::string name;
+};
+
+struct Tree {
+  std::vector<TDF_Label> shapes;  // distinct, in first-placed order
+  std::vector<Placed> placed;
+  std::uint32_t depth = 0;
+};
+
+// The leaves in the order the tree lists them; a shape placed again refers to its first entry.
+Tree walkTree(const Handle(TDocStd_Document) & doc) {
+  Tree tree;
+  std::map<std::string, std::size_t> seen;  // label entry → shape
+  for (XCAFPrs_DocumentExplorer it(doc, XCAFPrs_DocumentExplorerFlags_OnlyLeafNodes); it.More();
+       it.Next()) {
+    const XCAFPrs_DocumentNode& node = it.Current();
+    TCollection_AsciiString entry;
+    TDF_Tool::Entry(node.RefLabel, entry);
+    const auto [at, added] = seen.try_emplace(entry.ToCString(), tree.shapes.size());
+    if (added) tree.shapes.push_back(node.RefLabel);
+    std::string name = labelName(node.RefLabel);
+    if (name.empty()) name = labelName(node.Label);
+    tree.placed.push_back({at->second, node.RefLabel, node.Location, node.Style, name});
+    tree.depth = std::max(tree.depth, static_cast<std::uint32_t>(it.CurrentDepth() + 1));
+  }
+  return tree;
+}
+
+// The chord error for one shape, in the document's unit.
+double deflectionOf(const TopoDS_Shape& shape, const Request& request, double metresPerUnit) {
+  if (request.absoluteDeflection) return request.deflection / metresPerUnit;
+  Bnd_Box box;
+  BRepBndLib::Add(shape, box);
+  const double diagonal = box.IsVoid() ? 1.0 : std::sqrt(box.SquareExtent());
+  return std::max(request.deflection * diagonal, 1e-9);
+}
+
+// OCCT's mesher asks its progress indicator whether to stop: the caller's cancellation.
+class Cancellation : public Message_ProgressIndicator {
+ public:
+  explicit Cancellation(bool (*cancelled)()) : cancelled_(cancelled) {}
+  Standard_Boolean UserBreak() override { return cancelled_ && cancelled_(); }
+  void Show(const Message_ProgressScope&, const Standard_Boolean) override {}
+
+ private:
+  bool (*cancelled_)();
+};
+
+bool isCancelled(const Request& request) {
+  return request.cancelled && request.cancelled();
+}
+
+// Each distinct shape tessellated once, in parallel; a shape OCCT fails on gets the reason.
+std::vector<std::string> tessellate(const Tree& tree, const Request& request,
+                                    double metresPerUnit) {
+  std::vector<std::string> failures(tree.shapes.size());
+  const double angle = request.angleDegrees * M_PI / 180;
+  if (request.shapes) request.shapes(request.context, tree.shapes.size());
+  tbb::parallel_for(std::size_t{0}, tree.shapes.size(), [&](std::size_t s) {
+    if (isCancelled(request)) return;
+    const TopoDS_Shape shape = XCAFDoc_ShapeTool::GetShape(tree.shapes[s]);
+    try {
+      IMeshTools_Parameters parameters;
+      parameters.Deflection = deflectionOf(shape, request, metresPerUnit);
+      parameters.Angle = angle;
+      const Handle(Cancellation) cancellation = new Cancellation(request.cancelled);
+      BRepMesh_IncrementalMesh mesh(shape, parameters, cancellation->Start());
+      if (!mesh.IsDone() && !isCancelled(request)) failures[s] = "OCCT's mesher did not finish";
+      if (request.meshed) request.meshed(request.context);
+    } catch (const Standard_Failure& failure) {
+      failures[s] = fmt::format("OCCT's mesher failed: {} {}", failure.DynamicType()->Name(),
+                                failure.GetMessageString());
+    } catch (const std::exception& failure) {
+      failures[s] = fmt::format("the mesher failed: {}", failure.what());
+    }
+  });
+  return failures;
+}
+
+std::uint32_t facesWithoutTriangles(const TopoDS_Shape& shape) {
+  std::uint32_t missing = 0;
+  for (TopExp_Explorer face(shape, TopAbs_FACE); face.More(); face.Next()) {
+    TopLoc_Location location;
+    if (BRep_Tool::Triangulation(TopoDS::Face(face.Current()), location).IsNull()) ++missing;
+  }
+  return missing;
+}
+
+void pushColor(const Quantity_ColorRGBA& color, std::vector<std::uint8_t>& out) {
+  const auto byte = [](double v) {
+    return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+  };
+  // OCCT keeps colours linear; vertex colours are sRGB bytes like every other reader's.
+  Standard_Real r = 0, g = 0, b = 0;
+  color.GetRGB().Values(r, g, b, Quantity_TOC_sRGB);
+  out.insert(out.end(), {byte(r), byte(g), byte(b), byte(color.Alpha())});
+}
+
+// One placed instance's faces appended: positions in metres, normals and colours per vertex.
+void appendInstance(const Placed& placed, double metresPerUnit, Result& out) {
+  Instance instance{placed.name, out.positions.size() / 3, 0, out.indices.size() / 3, 0,
+                    placed.shape};
+  const Quantity_ColorRGBA grey(Quantity_Color(0.78, 0.78, 0.78, Quantity_TOC_sRGB));
+  for (RWMesh_FaceIterator face(placed.label, placed.location, true, placed.style); face.More();
+       face.Next()) {
+    if (face.IsEmptyMesh()) continue;
+    const std::uint64_t first = out.positions.size() / 3 - instance.firstVertex;
+    out.coloured |= face.HasFaceColor();
+    const Quantity_ColorRGBA& color = face.HasFaceColor() ? face.FaceColor() : grey;
+    for (Standard_Integer n = face.NodeLower(); n <= face.NodeUpper(); ++n) {
+      const gp_Pnt p = face.NodeTransformed(n);
+      out.positions.insert(out.positions.end(),
+                           {p.X() * metresPerUnit, p.Y() * metresPerUnit, p.Z() * metresPerUnit});
+      const gp_Dir d = face.NormalTransformed(n);
+      out.normals.insert(out.normals.end(), {static_cast<float>(d.X()), static_cast<float>(d.Y()),
+                                             static_cast<float>(d.Z())});
+      pushColor(color, out.colors);
+    }
+    const auto local = [&](Standard_Integer node) {
+      return static_cast<std::uint32_t>(first +
+                                        static_cast<std::uint64_t>(node - face.NodeLower()));
+    };
+    for (Standard_Integer t = face.ElemLower(); t <= face.ElemUpper(); ++t) {
+      Standard_Integer a = 0, b = 0, c = 0;
+      face.TriangleOriented(t).Get(a, b, c);
+      out.indices.insert(out.indices.end(), {local(a), local(b), local(c)});
+    }
+  }
+  instance.vertexCount = out.positions.size() / 3 - instance.firstVertex;
+  instance.triangleCount = out.indices.size() / 3 - instance.firstTriangle;
+  out.instances.push_back(std::move(instance));
+}
+
+// A warning for each shape OCCT could not mesh, wholly or in some faces, named by its part.
+void warnUnmeshed(const Tree& tree, const std::vector<std::string>& failures, Result& out) {
+  std::vector<bool> warned(tree.shapes.size());
+  for (const Placed& placed : tree.placed) {
+    if (warned[placed.shape]) continue;
+    warned[placed.shape] = true;
+    const std::string name = placed.name.empty() ? "(unnamed)" : placed.name;
+    if (!failures[placed.shape].empty()) {
+      out.warnings.push_back(
+          fmt::format("part \"{}\": {}; left out", name, failures[placed.shape]));
+      continue;
+    }
+    const std::uint32_t missing =
+        facesWithoutTriangles(XCAFDoc_ShapeTool::GetShape(tree.shapes[placed.shape]));
+    if (missing > 0)
+      out.warnings.push_back(
+          fmt::format("part \"{}\": {} face(s) did not mesh; left out", name, missing));
+  }
+}
+
+void read(const Request& request, Result& out) {
+  std::unique_lock lock(occt().reading);
+  Handle(TDocStd_Document) doc;
+  if (std::optional<Failure> failed = readDocument(request, doc)) {
+    out.status = failed->status;
+    out.error = failed->message;
+    if (!doc.IsNull()) XCAFApp_Application::GetApplication()->Close(doc);
+    return;
+  }
+  lock.unlock();
+  Standard_Real metresPerUnit = 1;
+  if (cadFormat(request.path) == CadFormat::kBrep ||
+      !XCAFDoc_DocumentTool::GetLengthUnit(doc, metresPerUnit) || !(metresPerUnit > 0))
+    metresPerUnit = 1;
+  const Tree tree = walkTree(doc);
+  const std::vector<std::string> failures = tessellate(tree, request, metresPerUnit);
+  if (isCancelled(request)) {
+    XCAFApp_Application::GetApplication()->Close(doc);
+    out = {};
+    out.status = 3;
+    out.error = "cancelled";
+    return;
+  }
+  for (const Placed& placed : tree.placed) appendInstance(placed, metresPerUnit, out);
+  if (!out.coloured) out.colors.clear();
+  warnUnmeshed(tree, failures, out);
+  out.shapes = tree.shapes.size();
+  out.depth = tree.depth;
+  XCAFApp_Application::GetApplication()->Close(doc);
+  if (out.indices.empty()) {
+    out.status = 1;
+    out.error =
+        tree.placed.empty() ? "no shape in the file" : "no part could be meshed (see the warnings)";
+  }
+}
+
+}  // namespace
+}  // namespace lodforge::cad
+
+// No OCCT exception leaves the module: a failure outside a part's meshing fails the read.
+extern "C" __attribute__((visibility("default"))) void lodforge_cad_read(
+    int version, const lodforge::cad::Request& request, lodforge::cad::Result& result) {
+  result = {};
+  if (version != lodforge::cad::kModuleVersion) {
+    result.status = 1;
+    result.error = fmt::format("the CAD module is version {}, lodforge wants {}",
+                               lodforge::cad::kModuleVersion, version);
+    return;
+  }
+  try {
+    lodforge::cad::read(request, result);
+  } catch (const Standard_Failure& failure) {
+    result = {};
+    result.status = 1;
+    result.error = fmt::format("OCCT failed: {} {}", failure.DynamicType()->Name(),
+                               failure.GetMessageString());
+  } catch (const std::exception& failure) {
+    result = {};
+    result.status = 1;
+    result.error = fmt::format("reading failed: {}", failure.what());
+  }
+}

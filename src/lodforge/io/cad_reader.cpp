@@ -1,0 +1,138 @@
+#include "lodforge/io/cad_reader.h"
+
+#include <dlfcn.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <mutex>
+
+#include <fmt/format.h>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/mesh.h"
+#include "lodforge/core/progress.h"
+#include "lodforge/io/cad_module.h"
+
+namespace lodforge {
+namespace {
+
+// Where the module is looked for: $LODFORGE_CAD_MODULE, beside the running program, then where
+// the build put it.
+std::vector<std::string> modulePlaces() {
+  std::vector<std::string> places;
+  if (const char* given = std::getenv("LODFORGE_CAD_MODULE")) places.emplace_back(given);
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) places.push_back((self.parent_path() / "liblodforge_cad.so").string());
+  places.emplace_back(LODFORGE_CAD_MODULE_PATH);
+  return places;
+}
+
+// The module's entry point, loaded once (never unloaded: OCCT keeps process-wide state).
+Status loadModule(cad::ReadFunction& entry) {
+  static std::once_flag once;
+  static cad::ReadFunction read = nullptr;
+  static std::string why;
+  std::call_once(once, [] {
+    for (const std::string& place : modulePlaces()) {
+      if (!std::filesystem::exists(place)) continue;
+      void* module = dlopen(place.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!module) {
+        why = dlerror();
+        continue;
+      }
+      read = reinterpret_cast<cad::ReadFunction>(dlsym(module, cad::kReadSymbol));
+      if (read) return;
+      why = fmt::format("{}: no {}", place, cad::kReadSymbol);
+    }
+    if (why.empty())
+      why = fmt::format("liblodforge_cad.so is in none of {}", fmt::join(modulePlaces(), ", "));
+  });
+  entry = read;
+  if (read) return {};
+  return Error{ErrorKind::kUnsupported,
+               fmt::format("this lodforge cannot read CAD files: its OpenCASCADE module did not "
+                           "load ({})",
+                           why)};
+}
+
+// The module's plain arrays as a Model, relative to an origin near the parts.
+Model toModel(const cad::Result& read) {
+  Model model;
+  Aabbd world;
+  for (std::size_t v = 0; v < read.positions.size(); v += 3)
+    world.add(Vec3d{read.positions[v], read.positions[v + 1], read.positions[v + 2]});
+  model.origin = chooseOrigin(world);
+  const std::size_t vertices = read.positions.size() / 3;
+  model.positions.resize(vertices);
+  model.normals.resize(vertices);
+  for (std::size_t v = 0; v < vertices; ++v) {
+    model.positions[v] =
+        toFloat(Vec3d{read.positions[3 * v], read.positions[3 * v + 1], read.positions[3 * v + 2]} -
+                model.origin);
+    model.normals[v] = {read.normals[3 * v], read.normals[3 * v + 1], read.normals[3 * v + 2]};
+  }
+  if (read.coloured) {
+    model.colors.resize(vertices);
+    for (std::size_t v = 0; v < vertices; ++v)
+      model.colors[v] = {read.colors[4 * v], read.colors[4 * v + 1], read.colors[4 * v + 2],
+                         read.colors[4 * v + 3]};
+  }
+  model.indices = read.indices;
+  model.objects.reserve(read.instances.size());
+  for (const cad::Instance& instance : read.instances) {
+    ObjectRecord object;
+    object.vertexOffset = instance.firstVertex;
+    object.triangleOffset = instance.firstTriangle;
+    object.vertexCount = static_cast<std::uint32_t>(instance.vertexCount);
+    object.triangleCount = static_cast<std::uint32_t>(instance.triangleCount);
+    object.nameOffset = model.names.size();
+    object.nameLength = static_cast<std::uint32_t>(instance.name.size());
+    model.names += instance.name;
+    object.bounds =
+        computeBounds(std::span(model.positions).subspan(object.vertexOffset, object.vertexCount));
+    model.objects.push_back(object);
+  }
+  return model;
+}
+
+}  // namespace
+
+bool isCadPath(const std::string& path) {
+  const std::string ext = fileExtension(path);
+  return ext == "step" || ext == "stp" || ext == "iges" || ext == "igs" || ext == "brep" ||
+         ext == "brp";
+}
+
+Result<Model> readCad(const std::string& path, const CadReadOptions& options,
+                      std::vector<std::string>* warnings, CadReadStats* stats) {
+  if (!(options.deflection > 0) || !std::isfinite(options.deflection))
+    return Error{ErrorKind::kUsage, "--deflection must be a positive number"};
+  if (!(options.angleDegrees > 0 && options.angleDegrees < 90))
+    return Error{ErrorKind::kUsage, "--angle must lie between 0 and 90 degrees"};
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error))
+    return ioError(path, "cannot open: no such file");
+  cad::ReadFunction module = nullptr;
+  LODFORGE_TRY(loadModule(module));
+  const cad::Request request{path, options.deflection, options.absoluteDeflection,
+                             options.angleDegrees, options.codePage};
+  cad::Result read;
+  module(cad::kModuleVersion, request, read);
+  if (warnings)
+    for (const std::string& w : read.warnings) warnings->push_back(fmt::format("{}: {}", path, w));
+  if (read.status == 2) return Error{ErrorKind::kUsage, read.error};
+  if (read.status == 3) return Error{ErrorKind::kCancelled, "cancelled"};
+  if (read.status != 0) return badInput(path, read.error);
+  for (const cad::Instance& instance : read.instances)
+    if (instance.vertexCount > std::numeric_limits<std::uint32_t>::max())
+      return Error{ErrorKind::kUnsupported,
+                   fmt::format("{}: part \"{}\" has more than 4G vertices at this deflection", path,
+                               instance.name)};
+  if (stats) *stats = {read.shapes, read.instances.size(), read.depth};
+  return toModel(read);
+}
+
+}  // namespace lodforge

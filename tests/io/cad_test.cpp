@@ -1,0 +1,288 @@
+// The CAD reader against OpenCASCADE's own reading of the same files: part counts and names
+// by an independent walk of the XDE tree, triangle counts by meshing the shape directly.
+#include <gtest/gtest.h>
+#include <BRepMesh_IncrementalMesh.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <Quantity_Color.hxx>
+#include <STEPCAFControl_Reader.hxx>
+#include <STEPCAFControl_Writer.hxx>
+#include <STEPControl_Reader.hxx>
+#include <TDataStd_Name.hxx>
+#include <TDocStd_Document.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_ColorTool.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+
+#include <functional>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "lodforge/io/cad_reader.h"
+#include "lodforge/io/model_io.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+const std::string kSamples = "/usr/share/opencascade/data";
+
+std::string occtName(const TDF_Label& label) {
+  Handle(TDataStd_Name) name;
+  if (!label.FindAttribute(TDataStd_Name::GetID(), name)) return {};
+  return TCollection_AsciiString(name->Get()).ToCString();
+}
+
+// OCCT's reading of a STEP file, walked with the shape tool (not the explorer the reader uses):
+// the product name of every placed leaf, in tree order.
+void leafNames(const TDF_Label& label, std::vector<std::string>& names) {
+  TDF_Label shape = label;
+  if (XCAFDoc_ShapeTool::IsReference(label)) XCAFDoc_ShapeTool::GetReferredShape(label, shape);
+  if (!XCAFDoc_ShapeTool::IsAssembly(shape)) {
+    names.push_back(occtName(shape));
+    return;
+  }
+  TDF_LabelSequence components;
+  XCAFDoc_ShapeTool::GetComponents(shape, components);
+  for (const TDF_Label& c : components) leafNames(c, names);
+}
+
+std::vector<std::string> occtLeafNames(const std::string& path) {
+  Handle(TDocStd_Document) doc;
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+  STEPCAFControl_Reader reader;
+  reader.SetNameMode(true);
+  EXPECT_EQ(reader.ReadFile(path.c_str()), IFSelect_RetDone);
+  EXPECT_TRUE(reader.Transfer(doc));
+  TDF_LabelSequence roots;
+  XCAFDoc_DocumentTool::ShapeTool(doc->Main())->GetFreeShapes(roots);
+  std::vector<std::string> names;
+  for (const TDF_Label& root : roots) leafNames(root, names);
+  XCAFApp_Application::GetApplication()->Close(doc);
+  return names;
+}
+
+// Triangles OCCT makes of a shape at an absolute deflection.
+std::uint64_t occtTriangles(const TopoDS_Shape& shape, double deflection, double angleDegrees) {
+  BRepMesh_IncrementalMesh mesh(shape, deflection, false, angleDegrees * M_PI / 180, false);
+  std::uint64_t triangles = 0;
+  for (TopExp_Explorer face(shape, TopAbs_FACE); face.More(); face.Next()) {
+    TopLoc_Location location;
+    const Handle(Poly_Triangulation) t =
+        BRep_Tool::Triangulation(TopoDS::Face(face.Current()), location);
+    if (!t.IsNull()) triangles += static_cast<std::uint64_t>(t->NbTriangles());
+  }
+  return triangles;
+}
+
+TEST(CadRead, AStepAssemblyHasOcctsPartsAndNamesInMetres) {
+  const std::string path = test::dataPath("cad/as1_motor.step");
+  std::vector<std::string> warnings;
+  CadReadStats stats;
+  Result<Model> model = readCad(path, {}, &warnings, &stats);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_TRUE(warnings.empty()) << warnings.front();
+  std::string why;
+  EXPECT_TRUE(isConsistent(*model, &why)) << why;
+
+  const std::vector<std::string> expected = occtLeafNames(path);
+  ASSERT_EQ(model->objectCount(), expected.size());
+  for (std::size_t o = 0; o < expected.size(); ++o)
+    EXPECT_EQ(model->objectName(o), expected[o]) << o;
+  EXPECT_EQ(stats.instances, expected.size());
+  EXPECT_LT(stats.shapes, stats.instances) << "some parts are placed more than once";
+  EXPECT_GE(stats.depth, 2u);
+
+  // Every instance of one shape has its triangles (tessellated once, placed twice).
+  std::map<std::string, std::pair<std::uint32_t, std::uint32_t>> counts;
+  for (std::size_t o = 0; o < model->objectCount(); ++o) {
+    const ObjectRecord& object = model->objects[o];
+    EXPECT_GT(object.triangleCount, 0u) << model->objectName(o);
+    const auto [at, added] = counts.try_emplace(std::string(model->objectName(o)),
+                                                object.vertexCount, object.triangleCount);
+    if (!added) {
+      EXPECT_EQ(at->second, std::make_pair(object.vertexCount, object.triangleCount))
+          << model->objectName(o);
+    }
+  }
+  // Metres, as OCCT's own conversion of the file to glTF has it (meshes/as1_motor.glb, y up):
+  // the file's coordinates are millimetres in the hundreds of thousands, a motor 209 m long.
+  Result<Model> glb = readModel(test::dataPath("meshes/as1_motor.glb"));
+  ASSERT_TRUE(glb.ok()) << glb.error().message;
+  const Vec3f size = model->bounds().size(), glbSize = glb->bounds().size();
+  EXPECT_NEAR(size.x, glbSize.x, 0.01 * glbSize.x);
+  EXPECT_NEAR(size.y, glbSize.z, 0.01 * glbSize.z);
+  EXPECT_NEAR(size.z, glbSize.y, 0.01 * glbSize.y);
+  // Its parts carry colours, and not all the same one.
+  ASSERT_TRUE(model->hasColors());
+  EXPECT_NE(model->colors.front(), model->colors.back());
+  ASSERT_TRUE(model->hasNormals());
+  for (const Vec3f& n : model->normals) ASSERT_NEAR(length(n), 1.0f, 1e-4f);
+}
+
+TEST(CadRead, TrianglesAreOcctsAtTheSameDeflection) {
+  struct Case {
+    std::string path;
+    double deflection;  // metres for STEP, the file's unit for BREP
+  };
+  for (const Case& c :
+       {Case{kSamples + "/step/screw.step", 0.0002}, Case{kSamples + "/occ/Ball.brep", 0.05}}) {
+    TopoDS_Shape shape;
+    if (c.path.ends_with(".brep")) {
+      BRep_Builder builder;
+      ASSERT_TRUE(BRepTools::Read(shape, c.path.c_str(), builder));
+    } else {
+      STEPControl_Reader reader;
+      ASSERT_EQ(reader.ReadFile(c.path.c_str()), IFSelect_RetDone);
+      reader.TransferRoots();
+      shape = reader.OneShape();
+    }
+    // OCCT reads STEP in millimetres by default.
+    const double occtDeflection = c.path.ends_with(".brep") ? c.deflection : c.deflection * 1000;
+    const std::uint64_t expected = occtTriangles(shape, occtDeflection, 20);
+    CadReadOptions options;
+    options.deflection = c.deflection;
+    options.absoluteDeflection = true;
+    Result<Model> model = readCad(c.path, options);
+    ASSERT_TRUE(model.ok()) << model.error().message;
+    EXPECT_GT(expected, 100u) << c.path;
+    EXPECT_NEAR(static_cast<double>(model->triangleCount()), static_cast<double>(expected),
+                0.02 * static_cast<double>(expected))
+        << c.path;
+    // A finer deflection makes more triangles.
+    options.deflection /= 4;
+    Result<Model> finer = readCad(c.path, options);
+    ASSERT_TRUE(finer.ok());
+    EXPECT_GT(finer->triangleCount(), model->triangleCount() * 3 / 2) << c.path;
+  }
+}
+
+TEST(CadRead, IgesAndBrepSamplesRead) {
+  for (const std::string name : {"iges/bearing.iges", "iges/hammer.iges", "occ/Ball.brep"}) {
+    Result<Model> model = readModel(kSamples + "/" + name);
+    ASSERT_TRUE(model.ok()) << model.error().message;
+    EXPECT_GT(model->triangleCount(), 500u) << name;
+    std::string why;
+    EXPECT_TRUE(isConsistent(*model, &why)) << name << ": " << why;
+  }
+  // A BREP file has no names; its part is named after the file.
+  Result<Model> ball = readModel(kSamples + "/occ/Ball.brep");
+  ASSERT_TRUE(ball.ok());
+  EXPECT_EQ(ball->objectName(0), "Ball");
+}
+
+// A STEP file of two coloured boxes named in Cyrillic, written by OCCT.
+void writeCyrillicStep(const std::string& path) {
+  Handle(TDocStd_Document) doc;
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+  const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+  const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
+  const TDF_Label box = shapes->AddShape(BRepPrimAPI_MakeBox(10, 20, 30).Shape(), false);
+  TDataStd_Name::Set(box, TCollection_ExtendedString("Корпус насоса", true));
+  colors->SetColor(box, Quantity_Color(1, 0, 0, Quantity_TOC_sRGB), XCAFDoc_ColorSurf);
+  const TDF_Label lid = shapes->AddShape(BRepPrimAPI_MakeBox(10, 20, 2).Shape(), false);
+  TDataStd_Name::Set(lid, TCollection_ExtendedString("Крышка", true));
+  STEPCAFControl_Writer writer;
+  ASSERT_TRUE(writer.Transfer(doc, STEPControl_AsIs));
+  ASSERT_EQ(writer.Write(path.c_str()), IFSelect_RetDone);
+  XCAFApp_Application::GetApplication()->Close(doc);
+}
+
+// The text with every Cyrillic letter (two-byte UTF-8, U+0410..U+044F) rewritten by `to`.
+std::string recodeCyrillic(const std::string& text,
+                           const std::function<std::string(unsigned)>& to) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if ((c == 0xD0 || c == 0xD1) && i + 1 < text.size()) {
+      const unsigned code = ((c & 0x1Fu) << 6) | (static_cast<unsigned char>(text[i + 1]) & 0x3Fu);
+      if (code >= 0x410 && code <= 0x44F) {
+        out += to(code);
+        ++i;
+        continue;
+      }
+    }
+    out.push_back(text[i]);
+  }
+  return out;
+}
+
+TEST(CadRead, CyrillicNamesArriveAsUtf8) {
+  test::TempDir dir;
+  const std::string utf8 = dir.file("pump.step");
+  writeCyrillicStep(utf8);  // OCCT writes the names as UTF-8
+  const std::string text = test::readFile(utf8);
+  ASSERT_NE(text.find("Крышка"), std::string::npos);
+  // The standard's escape: \X2\ and four hex digits of UTF-16 per letter, closed by \X0\ (one
+  // escape per letter keeps the rewrite simple; readers take runs of any length).
+  const std::string escaped = dir.file("pump-escaped.step");
+  test::writeFile(escaped, recodeCyrillic(text, [](unsigned code) {
+                    return fmt::format("\\X2\\{:04X}\\X0\\", code);
+                  }));
+  // Raw CP1251 bytes, as older Russian CAD systems write them (А..я are C0..FF).
+  const std::string legacy = dir.file("pump-cp1251.step");
+  test::writeFile(legacy, recodeCyrillic(text, [](unsigned code) {
+                    return std::string(1, static_cast<char>(0xC0 + (code - 0x410)));
+                  }));
+  CadReadOptions cp1251;
+  cp1251.codePage = "CP1251";
+  for (const auto& [path, options] :
+       {std::pair{utf8, CadReadOptions{}}, std::pair{escaped, CadReadOptions{}},
+        std::pair{legacy, cp1251}}) {
+    Result<Model> model = readCad(path, options);
+    ASSERT_TRUE(model.ok()) << model.error().message;
+    ASSERT_EQ(model->objectCount(), 2u) << path;
+    EXPECT_EQ(model->objectName(0), "Корпус насоса") << path;
+    EXPECT_EQ(model->objectName(1), "Крышка") << path;
+    ASSERT_TRUE(model->hasColors()) << path;
+    EXPECT_EQ(model->colors[model->objects[0].vertexOffset], (Rgba8{255, 0, 0, 255})) << path;
+  }
+  // Without the code page the legacy bytes are not these names.
+  Result<Model> unknown = readCad(legacy);
+  ASSERT_TRUE(unknown.ok()) << unknown.error().message;
+  EXPECT_NE(unknown->objectName(1), "Крышка");
+}
+
+TEST(CadRead, BadFilesAreBadInputNamingTheFile) {
+  test::TempDir dir;
+  const std::string screw = test::readFile(kSamples + "/step/screw.step");
+  struct Case {
+    std::string name, contents;
+  };
+  for (const Case& c : {
+           Case{"empty.step", ""},
+           Case{"garbage.step", "this is not STEP\n\x01\x02\x03"},
+           Case{"truncated.step", screw.substr(0, screw.size() / 2)},
+           Case{"no-shapes.step",
+                "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('x'),'2;1');\nFILE_NAME('x','',(''),"
+                "(''),'','','');\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\nDATA;\nENDSEC;\n"
+                "END-ISO-10303-21;\n"},
+           Case{"garbage.iges", "not IGES at all\n"},
+           Case{"garbage.brep", "DBRep_DrawableShape\ngarbage\n"},
+       }) {
+    const std::string path = dir.file(c.name);
+    test::writeFile(path, c.contents);
+    Result<Model> model = readCad(path);
+    ASSERT_FALSE(model.ok()) << c.name;
+    EXPECT_EQ(model.error().kind, ErrorKind::kBadInput) << c.name << ": " << model.error().message;
+    EXPECT_EQ(model.error().message.rfind(path + ": ", 0), 0u) << model.error().message;
+  }
+  // Bad options are usage errors.
+  CadReadOptions options;
+  options.codePage = "KOI9";
+  Result<Model> model = readCad(kSamples + "/step/screw.step", options);
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.error().kind, ErrorKind::kUsage) << model.error().message;
+  options = {};
+  options.deflection = 0;
+  EXPECT_EQ(readCad(kSamples + "/step/screw.step", options).error().kind, ErrorKind::kUsage);
+}
+
+}  // namespace
+}  // namespace lodforge

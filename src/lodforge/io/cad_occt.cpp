@@ -135,36 +135,36 @@ Failure badFile(std::string_view what) {
   return {1, reason(occt().messages->take(), what)};
 }
 
-// The STEP or IGES file into `doc`, lengths in metres; a failure's message, or nothing.
-std::optional<Failure> readStepOrIges(const std::string& path, CadFormat format,
-                                      const Request& request, Handle(TDocStd_Document) & doc) {
-  if (format == CadFormat::kStep) {
-    const std::string page = request.codePage.empty() ? "UTF8" : request.codePage;
-    if (!Interface_Static::SetCVal("read.step.codepage", page.c_str()))
-      return Failure{2, fmt::format("--code-page {}: not a code page OCCT knows (e.g. UTF8, "
-                                    "CP1251, CP1252, SJIS, GB)",
-                                    page)};
-    STEPCAFControl_Reader reader;
-    reader.SetColorMode(true);
-    reader.SetNameMode(true);
-    reader.SetLayerMode(true);
-    if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
-      return badFile("not a STEP file OCCT can read");
-    if (reader.NbRootsForTransfer() == 0) return badFile("a STEP file with no shape in it");
-    XCAFDoc_DocumentTool::SetLengthUnit(doc, 1.0);  // shapes in metres
-    if (!reader.Transfer(doc)) return badFile("OCCT could not transfer its shapes");
-    return {};
-  }
-  IGESCAFControl_Reader reader;
+// One XDE reader (STEP's or IGES's) over the file into `doc`, lengths in metres.
+template <class Reader>
+std::optional<Failure> transfer(Reader& reader, const std::string& path, std::string_view format,
+                                Handle(TDocStd_Document) & doc) {
   reader.SetColorMode(true);
   reader.SetNameMode(true);
   reader.SetLayerMode(true);
   if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
-    return badFile("not an IGES file OCCT can read");
-  if (reader.NbRootsForTransfer() == 0) return badFile("an IGES file with no shape in it");
+    return badFile(fmt::format("not {} file OCCT can read", format));
+  if (reader.NbRootsForTransfer() == 0)
+    return badFile(fmt::format("{} file with no shape in it", format));
   XCAFDoc_DocumentTool::SetLengthUnit(doc, 1.0);  // shapes in metres
   if (!reader.Transfer(doc)) return badFile("OCCT could not transfer its shapes");
   return {};
+}
+
+// The STEP or IGES file into `doc`; a failure's message, or nothing.
+std::optional<Failure> readStepOrIges(const std::string& path, CadFormat format,
+                                      const Request& request, Handle(TDocStd_Document) & doc) {
+  if (format == CadFormat::kIges) {
+    IGESCAFControl_Reader reader;
+    return transfer(reader, path, "an IGES", doc);
+  }
+  const std::string page = request.codePage.empty() ? "UTF8" : request.codePage;
+  if (!Interface_Static::SetCVal("read.step.codepage", page.c_str()))
+    return Failure{2, fmt::format("--code-page {}: not a code page OCCT knows (e.g. UTF8, "
+                                  "CP1251, CP1252, SJIS, GB)",
+                                  page)};
+  STEPCAFControl_Reader reader;
+  return transfer(reader, path, "a STEP", doc);
 }
 
 std::optional<Failure> readBrep(const std::string& path, Handle(TDocStd_Document) & doc) {

@@ -7,7 +7,10 @@ set -euo pipefail
 export LSAN_OPTIONS=suppressions=$(cd "$(dirname "$0")/.." && pwd)/tests/lsan-suppressions.txt:print_suppressions=0
 cd "$(dirname "$0")/.."
 seconds=${1:-20}
-readers=(ply obj stl gltf lfp png tiles las laz xyz lfc cad)
+# fuzz_cad is built but not run here: OCCT's BREP reader loops for minutes on some corrupt counts
+# (an OCCT bug the wrapper cannot stop yet; docs/cad.md). Run it by hand: scripts/fuzz.sh takes
+# READERS="cad" to pick readers.
+readers=(${READERS:-ply obj stl gltf lfp png tiles las laz xyz lfc})
 mkdir -p build/fuzz/artifacts
 run() {
   local reader=$1 work=build/fuzz/work/$1

@@ -19,9 +19,11 @@
 #include <Message_PrinterOStream.hxx>
 #include <Message_ProgressIndicator.hxx>
 #include <Message_ProgressScope.hxx>
+#include <OSD.hxx>
 #include <RWMesh_FaceIterator.hxx>
 #include <STEPCAFControl_Reader.hxx>
 #include <STEPControl_Controller.hxx>
+#include <Standard_ErrorHandler.hxx>
 #include <Standard_Failure.hxx>
 #include <TDF_Tool.hxx>
 #include <TDataStd_Name.hxx>
@@ -35,8 +37,10 @@
 #include <XCAFPrs_DocumentExplorer.hxx>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -123,6 +127,41 @@ std::string reason(std::vector<std::string> messages, std::string_view fallback)
   if (messages.empty()) return std::string(fallback);
   for (std::string& m : messages) std::replace(m.begin(), m.end(), '\n', ' ');
   return fmt::format("{} (OCCT: {})", fallback, fmt::join(messages, "; "));
+}
+
+// OCCT's signal handlers for the length of one read: a crash inside OCCT (a null surface in a
+// damaged IGES file, found by fuzz_cad) jumps to the nearest `guarded` and becomes a
+// Standard_Failure instead of ending the process. Ctrl-C and termination keep lodforge's
+// handlers; every handler is put back afterwards.
+class OcctSignals {
+ public:
+  OcctSignals() {
+    for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], nullptr, &saved_[i]);
+    OSD::SetSignal(OSD_SignalMode_Set, false);
+    for (std::size_t i = 0; i < kSignals.size(); ++i)
+      if (!isCrash(kSignals[i])) sigaction(kSignals[i], &saved_[i], nullptr);
+  }
+  ~OcctSignals() {
+    for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &saved_[i], nullptr);
+  }
+  OcctSignals(const OcctSignals&) = delete;
+  OcctSignals& operator=(const OcctSignals&) = delete;
+
+ private:
+  static constexpr std::array<int, 9> kSignals = {SIGSEGV, SIGBUS,  SIGFPE, SIGILL, SIGSYS,
+                                                  SIGINT,  SIGTERM, SIGHUP, SIGQUIT};
+  static bool isCrash(int signal) {
+    return signal == SIGSEGV || signal == SIGBUS || signal == SIGFPE || signal == SIGILL ||
+           signal == SIGSYS;
+  }
+  std::array<struct sigaction, kSignals.size()> saved_{};
+};
+
+// Runs `work` where a signal inside OCCT is thrown as a Standard_Failure (OCC_CATCH_SIGNALS).
+template <class Work>
+void guarded(Work&& work) {
+  OCC_CATCH_SIGNALS
+  work();
 }
 
 // A failure of the read, carried to the entry point: bad input (1) or a bad option (2).
@@ -282,8 +321,10 @@ std::vector<std::string> tessellate(const Tree& tree, const Request& request,
       parameters.Deflection = deflectionOf(shape, request, metresPerUnit);
       parameters.Angle = angle;
       const Handle(Cancellation) cancellation = new Cancellation(request.cancelled);
-      BRepMesh_IncrementalMesh mesh(shape, parameters, cancellation->Start());
-      if (!mesh.IsDone() && !isCancelled(request)) failures[s] = "OCCT's mesher did not finish";
+      guarded([&] {
+        BRepMesh_IncrementalMesh mesh(shape, parameters, cancellation->Start());
+        if (!mesh.IsDone() && !isCancelled(request)) failures[s] = "OCCT's mesher did not finish";
+      });
       if (request.meshed) request.meshed(request.context);
     } catch (const Standard_Failure& failure) {
       failures[s] = fmt::format("OCCT's mesher failed: {} {}", failure.DynamicType()->Name(),
@@ -369,8 +410,8 @@ void warnUnmeshed(const Tree& tree, const std::vector<std::string>& failures, Re
   }
 }
 
+// One read at a time (OCCT's reader statics and the signal handlers are process-wide).
 void read(const Request& request, Result& out) {
-  std::unique_lock lock(occt().reading);
   Handle(TDocStd_Document) doc;
   if (std::optional<Failure> failed = readDocument(request, doc)) {
     out.status = failed->status;
@@ -378,7 +419,6 @@ void read(const Request& request, Result& out) {
     if (!doc.IsNull()) XCAFApp_Application::GetApplication()->Close(doc);
     return;
   }
-  lock.unlock();
   Standard_Real metresPerUnit = 1;
   if (cadFormat(request.path) == CadFormat::kBrep ||
       !XCAFDoc_DocumentTool::GetLengthUnit(doc, metresPerUnit) || !(metresPerUnit > 0))
@@ -419,7 +459,9 @@ extern "C" __attribute__((visibility("default"))) void lodforge_cad_read(
     return;
   }
   try {
-    lodforge::cad::read(request, result);
+    const std::lock_guard lock(lodforge::cad::occt().reading);
+    const lodforge::cad::OcctSignals signals;
+    lodforge::cad::guarded([&] { lodforge::cad::read(request, result); });
   } catch (const Standard_Failure& failure) {
     result = {};
     result.status = 1;

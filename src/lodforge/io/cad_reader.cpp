@@ -11,7 +11,6 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/file.h"
-#include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/cad_module.h"
 
@@ -65,35 +64,26 @@ Model toModel(const cad::Result& read) {
   for (std::size_t v = 0; v < read.positions.size(); v += 3)
     world.add(Vec3d{read.positions[v], read.positions[v + 1], read.positions[v + 2]});
   model.origin = chooseOrigin(world);
-  const std::size_t vertices = read.positions.size() / 3;
-  model.positions.resize(vertices);
-  model.normals.resize(vertices);
-  for (std::size_t v = 0; v < vertices; ++v) {
-    model.positions[v] =
-        toFloat(Vec3d{read.positions[3 * v], read.positions[3 * v + 1], read.positions[3 * v + 2]} -
-                model.origin);
-    model.normals[v] = {read.normals[3 * v], read.normals[3 * v + 1], read.normals[3 * v + 2]};
-  }
-  if (read.coloured) {
-    model.colors.resize(vertices);
-    for (std::size_t v = 0; v < vertices; ++v)
-      model.colors[v] = {read.colors[4 * v], read.colors[4 * v + 1], read.colors[4 * v + 2],
-                         read.colors[4 * v + 3]};
-  }
-  model.indices = read.indices;
-  model.objects.reserve(read.instances.size());
+  // One object per instance through ModelBuilder (offsets, names, bounds); the module wrote the
+  // instances back to back, so appending them in order copies its arrays.
+  ModelBuilder builder(model);
   for (const cad::Instance& instance : read.instances) {
-    ObjectRecord object;
-    object.vertexOffset = instance.firstVertex;
-    object.triangleOffset = instance.firstTriangle;
-    object.vertexCount = static_cast<std::uint32_t>(instance.vertexCount);
-    object.triangleCount = static_cast<std::uint32_t>(instance.triangleCount);
-    object.nameOffset = model.names.size();
-    object.nameLength = static_cast<std::uint32_t>(instance.name.size());
-    model.names += instance.name;
-    object.bounds =
-        computeBounds(std::span(model.positions).subspan(object.vertexOffset, object.vertexCount));
-    model.objects.push_back(object);
+    builder.beginObject(instance.name);
+    for (std::uint64_t v = instance.firstVertex; v < instance.firstVertex + instance.vertexCount;
+         ++v) {
+      const double* p = &read.positions[3 * v];
+      model.positions.push_back(toFloat(Vec3d{p[0], p[1], p[2]} - model.origin));
+      model.normals.push_back(
+          {read.normals[3 * v], read.normals[3 * v + 1], read.normals[3 * v + 2]});
+      if (read.coloured)
+        model.colors.push_back({read.colors[4 * v], read.colors[4 * v + 1], read.colors[4 * v + 2],
+                                read.colors[4 * v + 3]});
+    }
+    const auto first =
+        read.indices.begin() + static_cast<std::ptrdiff_t>(3 * instance.firstTriangle);
+    model.indices.insert(model.indices.end(), first,
+                         first + static_cast<std::ptrdiff_t>(3 * instance.triangleCount));
+    builder.endObject();
   }
   return model;
 }

@@ -20,6 +20,7 @@
 #include "lodforge/tiles/point_tiles.h"
 #include "lodforge/tiles/tileset.h"
 #include "lodforge/tiles/tileset_output.h"
+#include "lodforge/tiles/tileset_parts.h"
 #include "lodforge/tiling/resume.h"
 #include "surface_options.h"
 
@@ -214,9 +215,13 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
                         : ""));
   }
   say(global,
-      fmt::format("wrote {}: {} tiles ({} leaves, {} levels above them), {} in {:.1f} s ({} "
+      fmt::format("wrote {}: {} tiles ({} leaves, {} levels above them){}, {} in {:.1f} s ({} "
                   "input triangles/s)",
                   options.output, formatCount(stats.tiles), formatCount(stats.leaves), stats.levels,
+                  stats.parts > 0 ? fmt::format(", {} named parts ({} in the root tile; {})",
+                                                formatCount(stats.parts),
+                                                formatCount(stats.partsInRoot), kPartsFileName)
+                                  : "",
                   formatBytes(stats.outputBytes), stats.seconds,
                   formatCount(static_cast<std::uint64_t>(static_cast<double>(stats.inputTriangles) /
                                                          std::max(stats.seconds, 1e-9)))));

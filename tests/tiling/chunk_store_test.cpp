@@ -26,17 +26,43 @@ TEST(WeldExact, MergesEqualPositionsKeepsTheFirstAndDropsDegenerates) {
   EXPECT_EQ(mesh.positions[3], (Vec3d{1, 1, 0}));
 }
 
+// Two parts touching at the same positions stay two parts: a feature never spreads to a
+// neighbour, however the chunks cut them; all-unknown features are dropped.
+TEST(WeldExact, WeldsWithinOnePartOnly) {
+  MeshPart mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 0}};
+  mesh.features = {4, 4, 4, 9, 9, 9, 4};
+  mesh.indices = {0, 1, 2, 3, 5, 4, 6, 1, 2};  // part 4's first triangle stored twice
+  weldExact(mesh);
+  ASSERT_EQ(mesh.vertexCount(), 6u);  // (1,0,0) and (0,1,0) once per part
+  ASSERT_EQ(mesh.features.size(), 6u);
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    EXPECT_EQ(mesh.features[mesh.indices[t]], mesh.features[mesh.indices[t + 1]]);
+    EXPECT_EQ(mesh.features[mesh.indices[t]], mesh.features[mesh.indices[t + 2]]);
+  }
+  EXPECT_EQ(distinctFeatures(mesh), (std::vector<std::uint32_t>{4, 9}));
+  MeshPart scan;
+  scan.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  scan.features = {kNoFeature, kNoFeature, kNoFeature};
+  scan.indices = {0, 1, 2};
+  weldExact(scan);
+  EXPECT_TRUE(scan.features.empty());
+  EXPECT_TRUE(distinctFeatures(scan).empty());
+}
+
 TEST(MeshFile, RoundTripsAndRefusesDamage) {
   test::TempDir dir;
   MeshPart mesh;
   mesh.positions = {{1e6 + 0.125, 2, 3}, {4, 5, 6}, {7, 8, 9.5}};
   mesh.colors = {{1, 2, 3, 4}, {5, 6, 7, 8}, {9, 10, 11, 12}};
+  mesh.features = {3, 3, kNoFeature};
   mesh.indices = {0, 1, 2};
   ASSERT_TRUE(saveMesh(mesh, dir.file("m.mesh")).ok());
   Result<MeshPart> back = loadMesh(dir.file("m.mesh"));
   ASSERT_TRUE(back.ok());
   EXPECT_EQ(back->positions, mesh.positions);
   EXPECT_EQ(back->colors, mesh.colors);
+  EXPECT_EQ(back->features, mesh.features);
   EXPECT_EQ(back->indices, mesh.indices);
   // Truncated, and an index past the vertices.
   std::string bytes = test::readFile(dir.file("m.mesh"));
@@ -87,6 +113,45 @@ std::vector<std::array<CutCorner, 3>> gridTriangles(int n) {
     }
   }
   return out;
+}
+
+// Two parts of one surface (its halves), cut into chunks: every vertex read back, input or made
+// by a cut, keeps its part, and the seam between the parts stays open.
+TEST(ChunkWriter, CutPiecesKeepTheirPart) {
+  test::TempDir dir;
+  auto triangles = gridTriangles(60);
+  Aabbd box;
+  for (auto& t : triangles) {
+    const std::uint32_t part = t[0].position.x + t[1].position.x + t[2].position.x < 9 ? 1 : 2;
+    for (CutCorner& c : t) {
+      c.feature = part;
+      c.source += part << 20;  // one input vertex per part
+      box.add(c.position);
+    }
+  }
+  ChunkWriter writer(ChunkGrid::over(box, 1.3), dir.file("chunks"), 5000);
+  for (const auto& t : triangles) ASSERT_TRUE(writer.addTriangle(t).ok());
+  ASSERT_TRUE(writer.flush().ok());
+  std::uint64_t seen[3] = {0, 0, 0};
+  for (const auto& [index, count] : writer.triangleCounts()) {
+    Result<MeshPart> chunk = writer.load(cellOfIndex(writer.grid(), index));
+    ASSERT_TRUE(chunk.ok());
+    ASSERT_EQ(chunk->features.size(), chunk->vertexCount());
+    for (std::size_t i = 0; i < chunk->indices.size(); ++i) {
+      const std::uint32_t v = chunk->indices[i];
+      const std::uint32_t part = chunk->features[v];
+      ASSERT_TRUE(part == 1 || part == 2);
+      EXPECT_EQ(part, chunk->features[chunk->indices[i / 3 * 3]]);
+      if (part == 1) {
+        EXPECT_LE(chunk->positions[v].x, 3.0 + 1e-12);
+      } else {
+        EXPECT_GE(chunk->positions[v].x, 3.0 - 1e-12);
+      }
+      if (i % 3 == 0) ++seen[part];
+    }
+  }
+  EXPECT_GT(seen[1], 0u);
+  EXPECT_GT(seen[2], 0u);
 }
 
 TEST(ChunkWriter, StoresAnInputVertexOnceAndLoadsTheSameForAnyBuffer) {

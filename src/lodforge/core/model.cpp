@@ -30,7 +30,7 @@ std::uint64_t Model::memoryBytes() const {
                           names.size());
 }
 
-void ModelBuilder::beginObject(std::string_view name) {
+void ModelBuilder::beginObject(std::string_view name, std::string_view path) {
   endObject();
   ObjectRecord record;
   record.vertexOffset = model_.positions.size();
@@ -38,6 +38,9 @@ void ModelBuilder::beginObject(std::string_view name) {
   record.nameOffset = model_.names.size();
   record.nameLength = static_cast<std::uint32_t>(name.size());
   model_.names.append(name);
+  record.pathOffset = model_.paths.size();
+  record.pathLength = static_cast<std::uint32_t>(path.size());
+  model_.paths.append(path);
   model_.objects.push_back(record);
   open_ = true;
 }
@@ -83,6 +86,7 @@ void weldModel(Model& model, const WeldOptions& options) {
   Model out;
   out.origin = model.origin;
   out.names = std::move(model.names);
+  out.paths = std::move(model.paths);
   out.objects.reserve(model.objects.size());
   std::vector<std::uint32_t> remap;
   for (std::size_t o = 0; o < model.objects.size(); ++o) {
@@ -148,6 +152,8 @@ bool isConsistent(const Model& model, std::string* why) {
       return fail(fmt::format("object {} does not follow its predecessor", i));
     if (o.nameOffset + o.nameLength > model.names.size())
       return fail(fmt::format("object {} name out of range", i));
+    if (o.pathOffset + o.pathLength > model.paths.size())
+      return fail(fmt::format("object {} path out of range", i));
     nextVertex += o.vertexCount;
     nextTriangle += o.triangleCount;
     if (nextVertex > model.positions.size() || nextTriangle > model.triangleCount())

@@ -26,6 +26,10 @@ struct ObjectRecord {
   std::uint32_t triangleCount = 0;
   std::uint64_t nameOffset = 0;  // into Model::names
   std::uint32_t nameLength = 0;
+  // Where the object sits in its assembly ("motor/rotor/shaft"), into Model::paths; empty when
+  // the input has no assembly tree.
+  std::uint64_t pathOffset = 0;
+  std::uint32_t pathLength = 0;
   Aabb bounds;  // of the object's vertices, relative to the model origin
 };
 
@@ -37,6 +41,7 @@ struct Model {
   std::vector<std::uint32_t> indices;  // 3 per triangle, local to the object
   std::vector<ObjectRecord> objects;
   std::string names;  // all object names, back to back
+  std::string paths;  // all object assembly paths, back to back (often empty)
 
   std::uint64_t vertexCount() const { return positions.size(); }
   std::uint64_t triangleCount() const { return indices.size() / 3; }
@@ -47,6 +52,10 @@ struct Model {
   std::string_view objectName(std::size_t object) const {
     const ObjectRecord& o = objects[object];
     return std::string_view(names).substr(o.nameOffset, o.nameLength);
+  }
+  std::string_view objectPath(std::size_t object) const {
+    const ObjectRecord& o = objects[object];
+    return std::string_view(paths).substr(o.pathOffset, o.pathLength);
   }
   std::span<const Vec3f> objectPositions(std::size_t object) const {
     const ObjectRecord& o = objects[object];
@@ -74,7 +83,7 @@ class ModelBuilder {
  public:
   explicit ModelBuilder(Model& model) : model_(model) {}
 
-  void beginObject(std::string_view name);
+  void beginObject(std::string_view name, std::string_view path = {});
   // Appends a vertex to the current object; returns its local index.
   std::uint32_t addVertex(Vec3f position);
   void addTriangle(std::uint32_t a, std::uint32_t b, std::uint32_t c);

@@ -10,7 +10,7 @@
 
 namespace lodforge::cad {
 
-inline constexpr int kModuleVersion = 2;  // bumped when these structs change
+inline constexpr int kModuleVersion = 3;  // bumped when these structs change
 inline constexpr const char* kReadSymbol = "lodforge_cad_read";
 
 struct Request {
@@ -29,6 +29,7 @@ struct Request {
 
 struct Instance {
   std::string name;
+  std::string path;  // product names from the root down to this instance, "/"-separated
   std::uint64_t firstVertex = 0, vertexCount = 0;
   std::uint64_t firstTriangle = 0, triangleCount = 0;
   std::uint64_t shape = 0;  // which distinct shape

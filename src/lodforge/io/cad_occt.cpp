@@ -256,6 +256,7 @@ struct Placed {
   TopLoc_Location location;
   XCAFPrs_Style style;
   std::string name;
+  std::string path;  // the names from the root down to this leaf, "/"-separated
 };
 
 struct Tree {
@@ -275,9 +276,15 @@ Tree walkTree(const Handle(TDocStd_Document) & doc) {
     TDF_Tool::Entry(node.RefLabel, entry);
     const auto [at, added] = seen.try_emplace(entry.ToCString(), tree.shapes.size());
     if (added) tree.shapes.push_back(node.RefLabel);
-    std::string name = labelName(node.RefLabel);
-    if (name.empty()) name = labelName(node.Label);
-    tree.placed.push_back({at->second, node.RefLabel, node.Location, node.Style, name});
+    const auto nameOf = [](const XCAFPrs_DocumentNode& n) {
+      std::string name = labelName(n.RefLabel);
+      return name.empty() ? labelName(n.Label) : name;
+    };
+    std::string path;
+    for (int depth = 0; depth <= it.CurrentDepth(); ++depth)
+      path += (depth > 0 ? "/" : "") + nameOf(it.Current(depth));
+    tree.placed.push_back(
+        {at->second, node.RefLabel, node.Location, node.Style, nameOf(node), std::move(path)});
     tree.depth = std::max(tree.depth, static_cast<std::uint32_t>(it.CurrentDepth() + 1));
   }
   return tree;
@@ -357,8 +364,8 @@ void pushColor(const Quantity_ColorRGBA& color, std::vector<std::uint8_t>& out) 
 
 // One placed instance's faces appended: positions in metres, normals and colours per vertex.
 void appendInstance(const Placed& placed, double metresPerUnit, Result& out) {
-  Instance instance{placed.name, out.positions.size() / 3, 0, out.indices.size() / 3, 0,
-                    placed.shape};
+  Instance instance{placed.name, placed.path, out.positions.size() / 3, 0, out.indices.size() / 3,
+                    0,           placed.shape};
   const Quantity_ColorRGBA grey(Quantity_Color(0.78, 0.78, 0.78, Quantity_TOC_sRGB));
   for (RWMesh_FaceIterator face(placed.label, placed.location, true, placed.style); face.More();
        face.Next()) {

@@ -68,7 +68,7 @@ Model toModel(const cad::Result& read) {
   // instances back to back, so appending them in order copies its arrays.
   ModelBuilder builder(model);
   for (const cad::Instance& instance : read.instances) {
-    builder.beginObject(instance.name);
+    builder.beginObject(instance.name, instance.path);
     for (std::uint64_t v = instance.firstVertex; v < instance.firstVertex + instance.vertexCount;
          ++v) {
       const double* p = &read.positions[3 * v];

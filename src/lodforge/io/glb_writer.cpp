@@ -43,6 +43,7 @@ struct GlbWriter::State {
   nlohmann::json materials = nlohmann::json::array();
   nlohmann::json nodes = nlohmann::json::array();
   std::string structuralMetadata;  // EXT_structural_metadata at the root, when set
+  bool meshFeatures = false;       // a primitive uses EXT_mesh_features
   std::vector<std::uint32_t> rootChildren;
   std::optional<Vec3d> rootTranslation;
   std::optional<std::uint32_t> defaultMaterial;
@@ -284,6 +285,18 @@ Result<std::uint32_t> GlbWriter::State::addIndices(const GlbMeshData& mesh) {
                      mesh.indices, vertexCount);
 }
 
+Result<std::uint32_t> GlbWriter::addBufferView(std::span<const std::byte> bytes) {
+  State& s = *state_;
+  if (s.binaryBytes % 8 != 0) {  // appendBinary keeps 4-byte alignment
+    const std::uint32_t pad = 0;
+    LODFORGE_TRY(s.appendBinary(&pad, sizeof pad));
+  }
+  const std::uint64_t offset = s.binaryBytes;
+  LODFORGE_TRY(s.appendBinary(bytes.data(), bytes.size()));
+  s.bufferViews.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes.size()}});
+  return static_cast<std::uint32_t>(s.bufferViews.size() - 1);
+}
+
 void GlbWriter::setStructuralMetadata(std::string json) {
   state_->structuralMetadata = std::move(json);
 }
@@ -317,6 +330,15 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
   if (mesh.propertyAttribute)
     primitive["extensions"]["EXT_structural_metadata"]["propertyAttributes"] = {
         *mesh.propertyAttribute};
+  if (mesh.featureIds) {
+    assert(std::any_of(mesh.extraAttributes.begin(), mesh.extraAttributes.end(),
+                       [](const GlbVertexAttribute& a) { return a.semantic == "_FEATURE_ID_0"; }));
+    primitive["extensions"]["EXT_mesh_features"]["featureIds"] = {
+        {{"featureCount", mesh.featureIds->featureCount},
+         {"attribute", 0},
+         {"propertyTable", mesh.featureIds->propertyTable}}};
+    s.meshFeatures = true;
+  }
   if (mesh.points) {
     primitive["mode"] = 0;
   } else {
@@ -412,6 +434,7 @@ Status GlbWriter::finish() {
     document["extensions"]["EXT_structural_metadata"] = nlohmann::json::parse(s.structuralMetadata);
     document["extensionsUsed"].push_back("EXT_structural_metadata");
   }
+  if (s.meshFeatures) document["extensionsUsed"].push_back("EXT_mesh_features");
   std::string json = document.dump();
   while (json.size() % 4 != 0) json += ' ';
 

@@ -27,6 +27,11 @@ struct GlbVertexAttribute {
   std::span<const std::byte> data;  // 4 bytes per vertex
 };
 
+struct GlbFeatureIds {
+  std::uint32_t featureCount = 0;  // distinct features the attribute holds (0..count-1)
+  std::uint32_t propertyTable = 0;
+};
+
 struct GlbMeshData {
   std::span<const Vec3f> positions;
   std::span<const Vec3f> normals;          // empty or one per vertex (normalised on write)
@@ -42,6 +47,9 @@ struct GlbMeshData {
   // EXT_structural_metadata: the property attribute (of setStructuralMetadata's) that describes
   // the extra attributes.
   std::optional<std::uint32_t> propertyAttribute = std::nullopt;
+  // EXT_mesh_features: the extra attribute "_FEATURE_ID_0" holds each vertex's feature, a row
+  // of this property table (of setStructuralMetadata's).
+  std::optional<GlbFeatureIds> featureIds = std::nullopt;
 };
 
 // The grid step of a quantised mesh inside `bounds`: its longest side over 65535.
@@ -74,8 +82,12 @@ class GlbWriter {
   // Writes the mesh's data; returns its mesh index for addNode. Empty meshes are refused (assert).
   Result<std::uint32_t> addMesh(const GlbMeshData& mesh, std::string_view name = {},
                                 std::optional<std::uint32_t> material = std::nullopt);
-  // The document's EXT_structural_metadata object (schema and property attributes), as JSON.
+  // The document's EXT_structural_metadata object (schema, property tables and attributes), as
+  // JSON.
   void setStructuralMetadata(std::string json);
+  // A buffer view of raw bytes, 8-byte aligned (a property table's values or string offsets);
+  // returns its index.
+  Result<std::uint32_t> addBufferView(std::span<const std::byte> bytes);
   // A node drawing `mesh` (or nothing) with an optional transform, a child of the root node.
   void addNode(std::string_view name, std::optional<std::uint32_t> mesh,
                const Mat4d* transform = nullptr);

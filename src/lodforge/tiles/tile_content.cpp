@@ -7,6 +7,7 @@
 
 #include "lodforge/core/mesh.h"
 #include "lodforge/io/glb_writer.h"
+#include "lodforge/tiles/tile_features.h"
 
 namespace lodforge {
 
@@ -28,9 +29,13 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   std::vector<Vec3f> positions(used);
   std::vector<Rgba8> colors(options.colors && !mesh.colors.empty() ? used : 0);
   std::vector<Vec3f> normals(used);
+  const bool features =
+      options.parts != nullptr && !options.parts->empty() && !mesh.features.empty();
+  std::vector<std::uint32_t> vertexFeatures(features ? used : 0);
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
     if (remap[v] == ~0u) continue;
     positions[remap[v]] = toFloat(mesh.positions[v] - center);
+    if (features) vertexFeatures[remap[v]] = mesh.features[v];
     if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
     if (!mesh.normals.empty()) normals[remap[v]] = mesh.normals[v];
   }
@@ -42,8 +47,17 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   Result<GlbWriter> writer = GlbWriter::create(
       path, {.doubleSided = false, .meshoptCompression = options.meshoptCompression});
   if (!writer) return writer.status();
-  Result<std::uint32_t> glbMesh =
-      writer->addMesh({positions, normals, colors, indices, options.quantize}, "tile");
+  GlbMeshData data{positions, normals, colors, indices, options.quantize};
+  std::vector<std::byte> featureStorage;
+  std::vector<GlbVertexAttribute> extra;
+  if (features) {
+    const TileFeatures tile = tileFeatures(vertexFeatures);
+    extra.push_back(featureIdAttribute(tile.rows, featureStorage));
+    LODFORGE_TRY(addPartTable(*writer, *options.parts, tile.parts));
+    data.extraAttributes = extra;
+    data.featureIds = GlbFeatureIds{static_cast<std::uint32_t>(tile.parts.size()), 0};
+  }
+  Result<std::uint32_t> glbMesh = writer->addMesh(data, "tile");
   if (!glbMesh) return glbMesh.status();
   writer->addNode("tile", *glbMesh);
   writer->setRootTranslation(toYUp(center));

@@ -6,6 +6,7 @@
 
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
+#include "lodforge/tiling/chunk_input.h"
 #include "lodforge/tiling/chunk_store.h"
 #include "lodforge/tiling/octree.h"
 
@@ -13,13 +14,15 @@ namespace lodforge {
 
 // The GLB of one tile: positions relative to the bounds' centre (float), that centre as the
 // root translation, the mesh's normals (area-weighted over this mesh alone if it has none),
-// colours when asked and the mesh has them; triangles
+// colours when asked and the mesh has them, each vertex's part (tile_features.h) when the mesh
+// has features and `parts` names them; triangles
 // ordered for the vertex cache and vertices for fetch (meshoptimizer), optionally
 // meshopt-compressed.
 struct TileContentOptions {
   bool colors = true;
   bool meshoptCompression = false;
   bool quantize = false;  // KHR_mesh_quantization over the tile's box
+  const PartTable* parts = nullptr;
 };
 Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path,
                         const TileContentOptions& options = {});

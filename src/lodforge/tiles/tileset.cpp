@@ -14,6 +14,7 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/tiles/surface_input.h"
 #include "lodforge/tiles/tileset_output.h"
+#include "lodforge/tiles/tileset_parts.h"
 #include "lodforge/tiling/resume.h"
 
 namespace lodforge {
@@ -169,7 +170,8 @@ Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& o
         return writeTileContent(mesh, node.bounds, tilesetDirectory + "/" + tileContentUri(node),
                                 {.colors = chunked.colors,
                                  .meshoptCompression = options.meshoptCompression,
-                                 .quantize = options.quantize && tileQuantized(node)});
+                                 .quantize = options.quantize && tileQuantized(node),
+                                 .parts = &chunked.parts});
       });
 }
 
@@ -180,6 +182,7 @@ void countChunks(const ChunkInput& chunked, TilesStats& stats) {
   stats.streamed = chunked.streamed;
   stats.chunkSize = chunked.chunks->grid().size;
   stats.leafTriangles = chunked.chunks->triangleCount();
+  stats.parts = chunked.parts.size();
 }
 
 void countTiles(const OctreeResult& tree, TilesStats& stats) {
@@ -194,6 +197,7 @@ void countTiles(const OctreeResult& tree, TilesStats& stats) {
     }
   }
   stats.levels = tree.levels;
+  stats.partsInRoot = tree.nodes[tree.root].features.size();
 }
 
 }  // namespace
@@ -236,8 +240,11 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   octree.resume = stats.resumed;
   Result<OctreeResult> tree = buildTiles(*chunked, options, octree, place.staging.path);
   if (!tree) return tree.status();
+  const std::string partsUri = chunked->parts.empty() ? "" : kPartsFileName;
   LODFORGE_TRY(writeTilesetJson(*tree, place.staging.path + "/tileset.json", chunked->frame,
-                                options.quantize));
+                                options.quantize, partsUri));
+  if (!partsUri.empty())
+    LODFORGE_TRY(writePartsJson(*tree, chunked->parts, place.staging.path + "/" + partsUri));
   countTiles(*tree, stats);
   stats.outputBytes = directoryBytes(place.staging.path);
 

@@ -30,7 +30,8 @@ std::string tileContentUri(const OctreeNode& node) {
 }
 
 Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
-                        const std::optional<Mat4d>& rootTransform, bool quantized) {
+                        const std::optional<Mat4d>& rootTransform, bool quantized,
+                        const std::string& partsUri) {
   // Children come before their parents in the node list: one pass collects each subtree's
   // largest quantisation error.
   std::vector<double> quantization(octree.nodes.size(), 0.0);
@@ -64,6 +65,7 @@ Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
       {"geometricError", nothing},
       {"root", tile(octree.root)}};
   if (rootTransform) tileset["root"]["transform"] = rootTransform->m;
+  if (!partsUri.empty()) tileset["asset"]["extras"]["parts"] = partsUri;
   return OutputFile::writeWhole(path, tileset.dump(1) + '\n');
 }
 

@@ -16,9 +16,10 @@ namespace lodforge {
 // contents at tiles/<name>.glb for the nodes with triangles, and the root's transform (local
 // frame to ECEF) when georeferenced. With `quantized` contents, each geometric error also holds
 // the largest quantisation error in the tile's subtree (still non-increasing parent to child).
+// `partsUri`, when given, goes to asset.extras.parts (tileset_parts.h).
 Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
                         const std::optional<Mat4d>& rootTransform = std::nullopt,
-                        bool quantized = false);
+                        bool quantized = false, const std::string& partsUri = {});
 
 // A tile's "box" bounding volume for axis-aligned bounds: centre, then three half-axes.
 std::array<double, 12> tileBox(const Aabbd& bounds);

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
+#include "lodforge/tiles/tileset_parts.h"
 
 namespace lodforge {
 
@@ -18,7 +19,7 @@ bool isLodforgeTileset(const std::string& directory) {
       !generator->get<std::string>().starts_with("lodforge"))
     return false;
   return directoryHoldsOnly(directory, [](const std::string& relative, bool isDirectory) {
-    if (relative == "tileset.json") return !isDirectory;
+    if (relative == "tileset.json" || relative == kPartsFileName) return !isDirectory;
     if (relative == "tiles") return isDirectory;
     return relative.starts_with("tiles/") && relative.ends_with(".glb") && !isDirectory &&
            relative.find('/', 6) == std::string::npos;

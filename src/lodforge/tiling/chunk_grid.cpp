@@ -78,6 +78,7 @@ CutCorner crossing(const CutCorner& p, const CutCorner& q, int axis, double coor
                lerp(a.color.a, b.color.a)};
   const auto f = static_cast<float>(t);
   out.normal = normalizeOr(a.normal + (b.normal - a.normal) * f, a.normal);
+  out.feature = a.feature;
   return out;
 }
 
@@ -144,7 +145,8 @@ struct Emitter {
                               static_cast<std::uint8_t>(std::lround(colorSum[2] / n)),
                               static_cast<std::uint8_t>(std::lround(colorSum[3] / n))},
                              normalizeOr(normalSum, unique[0].normal),
-                             CutCorner::kNoSource};
+                             CutCorner::kNoSource,
+                             unique[0].feature};
     const ChunkCell cell = grid.cellOf(centroid.position);
     if (unique.size() == 3) {
       const Vec3d normal =

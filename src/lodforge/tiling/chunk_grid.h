@@ -41,16 +41,21 @@ struct ChunkGrid {
   }
 };
 
+// The input object (a CAD part) a vertex belongs to, or none (a scan, a reconstructed surface).
+inline constexpr std::uint32_t kNoFeature = ~0u;
+
 // A corner of a triangle being cut: exact position, colour and unit normal (the input's, or
 // area-weighted over the whole input, so tiles agree on the normals of the vertices they share),
-// and the input vertex it is (kNoSource for a vertex made by cutting): a chunk stores an input
-// vertex once however many of its triangles use it.
+// the input vertex it is (kNoSource for a vertex made by cutting): a chunk stores an input
+// vertex once however many of its triangles use it; and its object (all three corners of a
+// triangle have the same, and so do the pieces cut from it).
 struct CutCorner {
   static constexpr std::uint64_t kNoSource = ~std::uint64_t{0};
   Vec3d position;
   Rgba8 color;
   Vec3f normal;
   std::uint64_t source = kNoSource;
+  std::uint32_t feature = kNoFeature;
 };
 
 // Cuts one triangle at every grid plane it crosses and returns the pieces, each inside one cell:

@@ -27,6 +27,19 @@ Result<Model> readInputModel(const std::string& path, const CadReadOptions& cad,
   return extractModel(*package, vertexCountsForRatio(*package, 1.0));
 }
 
+// The model's objects as the parts of the tileset.
+PartTable partTable(const std::string& path, const Model& model) {
+  PartTable parts;
+  parts.source = std::filesystem::path(path).filename().string();
+  parts.names.reserve(model.objectCount());
+  parts.paths.reserve(model.objectCount());
+  for (std::size_t o = 0; o < model.objectCount(); ++o) {
+    parts.names.emplace_back(model.objectName(o));
+    parts.paths.emplace_back(model.objectPath(o));
+  }
+  return parts;
+}
+
 Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& options) {
   ChunkInput input;
   Result<Model> model = readInputModel(path, options.cad, input.warnings);
@@ -34,6 +47,9 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
   input.inputTriangles = model->triangleCount();
   if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");
   input.colors = model->hasColors();
+  // Parts are named per vertex only when there is more than one.
+  const bool features = model->objectCount() > 1;
+  if (features) input.parts = partTable(path, *model);
   // World positions (through the transform, if any) and their bounds.
   std::vector<Vec3d> world(model->vertexCount());
   for (std::size_t v = 0; v < world.size(); ++v) {
@@ -105,6 +121,7 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
             input.colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
         triangle[k].normal = normals[object.vertexOffset + v];
         triangle[k].source = object.vertexOffset + v;
+        triangle[k].feature = features ? static_cast<std::uint32_t>(o) : kNoFeature;
       }
       LODFORGE_TRY(input.chunks->addSegmentTriangle(segmentBounds[component[t / 3]], triangle));
     }

@@ -36,6 +36,17 @@ struct ChunkInputOptions {
   int levels = 0;  // levels the octree must be able to build above the leaves (0: any)
 };
 
+// The input's objects (CAD parts) by feature id (CutCorner::feature): what tiles name per vertex.
+// Empty for an input of one object or none (a scan, a point cloud's surface).
+struct PartTable {
+  std::string source;              // the input file's name, without its folder
+  std::vector<std::string> names;  // by feature id
+  std::vector<std::string> paths;  // by feature id; empty strings where there is no assembly
+
+  std::size_t size() const { return names.size(); }
+  bool empty() const { return names.empty(); }
+};
+
 struct ChunkInput {
   std::unique_ptr<ChunkWriter> chunks;
   std::uint64_t inputTriangles = 0;
@@ -45,6 +56,7 @@ struct ChunkInput {
   std::optional<Mat4d> frame;  // the local frame's place on Earth (ECEF), when georeferenced
   std::optional<std::string> truncation;  // where a salvaged PLY was cut short
   std::vector<std::string> warnings;      // the reader's (a CAD part that did not mesh)
+  PartTable parts;
 };
 
 Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options);

@@ -34,6 +34,10 @@ std::uint64_t hashPosition(const Vec3d& p) {
 }  // namespace
 
 void weldExact(MeshPart& mesh) {
+  // A mesh of no objects (a scan: chunk records always carry the field) keeps no features.
+  if (std::all_of(mesh.features.begin(), mesh.features.end(),
+                  [](std::uint32_t f) { return f == kNoFeature; }))
+    mesh.features.clear();
   const std::uint32_t count = mesh.vertexCount();
   // Each vertex points at the first vertex (lowest index) with its position: an open-addressing
   // table keyed by position, filled in vertex order.
@@ -41,10 +45,14 @@ void weldExact(MeshPart& mesh) {
   while (capacity < 2 * std::size_t{count}) capacity *= 2;
   std::vector<std::uint32_t> table(capacity, ~0u);
   std::vector<std::uint32_t> representative(count);
+  const bool features = !mesh.features.empty();
+  const auto featureOf = [&](std::uint32_t v) { return features ? mesh.features[v] : kNoFeature; };
   for (std::uint32_t v = 0; v < count; ++v) {
     const Vec3d& p = mesh.positions[v];
-    std::size_t slot = hashPosition(p) & (capacity - 1);
-    while (table[slot] != ~0u && !(mesh.positions[table[slot]] == p))
+    const std::uint32_t feature = featureOf(v);
+    std::size_t slot = (hashPosition(p) ^ feature * 0x9E3779B97F4A7C15ull) & (capacity - 1);
+    while (table[slot] != ~0u &&
+           !(mesh.positions[table[slot]] == p && featureOf(table[slot]) == feature))
       slot = (slot + 1) & (capacity - 1);
     if (table[slot] == ~0u) table[slot] = v;
     representative[v] = table[slot];
@@ -69,6 +77,7 @@ void weldExact(MeshPart& mesh) {
   std::vector<Vec3d> positions(next);
   std::vector<Rgba8> colors(mesh.colors.empty() ? 0 : next);
   std::vector<Vec3f> normals(mesh.normals.empty() ? 0 : next);
+  std::vector<std::uint32_t> featureOfVertex(features ? next : 0);
   // The members of each group whose normals were summed, as a list through `summedNext`.
   std::vector<std::uint32_t> summedHead(normals.empty() ? 0 : next, ~0u);
   std::vector<std::uint32_t> summedNext(normals.empty() ? 0 : count, ~0u);
@@ -89,12 +98,22 @@ void weldExact(MeshPart& mesh) {
     if (remap[v] == ~0u) continue;  // not a representative, or unused
     positions[remap[v]] = mesh.positions[v];
     if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
+    if (features) featureOfVertex[remap[v]] = mesh.features[v];
   }
   for (std::size_t v = 0; v < normals.size(); ++v)
     normals[v] = normalizeOr(normals[v], Vec3f{0, 0, 1});
   mesh.positions = std::move(positions);
   mesh.colors = std::move(colors);
   mesh.normals = std::move(normals);
+  mesh.features = std::move(featureOfVertex);
+}
+
+std::vector<std::uint32_t> distinctFeatures(const MeshPart& mesh) {
+  std::vector<std::uint32_t> out(mesh.features);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  if (!out.empty() && out.back() == kNoFeature) out.pop_back();
+  return out;
 }
 
 MeshPart concatenate(std::span<const MeshPart> parts) {
@@ -103,6 +122,8 @@ MeshPart concatenate(std::span<const MeshPart> parts) {
       std::any_of(parts.begin(), parts.end(), [](const MeshPart& p) { return !p.colors.empty(); });
   const bool normals =
       std::any_of(parts.begin(), parts.end(), [](const MeshPart& p) { return !p.normals.empty(); });
+  const bool features = std::any_of(parts.begin(), parts.end(),
+                                    [](const MeshPart& p) { return !p.features.empty(); });
   for (const MeshPart& part : parts) {
     const std::uint32_t base = out.vertexCount();
     out.positions.insert(out.positions.end(), part.positions.begin(), part.positions.end());
@@ -120,6 +141,13 @@ MeshPart concatenate(std::span<const MeshPart> parts) {
         out.normals.insert(out.normals.end(), part.normals.begin(), part.normals.end());
       }
     }
+    if (features) {
+      if (part.features.empty()) {
+        out.features.resize(out.positions.size(), kNoFeature);
+      } else {
+        out.features.insert(out.features.end(), part.features.begin(), part.features.end());
+      }
+    }
     for (std::uint32_t i : part.indices) out.indices.push_back(base + i);
   }
   return out;
@@ -127,13 +155,13 @@ MeshPart concatenate(std::span<const MeshPart> parts) {
 
 namespace {
 
-constexpr char kMeshMagic[8] = {'L', 'F', 'M', 'E', 'S', 'H', '2', '\0'};
+constexpr char kMeshMagic[8] = {'L', 'F', 'M', 'E', 'S', 'H', '3', '\0'};
 // A chunk file is a run of blocks, one per append: magic, vertex count, triangle count (u32
 // each), the vertex records, then three u32 indices per triangle into the block's records.
 constexpr char kBlockMagic[4] = {'L', 'F', 'C', 'K'};
 constexpr std::size_t kBlockHeaderBytes = sizeof kBlockMagic + 2 * sizeof(std::uint32_t);
-// A vertex record: position (3 doubles), colour, normal (octahedral, 2 x 16 bits).
-constexpr std::size_t kCornerBytes = 3 * sizeof(double) + sizeof(Rgba8) + sizeof(std::uint32_t);
+// A vertex record: position (3 doubles), colour, normal (octahedral, 2 x 16 bits), feature.
+constexpr std::size_t kCornerBytes = 3 * sizeof(double) + sizeof(Rgba8) + 2 * sizeof(std::uint32_t);
 
 // Octahedral encoding of a unit normal (Cigolle et al. 2014): 0.005 degrees at 16 bits per
 // axis, a third of the bytes of three floats in every chunk-file corner.
@@ -169,6 +197,8 @@ void writeRecord(std::byte* out, const CutCorner& corner) {
   std::memcpy(out, xyz, sizeof xyz);
   std::memcpy(out + sizeof xyz, &corner.color, sizeof(Rgba8));
   std::memcpy(out + sizeof xyz + sizeof(Rgba8), &normal, sizeof normal);
+  std::memcpy(out + sizeof xyz + sizeof(Rgba8) + sizeof normal, &corner.feature,
+              sizeof corner.feature);
 }
 
 // Appends the vertex records in `bytes` (a whole number of them) to the mesh.
@@ -177,6 +207,7 @@ void appendRecords(std::span<const std::byte> bytes, MeshPart& mesh) {
   mesh.positions.resize(first + count);
   mesh.colors.resize(first + count);
   mesh.normals.resize(first + count);
+  mesh.features.resize(first + count);
   for (std::size_t i = 0; i < count; ++i) {
     const std::byte* at = bytes.data() + i * kCornerBytes;
     double xyz[3];
@@ -186,6 +217,8 @@ void appendRecords(std::span<const std::byte> bytes, MeshPart& mesh) {
     std::memcpy(&mesh.colors[first + i], at + sizeof xyz, sizeof(Rgba8));
     std::memcpy(&normal, at + sizeof xyz + sizeof(Rgba8), sizeof normal);
     mesh.normals[first + i] = decodeNormal(normal);
+    std::memcpy(&mesh.features[first + i], at + sizeof xyz + sizeof(Rgba8) + sizeof normal,
+                sizeof(std::uint32_t));
   }
 }
 
@@ -222,13 +255,14 @@ Status appendTo(const std::string& path, std::initializer_list<std::span<const s
 Status saveMesh(const MeshPart& mesh, const std::string& path) {
   Result<OutputFile> out = OutputFile::create(path, std::size_t{1} << 20);
   if (!out) return out.status();
-  const std::uint64_t header[4] = {mesh.positions.size(), mesh.colors.size(), mesh.normals.size(),
-                                   mesh.indices.size()};
+  const std::uint64_t header[5] = {mesh.positions.size(), mesh.colors.size(), mesh.normals.size(),
+                                   mesh.features.size(), mesh.indices.size()};
   LODFORGE_TRY(out->write(kMeshMagic, sizeof kMeshMagic));
   LODFORGE_TRY(out->write(header, sizeof header));
   LODFORGE_TRY(out->writeSpan(std::span<const Vec3d>(mesh.positions)));
   LODFORGE_TRY(out->writeSpan(std::span<const Rgba8>(mesh.colors)));
   LODFORGE_TRY(out->writeSpan(std::span<const Vec3f>(mesh.normals)));
+  LODFORGE_TRY(out->writeSpan(std::span<const std::uint32_t>(mesh.features)));
   LODFORGE_TRY(out->writeSpan(std::span<const std::uint32_t>(mesh.indices)));
   return out->commit();
 }
@@ -240,29 +274,31 @@ Result<MeshPart> loadMesh(const std::string& path) {
 }
 
 Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& name) {
-  std::uint64_t header[4];
+  std::uint64_t header[5];
   if (bytes.size() < sizeof kMeshMagic + sizeof header ||
       std::memcmp(bytes.data(), kMeshMagic, sizeof kMeshMagic) != 0)
     return badInputAtByte(name, 0, "not a lodforge mesh file (work file of `lodforge tiles`)");
   std::memcpy(header, bytes.data() + sizeof kMeshMagic, sizeof header);
   // Counts first, in a way that cannot overflow: each must fit the bytes that are there.
   const std::uint64_t body = bytes.size() - sizeof kMeshMagic - sizeof header;
-  const std::uint64_t sizes[4] = {sizeof(Vec3d), sizeof(Rgba8), sizeof(Vec3f),
-                                  sizeof(std::uint32_t)};
+  const std::uint64_t sizes[5] = {sizeof(Vec3d), sizeof(Rgba8), sizeof(Vec3f),
+                                  sizeof(std::uint32_t), sizeof(std::uint32_t)};
   std::uint64_t total = 0;
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < 5; ++i) {
     if (header[i] > body / sizes[i])
       return badInputAtByte(name, sizeof kMeshMagic, "mesh file sizes do not match its counts");
     total += header[i] * sizes[i];
   }
   if (total != body || (header[1] != 0 && header[1] != header[0]) ||
-      (header[2] != 0 && header[2] != header[0]) || header[3] % 3 != 0)
+      (header[2] != 0 && header[2] != header[0]) || (header[3] != 0 && header[3] != header[0]) ||
+      header[4] % 3 != 0)
     return badInputAtByte(name, sizeof kMeshMagic, "mesh file sizes do not match its counts");
   MeshPart mesh;
   mesh.positions.resize(header[0]);
   mesh.colors.resize(header[1]);
   mesh.normals.resize(header[2]);
-  mesh.indices.resize(header[3]);
+  mesh.features.resize(header[3]);
+  mesh.indices.resize(header[4]);
   const std::byte* at = bytes.data() + sizeof kMeshMagic + sizeof header;
   // (memcpy of nothing from or to an empty vector's null data() is undefined, hence the guards)
   const auto take = [&at](void* to, std::uint64_t count, std::uint64_t size) {
@@ -272,8 +308,9 @@ Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& 
   take(mesh.positions.data(), header[0], sizeof(Vec3d));
   take(mesh.colors.data(), header[1], sizeof(Rgba8));
   take(mesh.normals.data(), header[2], sizeof(Vec3f));
+  take(mesh.features.data(), header[3], sizeof(std::uint32_t));
   const std::byte* indicesAt = at;
-  take(mesh.indices.data(), header[3], sizeof(std::uint32_t));
+  take(mesh.indices.data(), header[4], sizeof(std::uint32_t));
   for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
     if (mesh.indices[i] >= header[0])
       return badInputAtByte(name, static_cast<std::uint64_t>(indicesAt - bytes.data()) + 4 * i,

@@ -23,21 +23,29 @@ struct MeshPart {
   std::vector<Vec3d> positions;
   std::vector<Rgba8> colors;   // empty or one per vertex
   std::vector<Vec3f> normals;  // empty or one unit normal per vertex
+  // Empty or one per vertex: the input object (part) it belongs to, or kNoFeature. Vertices of
+  // different objects are never welded, so no triangle spans two objects.
+  std::vector<std::uint32_t> features;
   std::vector<std::uint32_t> indices;
 
   std::uint32_t vertexCount() const { return static_cast<std::uint32_t>(positions.size()); }
   std::uint64_t triangleCount() const { return indices.size() / 3; }
   std::uint64_t memoryBytes() const {
     return positions.size() * sizeof(Vec3d) + colors.size() * sizeof(Rgba8) +
-           normals.size() * sizeof(Vec3f) + indices.size() * sizeof(std::uint32_t);
+           normals.size() * sizeof(Vec3f) +
+           (features.size() + indices.size()) * sizeof(std::uint32_t);
   }
 };
 
-// Welds bit-identical positions (cut vertices are made identical on purpose), drops triangles
-// that repeat a corner and vertices no triangle uses. The first vertex of a group keeps its
-// colour; the group's distinct normals are averaged (each once, so the result does not depend
-// on how often a vertex was stored). Deterministic.
+// Welds bit-identical positions of one object (cut vertices are made identical on purpose),
+// drops triangles that repeat a corner and vertices no triangle uses. The first vertex of a
+// group keeps its colour; the group's distinct normals are averaged (each once, so the result does
+// not depend on how often a vertex was stored). Features that are all kNoFeature are dropped.
+// Deterministic.
 void weldExact(MeshPart& mesh);
+
+// The mesh's features (kNoFeature left out), ascending, each once.
+std::vector<std::uint32_t> distinctFeatures(const MeshPart& mesh);
 
 // Appends `parts`, renumbering their indices.
 MeshPart concatenate(std::span<const MeshPart> parts);

@@ -114,6 +114,7 @@ class OctreeBuild {
   Status finish(OctreeNode& node, MeshPart&& mesh) {
     node.triangles = mesh.triangleCount();
     node.vertices = mesh.vertexCount();
+    node.features = distinctFeatures(mesh);
     node.meshPath = store_.meshPath(node);
     LODFORGE_TRY(sink_(node, mesh));
     LODFORGE_TRY(store_.save(std::move(mesh), node.meshPath));

@@ -48,6 +48,7 @@ struct OctreeNode {
   std::uint64_t vertices = 0;
   std::uint64_t droppedSegments = 0;    // small whole segments left out of this (parent) tile
   std::vector<std::uint32_t> children;  // indices into OctreeResult::nodes
+  std::vector<std::uint32_t> features;  // the input objects (parts) its mesh holds, ascending
   std::string meshPath;                 // the node's mesh in the work directory
 };
 

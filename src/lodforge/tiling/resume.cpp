@@ -39,8 +39,14 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
       {"colors", input.colors},
       {"streamed", input.streamed},
       {"frame", input.frame ? nlohmann::json(input.frame->m) : nlohmann::json()},
-      {"counts", counts}};
-  return OutputFile::writeWhole(path, state.dump());
+      {"counts", counts},
+      {"parts",
+       {{"source", input.parts.source},
+        {"names", input.parts.names},
+        {"paths", input.parts.paths}}}};
+  // (Part names come from the input and may not be UTF-8: replaced rather than thrown on.)
+  return OutputFile::writeWhole(
+      path, state.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::json& identity,
@@ -66,6 +72,11 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
     input.streamed = state.at("streamed").get<bool>();
     if (!state.at("frame").is_null())
       input.frame = Mat4d{state.at("frame").get<std::array<double, 16>>()};
+    const auto& parts = state.at("parts");
+    input.parts.source = parts.at("source").get<std::string>();
+    input.parts.names = parts.at("names").get<std::vector<std::string>>();
+    input.parts.paths = parts.at("paths").get<std::vector<std::string>>();
+    if (input.parts.paths.size() != input.parts.names.size()) return std::nullopt;
     input.chunks =
         std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
     return input;
@@ -79,10 +90,13 @@ std::string nodeSummaryPath(const std::string& meshPath) {
 }
 
 Status writeNodeSummary(const OctreeNode& node) {
-  const nlohmann::json summary = {
-      {"bounds", boundsToJson(node.bounds)},   {"geometricError", node.geometricError},
-      {"triangles", node.triangles},           {"vertices", node.vertices},
-      {"lockedVertices", node.lockedVertices}, {"droppedSegments", node.droppedSegments}};
+  const nlohmann::json summary = {{"bounds", boundsToJson(node.bounds)},
+                                  {"geometricError", node.geometricError},
+                                  {"triangles", node.triangles},
+                                  {"vertices", node.vertices},
+                                  {"lockedVertices", node.lockedVertices},
+                                  {"droppedSegments", node.droppedSegments},
+                                  {"features", node.features}};
   return OutputFile::writeWhole(nodeSummaryPath(node.meshPath), summary.dump());
 }
 
@@ -97,6 +111,7 @@ bool readNodeSummary(const std::string& path, OctreeNode& node) {
     node.vertices = summary.at("vertices").get<std::uint64_t>();
     node.lockedVertices = summary.at("lockedVertices").get<std::uint64_t>();
     node.droppedSegments = summary.at("droppedSegments").get<std::uint64_t>();
+    node.features = summary.at("features").get<std::vector<std::uint32_t>>();
   } catch (const nlohmann::json::exception&) {
     return false;  // a damaged summary: build the node again
   }

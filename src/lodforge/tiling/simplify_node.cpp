@@ -163,6 +163,7 @@ Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border,
         kept.positions.push_back(mesh.positions[mesh.indices[t + k]]);
         if (!mesh.colors.empty()) kept.colors.push_back(mesh.colors[mesh.indices[t + k]]);
         if (!mesh.normals.empty()) kept.normals.push_back(mesh.normals[mesh.indices[t + k]]);
+        if (!mesh.features.empty()) kept.features.push_back(mesh.features[mesh.indices[t + k]]);
         keptBorder.push_back(border[mesh.indices[t + k]]);
       }
       kept.indices.push_back(to);
@@ -219,10 +220,12 @@ SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& gri
   mesh.positions.resize(simplified.vertices.size());
   if (!merged.colors.empty()) mesh.colors.resize(simplified.vertices.size());
   if (!merged.normals.empty()) mesh.normals.resize(simplified.vertices.size());
+  if (!merged.features.empty()) mesh.features.resize(simplified.vertices.size());
   for (std::size_t i = 0; i < simplified.vertices.size(); ++i) {
     mesh.positions[i] = merged.positions[simplified.vertices[i]];
     if (!mesh.colors.empty()) mesh.colors[i] = merged.colors[simplified.vertices[i]];
     if (!mesh.normals.empty()) mesh.normals[i] = merged.normals[simplified.vertices[i]];
+    if (!mesh.features.empty()) mesh.features[i] = merged.features[simplified.vertices[i]];
   }
   mesh.indices = simplified.indices;
   // Geometric error: measured against the children's geometry, plus what they already

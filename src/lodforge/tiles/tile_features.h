@@ -1,0 +1,35 @@
+// The parts a mesh tile holds, pickable (3D Tiles 1.1 conventions): EXT_mesh_features gives each
+// vertex a feature ID, a row of the tile's EXT_structural_metadata property table, which names
+// the part (class "part": id, name, path, source). Rows are the tile's own parts only, so a
+// coarse tile that kept a few parts lists those few.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "lodforge/core/status.h"
+#include "lodforge/io/glb_writer.h"
+#include "lodforge/tiling/chunk_input.h"
+
+namespace lodforge {
+
+// A tile's features: its distinct parts (global feature ids, ascending) and each vertex's row.
+struct TileFeatures {
+  std::vector<std::uint32_t> parts;
+  std::vector<std::uint32_t> rows;  // one per vertex
+};
+// `features` is one global feature id per vertex (kNoFeature nowhere: the mesh is all parts).
+TileFeatures tileFeatures(std::span<const std::uint32_t> features);
+
+// The "_FEATURE_ID_0" attribute over `rows` (UNSIGNED_SHORT while the rows fit, else FLOAT,
+// exact to 2^24; glTF has no 32-bit integer vertex attribute), backed by `storage`.
+GlbVertexAttribute featureIdAttribute(std::span<const std::uint32_t> rows,
+                                      std::vector<std::byte>& storage);
+
+// The schema and the property table of `parts` (rows of `table`) into the writer; the table is
+// property table 0.
+Status addPartTable(GlbWriter& writer, const PartTable& table,
+                    std::span<const std::uint32_t> parts);
+
+}  // namespace lodforge

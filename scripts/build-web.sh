@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../web"
 [[ -d node_modules ]] || { echo "web/node_modules is missing: run scripts/install-deps.sh" >&2; exit 1; }
 if [[ -f dist/cesium/index.html && -f dist/three/index.html ]]; then
-  newer=$(find cesium three format.js point_colors.js panel.css vite.config.js package-lock.json -newer dist/cesium/index.html | head -1)
+  newer=$(find cesium three format.js point_colors.js parts_panel.js panel.css vite.config.js package-lock.json -newer dist/cesium/index.html | head -1)
   [[ -z $newer ]] && exit 0
 fi
 echo "build-web: vite build into web/dist"

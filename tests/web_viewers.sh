@@ -2,7 +2,8 @@
 # The browser viewers end to end (tests/js/web-viewers.mjs): `lodforge serve` on a free loopback
 # port, the CesiumJS and the three.js page in headless chromium, for a mesh tileset (the horse,
 # georeferenced, meshopt-compressed), a point tileset (a LAS placed from its own CRS) and the
-# surface reconstructed from a LAZ scan (tiles --surface, placed from the file's CRS).
+# surface reconstructed from a LAZ scan (tiles --surface, placed from the file's CRS), and a STEP
+# assembly whose parts are picked, found, highlighted and hidden in both viewers.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -10,7 +11,7 @@ here=$(cd "$(dirname "$0")" && pwd)
   { echo "the viewers are not built: run scripts/build-web.sh (make does)" >&2; exit 1; }
 [[ -d $here/js/node_modules/playwright-core ]] ||
   { echo "playwright-core is not installed: run scripts/install-deps.sh" >&2; exit 1; }
-rm -rf "$out" && mkdir -p "$out/horse-shots" "$out/autzen-shots" "$out/surface-shots"
+rm -rf "$out" && mkdir -p "$out/horse-shots" "$out/autzen-shots" "$out/surface-shots" "$out/motor-shots"
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse" --chunk-size 0.05 \
   --origin 8.5417,47.3769,408 --compress meshopt
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/horse" "$out/horse-shots" --min-coverage 0.03
@@ -18,3 +19,5 @@ node "$here/js/web-viewers.mjs" "$lodforge" "$out/horse" "$out/horse-shots" --mi
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/autzen" "$out/autzen-shots" --min-coverage 0.03
 "$lodforge" -q tiles "$data/points/autzen_trim.laz" --surface -o "$out/surface" --voxel 4 --chunk-size 100
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/surface" "$out/surface-shots" --min-coverage 0.03
+"$lodforge" -q tiles "$data/cad/as1_motor.step" -o "$out/motor" --origin 2.35,48.85,35
+node "$here/js/web-viewers.mjs" "$lodforge" "$out/motor" "$out/motor-shots" --min-coverage 0.03

@@ -6,7 +6,7 @@
 // and hiding every class in the legend must empty the view.
 //   node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage 0.02]
 import { spawn } from 'node:child_process';
-import { writeFileSync } from 'node:fs';
+import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { coverageOf, differenceOf, keepLocal, launchChromium } from './chromium.mjs';
 
@@ -68,6 +68,56 @@ async function checkColorModes(tab, viewer, coverage, firstPng, mine) {
   if (shown < minCoverage) mine(`with the classes shown again the model covers ${(100 * shown).toFixed(2)} %`);
 }
 
+// A tileset of parts: the viewer finds a known part by name (one the root tile still holds, the
+// largest) and flies to it; with every other part hidden, the pixels that pick anything pick it,
+// highlighted; a real click on one shows its name and path in the panel, as parts.json has them;
+// hiding it leaves that pixel to another part or to nothing.
+async function checkParts(tab, viewer, mine) {
+  const parts = JSON.parse(readFileSync(path.join(tilesetDir, 'parts.json'), 'utf8'));
+  const inRoot = new Set(parts.parts.map((p) => p.id));
+  for (const id of parts.levels[parts.levels.length - 1].missing) inRoot.delete(id);
+  const size = (p) => (p.bounds ? Math.hypot(p.bounds[3] - p.bounds[0], p.bounds[4] - p.bounds[1], p.bounds[5] - p.bounds[2]) : 0);
+  const known = parts.parts.filter((p) => inRoot.has(p.id)).sort((a, b) => size(b) - size(a))[0];
+  const count = await tab.evaluate(() => window.lodforge.parts.count);
+  if (count !== parts.parts.length) mine(`the viewer has ${count} parts, parts.json ${parts.parts.length}`);
+  const found = await tab.evaluate((name) => window.lodforge.parts.find(name), known.name);
+  if (!found.includes(known.id)) mine(`finding "${known.name}" gave ${JSON.stringify(found)}`);
+  await tab.evaluate((id) => window.lodforge.parts.isolate(id), known.id);
+  await tab.waitForFunction(() => window.lodforge.parts.idle(), null, { timeout: 60000 });
+  await tab.waitForTimeout(1000);
+  const box = await tab.evaluate(() => { const r = document.querySelector('canvas').getBoundingClientRect(); return [r.width, r.height]; });
+  const hits = [];
+  for (let j = 1; j < 16; ++j)
+    for (let i = 1; i < 24; ++i) {
+      const x = Math.round((box[0] * i) / 24), y = Math.round((box[1] * j) / 16);
+      const hit = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [x, y]);
+      if (hit) hits.push({ x, y, ...hit });
+    }
+  writeFileSync(path.join(outDir, `${viewer}-part.png`), await tab.screenshot());
+  const others = hits.filter((h) => h.id !== known.id);
+  console.log(`${viewer}: "${known.name}" (part ${known.id} of ${count}) found and isolated: ` +
+              `${hits.length} of 345 pixels pick it, ${others.length} pick another part`);
+  if (hits.length === 0) { mine(`part "${known.name}" is not on screen after finding it`); return; }
+  if (others.length > 0) mine(`with "${known.name}" isolated, pixels pick ${JSON.stringify(others[0])}`);
+  for (const h of hits) {
+    if (h.name !== known.name) mine(`the tile names part ${h.id} "${h.name}", parts.json "${known.name}"`);
+    if (!h.highlighted) mine(`part ${h.id} is not highlighted after finding it`);
+  }
+  const hit = hits[Math.floor(hits.length / 2)];
+  const box0 = await tab.evaluate(() => { const r = document.querySelector('canvas').getBoundingClientRect(); return [r.left, r.top]; });
+  await tab.mouse.click(box0[0] + hit.x, box0[1] + hit.y);
+  await tab.waitForTimeout(300);
+  const shown = await tab.evaluate(() => window.lodforge.parts.shown());
+  if (!shown.includes(known.name) || !shown.includes(known.path))
+    mine(`clicking part ${known.id} shows "${shown}", not its name "${known.name}" and path "${known.path}"`);
+  await tab.evaluate(() => window.lodforge.parts.showAll());
+  await tab.evaluate((id) => window.lodforge.parts.hide(id), known.id);
+  await tab.waitForTimeout(1000);
+  const after = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [hit.x, hit.y]);
+  if (after && after.id === known.id) mine(`part ${known.id} is still picked after hiding it`);
+  console.log(`${viewer}: a click shows "${shown}"; hidden, its pixel picks ${after ? `"${after.name}"` : 'nothing'}`);
+}
+
 const { context, close: closeBrowser } = await launchChromium();
 const problems = [];
 try {
@@ -97,6 +147,10 @@ try {
     console.log(`${viewer}: ${report.tilesLoaded} tiles loaded, "${stats}", model covers ${(100 * coverage).toFixed(1)} % (${shot})`);
     if (coverage < minCoverage) mine(`the model covers ${(100 * coverage).toFixed(2)} % of the view`);
     if (report.colorModes) await checkColorModes(tab, viewer, coverage, png, mine);
+    if (existsSync(path.join(tilesetDir, 'parts.json'))) {
+      if (!report.parts) mine('the tileset has parts.json, the viewer offers no parts');
+      else await checkParts(tab, viewer, mine);
+    }
     await tab.close();
   }
 } catch (e) {

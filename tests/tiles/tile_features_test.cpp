@@ -200,6 +200,12 @@ TEST(TileFeatures, EveryVertexOfEveryTileNamesItsPart) {
   EXPECT_EQ(parts["source"], "cad.glb");
   ASSERT_EQ(parts["parts"].size(), model->objectCount());
   EXPECT_EQ(parts["parts"][7]["name"], model->objectName(7));
+  const auto box = parts["parts"][7]["bounds"].get<std::array<double, 6>>();
+  const ObjectRecord& seventh = model->objects[7];
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_NEAR(box[axis], model->origin[axis] + seventh.bounds.min[axis], 1e-9);
+    EXPECT_NEAR(box[3 + axis], model->origin[axis] + seventh.bounds.max[axis], 1e-9);
+  }
   ASSERT_EQ(parts["levels"].size(), static_cast<std::size_t>(stats->levels) + 1);
   std::size_t missingAtTop = 0;
   for (const auto& level : parts["levels"]) {

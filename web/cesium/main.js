@@ -2,6 +2,7 @@
 // imagery or terrain (no globe), flies to the tileset, shows what is loaded and drawn, and
 // lets the screen-space error be chosen. window.lodforge reports to tests.
 import { drawnSummary, formatBytes, onScreenSpaceError } from '../format.js';
+import { boundsOf, loadParts, partsPanel } from '../parts_panel.js';
 import { CLASSES, classColor, colorModes, colorPanel, hexToRgb } from '../point_colors.js';
 
 const Cesium = window.Cesium;
@@ -31,7 +32,8 @@ async function rootContent(tileset) {
   const classes = new Set(values('_CLASSIFICATION', (at) => view.getUint8(at)));
   const wide = values('_INTENSITY', (at) => view.getUint16(at, true)).some((v) => v > 255);
   return { names: Object.keys(attributes), classes, intensityMax: wide ? 65535 : 255,
-           hasMetadata: !!(gltf.extensions && gltf.extensions.EXT_structural_metadata) };
+           hasMetadata: !!(gltf.extensions && gltf.extensions.EXT_structural_metadata &&
+                           gltf.extensions.EXT_structural_metadata.propertyAttributes) };
 }
 
 const vec3 = (rgb) => `vec3(${rgb.map((x) => x.toFixed(3)).join(', ')})`;
@@ -108,6 +110,62 @@ async function addColouring(tileset) {
   report.classes = () => [...root.classes];
 }
 
+// Tilesets of parts (EXT_mesh_features + the tiles' property tables): click a part to pick it,
+// find parts by name, hide them. A style keys on each feature's "id" property.
+async function addParts(viewer, tileset) {
+  const parts = await loadParts('/tiles/');
+  if (!parts) return;
+  let highlighted = [], hidden = [];
+  const idIs = (ids) => ids.map((id) => `\${id} === ${id}`).join(' || ');
+  const restyle = () => {
+    tileset.style = new Cesium.Cesium3DTileStyle({
+      show: hidden.length ? `!(${idIs(hidden)})` : 'true',
+      color: highlighted.length
+        ? { conditions: [[idIs(highlighted), "color('#ffd21f')"], ['true', "color('white')"]] }
+        : "color('white')",
+    });
+  };
+  const panel = partsPanel(parts, {
+    highlight: (ids) => { highlighted = ids; restyle(); },
+    hide: (ids) => { hidden = ids; restyle(); },
+    flyTo: (ids) => {
+      const b = boundsOf(parts, ids);
+      if (!b) return;
+      const toWorld = (x, y, z) =>
+        Cesium.Matrix4.multiplyByPoint(tileset.root.computedTransform, new Cesium.Cartesian3(x, y, z),
+                                       new Cesium.Cartesian3());
+      const sphere = Cesium.BoundingSphere.fromPoints([toWorld(b[0], b[1], b[2]), toWorld(b[3], b[4], b[5])]);
+      viewer.camera.flyToBoundingSphere(sphere, { duration: 0 });
+    },
+  });
+  const featureAt = (x, y) => {
+    const picked = viewer.scene.pick(new Cesium.Cartesian2(x, y));
+    return picked instanceof Cesium.Cesium3DTileFeature ? picked : null;
+  };
+  const handler = new Cesium.ScreenSpaceEventHandler(viewer.scene.canvas);
+  handler.setInputAction((click) => {
+    const feature = featureAt(click.position.x, click.position.y);
+    panel.picked(feature ? feature.getProperty('id') : null);
+  }, Cesium.ScreenSpaceEventType.LEFT_CLICK);
+  // For tests: what is at a pixel (CSS pixels of the canvas), as the tile's property table says.
+  report.parts = {
+    count: parts.parts.length,
+    pick: (x, y) => {
+      const f = featureAt(x, y);
+      if (!f) return null;
+      const color = f.color;
+      return { id: f.getProperty('id'), name: f.getProperty('name'), path: f.getProperty('path'),
+               highlighted: color.red === 1 && color.blue < 0.2 };
+    },
+    find: (text) => panel.find(text),
+    isolate: (id) => panel.hide(parts.parts.map((p) => p.id).filter((i) => i !== id)),
+    hide: (id) => panel.hide([id]),
+    showAll: () => panel.showAll(),
+    shown: () => panel.shown(),
+    idle: () => tileset.tilesLoaded,
+  };
+}
+
 async function main() {
   const viewer = new Cesium.Viewer('view', {
     baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false, animation: false,
@@ -146,6 +204,7 @@ async function main() {
   });
   onScreenSpaceError((pixels) => { tileset.maximumScreenSpaceError = pixels; });
   await addColouring(tileset);
+  await addParts(viewer, tileset);
   await viewer.flyTo(tileset, { duration: 0 });
 }
 

@@ -8,6 +8,7 @@ import { MeshoptDecoder } from 'three/examples/jsm/libs/meshopt_decoder.module.j
 import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
 import { drawnSummary, formatBytes, formatCount, onScreenSpaceError } from '../format.js';
+import { boundsOf, loadParts, partsPanel } from '../parts_panel.js';
 import { classColor, colorModes, colorPanel, intensityGrey, ramp } from '../point_colors.js';
 
 const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0 });
@@ -108,6 +109,132 @@ report.setClassVisible = (value, visible) => {
 };
 report.classes = () => [...colouring.classes];
 
+// Tilesets of parts: each mesh's "_feature_id_0" attribute gives a vertex's row in its tile's
+// property table; the table's "id" column (read from the tile's GLB, which the browser has
+// cached) turns rows into parts of parts.json. Highlighting and hiding recolour the vertices
+// (alpha 0 is discarded by alphaTest; a triangle's corners are all of one part).
+const HIGHLIGHT = [255, 210, 31];
+const partState = { parts: null, highlighted: new Set(), hidden: new Set(), meshes: new Set() };
+
+// The property table's "id" column of a tile's GLB.
+async function tilePartIds(url) {
+  const bytes = await (await fetch(url)).arrayBuffer();
+  const view = new DataView(bytes);
+  const jsonLength = view.getUint32(12, true);
+  const gltf = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, 20, jsonLength)));
+  const metadata = gltf.extensions && gltf.extensions.EXT_structural_metadata;
+  if (!metadata || !metadata.propertyTables) return null;
+  const table = metadata.propertyTables[0];
+  const ids = gltf.bufferViews[table.properties.id.values];
+  return new Uint32Array(bytes.slice(20 + jsonLength + 8 + (ids.byteOffset ?? 0),
+                                     20 + jsonLength + 8 + (ids.byteOffset ?? 0) + ids.byteLength));
+}
+
+function partOfVertex(mesh, vertex) {
+  const rows = mesh.geometry.getAttribute('_feature_id_0');
+  const ids = mesh.userData.partIds;
+  return rows && ids ? ids[Math.round(rows.getX(vertex))] : null;
+}
+
+function recolourParts(mesh) {
+  const g = mesh.geometry;
+  const color = g.getAttribute('color');
+  const rgb = mesh.userData.rgb;
+  for (let i = 0; i < color.count; ++i) {
+    const part = partOfVertex(mesh, i);
+    const c = partState.highlighted.has(part) ? HIGHLIGHT : rgb ? [rgb[4 * i], rgb[4 * i + 1], rgb[4 * i + 2]] : [255, 255, 255];
+    color.array.set([c[0], c[1], c[2], partState.hidden.has(part) ? 0 : 255], 4 * i);
+  }
+  color.needsUpdate = true;
+}
+
+// A tile's meshes, as they load: RGBA colours to write into (the original kept), its part ids.
+async function prepareParts(scene, url) {
+  const ids = await tilePartIds(url);
+  if (!ids) return;
+  scene.traverse((mesh) => {
+    if (!mesh.isMesh || !mesh.geometry.getAttribute('_feature_id_0')) return;
+    const g = mesh.geometry;
+    const old = g.getAttribute('color');
+    const count = g.getAttribute('position').count;
+    let rgb = null;
+    if (old) {
+      rgb = new Uint8Array(count * 4);
+      for (let i = 0; i < count; ++i) {
+        rgb[4 * i] = Math.round(old.getX(i) * 255);
+        rgb[4 * i + 1] = Math.round(old.getY(i) * 255);
+        rgb[4 * i + 2] = Math.round(old.getZ(i) * 255);
+      }
+    }
+    mesh.userData.rgb = rgb;
+    mesh.userData.partIds = ids;
+    g.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(count * 4), 4, true));
+    mesh.material = mesh.material.clone();
+    mesh.material.vertexColors = true;
+    mesh.material.alphaTest = 0.5;
+    mesh.material.needsUpdate = true;
+    partState.meshes.add(mesh);
+    recolourParts(mesh);
+  });
+}
+
+function addParts(parts, tiles, camera, controls, renderer, pivot) {
+  partState.parts = parts;
+  const restyle = () => { for (const mesh of partState.meshes) recolourParts(mesh); };
+  const raycaster = new THREE.Raycaster();
+  // The part drawn at a pixel (CSS pixels of the canvas): the nearest hit of a part not hidden.
+  const partAt = (x, y) => {
+    const r = renderer.domElement.getBoundingClientRect();
+    raycaster.setFromCamera(new THREE.Vector2((x / r.width) * 2 - 1, -(y / r.height) * 2 + 1), camera);
+    for (const hit of raycaster.intersectObject(tiles.group, true)) {
+      if (!hit.face || !partState.meshes.has(hit.object)) continue;
+      const part = partOfVertex(hit.object, hit.face.a);
+      if (part !== null && !partState.hidden.has(part)) return part;
+    }
+    return null;
+  };
+  const panel = partsPanel(parts, {
+    highlight: (ids) => { partState.highlighted = new Set(ids); restyle(); },
+    hide: (ids) => { partState.hidden = new Set(ids); restyle(); },
+    flyTo: (ids) => {
+      const b = boundsOf(parts, ids);
+      if (!b) return;
+      const corners = [new THREE.Vector3(b[0], b[1], b[2]), new THREE.Vector3(b[3], b[4], b[5])]
+        .map((p) => p.applyMatrix4(pivot.matrixWorld));
+      const centre = corners[0].clone().add(corners[1]).multiplyScalar(0.5);
+      const radius = Math.max(corners[0].distanceTo(corners[1]) / 2, 1e-6);
+      const direction = camera.position.clone().sub(controls.target).normalize();
+      controls.target.copy(centre);
+      camera.position.copy(centre).add(direction.multiplyScalar(radius * 2.5));
+      camera.near = radius / 1000;
+      camera.updateProjectionMatrix();
+      controls.update();
+    },
+  });
+  let down = null;
+  renderer.domElement.addEventListener('pointerdown', (e) => { down = [e.clientX, e.clientY]; });
+  renderer.domElement.addEventListener('pointerup', (e) => {
+    if (!down || Math.hypot(e.clientX - down[0], e.clientY - down[1]) > 4) return;  // a drag
+    const r = renderer.domElement.getBoundingClientRect();
+    panel.picked(partAt(e.clientX - r.left, e.clientY - r.top));
+  });
+  report.parts = {
+    count: parts.parts.length,
+    pick: (x, y) => {
+      const id = partAt(x, y);
+      if (id === null) return null;
+      const part = parts.parts[id];
+      return { id, name: part.name, path: part.path, highlighted: partState.highlighted.has(id) };
+    },
+    find: (text) => panel.find(text),
+    isolate: (id) => panel.hide(parts.parts.map((p) => p.id).filter((i) => i !== id)),
+    hide: (id) => panel.hide([id]),
+    showAll: () => panel.showAll(),
+    shown: () => panel.shown(),
+    idle: () => tiles.stats.downloading === 0 && tiles.stats.parsing === 0,
+  };
+}
+
 function main() {
   const renderer = new THREE.WebGLRenderer({ antialias: true });
   renderer.setPixelRatio(window.devicePixelRatio);
@@ -156,17 +283,33 @@ function main() {
     colouring.heights = [sphere.center.y - sphere.radius, sphere.center.y + sphere.radius];
     return true;
   };
+  const pending = new Set();  // part ids of tiles still being read
   tiles.addEventListener('load-model', (e) => {
     report.tilesLoaded += 1;
     e.scene.traverse((o) => { if (o.isPoints) preparePoints(o); });
+    if (partState.parts || report.partsPending) {
+      const base = new URL(`${e.tile.__basePath ?? '/tiles'}/`, location.href);
+      const job = prepareParts(e.scene, new URL(e.tile.content.uri, base).href)
+        .catch((error) => report.failed.push(`${e.tile.content.uri}: ${error}`))
+        .finally(() => pending.delete(job));
+      pending.add(job);
+    }
   });
   tiles.addEventListener('dispose-model', (e) => {
-    e.scene.traverse((o) => colouring.points.delete(o));
+    e.scene.traverse((o) => { colouring.points.delete(o); partState.meshes.delete(o); });
   });
   tiles.addEventListener('load-error', (e) => {
     report.failed.push(`${e.url}: ${e.error && e.error.message}`);
   });
   tiles.addEventListener('tiles-load-end', () => { if (framed && report.tilesLoaded > 0) report.loaded = true; });
+  report.partsPending = true;
+  loadParts('/tiles/').then((parts) => {
+    report.partsPending = false;
+    if (!parts) return;
+    addParts(parts, tiles, camera, controls, renderer, pivot);
+    const idle = report.parts.idle;
+    report.parts.idle = () => idle() && pending.size === 0;
+  }).catch((error) => { report.error = String(error); });
 
   onScreenSpaceError((pixels) => { tiles.errorTarget = pixels; });
   window.addEventListener('resize', () => {

@@ -44,8 +44,12 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   if (mesh.normals.empty()) computeVertexNormals(positions, indices, normals);
   for (Vec3f& p : positions) p = toYUp(p);
   for (Vec3f& n : normals) n = toYUp(n);
-  Result<GlbWriter> writer = GlbWriter::create(
-      path, {.doubleSided = false, .meshoptCompression = options.meshoptCompression});
+  // A tile of parts has its one node straight in the scene: 3d-tiles-renderer 0.4's
+  // EXT_mesh_features loader fails on a node without a mesh (the root that holds the centre).
+  Result<GlbWriter> writer =
+      GlbWriter::create(path, {.doubleSided = false,
+                               .meshoptCompression = options.meshoptCompression,
+                               .flatScene = features});
   if (!writer) return writer.status();
   GlbMeshData data{positions, normals, colors, indices, options.quantize};
   std::vector<std::byte> featureStorage;
@@ -59,8 +63,13 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   }
   Result<std::uint32_t> glbMesh = writer->addMesh(data, "tile");
   if (!glbMesh) return glbMesh.status();
-  writer->addNode("tile", *glbMesh);
-  writer->setRootTranslation(toYUp(center));
+  if (features) {
+    const Mat4d translation = Mat4d::translation(toYUp(center));
+    writer->addNode("tile", *glbMesh, &translation);
+  } else {
+    writer->addNode("tile", *glbMesh);
+    writer->setRootTranslation(toYUp(center));
+  }
   return writer->finish();
 }
 

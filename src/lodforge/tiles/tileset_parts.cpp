@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
+#include "lodforge/tiling/resume.h"
 
 namespace lodforge {
 
@@ -25,7 +26,11 @@ std::vector<std::vector<std::uint32_t>> partsMissingPerLevel(const OctreeResult&
 Status writePartsJson(const OctreeResult& octree, const PartTable& parts, const std::string& path) {
   nlohmann::json list = nlohmann::json::array();
   for (std::size_t i = 0; i < parts.size(); ++i)
-    list.push_back({{"id", i}, {"name", parts.names[i]}, {"path", parts.paths[i]}});
+    list.push_back(
+        {{"id", i},
+         {"name", parts.names[i]},
+         {"path", parts.paths[i]},
+         {"bounds", parts.bounds[i].empty() ? nlohmann::json() : boundsToJson(parts.bounds[i])}});
   nlohmann::json levels = nlohmann::json::array();
   const auto missing = partsMissingPerLevel(octree, parts.size());
   for (std::size_t level = 0; level < missing.size(); ++level)

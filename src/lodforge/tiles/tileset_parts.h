@@ -1,7 +1,8 @@
 // parts.json beside tileset.json, for a tileset of parts (a CAD assembly): every part with its
-// id (the "id" of the tiles' property tables), name, assembly path and source, and for each level
-// of the octree the parts none of its tiles holds any more (left out of coarse tiles as too small,
-// dropSmallSegments), so a viewer can say what a coarse view is missing.
+// id (the "id" of the tiles' property tables), name, assembly path and bounds (in the tileset's
+// frame, [min x, y, z, max x, y, z], null for a part without triangles), the source, and for each
+// level of the octree the parts none of its tiles holds any more (left out of coarse tiles as too
+// small, dropSmallSegments), so a viewer can say what a coarse view is missing.
 #pragma once
 
 #include <cstdint>

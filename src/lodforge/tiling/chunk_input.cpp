@@ -28,7 +28,7 @@ Result<Model> readInputModel(const std::string& path, const CadReadOptions& cad,
 }
 
 // The model's objects as the parts of the tileset.
-PartTable partTable(const std::string& path, const Model& model) {
+PartTable partTable(const std::string& path, const Model& model, std::span<const Vec3d> world) {
   PartTable parts;
   parts.source = std::filesystem::path(path).filename().string();
   parts.names.reserve(model.objectCount());
@@ -36,6 +36,9 @@ PartTable partTable(const std::string& path, const Model& model) {
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
     parts.names.emplace_back(model.objectName(o));
     parts.paths.emplace_back(model.objectPath(o));
+    Aabbd& box = parts.bounds.emplace_back();
+    for (std::uint32_t v = 0; v < model.objects[o].vertexCount; ++v)
+      box.add(world[model.objects[o].vertexOffset + v]);
   }
   return parts;
 }
@@ -49,7 +52,6 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
   input.colors = model->hasColors();
   // Parts are named per vertex only when there is more than one.
   const bool features = model->objectCount() > 1;
-  if (features) input.parts = partTable(path, *model);
   // World positions (through the transform, if any) and their bounds.
   std::vector<Vec3d> world(model->vertexCount());
   for (std::size_t v = 0; v < world.size(); ++v) {
@@ -60,6 +62,7 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
                                         v));
     input.bounds.add(world[v]);
   }
+  if (features) input.parts = partTable(path, *model, world);
   // Normals: the model's, or area-weighted over each whole object; turned with the positions.
   std::vector<Vec3f> normals = model->normals;
   if (!model->hasNormals()) {

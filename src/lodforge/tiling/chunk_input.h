@@ -42,6 +42,7 @@ struct PartTable {
   std::string source;              // the input file's name, without its folder
   std::vector<std::string> names;  // by feature id
   std::vector<std::string> paths;  // by feature id; empty strings where there is no assembly
+  std::vector<Aabbd> bounds;       // by feature id, in the tileset's frame (empty: no triangles)
 
   std::size_t size() const { return names.size(); }
   bool empty() const { return names.empty(); }

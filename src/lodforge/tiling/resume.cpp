@@ -22,6 +22,14 @@ Aabbd boundsFromJson(const nlohmann::json& json) {
   return bounds;
 }
 
+namespace {
+nlohmann::json boundsList(const std::vector<Aabbd>& boxes) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Aabbd& box : boxes) list.push_back(boundsToJson(box));
+  return list;
+}
+}  // namespace
+
 Status saveChunkState(const std::string& path, const nlohmann::json& identity,
                       const ChunkInput& input) {
   const ChunkGrid& grid = input.chunks->grid();
@@ -43,7 +51,8 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
       {"parts",
        {{"source", input.parts.source},
         {"names", input.parts.names},
-        {"paths", input.parts.paths}}}};
+        {"paths", input.parts.paths},
+        {"bounds", boundsList(input.parts.bounds)}}}};
   // (Part names come from the input and may not be UTF-8: replaced rather than thrown on.)
   return OutputFile::writeWhole(
       path, state.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
@@ -76,7 +85,10 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
     input.parts.source = parts.at("source").get<std::string>();
     input.parts.names = parts.at("names").get<std::vector<std::string>>();
     input.parts.paths = parts.at("paths").get<std::vector<std::string>>();
-    if (input.parts.paths.size() != input.parts.names.size()) return std::nullopt;
+    for (const auto& box : parts.at("bounds")) input.parts.bounds.push_back(boundsFromJson(box));
+    if (input.parts.paths.size() != input.parts.names.size() ||
+        input.parts.bounds.size() != input.parts.names.size())
+      return std::nullopt;
     input.chunks =
         std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
     return input;

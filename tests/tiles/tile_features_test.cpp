@@ -12,6 +12,7 @@
 
 #include "lodforge/core/random.h"
 #include "lodforge/generate/cad.h"
+#include "lodforge/io/glb_writer.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/tiles/tile_content.h"
 #include "lodforge/tiles/tileset.h"
@@ -47,7 +48,7 @@ struct DecodedTile {
   std::vector<std::uint32_t> rows;  // per vertex
   std::uint32_t featureCount = 0;
   std::vector<std::uint32_t> ids;  // per row
-  std::vector<std::string> names, paths, sources;
+  std::vector<std::string> names, paths, sources, materials;
 };
 
 std::string_view viewBytes(const DecodedTile& tile, std::uint32_t view) {
@@ -129,8 +130,14 @@ DecodedTile decodeTile(const fs::path& glb) {
   tile.ids.resize(idBytes.size() / 4);
   std::memcpy(tile.ids.data(), idBytes.data(), idBytes.size());
   tile.names = strings(tile, table["properties"]["name"], rows);
-  tile.paths = strings(tile, table["properties"]["path"], rows);
-  tile.sources = strings(tile, table["properties"]["source"], rows);
+  // A column of empty strings is left out (a buffer view may not be empty).
+  const auto column = [&](const char* key) {
+    return table["properties"].contains(key) ? strings(tile, table["properties"][key], rows)
+                                             : std::vector<std::string>(rows);
+  };
+  tile.paths = column("path");
+  tile.sources = column("source");
+  tile.materials = column("material");
   const auto used = tile.gltf["extensionsUsed"];
   EXPECT_NE(std::find(used.begin(), used.end(), "EXT_mesh_features"), used.end());
   EXPECT_NE(std::find(used.begin(), used.end(), "EXT_structural_metadata"), used.end());
@@ -219,6 +226,96 @@ TEST(TileFeatures, EveryVertexOfEveryTileNamesItsPart) {
   EXPECT_GT(missingAtTop, 0u);
   std::ifstream tilesetIn(root / "tiles" / "tileset.json");
   EXPECT_EQ(nlohmann::json::parse(tilesetIn)["asset"]["extras"]["parts"], kPartsFileName);
+}
+
+// Parts keep their materials through a GLB and the tiles: glass (BLEND, alpha 0.12 in its
+// colours) stays translucent at every level that still holds it, in a primitive of its own
+// drawing only glass; metal keeps its metallic-roughness; the table names each part's material.
+TEST(TileFeatures, EveryPartKeepsItsMaterialAtEveryLevel) {
+  const fs::path root = fs::path(::testing::TempDir()) / "tile-materials";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  ASSERT_TRUE(generateCad({.objects = 300, .seed = 4}, (root / "plain.glb").string()).ok());
+  Result<Model> model = readModel((root / "plain.glb").string());
+  ASSERT_TRUE(model.ok());
+  ASSERT_TRUE(model->hasColors());
+  model->materials = {{.name = "glass",
+                       .baseColor = {0.6f, 0.8f, 0.9f, 0.12f},
+                       .roughness = 0.05f,
+                       .alphaMode = AlphaMode::kBlend,
+                       .doubleSided = true},
+                      {.name = "steel", .metallic = 1, .roughness = 0.3f},
+                      {.name = "lamp", .emissive = {1, 0.5f, 0}}};
+  for (std::size_t o = 0; o < model->objectCount(); ++o) {
+    ObjectRecord& object = model->objects[o];
+    object.material = o % 4 == 3 ? kNoMaterial : static_cast<std::uint32_t>(o % 4);
+    for (std::uint32_t v = 0; v < object.vertexCount; ++v)
+      if (o % 4 == 0) model->colors[object.vertexOffset + v].a = 31;  // 0.12
+  }
+  const std::string input = (root / "cad.glb").string();
+  ASSERT_TRUE(writeGlb(*model, input, {.doubleSided = false}).ok());
+  Result<Model> back = readModel(input);
+  ASSERT_TRUE(back.ok());
+  // (Objects without a material got the writer's "default", which reads back as a fourth.)
+  ASSERT_EQ(back->materials.size(), 4u);
+  for (std::size_t m = 0; m < 3; ++m) {
+    EXPECT_EQ(back->materials[m].name, model->materials[m].name);
+    EXPECT_EQ(back->materials[m].alphaMode, model->materials[m].alphaMode);
+    EXPECT_EQ(back->materials[m].metallic, model->materials[m].metallic);
+    EXPECT_EQ(back->materials[m].emissive, model->materials[m].emissive);
+    EXPECT_EQ(back->materials[m].doubleSided, model->materials[m].doubleSided);
+  }
+  EXPECT_EQ(back->objects[4].material, 0u);
+  EXPECT_EQ(back->materials[back->objects[3].material].name, "default");
+
+  TilesOptions options;
+  options.octree.errorSamples = 2000;
+  options.input.trianglesPerChunk = 8192;
+  options.quantize = false;
+  Result<TilesStats> stats = writeTiles(input, (root / "tiles").string(), options);
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  std::set<int> levelsWithGlass;
+  for (const auto& entry : fs::directory_iterator(root / "tiles" / "tiles")) {
+    const DecodedTile tile = decodeTile(entry.path());
+    const std::vector<std::string>& materialNames = tile.materials;
+    for (std::size_t r = 0; r < tile.ids.size(); ++r) {
+      const std::uint32_t m = back->objects[tile.ids[r]].material;
+      EXPECT_EQ(materialNames[r], m == kNoMaterial ? "" : back->materials[m].name);
+    }
+    std::set<std::string> seen;
+    for (const auto& primitive : tile.gltf["meshes"][0]["primitives"]) {
+      const auto& material = tile.gltf["materials"][primitive["material"].get<std::size_t>()];
+      const std::string name = material.value("name", "");
+      EXPECT_TRUE(seen.insert(name).second) << "two primitives with material " << name;
+      // Every vertex this primitive draws is of a part with this material.
+      const auto& accessor = tile.gltf["accessors"][primitive["indices"].get<std::size_t>()];
+      const auto& view = tile.gltf["bufferViews"][accessor["bufferView"].get<std::size_t>()];
+      const char* at =
+          tile.bin.data() + view.value("byteOffset", 0u) + accessor.value("byteOffset", 0u);
+      const bool wide = accessor["componentType"] == 5125;
+      for (std::size_t i = 0; i < accessor["count"].get<std::size_t>(); ++i) {
+        std::uint32_t v = 0;
+        std::memcpy(&v, at + (wide ? 4 : 2) * i, wide ? 4 : 2);
+        const std::uint32_t m = back->objects[tile.ids[tile.rows[v]]].material;
+        ASSERT_EQ(name, m == kNoMaterial ? "default" : back->materials[m].name) << entry.path();
+      }
+      if (name == "glass") {
+        EXPECT_EQ(material["alphaMode"], "BLEND");
+        EXPECT_EQ(material["doubleSided"], true);
+        levelsWithGlass.insert(std::stoi(entry.path().filename().string()));
+      } else {
+        EXPECT_FALSE(material.contains("alphaMode")) << name;
+      }
+      if (name == "steel") {
+        EXPECT_EQ(material["pbrMetallicRoughness"]["metallicFactor"], 1.0);
+      }
+      if (name == "lamp") {
+        EXPECT_EQ(material["emissiveFactor"][1], 0.5);
+      }
+    }
+  }
+  EXPECT_EQ(levelsWithGlass.size(), static_cast<std::size_t>(stats->levels) + 1)
+      << "glass is translucent at every level";
 }
 
 // A mesh of one object (a scan) gets no features: nothing to pick, no bytes spent.

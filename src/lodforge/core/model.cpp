@@ -87,6 +87,7 @@ void weldModel(Model& model, const WeldOptions& options) {
   out.origin = model.origin;
   out.names = std::move(model.names);
   out.paths = std::move(model.paths);
+  out.materials = std::move(model.materials);
   out.objects.reserve(model.objects.size());
   std::vector<std::uint32_t> remap;
   for (std::size_t o = 0; o < model.objects.size(); ++o) {
@@ -154,6 +155,8 @@ bool isConsistent(const Model& model, std::string* why) {
       return fail(fmt::format("object {} name out of range", i));
     if (o.pathOffset + o.pathLength > model.paths.size())
       return fail(fmt::format("object {} path out of range", i));
+    if (o.material != kNoMaterial && o.material >= model.materials.size())
+      return fail(fmt::format("object {} material out of range", i));
     nextVertex += o.vertexCount;
     nextTriangle += o.triangleCount;
     if (nextVertex > model.positions.size() || nextTriangle > model.triangleCount())

@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "lodforge/core/material.h"
 #include "lodforge/core/math.h"
 
 namespace lodforge {
@@ -30,7 +31,8 @@ struct ObjectRecord {
   // the input has no assembly tree.
   std::uint64_t pathOffset = 0;
   std::uint32_t pathLength = 0;
-  Aabb bounds;  // of the object's vertices, relative to the model origin
+  std::uint32_t material = kNoMaterial;  // into Model::materials
+  Aabb bounds;                           // of the object's vertices, relative to the model origin
 };
 
 struct Model {
@@ -40,8 +42,9 @@ struct Model {
   std::vector<Rgba8> colors;           // empty or one per vertex
   std::vector<std::uint32_t> indices;  // 3 per triangle, local to the object
   std::vector<ObjectRecord> objects;
-  std::string names;  // all object names, back to back
-  std::string paths;  // all object assembly paths, back to back (often empty)
+  std::string names;                // all object names, back to back
+  std::string paths;                // all object assembly paths, back to back (often empty)
+  std::vector<Material> materials;  // what objects refer to (few: a table, not per object)
 
   std::uint64_t vertexCount() const { return positions.size(); }
   std::uint64_t triangleCount() const { return indices.size() / 3; }

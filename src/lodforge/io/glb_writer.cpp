@@ -58,6 +58,9 @@ struct GlbWriter::State {
   Status addColors(const GlbMeshData& mesh, nlohmann::json& attributes);
   Status addExtraAttributes(const GlbMeshData& mesh, nlohmann::json& attributes);
   Result<std::uint32_t> addIndices(const GlbMeshData& mesh);
+  // A primitive over `attributes` drawing the mesh's indices with `material` (default: white).
+  Result<nlohmann::json> primitive(const GlbMeshData& mesh, const nlohmann::json& attributes,
+                                   std::optional<std::uint32_t> material, GlbWriter& writer);
   // Binary chunk: in memory until it exceeds options.spillBytes, then appended to `spill`.
   std::vector<std::byte> binary;
   std::optional<OutputFile> spill;
@@ -170,6 +173,20 @@ std::uint32_t GlbWriter::addMaterial(const std::array<float, 4>& baseColor, std:
   if (state_->options.doubleSided) material["doubleSided"] = true;
   if (baseColor[3] < 1.0f) material["alphaMode"] = "BLEND";
   if (!name.empty()) material["name"] = std::string(name);
+  state_->materials.push_back(std::move(material));
+  return static_cast<std::uint32_t>(state_->materials.size() - 1);
+}
+
+std::uint32_t GlbWriter::addMaterial(const Material& m) {
+  nlohmann::json material = {{"pbrMetallicRoughness",
+                              {{"baseColorFactor", m.baseColor},
+                               {"metallicFactor", m.metallic},
+                               {"roughnessFactor", m.roughness}}}};
+  if (m.doubleSided) material["doubleSided"] = true;
+  if (m.alphaMode != AlphaMode::kOpaque) material["alphaMode"] = alphaModeName(m.alphaMode);
+  if (m.alphaMode == AlphaMode::kMask) material["alphaCutoff"] = m.alphaCutoff;
+  if (m.emissive != std::array<float, 3>{0, 0, 0}) material["emissiveFactor"] = m.emissive;
+  if (!m.name.empty()) material["name"] = m.name;
   state_->materials.push_back(std::move(material));
   return static_cast<std::uint32_t>(state_->materials.size() - 1);
 }
@@ -319,11 +336,36 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
   }
   LODFORGE_TRY(s.addColors(mesh, attributes));
   LODFORGE_TRY(s.addExtraAttributes(mesh, attributes));
+  // One primitive, or one per group of indices (each with its material) over the same vertices.
+  const GlbPrimitive whole{static_cast<std::uint32_t>(mesh.indices.size()), material};
+  const std::span<const GlbPrimitive> groups =
+      mesh.primitives.empty() ? std::span<const GlbPrimitive>(&whole, 1) : mesh.primitives;
+  nlohmann::json primitives = nlohmann::json::array();
+  std::size_t first = 0;
+  for (const GlbPrimitive& group : groups) {
+    GlbMeshData part = mesh;
+    part.indices = mesh.indices.subspan(first, mesh.points ? 0 : group.indexCount);
+    first += group.indexCount;
+    Result<nlohmann::json> primitive = s.primitive(part, attributes, group.material, *this);
+    if (!primitive) return primitive.status();
+    primitives.push_back(std::move(*primitive));
+  }
+  assert(mesh.points || first == mesh.indices.size());
+  nlohmann::json entry = {{"primitives", std::move(primitives)}};
+  if (!name.empty()) entry["name"] = std::string(name);
+  s.meshes.push_back(std::move(entry));
+  return static_cast<std::uint32_t>(s.meshes.size() - 1);
+}
+
+Result<nlohmann::json> GlbWriter::State::primitive(const GlbMeshData& mesh,
+                                                   const nlohmann::json& attributes,
+                                                   std::optional<std::uint32_t> material,
+                                                   GlbWriter& writer) {
+  State& s = *this;
   Result<std::uint32_t> indices = s.addIndices(mesh);
   if (!indices) return indices.status();
-
   if (!material) {
-    if (!s.defaultMaterial) s.defaultMaterial = addMaterial({1, 1, 1, 1}, "default");
+    if (!s.defaultMaterial) s.defaultMaterial = writer.addMaterial({1, 1, 1, 1}, "default");
     material = s.defaultMaterial;
   }
   nlohmann::json primitive = {{"attributes", attributes}, {"mode", 4}, {"material", *material}};
@@ -344,10 +386,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
   } else {
     primitive["indices"] = *indices;
   }
-  nlohmann::json entry = {{"primitives", nlohmann::json::array({primitive})}};
-  if (!name.empty()) entry["name"] = std::string(name);
-  s.meshes.push_back(std::move(entry));
-  return static_cast<std::uint32_t>(s.meshes.size() - 1);
+  return primitive;
 }
 
 namespace {
@@ -473,6 +512,19 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
   Result<GlbWriter> writer = GlbWriter::create(path, options);
   if (!writer) return writer.status();
   Progress progress("writing " + path, model.triangleCount());
+  // The model's materials, written when used; their base colour is in the vertex colours when
+  // there are any (readers bake it in), so it is white there.
+  std::vector<std::optional<std::uint32_t>> materials(model.materials.size());
+  const auto materialOf = [&](std::uint32_t m) -> std::optional<std::uint32_t> {
+    if (m >= materials.size()) return std::nullopt;
+    if (!materials[m]) {
+      Material material = model.materials[m];
+      if (model.hasColors()) material.baseColor = {1, 1, 1, 1};
+      if (options.doubleSided) material.doubleSided = true;
+      materials[m] = writer->addMaterial(material);
+    }
+    return materials[m];
+  };
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
     if (o % 1024 == 0) LODFORGE_TRY(checkCancelled());
     const ObjectRecord& record = model.objects[o];
@@ -485,7 +537,8 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
       if (model.hasColors())
         data.colors = std::span(model.colors).subspan(record.vertexOffset, record.vertexCount);
       data.indices = model.objectIndices(o);
-      Result<std::uint32_t> added = writer->addMesh(data, model.objectName(o));
+      Result<std::uint32_t> added =
+          writer->addMesh(data, model.objectName(o), materialOf(record.material));
       if (!added) return added.status();
       mesh = *added;
     }

@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "lodforge/core/material.h"
 #include "lodforge/core/model.h"
 #include "lodforge/core/status.h"
 
@@ -30,6 +31,12 @@ struct GlbVertexAttribute {
 struct GlbFeatureIds {
   std::uint32_t featureCount = 0;  // distinct features the attribute holds (0..count-1)
   std::uint32_t propertyTable = 0;
+};
+
+// A primitive of a mesh: the next `indexCount` indices, drawn with `material`.
+struct GlbPrimitive {
+  std::uint32_t indexCount = 0;
+  std::optional<std::uint32_t> material;
 };
 
 struct GlbMeshData {
@@ -50,6 +57,9 @@ struct GlbMeshData {
   // EXT_mesh_features: the extra attribute "_FEATURE_ID_0" holds each vertex's feature, a row
   // of this property table (of setStructuralMetadata's).
   std::optional<GlbFeatureIds> featureIds = std::nullopt;
+  // Empty: one primitive with addMesh's material. Otherwise the indices in groups, one primitive
+  // each, all over the same vertex attributes (a tile's parts grouped by material).
+  std::span<const GlbPrimitive> primitives = {};
 };
 
 // The grid step of a quantised mesh inside `bounds`: its longest side over 65535.
@@ -79,6 +89,8 @@ class GlbWriter {
 
   // A material with this base colour (linear RGBA); index for addMesh.
   std::uint32_t addMaterial(const std::array<float, 4>& baseColor, std::string_view name = {});
+  // A material as the input described it.
+  std::uint32_t addMaterial(const Material& material);
   // Writes the mesh's data; returns its mesh index for addNode. Empty meshes are refused (assert).
   Result<std::uint32_t> addMesh(const GlbMeshData& mesh, std::string_view name = {},
                                 std::optional<std::uint32_t> material = std::nullopt);

@@ -118,6 +118,7 @@ class Loader {
       : gltf_(gltf), name_(name), binOffset_(binOffset) {}
 
   Model load() {
+    readMaterials();
     decideColors();
     traverseScene();
     placeAtOrigin();
@@ -234,6 +235,30 @@ class Loader {
             loadComponent(data + i * elementSize + static_cast<std::size_t>(c) * size,
                           accessor.componentType, accessor.normalized);
       }
+    }
+  }
+
+  // The file's materials, in its order (objects refer to them by the same index). The base
+  // colour also goes into the vertex colours (decideColors), which every writer carries.
+  void readMaterials() {
+    for (const auto& m : gltf_.materials) {
+      Material material;
+      material.name = m.name;
+      const auto& pbr = m.pbrMetallicRoughness;
+      if (pbr.baseColorFactor.size() == 4)
+        for (std::size_t k = 0; k < 4; ++k)
+          material.baseColor[k] = static_cast<float>(pbr.baseColorFactor[k]);
+      material.metallic = static_cast<float>(pbr.metallicFactor);
+      material.roughness = static_cast<float>(pbr.roughnessFactor);
+      material.alphaMode = m.alphaMode == "BLEND"  ? AlphaMode::kBlend
+                           : m.alphaMode == "MASK" ? AlphaMode::kMask
+                                                   : AlphaMode::kOpaque;
+      material.alphaCutoff = static_cast<float>(m.alphaCutoff);
+      material.doubleSided = m.doubleSided;
+      if (m.emissiveFactor.size() == 3)
+        for (std::size_t k = 0; k < 3; ++k)
+          material.emissive[k] = static_cast<float>(m.emissiveFactor[k]);
+      model_.materials.push_back(std::move(material));
     }
   }
 
@@ -378,6 +403,15 @@ class Loader {
         if (mirrored) std::swap(b, c);
         model_.indices.insert(model_.indices.end(), {base + a, base + b, base + c});
       }
+    }
+    // One material per object: its first drawn primitive's (the vertex colours keep the others'
+    // base colours).
+    for (const auto& primitive : mesh.primitives) {
+      if (primitive.material < 0 ||
+          static_cast<std::size_t>(primitive.material) >= model_.materials.size())
+        continue;
+      model_.objects.back().material = static_cast<std::uint32_t>(primitive.material);
+      break;
     }
     builder.endObject();
   }

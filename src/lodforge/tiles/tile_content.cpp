@@ -54,12 +54,15 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   GlbMeshData data{positions, normals, colors, indices, options.quantize};
   std::vector<std::byte> featureStorage;
   std::vector<GlbVertexAttribute> extra;
+  std::vector<GlbPrimitive> primitives;
   if (features) {
     const TileFeatures tile = tileFeatures(vertexFeatures);
     extra.push_back(featureIdAttribute(tile.rows, featureStorage));
     LODFORGE_TRY(addPartTable(*writer, *options.parts, tile.parts));
     data.extraAttributes = extra;
     data.featureIds = GlbFeatureIds{static_cast<std::uint32_t>(tile.parts.size()), 0};
+    primitives = groupByMaterial(*writer, *options.parts, vertexFeatures, indices, !colors.empty());
+    data.primitives = primitives;
   }
   Result<std::uint32_t> glbMesh = writer->addMesh(data, "tile");
   if (!glbMesh) return glbMesh.status();

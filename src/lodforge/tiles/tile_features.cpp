@@ -13,7 +13,8 @@ namespace {
 constexpr int kUnsignedShort = 5123, kFloat = 5126;
 
 // A STRING property's two views (EXT_structural_metadata): the UTF-8 bytes back to back and
-// UINT32 offsets, one per row plus the end.
+// UINT32 offsets, one per row plus the end. Null when every string is empty (a buffer view may
+// not be empty; the property is left out of the table, as the class allows).
 Result<nlohmann::json> addStrings(GlbWriter& writer, std::span<const std::uint32_t> parts,
                                   const std::vector<std::string>& strings) {
   std::string values;
@@ -22,6 +23,7 @@ Result<nlohmann::json> addStrings(GlbWriter& writer, std::span<const std::uint32
     values += strings[part];
     offsets.push_back(static_cast<std::uint32_t>(values.size()));
   }
+  if (values.empty()) return nlohmann::json();
   Result<std::uint32_t> valueView = writer.addBufferView(std::as_bytes(std::span(values)));
   if (!valueView) return valueView.status();
   Result<std::uint32_t> offsetView = writer.addBufferView(std::as_bytes(std::span(offsets)));
@@ -62,6 +64,40 @@ GlbVertexAttribute featureIdAttribute(std::span<const std::uint32_t> rows,
   return {"_FEATURE_ID_0", narrow ? kUnsignedShort : kFloat, storage};
 }
 
+std::vector<GlbPrimitive> groupByMaterial(GlbWriter& writer, const PartTable& table,
+                                          std::span<const std::uint32_t> vertexFeatures,
+                                          std::span<std::uint32_t> indices, bool vertexColors) {
+  const auto materialOf = [&](std::size_t triangle) {
+    const std::uint32_t part = vertexFeatures[indices[3 * triangle]];
+    return part < table.materials.size() ? table.materials[part] : kNoMaterial;
+  };
+  const std::size_t triangles = indices.size() / 3;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> order(triangles);  // material, triangle
+  for (std::size_t t = 0; t < triangles; ++t)
+    order[t] = {materialOf(t), static_cast<std::uint32_t>(t)};
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  const std::vector<std::uint32_t> before(indices.begin(), indices.end());
+  std::vector<GlbPrimitive> groups;
+  std::uint32_t current = 0;
+  for (std::size_t i = 0; i < triangles; ++i) {
+    const auto [material, t] = order[i];
+    for (std::size_t k = 0; k < 3; ++k) indices[3 * i + k] = before[3 * std::size_t{t} + k];
+    if (groups.empty() || material != current) {
+      current = material;
+      std::optional<std::uint32_t> written;
+      if (material < table.materialTable.size()) {
+        Material m = table.materialTable[material];
+        if (vertexColors) m.baseColor = {1, 1, 1, 1};
+        written = writer.addMaterial(m);
+      }
+      groups.push_back({0, written});
+    }
+    groups.back().indexCount += 3;
+  }
+  return groups;
+}
+
 Status addPartTable(GlbWriter& writer, const PartTable& table,
                     std::span<const std::uint32_t> parts) {
   assert(table.paths.size() == table.names.size());
@@ -72,6 +108,13 @@ Status addPartTable(GlbWriter& writer, const PartTable& table,
   if (!names) return names.status();
   Result<nlohmann::json> paths = addStrings(writer, parts, table.paths);
   if (!paths) return paths.status();
+  // Each row's material by name (empty: none).
+  std::vector<std::string> materialNames(table.size());
+  for (std::size_t i = 0; i < table.size() && i < table.materials.size(); ++i)
+    if (table.materials[i] < table.materialTable.size())
+      materialNames[i] = table.materialTable[table.materials[i]].name;
+  Result<nlohmann::json> material = addStrings(writer, parts, materialNames);
+  if (!material) return material.status();
   const std::vector<std::string> sources(1, table.source);
   const std::vector<std::uint32_t> zeros(parts.size(), 0);
   Result<nlohmann::json> source = addStrings(writer, zeros, sources);
@@ -91,17 +134,19 @@ Status addPartTable(GlbWriter& writer, const PartTable& table,
             {"path",
              {{"type", "STRING"},
               {"description", "Names from the assembly's root down to the part, /-separated."}}},
+            {"material", {{"type", "STRING"}, {"description", "The name of the part's material."}}},
             {"source",
              {{"type", "STRING"}, {"description", "The file the part was read from."}}}}}}}}}};
-  const nlohmann::json metadata = {{"schema", schema},
-                                   {"propertyTables",
-                                    {{{"class", "part"},
-                                      {"count", parts.size()},
-                                      {"properties",
-                                       {{"id", {{"values", *idView}}},
-                                        {"name", *names},
-                                        {"path", *paths},
-                                        {"source", *source}}}}}}};
+  nlohmann::json metadata = {{"schema", schema},
+                             {"propertyTables",
+                              {{{"class", "part"},
+                                {"count", parts.size()},
+                                {"properties", {{"id", {{"values", *idView}}}}}}}}};
+  auto& properties = metadata["propertyTables"][0]["properties"];
+  const std::pair<const char*, const nlohmann::json*> strings[] = {
+      {"name", &*names}, {"path", &*paths}, {"material", &*material}, {"source", &*source}};
+  for (const auto& [key, value] : strings)
+    if (!value->is_null()) properties[key] = *value;
   writer.setStructuralMetadata(metadata.dump());
   return {};
 }

@@ -32,4 +32,13 @@ GlbVertexAttribute featureIdAttribute(std::span<const std::uint32_t> rows,
 Status addPartTable(GlbWriter& writer, const PartTable& table,
                     std::span<const std::uint32_t> parts);
 
+// The tile's triangles (`indices`, reordered in place) grouped by their part's material, stably
+// (cache order is kept within a group), each group a primitive with its material added to the
+// writer; parts without one share the writer's default. With `vertexColors` the base colour is
+// already in the colours (readers bake it in): the material keeps only its alpha mode,
+// metallic-roughness, double-sidedness and emission, over a white base.
+std::vector<GlbPrimitive> groupByMaterial(GlbWriter& writer, const PartTable& table,
+                                          std::span<const std::uint32_t> vertexFeatures,
+                                          std::span<std::uint32_t> indices, bool vertexColors);
+
 }  // namespace lodforge

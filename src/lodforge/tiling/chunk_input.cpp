@@ -1,5 +1,6 @@
 #include "lodforge/tiling/chunk_input.h"
 
+#include <algorithm>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -36,10 +37,21 @@ PartTable partTable(const std::string& path, const Model& model, std::span<const
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
     parts.names.emplace_back(model.objectName(o));
     parts.paths.emplace_back(model.objectPath(o));
+    parts.materials.push_back(model.objects[o].material);
     Aabbd& box = parts.bounds.emplace_back();
     for (std::uint32_t v = 0; v < model.objects[o].vertexCount; ++v)
       box.add(world[model.objects[o].vertexOffset + v]);
   }
+  // Equal materials once (files repeat them), so a tile draws one primitive per material.
+  std::vector<std::uint32_t> first(model.materials.size());
+  for (std::size_t m = 0; m < model.materials.size(); ++m) {
+    const auto same =
+        std::find(parts.materialTable.begin(), parts.materialTable.end(), model.materials[m]);
+    first[m] = static_cast<std::uint32_t>(same - parts.materialTable.begin());
+    if (same == parts.materialTable.end()) parts.materialTable.push_back(model.materials[m]);
+  }
+  for (std::uint32_t& m : parts.materials)
+    if (m != kNoMaterial) m = m < first.size() ? first[m] : kNoMaterial;
   return parts;
 }
 

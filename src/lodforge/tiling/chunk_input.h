@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "lodforge/core/material.h"
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
 #include "lodforge/io/cad_reader.h"
@@ -43,6 +44,8 @@ struct PartTable {
   std::vector<std::string> names;  // by feature id
   std::vector<std::string> paths;  // by feature id; empty strings where there is no assembly
   std::vector<Aabbd> bounds;       // by feature id, in the tileset's frame (empty: no triangles)
+  std::vector<std::uint32_t> materials;  // by feature id: into `materialTable`, or kNoMaterial
+  std::vector<Material> materialTable;
 
   std::size_t size() const { return names.size(); }
   bool empty() const { return names.empty(); }

@@ -28,6 +28,28 @@ nlohmann::json boundsList(const std::vector<Aabbd>& boxes) {
   for (const Aabbd& box : boxes) list.push_back(boundsToJson(box));
   return list;
 }
+
+nlohmann::json materialsToJson(const std::vector<Material>& materials) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Material& m : materials)
+    list.push_back({m.name, m.baseColor, m.metallic, m.roughness, static_cast<int>(m.alphaMode),
+                    m.alphaCutoff, m.doubleSided, m.emissive});
+  return list;
+}
+
+// Nothing for an unknown alpha mode; throws nlohmann::json::exception when malformed.
+std::optional<std::vector<Material>> materialsFromJson(const nlohmann::json& list) {
+  std::vector<Material> materials;
+  for (const auto& m : list) {
+    const int alpha = m.at(4).get<int>();
+    if (alpha < 0 || alpha > 2) return std::nullopt;
+    materials.push_back({m.at(0).get<std::string>(), m.at(1).get<std::array<float, 4>>(),
+                         m.at(2).get<float>(), m.at(3).get<float>(), static_cast<AlphaMode>(alpha),
+                         m.at(5).get<float>(), m.at(6).get<bool>(),
+                         m.at(7).get<std::array<float, 3>>()});
+  }
+  return materials;
+}
 }  // namespace
 
 Status saveChunkState(const std::string& path, const nlohmann::json& identity,
@@ -52,7 +74,9 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
        {{"source", input.parts.source},
         {"names", input.parts.names},
         {"paths", input.parts.paths},
-        {"bounds", boundsList(input.parts.bounds)}}}};
+        {"bounds", boundsList(input.parts.bounds)},
+        {"materials", input.parts.materials},
+        {"materialTable", materialsToJson(input.parts.materialTable)}}}};
   // (Part names come from the input and may not be UTF-8: replaced rather than thrown on.)
   return OutputFile::writeWhole(
       path, state.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
@@ -86,9 +110,16 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
     input.parts.names = parts.at("names").get<std::vector<std::string>>();
     input.parts.paths = parts.at("paths").get<std::vector<std::string>>();
     for (const auto& box : parts.at("bounds")) input.parts.bounds.push_back(boundsFromJson(box));
+    input.parts.materials = parts.at("materials").get<std::vector<std::uint32_t>>();
+    std::optional<std::vector<Material>> table = materialsFromJson(parts.at("materialTable"));
+    if (!table) return std::nullopt;
+    input.parts.materialTable = std::move(*table);
     if (input.parts.paths.size() != input.parts.names.size() ||
-        input.parts.bounds.size() != input.parts.names.size())
+        input.parts.bounds.size() != input.parts.names.size() ||
+        input.parts.materials.size() != input.parts.names.size())
       return std::nullopt;
+    for (std::uint32_t m : input.parts.materials)
+      if (m != kNoMaterial && m >= input.parts.materialTable.size()) return std::nullopt;
     input.chunks =
         std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
     return input;

@@ -7,6 +7,7 @@
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <Quantity_Color.hxx>
+#include <Quantity_ColorRGBA.hxx>
 #include <STEPCAFControl_Reader.hxx>
 #include <STEPCAFControl_Writer.hxx>
 #include <STEPControl_Reader.hxx>
@@ -247,6 +248,42 @@ TEST(CadRead, CyrillicNamesArriveAsUtf8) {
   Result<Model> unknown = readCad(legacy);
   ASSERT_TRUE(unknown.ok()) << unknown.error().message;
   EXPECT_NE(unknown->objectName(1), "Крышка");
+}
+
+// A STEP part with a translucent colour (STEP's surface_style_transparent, written by OCCT) keeps
+// its alpha in its colours and gets a blended material; an opaque part gets none; and the tiles
+// draw the glass with that material at every level.
+TEST(CadRead, TranslucentPartsAreBlended) {
+  test::TempDir dir;
+  const std::string path = dir.file("window.step");
+  {
+    Handle(TDocStd_Document) doc;
+    XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+    const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+    const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
+    const TDF_Label frame = shapes->AddShape(BRepPrimAPI_MakeBox(100, 10, 100).Shape(), false);
+    TDataStd_Name::Set(frame, "frame");
+    colors->SetColor(frame, Quantity_Color(0.3, 0.3, 0.3, Quantity_TOC_sRGB), XCAFDoc_ColorSurf);
+    const TDF_Label glass =
+        shapes->AddShape(BRepPrimAPI_MakeBox(gp_Pnt(10, 2, 10), 80, 2, 80).Shape(), false);
+    TDataStd_Name::Set(glass, "glass");
+    colors->SetColor(glass,
+                     Quantity_ColorRGBA(Quantity_Color(0.6, 0.8, 0.9, Quantity_TOC_sRGB), 0.12f),
+                     XCAFDoc_ColorSurf);
+    STEPCAFControl_Writer writer;
+    ASSERT_TRUE(writer.Transfer(doc, STEPControl_AsIs));
+    ASSERT_EQ(writer.Write(path.c_str()), IFSelect_RetDone);
+    XCAFApp_Application::GetApplication()->Close(doc);
+  }
+  Result<Model> model = readCad(path);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  ASSERT_EQ(model->objectCount(), 2u);
+  EXPECT_EQ(model->objectName(1), "glass");
+  EXPECT_EQ(model->objects[0].material, kNoMaterial);
+  ASSERT_LT(model->objects[1].material, model->materials.size());
+  EXPECT_EQ(model->materials[model->objects[1].material].alphaMode, AlphaMode::kBlend);
+  EXPECT_EQ(model->colors[model->objects[1].vertexOffset].a, 31);  // 0.12
+  EXPECT_EQ(model->colors[model->objects[0].vertexOffset].a, 255);
 }
 
 TEST(CadRead, BadFilesAreBadInputNamingTheFile) {

@@ -10,7 +10,7 @@
 
 namespace lodforge::cad {
 
-inline constexpr int kModuleVersion = 3;  // bumped when these structs change
+inline constexpr int kModuleVersion = 4;  // bumped when these structs change
 inline constexpr const char* kReadSymbol = "lodforge_cad_read";
 
 struct Request {
@@ -27,12 +27,25 @@ struct Request {
   void* context = nullptr;
 };
 
+// A part's material (glTF's model): OCCT's visual material where the file has one, else made
+// from its colours when a face is translucent.
+struct Material {
+  std::string name;
+  float baseColor[4] = {1, 1, 1, 1};  // linear
+  float metallic = 0, roughness = 0.5f;
+  int alphaMode = 0;  // 0 opaque, 1 mask, 2 blend
+  float alphaCutoff = 0.5f;
+  bool doubleSided = false;
+  float emissive[3] = {0, 0, 0};  // linear
+};
+
 struct Instance {
   std::string name;
   std::string path;  // product names from the root down to this instance, "/"-separated
   std::uint64_t firstVertex = 0, vertexCount = 0;
   std::uint64_t firstTriangle = 0, triangleCount = 0;
-  std::uint64_t shape = 0;  // which distinct shape
+  std::uint64_t shape = 0;       // which distinct shape
+  std::uint32_t material = ~0u;  // into Result::materials; ~0u: none
 };
 
 struct Result {
@@ -47,6 +60,7 @@ struct Result {
   bool coloured = false;
   std::vector<std::uint32_t> indices;  // 3 per triangle, local to the instance
   std::vector<Instance> instances;
+  std::vector<Material> materials;
   std::uint64_t shapes = 0;
   std::uint32_t depth = 0;
 };

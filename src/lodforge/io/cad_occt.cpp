@@ -34,6 +34,7 @@
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
+#include <XCAFDoc_VisMaterial.hxx>
 #include <XCAFPrs_DocumentExplorer.hxx>
 
 #include <algorithm>
@@ -362,17 +363,65 @@ void pushColor(const Quantity_ColorRGBA& color, std::vector<std::uint8_t>& out) 
   out.insert(out.end(), {byte(r), byte(g), byte(b), byte(color.Alpha())});
 }
 
+// The instance's material: OCCT's visual material (PBR, or common converted to PBR) when the
+// part has one; else, for a part with a translucent face (STEP's surface transparency), a
+// blended "translucent" material; else none. Equal materials are listed once.
+std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, Result& out) {
+  Material material;
+  const Handle(XCAFDoc_VisMaterial)& vis = style.Material();
+  if (!vis.IsNull() && !vis->IsEmpty()) {
+    const XCAFDoc_VisMaterialPBR pbr = vis->ConvertToPbrMaterial();
+    material.name = vis->RawName().IsNull() ? "" : vis->RawName()->ToCString();
+    Standard_Real r = 1, g = 1, b = 1;
+    pbr.BaseColor.GetRGB().Values(r, g, b, Quantity_TOC_RGB);  // linear, as glTF's
+    const float base[4] = {static_cast<float>(r), static_cast<float>(g), static_cast<float>(b),
+                           pbr.BaseColor.Alpha()};
+    for (int k = 0; k < 4; ++k) material.baseColor[k] = base[k];
+    material.metallic = pbr.Metallic;
+    material.roughness = pbr.Roughness;
+    for (int k = 0; k < 3; ++k) material.emissive[k] = pbr.EmissiveFactor[k];
+    const Graphic3d_AlphaMode alpha = vis->AlphaMode();
+    material.alphaMode = alpha == Graphic3d_AlphaMode_Mask    ? 1
+                         : alpha == Graphic3d_AlphaMode_Blend ? 2
+                         : alpha == Graphic3d_AlphaMode_BlendAuto && (translucent || base[3] < 1)
+                             ? 2
+                             : 0;
+    material.alphaCutoff = vis->AlphaCutOff();
+    material.doubleSided = vis->FaceCulling() == Graphic3d_TypeOfBackfacingModel_DoubleSided;
+  } else if (translucent) {
+    material.name = "translucent";
+    material.alphaMode = 2;
+    material.doubleSided = true;
+    material.roughness = 0.1f;
+  } else {
+    return ~0u;
+  }
+  for (std::size_t m = 0; m < out.materials.size(); ++m) {
+    const Material& o = out.materials[m];
+    if (o.name == material.name && o.alphaMode == material.alphaMode &&
+        o.metallic == material.metallic && o.roughness == material.roughness &&
+        o.doubleSided == material.doubleSided && o.alphaCutoff == material.alphaCutoff &&
+        std::equal(o.baseColor, o.baseColor + 4, material.baseColor) &&
+        std::equal(o.emissive, o.emissive + 3, material.emissive))
+      return static_cast<std::uint32_t>(m);
+  }
+  out.materials.push_back(material);
+  return static_cast<std::uint32_t>(out.materials.size() - 1);
+}
+
 // One placed instance's faces appended: positions in metres, normals and colours per vertex.
 void appendInstance(const Placed& placed, double metresPerUnit, Result& out) {
   Instance instance{placed.name, placed.path, out.positions.size() / 3, 0, out.indices.size() / 3,
                     0,           placed.shape};
   const Quantity_ColorRGBA grey(Quantity_Color(0.78, 0.78, 0.78, Quantity_TOC_sRGB));
+  bool translucent = false;
   for (RWMesh_FaceIterator face(placed.label, placed.location, true, placed.style); face.More();
        face.Next()) {
     if (face.IsEmptyMesh()) continue;
     const std::uint64_t first = out.positions.size() / 3 - instance.firstVertex;
     out.coloured |= face.HasFaceColor();
     const Quantity_ColorRGBA& color = face.HasFaceColor() ? face.FaceColor() : grey;
+    translucent |= color.Alpha() < 1.0f;
     for (Standard_Integer n = face.NodeLower(); n <= face.NodeUpper(); ++n) {
       const gp_Pnt p = face.NodeTransformed(n);
       out.positions.insert(out.positions.end(),
@@ -394,6 +443,7 @@ void appendInstance(const Placed& placed, double metresPerUnit, Result& out) {
   }
   instance.vertexCount = out.positions.size() / 3 - instance.firstVertex;
   instance.triangleCount = out.indices.size() / 3 - instance.firstTriangle;
+  instance.material = materialOf(placed.style, translucent, out);
   out.instances.push_back(std::move(instance));
 }
 

@@ -2,6 +2,7 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -66,9 +67,25 @@ Model toModel(const cad::Result& read) {
   model.origin = chooseOrigin(world);
   // One object per instance through ModelBuilder (offsets, names, bounds); the module wrote the
   // instances back to back, so appending them in order copies its arrays.
+  for (const cad::Material& m : read.materials) {
+    Material material;
+    material.name = m.name;
+    std::copy(m.baseColor, m.baseColor + 4, material.baseColor.begin());
+    material.metallic = m.metallic;
+    material.roughness = m.roughness;
+    material.alphaMode = m.alphaMode == 2   ? AlphaMode::kBlend
+                         : m.alphaMode == 1 ? AlphaMode::kMask
+                                            : AlphaMode::kOpaque;
+    material.alphaCutoff = m.alphaCutoff;
+    material.doubleSided = m.doubleSided;
+    std::copy(m.emissive, m.emissive + 3, material.emissive.begin());
+    model.materials.push_back(std::move(material));
+  }
   ModelBuilder builder(model);
   for (const cad::Instance& instance : read.instances) {
     builder.beginObject(instance.name, instance.path);
+    if (instance.material < model.materials.size())
+      model.objects.back().material = instance.material;
     for (std::uint64_t v = instance.firstVertex; v < instance.firstVertex + instance.vertexCount;
          ++v) {
       const double* p = &read.positions[3 * v];

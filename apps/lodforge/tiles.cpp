@@ -65,6 +65,7 @@ struct TilesCommand {
   std::string origin, crs;
   std::string compress = "none";
   bool noQuantization = false;
+  std::string parts = "auto";
   std::uint64_t blockSize = 50'000;
   std::uint64_t tilePoints = 50'000;
   std::string attributes = "all";
@@ -111,6 +112,11 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
   sub.add_flag("--no-quantization", options.noQuantization,
                "Float positions and normals everywhere instead of KHR_mesh_quantization (16-bit "
                "positions, 8-bit normals) in the tiles where it is invisible");
+  sub.add_option("--parts", options.parts,
+                 "Meshes: name each object (part) in the tiles, pickable in viewers: auto (CAD, "
+                 "glTF and .lfp inputs of several objects), on (any input of several objects, "
+                 "which keeps objects from welding together), or off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   addCountOption(sub, "--block-size", options.blockSize,
                  "Point clouds: most points per leaf tile (a block of the partition; default 50K)");
   addCountOption(sub, "--tile-points", options.tilePoints,
@@ -152,6 +158,9 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
   tiles.crs = options.crs;
   tiles.meshoptCompression = options.compress == "meshopt";
   tiles.quantize = !options.noQuantization;
+  tiles.input.parts = options.parts == "on"    ? PartsMode::kOn
+                      : options.parts == "off" ? PartsMode::kOff
+                                               : PartsMode::kAuto;
   if (!options.origin.empty()) {
     if (!options.crs.empty())
       return Error{ErrorKind::kUsage,
@@ -218,7 +227,7 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
       fmt::format("wrote {}: {} tiles ({} leaves, {} levels above them){}, {} in {:.1f} s ({} "
                   "input triangles/s)",
                   options.output, formatCount(stats.tiles), formatCount(stats.leaves), stats.levels,
-                  stats.parts > 0 ? fmt::format(", {} named parts ({} in the root tile; {})",
+                  stats.parts > 0 ? fmt::format(", {} named parts ({} in the coarsest tiles; {})",
                                                 formatCount(stats.parts),
                                                 formatCount(stats.partsInRoot), kPartsFileName)
                                   : "",

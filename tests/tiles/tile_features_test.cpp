@@ -318,6 +318,34 @@ TEST(TileFeatures, EveryPartKeepsItsMaterialAtEveryLevel) {
       << "glass is translucent at every level";
 }
 
+// An OBJ of two groups sharing a seam is a scan split in two by default: no parts, welded as
+// one surface; asked for, its groups become parts that weld apart.
+TEST(TileFeatures, ObjectsOfAScanBecomePartsOnlyWhenAsked) {
+  const fs::path root = fs::path(::testing::TempDir()) / "tile-features-obj";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  std::ofstream obj(root / "two.obj");
+  obj << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n"
+      << "o left\nf 1 2 3\nf 1 3 4\no right\nf 2 5 6\nf 2 6 3\n";
+  obj.close();
+  TilesOptions options;
+  options.quantize = false;
+  Result<TilesStats> scan = writeTiles((root / "two.obj").string(), (root / "a").string(), options);
+  ASSERT_TRUE(scan.ok()) << scan.error().message;
+  EXPECT_EQ(scan->parts, 0u);
+  EXPECT_FALSE(fs::exists(root / "a" / kPartsFileName));
+  options.input.parts = PartsMode::kOn;
+  Result<TilesStats> parts =
+      writeTiles((root / "two.obj").string(), (root / "b").string(), options);
+  ASSERT_TRUE(parts.ok()) << parts.error().message;
+  EXPECT_EQ(parts->parts, 2u);
+  const DecodedTile welded = decodeTile(root / "a" / "tiles" / "0-0-0-0.glb");
+  const DecodedTile apart = decodeTile(root / "b" / "tiles" / "0-0-0-0.glb");
+  EXPECT_EQ(welded.world.size(), 6u);  // the seam's two vertices once
+  EXPECT_EQ(apart.world.size(), 8u);   // once per part
+  EXPECT_EQ(apart.names, (std::vector<std::string>{"left", "right"}));
+}
+
 // A mesh of one object (a scan) gets no features: nothing to pick, no bytes spent.
 TEST(TileFeatures, AnInputOfOneObjectHasNone) {
   const fs::path root = fs::path(::testing::TempDir()) / "tile-features-one";

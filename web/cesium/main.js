@@ -115,19 +115,21 @@ async function addColouring(tileset) {
 async function addParts(viewer, tileset) {
   const parts = await loadParts('/tiles/');
   if (!parts) return;
-  let highlighted = [], hidden = [];
-  const idIs = (ids) => ids.map((id) => `\${id} === ${id}`).join(' || ');
-  const restyle = () => {
-    tileset.style = new Cesium.Cesium3DTileStyle({
-      show: hidden.length ? `!(${idIs(hidden)})` : 'true',
-      color: highlighted.length
-        ? { conditions: [[idIs(highlighted), "color('#ffd21f')"], ['true', "color('white')"]] }
-        : "color('white')",
-    });
+  // Set lookups rather than style expressions: an expression with a term per part would be
+  // 100,000 terms deep for a big assembly.
+  let highlighted = new Set(), hidden = new Set();
+  const highlight = Cesium.Color.fromCssColorString('#ffd21f');
+  const style = new Cesium.Cesium3DTileStyle();
+  style.show = { evaluate: (feature) => !hidden.has(feature.getProperty('id')) };
+  style.color = {
+    evaluateColor: (feature, result) => Cesium.Color.clone(
+      highlighted.has(feature.getProperty('id')) ? highlight : Cesium.Color.WHITE, result),
   };
+  tileset.style = style;
+  const restyle = () => tileset.makeStyleDirty();
   const panel = partsPanel(parts, {
-    highlight: (ids) => { highlighted = ids; restyle(); },
-    hide: (ids) => { hidden = ids; restyle(); },
+    highlight: (ids) => { highlighted = new Set(ids); restyle(); },
+    hide: (ids) => { hidden = new Set(ids); restyle(); },
     flyTo: (ids) => {
       const b = boundsOf(parts, ids);
       if (!b) return;

@@ -143,7 +143,9 @@ function recolourParts(mesh) {
   for (let i = 0; i < color.count; ++i) {
     const part = partOfVertex(mesh, i);
     const c = partState.highlighted.has(part) ? HIGHLIGHT : rgb ? [rgb[4 * i], rgb[4 * i + 1], rgb[4 * i + 2]] : [255, 255, 255];
-    color.array.set([c[0], c[1], c[2], partState.hidden.has(part) ? 0 : 255], 4 * i);
+    // Hidden parts get alpha 0 (discarded by alphaTest); the others keep theirs (glass).
+    const alpha = partState.hidden.has(part) ? 0 : rgb ? rgb[4 * i + 3] : 255;
+    color.array.set([c[0], c[1], c[2], alpha], 4 * i);
   }
   color.needsUpdate = true;
 }
@@ -151,7 +153,7 @@ function recolourParts(mesh) {
 // A tile's meshes, as they load: RGBA colours to write into (the original kept), its part ids.
 async function prepareParts(scene, url) {
   const ids = await tilePartIds(url);
-  if (!ids) return;
+  if (!ids || scene.userData.disposed) return;  // a tile disposed while its ids were read
   scene.traverse((mesh) => {
     if (!mesh.isMesh || !mesh.geometry.getAttribute('_feature_id_0')) return;
     const g = mesh.geometry;
@@ -164,6 +166,7 @@ async function prepareParts(scene, url) {
         rgb[4 * i] = Math.round(old.getX(i) * 255);
         rgb[4 * i + 1] = Math.round(old.getY(i) * 255);
         rgb[4 * i + 2] = Math.round(old.getZ(i) * 255);
+        rgb[4 * i + 3] = old.itemSize === 4 ? Math.round(old.getW(i) * 255) : 255;
       }
     }
     mesh.userData.rgb = rgb;
@@ -171,7 +174,7 @@ async function prepareParts(scene, url) {
     g.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(count * 4), 4, true));
     mesh.material = mesh.material.clone();
     mesh.material.vertexColors = true;
-    mesh.material.alphaTest = 0.5;
+    mesh.material.alphaTest = 0.01;  // hidden parts only: glass at alpha 0.12 stays
     mesh.material.needsUpdate = true;
     partState.meshes.add(mesh);
     recolourParts(mesh);
@@ -296,6 +299,7 @@ function main() {
     }
   });
   tiles.addEventListener('dispose-model', (e) => {
+    e.scene.userData.disposed = true;
     e.scene.traverse((o) => { colouring.points.delete(o); partState.meshes.delete(o); });
   });
   tiles.addEventListener('load-error', (e) => {
@@ -309,7 +313,7 @@ function main() {
     addParts(parts, tiles, camera, controls, renderer, pivot);
     const idle = report.parts.idle;
     report.parts.idle = () => idle() && pending.size === 0;
-  }).catch((error) => { report.error = String(error); });
+  }).catch((error) => { report.partsPending = false; report.error = String(error); });
 
   onScreenSpaceError((pixels) => { tiles.errorTarget = pixels; });
   window.addEventListener('resize', () => {

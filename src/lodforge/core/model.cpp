@@ -27,7 +27,7 @@ std::uint64_t modelMemoryBytes(std::uint64_t vertexCount, std::uint64_t triangle
 
 std::uint64_t Model::memoryBytes() const {
   return modelMemoryBytes(vertexCount(), triangleCount(), objectCount(), hasNormals(), hasColors(),
-                          names.size());
+                          names.size() + paths.size());
 }
 
 void ModelBuilder::beginObject(std::string_view name, std::string_view path) {

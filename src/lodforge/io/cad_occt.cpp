@@ -371,7 +371,9 @@ std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, Result& o
   const Handle(XCAFDoc_VisMaterial)& vis = style.Material();
   if (!vis.IsNull() && !vis->IsEmpty()) {
     const XCAFDoc_VisMaterialPBR pbr = vis->ConvertToPbrMaterial();
-    material.name = vis->RawName().IsNull() ? "" : vis->RawName()->ToCString();
+    material.name = vis->RawName().IsNull()
+                        ? ""
+                        : utf8(TCollection_ExtendedString(vis->RawName()->ToCString(), true));
     Standard_Real r = 1, g = 1, b = 1;
     pbr.BaseColor.GetRGB().Values(r, g, b, Quantity_TOC_RGB);  // linear, as glTF's
     const float base[4] = {static_cast<float>(r), static_cast<float>(g), static_cast<float>(b),

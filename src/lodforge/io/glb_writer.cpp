@@ -474,7 +474,8 @@ Status GlbWriter::finish() {
     document["extensionsUsed"].push_back("EXT_structural_metadata");
   }
   if (s.meshFeatures) document["extensionsUsed"].push_back("EXT_mesh_features");
-  std::string json = document.dump();
+  // (Names come from inputs and may not be UTF-8: replaced rather than thrown on.)
+  std::string json = document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   while (json.size() % 4 != 0) json += ' ';
 
   const bool hasBinary = s.binaryBytes > 0;

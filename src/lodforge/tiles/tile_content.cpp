@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include <fmt/format.h>
 #include <meshoptimizer.h>
 
 #include "lodforge/core/mesh.h"
@@ -31,6 +32,12 @@ Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::st
   std::vector<Vec3f> normals(used);
   const bool features =
       options.parts != nullptr && !options.parts->empty() && !mesh.features.empty();
+  // Features come from work files: one that names no part is damage, not a row to read past.
+  if (features)
+    for (std::uint32_t f : mesh.features)
+      if (f >= options.parts->size())
+        return badInput(path, fmt::format("tile mesh names part {} of {} (damaged work file?)", f,
+                                          options.parts->size()));
   std::vector<std::uint32_t> vertexFeatures(features ? used : 0);
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
     if (remap[v] == ~0u) continue;

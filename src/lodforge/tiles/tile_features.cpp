@@ -108,12 +108,16 @@ Status addPartTable(GlbWriter& writer, const PartTable& table,
   if (!names) return names.status();
   Result<nlohmann::json> paths = addStrings(writer, parts, table.paths);
   if (!paths) return paths.status();
-  // Each row's material by name (empty: none).
-  std::vector<std::string> materialNames(table.size());
-  for (std::size_t i = 0; i < table.size() && i < table.materials.size(); ++i)
-    if (table.materials[i] < table.materialTable.size())
-      materialNames[i] = table.materialTable[table.materials[i]].name;
-  Result<nlohmann::json> material = addStrings(writer, parts, materialNames);
+  // Each row's material by name (empty: none), for the tile's own parts only.
+  std::vector<std::string> materialNames(parts.size());
+  std::vector<std::uint32_t> rows(parts.size());
+  for (std::size_t r = 0; r < parts.size(); ++r) {
+    rows[r] = static_cast<std::uint32_t>(r);
+    const std::uint32_t m =
+        parts[r] < table.materials.size() ? table.materials[parts[r]] : kNoMaterial;
+    if (m < table.materialTable.size()) materialNames[r] = table.materialTable[m].name;
+  }
+  Result<nlohmann::json> material = addStrings(writer, rows, materialNames);
   if (!material) return material.status();
   const std::vector<std::string> sources(1, table.source);
   const std::vector<std::uint32_t> zeros(parts.size(), 0);

@@ -1,7 +1,7 @@
 // The parts a mesh tile holds, pickable (3D Tiles 1.1 conventions): EXT_mesh_features gives each
 // vertex a feature ID, a row of the tile's EXT_structural_metadata property table, which names
-// the part (class "part": id, name, path, source). Rows are the tile's own parts only, so a
-// coarse tile that kept a few parts lists those few.
+// the part (class "part": id, name, path, material, source). Rows are the tile's own parts only, so
+// a coarse tile that kept a few parts lists those few.
 #pragma once
 
 #include <cstdint>

@@ -120,6 +120,7 @@ nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
                                                   options.origin->latitude, options.origin->height)
                                     : ""},
           {"surface", surfaceIdentity(options.surface)},
+          {"parts", static_cast<int>(input.parts)},
           {"cad",
            {input.cad.deflection, input.cad.absoluteDeflection, input.cad.angleDegrees,
             input.cad.codePage}}};
@@ -197,7 +198,17 @@ void countTiles(const OctreeResult& tree, TilesStats& stats) {
     }
   }
   stats.levels = tree.levels;
-  stats.partsInRoot = tree.nodes[tree.root].features.size();
+  // The coarsest level with content (with --levels the root above it may have none).
+  int top = 0;
+  for (const OctreeNode& node : tree.nodes)
+    if (node.triangles > 0) top = std::max(top, node.level);
+  std::vector<std::uint32_t> coarsest;
+  for (const OctreeNode& node : tree.nodes)
+    if (node.level == top)
+      coarsest.insert(coarsest.end(), node.features.begin(), node.features.end());
+  std::sort(coarsest.begin(), coarsest.end());
+  stats.partsInRoot =
+      static_cast<std::uint64_t>(std::unique(coarsest.begin(), coarsest.end()) - coarsest.begin());
 }
 
 }  // namespace

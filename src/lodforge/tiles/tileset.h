@@ -58,7 +58,7 @@ struct TilesStats {
   std::uint64_t droppedSegments = 0;        // small whole segments parents left out (over parents)
   std::optional<ReconstructStats> surface;  // --surface, when not resumed
   std::uint64_t parts = 0;                  // named parts (parts.json), 0: none
-  std::uint64_t partsInRoot = 0;            // of them, those the root tile still holds
+  std::uint64_t partsInRoot = 0;            // of them, those the coarsest tiles still hold
 };
 
 // Where `lodforge tiles -o OUT` works: OUT.work holds the work files and the tileset being

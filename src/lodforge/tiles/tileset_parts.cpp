@@ -12,6 +12,7 @@ std::vector<std::vector<std::uint32_t>> partsMissingPerLevel(const OctreeResult&
   std::vector<std::vector<std::uint8_t>> present(static_cast<std::size_t>(octree.levels) + 1,
                                                  std::vector<std::uint8_t>(partCount, 0));
   for (const OctreeNode& node : octree.nodes) {
+    if (node.level < 0 || static_cast<std::size_t>(node.level) >= present.size()) continue;
     for (std::uint32_t f : node.features)
       if (f < partCount) present[static_cast<std::size_t>(node.level)][f] = 1;
   }

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/mesh.h"
@@ -28,6 +29,14 @@ Result<Model> readInputModel(const std::string& path, const CadReadOptions& cad,
   return extractModel(*package, vertexCountsForRatio(*package, 1.0));
 }
 
+// The text as valid UTF-8 (EXT_structural_metadata's strings must be): bytes that are not
+// become U+FFFD, as the JSON files beside the tiles would write them anyway.
+std::string validUtf8(std::string_view text) {
+  const std::string quoted = nlohmann::json(std::string(text))
+                                 .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return nlohmann::json::parse(quoted).get<std::string>();
+}
+
 // The model's objects as the parts of the tileset.
 PartTable partTable(const std::string& path, const Model& model, std::span<const Vec3d> world) {
   PartTable parts;
@@ -35,8 +44,8 @@ PartTable partTable(const std::string& path, const Model& model, std::span<const
   parts.names.reserve(model.objectCount());
   parts.paths.reserve(model.objectCount());
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
-    parts.names.emplace_back(model.objectName(o));
-    parts.paths.emplace_back(model.objectPath(o));
+    parts.names.push_back(validUtf8(model.objectName(o)));
+    parts.paths.push_back(validUtf8(model.objectPath(o)));
     parts.materials.push_back(model.objects[o].material);
     Aabbd& box = parts.bounds.emplace_back();
     for (std::uint32_t v = 0; v < model.objects[o].vertexCount; ++v)
@@ -52,6 +61,7 @@ PartTable partTable(const std::string& path, const Model& model, std::span<const
   }
   for (std::uint32_t& m : parts.materials)
     if (m != kNoMaterial) m = m < first.size() ? first[m] : kNoMaterial;
+  for (Material& m : parts.materialTable) m.name = validUtf8(m.name);
   return parts;
 }
 
@@ -63,7 +73,12 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
   if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");
   input.colors = model->hasColors();
   // Parts are named per vertex only when there is more than one.
-  const bool features = model->objectCount() > 1;
+  const std::string extension = fileExtension(path);
+  const bool assembly =
+      isCadPath(path) || extension == "glb" || extension == "gltf" || extension == "lfp";
+  const bool features =
+      model->objectCount() > 1 &&
+      (options.parts == PartsMode::kOn || (options.parts == PartsMode::kAuto && assembly));
   // World positions (through the transform, if any) and their bounds.
   std::vector<Vec3d> world(model->vertexCount());
   for (std::size_t v = 0; v < world.size(); ++v) {

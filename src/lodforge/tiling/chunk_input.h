@@ -21,6 +21,15 @@
 
 namespace lodforge {
 
+// Whether the objects of an input become parts (features, tile_features.h). Parts are never
+// welded to one another, so a scan split into objects (an OBJ's groups) would keep open seams
+// between them in coarse tiles: auto names parts for assemblies only.
+enum class PartsMode : std::uint8_t {
+  kAuto,  // CAD, glTF and .lfp inputs of more than one object
+  kOn,    // any input of more than one object
+  kOff,
+};
+
 struct ChunkInputOptions {
   double chunkSize = 0;  // 0: from the bounds and trianglesPerChunk
   std::uint64_t trianglesPerChunk = 64 * 1024;
@@ -34,6 +43,7 @@ struct ChunkInputOptions {
   std::function<bool(Vec3d, Vec3d&)> transform;
   bool salvageTruncated = false;  // a PLY cut short: read up to its last whole element
   CadReadOptions cad;             // tessellation of a CAD input
+  PartsMode parts = PartsMode::kAuto;
   int levels = 0;  // levels the octree must be able to build above the leaves (0: any)
 };
 

@@ -146,11 +146,19 @@ Status addPartTable(GlbWriter& writer, const PartTable& table,
                               {{{"class", "part"},
                                 {"count", parts.size()},
                                 {"properties", {{"id", {{"values", *idView}}}}}}}}};
+  // A column left out goes from the class too: 3d-tiles-renderer 0.4 reads every class property
+  // from the table.
   auto& properties = metadata["propertyTables"][0]["properties"];
+  auto& declared = metadata["schema"]["classes"]["part"]["properties"];
   const std::pair<const char*, const nlohmann::json*> strings[] = {
       {"name", &*names}, {"path", &*paths}, {"material", &*material}, {"source", &*source}};
-  for (const auto& [key, value] : strings)
-    if (!value->is_null()) properties[key] = *value;
+  for (const auto& [key, value] : strings) {
+    if (value->is_null()) {
+      declared.erase(key);
+    } else {
+      properties[key] = *value;
+    }
+  }
   writer.setStructuralMetadata(metadata.dump());
   return {};
 }

@@ -144,6 +144,15 @@ DecodedTile decodeTile(const fs::path& glb) {
   return tile;
 }
 
+// A few levels for a generated assembly of some hundred parts, float positions to decode.
+TilesOptions assemblyOptions() {
+  TilesOptions options;
+  options.octree.errorSamples = 2000;
+  options.input.trianglesPerChunk = 8192;
+  options.quantize = false;
+  return options;
+}
+
 // Tiles of a generated 600-part assembly: every vertex of every tile, leaves and the coarse
 // parents that merged and dropped parts, names the part it came from (it lies in that part's
 // box); the leaves hold every part; parts.json says which parts each level lost, exactly as the
@@ -156,11 +165,7 @@ TEST(TileFeatures, EveryVertexOfEveryTileNamesItsPart) {
   ASSERT_TRUE(generateCad({.objects = 600, .seed = 9}, input).ok());
   Result<Model> model = readModel(input);
   ASSERT_TRUE(model.ok());
-  TilesOptions options;
-  options.octree.errorSamples = 2000;
-  options.input.trianglesPerChunk = 8192;
-  options.quantize = false;
-  Result<TilesStats> stats = writeTiles(input, (root / "tiles").string(), options);
+  Result<TilesStats> stats = writeTiles(input, (root / "tiles").string(), assemblyOptions());
   ASSERT_TRUE(stats.ok()) << stats.error().message;
   EXPECT_EQ(stats->parts, model->objectCount());
   EXPECT_GT(stats->droppedSegments, 0u);
@@ -268,11 +273,7 @@ TEST(TileFeatures, EveryPartKeepsItsMaterialAtEveryLevel) {
   EXPECT_EQ(back->objects[4].material, 0u);
   EXPECT_EQ(back->materials[back->objects[3].material].name, "default");
 
-  TilesOptions options;
-  options.octree.errorSamples = 2000;
-  options.input.trianglesPerChunk = 8192;
-  options.quantize = false;
-  Result<TilesStats> stats = writeTiles(input, (root / "tiles").string(), options);
+  Result<TilesStats> stats = writeTiles(input, (root / "tiles").string(), assemblyOptions());
   ASSERT_TRUE(stats.ok()) << stats.error().message;
   std::set<int> levelsWithGlass;
   for (const auto& entry : fs::directory_iterator(root / "tiles" / "tiles")) {

@@ -1,7 +1,9 @@
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <map>
+#include <set>
 
 #include <draco/compression/encode.h>
 #include <draco/mesh/triangle_soup_mesh_builder.h>
@@ -78,6 +80,40 @@ TEST(GltfRead, RealCadAssembliesGiveOneObjectPerNodeInstance) {
     EXPECT_EQ(model->triangleCount(), c.triangles) << c.file;
     EXPECT_TRUE(isConsistent(*model));
   }
+}
+
+// Each object's assembly path is its node's names from the scene root, as the file's own
+// hierarchy gives them (read here straight from the GLB's JSON).
+TEST(GltfRead, ObjectsKeepTheirPathInTheNodeTree) {
+  const std::string path = test::dataPath("meshes/as1_motor.glb");
+  const std::string bytes = test::readFile(path);
+  std::uint32_t jsonLength = 0;
+  std::memcpy(&jsonLength, bytes.data() + 12, 4);
+  const nlohmann::json gltf = nlohmann::json::parse(bytes.substr(20, jsonLength));
+  const auto& nodes = gltf["nodes"];
+  std::vector<int> parent(nodes.size(), -1);
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    for (int child : nodes[n].value("children", std::vector<int>{}))
+      parent[static_cast<std::size_t>(child)] = static_cast<int>(n);
+  std::multiset<std::string> expected;
+  std::size_t deep = 0;
+  for (std::size_t n = 0; n < nodes.size(); ++n) {
+    if (!nodes[n].contains("mesh")) continue;
+    std::string p;
+    for (int at = static_cast<int>(n); at >= 0; at = parent[static_cast<std::size_t>(at)]) {
+      const std::string name = nodes[static_cast<std::size_t>(at)].value("name", "");
+      p = (name.empty() ? "node " + std::to_string(at) : name) + (p.empty() ? "" : "/" + p);
+    }
+    deep += std::count(p.begin(), p.end(), '/') >= 2 ? 1 : 0;
+    expected.insert(p);
+  }
+  Result<Model> model = readGltf(path);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  std::multiset<std::string> found;
+  for (std::size_t o = 0; o < model->objectCount(); ++o) found.emplace(model->objectPath(o));
+  EXPECT_EQ(found, expected);
+  EXPECT_GT(deep, 0u);  // a real tree, not a flat list
+  EXPECT_TRUE(isConsistent(*model));
 }
 
 TEST(GltfRead, InstancedMeshesAreExpandedWithTheirOwnTransforms) {

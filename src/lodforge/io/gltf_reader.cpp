@@ -290,11 +290,17 @@ class Loader {
       }
     }
     visited_.assign(gltf_.nodes.size(), false);
-    // Iterative depth-first walk: a hostile file cannot blow the stack.
-    std::vector<std::pair<int, Mat4d>> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, Mat4d{});
+    // Iterative depth-first walk: a hostile file cannot blow the stack. Each entry carries its
+    // parent's transform and path (the node names from the root, "/"-separated).
+    struct Entry {
+      int index;
+      Mat4d parent;
+      std::string path;
+    };
+    std::vector<Entry> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, Mat4d{}, {}});
     while (!stack.empty()) {
-      auto [index, parent] = stack.back();
+      auto [index, parent, parentPath] = std::move(stack.back());
       stack.pop_back();
       const auto& node = element(gltf_.nodes, index, "node", "scene hierarchy");
       if (visited_[static_cast<std::size_t>(index)])
@@ -302,20 +308,22 @@ class Loader {
                          index));
       visited_[static_cast<std::size_t>(index)] = true;
       const Mat4d world = parent * localTransform(node);
-      if (node.mesh >= 0) addNode(index, node, world);
+      const std::string name = node.name.empty() ? fmt::format("node {}", index) : node.name;
+      const std::string path = parentPath.empty() ? name : parentPath + "/" + name;
+      if (node.mesh >= 0) addNode(index, node, world, path);
       for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
-        stack.emplace_back(*child, world);
+        stack.push_back({*child, world, path});
     }
   }
 
-  void addNode(int index, const tinygltf::Node& node, const Mat4d& world) {
+  void addNode(int index, const tinygltf::Node& node, const Mat4d& world, const std::string& path) {
     const auto& mesh = element(gltf_.meshes, node.mesh, "mesh", fmt::format("node {}", index));
     std::string baseName = !node.name.empty()   ? node.name
                            : !mesh.name.empty() ? mesh.name
                                                 : fmt::format("node {}", index);
     const auto instancing = node.extensions.find("EXT_mesh_gpu_instancing");
     if (instancing == node.extensions.end()) {
-      addObject(baseName, node.mesh, mesh, world);
+      addObject(baseName, path, node.mesh, mesh, world);
       return;
     }
     // GPU instancing: one object per instance, each with its own transform.
@@ -338,7 +346,8 @@ class Loader {
       if (!r.empty())
         local = local * Mat4d::rotation(r[4 * i], r[4 * i + 1], r[4 * i + 2], r[4 * i + 3]);
       if (!s.empty()) local = local * Mat4d::scale({s[3 * i], s[3 * i + 1], s[3 * i + 2]});
-      addObject(fmt::format("{}#{}", baseName, i), node.mesh, mesh, world * local);
+      addObject(fmt::format("{}#{}", baseName, i), fmt::format("{}#{}", path, i), node.mesh, mesh,
+                world * local);
     }
   }
 
@@ -347,10 +356,10 @@ class Loader {
     std::vector<std::uint32_t> triangles;
   };
 
-  void addObject(const std::string& name, int meshIndex, const tinygltf::Mesh& mesh,
-                 const Mat4d& world) {
+  void addObject(const std::string& name, const std::string& path, int meshIndex,
+                 const tinygltf::Mesh& mesh, const Mat4d& world) {
     ModelBuilder builder(model_);
-    builder.beginObject(name);
+    builder.beginObject(name, path);
     const Mat4d normalMatrix = world.normalMatrix();
     const bool mirrored = world.determinant3() < 0;  // winding flips under a mirror
     for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {

@@ -37,6 +37,8 @@ struct Material {
   float alphaCutoff = 0.5f;
   bool doubleSided = false;
   float emissive[3] = {0, 0, 0};  // linear
+
+  bool operator==(const Material&) const = default;
 };
 
 struct Instance {

@@ -398,17 +398,10 @@ std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, Result& o
   } else {
     return ~0u;
   }
-  for (std::size_t m = 0; m < out.materials.size(); ++m) {
-    const Material& o = out.materials[m];
-    if (o.name == material.name && o.alphaMode == material.alphaMode &&
-        o.metallic == material.metallic && o.roughness == material.roughness &&
-        o.doubleSided == material.doubleSided && o.alphaCutoff == material.alphaCutoff &&
-        std::equal(o.baseColor, o.baseColor + 4, material.baseColor) &&
-        std::equal(o.emissive, o.emissive + 3, material.emissive))
-      return static_cast<std::uint32_t>(m);
-  }
-  out.materials.push_back(material);
-  return static_cast<std::uint32_t>(out.materials.size() - 1);
+  const auto index = static_cast<std::uint32_t>(
+      std::find(out.materials.begin(), out.materials.end(), material) - out.materials.begin());
+  if (index == out.materials.size()) out.materials.push_back(material);
+  return index;
 }
 
 // One placed instance's faces appended: positions in metres, normals and colours per vertex.

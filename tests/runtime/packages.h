@@ -79,7 +79,7 @@ class RuntimePackages {
                          static_cast<float>(random.uniform(-20, 20)),
                          static_cast<float>(random.uniform(-2, 2))};
       for (Vec3f& p : m.positions) p = p * scale + offset;
-      const Status added = writer->add(m, "part", Rgba8{});
+      const Status added = writer->add(m, {.name = "part"});
       EXPECT_TRUE(added.ok()) << added.message();
     }
     const Status finished = writer->finish();

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "lodforge/generate/cad.h"
+#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/gltf_reader.h"
 #include "lodforge/io/ply_writer.h"
 #include "lodforge/simplify/extract.h"
 #include "lodforge/simplify/package.h"
@@ -109,6 +111,54 @@ TEST(Extract, RatiosAndErrorsPickTheExpectedLevels) {
   const std::uint32_t n = vertexCountsForError(*package, bound)[0];
   EXPECT_LE(package->error(0)[n - o.minVertexCount], bound);
   EXPECT_TRUE(n == o.minVertexCount || package->error(0)[n - 1 - o.minVertexCount] > bound);
+}
+
+// A package keeps each object's assembly path and material, and `extract` hangs the objects back
+// in that tree with those materials: the GLB read again names the same paths.
+TEST(Extract, TheAssemblyTreeAndMaterialsComeBack) {
+  const std::string input = test::dataPath("meshes/2CylinderEngine.glb");
+  Result<Model> source = readGltf(input);
+  ASSERT_TRUE(source.ok());
+  test::TempDir dir;
+  ASSERT_TRUE(buildPackage(input, dir.file("e.lfp")).ok());
+  Result<Package> package = Package::open(dir.file("e.lfp"));
+  ASSERT_TRUE(package.ok());
+  ASSERT_TRUE(writeGlb(extractModel(*package, vertexCountsForRatio(*package, 0.5)),
+                       dir.file("e.glb"))
+                  .ok());
+  Result<Model> extracted = readGltf(dir.file("e.glb"));
+  ASSERT_TRUE(extracted.ok());
+  ASSERT_EQ(extracted->objectCount(), source->objectCount());
+  std::size_t withMaterial = 0;
+  for (std::size_t o = 0; o < source->objectCount(); ++o) {
+    // The same groups above the object's own node (named as the object is). The path's first
+    // component is the root node when all objects share it, else under a new "root".
+    const std::string_view path = source->objectPath(o);
+    const std::string expected =
+        std::string(path.substr(0, path.rfind('/') + 1)) + std::string(source->objectName(o));
+    EXPECT_TRUE(extracted->objectPath(o) == expected ||
+                extracted->objectPath(o) == "root/" + expected)
+        << extracted->objectPath(o) << " for " << expected;
+    EXPECT_NE(path.find('/'), std::string_view::npos);
+    EXPECT_EQ(extracted->objectName(o), source->objectName(o));
+    const std::uint32_t was = source->objects[o].material, is = extracted->objects[o].material;
+    ASSERT_EQ(was == kNoMaterial, is == kNoMaterial) << o;
+    if (was == kNoMaterial) continue;
+    ++withMaterial;
+    const Material &a = source->materials[was], &b = extracted->materials[is];
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.alphaMode, b.alphaMode);
+    EXPECT_EQ(a.metallic, b.metallic);
+    EXPECT_EQ(a.roughness, b.roughness);
+    EXPECT_EQ(a.emissive, b.emissive);
+  }
+  EXPECT_EQ(withMaterial, source->objectCount());
+  // Written and read once more, the tree is stable: the shared "root" is the root node again.
+  ASSERT_TRUE(writeGlb(*extracted, dir.file("again.glb")).ok());
+  Result<Model> again = readGltf(dir.file("again.glb"));
+  ASSERT_TRUE(again.ok());
+  for (std::size_t o = 0; o < again->objectCount(); ++o)
+    EXPECT_EQ(again->objectPath(o), extracted->objectPath(o));
 }
 
 }  // namespace

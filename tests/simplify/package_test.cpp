@@ -32,9 +32,12 @@ TEST(Package, WrittenObjectsReadBackIdentically) {
     Result<PackageWriter> writer = PackageWriter::create(dir.file("e.lfp"), {1, 2, 3}, true, false);
     ASSERT_TRUE(writer.ok());
     for (std::size_t o = 0; o < meshes.size(); ++o) {
-      ASSERT_TRUE(writer->add(meshes[o], engine->objectName(o), Rgba8{10, 20, 30, 255}).ok());
+      ASSERT_TRUE(writer
+                      ->add(meshes[o], {engine->objectName(o), Rgba8{10, 20, 30, 255},
+                                        engine->objectPath(o), engine->objects[o].material})
+                      .ok());
     }
-    ASSERT_TRUE(writer->finish().ok());
+    ASSERT_TRUE(writer->finish(engine->materials).ok());
   }
   EXPECT_EQ(test::listFolder(dir.path()),
             std::vector<std::string>{"e.lfp"});  // no spill files left
@@ -47,6 +50,8 @@ TEST(Package, WrittenObjectsReadBackIdentically) {
   for (std::size_t o = 0; o < meshes.size(); ++o) {
     const ProgressiveMesh& m = meshes[o];
     EXPECT_EQ(package->objectName(o), engine->objectName(o));
+    EXPECT_EQ(package->objectPath(o), engine->objectPath(o));
+    EXPECT_EQ(package->objectMaterial(o), engine->objects[o].material);
     EXPECT_EQ(package->object(o).minVertexCount, m.q);
     EXPECT_EQ(package->object(o).color, (Rgba8{10, 20, 30, 255}));
     EXPECT_TRUE(std::equal(m.positions.begin(), m.positions.end(), package->positions(o).begin()));
@@ -56,6 +61,12 @@ TEST(Package, WrittenObjectsReadBackIdentically) {
     EXPECT_TRUE(std::equal(m.map.begin(), m.map.end(), package->map(o).begin()));
     EXPECT_TRUE(std::equal(m.error.begin(), m.error.end(), package->error(o).begin()));
   }
+  // The engine's assembly tree and its materials, every field of them.
+  EXPECT_NE(engine->objectPath(0), "");
+  ASSERT_GT(engine->materials.size(), 1u);
+  ASSERT_EQ(package->materialCount(), engine->materials.size());
+  for (std::size_t m = 0; m < engine->materials.size(); ++m)
+    EXPECT_EQ(package->material(m), engine->materials[m]) << m;
   // Sections start on 64-byte boundaries.
   for (const PackageSectionEntry& e : package->header().sections) EXPECT_EQ(e.offset % 64, 0u);
 }
@@ -145,6 +156,11 @@ TEST_F(Corrupted, ForgedContentIsCaughtEvenWithValidChecksums) {
   const std::uint64_t objectsAt =
       h.sections[static_cast<std::uint32_t>(PackageSection::kObjects)].offset;
   const std::uint64_t mapAt = h.sections[static_cast<std::uint32_t>(PackageSection::kMap)].offset;
+  const std::uint64_t assemblyAt =
+      h.sections[static_cast<std::uint32_t>(PackageSection::kAssembly)].offset;
+  const std::uint64_t materialsAt =
+      h.sections[static_cast<std::uint32_t>(PackageSection::kMaterials)].offset;
+  ASSERT_GT(h.sections[static_cast<std::uint32_t>(PackageSection::kMaterials)].bytes, 0u);
   const Case cases[] = {
       {"ecol points up",
        [&](std::string& d) {
@@ -177,6 +193,24 @@ TEST_F(Corrupted, ForgedContentIsCaughtEvenWithValidChecksums) {
          m[1] = 0;
        },
        "object 0"},
+      {"material past the table",
+       [&](std::string& d) {
+         reinterpret_cast<PackageAssembly*>(d.data() + assemblyAt)[1].material = 1000;
+       },
+       "object 1: material 1000 of"},
+      {"path outside the names",
+       [&](std::string& d) {
+         reinterpret_cast<PackageAssembly*>(d.data() + assemblyAt)->pathLength = 1u << 30;
+       },
+       "object 0: assembly path outside"},
+      {"unknown alpha mode",
+       [&](std::string& d) { reinterpret_cast<PackageMaterial*>(d.data() + materialsAt)->alphaMode = 7; },
+       "material 0: alpha mode"},
+      {"material name outside the names",
+       [&](std::string& d) {
+         reinterpret_cast<PackageMaterial*>(d.data() + materialsAt)->nameOffset = 1ull << 40;
+       },
+       "material 0: name outside"},
       {"section outside the file",
        [&](std::string& d) {
          reinterpret_cast<PackageHeader*>(d.data())

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <unordered_map>
 #include <vector>
 
 #include <meshoptimizer.h>
@@ -45,7 +46,9 @@ struct GlbWriter::State {
   std::string structuralMetadata;  // EXT_structural_metadata at the root, when set
   bool meshFeatures = false;       // a primitive uses EXT_mesh_features
   std::vector<std::uint32_t> rootChildren;
+  std::vector<std::vector<std::uint32_t>> children;  // per node, those added under it
   std::optional<Vec3d> rootTranslation;
+  std::string rootName = "root";
   std::optional<std::uint32_t> defaultMaterial;
   // Per mesh: the grid of its quantised positions (origin, step), for the nodes that draw it.
   std::vector<std::optional<std::pair<Vec3d, double>>> dequantize;
@@ -397,8 +400,8 @@ bool isTranslation(const Mat4d& m) {
 }
 }  // namespace
 
-void GlbWriter::addNode(std::string_view name, std::optional<std::uint32_t> mesh,
-                        const Mat4d* transform) {
+std::uint32_t GlbWriter::addNode(std::string_view name, std::optional<std::uint32_t> mesh,
+                                 const Mat4d* transform, std::optional<std::uint32_t> parent) {
   nlohmann::json node = nlohmann::json::object();
   if (!name.empty()) node["name"] = std::string(name);
   if (mesh) node["mesh"] = *mesh;
@@ -419,8 +422,16 @@ void GlbWriter::addNode(std::string_view name, std::optional<std::uint32_t> mesh
   } else if (transform && transform->m != Mat4d{}.m) {
     node["matrix"] = transform->m;
   }
+  const auto index = static_cast<std::uint32_t>(state_->nodes.size());
   state_->nodes.push_back(std::move(node));
-  state_->rootChildren.push_back(static_cast<std::uint32_t>(state_->nodes.size() - 1));
+  state_->children.emplace_back();
+  assert(!parent || *parent < index);
+  (parent ? state_->children[*parent] : state_->rootChildren).push_back(index);
+  return index;
+}
+
+void GlbWriter::setRootName(std::string_view name) {
+  state_->rootName = name;
 }
 
 void GlbWriter::setRootTranslation(Vec3d translation) {
@@ -434,8 +445,10 @@ std::uint64_t GlbWriter::binaryBytes() const {
 Status GlbWriter::finish() {
   State& s = *state_;
   assert(!s.options.flatScene || !s.rootTranslation);
+  for (std::size_t n = 0; n < s.children.size(); ++n)
+    if (!s.children[n].empty()) s.nodes[n]["children"] = s.children[n];
   // The root node holds every object node, and the origin offset if there is one.
-  nlohmann::json root = {{"name", "root"}};
+  nlohmann::json root = {{"name", s.rootName}};
   if (!s.rootChildren.empty()) root["children"] = s.rootChildren;
   if (s.rootTranslation && *s.rootTranslation != Vec3d{})
     root["translation"] = {s.rootTranslation->x, s.rootTranslation->y, s.rootTranslation->z};
@@ -509,6 +522,61 @@ Status GlbWriter::finish() {
   return out->commit();
 }
 
+namespace {
+
+// The nodes above objects with assembly paths: one per distinct prefix, made on first use, so
+// "motor/rotor/shaft" and "motor/rotor/key" share "motor" and "rotor".
+class AssemblyNodes {
+ public:
+  // `shared`: the first component every path starts with ("" if none), which the root node
+  // stands for.
+  AssemblyNodes(GlbWriter& writer, std::string_view shared) : writer_(writer), shared_(shared) {
+    if (!shared_.empty()) writer_.setRootName(shared_);
+  }
+
+  // The node an object with this path hangs under (none: the root).
+  std::optional<std::uint32_t> parentOf(std::string_view path) {
+    if (!shared_.empty()) path.remove_prefix(shared_.size() + 1);
+    const auto slash = path.rfind('/');
+    if (slash == std::string_view::npos) return std::nullopt;
+    return nodeFor(path.substr(0, slash));
+  }
+
+ private:
+  std::uint32_t nodeFor(std::string_view prefix) {
+    if (const auto found = nodes_.find(std::string(prefix)); found != nodes_.end())
+      return found->second;
+    const auto slash = prefix.rfind('/');
+    const std::optional<std::uint32_t> parent =
+        slash == std::string_view::npos ? std::nullopt
+                                        : std::optional(nodeFor(prefix.substr(0, slash)));
+    const std::string_view name =
+        slash == std::string_view::npos ? prefix : prefix.substr(slash + 1);
+    const std::uint32_t node = writer_.addNode(name, std::nullopt, nullptr, parent);
+    nodes_.emplace(std::string(prefix), node);
+    return node;
+  }
+
+  GlbWriter& writer_;
+  std::string shared_;
+  std::unordered_map<std::string, std::uint32_t> nodes_;
+};
+
+// The first path component every object's path starts with, followed by more ("" if none).
+std::string_view sharedFirstComponent(const Model& model) {
+  std::string_view shared;
+  for (std::size_t o = 0; o < model.objectCount(); ++o) {
+    const std::string_view path = model.objectPath(o);
+    const auto slash = path.find('/');
+    if (slash == std::string_view::npos || slash == 0) return {};
+    if (o == 0) shared = path.substr(0, slash);
+    if (path.substr(0, slash) != shared) return {};
+  }
+  return shared;
+}
+
+}  // namespace
+
 Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptions& options) {
   Result<GlbWriter> writer = GlbWriter::create(path, options);
   if (!writer) return writer.status();
@@ -526,6 +594,7 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
     }
     return materials[m];
   };
+  AssemblyNodes assembly(*writer, sharedFirstComponent(model));
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
     if (o % 1024 == 0) LODFORGE_TRY(checkCancelled());
     const ObjectRecord& record = model.objects[o];
@@ -543,7 +612,7 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
       if (!added) return added.status();
       mesh = *added;
     }
-    writer->addNode(model.objectName(o), mesh);
+    writer->addNode(model.objectName(o), mesh, nullptr, assembly.parentOf(model.objectPath(o)));
     progress.advance(record.triangleCount);
   }
   progress.finish();

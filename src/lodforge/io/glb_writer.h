@@ -100,11 +100,15 @@ class GlbWriter {
   // A buffer view of raw bytes, 8-byte aligned (a property table's values or string offsets);
   // returns its index.
   Result<std::uint32_t> addBufferView(std::span<const std::byte> bytes);
-  // A node drawing `mesh` (or nothing) with an optional transform, a child of the root node.
-  void addNode(std::string_view name, std::optional<std::uint32_t> mesh,
-               const Mat4d* transform = nullptr);
+  // A node drawing `mesh` (or nothing) with an optional transform, a child of `parent` (a node
+  // added before) or of the root node; returns its index.
+  std::uint32_t addNode(std::string_view name, std::optional<std::uint32_t> mesh,
+                        const Mat4d* transform = nullptr,
+                        std::optional<std::uint32_t> parent = std::nullopt);
   // Translation of the root node: places float geometry at a double-precision origin.
   void setRootTranslation(Vec3d translation);
+  // The root node's name ("root" unless set).
+  void setRootName(std::string_view name);
   // Size of the binary chunk so far (GLB caps a file at 4 GiB).
   std::uint64_t binaryBytes() const;
   Status finish();
@@ -116,7 +120,10 @@ class GlbWriter {
 };
 
 // Writes a whole Model: one node + mesh per object (objects without triangles become empty
-// nodes), the origin as the root translation.
+// nodes), the origin as the root translation. Objects with an assembly path hang in the node
+// tree the path names ("motor/rotor/shaft": nodes "motor" and "rotor" above the object's node
+// "shaft"), one node per distinct prefix; a first component all paths share names the root node
+// instead, so a GLB read and written again keeps its tree.
 Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptions& options = {});
 
 }  // namespace lodforge

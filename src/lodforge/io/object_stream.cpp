@@ -19,6 +19,8 @@ class ModelStream final : public ObjectStream {
     const std::size_t o = next_++;
     const ObjectRecord& r = model_.objects[o];
     out.name = std::string(model_.objectName(o));
+    out.path = std::string(model_.objectPath(o));
+    out.material = r.material;
     const auto positions = model_.objectPositions(o);
     out.positions.assign(positions.begin(), positions.end());
     out.normals.clear();
@@ -40,6 +42,7 @@ class ModelStream final : public ObjectStream {
   bool hasColors() const override { return model_.hasColors(); }
   bool streaming() const override { return false; }
   std::uint64_t triangleCountHint() const override { return model_.triangleCount(); }
+  std::span<const Material> materials() const override { return model_.materials; }
 
  private:
   Model model_;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,8 @@ namespace lodforge {
 
 struct SourceObject {
   std::string name;
+  std::string path;                      // in the assembly; empty without a tree
+  std::uint32_t material = kNoMaterial;  // into the stream's materials()
   std::vector<Vec3f> positions;        // relative to the stream's origin
   std::vector<Vec3f> normals;          // empty or one per vertex
   std::vector<Rgba8> colors;           // empty or one per vertex
@@ -25,7 +28,7 @@ struct SourceObject {
 
   std::uint64_t memoryBytes() const {
     return positions.size() * 12 + normals.size() * 12 + colors.size() * 4 + indices.size() * 4 +
-           name.size();
+           name.size() + path.size();
   }
 };
 
@@ -40,6 +43,8 @@ class ObjectStream {
   virtual bool hasColors() const = 0;
   virtual bool streaming() const = 0;
   virtual std::uint64_t triangleCountHint() const = 0;  // for progress; faces for PLY
+  // What the objects' material indices refer to (empty for a grouped PLY).
+  virtual std::span<const Material> materials() const { return {}; }
 };
 
 struct ObjectStreamOptions {

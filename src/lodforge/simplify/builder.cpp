@@ -25,7 +25,8 @@ constexpr std::uint64_t kFixedBytes = std::uint64_t{48} << 20;
 
 struct Built {
   ProgressiveMesh mesh;
-  std::string name;
+  std::string name, path;
+  std::uint32_t material = kNoMaterial;
   Rgba8 color;
   std::uint64_t inputTriangles = 0;
 };
@@ -39,6 +40,8 @@ std::uint64_t footprint(const SourceObject& object) {
 Built buildOne(SourceObject& source, const ProgressiveOptions& options) {
   Built built;
   built.name = std::move(source.name);
+  built.path = std::move(source.path);
+  built.material = source.material;
   built.inputTriangles = source.indices.size() / 3;
   // The base colour: the first vertex's (CAD parts are usually one colour).
   built.color = source.colors.empty() ? Rgba8{} : source.colors.front();
@@ -113,7 +116,7 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
         [&](std::size_t i) { built[i] = buildOne(wave[i], options.progressive); },
         tbb::simple_partitioner());
     for (Built& b : built) {
-      LODFORGE_TRY(writer->add(b.mesh, b.name, b.color));
+      LODFORGE_TRY(writer->add(b.mesh, {b.name, b.color, b.path, b.material}));
       stats.objects += 1;
       stats.inputTriangles += b.inputTriangles;
       stats.vertices += b.mesh.vertexCount();
@@ -129,7 +132,7 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
     return badInput(input,
                     "no triangles: a package is built from a mesh (for a point cloud use "
                     "`lodforge points` or `lodforge tiles`)");
-  LODFORGE_TRY(writer->finish());
+  LODFORGE_TRY(writer->finish(stream.materials()));
   progress.finish();
   Result<std::uint64_t> size = fileSize(output);
   if (!size) return size.status();

@@ -42,6 +42,8 @@ Model extractModel(const Package& package, std::span<const std::uint32_t> vertex
   }
   Model model;
   model.origin = package.origin();
+  for (std::size_t m = 0; m < package.materialCount(); ++m)
+    model.materials.push_back(package.material(m));
   model.indices.resize(3 * starts[objects]);
   reformSelection(ReformSource::of(package), {ids, vertexCounts, starts, bases}, model.indices);
 
@@ -61,6 +63,10 @@ Model extractModel(const Package& package, std::span<const std::uint32_t> vertex
     record.nameOffset = model.names.size();
     record.nameLength = static_cast<std::uint32_t>(package.objectName(i).size());
     model.names.append(package.objectName(i));
+    record.pathOffset = model.paths.size();
+    record.pathLength = static_cast<std::uint32_t>(package.objectPath(i).size());
+    model.paths.append(package.objectPath(i));
+    record.material = package.objectMaterial(i);
     model.positions.insert(model.positions.end(), positions.begin(), positions.end());
     if (package.header().hasNormals()) {
       const auto normals = package.normals(i).first(n);

@@ -16,7 +16,8 @@ std::vector<std::uint32_t> vertexCountsForRatio(const Package& package, double r
 std::vector<std::uint32_t> vertexCountsForError(const Package& package, double error);
 
 // Every object at vertexCounts[object]: its first n vertices and its re-formed first map(n)
-// triangles. Objects keep their names; the model takes the package's origin.
+// triangles. Objects keep their names, assembly paths and materials; the model takes the
+// package's origin.
 Model extractModel(const Package& package, std::span<const std::uint32_t> vertexCounts);
 
 }  // namespace lodforge

@@ -18,7 +18,8 @@ namespace lodforge {
 
 std::string_view packageSectionName(PackageSection section) {
   static constexpr std::string_view kNames[] = {
-      "objects", "names", "positions", "normals", "colors", "triangles", "ecol", "map", "error"};
+      "objects", "names", "positions", "normals", "colors", "triangles",
+      "ecol",    "map",   "error",     "assembly", "materials"};
   return kNames[static_cast<std::uint32_t>(section)];
 }
 
@@ -99,7 +100,7 @@ Result<PackageWriter> PackageWriter::create(const std::string& path, Vec3d origi
   return PackageWriter(std::move(state));
 }
 
-Status PackageWriter::add(const ProgressiveMesh& mesh, std::string_view name, Rgba8 color) {
+Status PackageWriter::add(const ProgressiveMesh& mesh, const PackageObjectInfo& info) {
   State& s = *state_;
   PackageHeader& h = s.header;
   assert(mesh.normals.empty() != h.hasNormals() || mesh.vertexCount() == 0);
@@ -118,9 +119,12 @@ Status PackageWriter::add(const ProgressiveMesh& mesh, std::string_view name, Rg
   std::memcpy(record.boundsMin, &box.min, 12);
   std::memcpy(record.boundsMax, &box.max, 12);
   s.bounds.add(box);
-  record.nameOffset = s.spills[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
-  record.nameLength = static_cast<std::uint32_t>(name.size());
-  record.color = color;
+  const std::uint64_t namesAt = s.spills[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
+  record.nameOffset = namesAt;
+  record.nameLength = static_cast<std::uint32_t>(info.name.size());
+  record.color = info.color;
+  const PackageAssembly assembly{namesAt + info.name.size(),
+                                 static_cast<std::uint32_t>(info.path.size()), info.material};
 
   // An empty object still gets its one level (n = q = 0, no triangles).
   const std::vector<std::uint32_t> emptyMap = {0};
@@ -129,7 +133,9 @@ Status PackageWriter::add(const ProgressiveMesh& mesh, std::string_view name, Rg
   const auto& error = mesh.error.empty() ? emptyError : mesh.error;
 
   LODFORGE_TRY(s.append(PackageSection::kObjects, &record, sizeof record));
-  LODFORGE_TRY(s.append(PackageSection::kNames, name.data(), name.size()));
+  LODFORGE_TRY(s.append(PackageSection::kNames, info.name.data(), info.name.size()));
+  LODFORGE_TRY(s.append(PackageSection::kNames, info.path.data(), info.path.size()));
+  LODFORGE_TRY(s.append(PackageSection::kAssembly, &assembly, sizeof assembly));
   LODFORGE_TRY(s.append<Vec3f>(PackageSection::kPositions, mesh.positions));
   if (h.hasNormals()) LODFORGE_TRY(s.append<Vec3f>(PackageSection::kNormals, mesh.normals));
   if (h.hasColors()) LODFORGE_TRY(s.append<Rgba8>(PackageSection::kColors, mesh.colors));
@@ -144,9 +150,23 @@ Status PackageWriter::add(const ProgressiveMesh& mesh, std::string_view name, Rg
   return {};
 }
 
-Status PackageWriter::finish() {
+Status PackageWriter::finish(std::span<const Material> materials) {
   State& s = *state_;
   PackageHeader& h = s.header;
+  for (const Material& m : materials) {
+    PackageMaterial record;
+    std::copy(m.baseColor.begin(), m.baseColor.end(), record.baseColor);
+    std::copy(m.emissive.begin(), m.emissive.end(), record.emissive);
+    record.metallic = m.metallic;
+    record.roughness = m.roughness;
+    record.alphaCutoff = m.alphaCutoff;
+    record.alphaMode = static_cast<std::uint32_t>(m.alphaMode);
+    record.doubleSided = m.doubleSided ? 1 : 0;
+    record.nameOffset = s.spills[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
+    record.nameLength = static_cast<std::uint32_t>(m.name.size());
+    LODFORGE_TRY(s.append(PackageSection::kNames, m.name.data(), m.name.size()));
+    LODFORGE_TRY(s.append(PackageSection::kMaterials, &record, sizeof record));
+  }
   const Aabb bounds = s.bounds.empty() ? Aabb{Vec3f{}, Vec3f{}} : s.bounds;
   std::memcpy(h.boundsMin, &bounds.min, 12);
   std::memcpy(h.boundsMax, &bounds.max, 12);
@@ -206,6 +226,31 @@ std::span<const std::uint32_t> Package::allMap() const {
 std::string_view Package::objectName(std::size_t i) const {
   const auto names = section<char>(PackageSection::kNames);
   return {names.data() + object(i).nameOffset, object(i).nameLength};
+}
+std::string_view Package::objectPath(std::size_t i) const {
+  const auto names = section<char>(PackageSection::kNames);
+  const PackageAssembly& a = section<PackageAssembly>(PackageSection::kAssembly)[i];
+  return {names.data() + a.pathOffset, a.pathLength};
+}
+std::uint32_t Package::objectMaterial(std::size_t i) const {
+  return section<PackageAssembly>(PackageSection::kAssembly)[i].material;
+}
+std::size_t Package::materialCount() const {
+  return section<PackageMaterial>(PackageSection::kMaterials).size();
+}
+Material Package::material(std::size_t m) const {
+  const auto names = section<char>(PackageSection::kNames);
+  const PackageMaterial& r = section<PackageMaterial>(PackageSection::kMaterials)[m];
+  Material material;
+  material.name.assign(names.data() + r.nameOffset, r.nameLength);
+  std::copy(std::begin(r.baseColor), std::end(r.baseColor), material.baseColor.begin());
+  std::copy(std::begin(r.emissive), std::end(r.emissive), material.emissive.begin());
+  material.metallic = r.metallic;
+  material.roughness = r.roughness;
+  material.alphaCutoff = r.alphaCutoff;
+  material.alphaMode = static_cast<AlphaMode>(r.alphaMode);
+  material.doubleSided = r.doubleSided != 0;
+  return material;
 }
 std::span<const Vec3f> Package::positions(std::size_t i) const {
   return allPositions().subspan(object(i).vertexOffset, object(i).vertexCount);
@@ -268,6 +313,7 @@ Status Package::badAt(std::uint64_t at, std::string_view what) const {
 Status Package::validate(const OpenOptions& options) {
   LODFORGE_TRY(validateHeader());
   LODFORGE_TRY(validateSections(options));
+  LODFORGE_TRY(validateMaterials());
   return validateObjects();
 }
 
@@ -285,8 +331,9 @@ Status Package::validateHeader() {
   header_ = reinterpret_cast<const PackageHeader*>(bytes_.data());
   const PackageHeader& h = *header_;
   if (h.version != kPackageVersion) {
-    return badAt(8, fmt::format("package version {} (this lodforge reads version {})", h.version,
-                                kPackageVersion));
+    return badAt(8, fmt::format("package version {} (this lodforge reads version {}): build it "
+                                "again from its source with `lodforge build`",
+                                h.version, kPackageVersion));
   }
   if (h.headerChecksum != headerChecksumOf(h))
     return badAt(504, "header checksum mismatch: the package is corrupted");
@@ -316,7 +363,10 @@ Status Package::validateSections(const OpenOptions& options) const {
       h.triangleCount * 3 * sizeof(std::uint32_t),
       h.vertexCount * sizeof(std::uint32_t),
       h.levelCount * sizeof(std::uint32_t),
-      h.levelCount * sizeof(float)};
+      h.levelCount * sizeof(float),
+      h.objectCount * sizeof(PackageAssembly),
+      h.sections[static_cast<std::uint32_t>(PackageSection::kMaterials)].bytes /
+          sizeof(PackageMaterial) * sizeof(PackageMaterial)};
   for (std::uint32_t s = 0; s < kPackageSections; ++s) {
     const PackageSectionEntry& e = h.sections[s];
     const auto name = packageSectionName(static_cast<PackageSection>(s));
@@ -360,6 +410,11 @@ std::string Package::objectProblem(std::size_t i) const {
     return "levels outside the section";
   if (o.nameOffset > nameBytes || o.nameLength > nameBytes - o.nameOffset)
     return "name outside the section";
+  const PackageAssembly& a = section<PackageAssembly>(PackageSection::kAssembly)[i];
+  if (a.pathOffset > nameBytes || a.pathLength > nameBytes - a.pathOffset)
+    return "assembly path outside the names section";
+  if (a.material != kNoMaterial && a.material >= materialCount())
+    return fmt::format("material {} of {}", a.material, materialCount());
   if (o.minTriangleCount > o.triangleCount) return "map(q) > map(p)";
   const auto e = ecol(i);
   for (std::uint32_t v = 0; v < o.vertexCount; ++v) {
@@ -380,6 +435,33 @@ std::string Package::objectProblem(std::size_t i) const {
   for (std::size_t k = 0; k < err.size(); ++k) {
     if (!std::isfinite(err[k]) || err[k] < 0 || (k > 0 && err[k] > err[k - 1]))
       return "error table is not finite and non-increasing";
+  }
+  return {};
+}
+
+// Every material's name inside the names section and its fields in their ranges.
+Status Package::validateMaterials() const {
+  const PackageSectionEntry& names = header_->sections[static_cast<std::uint32_t>(PackageSection::kNames)];
+  const PackageSectionEntry& table =
+      header_->sections[static_cast<std::uint32_t>(PackageSection::kMaterials)];
+  const auto materials = section<PackageMaterial>(PackageSection::kMaterials);
+  for (std::size_t m = 0; m < materials.size(); ++m) {
+    const PackageMaterial& r = materials[m];
+    const bool finite = std::all_of(reinterpret_cast<const float*>(&r),
+                                    reinterpret_cast<const float*>(&r) + 10,
+                                    [](float v) { return std::isfinite(v); });
+    const char* problem = nullptr;
+    if (r.nameOffset > names.bytes || r.nameLength > names.bytes - r.nameOffset)
+      problem = "name outside the names section";
+    else if (r.alphaMode > static_cast<std::uint32_t>(AlphaMode::kBlend))
+      problem = "alpha mode is not OPAQUE, MASK or BLEND";
+    else if (r.doubleSided > 1)
+      problem = "doubleSided is neither 0 nor 1";
+    else if (!finite)
+      problem = "a factor is not finite";
+    if (problem)
+      return badAt(table.offset + m * sizeof(PackageMaterial),
+                   fmt::format("material {}: {}", m, problem));
   }
   return {};
 }

@@ -4,7 +4,8 @@
 //
 //   header        512 bytes: magic, version, counts, origin, bounds, section table, checksum
 //   objects       PackageObject[objectCount]                   (80 bytes each)
-//   names         object names, back to back (UTF-8, no terminator)
+//   names         object names, assembly paths and material names, back to back (UTF-8, no
+//                 terminator)
 //   positions     float[3] per vertex, rearranged, relative to the origin
 //   normals       float[3] per vertex (flag bit 0)
 //   colors        RGBA8 per vertex (flag bit 1)
@@ -12,6 +13,8 @@
 //   ecol          uint32 per vertex, object-local: ecol[i] < i for i >= q, ecol[i] = i below q
 //   map           uint32 per level: triangles at n vertices, n = q..p for each object
 //   error         float per level: geometric error at n vertices (model units)
+//   assembly      PackageAssembly[objectCount]: each object's path and material (16 bytes each)
+//   materials     PackageMaterial per material the objects use (64 bytes each)
 //
 // Each section carries an XXH3-64 checksum; the header checksums itself. Package::open checks
 // all of it, and every index a kernel will follow, before handing out a single span.
@@ -26,6 +29,7 @@
 #include <string_view>
 
 #include "lodforge/core/file.h"
+#include "lodforge/core/material.h"
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
 #include "lodforge/simplify/progressive.h"
@@ -42,13 +46,16 @@ enum class PackageSection : std::uint32_t {
   kEcol,
   kMap,
   kError,
+  kAssembly,
+  kMaterials,
   kCount
 };
 inline constexpr std::uint32_t kPackageSections =
     static_cast<std::uint32_t>(PackageSection::kCount);
 std::string_view packageSectionName(PackageSection section);
 
-inline constexpr std::uint32_t kPackageVersion = 1;
+// Version 2 added the assembly and materials sections.
+inline constexpr std::uint32_t kPackageVersion = 2;
 inline constexpr std::size_t kPackageAlignment = 64;
 // PNG-style magic: a high byte and CR LF / ^Z / LF catch text-mode transfers that damage files.
 inline constexpr std::array<char, 8> kPackageMagic = {'\x89', 'L',  'F',    'P',
@@ -99,6 +106,38 @@ struct PackageObject {
 };
 static_assert(sizeof(PackageObject) == 80);
 
+// Where an object sits in its assembly and what it is made of (kept beside PackageObject so the
+// runtime's hot table stays 80 bytes).
+struct PackageAssembly {
+  std::uint64_t pathOffset = 0;  // into names
+  std::uint32_t pathLength = 0;
+  std::uint32_t material = kNoMaterial;  // into materials
+};
+static_assert(sizeof(PackageAssembly) == 16);
+
+// A Material as stored (glTF's metallic-roughness model; core/material.h).
+struct PackageMaterial {
+  float baseColor[4] = {1, 1, 1, 1};
+  float emissive[3] = {0, 0, 0};
+  float metallic = 0;
+  float roughness = 0.5f;
+  float alphaCutoff = 0.5f;
+  std::uint32_t alphaMode = 0;  // AlphaMode
+  std::uint32_t doubleSided = 0;
+  std::uint64_t nameOffset = 0;  // into names
+  std::uint32_t nameLength = 0;
+  std::uint32_t reserved = 0;
+};
+static_assert(sizeof(PackageMaterial) == 64);
+
+// What the package says of an object besides its mesh.
+struct PackageObjectInfo {
+  std::string_view name = {};
+  Rgba8 color = {};  // the object's base colour
+  std::string_view path = {};
+  std::uint32_t material = kNoMaterial;  // into the materials given to finish()
+};
+
 // Writes a package object by object, each section streamed to its own temporary file, then
 // joined under a temporary name and renamed. Memory does not grow with the number of objects.
 class PackageWriter {
@@ -109,8 +148,9 @@ class PackageWriter {
   PackageWriter& operator=(PackageWriter&&) noexcept;
   ~PackageWriter();
 
-  Status add(const ProgressiveMesh& mesh, std::string_view name, Rgba8 color);
-  Status finish();
+  Status add(const ProgressiveMesh& mesh, const PackageObjectInfo& info);
+  // `materials` is what the objects' material indices refer to.
+  Status finish(std::span<const Material> materials = {});
   std::uint64_t objectCount() const;
 
  private:
@@ -143,6 +183,10 @@ class Package {
 
   const PackageObject& object(std::size_t i) const { return objects()[i]; }
   std::string_view objectName(std::size_t i) const;
+  std::string_view objectPath(std::size_t i) const;     // empty without an assembly tree
+  std::uint32_t objectMaterial(std::size_t i) const;  // kNoMaterial or < materialCount()
+  std::size_t materialCount() const;
+  Material material(std::size_t m) const;
   std::span<const Vec3f> positions(std::size_t i) const;
   std::span<const Vec3f> normals(std::size_t i) const;            // empty without normals
   std::span<const Rgba8> colors(std::size_t i) const;             // empty without colors
@@ -173,6 +217,7 @@ class Package {
   // What breaks object i's invariants (ranges inside the sections, ECol chains, corners, Map and
   // the error table), empty when nothing does.
   std::string objectProblem(std::size_t i) const;
+  Status validateMaterials() const;
   Status badAt(std::uint64_t at, std::string_view what) const;
   template <class T>
   std::span<const T> section(PackageSection s) const;

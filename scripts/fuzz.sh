@@ -10,7 +10,7 @@ seconds=${1:-20}
 # fuzz_cad is built but not run here: OCCT's BREP reader loops for minutes on some corrupt counts
 # (an OCCT bug the wrapper cannot stop yet; docs/cad.md). Run it by hand: scripts/fuzz.sh takes
 # READERS="cad" to pick readers.
-readers=(${READERS:-ply obj stl gltf lfp png tiles las laz xyz lfc})
+readers=(${READERS:-ply obj stl gltf lfp png tiles las laz xyz lfc assimp})
 mkdir -p build/fuzz/artifacts
 run() {
   local reader=$1 work=build/fuzz/work/$1

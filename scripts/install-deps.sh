@@ -17,6 +17,8 @@ packages=(
   # CAD: OpenCASCADE's data exchange (STEP, IGES, BREP through XDE); fontconfig is a link
   # dependency of its CMake config; occt-misc holds its sample files, used as test data
   libocct-data-exchange-dev libfontconfig1-dev occt-misc
+  # interchange formats (OFF, FBX, Collada, 3DS, IFC, …) through assimp
+  libassimp-dev
   # rendering (headless EGL on Mesa's llvmpipe, GLFW window, Dear ImGui)
   libepoxy-dev libegl-dev libgl1-mesa-dri libglfw3-dev libimgui-dev xvfb
   # tests and benchmarks

@@ -19,7 +19,9 @@ namespace {
 void report(const Global& global, const std::string& path, const Result<GenerateStats>& stats,
             double seconds) {
   std::string counts =
-      stats->triangles > 0
+      stats->triangles == 0 && stats->vertices == 0
+          ? fmt::format("{} parts as B-rep", formatCount(stats->objects))
+      : stats->triangles > 0
           ? fmt::format("{} objects, {} vertices, {} triangles", formatCount(stats->objects),
                         formatCount(stats->vertices), formatCount(stats->triangles))
           : fmt::format("{} points", formatCount(stats->vertices));
@@ -58,8 +60,10 @@ void addGenerate(CLI::App& app, const Global& global, Run& run) {
     sub->add_option("--seed", options->cad.seed, "Random seed (same seed, same file)");
     sub->add_option("--detail", options->cad.detail, "Tessellation density factor (default 1)")
         ->check(CLI::PositiveNumber);
-    sub->add_option("-o,--output", options->output,
-                    "Output .glb or .ply (default cad.glb, cad.ply above 100K parts)");
+    sub->add_option(
+        "-o,--output", options->output,
+        "Output .glb, .ply or .step (B-rep through OpenCASCADE; default cad.glb, cad.ply above "
+        "100K parts)");
     sub->callback([&global, &run, options] {
       if (options->output.empty())
         options->output = options->cad.objects > 100'000 ? "cad.ply" : "cad.glb";

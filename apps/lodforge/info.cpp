@@ -187,7 +187,8 @@ Status describePackage(const std::string& path, bool json) {
     const std::string_view tree = package->objectPath(i);
     if (tree.empty()) continue;
     ++placed;
-    depth = std::max(depth, 1 + static_cast<std::uint64_t>(std::count(tree.begin(), tree.end(), '/')));
+    depth =
+        std::max(depth, 1 + static_cast<std::uint64_t>(std::count(tree.begin(), tree.end(), '/')));
   }
   const std::uint64_t lodBytes = package->sectionBytes(PackageSection::kEcol) +
                                  package->sectionBytes(PackageSection::kMap) +

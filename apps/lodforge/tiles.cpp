@@ -114,8 +114,8 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
                "positions, 8-bit normals) in the tiles where it is invisible");
   sub.add_option("--parts", options.parts,
                  "Meshes: name each object (part) in the tiles, pickable in viewers: auto (CAD, "
-                 "glTF and .lfp inputs of several objects), on (any input of several objects, "
-                 "which keeps objects from welding together), or off")
+                 "glTF, FBX/DAE/IFC and .lfp inputs of several objects), on (any input of "
+                 "several objects, which keeps objects from welding together), or off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   addCountOption(sub, "--block-size", options.blockSize,
                  "Point clouds: most points per leaf tile (a block of the partition; default 50K)");

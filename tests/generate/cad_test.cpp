@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/mesh.h"
+#include "lodforge/io/cad_reader.h"
 #include "lodforge/io/gltf_reader.h"
 #include "lodforge/io/ply_reader.h"
 #include "test_support.h"
@@ -36,6 +37,43 @@ TEST(Cad, GlbAndPlyHoldTheSameAssembly) {
     ASSERT_NEAR(a.min.x, b.min.x, 1e-3f) << o;
     ASSERT_NEAR(a.max.z, b.max.z, 1e-3f) << o;
   }
+}
+
+// The STEP assembly (B-rep through OpenCASCADE) is the GLB's: the same parts in the same order,
+// each where the GLB has it (boxes agree to the chord error of the GLB's tessellation), the
+// catalogue bolts shared shapes.
+TEST(Cad, StepHoldsTheGlbsAssemblyAsBrep) {
+  test::TempDir dir;
+  const CadOptions options{.objects = 120, .seed = 9};
+  ASSERT_TRUE(generateCad(options, dir.file("a.glb")).ok());
+  Result<GenerateStats> step = generateCad(options, dir.file("a.step"));
+  ASSERT_TRUE(step.ok()) << step.error().message;
+  EXPECT_EQ(step->objects, 120u);
+  EXPECT_EQ(test::listFolder(dir.path()), (std::vector<std::string>{"a.glb", "a.step"}));
+  Result<Model> mesh = readGltf(dir.file("a.glb"));
+  CadReadStats stats;
+  Result<Model> brep = readCad(dir.file("a.step"), {}, nullptr, &stats);
+  ASSERT_TRUE(mesh.ok());
+  ASSERT_TRUE(brep.ok()) << brep.error().message;
+  ASSERT_EQ(brep->objectCount(), mesh->objectCount());
+  EXPECT_LT(stats.shapes, stats.instances);  // bolts placed more than once
+  std::size_t bolts = 0;
+  for (std::size_t o = 0; o < mesh->objectCount(); ++o) {
+    const std::string name(mesh->objectName(o));
+    if (name.rfind("bolt_", 0) == 0) {
+      EXPECT_EQ(brep->objectName(o).rfind("bolt M", 0), 0u) << brep->objectName(o);
+      ++bolts;
+    } else {
+      EXPECT_EQ(brep->objectName(o), name);
+    }
+    const Aabb a = mesh->objects[o].bounds, b = brep->objects[o].bounds;
+    const double size = length(toDouble(a.max - a.min));
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(mesh->origin[k] + a.min[k], brep->origin[k] + b.min[k], 0.03 * size) << name;
+      EXPECT_NEAR(mesh->origin[k] + a.max[k], brep->origin[k] + b.max[k], 0.03 * size) << name;
+    }
+  }
+  EXPECT_GT(bolts, 0u);
 }
 
 TEST(Cad, PartsVaryWidelyInKindSizeAndTessellation) {

@@ -13,13 +13,16 @@ TEST(ModelIo, FormatComesFromTheExtension) {
   EXPECT_EQ(formatFromPath("x.gltf"), FileFormat::kGltf);
   EXPECT_EQ(formatFromPath("x.obj"), FileFormat::kObj);
   EXPECT_EQ(formatFromPath("x.stl"), FileFormat::kStl);
-  EXPECT_EQ(formatFromPath("x.fbx"), FileFormat::kUnknown);
+  EXPECT_EQ(formatFromPath("x.fbx"), FileFormat::kAssimp);
+  EXPECT_EQ(formatFromPath("house.IFC"), FileFormat::kAssimp);
+  EXPECT_EQ(formatFromPath("x.vtk"), FileFormat::kUnknown);
+  EXPECT_FALSE(canWrite(FileFormat::kAssimp));
   EXPECT_FALSE(canWrite(FileFormat::kGltf));
   EXPECT_TRUE(canRead(FileFormat::kGltf));
 }
 
 TEST(ModelIo, UnknownFormatsAreUsageErrors) {
-  Result<Model> model = readModel("model.fbx");
+  Result<Model> model = readModel("model.vtk");
   ASSERT_FALSE(model.ok());
   EXPECT_EQ(model.error().kind, ErrorKind::kUsage);
   EXPECT_EQ(exitCodeFor(model.status()), 2);

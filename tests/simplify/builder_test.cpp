@@ -123,9 +123,9 @@ TEST(Extract, TheAssemblyTreeAndMaterialsComeBack) {
   ASSERT_TRUE(buildPackage(input, dir.file("e.lfp")).ok());
   Result<Package> package = Package::open(dir.file("e.lfp"));
   ASSERT_TRUE(package.ok());
-  ASSERT_TRUE(writeGlb(extractModel(*package, vertexCountsForRatio(*package, 0.5)),
-                       dir.file("e.glb"))
-                  .ok());
+  ASSERT_TRUE(
+      writeGlb(extractModel(*package, vertexCountsForRatio(*package, 0.5)), dir.file("e.glb"))
+          .ok());
   Result<Model> extracted = readGltf(dir.file("e.glb"));
   ASSERT_TRUE(extracted.ok());
   ASSERT_EQ(extracted->objectCount(), source->objectCount());

@@ -204,7 +204,9 @@ TEST_F(Corrupted, ForgedContentIsCaughtEvenWithValidChecksums) {
        },
        "object 0: assembly path outside"},
       {"unknown alpha mode",
-       [&](std::string& d) { reinterpret_cast<PackageMaterial*>(d.data() + materialsAt)->alphaMode = 7; },
+       [&](std::string& d) {
+         reinterpret_cast<PackageMaterial*>(d.data() + materialsAt)->alphaMode = 7;
+       },
        "material 0: alpha mode"},
       {"material name outside the names",
        [&](std::string& d) {

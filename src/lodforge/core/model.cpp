@@ -82,6 +82,21 @@ Vec3d chooseOrigin(const Aabbd& worldBounds) {
   return {std::round(c.x), std::round(c.y), std::round(c.z)};
 }
 
+void placeAtOrigin(Model& model, std::span<const Vec3d> world) {
+  assert(world.size() == model.positions.size());
+  Aabbd bounds;
+  for (const Vec3d& p : world) bounds.add(p);
+  model.origin = chooseOrigin(bounds);
+  for (std::size_t v = 0; v < world.size(); ++v)
+    model.positions[v] = toFloat(world[v] - model.origin);
+  for (ObjectRecord& o : model.objects) {
+    Aabb box;
+    for (std::uint64_t v = o.vertexOffset; v < o.vertexOffset + o.vertexCount; ++v)
+      box.add(model.positions[v]);
+    o.bounds = box;
+  }
+}
+
 void weldModel(Model& model, const WeldOptions& options) {
   Model out;
   out.origin = model.origin;

@@ -101,6 +101,9 @@ class ModelBuilder {
 // Picks a double origin for world coordinates: zero for models near the origin, otherwise the
 // box centre rounded to whole units so float offsets keep sub-millimetre precision.
 Vec3d chooseOrigin(const Aabbd& worldBounds);
+// The model's positions from world coordinates (one per position): the origin chosen for their
+// bounds, each position relative to it, each object's bounds (readers that transform nodes).
+void placeAtOrigin(Model& model, std::span<const Vec3d> world);
 
 // Welds each object's vertices (see weldVertices) and drops the triangles that welding made
 // degenerate (repeated corners). Objects stay separate: nothing welds across objects.

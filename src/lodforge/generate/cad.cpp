@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <memory>
@@ -15,6 +17,7 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/shapes.h"
+#include "lodforge/io/cad_writer.h"
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/io/ply_writer.h"
 
@@ -190,86 +193,169 @@ void buildBolt(int entry, std::uint64_t seed, double detail, PartMesh& mesh) {
   addDisk(mesh, shaft, -length, segments, false);
 }
 
-void buildPart(const PartPlan& plan, double detail, PartMesh& mesh) {
+// A part's dimensions, drawn from its shape seed: what both its mesh and its B-rep are made of.
+struct PartDims {
+  Kind kind = Kind::kBox;
+  float radius = 0, inner = 0, length = 0;  // tube, rod
+  Vec3f size;                               // box
+  std::vector<Vec2f> profile;               // bracket, beam: a counter-clockwise polygon
+  int columns = 0, rows = 0;                // plate
+  float cell = 0, hole = 0;                 // plate: cell side, hole radius over the cell
+  int segments = 1, rings = 1;              // tessellation
+};
+
+PartDims drawPart(const PartPlan& plan, double detail) {
   Random random(plan.shapeSeed);
+  PartDims d;
+  d.kind = plan.kind;
   switch (plan.kind) {
     case Kind::kBolt:
-      return;  // from the catalogue
+      break;  // from the catalogue
     case Kind::kTube: {
       const double radius = random.logUniform(0.01, 0.3);
-      const float outer = static_cast<float>(radius),
-                  inner = outer * static_cast<float>(random.uniform(0.75, 0.95));
-      const float length = static_cast<float>(random.logUniform(0.1, 5.0));
-      const int segments = segmentsFor(random, radius, detail, 8, 128);
-      const int rings =
-          std::clamp(static_cast<int>(detail * length / random.uniform(0.2, 2.0)), 1, 64);
-      addCylinderSide(mesh, outer, 0, length, segments, rings, true);
-      addCylinderSide(mesh, inner, 0, length, segments, rings, false);
-      addAnnulus(mesh, inner, outer, 0, segments, false);
-      addAnnulus(mesh, inner, outer, length, segments, true);
-      return;
+      d.radius = static_cast<float>(radius);
+      d.inner = d.radius * static_cast<float>(random.uniform(0.75, 0.95));
+      d.length = static_cast<float>(random.logUniform(0.1, 5.0));
+      d.segments = segmentsFor(random, radius, detail, 8, 128);
+      d.rings = std::clamp(static_cast<int>(detail * d.length / random.uniform(0.2, 2.0)), 1, 64);
+      break;
     }
-    case Kind::kBox: {
-      const Vec3f size{static_cast<float>(random.logUniform(0.02, 2.0)),
-                       static_cast<float>(random.logUniform(0.02, 2.0)),
-                       static_cast<float>(random.logUniform(0.02, 1.0))};
-      addBox(mesh, size, std::clamp(static_cast<int>(detail * random.uniform(1, 7)), 1, 32));
-      return;
-    }
+    case Kind::kBox:
+      d.size = {static_cast<float>(random.logUniform(0.02, 2.0)),
+                static_cast<float>(random.logUniform(0.02, 2.0)),
+                static_cast<float>(random.logUniform(0.02, 1.0))};
+      d.segments = std::clamp(static_cast<int>(detail * random.uniform(1, 7)), 1, 32);
+      break;
     case Kind::kBracket: {
       const float a = static_cast<float>(random.logUniform(0.03, 0.4)),
                   b = a * static_cast<float>(random.uniform(0.5, 1.5));
       const float t = std::min(a, b) * static_cast<float>(random.uniform(0.08, 0.25));
-      const std::array<Vec2f, 6> profile = {{{0, 0}, {a, 0}, {a, t}, {t, t}, {t, b}, {0, b}}};
-      const float length = static_cast<float>(random.logUniform(0.02, 0.5));
-      addExtrusion(mesh, profile, length,
-                   std::clamp(static_cast<int>(detail * random.uniform(1, 8)), 1, 64));
-      return;
+      d.profile = {{0, 0}, {a, 0}, {a, t}, {t, t}, {t, b}, {0, b}};
+      d.length = static_cast<float>(random.logUniform(0.02, 0.5));
+      d.segments = std::clamp(static_cast<int>(detail * random.uniform(1, 8)), 1, 64);
+      break;
     }
-    case Kind::kPlate: {
-      const int columns = static_cast<int>(1 + random.below(8)),
-                rows = static_cast<int>(1 + random.below(6));
-      const int segments =
+    case Kind::kPlate:
+      d.columns = static_cast<int>(1 + random.below(8));
+      d.rows = static_cast<int>(1 + random.below(6));
+      d.segments =
           std::clamp(8 * static_cast<int>(std::lround(detail * random.uniform(1, 4))), 8, 64);
-      addPerforatedPlate(mesh, columns, rows, static_cast<float>(random.logUniform(0.02, 0.3)),
-                         static_cast<float>(random.uniform(0.15, 0.4)), segments);
-      return;
-    }
+      // In this order: the plates GCC's right-to-left argument order drew before (same seed,
+      // same file).
+      d.hole = static_cast<float>(random.uniform(0.15, 0.4));
+      d.cell = static_cast<float>(random.logUniform(0.02, 0.3));
+      break;
     case Kind::kBeam: {
       // An I-section stringer: long, thin, finely sliced along its length.
       const float w = static_cast<float>(random.logUniform(0.01, 0.05)),
                   h = w * static_cast<float>(random.uniform(1.0, 2.0));
       const float t = w * 0.15f, web = w * 0.1f;
-      const std::array<Vec2f, 12> profile = {{{-w, -h},
-                                              {w, -h},
-                                              {w, -h + t},
-                                              {web, -h + t},
-                                              {web, h - t},
-                                              {w, h - t},
-                                              {w, h},
-                                              {-w, h},
-                                              {-w, h - t},
-                                              {-web, h - t},
-                                              {-web, -h + t},
-                                              {-w, -h + t}}};
-      const float length = static_cast<float>(random.uniform(2.0, 15.0));
-      addExtrusion(
-          mesh, profile, length,
-          std::clamp(static_cast<int>(detail * length / random.uniform(0.05, 1.0)), 1, 400));
-      return;
+      d.profile = {{-w, -h}, {w, -h}, {w, -h + t}, {web, -h + t}, {web, h - t},   {w, h - t},
+                   {w, h},   {-w, h}, {-w, h - t}, {-web, h - t}, {-web, -h + t}, {-w, -h + t}};
+      d.length = static_cast<float>(random.uniform(2.0, 15.0));
+      d.segments =
+          std::clamp(static_cast<int>(detail * d.length / random.uniform(0.05, 1.0)), 1, 400);
+      break;
     }
     case Kind::kRod: {
       const double radius = random.logUniform(0.003, 0.02);
-      const float length = static_cast<float>(random.uniform(1.0, 10.0));
-      const int segments = segmentsFor(random, radius, detail, 6, 24);
-      addCylinderSide(
-          mesh, static_cast<float>(radius), 0, length, segments,
-          std::clamp(static_cast<int>(detail * length / random.uniform(0.1, 2.0)), 1, 100), true);
-      addDisk(mesh, static_cast<float>(radius), 0, segments, false);
-      addDisk(mesh, static_cast<float>(radius), length, segments, true);
-      return;
+      d.radius = static_cast<float>(radius);
+      d.length = static_cast<float>(random.uniform(1.0, 10.0));
+      d.segments = segmentsFor(random, radius, detail, 6, 24);
+      d.rings = std::clamp(static_cast<int>(detail * d.length / random.uniform(0.1, 2.0)), 1, 100);
+      break;
     }
   }
+  return d;
+}
+
+void buildPart(const PartPlan& plan, double detail, PartMesh& mesh) {
+  const PartDims d = drawPart(plan, detail);
+  switch (d.kind) {
+    case Kind::kBolt:
+      return;  // from the catalogue
+    case Kind::kTube:
+      addCylinderSide(mesh, d.radius, 0, d.length, d.segments, d.rings, true);
+      addCylinderSide(mesh, d.inner, 0, d.length, d.segments, d.rings, false);
+      addAnnulus(mesh, d.inner, d.radius, 0, d.segments, false);
+      addAnnulus(mesh, d.inner, d.radius, d.length, d.segments, true);
+      return;
+    case Kind::kBox:
+      addBox(mesh, d.size, d.segments);
+      return;
+    case Kind::kBracket:
+    case Kind::kBeam:
+      addExtrusion(mesh, d.profile, d.length, d.segments);
+      return;
+    case Kind::kPlate:
+      addPerforatedPlate(mesh, d.columns, d.rows, d.cell, d.hole, d.segments);
+      return;
+    case Kind::kRod:
+      addCylinderSide(mesh, d.radius, 0, d.length, d.segments, d.rings, true);
+      addDisk(mesh, d.radius, 0, d.segments, false);
+      addDisk(mesh, d.radius, d.length, d.segments, true);
+      return;
+  }
+}
+
+// --- STEP: the same parts as B-rep ---
+
+cad::Loop circle(float radius, Vec2f centre = {}) {
+  return {radius, {centre.x, centre.y}};
+}
+
+cad::Loop polygon(std::span<const Vec2f> points) {
+  cad::Loop loop;
+  for (const Vec2f& p : points) loop.points.insert(loop.points.end(), {p.x, p.y});
+  return loop;
+}
+
+// The part's solids (sheets for plates) with the dimensions its mesh has.
+std::vector<cad::Prism> prismsOf(const PartDims& d) {
+  switch (d.kind) {
+    case Kind::kBolt:
+      return {};
+    case Kind::kTube:
+      return {{circle(d.radius), {circle(d.inner)}, 0, d.length}};
+    case Kind::kBox: {
+      const std::array<Vec2f, 4> square = {{{-d.size.x / 2, -d.size.y / 2},
+                                            {d.size.x / 2, -d.size.y / 2},
+                                            {d.size.x / 2, d.size.y / 2},
+                                            {-d.size.x / 2, d.size.y / 2}}};
+      return {{polygon(square), {}, -d.size.z / 2, d.size.z / 2}};
+    }
+    case Kind::kBracket:
+    case Kind::kBeam:
+      return {{polygon(d.profile), {}, 0, d.length}};
+    case Kind::kPlate: {
+      const float x0 = -0.5f * d.cell * static_cast<float>(d.columns),
+                  y0 = -0.5f * d.cell * static_cast<float>(d.rows);
+      const std::array<Vec2f, 4> sheet = {{{x0, y0}, {-x0, y0}, {-x0, -y0}, {x0, -y0}}};
+      cad::Prism plate{polygon(sheet), {}, 0, 0};
+      for (int row = 0; row < d.rows; ++row)
+        for (int column = 0; column < d.columns; ++column)
+          plate.holes.push_back(
+              circle(d.hole * d.cell, {x0 + (static_cast<float>(column) + 0.5f) * d.cell,
+                                       y0 + (static_cast<float>(row) + 0.5f) * d.cell}));
+      return {plate};
+    }
+    case Kind::kRod:
+      return {{circle(d.radius), {}, 0, d.length}};
+  }
+  return {};
+}
+
+// A catalogue bolt as buildBolt draws it: a hexagonal head on a round shaft.
+std::vector<cad::Prism> boltPrisms(int entry, std::uint64_t seed) {
+  Random random = Random::forItem(seed ^ 0xB017ull, static_cast<std::uint64_t>(entry));
+  const float shaft = static_cast<float>(random.logUniform(0.002, 0.012));
+  const float length = shaft * static_cast<float>(random.uniform(4, 14));
+  const float head = shaft * 1.7f, headHeight = shaft * 1.4f;
+  std::array<Vec2f, 6> hexagon;
+  for (int k = 0; k < 6; ++k)
+    hexagon[static_cast<std::size_t>(k)] = {head * static_cast<float>(std::cos(kPi / 3 * k)),
+                                            head * static_cast<float>(std::sin(kPi / 3 * k))};
+  return {{polygon(hexagon), {}, 0, headHeight}, {circle(shaft), {}, -length, 0}};
 }
 
 std::string partName(const PartPlan& plan, std::uint64_t index) {
@@ -467,6 +553,48 @@ Result<GenerateStats> writeGlb(const CadOptions& options, const std::string& pat
   return stats;
 }
 
+// The assembly as STEP through OpenCASCADE: one shape per part (bolts: one per catalogue entry
+// and finish, placed many times), each placed under the root with the part's transform.
+Result<GenerateStats> writeStep(const CadOptions& options, const std::string& path) {
+  cad::WriteRequest request;
+  request.path = path;
+  request.assembly = fmt::format("lodforge cad assembly (seed {})", options.seed);
+  std::map<std::pair<int, int>, std::uint64_t> bolts;  // (entry, finish) -> shape
+  Progress progress("cad (B-rep)", options.objects);
+  for (std::uint64_t index = 0; index < options.objects; ++index) {
+    if (index % 1024 == 0) LODFORGE_TRY(checkCancelled());
+    const PartPlan plan = planPart(options.seed, index);
+    const auto& color = kFinishes[plan.finish].color;
+    const std::string name = partName(plan, index);
+    std::uint64_t shape = request.shapes.size();
+    if (plan.kind == Kind::kBolt) {
+      const auto [at, added] = bolts.try_emplace({plan.bolt, plan.finish}, shape);
+      shape = at->second;
+      if (added)
+        request.shapes.push_back(
+            {fmt::format("bolt M{} {}", plan.bolt, kFinishes[plan.finish].name),
+             boltPrisms(plan.bolt, options.seed),
+             {color[0], color[1], color[2], color[3]}});
+    } else {
+      request.shapes.push_back({name,
+                                prismsOf(drawPart(plan, options.detail)),
+                                {color[0], color[1], color[2], color[3]}});
+    }
+    cad::Placement placement{name, shape, {}};
+    std::copy(plan.transform.m.begin(), plan.transform.m.end(), placement.matrix);
+    request.placements.push_back(std::move(placement));
+    progress.advance(1);
+  }
+  LODFORGE_TRY(writeStepAssembly(std::move(request)));
+  progress.finish();
+  GenerateStats stats;
+  stats.objects = options.objects;
+  Result<std::uint64_t> size = fileSize(path);
+  if (!size) return size.status();
+  stats.bytes = *size;
+  return stats;
+}
+
 }  // namespace
 
 Result<GenerateStats> generateCad(const CadOptions& options, const std::string& path) {
@@ -476,7 +604,9 @@ Result<GenerateStats> generateCad(const CadOptions& options, const std::string& 
   const std::string ext = fileExtension(path);
   if (ext == "glb") return writeGlb(options, path);
   if (ext == "ply") return writePly(options, path);
-  return Error{ErrorKind::kUsage, fmt::format("{}: the cad generator writes .glb or .ply", path)};
+  if (ext == "step" || ext == "stp") return writeStep(options, path);
+  return Error{ErrorKind::kUsage,
+               fmt::format("{}: the cad generator writes .glb, .ply or .step", path)};
 }
 
 }  // namespace lodforge

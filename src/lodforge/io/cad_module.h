@@ -10,8 +10,9 @@
 
 namespace lodforge::cad {
 
-inline constexpr int kModuleVersion = 4;  // bumped when these structs change
+inline constexpr int kModuleVersion = 5;  // bumped when these structs change
 inline constexpr const char* kReadSymbol = "lodforge_cad_read";
+inline constexpr const char* kWriteSymbol = "lodforge_cad_write";
 
 struct Request {
   std::string path;
@@ -67,7 +68,54 @@ struct Result {
   std::uint32_t depth = 0;
 };
 
-// The module's one entry point; `version` must equal kModuleVersion.
+// The module's reading entry point; `version` must equal kModuleVersion.
 using ReadFunction = void (*)(int version, const Request& request, Result& result);
+
+// --- writing (`lodforge generate cad -o X.step`) ---
+
+// A closed planar loop: a circle (radius > 0, centred at points[0], points[1]) or a polygon
+// (x, y pairs, counter-clockwise).
+struct Loop {
+  double radius = 0;
+  std::vector<double> points;
+};
+
+// The region inside `outer` and outside `holes`, swept along z from z0 to z1: a solid prism, or
+// a planar sheet where z0 == z1.
+struct Prism {
+  Loop outer;
+  std::vector<Loop> holes;
+  double z0 = 0, z1 = 0;
+};
+
+// A part's B-rep, in its own frame: one or more prisms (a compound when several).
+struct ShapeSpec {
+  std::string name;
+  std::vector<Prism> prisms;
+  float color[4] = {0.8f, 0.8f, 0.8f, 1};  // linear RGBA
+};
+
+// One placed instance of a shape under the assembly's root.
+struct Placement {
+  std::string name;
+  std::uint64_t shape = 0;
+  double matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  // rigid, column-major
+};
+
+struct WriteRequest {
+  std::string path;      // written as given (the caller names a temporary and renames it)
+  std::string assembly;  // the root product's name
+  std::vector<ShapeSpec> shapes;
+  std::vector<Placement> placements;
+  bool (*cancelled)() = nullptr;  // asked between shapes
+};
+
+struct WriteResult {
+  int status = 0;  // 0 ok, 1 failed, 3 cancelled
+  std::string error;
+};
+
+// Writes the assembly as STEP (AP214, names and colours); `version` must equal kModuleVersion.
+using WriteFunction = void (*)(int version, const WriteRequest& request, WriteResult& result);
 
 }  // namespace lodforge::cad

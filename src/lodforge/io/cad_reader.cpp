@@ -30,32 +30,24 @@ std::vector<std::string> modulePlaces() {
   return places;
 }
 
-// The module's entry point, loaded once (never unloaded: OCCT keeps process-wide state).
-Status loadModule(cad::ReadFunction& entry) {
+// The module, loaded once (never unloaded: OCCT keeps process-wide state); null, with `why`,
+// when it cannot be.
+void* loadedModule(std::string& why) {
   static std::once_flag once;
-  static cad::ReadFunction read = nullptr;
-  static std::string why;
+  static void* module = nullptr;
+  static std::string reason;
   std::call_once(once, [] {
     for (const std::string& place : modulePlaces()) {
       if (!std::filesystem::exists(place)) continue;
-      void* module = dlopen(place.c_str(), RTLD_NOW | RTLD_LOCAL);
-      if (!module) {
-        why = dlerror();
-        continue;
-      }
-      read = reinterpret_cast<cad::ReadFunction>(dlsym(module, cad::kReadSymbol));
-      if (read) return;
-      why = fmt::format("{}: no {}", place, cad::kReadSymbol);
+      module = dlopen(place.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (module) return;
+      reason = dlerror();
     }
-    if (why.empty())
-      why = fmt::format("liblodforge_cad.so is in none of {}", fmt::join(modulePlaces(), ", "));
+    if (reason.empty())
+      reason = fmt::format("liblodforge_cad.so is in none of {}", fmt::join(modulePlaces(), ", "));
   });
-  entry = read;
-  if (read) return {};
-  return Error{ErrorKind::kUnsupported,
-               fmt::format("this lodforge cannot read CAD files: its OpenCASCADE module did not "
-                           "load ({})",
-                           why)};
+  why = reason;
+  return module;
 }
 
 // The module's plain arrays as a Model, relative to an origin near the parts.
@@ -107,6 +99,19 @@ Model toModel(const cad::Result& read) {
 
 }  // namespace
 
+Status cadModuleSymbol(const char* symbol, void*& entry) {
+  std::string why;
+  if (void* module = loadedModule(why)) {
+    entry = dlsym(module, symbol);
+    if (entry) return {};
+    why = fmt::format("it has no {}", symbol);
+  }
+  return Error{ErrorKind::kUnsupported,
+               fmt::format("this lodforge cannot read or write CAD files: its OpenCASCADE module "
+                           "did not load ({})",
+                           why)};
+}
+
 bool isCadPath(const std::string& path) {
   const std::string ext = fileExtension(path);
   return ext == "step" || ext == "stp" || ext == "iges" || ext == "igs" || ext == "brep" ||
@@ -122,8 +127,9 @@ Result<Model> readCad(const std::string& path, const CadReadOptions& options,
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error))
     return ioError(path, "cannot open: no such file");
-  cad::ReadFunction module = nullptr;
-  LODFORGE_TRY(loadModule(module));
+  void* entry = nullptr;
+  LODFORGE_TRY(cadModuleSymbol(cad::kReadSymbol, entry));
+  const auto module = reinterpret_cast<cad::ReadFunction>(entry);
   const cad::Request request{path, options.deflection, options.absoluteDeflection,
                              options.angleDegrees, options.codePage};
   cad::Result read;

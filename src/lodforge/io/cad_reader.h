@@ -34,6 +34,9 @@ struct CadReadStats {
 
 bool isCadPath(const std::string& path);
 
+// An entry point of the OpenCASCADE module (cad_module.h), loaded on first use.
+Status cadModuleSymbol(const char* symbol, void*& entry);
+
 // Warnings name each part OCCT could not mesh (wholly or some faces); its other parts are kept.
 // No part left, no shape in the file, or a file OCCT cannot read: ErrorKind::kBadInput.
 Result<Model> readCad(const std::string& path, const CadReadOptions& options = {},

@@ -18,10 +18,8 @@ constexpr std::string_view kMeshHow =
     "convert it to .ply, .obj or .glb first, e.g. with MeshLab, Blender or assimp "
     "(`assimp export IN OUT.glb`)";
 
-constexpr std::array<Advice, 6> kAdvice = {{
-    {" ifc ", "an IFC building model",
-     "convert it to glTF first, e.g. with IfcConvert (IfcOpenShell): `IfcConvert IN.ifc OUT.glb`"},
-    {" off fbx dae 3ds wrl vrml x3d dxf 3mf vtk vtp ", "a mesh format", kMeshHow},
+constexpr std::array<Advice, 5> kAdvice = {{
+    {" wrl vrml vtk vtp usd usdz ", "a mesh format", kMeshHow},
     {" pcd ", "a PCL point cloud",
      "save it as .ply or as text .xyz first, e.g. with `pcl_pcd2ply` or CloudCompare"},
     {" e57 ", "an E57 scan",

@@ -11,7 +11,8 @@ namespace lodforge {
 
 // What each kind of command reads, for the message.
 inline constexpr std::string_view kMeshFormats =
-    ".ply .obj .stl .gltf .glb meshes and .step .stp .iges .igs .brep CAD models";
+    ".ply .obj .stl .gltf .glb meshes, .step .stp .iges .igs .brep CAD models and .off .fbx .dae "
+    ".3ds .3mf .ifc .x3d (assimp) scenes";
 inline constexpr std::string_view kPointFormats = ".las .ply .xyz .txt .csv .pts point clouds";
 
 // A usage error (exit 2): "PATH: unknown format (this command reads READS)", or for a known

@@ -563,17 +563,7 @@ class Loader {
 
   // World coordinates become float offsets from one double origin.
   void placeAtOrigin() {
-    Aabbd bounds;
-    for (const Vec3d& p : world_) bounds.add(p);
-    model_.origin = chooseOrigin(bounds);
-    for (std::size_t v = 0; v < world_.size(); ++v)
-      model_.positions[v] = toFloat(world_[v] - model_.origin);
-    for (ObjectRecord& o : model_.objects) {
-      Aabb box;
-      for (std::uint64_t v = o.vertexOffset; v < o.vertexOffset + o.vertexCount; ++v)
-        box.add(model_.positions[v]);
-      o.bounds = box;
-    }
+    lodforge::placeAtOrigin(model_, world_);
     // Normals only when every vertex has one; partial normals would mislead more than help.
     if (!missingNormals_ && !normalsByVertex_.empty()) model_.normals = std::move(normalsByVertex_);
   }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/file.h"
+#include "lodforge/io/assimp_reader.h"
 #include "lodforge/io/format_advice.h"
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/io/gltf_reader.h"
@@ -23,6 +24,7 @@ FileFormat formatFromPath(const std::string& path) {
   if (ext == "gltf") return FileFormat::kGltf;
   if (ext == "glb") return FileFormat::kGlb;
   if (isCadPath(path)) return FileFormat::kCad;
+  if (isAssimpExtension(ext)) return FileFormat::kAssimp;
   return FileFormat::kUnknown;
 }
 
@@ -40,6 +42,8 @@ std::string_view formatName(FileFormat format) {
       return "GLB";
     case FileFormat::kCad:
       return "CAD (STEP, IGES, BREP)";
+    case FileFormat::kAssimp:
+      return "interchange scene (assimp)";
     case FileFormat::kUnknown:
       break;
   }
@@ -71,6 +75,8 @@ Result<Model> readModel(const std::string& path, const ReadOptions& options) {
       return readGltf(path);
     case FileFormat::kCad:
       return readCad(path, options.cad, options.warnings);
+    case FileFormat::kAssimp:
+      return readAssimp(path);
     case FileFormat::kUnknown:
       break;
   }

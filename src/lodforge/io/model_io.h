@@ -12,8 +12,9 @@
 
 namespace lodforge {
 
-// kCad: STEP, IGES or BREP, read through OpenCASCADE (io/cad_reader.h); never written.
-enum class FileFormat : std::uint8_t { kUnknown, kPly, kObj, kStl, kGltf, kGlb, kCad };
+// kCad: STEP, IGES or BREP, read through OpenCASCADE (io/cad_reader.h); kAssimp: OFF, FBX,
+// Collada, 3DS, IFC and the other scenes assimp reads (io/assimp_reader.h). Neither is written.
+enum class FileFormat : std::uint8_t { kUnknown, kPly, kObj, kStl, kGltf, kGlb, kCad, kAssimp };
 
 FileFormat formatFromPath(const std::string& path);
 std::string_view formatName(FileFormat format);

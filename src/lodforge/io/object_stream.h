@@ -21,10 +21,10 @@ struct SourceObject {
   std::string name;
   std::string path;                      // in the assembly; empty without a tree
   std::uint32_t material = kNoMaterial;  // into the stream's materials()
-  std::vector<Vec3f> positions;        // relative to the stream's origin
-  std::vector<Vec3f> normals;          // empty or one per vertex
-  std::vector<Rgba8> colors;           // empty or one per vertex
-  std::vector<std::uint32_t> indices;  // local
+  std::vector<Vec3f> positions;          // relative to the stream's origin
+  std::vector<Vec3f> normals;            // empty or one per vertex
+  std::vector<Rgba8> colors;             // empty or one per vertex
+  std::vector<std::uint32_t> indices;    // local
 
   std::uint64_t memoryBytes() const {
     return positions.size() * 12 + normals.size() * 12 + colors.size() * 4 + indices.size() * 4 +

@@ -17,9 +17,9 @@
 namespace lodforge {
 
 std::string_view packageSectionName(PackageSection section) {
-  static constexpr std::string_view kNames[] = {
-      "objects", "names", "positions", "normals", "colors", "triangles",
-      "ecol",    "map",   "error",     "assembly", "materials"};
+  static constexpr std::string_view kNames[] = {"objects", "names",     "positions", "normals",
+                                                "colors",  "triangles", "ecol",      "map",
+                                                "error",   "assembly",  "materials"};
   return kNames[static_cast<std::uint32_t>(section)];
 }
 
@@ -441,15 +441,16 @@ std::string Package::objectProblem(std::size_t i) const {
 
 // Every material's name inside the names section and its fields in their ranges.
 Status Package::validateMaterials() const {
-  const PackageSectionEntry& names = header_->sections[static_cast<std::uint32_t>(PackageSection::kNames)];
+  const PackageSectionEntry& names =
+      header_->sections[static_cast<std::uint32_t>(PackageSection::kNames)];
   const PackageSectionEntry& table =
       header_->sections[static_cast<std::uint32_t>(PackageSection::kMaterials)];
   const auto materials = section<PackageMaterial>(PackageSection::kMaterials);
   for (std::size_t m = 0; m < materials.size(); ++m) {
     const PackageMaterial& r = materials[m];
-    const bool finite = std::all_of(reinterpret_cast<const float*>(&r),
-                                    reinterpret_cast<const float*>(&r) + 10,
-                                    [](float v) { return std::isfinite(v); });
+    const bool finite =
+        std::all_of(reinterpret_cast<const float*>(&r), reinterpret_cast<const float*>(&r) + 10,
+                    [](float v) { return std::isfinite(v); });
     const char* problem = nullptr;
     if (r.nameOffset > names.bytes || r.nameLength > names.bytes - r.nameOffset)
       problem = "name outside the names section";

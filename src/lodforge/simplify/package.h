@@ -183,7 +183,7 @@ class Package {
 
   const PackageObject& object(std::size_t i) const { return objects()[i]; }
   std::string_view objectName(std::size_t i) const;
-  std::string_view objectPath(std::size_t i) const;     // empty without an assembly tree
+  std::string_view objectPath(std::size_t i) const;   // empty without an assembly tree
   std::uint32_t objectMaterial(std::size_t i) const;  // kNoMaterial or < materialCount()
   std::size_t materialCount() const;
   Material material(std::size_t m) const;

@@ -73,9 +73,11 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
   if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");
   input.colors = model->hasColors();
   // Parts are named per vertex only when there is more than one.
-  const std::string extension = fileExtension(path);
-  const bool assembly =
-      isCadPath(path) || extension == "glb" || extension == "gltf" || extension == "lfp";
+  // Scenes of nodes are assemblies (CAD, glTF, assimp's formats, packages); scans are not.
+  const FileFormat format = formatFromPath(path);
+  const bool assembly = format == FileFormat::kCad || format == FileFormat::kGlb ||
+                        format == FileFormat::kGltf || format == FileFormat::kAssimp ||
+                        fileExtension(path) == "lfp";
   const bool features =
       model->objectCount() > 1 &&
       (options.parts == PartsMode::kOn || (options.parts == PartsMode::kAuto && assembly));

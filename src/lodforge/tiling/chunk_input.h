@@ -25,7 +25,7 @@ namespace lodforge {
 // welded to one another, so a scan split into objects (an OBJ's groups) would keep open seams
 // between them in coarse tiles: auto names parts for assemblies only.
 enum class PartsMode : std::uint8_t {
-  kAuto,  // CAD, glTF and .lfp inputs of more than one object
+  kAuto,  // CAD, glTF, assimp scenes and .lfp inputs of more than one object
   kOn,    // any input of more than one object
   kOff,
 };

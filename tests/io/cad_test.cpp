@@ -1,6 +1,7 @@
 // The CAD reader against OpenCASCADE's own reading of the same files: part counts and names
 // by an independent walk of the XDE tree, triangle counts by meshing the shape directly.
 #include <gtest/gtest.h>
+#include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepTools.hxx>
@@ -19,6 +20,7 @@
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
+#include <gp_Pln.hxx>
 
 #include <functional>
 #include <map>
@@ -284,6 +286,67 @@ TEST(CadRead, TranslucentPartsAreBlended) {
   EXPECT_EQ(model->materials[model->objects[1].material].alphaMode, AlphaMode::kBlend);
   EXPECT_EQ(model->colors[model->objects[1].vertexOffset].a, 31);  // 0.12
   EXPECT_EQ(model->colors[model->objects[0].vertexOffset].a, 255);
+}
+
+// A part whose back faces can be seen (a face outside any shell, a shell with a free edge) gets a
+// double-sided material, else a renderer culls its far side; a closed solid gets none, and a
+// translucent sheet stays the translucent material, which is double-sided too.
+TEST(CadRead, OpenShapesAreDoubleSided) {
+  test::TempDir dir;
+  const std::string path = dir.file("open.step");
+  {
+    Handle(TDocStd_Document) doc;
+    XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+    const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+    const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
+    const auto add = [&](const TopoDS_Shape& shape, const char* name) {
+      const TDF_Label label = shapes->AddShape(shape, false);
+      TDataStd_Name::Set(label, name);
+      return label;
+    };
+    add(BRepPrimAPI_MakeBox(10, 10, 10).Shape(), "solid");
+    add(BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0, 0, 20), gp_Dir(0, 0, 1)), 0, 10, 0, 10).Face(),
+        "sheet");
+    // The box without its top face: one shell, four free edges.
+    TopoDS_Shell lidless;
+    BRep_Builder builder;
+    builder.MakeShell(lidless);
+    int faces = 0;
+    for (TopExp_Explorer face(BRepPrimAPI_MakeBox(gp_Pnt(20, 0, 0), 10, 10, 10).Shape(),
+                              TopAbs_FACE);
+         face.More(); face.Next())
+      if (++faces != 6) builder.Add(lidless, face.Current());
+    add(lidless, "lidless");
+    const TDF_Label glass =
+        add(BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0, 0, 40), gp_Dir(0, 0, 1)), 0, 10, 0, 10).Face(),
+            "glass");
+    colors->SetColor(glass,
+                     Quantity_ColorRGBA(Quantity_Color(0.6, 0.8, 0.9, Quantity_TOC_sRGB), 0.12f),
+                     XCAFDoc_ColorSurf);
+    STEPCAFControl_Writer writer;
+    ASSERT_TRUE(writer.Transfer(doc, STEPControl_AsIs));
+    ASSERT_EQ(writer.Write(path.c_str()), IFSelect_RetDone);
+    XCAFApp_Application::GetApplication()->Close(doc);
+  }
+  Result<Model> model = readCad(path);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  ASSERT_EQ(model->objectCount(), 4u);
+  std::map<std::string, const Material*> materials;
+  for (std::size_t o = 0; o < model->objectCount(); ++o) {
+    const std::uint32_t m = model->objects[o].material;
+    materials[std::string(model->objectName(o))] =
+        m == kNoMaterial ? nullptr : &model->materials.at(m);
+  }
+  EXPECT_EQ(materials.at("solid"), nullptr);
+  for (const char* open : {"sheet", "lidless"}) {
+    ASSERT_NE(materials.at(open), nullptr) << open;
+    EXPECT_TRUE(materials.at(open)->doubleSided) << open;
+    EXPECT_EQ(materials.at(open)->alphaMode, AlphaMode::kOpaque) << open;
+  }
+  EXPECT_EQ(materials.at("sheet"), materials.at("lidless"));  // one material, listed once
+  ASSERT_NE(materials.at("glass"), nullptr);
+  EXPECT_EQ(materials.at("glass")->alphaMode, AlphaMode::kBlend);
+  EXPECT_TRUE(materials.at("glass")->doubleSided);
 }
 
 TEST(CadRead, BadFilesAreBadInputNamingTheFile) {

@@ -344,6 +344,22 @@ std::vector<std::string> tessellate(const Tree& tree, const Request& request,
   return failures;
 }
 
+// Whether a shape shows its back faces: some face lies outside a shell, or a shell has free
+// edges (a sheet, a surface model). Such a part needs doubleSided or its far side vanishes.
+bool isOpen(const TopoDS_Shape& shape) {
+  if (TopExp_Explorer(shape, TopAbs_FACE, TopAbs_SHELL).More()) return true;
+  for (TopExp_Explorer shell(shape, TopAbs_SHELL); shell.More(); shell.Next())
+    if (!BRep_Tool::IsClosed(shell.Current())) return true;
+  return false;
+}
+
+std::vector<char> openShapes(const Tree& tree) {
+  std::vector<char> open(tree.shapes.size());
+  for (std::size_t s = 0; s < tree.shapes.size(); ++s)
+    open[s] = isOpen(XCAFDoc_ShapeTool::GetShape(tree.shapes[s]));
+  return open;
+}
+
 std::uint32_t facesWithoutTriangles(const TopoDS_Shape& shape) {
   std::uint32_t missing = 0;
   for (TopExp_Explorer face(shape, TopAbs_FACE); face.More(); face.Next()) {
@@ -365,8 +381,9 @@ void pushColor(const Quantity_ColorRGBA& color, std::vector<std::uint8_t>& out) 
 
 // The instance's material: OCCT's visual material (PBR, or common converted to PBR) when the
 // part has one; else, for a part with a translucent face (STEP's surface transparency), a
-// blended "translucent" material; else none. Equal materials are listed once.
-std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, Result& out) {
+// blended "translucent" material; else, for an open shape, a "double-sided" one; else none.
+// Equal materials are listed once.
+std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, bool open, Result& out) {
   Material material;
   const Handle(XCAFDoc_VisMaterial)& vis = style.Material();
   if (!vis.IsNull() && !vis->IsEmpty()) {
@@ -395,6 +412,9 @@ std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, Result& o
     material.alphaMode = 2;
     material.doubleSided = true;
     material.roughness = 0.1f;
+  } else if (open) {
+    material.name = "double-sided";
+    material.doubleSided = true;
   } else {
     return ~0u;
   }
@@ -405,7 +425,7 @@ std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, Result& o
 }
 
 // One placed instance's faces appended: positions in metres, normals and colours per vertex.
-void appendInstance(const Placed& placed, double metresPerUnit, Result& out) {
+void appendInstance(const Placed& placed, bool open, double metresPerUnit, Result& out) {
   Instance instance{placed.name, placed.path, out.positions.size() / 3, 0, out.indices.size() / 3,
                     0,           placed.shape};
   const Quantity_ColorRGBA grey(Quantity_Color(0.78, 0.78, 0.78, Quantity_TOC_sRGB));
@@ -438,7 +458,7 @@ void appendInstance(const Placed& placed, double metresPerUnit, Result& out) {
   }
   instance.vertexCount = out.positions.size() / 3 - instance.firstVertex;
   instance.triangleCount = out.indices.size() / 3 - instance.firstTriangle;
-  instance.material = materialOf(placed.style, translucent, out);
+  instance.material = materialOf(placed.style, translucent, open, out);
   out.instances.push_back(std::move(instance));
 }
 
@@ -484,7 +504,9 @@ void read(const Request& request, Result& out) {
     out.error = "cancelled";
     return;
   }
-  for (const Placed& placed : tree.placed) appendInstance(placed, metresPerUnit, out);
+  const std::vector<char> open = openShapes(tree);
+  for (const Placed& placed : tree.placed)
+    appendInstance(placed, open[placed.shape] != 0, metresPerUnit, out);
   if (!out.coloured) out.colors.clear();
   warnUnmeshed(tree, failures, out);
   out.shapes = tree.shapes.size();

@@ -175,22 +175,35 @@ PartPlan planPart(std::uint64_t seed, std::uint64_t index) {
   return plan;
 }
 
-void buildBolt(int entry, std::uint64_t seed, double detail, PartMesh& mesh) {
-  Random random = Random::forItem(seed ^ 0xB017ull, static_cast<std::uint64_t>(entry));
-  const float shaft = static_cast<float>(random.logUniform(0.002, 0.012));
-  const float length = shaft * static_cast<float>(random.uniform(4, 14));
-  const float head = shaft * 1.7f, headHeight = shaft * 1.4f;
-  const int segments = std::clamp(static_cast<int>(detail * random.uniform(8, 20)), 6, 64);
-  // Hex head: a six-sided prism, flat-shaded.
+// A catalogue bolt's dimensions, drawn from its entry: what both its mesh and its B-rep are made
+// of. A hexagonal head on a round shaft.
+struct BoltDims {
+  float shaft = 0, length = 0, headHeight = 0;
   std::array<Vec2f, 6> hexagon;
+  int segments = 6;
+};
+
+BoltDims drawBolt(int entry, std::uint64_t seed, double detail) {
+  Random random = Random::forItem(seed ^ 0xB017ull, static_cast<std::uint64_t>(entry));
+  BoltDims d;
+  d.shaft = static_cast<float>(random.logUniform(0.002, 0.012));
+  d.length = d.shaft * static_cast<float>(random.uniform(4, 14));
+  const float head = d.shaft * 1.7f;
+  d.headHeight = d.shaft * 1.4f;
+  d.segments = std::clamp(static_cast<int>(detail * random.uniform(8, 20)), 6, 64);
   for (int k = 0; k < 6; ++k) {
     const double a = kPi / 3 * k;
-    hexagon[static_cast<std::size_t>(k)] = {head * static_cast<float>(std::cos(a)),
-                                            head * static_cast<float>(std::sin(a))};
+    d.hexagon[static_cast<std::size_t>(k)] = {head * static_cast<float>(std::cos(a)),
+                                              head * static_cast<float>(std::sin(a))};
   }
-  addExtrusion(mesh, hexagon, headHeight, 1);
-  addCylinderSide(mesh, shaft, -length, 0, segments, 1, true);
-  addDisk(mesh, shaft, -length, segments, false);
+  return d;
+}
+
+void buildBolt(int entry, std::uint64_t seed, double detail, PartMesh& mesh) {
+  const BoltDims d = drawBolt(entry, seed, detail);
+  addExtrusion(mesh, d.hexagon, d.headHeight, 1);  // flat-shaded
+  addCylinderSide(mesh, d.shaft, -d.length, 0, d.segments, 1, true);
+  addDisk(mesh, d.shaft, -d.length, d.segments, false);
 }
 
 // A part's dimensions, drawn from its shape seed: what both its mesh and its B-rep are made of.
@@ -345,17 +358,9 @@ std::vector<cad::Prism> prismsOf(const PartDims& d) {
   return {};
 }
 
-// A catalogue bolt as buildBolt draws it: a hexagonal head on a round shaft.
 std::vector<cad::Prism> boltPrisms(int entry, std::uint64_t seed) {
-  Random random = Random::forItem(seed ^ 0xB017ull, static_cast<std::uint64_t>(entry));
-  const float shaft = static_cast<float>(random.logUniform(0.002, 0.012));
-  const float length = shaft * static_cast<float>(random.uniform(4, 14));
-  const float head = shaft * 1.7f, headHeight = shaft * 1.4f;
-  std::array<Vec2f, 6> hexagon;
-  for (int k = 0; k < 6; ++k)
-    hexagon[static_cast<std::size_t>(k)] = {head * static_cast<float>(std::cos(kPi / 3 * k)),
-                                            head * static_cast<float>(std::sin(kPi / 3 * k))};
-  return {{polygon(hexagon), {}, 0, headHeight}, {circle(shaft), {}, -length, 0}};
+  const BoltDims d = drawBolt(entry, seed, 1);
+  return {{polygon(d.hexagon), {}, 0, d.headHeight}, {circle(d.shaft), {}, -d.length, 0}};
 }
 
 std::string partName(const PartPlan& plan, std::uint64_t index) {

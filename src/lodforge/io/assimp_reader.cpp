@@ -88,8 +88,9 @@ class SceneConverter {
   Result<Model> convert() {
     for (unsigned m = 0; m < scene_.mNumMaterials; ++m)
       model_.materials.push_back(convertMaterial(*scene_.mMaterials[m]));
-    for (unsigned m = 0; m < scene_.mNumMeshes && !withColors_; ++m)
-      withColors_ = scene_.mMeshes[m]->HasVertexColors(0) || scene_.mNumMaterials > 0;
+    withColors_ = scene_.mNumMaterials > 0 ||
+                  std::any_of(scene_.mMeshes, scene_.mMeshes + scene_.mNumMeshes,
+                              [](const aiMesh* mesh) { return mesh->HasVertexColors(0); });
     walk();
     if (!problem_.empty()) return badInput(path_, problem_);
     if (model_.triangleCount() == 0)
@@ -199,10 +200,6 @@ class SceneConverter {
 
 bool isAssimpExtension(std::string_view extension) {
   return std::find(kExtensions.begin(), kExtensions.end(), extension) != kExtensions.end();
-}
-
-std::string_view assimpExtensions() {
-  return ".off .fbx .dae .3ds .3mf .ifc .x3d and other assimp scenes";
 }
 
 namespace {

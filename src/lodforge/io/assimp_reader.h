@@ -17,8 +17,6 @@ namespace lodforge {
 
 // Whether the extension is one assimp reads for us (lower case, without the dot).
 bool isAssimpExtension(std::string_view extension);
-// The extensions, for messages: ".off .fbx .dae …".
-std::string_view assimpExtensions();
 
 Result<Model> readAssimp(const std::string& path);
 // The same from bytes in memory; `name` names them in errors and its extension picks the format

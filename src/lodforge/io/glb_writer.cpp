@@ -11,6 +11,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/io/glb_instances.h"
 
 namespace lodforge {
 
@@ -595,11 +596,18 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
     return materials[m];
   };
   AssemblyNodes assembly(*writer, sharedFirstComponent(model));
+  const std::vector<Placement> placements =
+      options.shareMeshes ? findPlacements(model) : std::vector<Placement>{};
+  std::vector<std::optional<std::uint32_t>> meshes(model.objectCount());
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
     if (o % 1024 == 0) LODFORGE_TRY(checkCancelled());
     const ObjectRecord& record = model.objects[o];
-    std::optional<std::uint32_t> mesh;
-    if (record.triangleCount > 0) {
+    const Placement* placed =
+        o < placements.size() && placements[o].source != o ? &placements[o] : nullptr;
+    std::optional<std::uint32_t>& mesh = meshes[o];
+    if (placed) {
+      mesh = meshes[placed->source];
+    } else if (record.triangleCount > 0) {
       GlbMeshData data;
       data.positions = model.objectPositions(o);
       if (model.hasNormals())
@@ -612,7 +620,8 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
       if (!added) return added.status();
       mesh = *added;
     }
-    writer->addNode(model.objectName(o), mesh, nullptr, assembly.parentOf(model.objectPath(o)));
+    writer->addNode(model.objectName(o), mesh, placed ? &placed->transform : nullptr,
+                    assembly.parentOf(model.objectPath(o)));
     progress.advance(record.triangleCount);
   }
   progress.finish();

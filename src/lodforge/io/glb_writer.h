@@ -78,6 +78,10 @@ struct GlbWriteOptions {
   // setRootTranslation is then not used, and addNode's translation-only transforms stay
   // translations.
   bool flatScene = false;
+  // writeGlb: an object that is an earlier object's mesh moved rigidly (a CAD shape placed
+  // again, a glTF mesh under several nodes) is written as that mesh under a node transform
+  // (findPlacements, glb_instances.h).
+  bool shareMeshes = true;
 };
 
 class GlbWriter {

@@ -1,0 +1,135 @@
+// Repeated meshes found again in a model of world positions (glb_instances.h): the rigid fit on
+// random point sets moved by random motions, and real assemblies written once per shape.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstring>
+
+#include "lodforge/core/random.h"
+#include "lodforge/io/glb_instances.h"
+#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/model_io.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+std::vector<Vec3f> randomPoints(Random& random, int count) {
+  std::vector<Vec3f> points;
+  for (int i = 0; i < count; ++i)
+    points.push_back({static_cast<float>(random.uniform(-1, 1)),
+                      static_cast<float>(random.uniform(-1, 1)),
+                      static_cast<float>(random.uniform(-1, 1))});
+  return points;
+}
+
+Mat4d randomMotion(Random& random) {
+  double q[4], norm = 0;
+  for (double& c : q) {
+    c = random.uniform(-1, 1);
+    norm += c * c;
+  }
+  norm = std::sqrt(norm);
+  Mat4d motion = Mat4d::rotation(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
+  for (int row = 0; row < 3; ++row) motion.at(row, 3) = random.uniform(-50, 50);
+  return motion;
+}
+
+std::vector<Vec3f> moved(const Mat4d& m, std::span<const Vec3f> points) {
+  std::vector<Vec3f> out;
+  for (const Vec3f& p : points) {
+    const Vec3d q = m.transformPoint(toDouble(p));
+    out.push_back({static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z)});
+  }
+  return out;
+}
+
+TEST(GlbInstances, ARigidMotionIsFoundAndNothingElse) {
+  Random random(20261126);
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::vector<Vec3f> points = randomPoints(random, 3 + trial % 40);
+    const Mat4d motion = randomMotion(random);
+    const std::vector<Vec3f> target = moved(motion, points);
+    const auto found = fitRigidMotion(points, target, 1e-5);
+    ASSERT_TRUE(found) << trial;
+    for (int k = 0; k < 16; ++k) EXPECT_NEAR(found->m[k], motion.m[k], 1e-4) << trial;
+    // A mirror image (of points not in one plane), a scaled copy and one vertex moved by 10× the
+    // tolerance are not motions.
+    const Mat4d mirror = motion * Mat4d::scale({-1, 1, 1});
+    if (points.size() > 3) {
+      EXPECT_FALSE(fitRigidMotion(points, moved(mirror, points), 1e-5)) << trial;
+    }
+    EXPECT_FALSE(
+        fitRigidMotion(points, moved(motion * Mat4d::scale({1.001, 1.001, 1.001}), points), 1e-5))
+        << trial;
+    std::vector<Vec3f> bent = target;
+    bent[trial % bent.size()].y += 1e-4f;
+    EXPECT_FALSE(fitRigidMotion(points, bent, 1e-5)) << trial;
+  }
+  // Points on a line span no frame.
+  const std::vector<Vec3f> line{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  EXPECT_FALSE(fitRigidMotion(line, line, 1e-5));
+}
+
+nlohmann::json glbJson(const std::string& path) {
+  const std::string bytes = test::readFile(path);
+  std::uint32_t jsonLength = 0;
+  std::memcpy(&jsonLength, bytes.data() + 12, 4);
+  return nlohmann::json::parse(bytes.substr(20, jsonLength));
+}
+
+// 2CylinderEngine.glb places 29 meshes under 67 nodes; read (world positions) and written again
+// it has its 29 meshes back, and read again every object lies where it lay, with its name.
+TEST(GlbInstances, AGltfAssemblyIsWrittenOncePerMesh) {
+  Result<Model> source = readModel(test::dataPath("meshes/2CylinderEngine.glb"));
+  ASSERT_TRUE(source.ok()) << source.error().message;
+  const std::vector<Placement> placements = findPlacements(*source);
+  std::size_t sources = 0;
+  for (std::size_t o = 0; o < placements.size(); ++o) sources += placements[o].source == o;
+  EXPECT_EQ(sources, 29u);
+
+  test::TempDir dir;
+  const std::string shared = dir.file("shared.glb"), apart = dir.file("apart.glb");
+  ASSERT_TRUE(writeGlb(*source, shared).ok());
+  GlbWriteOptions options;
+  options.shareMeshes = false;
+  ASSERT_TRUE(writeGlb(*source, apart, options).ok());
+  EXPECT_EQ(glbJson(shared)["meshes"].size(), 29u);
+  EXPECT_EQ(glbJson(apart)["meshes"].size(), source->objectCount());
+  EXPECT_LT(std::filesystem::file_size(shared), std::filesystem::file_size(apart) * 3 / 4);
+
+  Result<Model> back = readModel(shared);
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->objectCount(), source->objectCount());
+  ASSERT_EQ(back->vertexCount(), source->vertexCount());
+  const double size = length(toDouble(source->bounds().size()));
+  for (std::size_t o = 0; o < source->objectCount(); ++o) {
+    EXPECT_EQ(back->objectName(o), source->objectName(o));
+    const auto a = source->objectPositions(o), b = back->objectPositions(o);
+    for (std::size_t v = 0; v < a.size(); ++v) {
+      const Vec3d wa = toDouble(a[v]) + source->origin;
+      const Vec3d wb = toDouble(b[v]) + back->origin;
+      ASSERT_LT(length(wa - wb), 1e-5 * size) << source->objectName(o) << " vertex " << v;
+    }
+  }
+}
+
+// A STEP shape placed several times comes out of the CAD reader as equal triangles in different
+// places; written to GLB, each distinct shape is one mesh.
+TEST(GlbInstances, CadInstancesShareTheirShapesMesh) {
+  Result<Model> motor = readModel(test::dataPath("cad/as1_motor.step"));
+  ASSERT_TRUE(motor.ok()) << motor.error().message;
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(*motor, dir.file("motor.glb")).ok());
+  const nlohmann::json json = glbJson(dir.file("motor.glb"));
+  // 35 instances of 22 shapes (OCCT's count); two of the shapes mesh to the same triangles.
+  EXPECT_LE(json["meshes"].size(), 22u);
+  EXPECT_GE(json["meshes"].size(), 20u);
+  std::size_t placedByMatrix = 0;
+  for (const auto& node : json["nodes"]) placedByMatrix += node.contains("matrix");
+  EXPECT_EQ(placedByMatrix + json["meshes"].size(), motor->objectCount());
+}
+
+}  // namespace
+}  // namespace lodforge

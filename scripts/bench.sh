@@ -254,10 +254,13 @@ if [[ ${BENCH_ONLY:-} == laz ]]; then laz_section; exit 0; fi
 timed() {  # command...; prints "seconds peak-KiB" from /usr/bin/time -v
   local log=$work/time.log
   /usr/bin/time -v "$@" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
+  seconds_and_kib "$log"
+}
+seconds_and_kib() {  # a /usr/bin/time -v log; prints "seconds peak-KiB"
   local wall
-  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$log")
+  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$1")
   echo "$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")" \
-    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$log")"
+    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$1")"
 }
 potree_once() {  # tool, input; prints "seconds peak-KiB output-size"
   local tool=$1 input=$2 out=$work/potree-out
@@ -432,6 +435,41 @@ cad_section() {
       "$(du -h "$file" | cut -f1)" "$seconds" $((kib / 1024)) "$shapes" "$instances" "$triangles" \
       "$(awk -v n="$instances" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')" \
       "$(awk -v n="$triangles" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')"
+  done
+  cad_generated_section
+}
+
+# Generated STEP assemblies (`generate cad -o X.step`) at CAD_STEP_PARTS parts (default 1000
+# 10000): write, read + tessellate, and tiles end to end. 100000 works the same way but needs
+# ~1.7 GB of disk and, at the 10 K figures, ~18 GiB to write and ~14 GiB to read.
+cad_generated_section() {
+  echo
+  echo "== generated STEP assemblies ($(nproc) threads)"
+  printf '| %-7s | %-15s | %9s | %10s | %8s | %10s | %9s | %12s |\n' parts step size wall "peak RSS" triangles "parts/s" "triangles/s"
+  printf '|%s|%s|%s|%s|%s|%s|%s|%s|\n' --------- ----------------- ----------- ------------ ---------- ------------ ----------- --------------
+  local parts
+  for parts in ${CAD_STEP_PARTS:-1000 10000}; do
+    local step=$work/cad$parts.step result seconds kib triangles
+    result=$(timed "$lodforge" -q generate cad --objects "$parts" -o "$step")
+    seconds=${result% *} kib=${result#* }
+    printf '| %7s | %-15s | %9s | %9ss | %6d MiB | %10s | %9s | %12s |\n' "$parts" "write STEP" \
+      "$(du -h "$step" | cut -f1)" "$seconds" $((kib / 1024)) "" \
+      "$(awk -v n="$parts" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')" ""
+    /usr/bin/time -v "$lodforge" -q info "$step" --json > "$work/cad-info.json" 2> "$work/time.log"
+    result=$(seconds_and_kib "$work/time.log")
+    seconds=${result% *} kib=${result#* }
+    triangles=$(sed -n 's/^  "triangles": \([0-9]*\).*/\1/p' "$work/cad-info.json")
+    printf '| %7s | %-15s | %9s | %9ss | %6d MiB | %10s | %9s | %12s |\n' "$parts" "read+tessellate" \
+      "" "$seconds" $((kib / 1024)) "$triangles" \
+      "$(awk -v n="$parts" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')" \
+      "$(awk -v n="$triangles" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')"
+    result=$(timed "$lodforge" -q tiles "$step" -o "$work/cad-tiles")
+    seconds=${result% *} kib=${result#* }
+    printf '| %7s | %-15s | %9s | %9ss | %6d MiB | %10s | %9s | %12s |\n' "$parts" "tiles" \
+      "$(du -sh "$work/cad-tiles" | cut -f1)" "$seconds" $((kib / 1024)) "$triangles" \
+      "$(awk -v n="$parts" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')" \
+      "$(awk -v n="$triangles" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')"
+    rm -rf "$step" "$work/cad-tiles"
   done
 }
 if [[ ${BENCH_ONLY:-} == cad ]]; then cad_section; exit 0; fi

@@ -590,7 +590,6 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
     if (!materials[m]) {
       Material material = model.materials[m];
       if (model.hasColors()) material.baseColor = {1, 1, 1, 1};
-      if (options.doubleSided) material.doubleSided = true;
       materials[m] = writer->addMaterial(material);
     }
     return materials[m];

@@ -66,7 +66,8 @@ struct GlbMeshData {
 double glbQuantizationStep(const Aabbd& bounds);
 
 struct GlbWriteOptions {
-  // CAD parts are often open sheets: draw both sides unless told otherwise.
+  // The default material (objects without one of their own) draws both sides: a PLY, OBJ or
+  // STL mesh may well be an open sheet. The model's own materials keep their doubleSided.
   bool doubleSided = true;
   // Binary data beyond this stays on disk until finish() instead of in memory.
   std::size_t spillBytes = std::size_t{64} << 20;

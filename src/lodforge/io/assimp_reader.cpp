@@ -54,7 +54,10 @@ Material convertMaterial(const aiMaterial& m) {
     out.roughness = unit(roughness);
   if (aiColor3D emissive; m.Get(AI_MATKEY_COLOR_EMISSIVE, emissive) == AI_SUCCESS)
     out.emissive = {unit(emissive.r), unit(emissive.g), unit(emissive.b)};
-  if (int twoSided = 0; m.Get(AI_MATKEY_TWOSIDED, twoSided) == AI_SUCCESS)
+  // Most interchange formats do not say whether a surface is closed: both sides unless the file
+  // says one (assimp's DefaultMaterial, given to meshes without one, says nothing).
+  out.doubleSided = true;
+  if (int twoSided = 1; m.Get(AI_MATKEY_TWOSIDED, twoSided) == AI_SUCCESS)
     out.doubleSided = twoSided != 0;
   if (out.baseColor[3] < 1) {
     out.alphaMode = AlphaMode::kBlend;

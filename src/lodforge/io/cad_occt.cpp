@@ -406,7 +406,9 @@ std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, bool open
                              ? 2
                              : 0;
     material.alphaCutoff = vis->AlphaCutOff();
-    material.doubleSided = vis->FaceCulling() == Graphic3d_TypeOfBackfacingModel_DoubleSided;
+    // OCCT's Auto culls the back faces of closed solids only.
+    material.doubleSided = vis->FaceCulling() == Graphic3d_TypeOfBackfacingModel_DoubleSided ||
+                           (vis->FaceCulling() == Graphic3d_TypeOfBackfacingModel_Auto && open);
   } else if (translucent) {
     material.name = "translucent";
     material.alphaMode = 2;

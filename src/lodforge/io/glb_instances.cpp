@@ -1,6 +1,7 @@
 #include "lodforge/io/glb_instances.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
@@ -53,7 +54,8 @@ std::uint64_t signature(const Model& model, std::size_t o) {
   if (model.hasColors())
     for (std::uint64_t v = r.vertexOffset; v < r.vertexOffset + r.vertexCount; ++v) {
       const Rgba8 c = model.colors[v];
-      h = mix(h, (std::uint64_t{c.r} << 24) | (c.g << 16) | (c.b << 8) | c.a);
+      h = mix(h, (std::uint64_t{c.r} << 24) | (std::uint64_t{c.g} << 16) |
+                     (std::uint64_t{c.b} << 8) | c.a);
     }
   return h;
 }
@@ -76,25 +78,9 @@ bool normalsFollow(const Model& model, std::size_t a, std::size_t b, const Mat4d
   const ObjectRecord &ra = model.objects[a], &rb = model.objects[b];
   for (std::uint64_t v = 0; v < ra.vertexCount; ++v) {
     const Vec3d moved = motion.transformVector(toDouble(model.normals[ra.vertexOffset + v]));
-    if (length(moved - toDouble(model.normals[rb.vertexOffset + v])) > 1e-3) return false;
+    if (!(length(moved - toDouble(model.normals[rb.vertexOffset + v])) <= 1e-3)) return false;
   }
   return true;
-}
-
-// The largest triangle faces the same way after the motion: a flat mesh and its mirror image
-// have the same points, not the same front.
-bool windingFollows(const Model& model, std::size_t a, std::size_t b, const Mat4d& motion) {
-  const auto indices = model.objectIndices(a);
-  const auto pa = model.objectPositions(a), pb = model.objectPositions(b);
-  const auto normalOf = [&](std::span<const Vec3f> p, std::size_t t) {
-    const Vec3d p0 = toDouble(p[indices[t]]);
-    return cross(toDouble(p[indices[t + 1]]) - p0, toDouble(p[indices[t + 2]]) - p0);
-  };
-  std::size_t largest = 0;
-  double area = 0;
-  for (std::size_t t = 0; t < indices.size(); t += 3)
-    if (const double l = length(normalOf(pa, t)); l > area) area = l, largest = t;
-  return dot(motion.transformVector(normalOf(pa, largest)), normalOf(pb, largest)) > 0;
 }
 
 double diagonal(std::span<const Vec3f> p) {
@@ -130,8 +116,8 @@ std::optional<Mat4d> fitRigidMotion(std::span<const Vec3f> from, std::span<const
   const Vec3d shift = toCentre / n - motion.transformVector(fromCentre / n);
   for (int row = 0; row < 3; ++row) motion.at(row, 3) = shift[row];
   for (std::size_t i = 0; i < from.size(); ++i)
-    if (length(motion.transformPoint(toDouble(from[i])) - toDouble(to[i])) > tolerance)
-      return std::nullopt;
+    if (!(length(motion.transformPoint(toDouble(from[i])) - toDouble(to[i])) <= tolerance))
+      return std::nullopt;  // NaN fails too
   return motion;
 }
 
@@ -151,8 +137,7 @@ std::vector<Placement> findPlacements(const Model& model, double relativeToleran
     for (const std::uint32_t s : sources) {
       if (!sameTrianglesAndColours(model, s, o)) continue;
       const auto motion = fitRigidMotion(model.objectPositions(s), positions, tolerance);
-      if (!motion || !windingFollows(model, s, o, *motion) || !normalsFollow(model, s, o, *motion))
-        continue;
+      if (!motion || !normalsFollow(model, s, o, *motion)) continue;
       placements[o] = {s, *motion};
       break;
     }

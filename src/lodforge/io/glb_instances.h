@@ -27,8 +27,9 @@ std::optional<Mat4d> fitRigidMotion(std::span<const Vec3f> from, std::span<const
 
 // One placement per object. An object is placed from an earlier one when both have the same
 // triangles (indices), colours and material, and a rigid motion takes the earlier's vertices
-// onto its own within `relativeTolerance` of the object's size (normals within 1e-3). Only
-// objects with the same counts are compared, and at most `candidates` distinct meshes per count.
+// onto its own within `relativeTolerance` of the object's size (normals within 1e-3; the fronts
+// follow, the motion being proper and the indices equal). Only objects with the same signature
+// (counts, material, triangles, colours) are compared, against at most `candidates` meshes each.
 std::vector<Placement> findPlacements(const Model& model, double relativeTolerance = 1e-5,
                                       std::size_t candidates = 64);
 

@@ -129,6 +129,13 @@ try {
     tab.on('pageerror', (e) => mine(`page error: ${e.message}`));
     tab.on('requestfailed', (r) => mine(`request failed: ${r.url()}`));
     tab.on('response', (r) => { if (r.status() >= 400) mine(`HTTP ${r.status()}: ${r.url()}`); });
+    // Each tile is downloaded once while the three.js view first loads (the part ids come from
+    // the parse, not from a second download). CesiumJS's own scheduler may ask again for a tile
+    // it cancelled, so its page is not held to this.
+    const tileGets = new Map();
+    tab.on('request', (r) => {
+      if (r.url().endsWith('.glb')) tileGets.set(r.url(), (tileGets.get(r.url()) ?? 0) + 1);
+    });
     await tab.goto(`http://127.0.0.1:${port}/${viewer}/`);
     await tab.waitForFunction(() => window.lodforge && (window.lodforge.loaded || window.lodforge.error ||
                                                         window.lodforge.failed.length > 0),
@@ -138,6 +145,8 @@ try {
     for (const f of report.failed) mine(`tile failed: ${f}`);
     if (report.tilesLoaded < 1) mine('no tile loaded');
     await tab.waitForTimeout(1000);
+    const twice = [...tileGets].filter(([, n]) => n > 1);
+    if (viewer === 'three' && twice.length > 0) mine(`${twice.length} tile(s) downloaded more than once, e.g. ${twice[0][0]}`);
     const stats = await tab.evaluate(() => document.getElementById('stats').textContent);
     const png = await tab.screenshot();
     const shot = path.join(outDir, `${viewer}.png`);

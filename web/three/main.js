@@ -110,25 +110,23 @@ report.setClassVisible = (value, visible) => {
 report.classes = () => [...colouring.classes];
 
 // Tilesets of parts: each mesh's "_feature_id_0" attribute gives a vertex's row in its tile's
-// property table; the table's "id" column (read from the tile's GLB, which the browser has
-// cached) turns rows into parts of parts.json. Highlighting and hiding recolour the vertices
-// (alpha 0 is discarded by alphaTest; a triangle's corners are all of one part).
+// property table; the table's "id" column (read by partIdsPlugin as the tile's glTF is parsed)
+// turns rows into parts of parts.json. Highlighting and hiding recolour the vertices (alpha 0 is
+// discarded by alphaTest; a triangle's corners are all of one part).
 const HIGHLIGHT = [255, 210, 31];
 const partState = { parts: null, highlighted: new Set(), hidden: new Set(), meshes: new Set() };
 
-// The property table's "id" column of a tile's GLB.
-async function tilePartIds(url) {
-  const bytes = await (await fetch(url)).arrayBuffer();
-  const view = new DataView(bytes);
-  const jsonLength = view.getUint32(12, true);
-  const gltf = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, 20, jsonLength)));
-  const metadata = gltf.extensions && gltf.extensions.EXT_structural_metadata;
-  if (!metadata || !metadata.propertyTables) return null;
-  const table = metadata.propertyTables[0];
-  const ids = gltf.bufferViews[table.properties.id.values];
-  return new Uint32Array(bytes.slice(20 + jsonLength + 8 + (ids.byteOffset ?? 0),
-                                     20 + jsonLength + 8 + (ids.byteOffset ?? 0) + ids.byteLength));
-}
+// A GLTFLoader plugin: the property table's "id" column of a tile, from the bytes being parsed
+// (not downloaded a second time), kept as the tile scene's userData.partIds.
+const partIdsPlugin = (parser) => ({
+  name: 'lodforge_part_ids',
+  async afterRoot(result) {
+    const metadata = parser.json.extensions && parser.json.extensions.EXT_structural_metadata;
+    if (!metadata || !metadata.propertyTables) return;
+    const view = metadata.propertyTables[0].properties.id.values;
+    result.scene.userData.partIds = new Uint32Array(await parser.getDependency('bufferView', view));
+  },
+});
 
 function partOfVertex(mesh, vertex) {
   const rows = mesh.geometry.getAttribute('_feature_id_0');
@@ -151,9 +149,9 @@ function recolourParts(mesh) {
 }
 
 // A tile's meshes, as they load: RGBA colours to write into (the original kept), its part ids.
-async function prepareParts(scene, url) {
-  const ids = await tilePartIds(url);
-  if (!ids || scene.userData.disposed) return;  // a tile disposed while its ids were read
+function prepareParts(scene) {
+  const ids = scene.userData.partIds;
+  if (!ids) return;
   scene.traverse((mesh) => {
     if (!mesh.isMesh || !mesh.geometry.getAttribute('_feature_id_0')) return;
     const g = mesh.geometry;
@@ -254,7 +252,7 @@ function main() {
 
   const tiles = new TilesRenderer('/tiles/tileset.json');
   // EXT_meshopt_compression contents (lodforge tiles --compress meshopt).
-  tiles.registerPlugin(new GLTFExtensionsPlugin({ meshoptDecoder: MeshoptDecoder }));
+  tiles.registerPlugin(new GLTFExtensionsPlugin({ meshoptDecoder: MeshoptDecoder, plugins: [partIdsPlugin] }));
   tiles.errorTarget = 16;
   tiles.setCamera(camera);
   tiles.setResolutionFromRenderer(camera, renderer);
@@ -286,34 +284,22 @@ function main() {
     colouring.heights = [sphere.center.y - sphere.radius, sphere.center.y + sphere.radius];
     return true;
   };
-  const pending = new Set();  // part ids of tiles still being read
   tiles.addEventListener('load-model', (e) => {
     report.tilesLoaded += 1;
     e.scene.traverse((o) => { if (o.isPoints) preparePoints(o); });
-    if (partState.parts || report.partsPending) {
-      const base = new URL(`${e.tile.__basePath ?? '/tiles'}/`, location.href);
-      const job = prepareParts(e.scene, new URL(e.tile.content.uri, base).href)
-        .catch((error) => report.failed.push(`${e.tile.content.uri}: ${error}`))
-        .finally(() => pending.delete(job));
-      pending.add(job);
-    }
+    prepareParts(e.scene);
   });
   tiles.addEventListener('dispose-model', (e) => {
-    e.scene.userData.disposed = true;
     e.scene.traverse((o) => { colouring.points.delete(o); partState.meshes.delete(o); });
   });
   tiles.addEventListener('load-error', (e) => {
     report.failed.push(`${e.url}: ${e.error && e.error.message}`);
   });
   tiles.addEventListener('tiles-load-end', () => { if (framed && report.tilesLoaded > 0) report.loaded = true; });
-  report.partsPending = true;
   loadParts('/tiles/').then((parts) => {
-    report.partsPending = false;
     if (!parts) return;
     addParts(parts, tiles, camera, controls, renderer, pivot);
-    const idle = report.parts.idle;
-    report.parts.idle = () => idle() && pending.size === 0;
-  }).catch((error) => { report.partsPending = false; report.error = String(error); });
+  }).catch((error) => { report.error = String(error); });
 
   onScreenSpaceError((pixels) => { tiles.errorTarget = pixels; });
   window.addEventListener('resize', () => {

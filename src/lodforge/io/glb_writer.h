@@ -125,10 +125,11 @@ class GlbWriter {
 };
 
 // Writes a whole Model: one node per object with its mesh, or an earlier object's mesh under a
-// matrix when it repeats it (findPlacements; objects without triangles become empty nodes), the origin as the root translation. Objects with an assembly path hang in the node
-// tree the path names ("motor/rotor/shaft": nodes "motor" and "rotor" above the object's node
-// "shaft"), one node per distinct prefix; a first component all paths share names the root node
-// instead, so a GLB read and written again keeps its tree.
+// matrix when it repeats it (findPlacements; objects without triangles become empty nodes), the
+// origin as the root translation. Objects with an assembly path hang in the node tree the path
+// names ("motor/rotor/shaft": nodes "motor" and "rotor" above the object's node "shaft"), one node
+// per distinct prefix; a first component all paths share names the root node instead, so a GLB read
+// and written again keeps its tree.
 Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptions& options = {});
 
 }  // namespace lodforge

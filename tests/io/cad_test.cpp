@@ -180,21 +180,38 @@ TEST(CadRead, IgesAndBrepSamplesRead) {
   EXPECT_EQ(ball->objectName(0), "Ball");
 }
 
-// A STEP file of two coloured boxes named in Cyrillic, written by OCCT.
-void writeCyrillicStep(const std::string& path) {
+// A STEP file written by OCCT of the XDE document `fill` makes (shapes, names, colours).
+void writeStep(const std::string& path,
+               const std::function<void(XCAFDoc_ShapeTool&, XCAFDoc_ColorTool&)>& fill) {
   Handle(TDocStd_Document) doc;
   XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
-  const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
-  const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
-  const TDF_Label box = shapes->AddShape(BRepPrimAPI_MakeBox(10, 20, 30).Shape(), false);
-  TDataStd_Name::Set(box, TCollection_ExtendedString("Корпус насоса", true));
-  colors->SetColor(box, Quantity_Color(1, 0, 0, Quantity_TOC_sRGB), XCAFDoc_ColorSurf);
-  const TDF_Label lid = shapes->AddShape(BRepPrimAPI_MakeBox(10, 20, 2).Shape(), false);
-  TDataStd_Name::Set(lid, TCollection_ExtendedString("Крышка", true));
+  fill(*XCAFDoc_DocumentTool::ShapeTool(doc->Main()),
+       *XCAFDoc_DocumentTool::ColorTool(doc->Main()));
   STEPCAFControl_Writer writer;
   ASSERT_TRUE(writer.Transfer(doc, STEPControl_AsIs));
   ASSERT_EQ(writer.Write(path.c_str()), IFSelect_RetDone);
   XCAFApp_Application::GetApplication()->Close(doc);
+}
+
+// A shape of the document under its name.
+TDF_Label addNamed(XCAFDoc_ShapeTool& shapes, const TopoDS_Shape& shape,
+                   const TCollection_ExtendedString& name) {
+  const TDF_Label label = shapes.AddShape(shape, false);
+  TDataStd_Name::Set(label, name);
+  return label;
+}
+
+const Quantity_ColorRGBA kGlass(Quantity_Color(0.6, 0.8, 0.9, Quantity_TOC_sRGB), 0.12f);
+
+// A STEP file of two coloured boxes named in Cyrillic, written by OCCT.
+void writeCyrillicStep(const std::string& path) {
+  writeStep(path, [](XCAFDoc_ShapeTool& shapes, XCAFDoc_ColorTool& colors) {
+    const TDF_Label box = addNamed(shapes, BRepPrimAPI_MakeBox(10, 20, 30).Shape(),
+                                   TCollection_ExtendedString("Корпус насоса", true));
+    colors.SetColor(box, Quantity_Color(1, 0, 0, Quantity_TOC_sRGB), XCAFDoc_ColorSurf);
+    addNamed(shapes, BRepPrimAPI_MakeBox(10, 20, 2).Shape(),
+             TCollection_ExtendedString("Крышка", true));
+  });
 }
 
 // The text with every Cyrillic letter (two-byte UTF-8, U+0410..U+044F) rewritten by `to`.
@@ -258,25 +275,13 @@ TEST(CadRead, CyrillicNamesArriveAsUtf8) {
 TEST(CadRead, TranslucentPartsAreBlended) {
   test::TempDir dir;
   const std::string path = dir.file("window.step");
-  {
-    Handle(TDocStd_Document) doc;
-    XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
-    const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
-    const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
-    const TDF_Label frame = shapes->AddShape(BRepPrimAPI_MakeBox(100, 10, 100).Shape(), false);
-    TDataStd_Name::Set(frame, "frame");
-    colors->SetColor(frame, Quantity_Color(0.3, 0.3, 0.3, Quantity_TOC_sRGB), XCAFDoc_ColorSurf);
-    const TDF_Label glass =
-        shapes->AddShape(BRepPrimAPI_MakeBox(gp_Pnt(10, 2, 10), 80, 2, 80).Shape(), false);
-    TDataStd_Name::Set(glass, "glass");
-    colors->SetColor(glass,
-                     Quantity_ColorRGBA(Quantity_Color(0.6, 0.8, 0.9, Quantity_TOC_sRGB), 0.12f),
-                     XCAFDoc_ColorSurf);
-    STEPCAFControl_Writer writer;
-    ASSERT_TRUE(writer.Transfer(doc, STEPControl_AsIs));
-    ASSERT_EQ(writer.Write(path.c_str()), IFSelect_RetDone);
-    XCAFApp_Application::GetApplication()->Close(doc);
-  }
+  writeStep(path, [](XCAFDoc_ShapeTool& shapes, XCAFDoc_ColorTool& colors) {
+    const TDF_Label frame = addNamed(shapes, BRepPrimAPI_MakeBox(100, 10, 100).Shape(), "frame");
+    colors.SetColor(frame, Quantity_Color(0.3, 0.3, 0.3, Quantity_TOC_sRGB), XCAFDoc_ColorSurf);
+    colors.SetColor(
+        addNamed(shapes, BRepPrimAPI_MakeBox(gp_Pnt(10, 2, 10), 80, 2, 80).Shape(), "glass"),
+        kGlass, XCAFDoc_ColorSurf);
+  });
   Result<Model> model = readCad(path);
   ASSERT_TRUE(model.ok()) << model.error().message;
   ASSERT_EQ(model->objectCount(), 2u);
@@ -294,19 +299,12 @@ TEST(CadRead, TranslucentPartsAreBlended) {
 TEST(CadRead, OpenShapesAreDoubleSided) {
   test::TempDir dir;
   const std::string path = dir.file("open.step");
-  {
-    Handle(TDocStd_Document) doc;
-    XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
-    const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
-    const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
-    const auto add = [&](const TopoDS_Shape& shape, const char* name) {
-      const TDF_Label label = shapes->AddShape(shape, false);
-      TDataStd_Name::Set(label, name);
-      return label;
+  writeStep(path, [](XCAFDoc_ShapeTool& shapes, XCAFDoc_ColorTool& colors) {
+    const auto sheet = [](double z) {
+      return BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0, 0, z), gp_Dir(0, 0, 1)), 0, 10, 0, 10).Face();
     };
-    add(BRepPrimAPI_MakeBox(10, 10, 10).Shape(), "solid");
-    add(BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0, 0, 20), gp_Dir(0, 0, 1)), 0, 10, 0, 10).Face(),
-        "sheet");
+    addNamed(shapes, BRepPrimAPI_MakeBox(10, 10, 10).Shape(), "solid");
+    addNamed(shapes, sheet(20), "sheet");
     // The box without its top face: one shell, four free edges.
     TopoDS_Shell lidless;
     BRep_Builder builder;
@@ -316,18 +314,9 @@ TEST(CadRead, OpenShapesAreDoubleSided) {
                               TopAbs_FACE);
          face.More(); face.Next())
       if (++faces != 6) builder.Add(lidless, face.Current());
-    add(lidless, "lidless");
-    const TDF_Label glass =
-        add(BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0, 0, 40), gp_Dir(0, 0, 1)), 0, 10, 0, 10).Face(),
-            "glass");
-    colors->SetColor(glass,
-                     Quantity_ColorRGBA(Quantity_Color(0.6, 0.8, 0.9, Quantity_TOC_sRGB), 0.12f),
-                     XCAFDoc_ColorSurf);
-    STEPCAFControl_Writer writer;
-    ASSERT_TRUE(writer.Transfer(doc, STEPControl_AsIs));
-    ASSERT_EQ(writer.Write(path.c_str()), IFSelect_RetDone);
-    XCAFApp_Application::GetApplication()->Close(doc);
-  }
+    addNamed(shapes, lidless, "lidless");
+    colors.SetColor(addNamed(shapes, sheet(40), "glass"), kGlass, XCAFDoc_ColorSurf);
+  });
   Result<Model> model = readCad(path);
   ASSERT_TRUE(model.ok()) << model.error().message;
   ASSERT_EQ(model->objectCount(), 4u);

@@ -455,7 +455,8 @@ cad_generated_section() {
     printf '| %7s | %-15s | %9s | %9ss | %6d MiB | %10s | %9s | %12s |\n' "$parts" "write STEP" \
       "$(du -h "$step" | cut -f1)" "$seconds" $((kib / 1024)) "" \
       "$(awk -v n="$parts" -v s="$seconds" 'BEGIN { printf "%.0f", n / s }')" ""
-    /usr/bin/time -v "$lodforge" -q info "$step" --json > "$work/cad-info.json" 2> "$work/time.log"
+    /usr/bin/time -v "$lodforge" -q info "$step" --json > "$work/cad-info.json" 2> "$work/time.log" ||
+      { tail -20 "$work/time.log" >&2; exit 1; }
     result=$(seconds_and_kib "$work/time.log")
     seconds=${result% *} kib=${result#* }
     triangles=$(sed -n 's/^  "triangles": \([0-9]*\).*/\1/p' "$work/cad-info.json")

@@ -441,7 +441,7 @@ cad_section() {
 
 # Generated STEP assemblies (`generate cad -o X.step`) at CAD_STEP_PARTS parts (default 1000
 # 10000): write, read + tessellate, and tiles end to end. 100000 works the same way but needs
-# ~1.7 GB of disk and, at the 10 K figures, ~17 GiB to write and ~13 GiB to read.
+# ~1.7 GB of disk, ~17 GiB to write and ~13 GiB and ~1.75 h to read (BENCHMARKS.md).
 cad_generated_section() {
   echo
   echo "== generated STEP assemblies ($(nproc) threads)"

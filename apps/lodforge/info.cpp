@@ -88,6 +88,17 @@ nlohmann::json partNames(const Model& model) {
   return names;
 }
 
+// The CAD layers and how many parts each holds, in the model's order.
+nlohmann::json layerCounts(const Model& model) {
+  std::vector<std::uint64_t> count(model.layers.size());
+  for (const ObjectRecord& o : model.objects)
+    if (o.layer < count.size()) ++count[o.layer];
+  nlohmann::json layers = nlohmann::json::array();
+  for (std::size_t l = 0; l < count.size(); ++l)
+    layers.push_back({{"name", model.layers[l]}, {"count", count[l]}});
+  return layers;
+}
+
 Result<Summary> summarizeLoaded(const std::string& path, FileFormat format,
                                 const CadReadOptions& cadOptions) {
   std::vector<std::string> warnings;
@@ -101,7 +112,8 @@ Result<Summary> summarizeLoaded(const std::string& path, FileFormat format,
     s.cad = {{"shapes", cad.shapes},
              {"instances", cad.instances},
              {"depth", cad.depth},
-             {"parts", partNames(*model)}};
+             {"parts", partNames(*model)},
+             {"layers", layerCounts(*model)}};
   s.format = std::string(formatName(format));
   s.vertices = model->vertexCount();
   s.triangles = model->triangleCount();
@@ -166,6 +178,14 @@ void print(const std::string& path, const Summary& s) {
                parts[i]["count"].get<std::uint64_t>());
   if (parts.size() > kShown)
     fmt::print("  ... and {} more names (--json lists them all)\n", parts.size() - kShown);
+  const nlohmann::json& layers = s.cad["layers"];
+  if (layers.empty()) return;
+  fmt::print("layers     {}\n", formatCount(layers.size()));
+  for (std::size_t i = 0; i < std::min(layers.size(), kShown); ++i)
+    fmt::print("  {} ({} parts)\n", layers[i]["name"].get<std::string>(),
+               formatCount(layers[i]["count"].get<std::uint64_t>()));
+  if (layers.size() > kShown)
+    fmt::print("  ... and {} more layers (--json lists them all)\n", layers.size() - kShown);
 }
 
 // A progressive package: counts, levels, and what the LOD bookkeeping costs.

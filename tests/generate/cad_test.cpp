@@ -5,6 +5,8 @@
 #include <set>
 
 #include <gtest/gtest.h>
+
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/mesh.h"
@@ -57,9 +59,17 @@ TEST(Cad, StepHoldsTheGlbsAssemblyAsBrep) {
   ASSERT_TRUE(brep.ok()) << brep.error().message;
   ASSERT_EQ(brep->objectCount(), mesh->objectCount());
   EXPECT_LT(stats.shapes, stats.instances);  // bolts placed more than once
+  EXPECT_EQ(stats.depth, 3u);                // root, sub-assemblies of 100 parts, parts
+  // Every part on its kind's layer.
+  const std::map<std::string, std::string> layerOfKind = {
+      {"bolt", "fasteners"},    {"tube", "tubing"},    {"box", "housings"}, {"bracket", "brackets"},
+      {"plate", "sheet metal"}, {"beam", "structure"}, {"rod", "rods"}};
   std::size_t bolts = 0;
   for (std::size_t o = 0; o < mesh->objectCount(); ++o) {
     const std::string name(mesh->objectName(o));
+    EXPECT_EQ(brep->objectLayer(o), layerOfKind.at(name.substr(0, name.find('_')))) << name;
+    const std::string_view path = brep->objectPath(o);
+    EXPECT_NE(path.find(fmt::format("/group {:05}/", o / 100)), std::string_view::npos) << path;
     if (name.rfind("bolt_", 0) == 0) {
       EXPECT_EQ(brep->objectName(o).rfind("bolt M", 0), 0u) << brep->objectName(o);
       ++bolts;

@@ -19,11 +19,14 @@
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_LayerTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Pln.hxx>
+#include <gp_Trsf.hxx>
 
 #include <functional>
 #include <map>
+#include <set>
 
 #include <fmt/format.h>
 
@@ -336,6 +339,58 @@ TEST(CadRead, OpenShapesAreDoubleSided) {
   ASSERT_NE(materials.at("glass"), nullptr);
   EXPECT_EQ(materials.at("glass")->alphaMode, AlphaMode::kBlend);
   EXPECT_TRUE(materials.at("glass")->doubleSided);
+}
+
+// The names of an object's layers ("a; b" split), as a set: OCCT does not keep their order.
+std::set<std::string> layerSet(std::string_view joined) {
+  std::set<std::string> names;
+  while (!joined.empty()) {
+    const std::size_t end = std::min(joined.find("; "), joined.size());
+    names.emplace(joined.substr(0, end));
+    joined.remove_prefix(std::min(end + 2, joined.size()));
+  }
+  return names;
+}
+
+// Layers as CAD systems write them to STEP (on parts: an instance cannot be on one): every
+// placed instance carries its part's layers, a part on two layers names both, a part on none
+// has none, and each distinct set is listed once.
+TEST(CadRead, LayersArriveOnEveryInstanceOfTheirParts) {
+  test::TempDir dir;
+  const std::string path = dir.file("layers.step");
+  writeStep(path, [](XCAFDoc_ShapeTool& shapes, XCAFDoc_ColorTool&) {
+    const TDF_Label frame = addNamed(shapes, BRepPrimAPI_MakeBox(10, 10, 10).Shape(), "frame");
+    const TDF_Label cable =
+        addNamed(shapes, BRepPrimAPI_MakeBox(gp_Pnt(20, 0, 0), 1, 1, 10).Shape(), "cable");
+    addNamed(shapes, BRepPrimAPI_MakeBox(gp_Pnt(40, 0, 0), 5, 5, 5).Shape(), "loose");
+    const TDF_Label bolt = addNamed(shapes, BRepPrimAPI_MakeBox(1, 1, 3).Shape(), "bolt");
+    const TDF_Label fixing = shapes.NewShape();
+    TDataStd_Name::Set(fixing, "fixing");
+    for (double x : {0.0, 5.0}) {
+      gp_Trsf at;
+      at.SetTranslation(gp_Vec(x, 0, 12));
+      shapes.AddComponent(fixing, bolt, TopLoc_Location(at));
+    }
+    shapes.UpdateAssemblies();
+    const Handle(XCAFDoc_LayerTool) layers = XCAFDoc_DocumentTool::LayerTool(frame);
+    layers->SetLayer(frame, "structure");
+    layers->SetLayer(cable, "electrical");
+    layers->SetLayer(cable, "harness");
+    layers->SetLayer(bolt, "fasteners");
+  });
+  Result<Model> model = readCad(path);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  std::map<std::string, std::vector<std::set<std::string>>> layersByName;
+  for (std::size_t o = 0; o < model->objectCount(); ++o)
+    layersByName[std::string(model->objectName(o))].push_back(layerSet(model->objectLayer(o)));
+  using Sets = std::vector<std::set<std::string>>;
+  EXPECT_EQ(layersByName.at("frame"), (Sets{{"structure"}}));
+  EXPECT_EQ(layersByName.at("cable"), (Sets{{"electrical", "harness"}}));
+  EXPECT_EQ(layersByName.at("loose"), (Sets{{}}));
+  EXPECT_EQ(layersByName.at("bolt"), (Sets{{"fasteners"}, {"fasteners"}}));
+  EXPECT_EQ(model->layers.size(), 3u);  // structure, the cable's pair, fasteners
+  EXPECT_EQ(std::set<std::string>(model->layers.begin(), model->layers.end()).size(),
+            model->layers.size());
 }
 
 TEST(CadRead, BadFilesAreBadInputNamingTheFile) {

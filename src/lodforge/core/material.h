@@ -25,6 +25,8 @@ struct Material {
 
 // An object without a material (ObjectRecord::material).
 inline constexpr std::uint32_t kNoMaterial = ~0u;
+// Likewise for an object's CAD layer (Model::layers, a table beside the materials).
+inline constexpr std::uint32_t kNoLayer = ~0u;
 
 // glTF's name of an alpha mode ("OPAQUE", "MASK", "BLEND").
 const char* alphaModeName(AlphaMode mode);

@@ -27,6 +27,7 @@ struct ObjectRecord {
   std::uint32_t triangleCount = 0;
   std::uint64_t nameOffset = 0;  // into Model::names
   std::uint32_t nameLength = 0;
+  std::uint32_t layer = kNoLayer;  // into Model::layers (in the padding: the record stays 80 B)
   // Where the object sits in its assembly ("motor/rotor/shaft"), into Model::paths; empty when
   // the input has no assembly tree.
   std::uint64_t pathOffset = 0;
@@ -34,6 +35,7 @@ struct ObjectRecord {
   std::uint32_t material = kNoMaterial;  // into Model::materials
   Aabb bounds;                           // of the object's vertices, relative to the model origin
 };
+static_assert(sizeof(ObjectRecord) == 80);
 
 struct Model {
   Vec3d origin;
@@ -45,6 +47,9 @@ struct Model {
   std::string names;                // all object names, back to back
   std::string paths;                // all object assembly paths, back to back (often empty)
   std::vector<Material> materials;  // what objects refer to (few: a table, not per object)
+  // CAD layers objects are on, by name ("fasteners", or "a; b" for an object on two): a table
+  // like materials.
+  std::vector<std::string> layers;
 
   std::uint64_t vertexCount() const { return positions.size(); }
   std::uint64_t triangleCount() const { return indices.size() / 3; }
@@ -55,6 +60,10 @@ struct Model {
   std::string_view objectName(std::size_t object) const {
     const ObjectRecord& o = objects[object];
     return std::string_view(names).substr(o.nameOffset, o.nameLength);
+  }
+  std::string_view objectLayer(std::size_t object) const {
+    const std::uint32_t layer = objects[object].layer;
+    return layer < layers.size() ? std::string_view(layers[layer]) : std::string_view();
   }
   std::string_view objectPath(std::size_t object) const {
     const ObjectRecord& o = objects[object];

@@ -33,6 +33,12 @@ constexpr int kBoltCatalogue = 24;  // standard bolt sizes, instanced in GLB out
 
 enum class Kind : std::uint8_t { kBolt, kTube, kBox, kBracket, kPlate, kBeam, kRod };
 constexpr const char* kKindNames[] = {"bolt", "tube", "box", "bracket", "plate", "beam", "rod"};
+// The CAD layer each kind is drawn on in STEP output.
+constexpr const char* kKindLayers[] = {"fasteners",   "tubing",    "housings", "brackets",
+                                       "sheet metal", "structure", "rods"};
+// Parts per sub-assembly in STEP output: real assemblies are trees, and OCCT's STEP reader is
+// quadratic in the children of one product (STEPConstruct_Assembly::CheckSRRReversesNAUO).
+constexpr std::uint64_t kStepGroupSize = 100;
 
 struct Finish {
   const char* name;
@@ -559,7 +565,8 @@ Result<GenerateStats> writeGlb(const CadOptions& options, const std::string& pat
 }
 
 // The assembly as STEP through OpenCASCADE: one shape per part (bolts: one per catalogue entry
-// and finish, placed many times), each placed under the root with the part's transform.
+// and finish, placed many times, and on the layer of their kind), placed with the part's
+// transform in sub-assemblies of kStepGroupSize consecutive parts under the root.
 Result<GenerateStats> writeStep(const CadOptions& options, const std::string& path) {
   cad::WriteRequest request;
   request.path = path;
@@ -571,6 +578,7 @@ Result<GenerateStats> writeStep(const CadOptions& options, const std::string& pa
     const PartPlan plan = planPart(options.seed, index);
     const auto& color = kFinishes[plan.finish].color;
     const std::string name = partName(plan, index);
+    const std::string layer = kKindLayers[static_cast<int>(plan.kind)];
     std::uint64_t shape = request.shapes.size();
     if (plan.kind == Kind::kBolt) {
       const auto [at, added] = bolts.try_emplace({plan.bolt, plan.finish}, shape);
@@ -579,13 +587,17 @@ Result<GenerateStats> writeStep(const CadOptions& options, const std::string& pa
         request.shapes.push_back(
             {fmt::format("bolt M{} {}", plan.bolt, kFinishes[plan.finish].name),
              boltPrisms(plan.bolt, options.seed),
-             {color[0], color[1], color[2], color[3]}});
+             {color[0], color[1], color[2], color[3]},
+             layer});
     } else {
       request.shapes.push_back({name,
                                 prismsOf(drawPart(plan, options.detail)),
-                                {color[0], color[1], color[2], color[3]}});
+                                {color[0], color[1], color[2], color[3]},
+                                layer});
     }
-    cad::Placement placement{name, shape, {}};
+    const auto group = static_cast<std::uint32_t>(index / kStepGroupSize);
+    if (group == request.groups.size()) request.groups.push_back(fmt::format("group {:05}", group));
+    cad::Placement placement{name, shape, group, {}};
     std::copy(plan.transform.m.begin(), plan.transform.m.end(), placement.matrix);
     request.placements.push_back(std::move(placement));
     progress.advance(1);

@@ -10,7 +10,7 @@
 
 namespace lodforge::cad {
 
-inline constexpr int kModuleVersion = 5;  // bumped when these structs change
+inline constexpr int kModuleVersion = 6;  // bumped when these structs change
 inline constexpr const char* kReadSymbol = "lodforge_cad_read";
 inline constexpr const char* kWriteSymbol = "lodforge_cad_write";
 
@@ -44,7 +44,8 @@ struct Material {
 
 struct Instance {
   std::string name;
-  std::string path;  // product names from the root down to this instance, "/"-separated
+  std::string path;   // product names from the root down to this instance, "/"-separated
+  std::string layer;  // the CAD layers of the instance and its part, "; "-separated; often empty
   std::uint64_t firstVertex = 0, vertexCount = 0;
   std::uint64_t firstTriangle = 0, triangleCount = 0;
   std::uint64_t shape = 0;       // which distinct shape
@@ -93,18 +94,23 @@ struct ShapeSpec {
   std::string name;
   std::vector<Prism> prisms;
   float color[4] = {0.8f, 0.8f, 0.8f, 1};  // linear RGBA
+  std::string layer;                       // empty: on no layer
 };
 
-// One placed instance of a shape under the assembly's root.
+// One placed instance of a shape, under the assembly's root or one of its sub-assemblies.
 struct Placement {
   std::string name;
   std::uint64_t shape = 0;
+  std::uint32_t group = ~0u;  // into WriteRequest::groups; ~0u: directly under the root
   double matrix[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  // rigid, column-major
 };
 
 struct WriteRequest {
   std::string path;      // written as given (the caller names a temporary and renames it)
   std::string assembly;  // the root product's name
+  // Sub-assemblies placed under the root (identity transform), by name. Real assemblies are
+  // trees, and OCCT's STEP reader is quadratic in the children of one product.
+  std::vector<std::string> groups;
   std::vector<ShapeSpec> shapes;
   std::vector<Placement> placements;
   bool (*cancelled)() = nullptr;  // asked between shapes
@@ -115,7 +121,8 @@ struct WriteResult {
   std::string error;
 };
 
-// Writes the assembly as STEP (AP214, names and colours); `version` must equal kModuleVersion.
+// Writes the assembly as STEP (AP214, names, colours and layers); `version` must equal
+// kModuleVersion.
 using WriteFunction = void (*)(int version, const WriteRequest& request, WriteResult& result);
 
 }  // namespace lodforge::cad

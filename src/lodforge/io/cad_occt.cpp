@@ -33,6 +33,7 @@
 #include <TopoDS_Face.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_LayerTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <XCAFDoc_VisMaterial.hxx>
 #include <XCAFPrs_DocumentExplorer.hxx>
@@ -257,7 +258,8 @@ struct Placed {
   TopLoc_Location location;
   XCAFPrs_Style style;
   std::string name;
-  std::string path;  // the names from the root down to this leaf, "/"-separated
+  std::string path;   // the names from the root down to this leaf, "/"-separated
+  std::string layer;  // its layers, "; "-separated
 };
 
 struct Tree {
@@ -266,10 +268,29 @@ struct Tree {
   std::uint32_t depth = 0;
 };
 
+// The layers of a placed leaf, each once: its instance's and its part's (STEP keeps layers on
+// parts; IGES levels sit on either).
+std::string layersOf(const Handle(XCAFDoc_LayerTool) & tool, const XCAFPrs_DocumentNode& node) {
+  std::vector<std::string> names;
+  for (const TDF_Label& label : {node.Label, node.RefLabel}) {
+    Handle(TColStd_HSequenceOfExtendedString) found;
+    if (label.IsNull() || !tool->GetLayers(label, found) || found.IsNull()) continue;
+    for (Standard_Integer i = 1; i <= found->Length(); ++i) {
+      std::string name = utf8(found->Value(i));
+      if (!name.empty() && std::find(names.begin(), names.end(), name) == names.end())
+        names.push_back(std::move(name));
+    }
+  }
+  std::string joined;
+  for (const std::string& name : names) joined += (joined.empty() ? "" : "; ") + name;
+  return joined;
+}
+
 // The leaves in the order the tree lists them; a shape placed again refers to its first entry.
 Tree walkTree(const Handle(TDocStd_Document) & doc) {
   Tree tree;
   std::map<std::string, std::size_t> seen;  // label entry → shape
+  const Handle(XCAFDoc_LayerTool) layers = XCAFDoc_DocumentTool::LayerTool(doc->Main());
   for (XCAFPrs_DocumentExplorer it(doc, XCAFPrs_DocumentExplorerFlags_OnlyLeafNodes); it.More();
        it.Next()) {
     const XCAFPrs_DocumentNode& node = it.Current();
@@ -284,8 +305,8 @@ Tree walkTree(const Handle(TDocStd_Document) & doc) {
     std::string path;
     for (int depth = 0; depth <= it.CurrentDepth(); ++depth)
       path += (depth > 0 ? "/" : "") + nameOf(it.Current(depth));
-    tree.placed.push_back(
-        {at->second, node.RefLabel, node.Location, node.Style, nameOf(node), std::move(path)});
+    tree.placed.push_back({at->second, node.RefLabel, node.Location, node.Style, nameOf(node),
+                           std::move(path), layersOf(layers, node)});
     tree.depth = std::max(tree.depth, static_cast<std::uint32_t>(it.CurrentDepth() + 1));
   }
   return tree;
@@ -428,8 +449,9 @@ std::uint32_t materialOf(const XCAFPrs_Style& style, bool translucent, bool open
 
 // One placed instance's faces appended: positions in metres, normals and colours per vertex.
 void appendInstance(const Placed& placed, bool open, double metresPerUnit, Result& out) {
-  Instance instance{placed.name, placed.path, out.positions.size() / 3, 0, out.indices.size() / 3,
-                    0,           placed.shape};
+  Instance instance{
+      placed.name, placed.path, placed.layer, out.positions.size() / 3, 0, out.indices.size() / 3,
+      0,           placed.shape};
   const Quantity_ColorRGBA grey(Quantity_Color(0.78, 0.78, 0.78, Quantity_TOC_sRGB));
   bool translucent = false;
   for (RWMesh_FaceIterator face(placed.label, placed.location, true, placed.style); face.More();

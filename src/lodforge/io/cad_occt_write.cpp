@@ -2,6 +2,7 @@
 // built as B-rep, placed in an XDE document with names and colours, written as STEP. What
 // `lodforge generate cad -o X.step` uses, so CAD scale tests need no download.
 #include <fmt/format.h>
+#include <BRepAlgoAPI_Fuse.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
@@ -19,11 +20,15 @@
 #include <Standard_Failure.hxx>
 #include <TDataStd_Name.hxx>
 #include <TDocStd_Document.hxx>
+#include <TopTools_ListOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
+#include <TopoDS_Iterator.hxx>
+#include <TopoDS_Shell.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_LayerTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Ax2.hxx>
 #include <gp_Circ.hxx>
@@ -56,17 +61,41 @@ TopoDS_Shape makePrism(const Prism& prism) {
   ShapeFix_Face fix(face.Face());
   fix.FixOrientation();
   fix.Perform();
-  if (prism.z1 == prism.z0) return fix.Face();
-  return BRepPrimAPI_MakePrism(fix.Face(), gp_Vec(0, 0, prism.z1 - prism.z0)).Shape();
+  if (prism.z1 != prism.z0)
+    return BRepPrimAPI_MakePrism(fix.Face(), gp_Vec(0, 0, prism.z1 - prism.z0)).Shape();
+  // A sheet in a shell, as CAD systems write surface models: OCCT's STEP writer finds no
+  // representation item (so drops the layer) for a bare face.
+  BRep_Builder builder;
+  TopoDS_Shell shell;
+  builder.MakeShell(shell);
+  builder.Add(shell, fix.Face());
+  return shell;
 }
 
+// One solid where the prisms touch (a bolt's head and shank): OCCT's STEP writer drops the
+// layer of a compound.
 TopoDS_Shape makeShape(const ShapeSpec& spec) {
   if (spec.prisms.size() == 1) return makePrism(spec.prisms.front());
-  BRep_Builder builder;
-  TopoDS_Compound compound;
-  builder.MakeCompound(compound);
-  for (const Prism& prism : spec.prisms) builder.Add(compound, makePrism(prism));
-  return compound;
+  TopTools_ListOfShape arguments, tools;
+  for (std::size_t p = 0; p < spec.prisms.size(); ++p)
+    (p == 0 ? arguments : tools).Append(makePrism(spec.prisms[p]));
+  BRepAlgoAPI_Fuse fuse;
+  fuse.SetArguments(arguments);
+  fuse.SetTools(tools);
+  fuse.Build();
+  if (!fuse.IsDone()) throw std::runtime_error("OCCT could not fuse the prisms of " + spec.name);
+  fuse.SimplifyResult();
+  TopoDS_Shape fused = fuse.Shape();
+  // A single solid comes back wrapped in a compound.
+  if (fused.ShapeType() == TopAbs_COMPOUND) {
+    TopoDS_Iterator only(fused);
+    if (only.More()) {
+      const TopoDS_Shape first = only.Value();
+      only.Next();
+      if (!only.More()) fused = first;
+    }
+  }
+  return fused;
 }
 
 gp_Trsf transformOf(const double (&m)[16]) {
@@ -80,8 +109,15 @@ void write(const WriteRequest& request, WriteResult& result) {
   XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
   const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
   const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
+  const Handle(XCAFDoc_LayerTool) layers = XCAFDoc_DocumentTool::LayerTool(doc->Main());
   const TDF_Label root = shapes->NewShape();
   TDataStd_Name::Set(root, TCollection_ExtendedString(request.assembly.c_str(), true));
+  std::vector<TDF_Label> groups;
+  groups.reserve(request.groups.size());
+  for (const std::string& name : request.groups) {
+    groups.push_back(shapes->NewShape());
+    TDataStd_Name::Set(groups.back(), TCollection_ExtendedString(name.c_str(), true));
+  }
   std::vector<TDF_Label> labels;
   labels.reserve(request.shapes.size());
   for (const ShapeSpec& spec : request.shapes) {
@@ -96,17 +132,26 @@ void write(const WriteRequest& request, WriteResult& result) {
                                                        Quantity_TOC_RGB),
                                         spec.color[3]),
                      XCAFDoc_ColorSurf);
+    // STEP keeps layers on shapes only (an instance cannot be on a layer).
+    if (!spec.layer.empty())
+      layers->SetLayer(label, TCollection_ExtendedString(spec.layer.c_str(), true));
     labels.push_back(label);
   }
   for (const Placement& placement : request.placements) {
+    const TDF_Label parent = placement.group == ~0u ? root : groups.at(placement.group);
     const TDF_Label component = shapes->AddComponent(
-        root, labels.at(placement.shape), TopLoc_Location(transformOf(placement.matrix)));
+        parent, labels.at(placement.shape), TopLoc_Location(transformOf(placement.matrix)));
     TDataStd_Name::Set(component, TCollection_ExtendedString(placement.name.c_str(), true));
+  }
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    const TDF_Label component = shapes->AddComponent(root, groups[g], TopLoc_Location());
+    TDataStd_Name::Set(component, TCollection_ExtendedString(request.groups[g].c_str(), true));
   }
   shapes->UpdateAssemblies();
   STEPCAFControl_Writer writer;
   writer.SetColorMode(true);
   writer.SetNameMode(true);
+  writer.SetLayerMode(true);
   Interface_Static::SetCVal("write.step.schema", "AP214IS");
   Interface_Static::SetCVal("write.step.unit", "M");
   if (!writer.Transfer(doc, STEPControl_AsIs)) {

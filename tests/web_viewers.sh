@@ -3,7 +3,8 @@
 # port, the CesiumJS and the three.js page in headless chromium, for a mesh tileset (the horse,
 # georeferenced, meshopt-compressed), a point tileset (a LAS placed from its own CRS) and the
 # surface reconstructed from a LAZ scan (tiles --surface, placed from the file's CRS), and a STEP
-# assembly whose parts are picked, found, highlighted and hidden in both viewers.
+# assembly whose parts are picked, found, highlighted and hidden in both viewers, and a generated
+# STEP assembly whose parts are also hidden by CAD layer.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -11,7 +12,8 @@ here=$(cd "$(dirname "$0")" && pwd)
   { echo "the viewers are not built: run scripts/build-web.sh (make does)" >&2; exit 1; }
 [[ -d $here/js/node_modules/playwright-core ]] ||
   { echo "playwright-core is not installed: run scripts/install-deps.sh" >&2; exit 1; }
-rm -rf "$out" && mkdir -p "$out/horse-shots" "$out/autzen-shots" "$out/surface-shots" "$out/motor-shots"
+rm -rf "$out" && mkdir -p "$out/horse-shots" "$out/autzen-shots" "$out/surface-shots" "$out/motor-shots" \
+  "$out/layers-shots"
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse" --chunk-size 0.05 \
   --origin 8.5417,47.3769,408 --compress meshopt
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/horse" "$out/horse-shots" --min-coverage 0.03
@@ -21,3 +23,7 @@ node "$here/js/web-viewers.mjs" "$lodforge" "$out/autzen" "$out/autzen-shots" --
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/surface" "$out/surface-shots" --min-coverage 0.03
 "$lodforge" -q tiles "$data/cad/as1_motor.step" -o "$out/motor" --origin 2.35,48.85,35
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/motor" "$out/motor-shots" --min-coverage 0.03
+"$lodforge" -q generate cad --objects 200 -o "$out/layers.step"
+"$lodforge" -q tiles "$out/layers.step" -o "$out/layers"
+# 200 parts spread over a 64 m airframe: little of the view is covered.
+node "$here/js/web-viewers.mjs" "$lodforge" "$out/layers" "$out/layers-shots" --min-coverage 0.0003

@@ -1,7 +1,7 @@
 // The parts of a tileset of parts (a CAD assembly), for both viewers: parts.json (named by
-// tileset.json's asset.extras.parts: id, name, assembly path, bounds per part), and the panel
-// that finds a part by name, shows the one picked, hides it or shows everything again. The
-// viewer does the drawing: it gets the ids to highlight, hide or fly to.
+// tileset.json's asset.extras.parts: id, name, assembly path, CAD layer, bounds per part), and
+// the panel that finds a part by name, shows the one picked, hides it or its CAD layers, or shows
+// everything again. The viewer does the drawing: it gets the ids to highlight, hide or fly to.
 
 // parts.json of the tileset at `base` ('/tiles/'), or null when the tileset names no parts.
 export async function loadParts(base) {
@@ -17,6 +17,22 @@ export async function loadParts(base) {
 export function findParts(parts, text) {
   const needle = text.trim().toLowerCase();
   return parts.parts.filter((p) => p.name.toLowerCase().includes(needle)).map((p) => p.id);
+}
+
+// The CAD layers of a part ("a; b" names two), as a list.
+export function layerNames(part) {
+  return part && part.layer ? part.layer.split('; ') : [];
+}
+
+// Each CAD layer's name and the ids of the parts on it, in first-seen order.
+export function partsByLayer(parts) {
+  const layers = new Map();
+  for (const p of parts.parts)
+    for (const name of layerNames(p)) {
+      if (!layers.has(name)) layers.set(name, []);
+      layers.get(name).push(p.id);
+    }
+  return layers;
 }
 
 // The box around the parts `ids` in the tileset's frame, or null when none has triangles.
@@ -56,10 +72,49 @@ export function partsPanel(parts, view) {
   showAll.id = 'part-show-all';
   showAll.textContent = 'show all';
   section.append(title, find, found, picked, hide, showAll);
+  // One checkbox per CAD layer: a part on a layer turned off is hidden.
+  const layers = partsByLayer(parts);
+  const layersOff = new Set();
+  const layerBoxes = new Map();
+  if (layers.size > 0) {
+    // Folded at first: an assembly may have dozens of layers.
+    const list = document.createElement('details');
+    list.id = 'part-layers';
+    const summary = document.createElement('summary');
+    summary.textContent = `${layers.size} CAD layers`;
+    list.appendChild(summary);
+    for (const [name, ids] of layers) {
+      const label = document.createElement('label');
+      const box = document.createElement('input');
+      box.type = 'checkbox';
+      box.checked = true;
+      box.addEventListener('change', () => {
+        if (box.checked) layersOff.delete(name); else layersOff.add(name);
+        redraw();
+      });
+      layerBoxes.set(name, box);
+      label.append(box, `${name} (${ids.length})`);
+      list.append(label);
+    }
+    section.appendChild(list);
+  }
   panel.appendChild(section);
 
   const hidden = new Set();
   let current = null;
+  const redraw = () => {
+    const ids = new Set(hidden);
+    for (const name of layersOff) for (const id of layers.get(name) || []) ids.add(id);
+    view.hide([...ids]);
+  };
+  const setLayer = (name, shown) => {
+    const box = layerBoxes.get(name);
+    if (!box) return false;
+    box.checked = shown;
+    if (shown) layersOff.delete(name); else layersOff.add(name);
+    redraw();
+    return true;
+  };
   const select = (id) => {
     current = id;
     const part = id === null ? null : parts.parts[id];
@@ -71,6 +126,12 @@ export function partsPanel(parts, view) {
       path.className = 'part-path';
       path.textContent = part.path || '';
       picked.append(name, path);
+      if (part.layer) {
+        const layer = document.createElement('div');
+        layer.className = 'part-layer';
+        layer.textContent = `layer: ${part.layer}`;
+        picked.append(layer);
+      }
     }
     hide.disabled = part === null;
     view.highlight(part ? [id] : []);
@@ -86,15 +147,22 @@ export function partsPanel(parts, view) {
   hide.addEventListener('click', () => {
     if (current === null) return;
     hidden.add(current);
-    view.hide([...hidden]);
+    redraw();
     select(null);
   });
-  showAll.addEventListener('click', () => { hidden.clear(); view.hide([]); });
+  const showEverything = () => {
+    hidden.clear();
+    for (const name of [...layersOff]) setLayer(name, true);
+    redraw();
+  };
+  showAll.addEventListener('click', showEverything);
   return {
     picked: select,
     find: (text) => { find.value = text; return search(text); },
-    hide: (ids) => { for (const id of ids) hidden.add(id); view.hide([...hidden]); },
-    showAll: () => { hidden.clear(); view.hide([]); },
+    hide: (ids) => { for (const id of ids) hidden.add(id); redraw(); },
+    showAll: showEverything,
     shown: () => picked.textContent,
+    layers: () => [...layers.keys()],
+    setLayer,
   };
 }

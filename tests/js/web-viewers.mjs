@@ -71,7 +71,8 @@ async function checkColorModes(tab, viewer, coverage, firstPng, mine) {
 // A tileset of parts: the viewer finds a known part by name (one the root tile still holds, the
 // largest) and flies to it; with every other part hidden, the pixels that pick anything pick it,
 // highlighted; a real click on one shows its name and path in the panel, as parts.json has them;
-// hiding it leaves that pixel to another part or to nothing.
+// hiding it leaves that pixel to another part or to nothing. Where the parts are on CAD layers,
+// the pick and the panel name the part's layer, and turning its layer off hides it.
 async function checkParts(tab, viewer, mine) {
   const parts = JSON.parse(readFileSync(path.join(tilesetDir, 'parts.json'), 'utf8'));
   const inRoot = new Set(parts.parts.map((p) => p.id));
@@ -103,19 +104,48 @@ async function checkParts(tab, viewer, mine) {
     if (h.name !== known.name) mine(`the tile names part ${h.id} "${h.name}", parts.json "${known.name}"`);
     if (!h.highlighted) mine(`part ${h.id} is not highlighted after finding it`);
   }
-  const hit = hits[Math.floor(hits.length / 2)];
+  // A pixel the panel does not cover, where a real click reaches the canvas.
+  const panel = await tab.evaluate(() => { const r = document.getElementById('panel').getBoundingClientRect(); return [r.left, r.top, r.right, r.bottom]; });
+  const clear = hits.filter((h) => h.x < panel[0] || h.x > panel[2] || h.y < panel[1] || h.y > panel[3]);
+  if (clear.length === 0) { mine(`every pixel of part "${known.name}" lies under the panel`); return; }
+  const hit = clear[Math.floor(clear.length / 2)];
   const box0 = await tab.evaluate(() => { const r = document.querySelector('canvas').getBoundingClientRect(); return [r.left, r.top]; });
   await tab.mouse.click(box0[0] + hit.x, box0[1] + hit.y);
   await tab.waitForTimeout(300);
   const shown = await tab.evaluate(() => window.lodforge.parts.shown());
   if (!shown.includes(known.name) || !shown.includes(known.path))
     mine(`clicking part ${known.id} shows "${shown}", not its name "${known.name}" and path "${known.path}"`);
+  if (parts.parts.some((p) => p.layer)) await checkLayers(tab, viewer, known, hit, shown, mine);
   await tab.evaluate(() => window.lodforge.parts.showAll());
   await tab.evaluate((id) => window.lodforge.parts.hide(id), known.id);
   await tab.waitForTimeout(1000);
   const after = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [hit.x, hit.y]);
   if (after && after.id === known.id) mine(`part ${known.id} is still picked after hiding it`);
   console.log(`${viewer}: a click shows "${shown}"; hidden, its pixel picks ${after ? `"${after.name}"` : 'nothing'}`);
+}
+
+// The known part's CAD layer: in what its pixel picks (CesiumJS reads it from the tile's property
+// table), in the panel after a click, and in the layer list; with its layer off, the pixel no
+// longer picks it; back on, it does again.
+async function checkLayers(tab, viewer, known, hit, shown, mine) {
+  if (!known.layer) { mine(`part "${known.name}" has no layer in a tileset of layers`); return; }
+  if (hit.layer !== known.layer) mine(`the tile gives part ${known.id} layer "${hit.layer}", parts.json "${known.layer}"`);
+  if (!shown.includes(known.layer)) mine(`clicking part ${known.id} shows "${shown}", not its layer "${known.layer}"`);
+  const layers = await tab.evaluate(() => window.lodforge.parts.layers());
+  const name = known.layer.split('; ')[0];
+  if (!layers.includes(name)) { mine(`the layer list ${JSON.stringify(layers)} lacks "${name}"`); return; }
+  await tab.evaluate(() => window.lodforge.parts.showAll());
+  await tab.evaluate(([id, layer]) => { window.lodforge.parts.isolate(id); window.lodforge.parts.setLayer(layer, false); },
+                     [known.id, name]);
+  await tab.waitForTimeout(1000);
+  const off = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [hit.x, hit.y]);
+  if (off && off.id === known.id) mine(`part ${known.id} is still picked with its layer "${name}" off`);
+  await tab.evaluate((layer) => window.lodforge.parts.setLayer(layer, true), name);
+  await tab.waitForTimeout(1000);
+  const on = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [hit.x, hit.y]);
+  if (!on || on.id !== known.id) mine(`part ${known.id} is not picked again with its layer "${name}" back on`);
+  console.log(`${viewer}: part ${known.id} is on layer "${known.layer}" (${layers.length} layers); ` +
+              `off, its pixel picks ${off ? `"${off.name}"` : 'nothing'}; on again, "${on ? on.name : 'nothing'}"`);
 }
 
 const { context, close: closeBrowser } = await launchChromium();

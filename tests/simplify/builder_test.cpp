@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "lodforge/generate/cad.h"
+#include "lodforge/io/cad_reader.h"
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/io/gltf_reader.h"
 #include "lodforge/io/ply_writer.h"
@@ -116,6 +117,33 @@ TEST(Extract, RatiosAndErrorsPickTheExpectedLevels) {
 // A package keeps each object's assembly path and material, and `extract` hangs the objects back
 // in that tree with those materials: the GLB read again names the same paths. (2CylinderEngine's
 // materials are single-sided and stay so.)
+// CAD layers travel from a STEP assembly through the package to an extracted GLB (node extras)
+// and back.
+TEST(Extract, CadLayersComeBack) {
+  test::TempDir dir;
+  ASSERT_TRUE(generateCad({.objects = 120, .seed = 5}, dir.file("a.step")).ok());
+  Result<Model> source = readCad(dir.file("a.step"));
+  ASSERT_TRUE(source.ok()) << source.error().message;
+  ASSERT_TRUE(buildPackage(dir.file("a.step"), dir.file("a.lfp")).ok());
+  Result<Package> package = Package::open(dir.file("a.lfp"));
+  ASSERT_TRUE(package.ok()) << package.error().message;
+  ASSERT_EQ(package->objectCount(), source->objectCount());
+  EXPECT_EQ(package->layerCount(), source->layers.size());
+  ASSERT_TRUE(
+      writeGlb(extractModel(*package, vertexCountsForRatio(*package, 0.5)), dir.file("a.glb"))
+          .ok());
+  Result<Model> extracted = readGltf(dir.file("a.glb"));
+  ASSERT_TRUE(extracted.ok());
+  ASSERT_EQ(extracted->objectCount(), source->objectCount());
+  std::size_t onLayers = 0;
+  for (std::size_t o = 0; o < source->objectCount(); ++o) {
+    EXPECT_EQ(package->objectLayer(o), source->objectLayer(o)) << o;
+    EXPECT_EQ(extracted->objectLayer(o), source->objectLayer(o)) << o;
+    onLayers += source->objectLayer(o).empty() ? 0 : 1;
+  }
+  EXPECT_EQ(onLayers, source->objectCount());
+}
+
 TEST(Extract, TheAssemblyTreeAndMaterialsComeBack) {
   const std::string input = test::dataPath("meshes/2CylinderEngine.glb");
   Result<Model> source = readGltf(input);

@@ -27,17 +27,23 @@ TEST(Package, WrittenObjectsReadBackIdentically) {
   Result<Model> engine = readModel(test::dataPath("meshes/2CylinderEngine.glb"));
   ASSERT_TRUE(engine.ok());
   const std::vector<ProgressiveMesh> meshes = meshesOf(*engine);
+  // Layers as a CAD reader gives them: a table, objects on one entry or none.
+  const std::vector<std::string> layers = {"structure", "électrique; harness"};
+  const auto layerOf = [](std::size_t o) {
+    return o % 3 == 2 ? kNoLayer : static_cast<std::uint32_t>(o % 3);
+  };
   test::TempDir dir;
   {
     Result<PackageWriter> writer = PackageWriter::create(dir.file("e.lfp"), {1, 2, 3}, true, false);
     ASSERT_TRUE(writer.ok());
     for (std::size_t o = 0; o < meshes.size(); ++o) {
-      ASSERT_TRUE(writer
-                      ->add(meshes[o], {engine->objectName(o), Rgba8{10, 20, 30, 255},
-                                        engine->objectPath(o), engine->objects[o].material})
-                      .ok());
+      ASSERT_TRUE(
+          writer
+              ->add(meshes[o], {engine->objectName(o), Rgba8{10, 20, 30, 255},
+                                engine->objectPath(o), engine->objects[o].material, layerOf(o)})
+              .ok());
     }
-    ASSERT_TRUE(writer->finish(engine->materials).ok());
+    ASSERT_TRUE(writer->finish(engine->materials, layers).ok());
   }
   EXPECT_EQ(test::listFolder(dir.path()),
             std::vector<std::string>{"e.lfp"});  // no spill files left
@@ -52,6 +58,8 @@ TEST(Package, WrittenObjectsReadBackIdentically) {
     EXPECT_EQ(package->objectName(o), engine->objectName(o));
     EXPECT_EQ(package->objectPath(o), engine->objectPath(o));
     EXPECT_EQ(package->objectMaterial(o), engine->objects[o].material);
+    EXPECT_EQ(package->objectLayerIndex(o), layerOf(o));
+    EXPECT_EQ(package->objectLayer(o), layerOf(o) == kNoLayer ? "" : layers[layerOf(o)]);
     EXPECT_EQ(package->object(o).minVertexCount, m.q);
     EXPECT_EQ(package->object(o).color, (Rgba8{10, 20, 30, 255}));
     EXPECT_TRUE(std::equal(m.positions.begin(), m.positions.end(), package->positions(o).begin()));
@@ -67,6 +75,8 @@ TEST(Package, WrittenObjectsReadBackIdentically) {
   ASSERT_EQ(package->materialCount(), engine->materials.size());
   for (std::size_t m = 0; m < engine->materials.size(); ++m)
     EXPECT_EQ(package->material(m), engine->materials[m]) << m;
+  ASSERT_EQ(package->layerCount(), layers.size());
+  for (std::size_t l = 0; l < layers.size(); ++l) EXPECT_EQ(package->layer(l), layers[l]);
   // Sections start on 64-byte boundaries.
   for (const PackageSectionEntry& e : package->header().sections) EXPECT_EQ(e.offset % 64, 0u);
 }
@@ -160,6 +170,8 @@ TEST_F(Corrupted, ForgedContentIsCaughtEvenWithValidChecksums) {
       h.sections[static_cast<std::uint32_t>(PackageSection::kAssembly)].offset;
   const std::uint64_t materialsAt =
       h.sections[static_cast<std::uint32_t>(PackageSection::kMaterials)].offset;
+  const std::uint64_t objectLayersAt =
+      h.sections[static_cast<std::uint32_t>(PackageSection::kObjectLayers)].offset;
   ASSERT_GT(h.sections[static_cast<std::uint32_t>(PackageSection::kMaterials)].bytes, 0u);
   const Case cases[] = {
       {"ecol points up",
@@ -198,6 +210,9 @@ TEST_F(Corrupted, ForgedContentIsCaughtEvenWithValidChecksums) {
          reinterpret_cast<PackageAssembly*>(d.data() + assemblyAt)[1].material = 1000;
        },
        "object 1: material 1000 of"},
+      {"layer past the table",
+       [&](std::string& d) { reinterpret_cast<std::uint32_t*>(d.data() + objectLayersAt)[2] = 7; },
+       "object 2: layer 7 of 0"},
       {"path outside the names",
        [&](std::string& d) {
          reinterpret_cast<PackageAssembly*>(d.data() + assemblyAt)->pathLength = 1u << 30;

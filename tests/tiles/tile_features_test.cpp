@@ -12,6 +12,7 @@
 
 #include "lodforge/core/random.h"
 #include "lodforge/generate/cad.h"
+#include "lodforge/io/cad_reader.h"
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/tiles/tile_content.h"
@@ -48,7 +49,7 @@ struct DecodedTile {
   std::vector<std::uint32_t> rows;  // per vertex
   std::uint32_t featureCount = 0;
   std::vector<std::uint32_t> ids;  // per row
-  std::vector<std::string> names, paths, sources, materials;
+  std::vector<std::string> names, paths, sources, materials, layers;
 };
 
 std::string_view viewBytes(const DecodedTile& tile, std::uint32_t view) {
@@ -138,6 +139,7 @@ DecodedTile decodeTile(const fs::path& glb) {
   tile.paths = column("path");
   tile.sources = column("source");
   tile.materials = column("material");
+  tile.layers = column("layer");
   const auto used = tile.gltf["extensionsUsed"];
   EXPECT_NE(std::find(used.begin(), used.end(), "EXT_mesh_features"), used.end());
   EXPECT_NE(std::find(used.begin(), used.end(), "EXT_structural_metadata"), used.end());
@@ -231,6 +233,37 @@ TEST(TileFeatures, EveryVertexOfEveryTileNamesItsPart) {
   EXPECT_GT(missingAtTop, 0u);
   std::ifstream tilesetIn(root / "tiles" / "tileset.json");
   EXPECT_EQ(nlohmann::json::parse(tilesetIn)["asset"]["extras"]["parts"], kPartsFileName);
+}
+
+// A STEP assembly's CAD layers reach the tiles: every row of every tile's property table has its
+// part's layer, and parts.json lists it beside the name.
+TEST(TileFeatures, CadLayersReachEveryTileAndPartsJson) {
+  const fs::path root = fs::path(::testing::TempDir()) / "tile-layers";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  const std::string input = (root / "cad.step").string();
+  ASSERT_TRUE(generateCad({.objects = 150, .seed = 4}, input).ok());
+  Result<Model> model = readCad(input);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  ASSERT_GT(model->layers.size(), 3u);
+  Result<TilesStats> stats = writeTiles(input, (root / "tiles").string(), assemblyOptions());
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  std::set<std::string> seen;
+  for (const auto& entry : fs::directory_iterator(root / "tiles" / "tiles")) {
+    const DecodedTile tile = decodeTile(entry.path());
+    ASSERT_EQ(tile.layers.size(), tile.ids.size()) << entry.path();
+    for (std::size_t r = 0; r < tile.ids.size(); ++r) {
+      ASSERT_LT(tile.ids[r], model->objectCount());
+      EXPECT_EQ(tile.layers[r], model->objectLayer(tile.ids[r])) << entry.path() << " row " << r;
+      seen.insert(tile.layers[r]);
+    }
+  }
+  EXPECT_EQ(seen, std::set<std::string>(model->layers.begin(), model->layers.end()));
+  std::ifstream in(root / "tiles" / kPartsFileName);
+  const nlohmann::json parts = nlohmann::json::parse(in);
+  ASSERT_EQ(parts["parts"].size(), model->objectCount());
+  for (std::size_t o = 0; o < model->objectCount(); ++o)
+    EXPECT_EQ(parts["parts"][o]["layer"], model->objectLayer(o)) << o;
 }
 
 // Parts keep their materials through a GLB and the tiles: glass (BLEND, alpha 0.12 in its

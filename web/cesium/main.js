@@ -157,13 +157,15 @@ async function addParts(viewer, tileset) {
       if (!f) return null;
       const color = f.color;
       return { id: f.getProperty('id'), name: f.getProperty('name'), path: f.getProperty('path'),
-               highlighted: color.red === 1 && color.blue < 0.2 };
+               layer: f.getProperty('layer') || '', highlighted: color.red === 1 && color.blue < 0.2 };
     },
     find: (text) => panel.find(text),
     isolate: (id) => panel.hide(parts.parts.map((p) => p.id).filter((i) => i !== id)),
     hide: (id) => panel.hide([id]),
     showAll: () => panel.showAll(),
     shown: () => panel.shown(),
+    layers: () => panel.layers(),
+    setLayer: (name, shown) => panel.setLayer(name, shown),
     idle: () => tileset.tilesLoaded,
   };
 }

@@ -128,6 +128,12 @@ const partIdsPlugin = (parser) => ({
   },
 });
 
+// A part's CAD layers as parts.json names them ('' for none).
+function partLayer(id) {
+  const part = partState.parts && partState.parts.parts[id];
+  return (part && part.layer) || '';
+}
+
 function partOfVertex(mesh, vertex) {
   const rows = mesh.geometry.getAttribute('_feature_id_0');
   const ids = mesh.userData.partIds;
@@ -225,13 +231,16 @@ function addParts(parts, tiles, camera, controls, renderer, pivot) {
       const id = partAt(x, y);
       if (id === null) return null;
       const part = parts.parts[id];
-      return { id, name: part.name, path: part.path, highlighted: partState.highlighted.has(id) };
+      return { id, name: part.name, path: part.path, layer: partLayer(id),
+               highlighted: partState.highlighted.has(id) };
     },
     find: (text) => panel.find(text),
     isolate: (id) => panel.hide(parts.parts.map((p) => p.id).filter((i) => i !== id)),
     hide: (id) => panel.hide([id]),
     showAll: () => panel.showAll(),
     shown: () => panel.shown(),
+    layers: () => panel.layers(),
+    setLayer: (name, shown) => panel.setLayer(name, shown),
     idle: () => tiles.stats.downloading === 0 && tiles.stats.parsing === 0,
   };
 }

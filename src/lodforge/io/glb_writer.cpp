@@ -402,9 +402,11 @@ bool isTranslation(const Mat4d& m) {
 }  // namespace
 
 std::uint32_t GlbWriter::addNode(std::string_view name, std::optional<std::uint32_t> mesh,
-                                 const Mat4d* transform, std::optional<std::uint32_t> parent) {
+                                 const Mat4d* transform, std::optional<std::uint32_t> parent,
+                                 std::string_view layer) {
   nlohmann::json node = nlohmann::json::object();
   if (!name.empty()) node["name"] = std::string(name);
+  if (!layer.empty()) node["extras"] = {{"layer", std::string(layer)}};
   if (mesh) node["mesh"] = *mesh;
   const auto& grid = mesh ? state_->dequantize[*mesh] : std::nullopt;
   if (state_->options.flatScene && transform && isTranslation(*transform)) {
@@ -620,7 +622,7 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
       mesh = *added;
     }
     writer->addNode(model.objectName(o), mesh, placed ? &placed->transform : nullptr,
-                    assembly.parentOf(model.objectPath(o)));
+                    assembly.parentOf(model.objectPath(o)), model.objectLayer(o));
     progress.advance(record.triangleCount);
   }
   progress.finish();

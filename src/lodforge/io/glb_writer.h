@@ -106,10 +106,11 @@ class GlbWriter {
   // returns its index.
   Result<std::uint32_t> addBufferView(std::span<const std::byte> bytes);
   // A node drawing `mesh` (or nothing) with an optional transform, a child of `parent` (a node
-  // added before) or of the root node; returns its index.
+  // added before) or of the root node; returns its index. A CAD `layer` goes to its extras.
   std::uint32_t addNode(std::string_view name, std::optional<std::uint32_t> mesh,
                         const Mat4d* transform = nullptr,
-                        std::optional<std::uint32_t> parent = std::nullopt);
+                        std::optional<std::uint32_t> parent = std::nullopt,
+                        std::string_view layer = {});
   // Translation of the root node: places float geometry at a double-precision origin.
   void setRootTranslation(Vec3d translation);
   // The root node's name ("root" unless set).

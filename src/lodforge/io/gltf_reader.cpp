@@ -310,10 +310,27 @@ class Loader {
       const Mat4d world = parent * localTransform(node);
       const std::string name = node.name.empty() ? fmt::format("node {}", index) : node.name;
       const std::string path = parentPath.empty() ? name : parentPath + "/" + name;
-      if (node.mesh >= 0) addNode(index, node, world, path);
+      if (node.mesh >= 0) {
+        const std::size_t first = model_.objects.size();
+        addNode(index, node, world, path);
+        setLayer(node, first);
+      }
       for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
         stack.push_back({*child, world, path});
     }
+  }
+
+  // A node's CAD layers (extras.layer, as lodforge's GLB writer keeps them) on the objects it
+  // added from `first` on.
+  void setLayer(const tinygltf::Node& node, std::size_t first) {
+    if (!node.extras.IsObject() || !node.extras.Has("layer")) return;
+    const tinygltf::Value& value = node.extras.Get("layer");
+    if (!value.IsString() || value.Get<std::string>().empty()) return;
+    const std::string& name = value.Get<std::string>();
+    const auto at = std::find(model_.layers.begin(), model_.layers.end(), name);
+    const auto layer = static_cast<std::uint32_t>(at - model_.layers.begin());
+    if (at == model_.layers.end()) model_.layers.push_back(name);
+    for (std::size_t o = first; o < model_.objects.size(); ++o) model_.objects[o].layer = layer;
   }
 
   void addNode(int index, const tinygltf::Node& node, const Mat4d& world, const std::string& path) {

@@ -21,6 +21,7 @@ class ModelStream final : public ObjectStream {
     out.name = std::string(model_.objectName(o));
     out.path = std::string(model_.objectPath(o));
     out.material = r.material;
+    out.layer = r.layer < model_.layers.size() ? r.layer : kNoLayer;
     const auto positions = model_.objectPositions(o);
     out.positions.assign(positions.begin(), positions.end());
     out.normals.clear();
@@ -43,6 +44,7 @@ class ModelStream final : public ObjectStream {
   bool streaming() const override { return false; }
   std::uint64_t triangleCountHint() const override { return model_.triangleCount(); }
   std::span<const Material> materials() const override { return model_.materials; }
+  std::span<const std::string> layers() const override { return model_.layers; }
 
  private:
   Model model_;

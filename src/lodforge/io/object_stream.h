@@ -21,6 +21,7 @@ struct SourceObject {
   std::string name;
   std::string path;                      // in the assembly; empty without a tree
   std::uint32_t material = kNoMaterial;  // into the stream's materials()
+  std::uint32_t layer = kNoLayer;        // into the stream's layers()
   std::vector<Vec3f> positions;          // relative to the stream's origin
   std::vector<Vec3f> normals;            // empty or one per vertex
   std::vector<Rgba8> colors;             // empty or one per vertex
@@ -45,6 +46,8 @@ class ObjectStream {
   virtual std::uint64_t triangleCountHint() const = 0;  // for progress; faces for PLY
   // What the objects' material indices refer to (empty for a grouped PLY).
   virtual std::span<const Material> materials() const { return {}; }
+  // What the objects' layer indices refer to (CAD layers; empty for a grouped PLY).
+  virtual std::span<const std::string> layers() const { return {}; }
 };
 
 struct ObjectStreamOptions {

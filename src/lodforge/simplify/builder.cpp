@@ -27,6 +27,7 @@ struct Built {
   ProgressiveMesh mesh;
   std::string name, path;
   std::uint32_t material = kNoMaterial;
+  std::uint32_t layer = kNoLayer;
   Rgba8 color;
   std::uint64_t inputTriangles = 0;
 };
@@ -42,6 +43,7 @@ Built buildOne(SourceObject& source, const ProgressiveOptions& options) {
   built.name = std::move(source.name);
   built.path = std::move(source.path);
   built.material = source.material;
+  built.layer = source.layer;
   built.inputTriangles = source.indices.size() / 3;
   // The base colour: the first vertex's (CAD parts are usually one colour).
   built.color = source.colors.empty() ? Rgba8{} : source.colors.front();
@@ -116,7 +118,7 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
         [&](std::size_t i) { built[i] = buildOne(wave[i], options.progressive); },
         tbb::simple_partitioner());
     for (Built& b : built) {
-      LODFORGE_TRY(writer->add(b.mesh, {b.name, b.color, b.path, b.material}));
+      LODFORGE_TRY(writer->add(b.mesh, {b.name, b.color, b.path, b.material, b.layer}));
       stats.objects += 1;
       stats.inputTriangles += b.inputTriangles;
       stats.vertices += b.mesh.vertexCount();
@@ -132,7 +134,7 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
     return badInput(input,
                     "no triangles: a package is built from a mesh (for a point cloud use "
                     "`lodforge points` or `lodforge tiles`)");
-  LODFORGE_TRY(writer->finish(stream.materials()));
+  LODFORGE_TRY(writer->finish(stream.materials(), stream.layers()));
   progress.finish();
   Result<std::uint64_t> size = fileSize(output);
   if (!size) return size.status();

@@ -44,6 +44,8 @@ Model extractModel(const Package& package, std::span<const std::uint32_t> vertex
   model.origin = package.origin();
   for (std::size_t m = 0; m < package.materialCount(); ++m)
     model.materials.push_back(package.material(m));
+  for (std::size_t l = 0; l < package.layerCount(); ++l)
+    model.layers.emplace_back(package.layer(l));
   model.indices.resize(3 * starts[objects]);
   reformSelection(ReformSource::of(package), {ids, vertexCounts, starts, bases}, model.indices);
 
@@ -67,6 +69,7 @@ Model extractModel(const Package& package, std::span<const std::uint32_t> vertex
     record.pathLength = static_cast<std::uint32_t>(package.objectPath(i).size());
     model.paths.append(package.objectPath(i));
     record.material = package.objectMaterial(i);
+    record.layer = package.objectLayerIndex(i);
     model.positions.insert(model.positions.end(), positions.begin(), positions.end());
     if (package.header().hasNormals()) {
       const auto normals = package.normals(i).first(n);

@@ -17,9 +17,9 @@
 namespace lodforge {
 
 std::string_view packageSectionName(PackageSection section) {
-  static constexpr std::string_view kNames[] = {"objects", "names",     "positions", "normals",
-                                                "colors",  "triangles", "ecol",      "map",
-                                                "error",   "assembly",  "materials"};
+  static constexpr std::string_view kNames[] = {
+      "objects", "names", "positions", "normals",   "colors",       "triangles", "ecol",
+      "map",     "error", "assembly",  "materials", "objectLayers", "layers"};
   return kNames[static_cast<std::uint32_t>(section)];
 }
 
@@ -136,6 +136,7 @@ Status PackageWriter::add(const ProgressiveMesh& mesh, const PackageObjectInfo& 
   LODFORGE_TRY(s.append(PackageSection::kNames, info.name.data(), info.name.size()));
   LODFORGE_TRY(s.append(PackageSection::kNames, info.path.data(), info.path.size()));
   LODFORGE_TRY(s.append(PackageSection::kAssembly, &assembly, sizeof assembly));
+  LODFORGE_TRY(s.append(PackageSection::kObjectLayers, &info.layer, sizeof info.layer));
   LODFORGE_TRY(s.append<Vec3f>(PackageSection::kPositions, mesh.positions));
   if (h.hasNormals()) LODFORGE_TRY(s.append<Vec3f>(PackageSection::kNormals, mesh.normals));
   if (h.hasColors()) LODFORGE_TRY(s.append<Rgba8>(PackageSection::kColors, mesh.colors));
@@ -150,7 +151,8 @@ Status PackageWriter::add(const ProgressiveMesh& mesh, const PackageObjectInfo& 
   return {};
 }
 
-Status PackageWriter::finish(std::span<const Material> materials) {
+Status PackageWriter::finish(std::span<const Material> materials,
+                             std::span<const std::string> layers) {
   State& s = *state_;
   PackageHeader& h = s.header;
   for (const Material& m : materials) {
@@ -166,6 +168,12 @@ Status PackageWriter::finish(std::span<const Material> materials) {
     record.nameLength = static_cast<std::uint32_t>(m.name.size());
     LODFORGE_TRY(s.append(PackageSection::kNames, m.name.data(), m.name.size()));
     LODFORGE_TRY(s.append(PackageSection::kMaterials, &record, sizeof record));
+  }
+  for (const std::string& name : layers) {
+    const PackageLayer record{s.spills[static_cast<std::uint32_t>(PackageSection::kNames)].bytes,
+                              static_cast<std::uint32_t>(name.size())};
+    LODFORGE_TRY(s.append(PackageSection::kNames, name.data(), name.size()));
+    LODFORGE_TRY(s.append(PackageSection::kLayers, &record, sizeof record));
   }
   const Aabb bounds = s.bounds.empty() ? Aabb{Vec3f{}, Vec3f{}} : s.bounds;
   std::memcpy(h.boundsMin, &bounds.min, 12);
@@ -234,6 +242,21 @@ std::string_view Package::objectPath(std::size_t i) const {
 }
 std::uint32_t Package::objectMaterial(std::size_t i) const {
   return section<PackageAssembly>(PackageSection::kAssembly)[i].material;
+}
+std::uint32_t Package::objectLayerIndex(std::size_t i) const {
+  return section<std::uint32_t>(PackageSection::kObjectLayers)[i];
+}
+std::string_view Package::objectLayer(std::size_t i) const {
+  const std::uint32_t l = objectLayerIndex(i);
+  return l == kNoLayer ? std::string_view() : layer(l);
+}
+std::size_t Package::layerCount() const {
+  return section<PackageLayer>(PackageSection::kLayers).size();
+}
+std::string_view Package::layer(std::size_t l) const {
+  const auto names = section<char>(PackageSection::kNames);
+  const PackageLayer& r = section<PackageLayer>(PackageSection::kLayers)[l];
+  return {names.data() + r.nameOffset, r.nameLength};
 }
 std::size_t Package::materialCount() const {
   return section<PackageMaterial>(PackageSection::kMaterials).size();
@@ -314,6 +337,7 @@ Status Package::validate(const OpenOptions& options) {
   LODFORGE_TRY(validateHeader());
   LODFORGE_TRY(validateSections(options));
   LODFORGE_TRY(validateMaterials());
+  LODFORGE_TRY(validateLayers());
   return validateObjects();
 }
 
@@ -366,7 +390,10 @@ Status Package::validateSections(const OpenOptions& options) const {
       h.levelCount * sizeof(float),
       h.objectCount * sizeof(PackageAssembly),
       h.sections[static_cast<std::uint32_t>(PackageSection::kMaterials)].bytes /
-          sizeof(PackageMaterial) * sizeof(PackageMaterial)};
+          sizeof(PackageMaterial) * sizeof(PackageMaterial),
+      h.objectCount * sizeof(std::uint32_t),
+      h.sections[static_cast<std::uint32_t>(PackageSection::kLayers)].bytes / sizeof(PackageLayer) *
+          sizeof(PackageLayer)};
   for (std::uint32_t s = 0; s < kPackageSections; ++s) {
     const PackageSectionEntry& e = h.sections[s];
     const auto name = packageSectionName(static_cast<PackageSection>(s));
@@ -415,6 +442,8 @@ std::string Package::objectProblem(std::size_t i) const {
     return "assembly path outside the names section";
   if (a.material != kNoMaterial && a.material >= materialCount())
     return fmt::format("material {} of {}", a.material, materialCount());
+  if (const std::uint32_t l = objectLayerIndex(i); l != kNoLayer && l >= layerCount())
+    return fmt::format("layer {} of {}", l, layerCount());
   if (o.minTriangleCount > o.triangleCount) return "map(q) > map(p)";
   const auto e = ecol(i);
   for (std::uint32_t v = 0; v < o.vertexCount; ++v) {
@@ -463,6 +492,22 @@ Status Package::validateMaterials() const {
     if (problem)
       return badAt(table.offset + m * sizeof(PackageMaterial),
                    fmt::format("material {}: {}", m, problem));
+  }
+  return {};
+}
+
+// Every layer's name inside the names section.
+Status Package::validateLayers() const {
+  const PackageSectionEntry& names =
+      header_->sections[static_cast<std::uint32_t>(PackageSection::kNames)];
+  const PackageSectionEntry& table =
+      header_->sections[static_cast<std::uint32_t>(PackageSection::kLayers)];
+  const auto layers = section<PackageLayer>(PackageSection::kLayers);
+  for (std::size_t l = 0; l < layers.size(); ++l) {
+    if (layers[l].nameOffset > names.bytes ||
+        layers[l].nameLength > names.bytes - layers[l].nameOffset)
+      return badAt(table.offset + l * sizeof(PackageLayer),
+                   fmt::format("layer {}: name outside the names section", l));
   }
   return {};
 }

@@ -15,6 +15,8 @@
 //   error         float per level: geometric error at n vertices (model units)
 //   assembly      PackageAssembly[objectCount]: each object's path and material (16 bytes each)
 //   materials     PackageMaterial per material the objects use (64 bytes each)
+//   objectLayers  uint32 per object: its CAD layer, into layers, or ~0u
+//   layers        PackageLayer per layer the objects are on (16 bytes each)
 //
 // Each section carries an XXH3-64 checksum; the header checksums itself. Package::open checks
 // all of it, and every index a kernel will follow, before handing out a single span.
@@ -48,14 +50,16 @@ enum class PackageSection : std::uint32_t {
   kError,
   kAssembly,
   kMaterials,
+  kObjectLayers,
+  kLayers,
   kCount
 };
 inline constexpr std::uint32_t kPackageSections =
     static_cast<std::uint32_t>(PackageSection::kCount);
 std::string_view packageSectionName(PackageSection section);
 
-// Version 2 added the assembly and materials sections.
-inline constexpr std::uint32_t kPackageVersion = 2;
+// Version 2 added the assembly and materials sections, version 3 the layers.
+inline constexpr std::uint32_t kPackageVersion = 3;
 inline constexpr std::size_t kPackageAlignment = 64;
 // PNG-style magic: a high byte and CR LF / ^Z / LF catch text-mode transfers that damage files.
 inline constexpr std::array<char, 8> kPackageMagic = {'\x89', 'L',  'F',    'P',
@@ -130,12 +134,21 @@ struct PackageMaterial {
 };
 static_assert(sizeof(PackageMaterial) == 64);
 
+// A CAD layer's name as stored.
+struct PackageLayer {
+  std::uint64_t nameOffset = 0;  // into names
+  std::uint32_t nameLength = 0;
+  std::uint32_t reserved = 0;
+};
+static_assert(sizeof(PackageLayer) == 16);
+
 // What the package says of an object besides its mesh.
 struct PackageObjectInfo {
   std::string_view name = {};
   Rgba8 color = {};  // the object's base colour
   std::string_view path = {};
   std::uint32_t material = kNoMaterial;  // into the materials given to finish()
+  std::uint32_t layer = kNoLayer;        // into the layers given to finish()
 };
 
 // Writes a package object by object, each section streamed to its own temporary file, then
@@ -149,8 +162,8 @@ class PackageWriter {
   ~PackageWriter();
 
   Status add(const ProgressiveMesh& mesh, const PackageObjectInfo& info);
-  // `materials` is what the objects' material indices refer to.
-  Status finish(std::span<const Material> materials = {});
+  // `materials` and `layers` are what the objects' material and layer indices refer to.
+  Status finish(std::span<const Material> materials = {}, std::span<const std::string> layers = {});
   std::uint64_t objectCount() const;
 
  private:
@@ -186,6 +199,10 @@ class Package {
   std::string_view objectPath(std::size_t i) const;   // empty without an assembly tree
   std::uint32_t objectMaterial(std::size_t i) const;  // kNoMaterial or < materialCount()
   std::size_t materialCount() const;
+  std::uint32_t objectLayerIndex(std::size_t i) const;  // kNoLayer or < layerCount()
+  std::string_view objectLayer(std::size_t i) const;    // empty: on no layer
+  std::size_t layerCount() const;
+  std::string_view layer(std::size_t l) const;
   Material material(std::size_t m) const;
   std::span<const Vec3f> positions(std::size_t i) const;
   std::span<const Vec3f> normals(std::size_t i) const;            // empty without normals
@@ -218,6 +235,7 @@ class Package {
   // the error table), empty when nothing does.
   std::string objectProblem(std::size_t i) const;
   Status validateMaterials() const;
+  Status validateLayers() const;
   Status badAt(std::uint64_t at, std::string_view what) const;
   template <class T>
   std::span<const T> section(PackageSection s) const;

@@ -108,17 +108,21 @@ Status addPartTable(GlbWriter& writer, const PartTable& table,
   if (!names) return names.status();
   Result<nlohmann::json> paths = addStrings(writer, parts, table.paths);
   if (!paths) return paths.status();
-  // Each row's material by name (empty: none), for the tile's own parts only.
-  std::vector<std::string> materialNames(parts.size());
+  // Each row's material and layer by name (empty: none), for the tile's own parts only.
+  std::vector<std::string> materialNames(parts.size()), layerNames(parts.size());
   std::vector<std::uint32_t> rows(parts.size());
   for (std::size_t r = 0; r < parts.size(); ++r) {
     rows[r] = static_cast<std::uint32_t>(r);
     const std::uint32_t m =
         parts[r] < table.materials.size() ? table.materials[parts[r]] : kNoMaterial;
     if (m < table.materialTable.size()) materialNames[r] = table.materialTable[m].name;
+    const std::uint32_t l = parts[r] < table.layers.size() ? table.layers[parts[r]] : kNoLayer;
+    if (l < table.layerTable.size()) layerNames[r] = table.layerTable[l];
   }
   Result<nlohmann::json> material = addStrings(writer, rows, materialNames);
   if (!material) return material.status();
+  Result<nlohmann::json> layer = addStrings(writer, rows, layerNames);
+  if (!layer) return layer.status();
   const std::vector<std::string> sources(1, table.source);
   const std::vector<std::uint32_t> zeros(parts.size(), 0);
   Result<nlohmann::json> source = addStrings(writer, zeros, sources);
@@ -139,6 +143,9 @@ Status addPartTable(GlbWriter& writer, const PartTable& table,
              {{"type", "STRING"},
               {"description", "Names from the assembly's root down to the part, /-separated."}}},
             {"material", {{"type", "STRING"}, {"description", "The name of the part's material."}}},
+            {"layer",
+             {{"type", "STRING"},
+              {"description", "The part's CAD layers, \"; \"-separated (empty: none)."}}},
             {"source",
              {{"type", "STRING"}, {"description", "The file the part was read from."}}}}}}}}}};
   nlohmann::json metadata = {{"schema", schema},
@@ -150,8 +157,11 @@ Status addPartTable(GlbWriter& writer, const PartTable& table,
   // from the table.
   auto& properties = metadata["propertyTables"][0]["properties"];
   auto& declared = metadata["schema"]["classes"]["part"]["properties"];
-  const std::pair<const char*, const nlohmann::json*> strings[] = {
-      {"name", &*names}, {"path", &*paths}, {"material", &*material}, {"source", &*source}};
+  const std::pair<const char*, const nlohmann::json*> strings[] = {{"name", &*names},
+                                                                   {"path", &*paths},
+                                                                   {"material", &*material},
+                                                                   {"layer", &*layer},
+                                                                   {"source", &*source}};
   for (const auto& [key, value] : strings) {
     if (value->is_null()) {
       declared.erase(key);

@@ -26,12 +26,16 @@ std::vector<std::vector<std::uint32_t>> partsMissingPerLevel(const OctreeResult&
 
 Status writePartsJson(const OctreeResult& octree, const PartTable& parts, const std::string& path) {
   nlohmann::json list = nlohmann::json::array();
-  for (std::size_t i = 0; i < parts.size(); ++i)
-    list.push_back(
-        {{"id", i},
-         {"name", parts.names[i]},
-         {"path", parts.paths[i]},
-         {"bounds", parts.bounds[i].empty() ? nlohmann::json() : boundsToJson(parts.bounds[i])}});
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    nlohmann::json part = {
+        {"id", i},
+        {"name", parts.names[i]},
+        {"path", parts.paths[i]},
+        {"bounds", parts.bounds[i].empty() ? nlohmann::json() : boundsToJson(parts.bounds[i])}};
+    if (i < parts.layers.size() && parts.layers[i] < parts.layerTable.size())
+      part["layer"] = parts.layerTable[parts.layers[i]];
+    list.push_back(std::move(part));
+  }
   nlohmann::json levels = nlohmann::json::array();
   const auto missing = partsMissingPerLevel(octree, parts.size());
   for (std::size_t level = 0; level < missing.size(); ++level)

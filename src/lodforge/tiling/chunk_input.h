@@ -56,6 +56,8 @@ struct PartTable {
   std::vector<Aabbd> bounds;       // by feature id, in the tileset's frame (empty: no triangles)
   std::vector<std::uint32_t> materials;  // by feature id: into `materialTable`, or kNoMaterial
   std::vector<Material> materialTable;
+  std::vector<std::uint32_t> layers;    // by feature id: into `layerTable`, or kNoLayer
+  std::vector<std::string> layerTable;  // CAD layer names (few)
 
   std::size_t size() const { return names.size(); }
   bool empty() const { return names.empty(); }

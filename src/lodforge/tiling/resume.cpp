@@ -76,7 +76,9 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
         {"paths", input.parts.paths},
         {"bounds", boundsList(input.parts.bounds)},
         {"materials", input.parts.materials},
-        {"materialTable", materialsToJson(input.parts.materialTable)}}}};
+        {"materialTable", materialsToJson(input.parts.materialTable)},
+        {"layers", input.parts.layers},
+        {"layerTable", input.parts.layerTable}}}};
   // (Part names come from the input and may not be UTF-8: replaced rather than thrown on.)
   return OutputFile::writeWhole(
       path, state.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
@@ -114,12 +116,17 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
     std::optional<std::vector<Material>> table = materialsFromJson(parts.at("materialTable"));
     if (!table) return std::nullopt;
     input.parts.materialTable = std::move(*table);
+    input.parts.layers = parts.at("layers").get<std::vector<std::uint32_t>>();
+    input.parts.layerTable = parts.at("layerTable").get<std::vector<std::string>>();
     if (input.parts.paths.size() != input.parts.names.size() ||
         input.parts.bounds.size() != input.parts.names.size() ||
-        input.parts.materials.size() != input.parts.names.size())
+        input.parts.materials.size() != input.parts.names.size() ||
+        input.parts.layers.size() != input.parts.names.size())
       return std::nullopt;
     for (std::uint32_t m : input.parts.materials)
       if (m != kNoMaterial && m >= input.parts.materialTable.size()) return std::nullopt;
+    for (std::uint32_t l : input.parts.layers)
+      if (l != kNoLayer && l >= input.parts.layerTable.size()) return std::nullopt;
     input.chunks =
         std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
     return input;

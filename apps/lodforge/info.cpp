@@ -201,7 +201,7 @@ Status describePackage(const std::string& path, bool json) {
     if (!package->error(i).empty())
       maxError = std::max(maxError, static_cast<double>(package->error(i).front()));
   }
-  // The assembly: how many objects sit in a tree, how deep it goes, how many materials.
+  // The assembly: how many objects sit in a tree, how deep it goes, how many materials and layers.
   std::uint64_t placed = 0, depth = 0;
   for (std::size_t i = 0; i < package->objectCount(); ++i) {
     const std::string_view tree = package->objectPath(i);
@@ -233,6 +233,7 @@ Status describePackage(const std::string& path, bool json) {
                         {"objectsInAssembly", placed},
                         {"assemblyDepth", depth},
                         {"materials", package->materialCount()},
+                        {"layers", package->layerCount()},
                         {"origin", {h.origin[0], h.origin[1], h.origin[2]}}};
     for (std::uint32_t s = 0; s < kPackageSections; ++s)
       j["sections"][std::string(packageSectionName(static_cast<PackageSection>(s)))] =
@@ -248,8 +249,8 @@ Status describePackage(const std::string& path, bool json) {
              formatCount(minVertices), h.hasColors() ? " (normals, colors)" : " (normals)");
   fmt::print("triangles  {} full, {} at the simplest level\n", formatCount(h.triangleCount),
              formatCount(minTriangles));
-  fmt::print("assembly   {} of the objects in a tree {} deep, {} materials\n", formatCount(placed),
-             depth, package->materialCount());
+  fmt::print("assembly   {} of the objects in a tree {} deep, {} materials, {} layers\n",
+             formatCount(placed), depth, package->materialCount(), package->layerCount());
   fmt::print("levels     {} (every vertex count of every object)\n", formatCount(h.levelCount));
   fmt::print("error      up to {:.6g} model units at the simplest level\n", maxError);
   fmt::print("bounds     min ({:.6g}, {:.6g}, {:.6g})  max ({:.6g}, {:.6g}, {:.6g})\n",

@@ -129,11 +129,15 @@ std::vector<Placement> findPlacements(const Model& model, double relativeToleran
     placements[o].source = static_cast<std::uint32_t>(o);
     if (model.objects[o].triangleCount == 0) continue;
     const std::span<const Vec3f> positions = model.objectPositions(o);
+    std::vector<std::uint32_t>& sources = meshes[signature(model, o)];
+    if (sources.empty()) {  // the first of its kind: nothing to fit, no tolerance needed
+      if (candidates > 0) sources.push_back(static_cast<std::uint32_t>(o));
+      continue;
+    }
     // Float positions round with their distance from the origin, not with the part's size.
     double far = 0;
     for (const Vec3f& p : positions) far = std::max(far, length(toDouble(p)));
     const double tolerance = std::max(relativeTolerance * diagonal(positions), 4 * 0x1p-24 * far);
-    std::vector<std::uint32_t>& sources = meshes[signature(model, o)];
     for (const std::uint32_t s : sources) {
       if (!sameTrianglesAndColours(model, s, o)) continue;
       const auto motion = fitRigidMotion(model.objectPositions(s), positions, tolerance);

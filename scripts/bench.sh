@@ -441,7 +441,7 @@ cad_section() {
 
 # Generated STEP assemblies (`generate cad -o X.step`) at CAD_STEP_PARTS parts (default 1000
 # 10000): write, read + tessellate, and tiles end to end. 100000 works the same way but needs
-# ~1.7 GB of disk, ~17 GiB to write and ~13 GiB and ~1.75 h to read (BENCHMARKS.md).
+# ~1.7 GB of disk, ~17 GiB and ~13 min to write, ~12.3 GiB and ~25 min to tile (BENCHMARKS.md).
 cad_generated_section() {
   echo
   echo "== generated STEP assemblies ($(nproc) threads)"

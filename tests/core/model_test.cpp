@@ -93,7 +93,12 @@ TEST(WeldModel, WeldsInsideObjectsButNeverAcross) {
     builder.addTriangle(3, 4, 5);
   }
   builder.endObject();
+  model.layers = {"structure"};  // a CAD layer stays with its object
+  model.objects[1].layer = 0;
   weldModel(model, {});
+  ASSERT_EQ(model.layers, std::vector<std::string>{"structure"});
+  EXPECT_EQ(model.objectLayer(0), "");
+  EXPECT_EQ(model.objectLayer(1), "structure");
   EXPECT_EQ(model.objects[0].vertexCount, 4u);
   EXPECT_EQ(model.objects[1].vertexCount, 4u);
   EXPECT_EQ(model.vertexCount(), 8u);

@@ -166,6 +166,24 @@ TEST(GltfRead, NodeTransformsMaterialsAndVertexColours) {
   EXPECT_EQ(model->colors[2], (Rgba8{255, 0, 0, 128}));
 }
 
+// A node's extras.layer (what lodforge's GLB writer keeps of a CAD layer) names its objects'
+// layer, each distinct name once; an extras.layer that is not a string, or empty, is no layer.
+TEST(GltfRead, NodeExtrasLayerIsTheObjectsLayer) {
+  json doc = triangleDocument();
+  doc["scenes"][0]["nodes"] = {0, 1, 2, 3, 4};
+  doc["nodes"] = {{{"mesh", 0}, {"name", "a"}, {"extras", {{"layer", "structure"}}}},
+                  {{"mesh", 0}, {"name", "b"}, {"extras", {{"layer", 7}}}},
+                  {{"mesh", 0}, {"name", "c"}, {"extras", {{"layer", "structure"}}}},
+                  {{"mesh", 0}, {"name", "d"}, {"extras", {{"layer", ""}}}},
+                  {{"mesh", 0}, {"name", "e"}, {"extras", {{"layer", "wiring"}}}}};
+  Result<Model> model = readGlb(makeGlb(doc, triangleBinary()));
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  ASSERT_EQ(model->objectCount(), 5u);
+  EXPECT_EQ(model->layers, (std::vector<std::string>{"structure", "wiring"}));
+  const std::vector<std::string> expected = {"structure", "", "structure", "", "wiring"};
+  for (std::size_t o = 0; o < 5; ++o) EXPECT_EQ(model->objectLayer(o), expected[o]) << o;
+}
+
 TEST(GltfRead, MirroringTransformsKeepTrianglesFacingTheirNormals) {
   json doc = triangleDocument();
   doc["nodes"][0]["scale"] = {-1, 1, 1};

@@ -103,6 +103,7 @@ void weldModel(Model& model, const WeldOptions& options) {
   out.names = std::move(model.names);
   out.paths = std::move(model.paths);
   out.materials = std::move(model.materials);
+  out.layers = std::move(model.layers);
   out.objects.reserve(model.objects.size());
   std::vector<std::uint32_t> remap;
   for (std::size_t o = 0; o < model.objects.size(); ++o) {
@@ -172,6 +173,8 @@ bool isConsistent(const Model& model, std::string* why) {
       return fail(fmt::format("object {} path out of range", i));
     if (o.material != kNoMaterial && o.material >= model.materials.size())
       return fail(fmt::format("object {} material out of range", i));
+    if (o.layer != kNoLayer && o.layer >= model.layers.size())
+      return fail(fmt::format("object {} layer out of range", i));
     nextVertex += o.vertexCount;
     nextTriangle += o.triangleCount;
     if (nextVertex > model.positions.size() || nextTriangle > model.triangleCount())

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <unordered_map>
 #include <vector>
 
 #include <draco/compression/decode.h>
@@ -327,10 +328,12 @@ class Loader {
     const tinygltf::Value& value = node.extras.Get("layer");
     if (!value.IsString() || value.Get<std::string>().empty()) return;
     const std::string& name = value.Get<std::string>();
-    const auto at = std::find(model_.layers.begin(), model_.layers.end(), name);
-    const auto layer = static_cast<std::uint32_t>(at - model_.layers.begin());
-    if (at == model_.layers.end()) model_.layers.push_back(name);
-    for (std::size_t o = first; o < model_.objects.size(); ++o) model_.objects[o].layer = layer;
+    // A map, not a search of the table: a file may give every node a layer of its own.
+    const auto [at, added] =
+        layerIndex_.try_emplace(name, static_cast<std::uint32_t>(model_.layers.size()));
+    if (added) model_.layers.push_back(name);
+    for (std::size_t o = first; o < model_.objects.size(); ++o)
+      model_.objects[o].layer = at->second;
   }
 
   void addNode(int index, const tinygltf::Node& node, const Mat4d& world, const std::string& path) {
@@ -592,6 +595,7 @@ class Loader {
   std::vector<Vec3d> world_;
   std::vector<Vec3f> normalsByVertex_;
   std::vector<bool> visited_;
+  std::unordered_map<std::string, std::uint32_t> layerIndex_;  // into model_.layers
   bool withColors_ = false;
   bool missingNormals_ = false;
 };

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad, instances or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -475,6 +475,33 @@ cad_generated_section() {
 }
 if [[ ${BENCH_ONLY:-} == cad ]]; then cad_section; exit 0; fi
 
+# Repeated shapes: `build` with its shape cache and with --no-instances, then `extract` at half
+# the vertices, on the real assemblies and a generated 10 K-part GLB (its bolts are shared).
+instances_section() {
+  echo
+  echo "== build: repeated shapes simplified once, or every object on its own (--no-instances)"
+  printf '| %-20s | %-14s | %8s | %9s | %10s | %8s | %14s |\n' input build wall "peak RSS" placed package "extract meshes"
+  printf '|%s|%s|%s|%s|%s|%s|%s|\n' ---------------------- ---------------- ---------- ----------- ------------ ---------- ----------------
+  local data=${LODFORGE_DATA:-../shared/data}
+  [[ -d $data ]] || data=/work/shared/data
+  "$lodforge" -q generate cad --objects 10K -o "$work/cad10k.glb"
+  for input in "$data/meshes/2CylinderEngine.glb" "$data/cad/as1_motor.step" "$work/cad10k.glb"; do
+    for mode in instances own; do
+      local flag=() log=$work/build.log result
+      [[ $mode == own ]] && flag=(--no-instances)
+      result=$(timed "$lodforge" build "$input" -o "$work/inst.lfp" "${flag[@]}")
+      "$lodforge" build "$input" -o "$work/inst.lfp" "${flag[@]}" > "$log"
+      "$lodforge" -q extract "$work/inst.lfp" --ratio 0.5 -o "$work/inst.glb"
+      printf '| %-20s | %-14s | %7ss | %5d MiB | %10s | %8s | %14s |\n' "$(basename "$input")" "$mode" \
+        "${result% *}" $((${result#* } / 1024)) "$(sed -n 's/.*objects (\([0-9,]*\) placed.*/\1/p' "$log")" \
+        "$(du -h "$work/inst.lfp" | cut -f1)" \
+        "$(python3 -c 'import json,struct,sys; b=open(sys.argv[1],"rb").read(); n=struct.unpack("<I",b[12:16])[0]; print(len(json.loads(b[20:20+n])["meshes"]))' "$work/inst.glb")"
+    done
+  done
+  rm -f "$work/cad10k.glb" "$work/inst.lfp" "$work/inst.glb" "$work/build.log"
+}
+if [[ ${BENCH_ONLY:-} == instances ]]; then instances_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -501,5 +528,6 @@ potree_section
 surface_section
 surface_tiles_section
 cad_section
+instances_section
 render_section
 runtime_section

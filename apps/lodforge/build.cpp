@@ -16,7 +16,7 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
     std::string input, output;
     std::string cost = "quadric";
     std::string direction = "cheaper";
-    bool salvage = false;
+    bool salvage = false, noInstances = false;
     CadCommand cad;
   };
   auto options = std::make_shared<Options>();
@@ -33,6 +33,9 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
                   "into higher)")
       ->check(CLI::IsMember({"cheaper", "paper"}));
   sub->add_flag("--salvage", options->salvage, "Keep what a truncated PLY holds up to the cut");
+  sub->add_flag(
+      "--no-instances", options->noInstances,
+      "Simplify every object on its own, even one that repeats an earlier object's shape");
   addCadOptions(*sub, options->cad);
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
@@ -49,6 +52,7 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
           options->direction == "paper" ? CollapseDirection::kPaper : CollapseDirection::kCheaper;
       build.memoryLimit = global.memoryLimit;
       build.read.salvageTruncated = options->salvage;
+      build.placeRepeatedShapes = !options->noInstances;
       Result<CadReadOptions> cad = cadOptions(options->cad);
       if (!cad) return cad.status();
       build.read.cad = *cad;
@@ -59,12 +63,11 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
       if (!stats) return stats.status();
       say(global,
           fmt::format(
-              "wrote {}: {} objects, {} vertices, {} triangles ({} at the simplest level), {} in "
-              "{:.1f} s "
-              "({} input triangles/s)",
-              options->output, formatCount(stats->objects), formatCount(stats->vertices),
-              formatCount(stats->triangles), formatCount(stats->minTriangles),
-              formatBytes(stats->packageBytes), stats->seconds,
+              "wrote {}: {} objects ({} placed again from an earlier one's shape), {} vertices, {} "
+              "triangles ({} at the simplest level), {} in {:.1f} s ({} input triangles/s)",
+              options->output, formatCount(stats->objects), formatCount(stats->placements),
+              formatCount(stats->vertices), formatCount(stats->triangles),
+              formatCount(stats->minTriangles), formatBytes(stats->packageBytes), stats->seconds,
               formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->inputTriangles) /
                                                      std::max(stats->seconds, 1e-9)))));
       detail(global, fmt::format("{}; {} waves; peak memory {}",

@@ -12,40 +12,15 @@
 #include "lodforge/io/glb_instances.h"
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/io/model_io.h"
+#include "rigid_support.h"
 #include "test_support.h"
 
 namespace lodforge {
 namespace {
 
-std::vector<Vec3f> randomPoints(Random& random, int count) {
-  std::vector<Vec3f> points;
-  for (int i = 0; i < count; ++i)
-    points.push_back({static_cast<float>(random.uniform(-1, 1)),
-                      static_cast<float>(random.uniform(-1, 1)),
-                      static_cast<float>(random.uniform(-1, 1))});
-  return points;
-}
-
-Mat4d randomMotion(Random& random) {
-  double q[4], norm = 0;
-  for (double& c : q) {
-    c = random.uniform(-1, 1);
-    norm += c * c;
-  }
-  norm = std::sqrt(norm);
-  Mat4d motion = Mat4d::rotation(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
-  for (int row = 0; row < 3; ++row) motion.at(row, 3) = random.uniform(-50, 50);
-  return motion;
-}
-
-std::vector<Vec3f> moved(const Mat4d& m, std::span<const Vec3f> points) {
-  std::vector<Vec3f> out;
-  for (const Vec3f& p : points) {
-    const Vec3d q = m.transformPoint(toDouble(p));
-    out.push_back({static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z)});
-  }
-  return out;
-}
+using test::moved;
+using test::randomMotion;
+using test::randomPoints;
 
 TEST(GlbInstances, ARigidMotionIsFoundAndNothingElse) {
   Random random(20261126);

@@ -4,6 +4,7 @@
 
 #include "lodforge/generate/cad.h"
 #include "lodforge/io/cad_reader.h"
+#include "lodforge/io/glb_instances.h"
 #include "lodforge/io/glb_writer.h"
 #include "lodforge/io/gltf_reader.h"
 #include "lodforge/io/ply_writer.h"
@@ -18,8 +19,12 @@ TEST(Builder, StreamedPlyAndLoadedGlbGiveTheSamePackageContent) {
   test::TempDir dir;
   ASSERT_TRUE(generateCad({.objects = 500, .seed = 9}, dir.file("a.glb")).ok());
   ASSERT_TRUE(generateCad({.objects = 500, .seed = 9}, dir.file("a.ply")).ok());
-  Result<BuildStats> fromPly = buildPackage(dir.file("a.ply"), dir.file("ply.lfp"));
-  Result<BuildStats> fromGlb = buildPackage(dir.file("a.glb"), dir.file("glb.lfp"));
+  // Each object on its own: the PLY's float world positions lose some repeats that the GLB's
+  // shared meshes keep, and a placed object has its shape's triangle order.
+  BuildOptions own;
+  own.placeRepeatedShapes = false;
+  Result<BuildStats> fromPly = buildPackage(dir.file("a.ply"), dir.file("ply.lfp"), own);
+  Result<BuildStats> fromGlb = buildPackage(dir.file("a.glb"), dir.file("glb.lfp"), own);
   ASSERT_TRUE(fromPly.ok()) << fromPly.error().message;
   ASSERT_TRUE(fromGlb.ok()) << fromGlb.error().message;
   EXPECT_TRUE(fromPly->streamed);
@@ -65,16 +70,21 @@ TEST(Builder, UngroupedPlyFallsBackToLoading) {
 TEST(Builder, MemoryLimitSplitsTheWorkIntoWavesOrRefusesAHugeObject) {
   test::TempDir dir;
   ASSERT_TRUE(generateCad({.objects = 400, .seed = 2}, dir.file("a.ply")).ok());
+  // The shape cache gets an eighth of the limit, so a small limit keeps fewer shapes and builds
+  // more repeats anew: the package is the same either way without it.
   BuildOptions small;
   small.memoryLimit = 56 << 20;  // 48 MiB fixed + 8 MiB: a few parts at a time
+  small.placeRepeatedShapes = false;
   Result<BuildStats> waves = buildPackage(dir.file("a.ply"), dir.file("a.lfp"), small);
   ASSERT_TRUE(waves.ok()) << waves.error().message;
   EXPECT_GT(waves->waves, 3u);
-  Result<BuildStats> oneWave = buildPackage(dir.file("a.ply"), dir.file("b.lfp"));
+  BuildOptions unlimited;
+  unlimited.placeRepeatedShapes = false;
+  Result<BuildStats> oneWave = buildPackage(dir.file("a.ply"), dir.file("b.lfp"), unlimited);
   ASSERT_TRUE(oneWave.ok());
   EXPECT_EQ(oneWave->waves, 1u);
-  EXPECT_EQ(test::readFile(dir.file("a.lfp")),
-            test::readFile(dir.file("b.lfp")));  // same package either way
+  EXPECT_TRUE(test::readFile(dir.file("a.lfp")) == test::readFile(dir.file("b.lfp")))
+      << "the package depends on the memory limit";
 
   BuildOptions tiny;
   tiny.memoryLimit = 52 << 20;  // 4 MiB for objects; the horse needs ~20 MiB
@@ -90,6 +100,85 @@ TEST(Builder, MemoryLimitSplitsTheWorkIntoWavesOrRefusesAHugeObject) {
   ASSERT_FALSE(refused.ok());
   EXPECT_NE(refused.error().message.find("too small to build anything"), std::string::npos);
   EXPECT_TRUE(test::listFolder(dir.path()).size() == 3);  // a.ply, a.lfp, b.lfp: no temporaries
+}
+
+// How many objects are written with a mesh of their own (findPlacements places the others).
+std::size_t distinctMeshes(const Model& model) {
+  std::size_t own = 0;
+  const std::vector<Placement> placements = findPlacements(model);
+  for (std::size_t o = 0; o < placements.size(); ++o) own += placements[o].source == o ? 1 : 0;
+  return own;
+}
+
+// 2CylinderEngine places 29 meshes 67 times. The builder simplifies each shape once: a placed
+// object's levels are its shape's (same triangles, collapses and errors) and it sits where its
+// input does. Across waves too (a small memory limit).
+TEST(Builder, AShapePlacedAgainIsBuiltOnceAndSitsWhereItsInputDoes) {
+  const std::string input = test::dataPath("meshes/2CylinderEngine.glb");
+  Result<Model> source = readGltf(input);
+  ASSERT_TRUE(source.ok());
+  const std::vector<Placement> expected = findPlacements(*source);
+  const std::size_t repeats = source->objectCount() - distinctMeshes(*source);
+  ASSERT_GT(repeats, 30u);
+  test::TempDir dir;
+  // A small limit: several waves, and a shape cache (an eighth of it) that holds only some
+  // shapes, so fewer repeats are placed, from whichever kept shape they fit.
+  BuildOptions small;
+  small.memoryLimit = 80 << 20;
+  for (const bool limited : {false, true}) {
+    Result<BuildStats> stats =
+        buildPackage(input, dir.file("e.lfp"), limited ? small : BuildOptions{});
+    ASSERT_TRUE(stats.ok()) << stats.error().message;
+    if (limited) {
+      EXPECT_GT(stats->waves, 1u);
+      EXPECT_GT(stats->placements, 0u);
+      EXPECT_LT(stats->placements, repeats);
+    } else {
+      EXPECT_EQ(stats->placements, repeats);
+    }
+    Result<Package> package = Package::open(dir.file("e.lfp"));
+    ASSERT_TRUE(package.ok());
+    const Model full = extractModel(*package, vertexCountsForRatio(*package, 1.0));
+    for (std::size_t o = 0; o < source->objectCount(); ++o) {
+      const std::size_t s = expected[o].source;
+      if (s != o && !limited) {
+        EXPECT_TRUE(std::ranges::equal(package->triangles(o), package->triangles(s))) << o;
+        EXPECT_TRUE(std::ranges::equal(package->ecol(o), package->ecol(s))) << o;
+        EXPECT_TRUE(std::ranges::equal(package->error(o), package->error(s))) << o;
+      }
+      // Every extracted vertex is an input vertex (the welded full detail), within the fit.
+      const auto in = source->objectPositions(o);
+      const double tolerance = 1e-5 * length(toDouble(source->objects[o].bounds.size())) + 1e-5;
+      for (const Vec3f& p : full.objectPositions(o)) {
+        double nearest = 1e30;
+        for (const Vec3f& q : in) nearest = std::min(nearest, length(toDouble(p) - toDouble(q)));
+        ASSERT_LE(nearest, tolerance) << "object " << o << (limited ? " (limited)" : "");
+      }
+    }
+  }
+  BuildOptions own;
+  own.placeRepeatedShapes = false;
+  Result<BuildStats> each = buildPackage(input, dir.file("own.lfp"), own);
+  ASSERT_TRUE(each.ok());
+  EXPECT_EQ(each->placements, 0u);
+}
+
+// `extract` writes a repeated shape once at any level: the extracted model's objects are the
+// package's placements again.
+TEST(Extract, InstancesComeBackAsOneMeshPerShapeAtEveryLevel) {
+  const std::string input = test::dataPath("meshes/2CylinderEngine.glb");
+  Result<Model> source = readGltf(input);
+  ASSERT_TRUE(source.ok());
+  test::TempDir dir;
+  ASSERT_TRUE(buildPackage(input, dir.file("e.lfp")).ok());
+  Result<Package> package = Package::open(dir.file("e.lfp"));
+  ASSERT_TRUE(package.ok());
+  for (const double ratio : {1.0, 0.5, 0.1, 0.0}) {
+    const Model extracted = extractModel(*package, vertexCountsForRatio(*package, ratio));
+    EXPECT_EQ(distinctMeshes(extracted), distinctMeshes(*source)) << ratio;
+  }
+  const Model byError = extractModel(*package, vertexCountsForError(*package, 0.5));
+  EXPECT_EQ(distinctMeshes(byError), distinctMeshes(*source));
 }
 
 TEST(Extract, RatiosAndErrorsPickTheExpectedLevels) {
@@ -114,9 +203,6 @@ TEST(Extract, RatiosAndErrorsPickTheExpectedLevels) {
   EXPECT_TRUE(n == o.minVertexCount || package->error(0)[n - 1 - o.minVertexCount] > bound);
 }
 
-// A package keeps each object's assembly path and material, and `extract` hangs the objects back
-// in that tree with those materials: the GLB read again names the same paths. (2CylinderEngine's
-// materials are single-sided and stay so.)
 // CAD layers travel from a STEP assembly through the package to an extracted GLB (node extras)
 // and back.
 TEST(Extract, CadLayersComeBack) {
@@ -144,6 +230,9 @@ TEST(Extract, CadLayersComeBack) {
   EXPECT_EQ(onLayers, source->objectCount());
 }
 
+// A package keeps each object's assembly path and material, and `extract` hangs the objects back
+// in that tree with those materials: the GLB read again names the same paths. (2CylinderEngine's
+// materials are single-sided and stay so.)
 TEST(Extract, TheAssemblyTreeAndMaterialsComeBack) {
   const std::string input = test::dataPath("meshes/2CylinderEngine.glb");
   Result<Model> source = readGltf(input);

@@ -1,86 +1,30 @@
 #include "lodforge/io/glb_instances.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
 
+#include <Eigen/Geometry>
+
 namespace lodforge {
 namespace {
 
-// An orthonormal, right-handed frame of three points: columns u, v, w.
-struct Frame {
-  Vec3d u, v, w;
-};
-
-std::optional<Frame> frameOf(Vec3d a, Vec3d b, Vec3d c) {
-  const Vec3d ab = b - a, normal = cross(ab, c - a);
-  const double lengthAb = length(ab), lengthNormal = length(normal);
-  if (!(lengthAb > 0) || !(lengthNormal > 0)) return std::nullopt;
-  Frame f;
-  f.u = ab / lengthAb;
-  f.w = normal / lengthNormal;
-  f.v = cross(f.w, f.u);
-  return f;
-}
-
-// Three vertices far apart and far from collinear, so the frames they span are well conditioned.
-std::optional<std::array<std::size_t, 3>> spanningVertices(std::span<const Vec3f> p) {
-  if (p.size() < 3) return std::nullopt;
-  std::size_t b = 0, c = 0;
+// Whether the vertices stand off a line through the first and the farthest from it.
+bool spansAPlane(std::span<const Vec3f> p) {
+  if (p.size() < 3) return false;
+  std::size_t b = 0;
   double far = 0, wide = 0;
   for (std::size_t i = 1; i < p.size(); ++i)
     if (const double d = length(toDouble(p[i]) - toDouble(p[0])); d > far) far = d, b = i;
   const Vec3d ab = toDouble(p[b]) - toDouble(p[0]);
   for (std::size_t i = 1; i < p.size(); ++i)
-    if (const double d = length(cross(ab, toDouble(p[i]) - toDouble(p[0]))); d > wide)
-      wide = d, c = i;
-  // Nearly collinear vertices give a frame that turns with rounding noise.
-  if (!(far > 0) || !(wide > 1e-6 * far * far)) return std::nullopt;
-  return std::array{std::size_t{0}, b, c};
+    wide = std::max(wide, length(cross(ab, toDouble(p[i]) - toDouble(p[0]))));
+  return far > 0 && wide > 1e-6 * far * far;
 }
 
 std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
   return (h ^ v) * 0x100000001b3ull + (h >> 29);
-}
-
-// What two placements of one mesh share exactly: counts, material, triangles, colours.
-std::uint64_t signature(const Model& model, std::size_t o) {
-  const ObjectRecord& r = model.objects[o];
-  std::uint64_t h =
-      mix(mix(mix(0xcbf29ce484222325ull, r.vertexCount), r.triangleCount), r.material);
-  for (const std::uint32_t i : model.objectIndices(o)) h = mix(h, i);
-  if (model.hasColors())
-    for (std::uint64_t v = r.vertexOffset; v < r.vertexOffset + r.vertexCount; ++v) {
-      const Rgba8 c = model.colors[v];
-      h = mix(h, (std::uint64_t{c.r} << 24) | (std::uint64_t{c.g} << 16) |
-                     (std::uint64_t{c.b} << 8) | c.a);
-    }
-  return h;
-}
-
-bool sameTrianglesAndColours(const Model& model, std::size_t a, std::size_t b) {
-  const ObjectRecord &ra = model.objects[a], &rb = model.objects[b];
-  if (ra.vertexCount != rb.vertexCount || ra.triangleCount != rb.triangleCount ||
-      ra.material != rb.material)
-    return false;
-  const auto ia = model.objectIndices(a), ib = model.objectIndices(b);
-  if (!std::equal(ia.begin(), ia.end(), ib.begin())) return false;
-  if (!model.hasColors()) return true;
-  const auto ca = std::span(model.colors).subspan(ra.vertexOffset, ra.vertexCount);
-  const auto cb = std::span(model.colors).subspan(rb.vertexOffset, rb.vertexCount);
-  return std::equal(ca.begin(), ca.end(), cb.begin());
-}
-
-bool normalsFollow(const Model& model, std::size_t a, std::size_t b, const Mat4d& motion) {
-  if (!model.hasNormals()) return true;
-  const ObjectRecord &ra = model.objects[a], &rb = model.objects[b];
-  for (std::uint64_t v = 0; v < ra.vertexCount; ++v) {
-    const Vec3d moved = motion.transformVector(toDouble(model.normals[ra.vertexOffset + v]));
-    if (!(length(moved - toDouble(model.normals[rb.vertexOffset + v])) <= 1e-3)) return false;
-  }
-  return true;
 }
 
 double diagonal(std::span<const Vec3f> p) {
@@ -93,60 +37,118 @@ double diagonal(std::span<const Vec3f> p) {
 
 std::optional<Mat4d> fitRigidMotion(std::span<const Vec3f> from, std::span<const Vec3f> to,
                                     double tolerance) {
-  if (from.size() != to.size()) return std::nullopt;
-  const auto picked = spanningVertices(from);
-  if (!picked) return std::nullopt;
-  const auto [a, b, c] = *picked;
-  const auto source = frameOf(toDouble(from[a]), toDouble(from[b]), toDouble(from[c]));
-  const auto target = frameOf(toDouble(to[a]), toDouble(to[b]), toDouble(to[c]));
-  if (!source || !target) return std::nullopt;
-  // R = T Sᵀ with S, T the frames as columns; both right-handed, so R never mirrors.
-  Mat4d motion;
-  const Vec3d s[3] = {source->u, source->v, source->w}, t[3] = {target->u, target->v, target->w};
-  for (int row = 0; row < 3; ++row)
-    for (int col = 0; col < 3; ++col)
-      motion.at(row, col) = t[0][row] * s[0][col] + t[1][row] * s[1][col] + t[2][row] * s[2][col];
-  // The translation through the centroids spreads the rounding over all vertices.
-  Vec3d fromCentre, toCentre;
+  // Nearly collinear vertices leave the turn about their line undetermined: no motion.
+  if (from.size() != to.size() || !spansAPlane(from)) return std::nullopt;
+  // The least-squares rotation (Kabsch, through Umeyama's SVD with the sign fixed, so it never
+  // mirrors): every vertex weighs in, so float rounding of a thin part does not tilt it as a
+  // frame of three vertices would.
+  Eigen::Matrix3Xd a(3, from.size()), b(3, to.size());
   for (std::size_t i = 0; i < from.size(); ++i) {
-    fromCentre += toDouble(from[i]);
-    toCentre += toDouble(to[i]);
+    const auto column = static_cast<Eigen::Index>(i);
+    a.col(column) << from[i][0], from[i][1], from[i][2];
+    b.col(column) << to[i][0], to[i][1], to[i][2];
   }
-  const double n = static_cast<double>(from.size());
-  const Vec3d shift = toCentre / n - motion.transformVector(fromCentre / n);
-  for (int row = 0; row < 3; ++row) motion.at(row, 3) = shift[row];
+  const Eigen::Matrix4d fit = Eigen::umeyama(a, b, false);
+  Mat4d motion;
+  for (int row = 0; row < 3; ++row)
+    for (int col = 0; col < 4; ++col) motion.at(row, col) = fit(row, col);
   for (std::size_t i = 0; i < from.size(); ++i)
     if (!(length(motion.transformPoint(toDouble(from[i])) - toDouble(to[i])) <= tolerance))
       return std::nullopt;  // NaN fails too
   return motion;
 }
 
+PlacementKey placementKey(const MeshView& mesh, double relativeTolerance) {
+  PlacementKey key;
+  std::uint64_t h = mix(mix(mix(0xcbf29ce484222325ull, mesh.positions.size()), mesh.indices.size()),
+                        mesh.material);
+  for (const std::uint32_t i : mesh.indices) h = mix(h, i);
+  for (const Rgba8 c : mesh.colors)
+    h = mix(h, (std::uint64_t{c.r} << 24) | (std::uint64_t{c.g} << 16) | (std::uint64_t{c.b} << 8) |
+                   c.a);
+  key.signature = h;
+  if (mesh.positions.empty()) return key;
+  Vec3d centre;
+  double far = 0;
+  for (const Vec3f& p : mesh.positions) {
+    centre += toDouble(p);
+    // Float positions round with their distance from the origin, not with the part's size.
+    far = std::max(far, length(toDouble(p)));
+  }
+  centre = centre / static_cast<double>(mesh.positions.size());
+  double squares = 0;
+  for (const Vec3f& p : mesh.positions) squares += dot(toDouble(p) - centre, toDouble(p) - centre);
+  key.spread = std::sqrt(squares / static_cast<double>(mesh.positions.size()));
+  // Both meshes round (half an ulp per coordinate each) and the fit spreads that: 8 ulps.
+  key.tolerance = std::max(relativeTolerance * diagonal(mesh.positions), 8 * 0x1p-24 * far);
+  return key;
+}
+
+std::optional<Mat4d> placementOf(const MeshView& source, const MeshView& mesh, double tolerance) {
+  if (source.material != mesh.material || !std::ranges::equal(source.indices, mesh.indices) ||
+      !std::ranges::equal(source.colors, mesh.colors) ||
+      source.normals.size() != mesh.normals.size())
+    return std::nullopt;
+  const auto motion = fitRigidMotion(source.positions, mesh.positions, tolerance);
+  if (!motion) return std::nullopt;
+  for (std::size_t v = 0; v < source.normals.size(); ++v) {
+    const Vec3d moved = motion->transformVector(toDouble(source.normals[v]));
+    if (!(length(moved - toDouble(mesh.normals[v])) <= 1e-3)) return std::nullopt;
+  }
+  return motion;
+}
+
+std::optional<FoundPlacement> PlacementIndex::find(
+    const PlacementKey& key, const MeshView& mesh,
+    const std::function<MeshView(std::uint32_t)>& kept) const {
+  const auto meshes = meshes_.find(key.signature);
+  if (meshes == meshes_.end()) return std::nullopt;
+  // Vertices within the tolerance move the centroid and the spread by at most as much each.
+  const double window = 2 * key.tolerance;
+  std::size_t tried = 0;
+  for (auto at = meshes->second.lower_bound(key.spread - window);
+       at != meshes->second.end() && at->first <= key.spread + window && tried < candidates_;
+       ++at, ++tried) {
+    // The kept mesh may lie farther from the origin and round more.
+    const auto [id, tolerance] = at->second;
+    if (const auto motion = placementOf(kept(id), mesh, std::max(key.tolerance, tolerance)))
+      return FoundPlacement{id, *motion};
+  }
+  return std::nullopt;
+}
+
+bool PlacementIndex::add(const PlacementKey& key, std::uint32_t id) {
+  auto& meshes = meshes_[key.signature];
+  const double window = 2 * key.tolerance;
+  const auto first = meshes.lower_bound(key.spread - window);
+  const auto last = meshes.upper_bound(key.spread + window);
+  if (static_cast<std::size_t>(std::distance(first, last)) >= candidates_) return false;
+  meshes.emplace(key.spread, std::pair{id, key.tolerance});
+  return true;
+}
+
 std::vector<Placement> findPlacements(const Model& model, double relativeTolerance,
                                       std::size_t candidates) {
+  const auto view = [&](std::uint32_t o) {
+    const ObjectRecord& r = model.objects[o];
+    MeshView mesh{model.objectPositions(o), {}, {}, model.objectIndices(o), r.material};
+    if (model.hasNormals())
+      mesh.normals = std::span(model.normals).subspan(r.vertexOffset, r.vertexCount);
+    if (model.hasColors())
+      mesh.colors = std::span(model.colors).subspan(r.vertexOffset, r.vertexCount);
+    return mesh;
+  };
   std::vector<Placement> placements(model.objectCount());
-  std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> meshes;  // signature → sources
-  for (std::size_t o = 0; o < model.objectCount(); ++o) {
-    placements[o].source = static_cast<std::uint32_t>(o);
+  PlacementIndex index(candidates);
+  for (std::uint32_t o = 0; o < model.objectCount(); ++o) {
+    placements[o].source = o;
     if (model.objects[o].triangleCount == 0) continue;
-    const std::span<const Vec3f> positions = model.objectPositions(o);
-    std::vector<std::uint32_t>& sources = meshes[signature(model, o)];
-    if (sources.empty()) {  // the first of its kind: nothing to fit, no tolerance needed
-      if (candidates > 0) sources.push_back(static_cast<std::uint32_t>(o));
-      continue;
-    }
-    // Float positions round with their distance from the origin, not with the part's size.
-    double far = 0;
-    for (const Vec3f& p : positions) far = std::max(far, length(toDouble(p)));
-    const double tolerance = std::max(relativeTolerance * diagonal(positions), 4 * 0x1p-24 * far);
-    for (const std::uint32_t s : sources) {
-      if (!sameTrianglesAndColours(model, s, o)) continue;
-      const auto motion = fitRigidMotion(model.objectPositions(s), positions, tolerance);
-      if (!motion || !normalsFollow(model, s, o, *motion)) continue;
-      placements[o] = {s, *motion};
-      break;
-    }
-    if (placements[o].source == o && sources.size() < candidates)
-      sources.push_back(static_cast<std::uint32_t>(o));
+    const MeshView mesh = view(o);
+    const PlacementKey key = placementKey(mesh, relativeTolerance);
+    if (const auto found = index.find(key, mesh, view))
+      placements[o] = {found->source, found->motion};
+    else
+      index.add(key, o);
   }
   return placements;
 }

@@ -1,11 +1,15 @@
 // Repeated meshes in a model of world positions: objects that are one mesh placed again (a CAD
 // shape placed many times, a glTF mesh under several nodes) are found again so a GLB writes the
-// mesh once and places it with a node transform.
+// mesh once and places it with a node transform, and `lodforge build` simplifies it once.
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <optional>
 #include <span>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "lodforge/core/math.h"
@@ -25,11 +29,56 @@ struct Placement {
 std::optional<Mat4d> fitRigidMotion(std::span<const Vec3f> from, std::span<const Vec3f> to,
                                     double tolerance);
 
+// One object's mesh as placements compare it; normals and colours empty when there are none.
+struct MeshView {
+  std::span<const Vec3f> positions, normals;
+  std::span<const Rgba8> colors;
+  std::span<const std::uint32_t> indices;  // local
+  std::uint32_t material = kNoMaterial;
+};
+
+// What a search for a mesh's placement needs: what two placements of one mesh share exactly
+// (counts, material, triangles, colours) hashed, its spread (the RMS distance of its vertices
+// from their centroid, which a rigid motion keeps), and how far a placed vertex may lie from the
+// moved source (`relativeTolerance` of the mesh's size, never less than float rounding at its
+// distance from the origin).
+struct PlacementKey {
+  std::uint64_t signature = 0;
+  double spread = 0, tolerance = 0;
+};
+PlacementKey placementKey(const MeshView& mesh, double relativeTolerance);
+
+// The motion that places `source` as `mesh`: same triangles, colours and material, every vertex
+// within `tolerance` after the motion, normals within 1e-3 (the fronts follow, the motion being
+// proper and the indices equal); none otherwise.
+std::optional<Mat4d> placementOf(const MeshView& source, const MeshView& mesh, double tolerance);
+
+struct FoundPlacement {
+  std::uint32_t source = 0;
+  Mat4d motion;
+};
+
+// Meshes kept to place others from, by signature and spread: a search fits only the kept meshes
+// whose spread is within the tolerance, at most `candidates` of them.
+class PlacementIndex {
+ public:
+  explicit PlacementIndex(std::size_t candidates = 64) : candidates_(candidates) {}
+  // The first kept mesh that `mesh` is a placement of; `kept` gives a kept mesh by its id.
+  std::optional<FoundPlacement> find(const PlacementKey& key, const MeshView& mesh,
+                                     const std::function<MeshView(std::uint32_t)>& kept) const;
+  // Keeps mesh `id`; false when as many meshes like it are kept already.
+  bool add(const PlacementKey& key, std::uint32_t id);
+
+ private:
+  std::size_t candidates_;
+  // signature → spread → (id, tolerance)
+  std::unordered_map<std::uint64_t, std::multimap<double, std::pair<std::uint32_t, double>>>
+      meshes_;
+};
+
 // One placement per object. An object is placed from an earlier one when both have the same
 // triangles (indices), colours and material, and a rigid motion takes the earlier's vertices
-// onto its own within `relativeTolerance` of the object's size (normals within 1e-3; the fronts
-// follow, the motion being proper and the indices equal). Only objects with the same signature
-// (counts, material, triangles, colours) are compared, against at most `candidates` meshes each.
+// onto its own (placementOf, within its key's tolerance), found through a PlacementIndex.
 std::vector<Placement> findPlacements(const Model& model, double relativeTolerance = 1e-5,
                                       std::size_t candidates = 64);
 

@@ -13,6 +13,7 @@
 #include "lodforge/io/object_stream.h"
 #include "lodforge/simplify/package.h"
 #include "lodforge/simplify/prepare.h"
+#include "lodforge/simplify/shape_cache.h"
 
 namespace lodforge {
 
@@ -38,7 +39,8 @@ std::uint64_t footprint(const SourceObject& object) {
   return 2 * object.memoryBytes() + progressiveBuildBytes(vertices, triangles);
 }
 
-Built buildOne(SourceObject& source, const ProgressiveOptions& options) {
+// What the package says of an object besides its mesh; the object keeps its arrays.
+Built describe(SourceObject& source) {
   Built built;
   built.name = std::move(source.name);
   built.path = std::move(source.path);
@@ -47,12 +49,72 @@ Built buildOne(SourceObject& source, const ProgressiveOptions& options) {
   built.inputTriangles = source.indices.size() / 3;
   // The base colour: the first vertex's (CAD parts are usually one colour).
   built.color = source.colors.empty() ? Rgba8{} : source.colors.front();
+  return built;
+}
+
+Built buildOne(SourceObject& source, const ProgressiveOptions& options) {
+  Built built = describe(source);
   PreparedObject prepared =
       prepareObject(source.positions, source.normals, source.colors, source.indices);
   source = SourceObject{};  // release the input before the simplifier allocates
   built.mesh = buildProgressive(prepared.positions, prepared.indices, prepared.normals,
                                 prepared.colors, options);
   return built;
+}
+
+// One object of a wave, in stream order: built here, or a placement of a shape built before it.
+struct WaveObject {
+  SourceObject source;  // emptied for a placement
+  ShapeLookup shape;
+  Built built;  // a placement's description until its mesh is placed
+};
+
+// A wave: as many objects as fit the budget (at least one); `carried` is the object that did not
+// fit the last one. Placements of remembered shapes cost no build and little memory.
+Status readWave(ObjectStream& stream, ShapeCache& shapes, std::uint64_t budget,
+                std::optional<WaveObject>& carried, std::vector<WaveObject>& wave) {
+  wave.clear();
+  std::uint64_t bytes = 0;
+  while (wave.size() < kMaxWaveObjects) {
+    WaveObject object;
+    if (carried) {
+      object = std::move(*carried);
+      carried.reset();
+    } else {
+      Result<bool> more = stream.next(object.source);
+      if (!more) return more.status();
+      if (!*more) break;
+      object.shape = shapes.lookup(object.source);
+      if (object.shape.placed) {
+        object.built = describe(object.source);
+        object.source = SourceObject{};
+      }
+    }
+    const std::uint64_t need = object.shape.placed ? 0 : footprint(object.source);
+    if (need > budget) {
+      return Error{ErrorKind::kLimit,
+                   fmt::format("object '{}' ({} triangles) needs about {} to build, more than the "
+                               "{} memory limit",
+                               object.source.name, formatCount(object.source.indices.size() / 3),
+                               formatBytes(need), formatBytes(budget))};
+    }
+    if (!wave.empty() && bytes + need > budget) {
+      carried = std::move(object);
+      break;
+    }
+    bytes += need;
+    wave.push_back(std::move(object));
+  }
+  return {};
+}
+
+void count(const Built& b, BuildStats& stats) {
+  stats.objects += 1;
+  stats.inputTriangles += b.inputTriangles;
+  stats.vertices += b.mesh.vertexCount();
+  stats.triangles += b.mesh.triangleCount();
+  stats.minVertices += b.mesh.q;
+  stats.minTriangles += b.mesh.map.empty() ? 0 : b.mesh.map.front();
 }
 
 Result<BuildStats> build(const std::string& input, ObjectStream& stream, const std::string& output,
@@ -66,67 +128,44 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
                     formatBytes(options.memoryLimit),
                     formatBytes(kFixedBytes + (std::uint64_t{4} << 20)), formatBytes(kFixedBytes))};
   }
-  // The objects in flight get what the limit leaves (a quarter of the machine by default).
-  const std::uint64_t budget = options.memoryLimit
-                                   ? options.memoryLimit - kFixedBytes
-                                   : std::max<std::uint64_t>(physicalMemoryBytes() / 4, 256 << 20);
+  // The objects in flight get what the limit leaves (a quarter of the machine by default), less
+  // an eighth for the shapes kept to place again.
+  const std::uint64_t limit = options.memoryLimit
+                                  ? options.memoryLimit - kFixedBytes
+                                  : std::max<std::uint64_t>(physicalMemoryBytes() / 4, 256 << 20);
+  ShapeCache shapes(options.placeRepeatedShapes ? limit / 8 : 0);
+  const std::uint64_t budget = limit - limit / 8;
   Result<PackageWriter> writer =
       PackageWriter::create(output, stream.origin(), true, stream.hasColors());
   if (!writer) return writer.status();
   BuildStats stats;
   stats.streamed = stream.streaming();
   Progress progress("building", stream.triangleCountHint());
-  std::optional<SourceObject> carried;
-  std::vector<SourceObject> wave;
-  std::vector<Built> built;
+  std::optional<WaveObject> carried;
+  std::vector<WaveObject> wave;
   while (true) {
-    // A wave: as many objects as fit the budget (at least one).
-    wave.clear();
-    std::uint64_t bytes = 0;
-    while (wave.size() < kMaxWaveObjects) {
-      SourceObject object;
-      if (carried) {
-        object = std::move(*carried);
-        carried.reset();
-      } else {
-        Result<bool> more = stream.next(object);
-        if (!more) return more.status();
-        if (!*more) break;
-      }
-      const std::uint64_t need = footprint(object);
-      if (need > budget) {
-        return Error{
-            ErrorKind::kLimit,
-            fmt::format("object '{}' ({} triangles) needs about {} to build, more than the "
-                        "{} memory limit",
-                        object.name, formatCount(object.indices.size() / 3), formatBytes(need),
-                        formatBytes(budget))};
-      }
-      if (!wave.empty() && bytes + need > budget) {
-        carried = std::move(object);
-        break;
-      }
-      bytes += need;
-      wave.push_back(std::move(object));
-    }
+    LODFORGE_TRY(readWave(stream, shapes, budget, carried, wave));
     if (wave.empty()) break;
     ++stats.waves;
-    built.clear();
-    built.resize(wave.size());
     tbb::parallel_for(
         std::size_t{0}, wave.size(),
-        [&](std::size_t i) { built[i] = buildOne(wave[i], options.progressive); },
+        [&](std::size_t i) {
+          if (!wave[i].shape.placed) wave[i].built = buildOne(wave[i].source, options.progressive);
+        },
         tbb::simple_partitioner());
-    for (Built& b : built) {
+    // In stream order, so a shape's mesh is kept before any placement of it is written.
+    for (WaveObject& object : wave) {
+      Built& b = object.built;
+      if (const auto& placed = object.shape.placed) {
+        b.mesh = placedMesh(shapes.mesh(placed->shape), placed->motion);
+        stats.placements += 1;
+      } else if (object.shape.remembered) {
+        shapes.setMesh(*object.shape.remembered, b.mesh);
+      }
       LODFORGE_TRY(writer->add(b.mesh, {b.name, b.color, b.path, b.material, b.layer}));
-      stats.objects += 1;
-      stats.inputTriangles += b.inputTriangles;
-      stats.vertices += b.mesh.vertexCount();
-      stats.triangles += b.mesh.triangleCount();
-      stats.minVertices += b.mesh.q;
-      stats.minTriangles += b.mesh.map.empty() ? 0 : b.mesh.map.front();
+      count(b, stats);
       progress.advance(b.inputTriangles);
-      b = Built{};
+      object = WaveObject{};
     }
     LODFORGE_TRY(checkCancelled());
   }

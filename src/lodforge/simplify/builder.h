@@ -1,6 +1,7 @@
 // `lodforge build`: every object of an input through prepareObject and buildProgressive into a
 // package. Objects stream in (a grouped PLY never sits in memory whole), are built in parallel
-// waves that fit the memory limit, and are written in input order as they finish.
+// waves that fit the memory limit, and are written in input order as they finish. A shape
+// placed again is built once (shape_cache.h).
 #pragma once
 
 #include <cstdint>
@@ -18,6 +19,9 @@ struct BuildOptions {
   // memory for the objects in flight.
   std::uint64_t memoryLimit = 0;
   ReadOptions read;
+  // An object that is an earlier object's shape moved rigidly gets that shape's progressive mesh
+  // moved likewise (ShapeCache), so all placements share their levels and are simplified once.
+  bool placeRepeatedShapes = true;
 };
 
 struct BuildStats {
@@ -28,6 +32,8 @@ struct BuildStats {
   std::uint64_t minVertices = 0, minTriangles = 0;  // the simplest level, summed
   std::uint64_t packageBytes = 0;
   std::uint64_t waves = 0;
+  // Objects written as an earlier object's shape moved rigidly (ShapeCache), not built anew.
+  std::uint64_t placements = 0;
   bool streamed = false;
   double seconds = 0;
 };

@@ -88,10 +88,7 @@ export function partsPanel(parts, view) {
       const box = document.createElement('input');
       box.type = 'checkbox';
       box.checked = true;
-      box.addEventListener('change', () => {
-        if (box.checked) layersOff.delete(name); else layersOff.add(name);
-        redraw();
-      });
+      box.addEventListener('change', () => setLayer(name, box.checked));
       layerBoxes.set(name, box);
       label.append(box, `${name} (${ids.length})`);
       list.append(label);
@@ -107,13 +104,18 @@ export function partsPanel(parts, view) {
     for (const name of layersOff) for (const id of layers.get(name) || []) ids.add(id);
     view.hide([...ids]);
   };
-  const setLayer = (name, shown) => {
+  // Ticks or clears the layer's box; redraws unless the caller will once for several.
+  const showLayer = (name, shown) => {
     const box = layerBoxes.get(name);
     if (!box) return false;
     box.checked = shown;
     if (shown) layersOff.delete(name); else layersOff.add(name);
-    redraw();
     return true;
+  };
+  const setLayer = (name, shown) => {
+    const known = showLayer(name, shown);
+    if (known) redraw();
+    return known;
   };
   const select = (id) => {
     current = id;
@@ -152,8 +154,8 @@ export function partsPanel(parts, view) {
   });
   const showEverything = () => {
     hidden.clear();
-    for (const name of [...layersOff]) setLayer(name, true);
-    redraw();
+    for (const name of [...layersOff]) showLayer(name, true);
+    redraw();  // once, not per layer
   };
   showAll.addEventListener('click', showEverything);
   return {

@@ -57,6 +57,13 @@ void ModelBuilder::addTriangle(std::uint32_t a, std::uint32_t b, std::uint32_t c
   model_.indices.insert(model_.indices.end(), {a, b, c});
 }
 
+std::uint32_t LayerTable::index(const std::string& name) {
+  if (name.empty()) return kNoLayer;
+  const auto [at, added] = index_.try_emplace(name, static_cast<std::uint32_t>(layers_.size()));
+  if (added) layers_.push_back(name);
+  return at->second;
+}
+
 void ModelBuilder::endObject() {
   if (!open_) return;
   open_ = false;

@@ -13,6 +13,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "lodforge/core/material.h"
@@ -105,6 +106,20 @@ class ModelBuilder {
  private:
   Model& model_;
   bool open_ = false;
+};
+
+// Gives each distinct CAD layer name one index in a layer table (Model::layers): readers intern
+// the names they meet through it. A map, not a search of the table: a file may give every part a
+// layer of its own.
+class LayerTable {
+ public:
+  explicit LayerTable(std::vector<std::string>& layers) : layers_(layers) {}
+  // kNoLayer for an empty name.
+  std::uint32_t index(const std::string& name);
+
+ private:
+  std::vector<std::string>& layers_;
+  std::unordered_map<std::string, std::uint32_t> index_;
 };
 
 // Picks a double origin for world coordinates: zero for models near the origin, otherwise the

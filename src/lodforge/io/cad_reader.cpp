@@ -6,7 +6,6 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
-#include <map>
 #include <memory>
 #include <mutex>
 
@@ -75,17 +74,12 @@ Model toModel(const cad::Result& read) {
     model.materials.push_back(std::move(material));
   }
   ModelBuilder builder(model);
-  std::map<std::string_view, std::uint32_t> layers;
+  LayerTable layers(model.layers);
   for (const cad::Instance& instance : read.instances) {
     builder.beginObject(instance.name, instance.path);
     if (instance.material < model.materials.size())
       model.objects.back().material = instance.material;
-    if (!instance.layer.empty()) {
-      const auto [at, added] =
-          layers.try_emplace(instance.layer, static_cast<std::uint32_t>(model.layers.size()));
-      if (added) model.layers.push_back(instance.layer);
-      model.objects.back().layer = at->second;
-    }
+    model.objects.back().layer = layers.index(instance.layer);
     for (std::uint64_t v = instance.firstVertex; v < instance.firstVertex + instance.vertexCount;
          ++v) {
       const double* p = &read.positions[3 * v];

@@ -327,13 +327,8 @@ class Loader {
     if (!node.extras.IsObject() || !node.extras.Has("layer")) return;
     const tinygltf::Value& value = node.extras.Get("layer");
     if (!value.IsString() || value.Get<std::string>().empty()) return;
-    const std::string& name = value.Get<std::string>();
-    // A map, not a search of the table: a file may give every node a layer of its own.
-    const auto [at, added] =
-        layerIndex_.try_emplace(name, static_cast<std::uint32_t>(model_.layers.size()));
-    if (added) model_.layers.push_back(name);
-    for (std::size_t o = first; o < model_.objects.size(); ++o)
-      model_.objects[o].layer = at->second;
+    const std::uint32_t layer = layers_.index(value.Get<std::string>());
+    for (std::size_t o = first; o < model_.objects.size(); ++o) model_.objects[o].layer = layer;
   }
 
   void addNode(int index, const tinygltf::Node& node, const Mat4d& world, const std::string& path) {
@@ -595,7 +590,7 @@ class Loader {
   std::vector<Vec3d> world_;
   std::vector<Vec3f> normalsByVertex_;
   std::vector<bool> visited_;
-  std::unordered_map<std::string, std::uint32_t> layerIndex_;  // into model_.layers
+  LayerTable layers_{model_.layers};
   bool withColors_ = false;
   bool missingNormals_ = false;
 };

@@ -30,6 +30,11 @@ bool looksLikePackage(std::span<const std::byte> firstBytes) {
 
 namespace {
 
+// Whether `count` items from `offset` run past `total` (written so that nothing overflows).
+bool outside(std::uint64_t offset, std::uint64_t count, std::uint64_t total) {
+  return offset > total || count > total - offset;
+}
+
 std::uint64_t headerChecksumOf(const PackageHeader& header) {
   return checksum64(
       {reinterpret_cast<const std::byte*>(&header), offsetof(PackageHeader, headerChecksum)});
@@ -429,16 +434,13 @@ std::string Package::objectProblem(std::size_t i) const {
   const PackageObject& o = objects()[i];
   const std::uint64_t levels = std::uint64_t{o.vertexCount} - o.minVertexCount + 1;
   if (o.minVertexCount > o.vertexCount) return "q > p";
-  if (o.vertexOffset > h.vertexCount || o.vertexCount > h.vertexCount - o.vertexOffset)
-    return "vertices outside the section";
-  if (o.triangleOffset > h.triangleCount || o.triangleCount > h.triangleCount - o.triangleOffset)
+  if (outside(o.vertexOffset, o.vertexCount, h.vertexCount)) return "vertices outside the section";
+  if (outside(o.triangleOffset, o.triangleCount, h.triangleCount))
     return "triangles outside the section";
-  if (o.levelOffset > h.levelCount || levels > h.levelCount - o.levelOffset)
-    return "levels outside the section";
-  if (o.nameOffset > nameBytes || o.nameLength > nameBytes - o.nameOffset)
-    return "name outside the section";
+  if (outside(o.levelOffset, levels, h.levelCount)) return "levels outside the section";
+  if (outside(o.nameOffset, o.nameLength, nameBytes)) return "name outside the section";
   const PackageAssembly& a = section<PackageAssembly>(PackageSection::kAssembly)[i];
-  if (a.pathOffset > nameBytes || a.pathLength > nameBytes - a.pathOffset)
+  if (outside(a.pathOffset, a.pathLength, nameBytes))
     return "assembly path outside the names section";
   if (a.material != kNoMaterial && a.material >= materialCount())
     return fmt::format("material {} of {}", a.material, materialCount());
@@ -481,7 +483,7 @@ Status Package::validateMaterials() const {
         std::all_of(reinterpret_cast<const float*>(&r), reinterpret_cast<const float*>(&r) + 10,
                     [](float v) { return std::isfinite(v); });
     const char* problem = nullptr;
-    if (r.nameOffset > names.bytes || r.nameLength > names.bytes - r.nameOffset)
+    if (outside(r.nameOffset, r.nameLength, names.bytes))
       problem = "name outside the names section";
     else if (r.alphaMode > static_cast<std::uint32_t>(AlphaMode::kBlend))
       problem = "alpha mode is not OPAQUE, MASK or BLEND";
@@ -504,8 +506,7 @@ Status Package::validateLayers() const {
       header_->sections[static_cast<std::uint32_t>(PackageSection::kLayers)];
   const auto layers = section<PackageLayer>(PackageSection::kLayers);
   for (std::size_t l = 0; l < layers.size(); ++l) {
-    if (layers[l].nameOffset > names.bytes ||
-        layers[l].nameLength > names.bytes - layers[l].nameOffset)
+    if (outside(layers[l].nameOffset, layers[l].nameLength, names.bytes))
       return badAt(table.offset + l * sizeof(PackageLayer),
                    fmt::format("layer {}: name outside the names section", l));
   }

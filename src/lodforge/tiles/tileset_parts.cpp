@@ -32,7 +32,7 @@ Status writePartsJson(const OctreeResult& octree, const PartTable& parts, const 
         {"name", parts.names[i]},
         {"path", parts.paths[i]},
         {"bounds", parts.bounds[i].empty() ? nlohmann::json() : boundsToJson(parts.bounds[i])}};
-    if (i < parts.layers.size() && parts.layers[i] < parts.layerTable.size())
+    if (parts.layers[i] != kNoLayer)  // one per part, inside the table (resume checks both)
       part["layer"] = parts.layerTable[parts.layers[i]];
     list.push_back(std::move(part));
   }

@@ -47,8 +47,7 @@ PartTable partTable(const std::string& path, const Model& model, std::span<const
     parts.names.push_back(validUtf8(model.objectName(o)));
     parts.paths.push_back(validUtf8(model.objectPath(o)));
     parts.materials.push_back(model.objects[o].material);
-    parts.layers.push_back(model.objects[o].layer < model.layers.size() ? model.objects[o].layer
-                                                                        : kNoLayer);
+    parts.layers.push_back(model.objects[o].layer);
     Aabbd& box = parts.bounds.emplace_back();
     for (std::uint32_t v = 0; v < model.objects[o].vertexCount; ++v)
       box.add(world[model.objects[o].vertexOffset + v]);

@@ -61,18 +61,23 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
       Result<BuildStats> stats = buildPackage(options->input, options->output, build);
       for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
       if (!stats) return stats.status();
+      // Placements only when there are some (never with --no-instances).
+      const std::string placed = stats->placements == 0
+                                     ? std::string()
+                                     : fmt::format(" ({} placed again from an earlier one's shape)",
+                                                   formatCount(stats->placements));
       say(global,
           fmt::format(
-              "wrote {}: {} objects ({} placed again from an earlier one's shape), {} vertices, {} "
-              "triangles ({} at the simplest level), {} in {:.1f} s ({} input triangles/s)",
-              options->output, formatCount(stats->objects), formatCount(stats->placements),
-              formatCount(stats->vertices), formatCount(stats->triangles),
-              formatCount(stats->minTriangles), formatBytes(stats->packageBytes), stats->seconds,
+              "wrote {}: {} objects{}, {} vertices, {} triangles ({} at the simplest "
+              "level), {} in {:.1f} s ({} input triangles/s)",
+              options->output, formatCount(stats->objects), placed, formatCount(stats->vertices),
+              formatCount(stats->triangles), formatCount(stats->minTriangles),
+              formatBytes(stats->packageBytes), stats->seconds,
               formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->inputTriangles) /
                                                      std::max(stats->seconds, 1e-9)))));
-      detail(global, fmt::format("{}; {} waves; peak memory {}",
+      detail(global, fmt::format("{}; {} waves; shapes kept to place again {}; peak memory {}",
                                  stats->streamed ? "streamed" : "loaded whole", stats->waves,
-                                 formatBytes(peakRssBytes())));
+                                 formatBytes(stats->shapeCacheBytes), formatBytes(peakRssBytes())));
       return {};
     };
   });

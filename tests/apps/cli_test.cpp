@@ -448,6 +448,36 @@ TEST(CliPackage, BuildInfoAndExtract) {
       2);
 }
 
+nlohmann::json glbJson(const std::string& path);
+
+// 2CylinderEngine repeats 29 shapes in 67 objects: `build` places the repeats and `extract` writes
+// 29 meshes; with --no-instances every object is built and written on its own. The package does
+// not depend on the thread count.
+TEST(CliPackage, RepeatedShapesAreBuiltOnceUnlessAskedNotTo) {
+  test::TempDir dir;
+  const std::string input = test::dataPath("meshes/2CylinderEngine.glb");
+  Outcome o = lodforge("build " + input + " -o " + dir.file("a.lfp"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("67 objects (38 placed again from an earlier one's shape)"),
+            std::string::npos)
+      << o.out;
+  ASSERT_EQ(lodforge("-q --threads 1 build " + input + " -o " + dir.file("one.lfp"), dir).code, 0);
+  EXPECT_TRUE(test::readFile(dir.file("a.lfp")) == test::readFile(dir.file("one.lfp")))
+      << "the package depends on the thread count";
+  o = lodforge("build " + input + " --no-instances -o " + dir.file("own.lfp"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(o.out.find("placed again"), std::string::npos) << o.out;
+  // Built on their own, most placements simplify differently and no longer match.
+  std::size_t meshes[2] = {};
+  for (int i = 0; i < 2; ++i) {
+    const std::string package = dir.file(i == 0 ? "a.lfp" : "own.lfp"), glb = package + ".glb";
+    ASSERT_EQ(lodforge("-q extract " + package + " --ratio 0.5 -o " + glb, dir).code, 0);
+    meshes[i] = glbJson(glb)["meshes"].size();
+  }
+  EXPECT_EQ(meshes[0], 29u);
+  EXPECT_GT(meshes[1], 2 * 29u);
+}
+
 TEST(CliPackage, DamagedPackagesAreRefusedWithExitCode2) {
   test::TempDir dir;
   const std::string package = dir.file("m.lfp");

@@ -114,6 +114,32 @@ TEST(GlbInstances, FlatMeshesAndTheirNormals) {
   EXPECT_EQ(findPlacements(model(mirrored, 1))[1].source, 1u);
 }
 
+// A 2 cm part placed 2 km from the origin rounds ~1e-4 there: its copy near the origin is still
+// found, whichever of the two comes first (the search looks as far as the rounder one needs).
+TEST(GlbInstances, AFarCopyAndANearOneAreFoundInEitherOrder) {
+  Random random(4711);
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<Vec3f> part = randomPoints(random, 30);
+    for (Vec3f& p : part) p = p * 0.01f;
+    Mat4d far = randomMotion(random), near = randomMotion(random);
+    for (int row = 0; row < 3; ++row) {
+      far.at(row, 3) = row == 0 ? 2000 : 0;
+      near.at(row, 3) = 0.05 * row;
+    }
+    for (const bool farFirst : {true, false}) {
+      Model model;
+      ModelBuilder builder(model);
+      for (const Mat4d& at : farFirst ? std::array{far, near} : std::array{near, far}) {
+        builder.beginObject("part");
+        for (const Vec3f& p : moved(at, part)) builder.addVertex(p);
+        for (std::uint32_t t = 0; t + 2 < 30; ++t) builder.addTriangle(t, t + 1, t + 2);
+        builder.endObject();
+      }
+      EXPECT_EQ(findPlacements(model)[1].source, 0u) << trial << (farFirst ? " far first" : "");
+    }
+  }
+}
+
 // 2CylinderEngine.glb places 29 meshes under 67 nodes; read (world positions) and written again
 // it has its 29 meshes back, and read again every object lies where it lay, with its name.
 TEST(GlbInstances, AGltfAssemblyIsWrittenOncePerMesh) {

@@ -79,8 +79,11 @@ PlacementKey placementKey(const MeshView& mesh, double relativeTolerance) {
   double squares = 0;
   for (const Vec3f& p : mesh.positions) squares += dot(toDouble(p) - centre, toDouble(p) - centre);
   key.spread = std::sqrt(squares / static_cast<double>(mesh.positions.size()));
-  // Both meshes round (half an ulp per coordinate each) and the fit spreads that: 8 ulps.
+  // Both meshes round (up to half an ulp, 2⁻²⁴·|x|, per coordinate each) and the fit spreads
+  // that: eight times 2⁻²⁴ of the distance from the origin.
   key.tolerance = std::max(relativeTolerance * diagonal(mesh.positions), 8 * 0x1p-24 * far);
+  key.fittable =
+      std::isfinite(key.spread) && std::isfinite(key.tolerance) && spansAPlane(mesh.positions);
   return key;
 }
 
@@ -102,28 +105,43 @@ std::optional<FoundPlacement> PlacementIndex::find(
     const PlacementKey& key, const MeshView& mesh,
     const std::function<MeshView(std::uint32_t)>& kept) const {
   const auto meshes = meshes_.find(key.signature);
-  if (meshes == meshes_.end()) return std::nullopt;
-  // Vertices within the tolerance move the centroid and the spread by at most as much each.
-  const double window = 2 * key.tolerance;
-  std::size_t tried = 0;
-  for (auto at = meshes->second.lower_bound(key.spread - window);
-       at != meshes->second.end() && at->first <= key.spread + window && tried < candidates_;
-       ++at, ++tried) {
-    // The kept mesh may lie farther from the origin and round more.
-    const auto [id, tolerance] = at->second;
-    if (const auto motion = placementOf(kept(id), mesh, std::max(key.tolerance, tolerance)))
-      return FoundPlacement{id, *motion};
+  if (!key.fittable || meshes == meshes_.end()) return std::nullopt;
+  // A rigid copy's vertices lie within the tolerance, which moves the centroid and the spread by
+  // at most as much each; the kept mesh may lie farther from the origin and round more.
+  const auto& bySpread = meshes->second.bySpread;
+  const double window = 2 * std::max(key.tolerance, meshes->second.widest);
+  struct Candidate {
+    double difference, tolerance;
+    std::uint32_t id;
+  };
+  std::vector<Candidate> near;
+  for (auto at = bySpread.lower_bound(key.spread - window);
+       at != bySpread.end() && at->first <= key.spread + window; ++at) {
+    const auto [id, keptTolerance] = at->second;
+    const double tolerance = std::max(key.tolerance, keptTolerance);
+    if (const double difference = std::abs(at->first - key.spread); difference <= 2 * tolerance)
+      near.push_back({difference, tolerance, id});
   }
+  // Nearest spread first (ties by id, the earlier kept), so the cap drops the least likely.
+  std::sort(near.begin(), near.end(), [](const Candidate& a, const Candidate& b) {
+    return a.difference != b.difference ? a.difference < b.difference : a.id < b.id;
+  });
+  if (near.size() > candidates_) near.resize(candidates_);
+  for (const Candidate& candidate : near)
+    if (const auto motion = placementOf(kept(candidate.id), mesh, candidate.tolerance))
+      return FoundPlacement{candidate.id, *motion};
   return std::nullopt;
 }
 
 bool PlacementIndex::add(const PlacementKey& key, std::uint32_t id) {
-  auto& meshes = meshes_[key.signature];
+  if (!key.fittable) return false;
+  Kept& meshes = meshes_[key.signature];
   const double window = 2 * key.tolerance;
-  const auto first = meshes.lower_bound(key.spread - window);
-  const auto last = meshes.upper_bound(key.spread + window);
+  const auto first = meshes.bySpread.lower_bound(key.spread - window);
+  const auto last = meshes.bySpread.upper_bound(key.spread + window);
   if (static_cast<std::size_t>(std::distance(first, last)) >= candidates_) return false;
-  meshes.emplace(key.spread, std::pair{id, key.tolerance});
+  meshes.bySpread.emplace(key.spread, std::pair{id, key.tolerance});
+  meshes.widest = std::max(meshes.widest, key.tolerance);
   return true;
 }
 

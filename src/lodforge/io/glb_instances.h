@@ -45,6 +45,8 @@ struct MeshView {
 struct PlacementKey {
   std::uint64_t signature = 0;
   double spread = 0, tolerance = 0;
+  // Finite, and not so near a line that the turn about it is undetermined: a fit can succeed.
+  bool fittable = false;
 };
 PlacementKey placementKey(const MeshView& mesh, double relativeTolerance);
 
@@ -58,22 +60,26 @@ struct FoundPlacement {
   Mat4d motion;
 };
 
-// Meshes kept to place others from, by signature and spread: a search fits only the kept meshes
-// whose spread is within the tolerance, at most `candidates` of them.
+// Meshes kept to place others from, by signature and spread: a search fits only kept meshes whose
+// spread is within twice the larger of the two tolerances, nearest spread first, at most
+// `candidates` of them.
 class PlacementIndex {
  public:
   explicit PlacementIndex(std::size_t candidates = 64) : candidates_(candidates) {}
-  // The first kept mesh that `mesh` is a placement of; `kept` gives a kept mesh by its id.
+  // A kept mesh that `mesh` is a placement of (the nearest in spread that fits); `kept` gives a
+  // kept mesh by its id.
   std::optional<FoundPlacement> find(const PlacementKey& key, const MeshView& mesh,
                                      const std::function<MeshView(std::uint32_t)>& kept) const;
-  // Keeps mesh `id`; false when as many meshes like it are kept already.
+  // Keeps mesh `id`; false when it cannot be fitted or as many meshes like it are kept already.
   bool add(const PlacementKey& key, std::uint32_t id);
 
  private:
+  struct Kept {
+    std::multimap<double, std::pair<std::uint32_t, double>> bySpread;  // → (id, tolerance)
+    double widest = 0;  // the largest tolerance kept: how far a search must look
+  };
   std::size_t candidates_;
-  // signature → spread → (id, tolerance)
-  std::unordered_map<std::uint64_t, std::multimap<double, std::pair<std::uint32_t, double>>>
-      meshes_;
+  std::unordered_map<std::uint64_t, Kept> meshes_;  // by signature
 };
 
 // One placement per object. An object is placed from an earlier one when both have the same

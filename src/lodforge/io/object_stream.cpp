@@ -21,7 +21,7 @@ class ModelStream final : public ObjectStream {
     out.name = std::string(model_.objectName(o));
     out.path = std::string(model_.objectPath(o));
     out.material = r.material;
-    out.layer = r.layer;  // the readers keep it kNoLayer or inside the table (isConsistent)
+    out.layer = r.layer;  // the readers keep it kNoLayer or inside the table
     const auto positions = model_.objectPositions(o);
     out.positions.assign(positions.begin(), positions.end());
     out.normals.clear();

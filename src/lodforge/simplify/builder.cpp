@@ -129,12 +129,13 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
                     formatBytes(kFixedBytes + (std::uint64_t{4} << 20)), formatBytes(kFixedBytes))};
   }
   // The objects in flight get what the limit leaves (a quarter of the machine by default), less
-  // an eighth for the shapes kept to place again.
+  // an eighth for the shapes kept to place again (none without placements).
   const std::uint64_t limit = options.memoryLimit
                                   ? options.memoryLimit - kFixedBytes
                                   : std::max<std::uint64_t>(physicalMemoryBytes() / 4, 256 << 20);
-  ShapeCache shapes(options.placeRepeatedShapes ? limit / 8 : 0);
-  const std::uint64_t budget = limit - limit / 8;
+  const std::uint64_t cacheBytes = options.placeRepeatedShapes ? limit / 8 : 0;
+  ShapeCache shapes(cacheBytes);
+  const std::uint64_t budget = limit - cacheBytes;
   Result<PackageWriter> writer =
       PackageWriter::create(output, stream.origin(), true, stream.hasColors());
   if (!writer) return writer.status();
@@ -178,6 +179,7 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
   Result<std::uint64_t> size = fileSize(output);
   if (!size) return size.status();
   stats.packageBytes = *size;
+  stats.shapeCacheBytes = shapes.bytes();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }

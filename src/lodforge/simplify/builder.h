@@ -34,6 +34,7 @@ struct BuildStats {
   std::uint64_t waves = 0;
   // Objects written as an earlier object's shape moved rigidly (ShapeCache), not built anew.
   std::uint64_t placements = 0;
+  std::uint64_t shapeCacheBytes = 0;  // what the shapes kept to place again held at the end
   bool streamed = false;
   double seconds = 0;
 };

@@ -44,6 +44,7 @@ ShapeLookup ShapeCache::lookup(const SourceObject& object) {
 }
 
 void ShapeCache::setMesh(std::uint32_t shape, const ProgressiveMesh& mesh) {
+  shapes_[shape].built = true;
   ProgressiveMesh& kept = shapes_[shape].mesh;
   kept.q = mesh.q;
   kept.positions = mesh.positions;

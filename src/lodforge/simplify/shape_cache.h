@@ -4,6 +4,7 @@
 // and `extract` writes the mesh once with a node transform per placement.
 #pragma once
 
+#include <cassert>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -39,13 +40,17 @@ class ShapeCache {
   // placement of it is written.
   ShapeLookup lookup(const SourceObject& object);
   void setMesh(std::uint32_t shape, const ProgressiveMesh& mesh);
-  const ProgressiveMesh& mesh(std::uint32_t shape) const { return shapes_[shape].mesh; }
+  const ProgressiveMesh& mesh(std::uint32_t shape) const {
+    assert(shapes_[shape].built);  // the builder writes in stream order
+    return shapes_[shape].mesh;
+  }
   std::uint64_t bytes() const { return bytes_; }
 
  private:
   struct Shape {
     SourceObject input;  // without name and path
     ProgressiveMesh mesh;
+    bool built = false;  // mesh set
   };
   std::uint64_t capacity_, bytes_ = 0;
   double relativeTolerance_;

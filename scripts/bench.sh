@@ -480,8 +480,8 @@ if [[ ${BENCH_ONLY:-} == cad ]]; then cad_section; exit 0; fi
 instances_section() {
   echo
   echo "== build: repeated shapes simplified once, or every object on its own (--no-instances)"
-  printf '| %-20s | %-14s | %8s | %9s | %10s | %8s | %14s |\n' input build wall "peak RSS" placed package "extract meshes"
-  printf '|%s|%s|%s|%s|%s|%s|%s|\n' ---------------------- ---------------- ---------- ----------- ------------ ---------- ----------------
+  printf '| %-20s | %-9s | %8s | %9s | %8s | %8s | %14s | %11s |\n' input build wall "peak RSS" placed package "extract meshes" "extract GLB"
+  printf '|%s|%s|%s|%s|%s|%s|%s|%s|\n' ---------------------- ----------- ---------- ----------- ---------- ---------- ---------------- -------------
   local data=${LODFORGE_DATA:-../shared/data}
   [[ -d $data ]] || data=/work/shared/data
   "$lodforge" -q generate cad --objects 10K -o "$work/cad10k.glb"
@@ -489,13 +489,16 @@ instances_section() {
     for mode in instances own; do
       local flag=() log=$work/build.log result
       [[ $mode == own ]] && flag=(--no-instances)
-      result=$(timed "$lodforge" build "$input" -o "$work/inst.lfp" "${flag[@]}")
-      "$lodforge" build "$input" -o "$work/inst.lfp" "${flag[@]}" > "$log"
+      # One run: its message (how many were placed) to the log, its time and memory to time.log.
+      /usr/bin/time -v "$lodforge" build "$input" -o "$work/inst.lfp" "${flag[@]}" > "$log" \
+        2> "$work/time.log" || { tail -20 "$work/time.log" >&2; exit 1; }
+      result=$(seconds_and_kib "$work/time.log")
       "$lodforge" -q extract "$work/inst.lfp" --ratio 0.5 -o "$work/inst.glb"
-      printf '| %-20s | %-14s | %7ss | %5d MiB | %10s | %8s | %14s |\n' "$(basename "$input")" "$mode" \
-        "${result% *}" $((${result#* } / 1024)) "$(sed -n 's/.*objects (\([0-9,]*\) placed.*/\1/p' "$log")" \
+      printf '| %-20s | %-9s | %7ss | %5d MiB | %8s | %8s | %14s | %11s |\n' "$(basename "$input")" "$mode" \
+        "${result% *}" $((${result#* } / 1024)) "$(sed -n 's/.*objects (\([0-9,]*\) placed.*/\1/p' "$log" | grep . || echo 0)" \
         "$(du -h "$work/inst.lfp" | cut -f1)" \
-        "$(python3 -c 'import json,struct,sys; b=open(sys.argv[1],"rb").read(); n=struct.unpack("<I",b[12:16])[0]; print(len(json.loads(b[20:20+n])["meshes"]))' "$work/inst.glb")"
+        "$(python3 -c 'import json,struct,sys; b=open(sys.argv[1],"rb").read(); n=struct.unpack("<I",b[12:16])[0]; print(len(json.loads(b[20:20+n])["meshes"]))' "$work/inst.glb")" \
+        "$(du -h "$work/inst.glb" | cut -f1)"
     done
   done
   rm -f "$work/cad10k.glb" "$work/inst.lfp" "$work/inst.glb" "$work/build.log"

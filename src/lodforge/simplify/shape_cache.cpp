@@ -12,6 +12,19 @@ std::uint64_t meshBytes(std::uint64_t vertices, std::uint64_t triangles) {
   return vertices * (12 + 12 + 4 + 4 + 4 + 4) + triangles * 12;
 }
 
+// Everything of a progressive mesh but where its vertices are: what every placement shares. The
+// permutations are left out (only the build that made the mesh uses them).
+ProgressiveMesh levelsOf(const ProgressiveMesh& mesh) {
+  ProgressiveMesh levels;
+  levels.q = mesh.q;
+  levels.colors = mesh.colors;
+  levels.triangles = mesh.triangles;
+  levels.ecol = mesh.ecol;
+  levels.map = mesh.map;
+  levels.error = mesh.error;
+  return levels;
+}
+
 }  // namespace
 
 ShapeCache::ShapeCache(std::uint64_t bytes, double relativeTolerance, std::size_t candidates)
@@ -44,32 +57,21 @@ ShapeLookup ShapeCache::lookup(const SourceObject& object) {
 }
 
 void ShapeCache::setMesh(std::uint32_t shape, const ProgressiveMesh& mesh) {
-  shapes_[shape].built = true;
-  ProgressiveMesh& kept = shapes_[shape].mesh;
-  kept.q = mesh.q;
-  kept.positions = mesh.positions;
-  kept.normals = mesh.normals;
-  kept.colors = mesh.colors;
-  kept.triangles = mesh.triangles;
-  kept.ecol = mesh.ecol;
-  kept.map = mesh.map;
-  kept.error = mesh.error;
+  Shape& kept = shapes_[shape];
+  kept.mesh = levelsOf(mesh);
+  kept.mesh.positions = mesh.positions;
+  kept.mesh.normals = mesh.normals;
+  kept.built = true;
 }
 
 ProgressiveMesh placedMesh(const ProgressiveMesh& mesh, const Mat4d& motion) {
-  ProgressiveMesh placed;
-  placed.q = mesh.q;
+  ProgressiveMesh placed = levelsOf(mesh);
   placed.positions.reserve(mesh.positions.size());
   for (const Vec3f& p : mesh.positions)
     placed.positions.push_back(toFloat(motion.transformPoint(toDouble(p))));
   placed.normals.reserve(mesh.normals.size());
   for (const Vec3f& n : mesh.normals)
     placed.normals.push_back(toFloat(motion.transformVector(toDouble(n))));
-  placed.colors = mesh.colors;
-  placed.triangles = mesh.triangles;
-  placed.ecol = mesh.ecol;
-  placed.map = mesh.map;
-  placed.error = mesh.error;
   return placed;
 }
 

@@ -19,6 +19,10 @@ namespace lodforge {
 
 // Where an object's triangles come from in the written file: its own mesh (source == the
 // object, transform the identity) or an earlier object's, moved by `transform`.
+// How far a placed vertex may lie from the moved source, relative to the mesh's size: loose
+// enough for a writer's float rounding, far below anything a viewer shows.
+inline constexpr double kPlacementTolerance = 1e-5;
+
 struct Placement {
   std::uint32_t source = 0;
   Mat4d transform;
@@ -85,7 +89,8 @@ class PlacementIndex {
 // One placement per object. An object is placed from an earlier one when both have the same
 // triangles (indices), colours and material, and a rigid motion takes the earlier's vertices
 // onto its own (placementOf, within its key's tolerance), found through a PlacementIndex.
-std::vector<Placement> findPlacements(const Model& model, double relativeTolerance = 1e-5,
+std::vector<Placement> findPlacements(const Model& model,
+                                      double relativeTolerance = kPlacementTolerance,
                                       std::size_t candidates = 64);
 
 }  // namespace lodforge

@@ -33,7 +33,7 @@ class ShapeCache {
   // Holds at most about `bytes` of shapes (their input and built mesh; 0: none); objects met after
   // that are compared with the shapes held but not kept. At most `candidates` shapes alike
   // (PlacementIndex).
-  explicit ShapeCache(std::uint64_t bytes, double relativeTolerance = 1e-5,
+  explicit ShapeCache(std::uint64_t bytes, double relativeTolerance = kPlacementTolerance,
                       std::size_t candidates = 64);
 
   // Objects must come in stream order; a remembered shape's mesh must be set before the first

@@ -67,7 +67,10 @@ std::uint32_t nearestMember(const PointIndex& index, std::span<const Vec3d> poin
 // order, offers itself to the vertices of the cells within reach, which keep the nearest (the
 // first among equals). A vertex's nearest member lies within the radius of a corner with a value
 // plus an edge of a tetrahedron (√3 voxels), so `reach` voxels round a point find it; a cell none
-// of whose vertices could take the point is passed over.
+// of whose vertices could take the point is passed over. Once the vertices near a point have
+// found near points, the reach shrinks to the farthest of those (as of the last refresh(); they
+// only get nearer, so a stale bound reaches farther, never less far): in a dense cloud a point
+// looks at a few cells, not at the thousand within the radius.
 class NearestPoints {
  public:
   NearestPoints(const VoxelGrid& grid, const ChunkCorners& corners, std::span<const Vec3d> vertices,
@@ -81,7 +84,7 @@ class NearestPoints {
     start_.assign(cellCount() + 1, 0);
     for (std::size_t v = 0; v < vertices.size(); ++v) {
       const std::array<std::uint32_t, 3> c = cellAround(vertices[v]);
-      cellOf[v] = (static_cast<std::size_t>(c[2]) * cells_[1] + c[1]) * cells_[0] + c[0];
+      cellOf[v] = cellIndex(c[0], c[1], c[2]);
       ++start_[cellOf[v] + 1];
     }
     for (std::size_t c = 0; c < cellCount(); ++c) start_[c + 1] += start_[c];
@@ -93,6 +96,23 @@ class NearestPoints {
     worst2_.resize(cellCount());
     for (std::size_t c = 0; c < cellCount(); ++c)
       worst2_[c] = start_[c] == start_[c + 1] ? -1 : std::numeric_limits<double>::infinity();
+    for (std::size_t a = 0; a < 3; ++a) blocks_[a] = (cells_[a] + kBlock - 1) / kBlock;
+    nearBound_.resize(static_cast<std::size_t>(blocks_[0]) * blocks_[1] * blocks_[2]);
+    refresh();
+  }
+
+  // Per block of cells, the largest best distance of the vertices within reach of it (-1: none).
+  void refresh() {
+    std::fill(nearBound_.begin(), nearBound_.end(), -1.0);
+    for (std::uint32_t k = 0; k < cells_[2]; ++k)
+      for (std::uint32_t j = 0; j < cells_[1]; ++j)
+        for (std::uint32_t i = 0; i < cells_[0]; ++i) {
+          double& bound = nearBound_[blockIndex(i / kBlock, j / kBlock, k / kBlock)];
+          bound = std::max(bound, worst2_[cellIndex(i, j, k)]);
+        }
+    // A cell within reach of a point's cell is at most this many blocks from the point's block.
+    const auto across = static_cast<std::uint32_t>(kBlock - 1 + std::ceil(reach_)) / kBlock;
+    for (std::size_t axis = 0; axis < 3; ++axis) dilate(axis, across);
   }
 
   std::uint32_t rows() const { return cells_[1]; }
@@ -100,16 +120,30 @@ class NearestPoints {
   // Offers the block's points to the vertices of cells in rows [rowFirst, rowEnd).
   void add(std::span<const CloudRecord> block, std::uint32_t rowFirst, std::uint32_t rowEnd) {
     for (const CloudRecord& r : block) {
+      // Out of these rows' reach whatever the bound (most points, with many threads).
+      const double gy =
+          (r.position.y - grid_.origin.y) / grid_.voxel - static_cast<double>(first_[1]);
+      if (floorToInt(gy + reach_) < rowFirst || floorToInt(gy - reach_) >= rowEnd) continue;
+      std::array<double, 3> g{};
+      std::array<std::size_t, 3> at{};  // the block of the point's cell (the nearest in the box)
+      for (std::size_t a = 0; a < 3; ++a) {
+        g[a] = (r.position[static_cast<int>(a)] - grid_.origin[static_cast<int>(a)]) / grid_.voxel -
+               static_cast<double>(first_[a]);
+        at[a] = static_cast<std::size_t>(
+                    std::clamp<std::int64_t>(floorToInt(g[a]), 0, std::int64_t{cells_[a]} - 1)) /
+                kBlock;
+      }
+      const double bound = nearBound_[blockIndex(at[0], at[1], at[2])];
+      if (bound < 0) continue;
+      // Beyond sqrt(bound) (and the cells' margin of a thousandth of a voxel) no cell can take it.
+      const double reach = std::min(reach_, std::sqrt(bound) / grid_.voxel + 0.01);
       std::array<std::int64_t, 3> lo{}, hi{};
       bool inside = true;
-      for (std::size_t a = 0; a < 3; ++a) {
-        const double g =
-            (r.position[static_cast<int>(a)] - grid_.origin[static_cast<int>(a)]) / grid_.voxel -
-            static_cast<double>(first_[a]);
+      for (std::size_t a = 0; a < 3 && inside; ++a) {
         const std::int64_t begin = a == 1 ? rowFirst : 0, end = a == 1 ? rowEnd : cells_[a];
-        lo[a] = std::max<std::int64_t>(static_cast<std::int64_t>(std::floor(g - reach_)), begin);
-        hi[a] = std::min<std::int64_t>(static_cast<std::int64_t>(std::floor(g + reach_)), end - 1);
-        inside = inside && lo[a] <= hi[a];
+        lo[a] = std::max<std::int64_t>(floorToInt(g[a] - reach), begin);
+        hi[a] = std::min<std::int64_t>(floorToInt(g[a] + reach), end - 1);
+        inside = lo[a] <= hi[a];
       }
       if (!inside) continue;
       for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
@@ -121,8 +155,31 @@ class NearestPoints {
   std::vector<Rgba8> colors() && { return std::move(colors_); }
 
  private:
+  static constexpr std::uint32_t kBlock = 4;  // cells along a block's edge
+
   std::size_t cellCount() const {
     return static_cast<std::size_t>(cells_[0]) * cells_[1] * cells_[2];
+  }
+  std::size_t cellIndex(std::size_t i, std::size_t j, std::size_t k) const {
+    return (k * cells_[1] + j) * cells_[0] + i;
+  }
+  std::size_t blockIndex(std::size_t i, std::size_t j, std::size_t k) const {
+    return (k * blocks_[1] + j) * blocks_[0] + i;
+  }
+
+  // nearBound_ replaced by the largest within `across` blocks along `axis`.
+  void dilate(std::size_t axis, std::uint32_t across) {
+    const std::array<std::size_t, 3> step{1, blocks_[0], std::size_t{blocks_[0]} * blocks_[1]};
+    const std::vector<double> before = nearBound_;
+    for (std::size_t b = 0; b < nearBound_.size(); ++b) {
+      const std::size_t along = b / step[axis] % blocks_[axis];
+      const std::size_t from = along >= across ? along - across : 0;
+      const std::size_t to = std::min<std::size_t>(blocks_[axis] - 1, along + across);
+      double bound = -1;
+      for (std::size_t t = from; t <= to; ++t)
+        bound = std::max(bound, before[b - along * step[axis] + t * step[axis]]);
+      nearBound_[b] = bound;
+    }
   }
 
   std::array<std::uint32_t, 3> cellAround(Vec3d p) const {
@@ -138,9 +195,8 @@ class NearestPoints {
 
   void offer(const CloudRecord& r, std::array<std::int64_t, 3> cell) {
     const std::size_t c =
-        (static_cast<std::size_t>(cell[2]) * cells_[1] + static_cast<std::size_t>(cell[1])) *
-            cells_[0] +
-        static_cast<std::size_t>(cell[0]);
+        cellIndex(static_cast<std::size_t>(cell[0]), static_cast<std::size_t>(cell[1]),
+                  static_cast<std::size_t>(cell[2]));
     if (worst2_[c] < 0) return;
     // The point's distance to the cell, the cell a thousandth of a voxel wider (a vertex may
     // round out of it): no vertex in it is nearer.
@@ -175,6 +231,8 @@ class NearestPoints {
   std::array<std::uint32_t, 3> cells_{};
   std::vector<std::size_t> start_, order_;  // a cell's vertices: order_[start_[c], start_[c+1])
   std::vector<double> best2_, worst2_;      // per vertex; per cell its vertices' largest (-1: none)
+  std::array<std::uint32_t, 3> blocks_{};
+  std::vector<double> nearBound_;  // per block of kBlock³ cells (refresh())
   std::vector<Rgba8> colors_;
 };
 
@@ -224,10 +282,20 @@ Result<SurfacePiece> streamedChunkPiece(const ChunkLayout& layout, std::uint64_t
   SurfacePiece piece = polygonize(layout.grid, sums.values(), corners.first, corners.size);
   if (!colors || piece.positions.empty()) return piece;
   NearestPoints nearest(layout.grid, corners, piece.positions, distance.radius + 2);
+  // The bounds start unknown (every point looks the whole reach round it): refreshed after 1 K
+  // points, then after as many again as were offered, up to a file block.
+  std::size_t offered = 0;
   LODFORGE_TRY(forEachRecordBlock(runFile, [&](std::span<const CloudRecord> block) {
-    forEachRowShare(nearest.rows(), [&](std::uint32_t first, std::uint32_t end) {
-      nearest.add(block, first, end);
-    });
+    while (!block.empty()) {
+      const std::span<const CloudRecord> part =
+          block.first(std::min(block.size(), std::max<std::size_t>(1024, offered)));
+      forEachRowShare(nearest.rows(), [&](std::uint32_t first, std::uint32_t end) {
+        nearest.add(part, first, end);
+      });
+      nearest.refresh();
+      offered += part.size();
+      block = block.subspan(part.size());
+    }
     return Status{};
   }));
   piece.colors = std::move(nearest).colors();

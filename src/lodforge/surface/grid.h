@@ -11,6 +11,17 @@
 
 namespace lodforge {
 
+// floor and ceil to an integer without a call into libm (the per-point loops run them by the
+// hundred million); exact for |x| < 2⁶³.
+inline std::int64_t floorToInt(double x) {
+  const auto t = static_cast<std::int64_t>(x);
+  return static_cast<double>(t) > x ? t - 1 : t;
+}
+inline std::int64_t ceilToInt(double x) {
+  const auto t = static_cast<std::int64_t>(x);
+  return static_cast<double>(t) < x ? t + 1 : t;
+}
+
 struct VoxelGrid {
   Vec3d origin;  // world position of global corner (0, 0, 0)
   double voxel = 1;

@@ -22,15 +22,14 @@ void CornerSums::add(Vec3d at, Vec3f normal, std::uint32_t rowFirst, std::uint32
   const double inverseRadius2 = 1 / radius2, inverseVoxel = 1 / grid_.voxel;
   const Vec3d n = toDouble(normal);
   std::array<std::int64_t, 3> lo{}, hi{};
-  for (std::size_t a = 0; a < 3; ++a) {
+  // Rows first: a thread owning a share of the rows passes over most points here.
+  for (const std::size_t a : {std::size_t{1}, std::size_t{0}, std::size_t{2}}) {
     const double g = (at[static_cast<int>(a)] - grid_.origin[static_cast<int>(a)]) / grid_.voxel;
     const auto first = static_cast<std::int64_t>(first_[a]);
     const std::int64_t begin = a == 1 ? first + rowFirst : first;
     const std::int64_t end = a == 1 ? first + rowEnd : first + size_[a];
-    lo[a] =
-        std::max<std::int64_t>(static_cast<std::int64_t>(std::ceil(g - options_.radius)), begin);
-    hi[a] =
-        std::min<std::int64_t>(static_cast<std::int64_t>(std::floor(g + options_.radius)), end - 1);
+    lo[a] = std::max<std::int64_t>(ceilToInt(g - options_.radius), begin);
+    hi[a] = std::min<std::int64_t>(floorToInt(g + options_.radius), end - 1);
     if (lo[a] > hi[a]) return;
   }
   const double gx = (at.x - grid_.origin.x) / grid_.voxel;

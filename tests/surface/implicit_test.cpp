@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "lodforge/core/random.h"
 
@@ -75,21 +76,18 @@ TEST(SignedDistance, ACornerHasTheSameValueInEveryBox) {
       }
 }
 
-// Rows of corners added apart (as threads share a streamed chunk's rows) hold the same bits as
-// all rows at once.
-TEST(SignedDistance, RowsAddedApartAreTheSameAsAllAtOnce) {
+// The cells spread by one thread or shared by rows between several hold the same bits.
+TEST(SignedDistance, TheSameBitsForAnyThreadCount) {
   Cloud cloud = plane(3000, 7);
   Random random(4);
   for (Vec3d& p : cloud.positions) p.z += random.uniform(-0.05, 0.05);
   const VoxelGrid grid{{0, 0, -1}, 0.2, {21, 21, 11}};
-  CornerSums whole(grid, {}, {2, 1, 0}, {17, 19, 11});
-  CornerSums apart(grid, {}, {2, 1, 0}, {17, 19, 11});
-  for (std::size_t p = 0; p < cloud.positions.size(); ++p) {
-    whole.add(cloud.positions[p], cloud.normals[p]);
-    for (const auto& [first, end] : {std::pair{0u, 5u}, {5u, 6u}, {6u, 19u}})
-      apart.add(cloud.positions[p], cloud.normals[p], first, end);
-  }
-  const CornerValues a = whole.values(), b = apart.values();
+  CornerSums sums(grid, {}, {2, 1, 0}, {17, 19, 11});
+  for (std::size_t p = 0; p < cloud.positions.size(); ++p)
+    sums.add(cloud.positions[p], cloud.normals[p]);
+  tbb::task_arena one(1), three(3);
+  const CornerValues a = one.execute([&] { return sums.values(); });
+  const CornerValues b = three.execute([&] { return sums.values(); });
   ASSERT_EQ(a.values.size(), b.values.size());
   EXPECT_EQ(std::memcmp(a.values.data(), b.values.data(), a.values.size() * 4), 0);
   std::size_t known = 0;

@@ -249,6 +249,7 @@ TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
   ReconstructOptions options;
   options.voxel = 1.1;
   options.chunkVoxels = 9;
+  options.runPoints = 1'000'000;  // every chunk's points, overlaps included, in one run
   Result<ReconstructStats> one = reconstructToFile(cloud, dir.file("one.ply"), options);
   ASSERT_TRUE(one.ok()) << one.error().message;
   EXPECT_EQ(one->runs, 1u);

@@ -274,9 +274,7 @@ Result<SurfacePiece> streamedChunkPiece(const ChunkLayout& layout, std::uint64_t
   const ChunkCorners corners = cornersOf(layout, chunk);
   CornerSums sums(layout.grid, distance, corners.boxFirst, corners.boxSize);
   LODFORGE_TRY(forEachRecordBlock(runFile, [&](std::span<const CloudRecord> block) {
-    forEachRowShare(sums.rows(), [&](std::uint32_t first, std::uint32_t end) {
-      for (const CloudRecord& r : block) sums.add(r.position, r.normal, first, end);
-    });
+    for (const CloudRecord& r : block) sums.add(r.position, r.normal);
     return Status{};
   }));
   SurfacePiece piece = polygonize(layout.grid, sums.values(), corners.first, corners.size);

@@ -2,8 +2,9 @@
 // and a corner of margin, polygonized within its own corners, a vertex's colour its nearest
 // point's. A chunk is made from its points held in memory (a run of chunks read whole) or, when
 // its points alone are more than a run may hold, streamed from its run file in blocks: the sums
-// then live at the corners only, and memory does not grow with the points. Both add a corner's
-// points in input order and pick the same nearest point, so they make the same bits.
+// then live in the point cells and at the corners only, and memory does not grow with the
+// points. Both sum a cell's points in input order and pick the same nearest point, so they make
+// the same bits.
 #pragma once
 
 #include <cstdint>

@@ -33,6 +33,15 @@ struct VoxelGrid {
   }
 };
 
+// Points are summed per half-voxel cell before they are spread to the corners (implicit.h): the
+// cell holding p, in global half-voxel coordinates.
+inline constexpr int kCellSplit = 2;
+inline std::array<std::int64_t, 3> pointCellOf(const VoxelGrid& grid, const Vec3d& p) {
+  const double scale = kCellSplit / grid.voxel;
+  return {floorToInt((p.x - grid.origin.x) * scale), floorToInt((p.y - grid.origin.y) * scale),
+          floorToInt((p.z - grid.origin.z) * scale)};
+}
+
 // The values of a box of global corners [first, first + size) (x fastest), NaN where no point
 // is near enough to say.
 struct CornerValues {

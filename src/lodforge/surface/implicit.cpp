@@ -3,26 +3,51 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace lodforge {
 
 CornerSums::CornerSums(const VoxelGrid& grid, const DistanceOptions& options,
                        std::array<std::uint64_t, 3> first, std::array<std::uint32_t, 3> size)
-    : grid_(grid),
-      options_(options),
-      first_(first),
-      size_(size),
-      corners_(static_cast<std::size_t>(size[0]) * size[1] * size[2]) {}
+    : grid_(grid), options_(options), first_(first), size_(size) {}
 
-void CornerSums::add(Vec3d at, Vec3f normal, std::uint32_t rowFirst, std::uint32_t rowEnd) {
+namespace {
+
+// The corner of a point cell, where its sums are taken from.
+Vec3d cellCorner(const VoxelGrid& grid, const std::array<std::int64_t, 3>& key) {
+  return grid.origin + Vec3d{static_cast<double>(key[0]), static_cast<double>(key[1]),
+                             static_cast<double>(key[2])} *
+                           (grid.voxel / kCellSplit);
+}
+
+}  // namespace
+
+void CornerSums::add(Vec3d at, Vec3f normal) {
+  const std::array<std::int64_t, 3> key = pointCellOf(grid_, at);
+  Cell& cell = cells_[key];
+  const Vec3d q = at - cellCorner(grid_, key), n = toDouble(normal);
+  cell.offset = cell.offset + q;
+  cell.normal = cell.normal + n;
+  cell.plane += dot(n, q);
+  ++cell.count;
+}
+
+void CornerSums::spread(const std::array<std::int64_t, 3>& key, const Cell& cell,
+                        std::vector<Sums>& corners, std::uint32_t rowFirst,
+                        std::uint32_t rowEnd) const {
   const double radius = options_.radius * grid_.voxel, radius2 = radius * radius;
   // A row of corners whose (y, z) alone are this far is wholly out of reach (with a margin for
   // the rounding of the full sum, so that no corner within the radius is skipped).
   const double rowReach2 = radius2 * (1 + 1e-9);
   const double inverseRadius2 = 1 / radius2, inverseVoxel = 1 / grid_.voxel;
-  const Vec3d n = toDouble(normal);
+  const Vec3d o = cellCorner(grid_, key);
+  const auto count = static_cast<double>(cell.count);
+  const Vec3d at = o + cell.offset / count;  // the centroid
   std::array<std::int64_t, 3> lo{}, hi{};
-  // Rows first: a thread owning a share of the rows passes over most points here.
+  // Rows first: a thread owning a share of the rows passes over most cells here.
   for (const std::size_t a : {std::size_t{1}, std::size_t{0}, std::size_t{2}}) {
     const double g = (at[static_cast<int>(a)] - grid_.origin[static_cast<int>(a)]) / grid_.voxel;
     const auto first = static_cast<std::int64_t>(first_[a]);
@@ -33,6 +58,7 @@ void CornerSums::add(Vec3d at, Vec3f normal, std::uint32_t rowFirst, std::uint32
     if (lo[a] > hi[a]) return;
   }
   const double gx = (at.x - grid_.origin.x) / grid_.voxel;
+  const Vec3f direction = toFloat(cell.normal);
   for (std::int64_t k = lo[2]; k <= hi[2]; ++k) {
     for (std::int64_t j = lo[1]; j <= hi[1]; ++j) {
       const Vec3d row =
@@ -42,9 +68,9 @@ void CornerSums::add(Vec3d at, Vec3f normal, std::uint32_t rowFirst, std::uint32
       const double across2 = row.y * row.y + row.z * row.z;
       if (across2 >= rowReach2) continue;
       Sums* line =
-          &corners_[(static_cast<std::size_t>(k - static_cast<std::int64_t>(first_[2])) * size_[1] +
-                     static_cast<std::size_t>(j - static_cast<std::int64_t>(first_[1]))) *
-                    size_[0]];
+          &corners[(static_cast<std::size_t>(k - static_cast<std::int64_t>(first_[2])) * size_[1] +
+                    static_cast<std::size_t>(j - static_cast<std::int64_t>(first_[1]))) *
+                   size_[0]];
       // The row's corners within reach, a corner wider each way (the test below decides).
       // (Truncation is floor for these non-negative grid coordinates; a corner's margin covers
       // the rest.)
@@ -61,23 +87,42 @@ void CornerSums::add(Vec3d at, Vec3f normal, std::uint32_t rowFirst, std::uint32
         const double t = 1 - d2 * inverseRadius2;
         const double w = t * t;
         Sums& corner = line[i - static_cast<std::int64_t>(first_[0])];
-        corner.weight += w;
-        corner.sum += w * dot(n, d);
-        corner.offset = corner.offset - toFloat(d * w);
-        corner.direction = corner.direction + toFloat(n * w);
-        ++corner.near;
+        corner.weight += w * count;
+        corner.sum += w * (dot(cell.normal, c - o) - cell.plane);
+        corner.offset = corner.offset - toFloat(d * (w * count));
+        corner.direction = corner.direction + direction * static_cast<float>(w);
+        corner.near += cell.count;
       }
     }
   }
 }
 
 CornerValues CornerSums::values() const {
+  // The cells in global order (z, y, x): the order every corner adds them in.
+  using Entry = std::pair<const std::array<std::int64_t, 3>, Cell>;
+  std::vector<const Entry*> order;
+  order.reserve(cells_.size());
+  for (const Entry& entry : cells_) order.push_back(&entry);
+  std::sort(order.begin(), order.end(), [](const Entry* a, const Entry* b) {
+    const auto& p = a->first;
+    const auto& q = b->first;
+    return std::tie(p[2], p[1], p[0]) < std::tie(q[2], q[1], q[0]);
+  });
+  std::vector<Sums> corners(static_cast<std::size_t>(size_[0]) * size_[1] * size_[2]);
+  const std::uint32_t rows = size_[1];
+  const auto shares = std::min<std::uint32_t>(
+      rows, static_cast<std::uint32_t>(4 * std::max(1, tbb::this_task_arena::max_concurrency())));
+  tbb::parallel_for(std::uint32_t{0}, shares, [&](std::uint32_t share) {
+    const auto first = static_cast<std::uint32_t>(std::uint64_t{rows} * share / shares);
+    const auto end = static_cast<std::uint32_t>(std::uint64_t{rows} * (share + 1) / shares);
+    for (const Entry* entry : order) spread(entry->first, entry->second, corners, first, end);
+  });
   CornerValues values{first_, size_, {}};
-  values.values.assign(corners_.size(), std::numeric_limits<float>::quiet_NaN());
+  values.values.assign(corners.size(), std::numeric_limits<float>::quiet_NaN());
   const double radius = options_.radius * grid_.voxel;
   const double edge2 = options_.edge * options_.edge * radius * radius;
-  for (std::size_t c = 0; c < corners_.size(); ++c) {
-    const Sums& corner = corners_[c];
+  for (std::size_t c = 0; c < corners.size(); ++c) {
+    const Sums& corner = corners[c];
     if (corner.near < options_.minPoints) continue;
     // The near points' centroid seen from the corner, along their mean plane.
     const Vec3d offset = toDouble(corner.offset) * (1 / corner.weight);

@@ -4,15 +4,17 @@
 // fewer than `minPoints` points are that near: no surface bridges a hole.
 //
 // §3.3 makes the values of overlapping chunks identical by averaging them; here they are
-// identical by construction: a corner's value depends only on the points within the radius,
-// every chunk holds all of them (its overlap is at least the radius) and adds them in one order
-// that is the same for every chunk (input order), so two chunks compute the same bits. No value
-// either past the edge of the points (DistanceOptions::edge).
+// identical by construction: a corner's value depends only on the point cells within the
+// radius, every chunk holds all of their points (its overlap is at least the radius, in whole
+// cells), sums each cell in input order and spreads the cells in one global order, so two
+// chunks compute the same bits. No value either past the edge of the points
+// (DistanceOptions::edge).
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <span>
+#include <unordered_map>
 #include <vector>
 
 #include "lodforge/core/math.h"
@@ -36,33 +38,54 @@ struct DistanceOptions {
   double edge = 0.5;
 };
 
-// The sums behind a box's corner values, filled a point at a time: a chunk's points can be
-// streamed through it from a file, and split by rows of corners between threads (each row adds
-// the same points in the same order whichever thread owns it).
+// The sums behind a box's corner values, filled a point at a time (a chunk's points can be
+// streamed through it from a file). A point is first summed into its half-voxel point cell
+// (pointCellOf): count, Σ(p − o), Σn and Σ n·(p − o) from the cell's corner o, in input order;
+// values() then spreads each cell to the corners within the radius of its centroid, the cells in
+// global order, split by rows of corners between the threads. The plane distances are exact sums
+// (Σ n·(c − p) = Σn·(c − o) − Σ n·(p − o)); only the weight is taken at the centroid, a quarter
+// voxel from any point at most, where a dense cloud would spread every point on its own. A cell
+// summed in any box that holds all its points is the same bits, and so is every corner value.
 class CornerSums {
  public:
   CornerSums(const VoxelGrid& grid, const DistanceOptions& options,
              std::array<std::uint64_t, 3> first, std::array<std::uint32_t, 3> size);
-  // Adds a point (in input order) to the box's corners within the radius whose row (y index in
-  // the box) is in [rowFirst, rowEnd).
-  void add(Vec3d at, Vec3f normal, std::uint32_t rowFirst, std::uint32_t rowEnd);
-  void add(Vec3d at, Vec3f normal) { add(at, normal, 0, size_[1]); }
-  std::uint32_t rows() const { return size_[1]; }
+  // Adds a point (in input order: the order of every sum).
+  void add(Vec3d at, Vec3f normal);
   // The values: NaN where fewer than minPoints points are near or past the edge of the points.
   CornerValues values() const;
 
  private:
-  // One corner's sums side by side: a point's update touches one cache line per corner.
+  // One point cell's sums.
+  struct Cell {
+    Vec3d offset, normal;  // Σ (p − o), Σ n
+    double plane = 0;      // Σ n·(p − o)
+    std::uint32_t count = 0;
+  };
+  // One corner's sums side by side: a cell's update touches one cache line per corner.
   struct Sums {
     double weight = 0, sum = 0;
     Vec3f offset, direction;  // Σ w (p − c), Σ w n (only compared)
     std::uint32_t near = 0;
   };
+  struct CellHash {
+    std::size_t operator()(const std::array<std::int64_t, 3>& c) const {
+      const auto x = static_cast<std::uint64_t>(c[0]), y = static_cast<std::uint64_t>(c[1]),
+                 z = static_cast<std::uint64_t>(c[2]);
+      return static_cast<std::size_t>((x * 0x9E3779B97F4A7C15ull) ^ (y * 0xC2B2AE3D27D4EB4Full) ^
+                                      (z * 0x165667B19E3779F9ull));
+    }
+  };
+  // Spreads a cell to the box's corners within the radius of its centroid whose row (y index in
+  // the box) is in [rowFirst, rowEnd).
+  void spread(const std::array<std::int64_t, 3>& key, const Cell& cell, std::vector<Sums>& corners,
+              std::uint32_t rowFirst, std::uint32_t rowEnd) const;
+
   const VoxelGrid& grid_;
   DistanceOptions options_;
   std::array<std::uint64_t, 3> first_;
   std::array<std::uint32_t, 3> size_;
-  std::vector<Sums> corners_;
+  std::unordered_map<std::array<std::int64_t, 3>, Cell, CellHash> cells_;
 };
 
 // Fills values.values for the box values.first/size from the points (CornerSums in one go).

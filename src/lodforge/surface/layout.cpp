@@ -10,11 +10,13 @@ namespace lodforge {
 ChunkBox ChunkLayout::reach(const Vec3d& p, double radius) const {
   ChunkBox box;
   const std::uint64_t size = n;
+  const std::array<std::int64_t, 3> cell = pointCellOf(grid, p);
   for (std::size_t a = 0; a < 3; ++a) {
-    const int axis = static_cast<int>(a);
-    const double g = (p[axis] - grid.origin[axis]) / grid.voxel;
-    const auto first = static_cast<std::uint64_t>(std::max(0.0, std::ceil(g - radius)));
-    const auto last = static_cast<std::uint64_t>(std::max(0.0, std::floor(g + radius)));
+    // The cell's extent along the axis, in voxels.
+    const double low = static_cast<double>(cell[a]) / kCellSplit;
+    const double high = static_cast<double>(cell[a] + 1) / kCellSplit;
+    const auto first = static_cast<std::uint64_t>(std::max(0.0, std::ceil(low - radius)));
+    const auto last = static_cast<std::uint64_t>(std::max(0.0, std::floor(high + radius)));
     // Corner x lies in chunks ceil(x / n) − 1 … floor(x / n).
     box.lo[a] = std::min(chunks[a] - 1, first == 0 ? 0 : (first + size - 1) / size - 1);
     box.hi[a] = std::min(chunks[a] - 1, last / size);

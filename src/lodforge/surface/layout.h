@@ -30,7 +30,8 @@ struct ChunkLayout {
   std::array<std::uint64_t, 3> chunkAt(std::uint64_t c) const {
     return {c % chunks[0], (c / chunks[0]) % chunks[1], c / (chunks[0] * chunks[1])};
   }
-  // The chunks holding a corner within `radius` voxels of p.
+  // The chunks holding a corner within `radius` voxels of p's point cell (pointCellOf): every
+  // point of a cell reaches the same chunks, so each chunk sums a cell's points alike.
   ChunkBox reach(const Vec3d& p, double radius) const;
   // The chunk whose cells hold p.
   std::uint64_t owner(const Vec3d& p) const;

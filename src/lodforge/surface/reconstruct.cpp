@@ -35,9 +35,10 @@ constexpr std::uint64_t kBytesPerPropagatedPoint = 24 + 12 + 12 * 4 * 3;
 // Bytes of one chunk in flight per corner: the weight and sum (doubles), offsets and
 // directions (floats), count and value.
 constexpr std::uint64_t kBytesPerCorner = 8 + 8 + 12 + 12 + 4 + 4;
-// Bytes a point of a run costs: its record, its places in the chunks' lists, and the gathered
-// copies of the chunks in flight with their k-d trees for colours.
-constexpr std::uint64_t kBytesPerRunPoint = 48 + 8 + 44 + 40;
+// Bytes a point of a run costs: its record, its places in the chunks' lists, the gathered
+// copies of the chunks in flight with their k-d trees for colours, and its point cell in the
+// chunks' sums (a hash node, when every point has a cell of its own).
+constexpr std::uint64_t kBytesPerRunPoint = 48 + 8 + 44 + 40 + 112;
 // What the rest holds besides the runs and the grids (the join's wavefront, buffers).
 constexpr std::uint64_t kOtherBytes = std::uint64_t{48} << 20;
 
@@ -395,6 +396,8 @@ nlohmann::json reconstructIdentity(const std::string& input, const ReconstructOp
       {"radius", options.distance.radius},
       {"minPoints", options.distance.minPoints},
       {"edge", options.distance.edge},
+      // How the distances are summed: runs kept by a version that summed otherwise are not ours.
+      {"sums", "half-voxel point cells"},
       {"neighbours", options.normals.neighbours},
       {"orientation", static_cast<int>(options.normals.orientation)},
       {"viewpoint", {view.x, view.y, view.z}},

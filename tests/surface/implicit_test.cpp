@@ -88,8 +88,11 @@ TEST(SignedDistance, TheSameBitsForAnyThreadCount) {
   tbb::task_arena one(1), three(3);
   const CornerValues a = one.execute([&] { return sums.values(); });
   const CornerValues b = three.execute([&] { return sums.values(); });
+  const CornerValues c = sums.values(1), d = three.execute([&] { return sums.values(5); });
   ASSERT_EQ(a.values.size(), b.values.size());
   EXPECT_EQ(std::memcmp(a.values.data(), b.values.data(), a.values.size() * 4), 0);
+  EXPECT_EQ(std::memcmp(a.values.data(), c.values.data(), a.values.size() * 4), 0);
+  EXPECT_EQ(std::memcmp(a.values.data(), d.values.data(), a.values.size() * 4), 0);
   std::size_t known = 0;
   for (const float v : a.values) known += std::isnan(v) ? 0 : 1;
   EXPECT_GT(known, 500u);

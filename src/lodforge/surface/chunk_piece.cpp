@@ -256,7 +256,7 @@ SurfacePiece heldChunkPiece(const ChunkLayout& layout, std::uint64_t chunk,
   const ChunkCorners corners = cornersOf(layout, chunk);
   CornerSums sums(layout.grid, distance, corners.boxFirst, corners.boxSize);
   for (const std::uint32_t m : members) sums.add(records[m].position, records[m].normal);
-  SurfacePiece piece = polygonize(layout.grid, sums.values(), corners.first, corners.size);
+  SurfacePiece piece = polygonize(layout.grid, sums.values(1), corners.first, corners.size);
   if (colors && !piece.positions.empty()) {
     std::vector<Vec3d> p(members.size());
     for (std::size_t m = 0; m < members.size(); ++m) p[m] = records[members[m]].position;

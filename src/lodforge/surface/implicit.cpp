@@ -97,7 +97,7 @@ void CornerSums::spread(const std::array<std::int64_t, 3>& key, const Cell& cell
   }
 }
 
-CornerValues CornerSums::values() const {
+CornerValues CornerSums::values(int threads) const {
   // The cells in global order (z, y, x): the order every corner adds them in.
   using Entry = std::pair<const std::array<std::int64_t, 3>, Cell>;
   std::vector<const Entry*> order;
@@ -110,13 +110,29 @@ CornerValues CornerSums::values() const {
   });
   std::vector<Sums> corners(static_cast<std::size_t>(size_[0]) * size_[1] * size_[2]);
   const std::uint32_t rows = size_[1];
-  const auto shares = std::min<std::uint32_t>(
-      rows, static_cast<std::uint32_t>(4 * std::max(1, tbb::this_task_arena::max_concurrency())));
-  tbb::parallel_for(std::uint32_t{0}, shares, [&](std::uint32_t share) {
-    const auto first = static_cast<std::uint32_t>(std::uint64_t{rows} * share / shares);
-    const auto end = static_cast<std::uint32_t>(std::uint64_t{rows} * (share + 1) / shares);
-    for (const Entry* entry : order) spread(entry->first, entry->second, corners, first, end);
-  });
+  if (threads == 0) threads = std::max(1, tbb::this_task_arena::max_concurrency());
+  if (threads == 1) {
+    for (const Entry* entry : order) spread(entry->first, entry->second, corners, 0, rows);
+  } else {
+    // Each share of the rows passes over the cells that reach none of its rows by two integer
+    // comparisons: the rows a cell's centroid reaches (a row more each way for rounding).
+    std::vector<std::pair<std::int64_t, std::int64_t>> reached(order.size());
+    for (std::size_t e = 0; e < order.size(); ++e) {
+      const Cell& cell = order[e]->second;
+      const double y =
+          cellCorner(grid_, order[e]->first).y + cell.offset.y / static_cast<double>(cell.count);
+      const double g = (y - grid_.origin.y) / grid_.voxel - static_cast<double>(first_[1]);
+      reached[e] = {floorToInt(g - options_.radius) - 1, floorToInt(g + options_.radius) + 1};
+    }
+    const auto shares = std::min<std::uint32_t>(rows, static_cast<std::uint32_t>(4 * threads));
+    tbb::parallel_for(std::uint32_t{0}, shares, [&](std::uint32_t share) {
+      const auto first = static_cast<std::uint32_t>(std::uint64_t{rows} * share / shares);
+      const auto end = static_cast<std::uint32_t>(std::uint64_t{rows} * (share + 1) / shares);
+      for (std::size_t e = 0; e < order.size(); ++e)
+        if (reached[e].second >= first && reached[e].first < end)
+          spread(order[e]->first, order[e]->second, corners, first, end);
+    });
+  }
   CornerValues values{first_, size_, {}};
   values.values.assign(corners.size(), std::numeric_limits<float>::quiet_NaN());
   const double radius = options_.radius * grid_.voxel;

@@ -53,7 +53,9 @@ class CornerSums {
   // Adds a point (in input order: the order of every sum).
   void add(Vec3d at, Vec3f normal);
   // The values: NaN where fewer than minPoints points are near or past the edge of the points.
-  CornerValues values() const;
+  // The rows of corners are shared between `threads` (0: the arena's; 1: this thread alone, as
+  // when the chunks themselves are made in parallel); the same bits for any count.
+  CornerValues values(int threads = 0) const;
 
  private:
   // One point cell's sums.

@@ -48,7 +48,8 @@ double distance2(Vec3d a, Vec3d b) {
 std::uint32_t nearestMember(const PointIndex& index, std::span<const Vec3d> points, Vec3d q) {
   std::vector<std::uint32_t> found;
   std::vector<double> found2;
-  for (std::size_t k = 8;; k *= 4) {
+  // Two at first: the nearest, and whether the next ties with it (rare but for duplicates).
+  for (std::size_t k = 2;; k *= 4) {
     found.resize(k);
     found2.resize(k);
     const std::size_t n = index.nearest(q, k, found.data(), found2.data());

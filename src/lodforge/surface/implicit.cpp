@@ -61,12 +61,15 @@ void CornerSums::spread(const std::array<std::int64_t, 3>& key, const Cell& cell
   const Vec3f direction = toFloat(cell.normal);
   for (std::int64_t k = lo[2]; k <= hi[2]; ++k) {
     for (std::int64_t j = lo[1]; j <= hi[1]; ++j) {
-      const Vec3d row =
+      const Vec3d rowStart =
           grid_.position(static_cast<std::uint64_t>(lo[0]), static_cast<std::uint64_t>(j),
-                         static_cast<std::uint64_t>(k)) -
-          at;
+                         static_cast<std::uint64_t>(k));
+      const Vec3d row = rowStart - at;
       const double across2 = row.y * row.y + row.z * row.z;
       if (across2 >= rowReach2) continue;
+      // Σ n·(c − p) = Σn·(c − o) − Σ n·(p − o); the y and z terms are the row's.
+      const double planeAcross =
+          cell.normal.y * (rowStart.y - o.y) + cell.normal.z * (rowStart.z - o.z) - cell.plane;
       Sums* line =
           &corners[(static_cast<std::size_t>(k - static_cast<std::int64_t>(first_[2])) * size_[1] +
                     static_cast<std::size_t>(j - static_cast<std::int64_t>(first_[1]))) *
@@ -79,17 +82,16 @@ void CornerSums::spread(const std::array<std::int64_t, 3>& key, const Cell& cell
           std::max(lo[0], static_cast<std::int64_t>(std::max(0.0, gx - half)) - 1);
       const std::int64_t last = std::min(hi[0], static_cast<std::int64_t>(gx + half) + 1);
       for (std::int64_t i = first; i <= last; ++i) {
-        const Vec3d c = grid_.position(static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(j),
-                                       static_cast<std::uint64_t>(k));
-        const Vec3d d = c - at;
-        const double d2 = dot(d, d);
+        const double cx = grid_.origin.x + static_cast<double>(i) * grid_.voxel;
+        const double dx = cx - at.x;
+        const double d2 = dx * dx + across2;
         if (d2 >= radius2) continue;
         const double t = 1 - d2 * inverseRadius2;
-        const double w = t * t;
+        const double w = t * t, wn = w * count;
         Sums& corner = line[i - static_cast<std::int64_t>(first_[0])];
-        corner.weight += w * count;
-        corner.sum += w * (dot(cell.normal, c - o) - cell.plane);
-        corner.offset = corner.offset - toFloat(d * (w * count));
+        corner.weight += wn;
+        corner.sum += w * (cell.normal.x * (cx - o.x) + planeAcross);
+        corner.offset = corner.offset - toFloat(Vec3d{dx, row.y, row.z} * wn);
         corner.direction = corner.direction + direction * static_cast<float>(w);
         corner.near += cell.count;
       }

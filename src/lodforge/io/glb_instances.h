@@ -17,12 +17,12 @@
 
 namespace lodforge {
 
-// Where an object's triangles come from in the written file: its own mesh (source == the
-// object, transform the identity) or an earlier object's, moved by `transform`.
 // How far a placed vertex may lie from the moved source, relative to the mesh's size: loose
 // enough for a writer's float rounding, far below anything a viewer shows.
 inline constexpr double kPlacementTolerance = 1e-5;
 
+// Where an object's triangles come from in the written file: its own mesh (source == the
+// object, transform the identity) or an earlier object's, moved by `transform`.
 struct Placement {
   std::uint32_t source = 0;
   Mat4d transform;

@@ -5,10 +5,8 @@
 #include <limits>
 #include <vector>
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
 #include "lodforge/surface/point_index.h"
+#include "lodforge/surface/row_shares.h"
 
 namespace lodforge {
 
@@ -121,19 +119,17 @@ class NearestPoints {
   // Offers the block's points to the vertices of cells in rows [rowFirst, rowEnd).
   void add(std::span<const CloudRecord> block, std::uint32_t rowFirst, std::uint32_t rowEnd) {
     for (const CloudRecord& r : block) {
-      // Out of these rows' reach whatever the bound (most points, with many threads).
-      const double gy =
-          (r.position.y - grid_.origin.y) / grid_.voxel - static_cast<double>(first_[1]);
-      if (floorToInt(gy + reach_) < rowFirst || floorToInt(gy - reach_) >= rowEnd) continue;
       std::array<double, 3> g{};
-      std::array<std::size_t, 3> at{};  // the block of the point's cell (the nearest in the box)
-      for (std::size_t a = 0; a < 3; ++a) {
+      for (std::size_t a = 0; a < 3; ++a)
         g[a] = (r.position[static_cast<int>(a)] - grid_.origin[static_cast<int>(a)]) / grid_.voxel -
                static_cast<double>(first_[a]);
+      // Out of these rows' reach whatever the bound (most points, with many threads).
+      if (floorToInt(g[1] + reach_) < rowFirst || floorToInt(g[1] - reach_) >= rowEnd) continue;
+      std::array<std::size_t, 3> at{};  // the block of the point's cell (the nearest in the box)
+      for (std::size_t a = 0; a < 3; ++a)
         at[a] = static_cast<std::size_t>(
                     std::clamp<std::int64_t>(floorToInt(g[a]), 0, std::int64_t{cells_[a]} - 1)) /
                 kBlock;
-      }
       const double bound = nearBound_[blockIndex(at[0], at[1], at[2])];
       if (bound < 0) continue;
       // Beyond sqrt(bound) (and the cells' margin of a thousandth of a voxel) no cell can take it.
@@ -237,17 +233,6 @@ class NearestPoints {
   std::vector<Rgba8> colors_;
 };
 
-// Splits rows [0, rows) between the threads and calls each(first, end) for each share.
-template <class F>
-void forEachRowShare(std::uint32_t rows, F&& each) {
-  const auto shares = std::min<std::uint32_t>(
-      rows, static_cast<std::uint32_t>(4 * std::max(1, tbb::this_task_arena::max_concurrency())));
-  tbb::parallel_for(std::uint32_t{0}, shares, [&](std::uint32_t s) {
-    each(static_cast<std::uint32_t>(std::uint64_t{rows} * s / shares),
-         static_cast<std::uint32_t>(std::uint64_t{rows} * (s + 1) / shares));
-  });
-}
-
 }  // namespace
 
 SurfacePiece heldChunkPiece(const ChunkLayout& layout, std::uint64_t chunk,
@@ -288,7 +273,7 @@ Result<SurfacePiece> streamedChunkPiece(const ChunkLayout& layout, std::uint64_t
     while (!block.empty()) {
       const std::span<const CloudRecord> part =
           block.first(std::min(block.size(), std::max<std::size_t>(1024, offered)));
-      forEachRowShare(nearest.rows(), [&](std::uint32_t first, std::uint32_t end) {
+      forEachRowShare(nearest.rows(), 0, [&](std::uint32_t first, std::uint32_t end) {
         nearest.add(part, first, end);
       });
       nearest.refresh();

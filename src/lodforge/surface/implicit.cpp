@@ -5,8 +5,7 @@
 #include <limits>
 #include <tuple>
 
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include "lodforge/surface/row_shares.h"
 
 namespace lodforge {
 
@@ -35,6 +34,10 @@ void CornerSums::add(Vec3d at, Vec3f normal) {
   ++cell.count;
 }
 
+Vec3d CornerSums::centroidOf(const std::array<std::int64_t, 3>& key, const Cell& cell) const {
+  return cellCorner(grid_, key) + cell.offset / static_cast<double>(cell.count);
+}
+
 void CornerSums::spread(const std::array<std::int64_t, 3>& key, const Cell& cell,
                         std::vector<Sums>& corners, std::uint32_t rowFirst,
                         std::uint32_t rowEnd) const {
@@ -45,7 +48,7 @@ void CornerSums::spread(const std::array<std::int64_t, 3>& key, const Cell& cell
   const double inverseRadius2 = 1 / radius2, inverseVoxel = 1 / grid_.voxel;
   const Vec3d o = cellCorner(grid_, key);
   const auto count = static_cast<double>(cell.count);
-  const Vec3d at = o + cell.offset / count;  // the centroid
+  const Vec3d at = centroidOf(key, cell);
   std::array<std::int64_t, 3> lo{}, hi{};
   // Rows first: a thread owning a share of the rows passes over most cells here.
   for (const std::size_t a : {std::size_t{1}, std::size_t{0}, std::size_t{2}}) {
@@ -111,25 +114,18 @@ CornerValues CornerSums::values(int threads) const {
     return std::tie(p[2], p[1], p[0]) < std::tie(q[2], q[1], q[0]);
   });
   std::vector<Sums> corners(static_cast<std::size_t>(size_[0]) * size_[1] * size_[2]);
-  const std::uint32_t rows = size_[1];
-  if (threads == 0) threads = std::max(1, tbb::this_task_arena::max_concurrency());
   if (threads == 1) {
-    for (const Entry* entry : order) spread(entry->first, entry->second, corners, 0, rows);
+    for (const Entry* entry : order) spread(entry->first, entry->second, corners, 0, size_[1]);
   } else {
     // Each share of the rows passes over the cells that reach none of its rows by two integer
     // comparisons: the rows a cell's centroid reaches (a row more each way for rounding).
     std::vector<std::pair<std::int64_t, std::int64_t>> reached(order.size());
     for (std::size_t e = 0; e < order.size(); ++e) {
-      const Cell& cell = order[e]->second;
-      const double y =
-          cellCorner(grid_, order[e]->first).y + cell.offset.y / static_cast<double>(cell.count);
+      const double y = centroidOf(order[e]->first, order[e]->second).y;
       const double g = (y - grid_.origin.y) / grid_.voxel - static_cast<double>(first_[1]);
       reached[e] = {floorToInt(g - options_.radius) - 1, floorToInt(g + options_.radius) + 1};
     }
-    const auto shares = std::min<std::uint32_t>(rows, static_cast<std::uint32_t>(4 * threads));
-    tbb::parallel_for(std::uint32_t{0}, shares, [&](std::uint32_t share) {
-      const auto first = static_cast<std::uint32_t>(std::uint64_t{rows} * share / shares);
-      const auto end = static_cast<std::uint32_t>(std::uint64_t{rows} * (share + 1) / shares);
+    forEachRowShare(size_[1], threads, [&](std::uint32_t first, std::uint32_t end) {
       for (std::size_t e = 0; e < order.size(); ++e)
         if (reached[e].second >= first && reached[e].first < end)
           spread(order[e]->first, order[e]->second, corners, first, end);

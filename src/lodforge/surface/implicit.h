@@ -78,6 +78,8 @@ class CornerSums {
                                       (z * 0x165667B19E3779F9ull));
     }
   };
+  // Where a cell's points are on average: where its weights are taken.
+  Vec3d centroidOf(const std::array<std::int64_t, 3>& key, const Cell& cell) const;
   // Spreads a cell to the box's corners within the radius of its centroid whose row (y index in
   // the box) is in [rowFirst, rowEnd).
   void spread(const std::array<std::int64_t, 3>& key, const Cell& cell, std::vector<Sums>& corners,

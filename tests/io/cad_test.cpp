@@ -25,6 +25,7 @@
 #include <gp_Trsf.hxx>
 
 #include <functional>
+#include <iostream>
 #include <map>
 #include <set>
 
@@ -437,6 +438,25 @@ TEST(CadRead, BadFilesAreBadInputNamingTheFile) {
   options = {};
   options.deflection = 0;
   EXPECT_EQ(readCad(kSamples + "/step/screw.step", options).error().kind, ErrorKind::kUsage);
+}
+
+// A BREP location raised to the power 50,000,000 (found by fuzz_cad): OCCT's
+// TopLoc_Location::Powered recurses once per power and overflows the stack. OCCT's handler runs on
+// an alternate signal stack, so the read fails as bad input and the process goes on; std::cout,
+// which the BREP read redirects, gets its own buffer back (a dangling one crashed at exit).
+TEST(CadRead, AStackOverflowInsideOcctIsBadInput) {
+  std::streambuf* const out = std::cout.rdbuf();
+  const std::string powered = test::testDataPath("cad/powered-location.brep");
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    Result<Model> overflowed = readCad(powered);
+    ASSERT_FALSE(overflowed.ok());
+    EXPECT_EQ(overflowed.error().kind, ErrorKind::kBadInput) << overflowed.error().message;
+    EXPECT_EQ(overflowed.error().message.rfind(powered + ": OCCT crashed", 0), 0u)
+        << overflowed.error().message;
+  }
+  EXPECT_EQ(std::cout.rdbuf(), out);
+  Result<Model> box = readCad(kSamples + "/step/screw.step");
+  EXPECT_TRUE(box.ok()) << box.error().message;
 }
 
 }  // namespace

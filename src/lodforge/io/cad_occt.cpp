@@ -20,6 +20,7 @@
 #include <Message_ProgressIndicator.hxx>
 #include <Message_ProgressScope.hxx>
 #include <OSD.hxx>
+#include <OSD_Signal.hxx>
 #include <RWMesh_FaceIterator.hxx>
 #include <STEPCAFControl_Reader.hxx>
 #include <STEPControl_Controller.hxx>
@@ -49,6 +50,7 @@
 #include <mutex>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include "lodforge/io/cad_module.h"
 
@@ -140,8 +142,18 @@ class OcctSignals {
   OcctSignals() {
     for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], nullptr, &saved_[i]);
     OSD::SetSignal(OSD_SignalMode_Set, false);
-    for (std::size_t i = 0; i < kSignals.size(); ++i)
-      if (!isCrash(kSignals[i])) sigaction(kSignals[i], &saved_[i], nullptr);
+    for (std::size_t i = 0; i < kSignals.size(); ++i) {
+      if (!isCrash(kSignals[i])) {
+        sigaction(kSignals[i], &saved_[i], nullptr);
+        continue;
+      }
+      // OCCT's handler runs on the thread's alternate stack (SignalStack), so a stack overflow
+      // inside OCCT reaches it too.
+      struct sigaction occt {};
+      sigaction(kSignals[i], nullptr, &occt);
+      occt.sa_flags |= SA_ONSTACK;
+      sigaction(kSignals[i], &occt, nullptr);
+    }
   }
   ~OcctSignals() {
     for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &saved_[i], nullptr);
@@ -159,9 +171,32 @@ class OcctSignals {
   std::array<struct sigaction, kSignals.size()> saved_{};
 };
 
+// An alternate signal stack for this thread while it runs OCCT: a stack overflow inside OCCT
+// (TopLoc_Location::Powered recurses once per power, and a damaged BREP location can ask for
+// 50 million, found by fuzz_cad) leaves no stack for the handler on the thread's own. The stack
+// the thread had before (ASan's, for one) is put back afterwards.
+class SignalStack {
+ public:
+  SignalStack() {
+    thread_local std::vector<char> memory(std::size_t{256} << 10);
+    stack_t mine{};
+    mine.ss_sp = memory.data();
+    mine.ss_size = memory.size();
+    sigaltstack(&mine, &saved_);
+  }
+  ~SignalStack() { sigaltstack(&saved_, nullptr); }
+  SignalStack(const SignalStack&) = delete;
+  SignalStack& operator=(const SignalStack&) = delete;
+
+ private:
+  stack_t saved_{};
+};
+
 // Runs `work` where a signal inside OCCT is thrown as a Standard_Failure (OCC_CATCH_SIGNALS).
+// The signal jumps here past the frames in between, whose destructors do not run.
 template <class Work>
 void guarded(Work&& work) {
+  const SignalStack stack;
   OCC_CATCH_SIGNALS
   work();
 }
@@ -211,12 +246,14 @@ std::optional<Failure> readStepOrIges(const std::string& path, CadFormat format,
 std::optional<Failure> readBrep(const std::string& path, Handle(TDocStd_Document) & doc) {
   TopoDS_Shape shape;
   BRep_Builder builder;
-  // BRepTools reports on std::cout, not through the messenger: kept for the error instead.
+  // BRepTools reports on std::cout, not through the messenger: kept for the error instead. A
+  // crash inside the read jumps to the nearest `guarded`, so that one is here, where std::cout's
+  // own buffer is put back.
   std::ostringstream said;
   std::streambuf* const out = std::cout.rdbuf(said.rdbuf());
   bool read = false;
   try {
-    read = BRepTools::Read(shape, path.c_str(), builder);
+    guarded([&] { read = BRepTools::Read(shape, path.c_str(), builder); });
   } catch (...) {
     std::cout.rdbuf(out);
     throw;
@@ -506,6 +543,17 @@ void warnUnmeshed(const Tree& tree, const std::vector<std::string>& failures, Re
   }
 }
 
+// What a failure of the whole read tells the user. A crash inside OCCT (a signal OcctSignals
+// turned into a failure) says so; the address in OCCT's own message is of no use to them.
+std::string describe(const Standard_Failure& failure) {
+  if (failure.IsKind(STANDARD_TYPE(OSD_Signal)))
+    return fmt::format(
+        "OCCT crashed reading it ({}): the file is damaged, or beyond what OCCT can read",
+        failure.DynamicType()->Name());
+  return fmt::format("OCCT failed: {} {}", failure.DynamicType()->Name(),
+                     failure.GetMessageString());
+}
+
 // One read at a time (OCCT's reader statics and the signal handlers are process-wide).
 void read(const Request& request, Result& out) {
   Handle(TDocStd_Document) doc;
@@ -563,8 +611,7 @@ extern "C" __attribute__((visibility("default"))) void lodforge_cad_read(
   } catch (const Standard_Failure& failure) {
     result = {};
     result.status = 1;
-    result.error = fmt::format("OCCT failed: {} {}", failure.DynamicType()->Name(),
-                               failure.GetMessageString());
+    result.error = lodforge::cad::describe(failure);
   } catch (const std::exception& failure) {
     result = {};
     result.status = 1;

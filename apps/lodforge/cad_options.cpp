@@ -17,12 +17,16 @@ void addCadOptions(CLI::App& sub, CadCommand& options) {
   sub.add_option("--code-page", options.codePage,
                  "STEP: the code page of names that are neither UTF-8 nor escaped (CP1251, "
                  "CP1252, SJIS, GB, ...)");
+  sub.add_flag("--hidden", options.hidden,
+               "CAD: keep the parts the file hides (invisible products, hidden layers); "
+               "without it they are left out");
 }
 
 Result<CadReadOptions> cadOptions(const CadCommand& options) {
   CadReadOptions cad;
   cad.angleDegrees = options.angle;
   cad.codePage = options.codePage;
+  cad.hidden = options.hidden;
   const std::string& text = options.deflection;
   double value = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);

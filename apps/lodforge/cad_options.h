@@ -1,5 +1,5 @@
 // The tessellation options of every command that reads CAD files (STEP, IGES, BREP):
-// --deflection, --angle and --code-page (docs/cad.md).
+// --deflection, --angle, --code-page and --hidden (docs/cad.md).
 #pragma once
 
 #include <string>
@@ -15,6 +15,7 @@ struct CadCommand {
   std::string deflection = "0.001";
   double angle = CadReadOptions{}.angleDegrees;
   std::string codePage;
+  bool hidden = false;
 };
 
 void addCadOptions(CLI::App& sub, CadCommand& options);

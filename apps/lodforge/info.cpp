@@ -109,11 +109,8 @@ Result<Summary> summarizeLoaded(const std::string& path, FileFormat format,
   if (!model) return model.status();
   Summary s;
   if (format == FileFormat::kCad)
-    s.cad = {{"shapes", cad.shapes},
-             {"instances", cad.instances},
-             {"depth", cad.depth},
-             {"parts", partNames(*model)},
-             {"layers", layerCounts(*model)}};
+    s.cad = {{"shapes", cad.shapes}, {"instances", cad.instances}, {"depth", cad.depth},
+             {"hidden", cad.hidden}, {"parts", partNames(*model)}, {"layers", layerCounts(*model)}};
   s.format = std::string(formatName(format));
   s.vertices = model->vertexCount();
   s.triangles = model->triangleCount();
@@ -167,10 +164,12 @@ void print(const std::string& path, const Summary& s) {
   fmt::print("memory     {} to load\n", formatBytes(s.memoryBytes));
   if (!s.extras.empty()) printPointAttributes({{"extras", s.extras}});
   if (s.cad.empty()) return;
-  fmt::print("parts      {} shapes placed {} times, assembly depth {}\n",
+  const auto hidden = s.cad["hidden"].get<std::uint64_t>();
+  fmt::print("parts      {} shapes placed {} times, assembly depth {}{}\n",
              formatCount(s.cad["shapes"].get<std::uint64_t>()),
              formatCount(s.cad["instances"].get<std::uint64_t>()),
-             s.cad["depth"].get<std::uint32_t>());
+             s.cad["depth"].get<std::uint32_t>(),
+             hidden > 0 ? fmt::format("; {} hidden, left out", formatCount(hidden)) : "");
   const nlohmann::json& parts = s.cad["parts"];
   constexpr std::size_t kShown = 12;
   for (std::size_t i = 0; i < std::min(parts.size(), kShown); ++i)

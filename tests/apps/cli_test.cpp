@@ -1196,6 +1196,30 @@ TEST(CliCad, AStepAssemblyIsDescribedConvertedAndTiled) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("x.glb")));
 }
 
+// A STEP file (written by OCCT) whose "ghost" product is invisible and whose "scaffold" sits on a
+// hidden layer: info and convert leave both out and say so, --hidden keeps them.
+TEST(CliCad, HiddenPartsAreLeftOutUnlessKept) {
+  test::TempDir dir;
+  const std::string step = test::testDataPath("cad/hidden-parts.step");
+  nlohmann::json j = info(step, dir);
+  EXPECT_EQ(j["objects"], 1u);
+  EXPECT_EQ(j["cad"]["hidden"], 2u);
+  const Outcome text = lodforge("info " + step, dir);
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("2 hidden, left out"), std::string::npos) << text.out;
+  EXPECT_NE(text.err.find("warning: " + step + ": 2 part(s) the file hides left out"),
+            std::string::npos)
+      << text.err;
+  Outcome o = lodforge("info --json --hidden " + step, dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  j = nlohmann::json::parse(o.out);
+  EXPECT_EQ(j["objects"], 3u);
+  EXPECT_EQ(j["cad"]["hidden"], 0u);
+  o = lodforge("convert " + step + " --hidden -o " + dir.file("all.glb"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(info(dir.file("all.glb"), dir)["objects"], 3u);
+}
+
 // The JSON chunk of a GLB file.
 nlohmann::json glbJson(const std::string& path) {
   const std::string bytes = test::readFile(path);

@@ -24,6 +24,7 @@
 #include <gp_Pln.hxx>
 #include <gp_Trsf.hxx>
 
+#include <algorithm>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -392,6 +393,64 @@ TEST(CadRead, LayersArriveOnEveryInstanceOfTheirParts) {
   EXPECT_EQ(model->layers.size(), 3u);  // structure, the cable's pair, fasteners
   EXPECT_EQ(std::set<std::string>(model->layers.begin(), model->layers.end()).size(),
             model->layers.size());
+}
+
+// The names of the model's objects, sorted.
+std::vector<std::string> sortedNames(const Model& model) {
+  std::vector<std::string> names;
+  for (std::size_t o = 0; o < model.objectCount(); ++o) names.emplace_back(model.objectName(o));
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// Parts a CAD system hides, as OCCT writes them to STEP (INVISIBILITY of a product, and of a
+// layer's assignment): left out by default with a warning that counts them, kept with `hidden`;
+// a visible layer hides nothing; a file that hides every part is bad input that says what works.
+TEST(CadRead, HiddenPartsAreLeftOutUnlessKept) {
+  test::TempDir dir;
+  const std::string path = dir.file("hidden.step");
+  writeStep(path, [](XCAFDoc_ShapeTool& shapes, XCAFDoc_ColorTool& colors) {
+    const TDF_Label shown = addNamed(shapes, BRepPrimAPI_MakeBox(1, 1, 1).Shape(), "shown");
+    const TDF_Label ghost =
+        addNamed(shapes, BRepPrimAPI_MakeBox(gp_Pnt(2, 0, 0), 1, 1, 1).Shape(), "ghost");
+    const TDF_Label scaffold =
+        addNamed(shapes, BRepPrimAPI_MakeBox(gp_Pnt(4, 0, 0), 1, 1, 1).Shape(), "scaffold");
+    colors.SetVisibility(ghost, false);
+    const Handle(XCAFDoc_LayerTool) layers = XCAFDoc_DocumentTool::LayerTool(shown);
+    layers->SetLayer(shown, "main");
+    layers->SetLayer(scaffold, "construction");
+    TDF_Label construction;
+    ASSERT_TRUE(layers->FindLayer("construction", construction));
+    layers->SetVisibility(construction, false);
+  });
+  std::vector<std::string> warnings;
+  CadReadStats stats;
+  Result<Model> model = readCad(path, {}, &warnings, &stats);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(sortedNames(*model), (std::vector<std::string>{"shown"}));
+  EXPECT_EQ(stats.hidden, 2u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], path + ": 2 part(s) the file hides left out (--hidden keeps them)");
+
+  CadReadOptions keep;
+  keep.hidden = true;
+  warnings.clear();
+  model = readCad(path, keep, &warnings, &stats);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(sortedNames(*model), (std::vector<std::string>{"ghost", "scaffold", "shown"}));
+  EXPECT_EQ(stats.hidden, 0u);
+  EXPECT_TRUE(warnings.empty());
+
+  const std::string allHidden = dir.file("all-hidden.step");
+  writeStep(allHidden, [](XCAFDoc_ShapeTool& shapes, XCAFDoc_ColorTool& colors) {
+    colors.SetVisibility(addNamed(shapes, BRepPrimAPI_MakeBox(1, 1, 1).Shape(), "ghost"), false);
+  });
+  Result<Model> none = readCad(allHidden);
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.error().kind, ErrorKind::kBadInput);
+  EXPECT_EQ(none.error().message,
+            allHidden + ": the file hides every part in it (--hidden keeps them)");
+  EXPECT_TRUE(readCad(allHidden, keep).ok());
 }
 
 TEST(CadRead, BadFilesAreBadInputNamingTheFile) {

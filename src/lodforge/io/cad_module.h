@@ -10,7 +10,7 @@
 
 namespace lodforge::cad {
 
-inline constexpr int kModuleVersion = 6;  // bumped when these structs change
+inline constexpr int kModuleVersion = 7;  // bumped when these structs change
 inline constexpr const char* kReadSymbol = "lodforge_cad_read";
 inline constexpr const char* kWriteSymbol = "lodforge_cad_write";
 
@@ -20,6 +20,7 @@ struct Request {
   bool absoluteDeflection = false;  // metres, else a fraction of each shape's diagonal
   double angleDegrees = 20;
   std::string codePage;  // OCCT's read.step.codepage; empty: UTF-8
+  bool hidden = false;   // keep the parts the file hides (else they are left out)
   // Asked between shapes and inside OCCT's mesher (its user break): true stops the read.
   bool (*cancelled)() = nullptr;
   // Told the number of distinct shapes once, then each shape meshed (from any thread).
@@ -67,6 +68,7 @@ struct Result {
   std::vector<Material> materials;
   std::uint64_t shapes = 0;
   std::uint32_t depth = 0;
+  std::uint64_t hidden = 0;  // placed parts left out because the file hides them
 };
 
 // The module's reading entry point; `version` must equal kModuleVersion.

@@ -26,6 +26,7 @@
 #include <STEPControl_Controller.hxx>
 #include <Standard_ErrorHandler.hxx>
 #include <Standard_Failure.hxx>
+#include <TDF_LabelSequence.hxx>
 #include <TDF_Tool.hxx>
 #include <TDataStd_Name.hxx>
 #include <TDocStd_Document.hxx>
@@ -33,6 +34,7 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Face.hxx>
 #include <XCAFApp_Application.hxx>
+#include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_LayerTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
@@ -303,6 +305,7 @@ struct Tree {
   std::vector<TDF_Label> shapes;  // distinct, in first-placed order
   std::vector<Placed> placed;
   std::uint32_t depth = 0;
+  std::uint64_t hidden = 0;  // leaves left out because the file hides them
 };
 
 // The layers of a placed leaf, each once: its instance's and its part's (STEP keeps layers on
@@ -323,13 +326,38 @@ std::string layersOf(const Handle(XCAFDoc_LayerTool) & tool, const XCAFPrs_Docum
   return joined;
 }
 
+// Whether the file hides the explorer's leaf: a product or instance on its path marked
+// invisible (STEP's INVISIBILITY, XCAFDoc_ColorTool::IsVisible), or the leaf on a hidden layer.
+// A layer hides what is on it, so one hidden layer of several is enough.
+bool isHidden(const XCAFPrs_DocumentExplorer& it, const Handle(XCAFDoc_ColorTool) & colors,
+              const Handle(XCAFDoc_LayerTool) & layers) {
+  for (int depth = 0; depth <= it.CurrentDepth(); ++depth) {
+    const XCAFPrs_DocumentNode& node = it.Current(depth);
+    for (const TDF_Label& label : {node.Label, node.RefLabel})
+      if (!label.IsNull() && !colors->IsVisible(label)) return true;
+  }
+  for (const TDF_Label& label : {it.Current().Label, it.Current().RefLabel}) {
+    TDF_LabelSequence on;
+    if (label.IsNull() || !layers->GetLayers(label, on)) continue;
+    for (Standard_Integer i = 1; i <= on.Length(); ++i)
+      if (!layers->IsVisible(on.Value(i))) return true;
+  }
+  return false;
+}
+
 // The leaves in the order the tree lists them; a shape placed again refers to its first entry.
-Tree walkTree(const Handle(TDocStd_Document) & doc) {
+// Leaves the file hides are counted and left out, unless `keepHidden`.
+Tree walkTree(const Handle(TDocStd_Document) & doc, bool keepHidden) {
   Tree tree;
   std::map<std::string, std::size_t> seen;  // label entry → shape
   const Handle(XCAFDoc_LayerTool) layers = XCAFDoc_DocumentTool::LayerTool(doc->Main());
+  const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
   for (XCAFPrs_DocumentExplorer it(doc, XCAFPrs_DocumentExplorerFlags_OnlyLeafNodes); it.More();
        it.Next()) {
+    if (!keepHidden && isHidden(it, colors, layers)) {
+      ++tree.hidden;
+      continue;
+    }
     const XCAFPrs_DocumentNode& node = it.Current();
     TCollection_AsciiString entry;
     TDF_Tool::Entry(node.RefLabel, entry);
@@ -567,7 +595,7 @@ void read(const Request& request, Result& out) {
   if (cadFormat(request.path) == CadFormat::kBrep ||
       !XCAFDoc_DocumentTool::GetLengthUnit(doc, metresPerUnit) || !(metresPerUnit > 0))
     metresPerUnit = 1;
-  const Tree tree = walkTree(doc);
+  const Tree tree = walkTree(doc, request.hidden);
   const std::vector<std::string> failures = tessellate(tree, request, metresPerUnit);
   if (isCancelled(request)) {
     XCAFApp_Application::GetApplication()->Close(doc);
@@ -583,11 +611,13 @@ void read(const Request& request, Result& out) {
   warnUnmeshed(tree, failures, out);
   out.shapes = tree.shapes.size();
   out.depth = tree.depth;
+  out.hidden = tree.hidden;
   XCAFApp_Application::GetApplication()->Close(doc);
   if (out.indices.empty()) {
     out.status = 1;
-    out.error =
-        tree.placed.empty() ? "no shape in the file" : "no part could be meshed (see the warnings)";
+    out.error = !tree.placed.empty() ? "no part could be meshed (see the warnings)"
+                : tree.hidden > 0    ? "the file hides every part in it (--hidden keeps them)"
+                                     : "no shape in the file";
   }
 }
 

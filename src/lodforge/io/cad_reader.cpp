@@ -132,12 +132,20 @@ Result<Model> readCad(const std::string& path, const CadReadOptions& options,
   void* entry = nullptr;
   LODFORGE_TRY(cadModuleSymbol(cad::kReadSymbol, entry));
   const auto module = reinterpret_cast<cad::ReadFunction>(entry);
-  const cad::Request request{path, options.deflection, options.absoluteDeflection,
-                             options.angleDegrees, options.codePage};
+  const cad::Request request{.path = path,
+                             .deflection = options.deflection,
+                             .absoluteDeflection = options.absoluteDeflection,
+                             .angleDegrees = options.angleDegrees,
+                             .codePage = options.codePage,
+                             .hidden = options.hidden};
   cad::Result read;
   module(cad::kModuleVersion, request, read);
-  if (warnings)
+  if (warnings) {
     for (const std::string& w : read.warnings) warnings->push_back(fmt::format("{}: {}", path, w));
+    if (read.hidden > 0 && read.status == 0)
+      warnings->push_back(fmt::format(
+          "{}: {} part(s) the file hides left out (--hidden keeps them)", path, read.hidden));
+  }
   if (read.status == 2) return Error{ErrorKind::kUsage, read.error};
   if (read.status == 3) return Error{ErrorKind::kCancelled, "cancelled"};
   if (read.status != 0) return badInput(path, read.error);
@@ -146,7 +154,7 @@ Result<Model> readCad(const std::string& path, const CadReadOptions& options,
       return Error{ErrorKind::kUnsupported,
                    fmt::format("{}: part \"{}\" has more than 4G vertices at this deflection", path,
                                instance.name)};
-  if (stats) *stats = {read.shapes, read.instances.size(), read.depth};
+  if (stats) *stats = {read.shapes, read.instances.size(), read.depth, read.hidden};
   return toModel(read);
 }
 

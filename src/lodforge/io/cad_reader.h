@@ -24,12 +24,16 @@ struct CadReadOptions {
   // Legacy 8-bit names (not UTF-8, not STEP's \X2\ escapes) read in this code page; OCCT's names,
   // e.g. "CP1251", "SJIS", "GB", "CP1252". Empty: UTF-8.
   std::string codePage;
+  // Keep the parts the file hides: a product or instance marked invisible (STEP's INVISIBILITY)
+  // or on a hidden layer. Without it they are left out, as the CAD system shows the model.
+  bool hidden = false;
 };
 
 struct CadReadStats {
   std::uint64_t shapes = 0;     // distinct shapes tessellated
   std::uint64_t instances = 0;  // placed instances (objects)
   std::uint32_t depth = 0;      // the assembly tree's depth
+  std::uint64_t hidden = 0;     // placed parts the file hides, left out (0 with `hidden`)
 };
 
 bool isCadPath(const std::string& path);

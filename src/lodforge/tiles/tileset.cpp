@@ -123,7 +123,7 @@ nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
           {"parts", static_cast<int>(input.parts)},
           {"cad",
            {input.cad.deflection, input.cad.absoluteDeflection, input.cad.angleDegrees,
-            input.cad.codePage}}};
+            input.cad.codePage, input.cad.hidden}}};
 }
 
 // The reconstruction's options for --surface: it keeps its work for --resume too, unless a CRS

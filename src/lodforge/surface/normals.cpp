@@ -4,6 +4,7 @@
 #include <cmath>
 #include <queue>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <Eigen/Eigenvalues>
 
@@ -13,14 +14,19 @@ namespace lodforge {
 
 namespace {
 
-// The k nearest of every point (itself included), k per point.
+// The k nearest of every point (itself included), k per point. Asked in the tree's leaf order,
+// where one query's data is mostly the last one's (the answers do not depend on the order).
 std::vector<std::uint32_t> nearest(const PointIndex& tree, std::span<const Vec3d> points,
                                    std::size_t k) {
   std::vector<std::uint32_t> out(points.size() * k);
-  tbb::parallel_for(std::size_t{0}, points.size(), [&](std::size_t i) {
+  const std::span<const std::uint32_t> order = tree.leafOrder();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size()), [&](const auto& range) {
     std::vector<double> d2(k);
-    const std::size_t found = tree.nearest(points[i], k, out.data() + i * k, d2.data());
-    for (std::size_t f = found; f < k; ++f) out[i * k + f] = out[i * k];  // fewer than k points
+    for (std::size_t at = range.begin(); at != range.end(); ++at) {
+      const std::size_t i = order[at];
+      const std::size_t found = tree.nearest(points[i], k, out.data() + i * k, d2.data());
+      for (std::size_t f = found; f < k; ++f) out[i * k + f] = out[i * k];  // fewer than k
+    }
   });
   return out;
 }
@@ -98,7 +104,9 @@ std::vector<Vec3f> estimateNormals(std::span<const Vec3d> positions, const Point
   const std::size_t k = std::min<std::size_t>(
       positions.size(), static_cast<std::size_t>(std::max(3, options.neighbours)));
   const std::vector<std::uint32_t> knn = nearest(tree, positions, k);
-  tbb::parallel_for(std::size_t{0}, positions.size(), [&](std::size_t i) {
+  const std::span<const std::uint32_t> order = tree.leafOrder();
+  tbb::parallel_for(std::size_t{0}, positions.size(), [&](std::size_t at) {
+    const std::size_t i = order[at];
     normals[i] = leastSpread(positions, std::span<const std::uint32_t>(knn).subspan(i * k, k));
   });
   switch (options.orientation) {

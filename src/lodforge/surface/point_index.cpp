@@ -39,4 +39,8 @@ std::size_t PointIndex::nearest(Vec3d q, std::size_t k, std::uint32_t* indices,
   return tree_->index.knnSearch(at, k, indices, distances2);
 }
 
+std::span<const std::uint32_t> PointIndex::leafOrder() const {
+  return tree_->index.vAcc;
+}
+
 }  // namespace lodforge

@@ -7,6 +7,7 @@
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
+#include <IGESCAFControl_Writer.hxx>
 #include <Quantity_Color.hxx>
 #include <Quantity_ColorRGBA.hxx>
 #include <STEPCAFControl_Reader.hxx>
@@ -451,6 +452,51 @@ TEST(CadRead, HiddenPartsAreLeftOutUnlessKept) {
   EXPECT_EQ(none.error().message,
             allHidden + ": the file hides every part in it (--hidden keeps them)");
   EXPECT_TRUE(readCad(allHidden, keep).ok());
+}
+
+// IGES hides an entity by its blank status (columns 65-66 of its directory entry's first line),
+// which OCCT's reader does not carry; the reader marks a blanked root's shape hidden itself. The
+// file is written by OCCT (three parts, each a root 402 group) and the second root blanked.
+TEST(CadRead, BlankedIgesRootsAreHidden) {
+  test::TempDir dir;
+  const std::string path = dir.file("blanked.igs");
+  {
+    Handle(TDocStd_Document) doc;
+    XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+    XCAFDoc_ShapeTool& shapes = *XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+    addNamed(shapes, BRepPrimAPI_MakeBox(1, 1, 1).Shape(), "shown");
+    addNamed(shapes, BRepPrimAPI_MakeBox(gp_Pnt(2, 0, 0), 1, 1, 1).Shape(), "blanked");
+    addNamed(shapes, BRepPrimAPI_MakeBox(gp_Pnt(4, 0, 0), 1, 1, 1).Shape(), "also shown");
+    IGESCAFControl_Writer writer;
+    ASSERT_TRUE(writer.Transfer(doc));
+    ASSERT_TRUE(writer.Write(path.c_str()));
+    XCAFApp_Application::GetApplication()->Close(doc);
+  }
+  std::string text = test::readFile(path);
+  std::vector<std::size_t> roots;  // the first line of each independent 402's directory entry
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string_view line(text.data() + at, end - at);
+    if (line.size() >= 80 && line[72] == 'D' && (line[79] - '0') % 2 == 1 &&
+        line.substr(0, 8) == "     402" && line.substr(66, 2) == "00")
+      roots.push_back(at);
+    at = end + 1;
+  }
+  ASSERT_EQ(roots.size(), 3u);
+  ASSERT_EQ(text.substr(roots[1] + 64, 2), "00");
+  text.replace(roots[1] + 64, 2, "01");
+  test::writeFile(path, text);
+
+  CadReadStats stats;
+  Result<Model> model = readCad(path, {}, nullptr, &stats);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(sortedNames(*model), (std::vector<std::string>{"also shown", "shown"}));
+  EXPECT_EQ(stats.hidden, 1u);
+  CadReadOptions keep;
+  keep.hidden = true;
+  model = readCad(path, keep, nullptr, &stats);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(sortedNames(*model), (std::vector<std::string>{"also shown", "blanked", "shown"}));
 }
 
 TEST(CadRead, BadFilesAreBadInputNamingTheFile) {

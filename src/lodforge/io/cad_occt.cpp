@@ -11,7 +11,9 @@
 #include <Bnd_Box.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESControl_Controller.hxx>
+#include <IGESData_IGESEntity.hxx>
 #include <IMeshTools_Parameters.hxx>
+#include <Interface_InterfaceModel.hxx>
 #include <Interface_Static.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
@@ -33,6 +35,8 @@
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Face.hxx>
+#include <TransferBRep.hxx>
+#include <Transfer_TransientProcess.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
@@ -40,6 +44,8 @@
 #include <XCAFDoc_ShapeTool.hxx>
 #include <XCAFDoc_VisMaterial.hxx>
 #include <XCAFPrs_DocumentExplorer.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
 
 #include <algorithm>
 #include <array>
@@ -229,12 +235,34 @@ std::optional<Failure> transfer(Reader& reader, const std::string& path, std::st
   return {};
 }
 
+// IGES keeps visibility in each entity's blank status, which OCCT's reader does not carry into
+// the document: the shape of a blanked root entity is marked invisible here, as STEP's
+// INVISIBILITY is by OCCT, so walkTree treats both alike.
+void hideBlankedRoots(IGESCAFControl_Reader& reader, const Handle(TDocStd_Document) & doc) {
+  const Handle(XSControl_WorkSession) session = reader.WS();
+  const Handle(Interface_InterfaceModel) model = session->Model();
+  const Handle(Transfer_TransientProcess) process = session->TransferReader()->TransientProcess();
+  if (model.IsNull() || process.IsNull()) return;
+  const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+  const Handle(XCAFDoc_ColorTool) colors = XCAFDoc_DocumentTool::ColorTool(doc->Main());
+  for (Standard_Integer i = 1; i <= model->NbEntities(); ++i) {
+    const Handle(IGESData_IGESEntity) entity =
+        Handle(IGESData_IGESEntity)::DownCast(model->Value(i));
+    if (entity.IsNull() || entity->BlankStatus() != 1 || entity->SubordinateStatus() != 0) continue;
+    const TopoDS_Shape shape = TransferBRep::ShapeResult(process, entity);
+    TDF_Label label;
+    if (!shape.IsNull() && shapes->Search(shape, label)) colors->SetVisibility(label, false);
+  }
+}
+
 // The STEP or IGES file into `doc`; a failure's message, or nothing.
 std::optional<Failure> readStepOrIges(const std::string& path, CadFormat format,
                                       const Request& request, Handle(TDocStd_Document) & doc) {
   if (format == CadFormat::kIges) {
     IGESCAFControl_Reader reader;
-    return transfer(reader, path, "an IGES", doc);
+    std::optional<Failure> failed = transfer(reader, path, "an IGES", doc);
+    if (!failed) hideBlankedRoots(reader, doc);
+    return failed;
   }
   const std::string page = request.codePage.empty() ? "UTF8" : request.codePage;
   if (!Interface_Static::SetCVal("read.step.codepage", page.c_str()))

@@ -251,7 +251,9 @@ void hideBlankedRoots(IGESCAFControl_Reader& reader, const Handle(TDocStd_Docume
     if (entity.IsNull() || entity->BlankStatus() != 1 || entity->SubordinateStatus() != 0) continue;
     const TopoDS_Shape shape = TransferBRep::ShapeResult(process, entity);
     TDF_Label label;
-    if (!shape.IsNull() && shapes->Search(shape, label)) colors->SetVisibility(label, false);
+    // The root's own label (each transferred root is a shape of the document), not a subshape.
+    if (!shape.IsNull() && shapes->Search(shape, label, true, true, false))
+      colors->SetVisibility(label, false);
   }
 }
 

@@ -114,7 +114,7 @@ CornerValues CornerSums::values(int threads) const {
     return std::tie(p[2], p[1], p[0]) < std::tie(q[2], q[1], q[0]);
   });
   std::vector<Sums> corners(static_cast<std::size_t>(size_[0]) * size_[1] * size_[2]);
-  if (threads == 1) {
+  if (rowShareThreads(threads) == 1) {
     for (const Entry* entry : order) spread(entry->first, entry->second, corners, 0, size_[1]);
   } else {
     // Each share of the rows passes over the cells that reach none of its rows by two integer

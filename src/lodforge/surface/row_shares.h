@@ -11,11 +11,16 @@
 
 namespace lodforge {
 
+// The threads to share rows between: `threads`, or the arena's for 0.
+inline int rowShareThreads(int threads) {
+  return threads == 0 ? std::max(1, tbb::this_task_arena::max_concurrency()) : threads;
+}
+
 // Splits rows [0, rows) into shares, four per thread (`threads`, 0: the arena's), and calls
 // each(first, end) for every share, in parallel.
 template <class F>
 void forEachRowShare(std::uint32_t rows, int threads, F&& each) {
-  if (threads == 0) threads = std::max(1, tbb::this_task_arena::max_concurrency());
+  threads = rowShareThreads(threads);
   const auto shares = std::min<std::uint32_t>(rows, static_cast<std::uint32_t>(4 * threads));
   tbb::parallel_for(std::uint32_t{0}, shares, [&](std::uint32_t s) {
     each(static_cast<std::uint32_t>(std::uint64_t{rows} * s / shares),

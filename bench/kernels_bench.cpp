@@ -10,10 +10,10 @@
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/scan.h"
-#include "lodforge/io/glb_writer.h"
-#include "lodforge/io/obj_reader.h"
-#include "lodforge/io/ply_reader.h"
-#include "lodforge/io/ply_writer.h"
+#include "lodforge/io/mesh/glb_writer.h"
+#include "lodforge/io/mesh/obj_reader.h"
+#include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/mesh/ply_writer.h"
 #include "lodforge/points/cluster.h"
 
 namespace lodforge {

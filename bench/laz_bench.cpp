@@ -12,8 +12,8 @@
 #include <thread>
 #include <vector>
 
-#include "lodforge/io/las_copy.h"
-#include "lodforge/io/las_reader.h"
+#include "lodforge/io/points/las_copy.h"
+#include "lodforge/io/points/las_reader.h"
 
 namespace {
 

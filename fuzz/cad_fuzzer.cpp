@@ -8,7 +8,7 @@
 #include <string>
 
 #include "fuzz_check.h"
-#include "lodforge/io/cad_reader.h"
+#include "lodforge/io/cad/cad_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace lodforge;

@@ -10,7 +10,7 @@
 
 #include "lodforge/core/model.h"
 #include "lodforge/core/status.h"
-#include "lodforge/io/point_batch.h"
+#include "lodforge/io/points/point_batch.h"
 
 namespace lodforge::fuzz {
 

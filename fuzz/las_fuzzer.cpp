@@ -7,7 +7,7 @@
 #include <cstdlib>
 
 #include "fuzz_check.h"
-#include "lodforge/io/las_reader.h"
+#include "lodforge/io/points/las_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace lodforge;

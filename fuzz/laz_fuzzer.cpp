@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "fuzz_check.h"
-#include "lodforge/io/laz_chunks.h"
+#include "lodforge/io/points/laz/laz_chunks.h"
 
 namespace {
 

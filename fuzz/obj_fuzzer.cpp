@@ -2,7 +2,7 @@
 #include <cstdint>
 
 #include "fuzz_check.h"
-#include "lodforge/io/obj_reader.h"
+#include "lodforge/io/mesh/obj_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace lodforge;

@@ -7,7 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "lodforge/core/status.h"
-#include "lodforge/io/cad_reader.h"
+#include "lodforge/io/cad/cad_reader.h"
 
 namespace lodforge::cli {
 

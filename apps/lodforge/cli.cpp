@@ -7,7 +7,7 @@
 
 #include "lodforge/core/threads.h"
 #include "lodforge/core/units.h"
-#include "lodforge/io/point_reader.h"
+#include "lodforge/io/points/point_reader.h"
 
 namespace lodforge::cli {
 

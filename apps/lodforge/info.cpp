@@ -15,10 +15,10 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
 #include "lodforge/io/format_advice.h"
-#include "lodforge/io/las_reader.h"
+#include "lodforge/io/points/las_reader.h"
 #include "lodforge/io/model_io.h"
-#include "lodforge/io/ply_reader.h"
-#include "lodforge/io/point_reader.h"
+#include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/points/point_reader.h"
 #include "lodforge/points/cloud_file.h"
 #include "lodforge/simplify/package.h"
 

@@ -9,7 +9,7 @@
 
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
-#include "lodforge/io/point_reader.h"
+#include "lodforge/io/points/point_reader.h"
 #include "lodforge/tiles/point_attributes.h"
 
 namespace lodforge::cli {

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/status.h"
-#include "lodforge/io/point_extras.h"
+#include "lodforge/io/points/point_extras.h"
 
 namespace lodforge::cli {
 

@@ -9,7 +9,7 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
 #include "lodforge/core/units.h"
-#include "lodforge/io/point_reader.h"
+#include "lodforge/io/points/point_reader.h"
 #include "lodforge/surface/reconstruct.h"
 #include "lodforge/surface/resume_state.h"
 #include "outputs.h"

@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/mesh.h"
-#include "lodforge/io/cad_reader.h"
-#include "lodforge/io/gltf_reader.h"
-#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/cad/cad_reader.h"
+#include "lodforge/io/mesh/gltf_reader.h"
+#include "lodforge/io/mesh/ply_reader.h"
 #include "test_support.h"
 
 namespace lodforge {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "lodforge/core/mesh.h"
-#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/mesh/ply_reader.h"
 #include "test_support.h"
 
 namespace lodforge {

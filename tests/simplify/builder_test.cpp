@@ -3,11 +3,11 @@
 #include <gtest/gtest.h>
 
 #include "lodforge/generate/cad.h"
-#include "lodforge/io/cad_reader.h"
-#include "lodforge/io/glb_instances.h"
-#include "lodforge/io/glb_writer.h"
-#include "lodforge/io/gltf_reader.h"
-#include "lodforge/io/ply_writer.h"
+#include "lodforge/io/cad/cad_reader.h"
+#include "lodforge/simplify/glb_instances.h"
+#include "lodforge/io/mesh/glb_writer.h"
+#include "lodforge/io/mesh/gltf_reader.h"
+#include "lodforge/io/mesh/ply_writer.h"
 #include "lodforge/simplify/extract.h"
 #include "lodforge/simplify/package.h"
 #include "test_support.h"

@@ -11,7 +11,7 @@
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/cad.h"
-#include "lodforge/io/gltf_reader.h"
+#include "lodforge/io/mesh/gltf_reader.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/simplify/prepare.h"
 #include "lodforge/simplify/reform.h"

@@ -14,7 +14,7 @@
 
 #include "lodforge/core/random.h"
 #include "lodforge/generate/points.h"
-#include "lodforge/io/las_reader.h"
+#include "lodforge/io/points/las_reader.h"
 #include "lodforge/tiles/point_attributes.h"
 #include "test_support.h"
 

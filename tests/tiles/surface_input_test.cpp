@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "lodforge/core/random.h"
-#include "lodforge/io/ply_writer.h"
+#include "lodforge/io/mesh/ply_writer.h"
 #include "test_support.h"
 
 namespace lodforge {

@@ -12,8 +12,8 @@
 
 #include "lodforge/core/random.h"
 #include "lodforge/generate/cad.h"
-#include "lodforge/io/cad_reader.h"
-#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/cad/cad_reader.h"
+#include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/tiles/tile_content.h"
 #include "lodforge/tiles/tileset.h"

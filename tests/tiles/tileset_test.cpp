@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/generate/cad.h"
-#include "lodforge/io/gltf_reader.h"
+#include "lodforge/io/mesh/gltf_reader.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/simplify/builder.h"
 

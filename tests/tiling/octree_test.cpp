@@ -17,7 +17,7 @@
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
 #include "lodforge/io/model_io.h"
-#include "lodforge/io/ply_writer.h"
+#include "lodforge/io/mesh/ply_writer.h"
 #include "lodforge/tiles/surface_input.h"
 
 namespace lodforge {

@@ -17,9 +17,9 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/shapes.h"
-#include "lodforge/io/cad_writer.h"
-#include "lodforge/io/glb_writer.h"
-#include "lodforge/io/ply_writer.h"
+#include "lodforge/io/cad/cad_writer.h"
+#include "lodforge/io/mesh/glb_writer.h"
+#include "lodforge/io/mesh/ply_writer.h"
 
 namespace lodforge {
 

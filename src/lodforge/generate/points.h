@@ -8,7 +8,7 @@
 
 #include "lodforge/core/status.h"
 #include "lodforge/generate/stats.h"
-#include "lodforge/io/point_extras.h"
+#include "lodforge/io/points/point_extras.h"
 
 namespace lodforge {
 

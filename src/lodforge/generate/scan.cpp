@@ -9,7 +9,7 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/generate/terrain.h"
-#include "lodforge/io/ply_writer.h"
+#include "lodforge/io/mesh/ply_writer.h"
 
 namespace lodforge {
 

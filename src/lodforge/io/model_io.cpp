@@ -3,16 +3,16 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/file.h"
-#include "lodforge/io/assimp_reader.h"
+#include "lodforge/io/mesh/assimp_reader.h"
 #include "lodforge/io/format_advice.h"
-#include "lodforge/io/glb_writer.h"
-#include "lodforge/io/gltf_reader.h"
-#include "lodforge/io/obj_reader.h"
-#include "lodforge/io/obj_writer.h"
-#include "lodforge/io/ply_reader.h"
-#include "lodforge/io/ply_writer.h"
-#include "lodforge/io/stl_reader.h"
-#include "lodforge/io/stl_writer.h"
+#include "lodforge/io/mesh/glb_writer.h"
+#include "lodforge/io/mesh/gltf_reader.h"
+#include "lodforge/io/mesh/obj_reader.h"
+#include "lodforge/io/mesh/obj_writer.h"
+#include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/mesh/ply_writer.h"
+#include "lodforge/io/mesh/stl_reader.h"
+#include "lodforge/io/mesh/stl_writer.h"
 
 namespace lodforge {
 

@@ -8,12 +8,12 @@
 
 #include "lodforge/core/model.h"
 #include "lodforge/core/status.h"
-#include "lodforge/io/cad_reader.h"
+#include "lodforge/io/cad/cad_reader.h"
 
 namespace lodforge {
 
-// kCad: STEP, IGES or BREP, read through OpenCASCADE (io/cad_reader.h); kAssimp: OFF, FBX,
-// Collada, 3DS, IFC and the other scenes assimp reads (io/assimp_reader.h). Neither is written.
+// kCad: STEP, IGES or BREP, read through OpenCASCADE (io/cad/cad_reader.h); kAssimp: OFF, FBX,
+// Collada, 3DS, IFC and the other scenes assimp reads (io/mesh/assimp_reader.h). Neither is written.
 enum class FileFormat : std::uint8_t { kUnknown, kPly, kObj, kStl, kGltf, kGlb, kCad, kAssimp };
 
 FileFormat formatFromPath(const std::string& path);

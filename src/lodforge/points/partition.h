@@ -14,7 +14,7 @@
 
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
-#include "lodforge/io/point_reader.h"
+#include "lodforge/io/points/point_reader.h"
 
 namespace lodforge {
 

@@ -10,7 +10,7 @@
 #include "lodforge/core/memory.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
-#include "lodforge/io/object_stream.h"
+#include "lodforge/io/mesh/object_stream.h"
 #include "lodforge/simplify/package.h"
 #include "lodforge/simplify/prepare.h"
 #include "lodforge/simplify/shape_cache.h"

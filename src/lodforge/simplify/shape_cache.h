@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "lodforge/core/math.h"
-#include "lodforge/io/glb_instances.h"
-#include "lodforge/io/object_stream.h"
+#include "lodforge/simplify/glb_instances.h"
+#include "lodforge/io/mesh/object_stream.h"
 #include "lodforge/simplify/progressive.h"
 
 namespace lodforge {

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/progress.h"
-#include "lodforge/io/point_reader.h"
+#include "lodforge/io/points/point_reader.h"
 
 namespace lodforge {
 

@@ -4,7 +4,7 @@
 #include <numeric>
 
 #include "lodforge/core/progress.h"
-#include "lodforge/io/ply_writer.h"
+#include "lodforge/io/mesh/ply_writer.h"
 
 namespace lodforge {
 

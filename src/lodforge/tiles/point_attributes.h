@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "lodforge/core/status.h"
-#include "lodforge/io/glb_writer.h"
-#include "lodforge/io/point_extras.h"
+#include "lodforge/io/mesh/glb_writer.h"
+#include "lodforge/io/points/point_extras.h"
 #include "lodforge/points/partition.h"
 
 namespace lodforge {

@@ -17,7 +17,7 @@
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
-#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/points/build.h"
 #include "lodforge/points/partition.h"
 #include "lodforge/tiles/point_attributes.h"

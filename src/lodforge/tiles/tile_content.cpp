@@ -7,7 +7,7 @@
 #include <meshoptimizer.h>
 
 #include "lodforge/core/mesh.h"
-#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/tiles/tile_features.h"
 
 namespace lodforge {

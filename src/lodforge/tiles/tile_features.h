@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "lodforge/core/status.h"
-#include "lodforge/io/glb_writer.h"
+#include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/tiling/chunk_input.h"
 
 namespace lodforge {

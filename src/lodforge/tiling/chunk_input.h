@@ -16,7 +16,7 @@
 #include "lodforge/core/material.h"
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
-#include "lodforge/io/cad_reader.h"
+#include "lodforge/io/cad/cad_reader.h"
 #include "lodforge/tiling/chunk_store.h"
 
 namespace lodforge {

@@ -17,7 +17,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
-#include "lodforge/io/ply_reader.h"
+#include "lodforge/io/mesh/ply_reader.h"
 #include "lodforge/tiling/chunk_grid.h"
 #include "lodforge/tiling/chunk_sizing.h"
 

@@ -1,0 +1,248 @@
+#include "lodforge/io/mesh/assimp_reader.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+#include <assimp/Importer.hpp>
+#include <assimp/ProgressHandler.hpp>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+
+namespace lodforge {
+
+namespace {
+
+// What we hand to assimp: scenes of meshes. Formats we read ourselves (PLY, OBJ, STL, glTF,
+// STEP) and animation-only ones (BVH, MD5 animations) are not in the list.
+constexpr std::array<std::string_view, 20> kExtensions = {
+    "off", "fbx", "dae",  "zae", "3ds", "3mf",  "ifc", "ifczip", "x3d",  "x3db",
+    "x",   "ac",  "ac3d", "ase", "lwo", "ms3d", "b3d", "dxf",    "ogex", "xgl"};
+
+// Ctrl-C between assimp's steps: returning false makes ReadFile give up.
+class CancelOnInterrupt final : public Assimp::ProgressHandler {
+ public:
+  bool Update(float) override { return !cancelRequested(); }
+};
+
+float unit(float x) {
+  return std::isfinite(x) ? std::clamp(x, 0.0f, 1.0f) : 0.0f;
+}
+
+// assimp's material keys as glTF's metallic-roughness model. Opacity below 1 (IFC's and
+// Collada's transparency, FBX's TransparencyFactor) is BLEND and double-sided, as glass is.
+Material convertMaterial(const aiMaterial& m) {
+  Material out;
+  if (aiString name; m.Get(AI_MATKEY_NAME, name) == AI_SUCCESS) out.name = name.C_Str();
+  aiColor4D color;
+  if (m.Get(AI_MATKEY_BASE_COLOR, color) == AI_SUCCESS ||
+      m.Get(AI_MATKEY_COLOR_DIFFUSE, color) == AI_SUCCESS)
+    out.baseColor = {unit(color.r), unit(color.g), unit(color.b), unit(color.a)};
+  // An opacity of exactly 0 is what several exporters write for "not set"; an invisible part
+  // is never what a user means.
+  if (float opacity = 1; m.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS && opacity > 0)
+    out.baseColor[3] *= unit(opacity);
+  if (float metallic = 0; m.Get(AI_MATKEY_METALLIC_FACTOR, metallic) == AI_SUCCESS)
+    out.metallic = unit(metallic);
+  if (float roughness = 0; m.Get(AI_MATKEY_ROUGHNESS_FACTOR, roughness) == AI_SUCCESS)
+    out.roughness = unit(roughness);
+  if (aiColor3D emissive; m.Get(AI_MATKEY_COLOR_EMISSIVE, emissive) == AI_SUCCESS)
+    out.emissive = {unit(emissive.r), unit(emissive.g), unit(emissive.b)};
+  // Most interchange formats do not say whether a surface is closed: both sides unless the file
+  // says one (assimp's DefaultMaterial, given to meshes without one, says nothing).
+  out.doubleSided = true;
+  if (int twoSided = 1; m.Get(AI_MATKEY_TWOSIDED, twoSided) == AI_SUCCESS)
+    out.doubleSided = twoSided != 0;
+  if (out.baseColor[3] < 1) {
+    out.alphaMode = AlphaMode::kBlend;
+    out.doubleSided = true;
+  }
+  return out;
+}
+
+Mat4d toMat4d(const aiMatrix4x4& a) {
+  // aiMatrix4x4 is row-major (a1..a4 the first row); Mat4d is column-major.
+  const float rows[4][4] = {{a.a1, a.a2, a.a3, a.a4},
+                            {a.b1, a.b2, a.b3, a.b4},
+                            {a.c1, a.c2, a.c3, a.c4},
+                            {a.d1, a.d2, a.d3, a.d4}};
+  Mat4d m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m.at(r, c) = rows[r][c];
+  return m;
+}
+
+std::uint8_t channel(double x) {
+  return static_cast<std::uint8_t>(
+      std::lround(std::clamp(std::isfinite(x) ? x : 0.0, 0.0, 1.0) * 255));
+}
+
+// The scene's node tree walked from the root, every mesh reference an object.
+class SceneConverter {
+ public:
+  SceneConverter(const aiScene& scene, const std::string& path) : scene_(scene), path_(path) {}
+
+  Result<Model> convert() {
+    for (unsigned m = 0; m < scene_.mNumMaterials; ++m)
+      model_.materials.push_back(convertMaterial(*scene_.mMaterials[m]));
+    withColors_ = scene_.mNumMaterials > 0 ||
+                  std::any_of(scene_.mMeshes, scene_.mMeshes + scene_.mNumMeshes,
+                              [](const aiMesh* mesh) { return mesh->HasVertexColors(0); });
+    walk();
+    if (!problem_.empty()) return badInput(path_, problem_);
+    if (model_.triangleCount() == 0)
+      return badInput(path_, "the scene holds no triangles (only points, lines or nothing)");
+    placeAtOrigin();
+    return std::move(model_);
+  }
+
+ private:
+  struct Visit {
+    const aiNode* node;
+    Mat4d parent;
+    std::string path;  // of the parent
+  };
+
+  // Depth first, children in file order. assimp's root is its own container: its name starts
+  // no path unless it draws meshes itself.
+  void walk() {
+    std::vector<Visit> stack = {{scene_.mRootNode, Mat4d{}, {}}};
+    std::size_t visited = 0;
+    while (!stack.empty()) {
+      const Visit visit = std::move(stack.back());
+      stack.pop_back();
+      const aiNode& node = *visit.node;
+      const Mat4d world = visit.parent * toMat4d(node.mTransformation);
+      const std::string name =
+          node.mName.length > 0 ? node.mName.C_Str() : fmt::format("node {}", visited);
+      ++visited;
+      const bool container = &node == scene_.mRootNode && node.mNumMeshes == 0;
+      const std::string path = container            ? std::string{}
+                               : visit.path.empty() ? name
+                                                    : visit.path + "/" + name;
+      for (unsigned k = 0; k < node.mNumMeshes; ++k) {
+        const std::string suffix = node.mNumMeshes > 1 ? fmt::format("#{}", k) : std::string{};
+        addObject(name + suffix, path + suffix, node.mMeshes[k], world);
+      }
+      for (unsigned c = node.mNumChildren; c-- > 0;)
+        stack.push_back({node.mChildren[c], world, path});
+    }
+  }
+
+  void addObject(const std::string& name, const std::string& path, unsigned meshIndex,
+                 const Mat4d& world) {
+    if (meshIndex >= scene_.mNumMeshes) return;
+    const aiMesh& mesh = *scene_.mMeshes[meshIndex];
+    ModelBuilder builder(model_);
+    builder.beginObject(name, path);
+    if (mesh.mMaterialIndex < model_.materials.size())
+      model_.objects.back().material = mesh.mMaterialIndex;
+    const Mat4d normalMatrix = world.normalMatrix();
+    const bool mirrored = world.determinant3() < 0;
+    const std::array<float, 4> factor = mesh.mMaterialIndex < model_.materials.size()
+                                            ? model_.materials[mesh.mMaterialIndex].baseColor
+                                            : std::array<float, 4>{1, 1, 1, 1};
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      const aiVector3D& p = mesh.mVertices[v];
+      world_.push_back(world.transformPoint({p.x, p.y, p.z}));
+      if (!isFinite(world_.back()) && problem_.empty())
+        problem_ =
+            fmt::format("mesh {} ('{}') vertex {} is not finite", meshIndex, mesh.mName.C_Str(), v);
+      model_.positions.push_back({});  // filled by placeAtOrigin
+      if (mesh.HasNormals()) {
+        const aiVector3D& n = mesh.mNormals[v];
+        normals_.push_back(
+            toFloat(normalizeOr(normalMatrix.transformVector({n.x, n.y, n.z}), Vec3d{})));
+      } else {
+        normals_.push_back({});
+        missingNormals_ = true;
+      }
+      if (withColors_) {
+        std::array<double, 4> c = {factor[0], factor[1], factor[2], factor[3]};
+        if (mesh.HasVertexColors(0)) {
+          const aiColor4D& vc = mesh.mColors[0][v];
+          c = {c[0] * vc.r, c[1] * vc.g, c[2] * vc.b, c[3] * vc.a};
+        }
+        model_.colors.push_back({channel(c[0]), channel(c[1]), channel(c[2]), channel(c[3])});
+      }
+    }
+    for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
+      const aiFace& face = mesh.mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines (triangulated before)
+      std::uint32_t a = face.mIndices[0], b = face.mIndices[1], c = face.mIndices[2];
+      if (std::max({a, b, c}) >= mesh.mNumVertices) continue;  // validated by assimp
+      if (mirrored) std::swap(b, c);
+      builder.addTriangle(a, b, c);
+    }
+    builder.endObject();
+  }
+
+  void placeAtOrigin() {
+    lodforge::placeAtOrigin(model_, world_);
+    // Normals only when every vertex has one, as the glTF reader keeps them.
+    if (!missingNormals_ && !normals_.empty()) model_.normals = std::move(normals_);
+  }
+
+  const aiScene& scene_;
+  const std::string& path_;
+  Model model_;
+  std::vector<Vec3d> world_;
+  std::vector<Vec3f> normals_;
+  bool withColors_ = false;
+  bool missingNormals_ = false;
+  std::string problem_;  // the first thing wrong with the scene
+};
+
+}  // namespace
+
+bool isAssimpExtension(std::string_view extension) {
+  return std::find(kExtensions.begin(), kExtensions.end(), extension) != kExtensions.end();
+}
+
+namespace {
+
+// Reads with `read(importer, flags)` (from a file or from memory) and converts the scene.
+template <class Read>
+Result<Model> import(const std::string& name, Read&& read) {
+  try {
+    Assimp::Importer importer;
+    importer.SetProgressHandler(new CancelOnInterrupt);  // the importer owns and deletes it
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    const aiScene* scene =
+        read(importer, aiProcess_Triangulate | aiProcess_SortByPType |
+                           aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure);
+    LODFORGE_TRY(checkCancelled());
+    if (!scene) return badInput(name, fmt::format("assimp: {}", importer.GetErrorString()));
+    if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || !scene->mRootNode)
+      return badInput(name, "assimp read an incomplete scene (no node tree)");
+    return SceneConverter(*scene, name).convert();
+  } catch (const std::exception& e) {
+    return badInput(name, fmt::format("assimp: {}", e.what()));
+  }
+}
+
+}  // namespace
+
+Result<Model> readAssimp(const std::string& path) {
+  Result<std::uint64_t> size = fileSize(path);  // a missing file says so, not assimp's words
+  if (!size) return size.status();
+  return import(path, [&](Assimp::Importer& importer, unsigned flags) {
+    return importer.ReadFile(path, flags);
+  });
+}
+
+Result<Model> readAssimpFromMemory(std::span<const std::byte> bytes, const std::string& name) {
+  const std::string hint = fileExtension(name);
+  return import(name, [&](Assimp::Importer& importer, unsigned flags) {
+    return importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, hint.c_str());
+  });
+}
+
+}  // namespace lodforge

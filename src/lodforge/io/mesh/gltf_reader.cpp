@@ -1,0 +1,764 @@
+#include "lodforge/io/mesh/gltf_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <unordered_map>
+#include <vector>
+
+#include <draco/compression/decode.h>
+#include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
+
+#include "lodforge/core/file.h"
+
+namespace lodforge {
+
+namespace {
+
+constexpr int kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
+constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123,
+              kUnsignedInt = 5125, kFloat = 5126;
+constexpr std::uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr std::uint32_t kChunkJson = 0x4E4F534A;
+constexpr std::uint32_t kChunkBin = 0x004E4942;
+// Debian's tinygltf (2.8) sizes the BIN chunk as everything after the JSON chunk, its 8-byte
+// header included, so it copies a buffer up to 8 bytes longer than the chunk from past the end
+// of the file. GLB is parsed from a copy with that many zero bytes after the end, and the
+// buffer is checked against the real chunk length afterwards.
+constexpr std::size_t kTinygltfOverread = 8;
+
+std::size_t componentSize(int type) {
+  switch (type) {
+    case kByte:
+    case kUnsignedByte:
+      return 1;
+    case kShort:
+    case kUnsignedShort:
+      return 2;
+    case kUnsignedInt:
+    case kFloat:
+      return 4;
+    default:
+      return 0;
+  }
+}
+
+// One component, converted as glTF's normalisation rules say (spec 3.11, "Animations" table).
+double loadComponent(const unsigned char* p, int type, bool normalized) {
+  switch (type) {
+    case kByte: {
+      std::int8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case kUnsignedByte:
+      return normalized ? *p / 255.0 : *p;
+    case kShort: {
+      std::int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case kUnsignedShort: {
+      std::uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0 : v;
+    }
+    case kUnsignedInt: {
+      std::uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+    default: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return static_cast<double>(v);
+    }
+  }
+}
+
+Mat4d localTransform(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) {
+    Mat4d m;
+    std::copy(node.matrix.begin(), node.matrix.end(), m.m.begin());
+    return m;
+  }
+  Mat4d t, r, s;
+  if (node.translation.size() == 3)
+    t = Mat4d::translation({node.translation[0], node.translation[1], node.translation[2]});
+  if (node.rotation.size() == 4)
+    r = Mat4d::rotation(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
+  if (node.scale.size() == 3) s = Mat4d::scale({node.scale[0], node.scale[1], node.scale[2]});
+  return t * r * s;
+}
+
+bool refuseFileExists(const std::string&, void*) {
+  return false;
+}
+std::string keepPath(const std::string& path, void*) {
+  return path;
+}
+bool refuseRead(std::vector<unsigned char>*, std::string* err, const std::string& path, void*) {
+  if (err) *err += "external file '" + path + "' not allowed";
+  return false;
+}
+bool refuseWrite(std::string*, const std::string&, const std::vector<unsigned char>&, void*) {
+  return false;
+}
+// Images are never decoded: lodforge reads geometry and colours, not textures.
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+               const unsigned char*, int, void*) {
+  return true;
+}
+
+class Loader {
+ public:
+  Loader(const tinygltf::Model& gltf, const std::string& name, std::uint64_t binOffset)
+      : gltf_(gltf), name_(name), binOffset_(binOffset) {}
+
+  Model load() {
+    readMaterials();
+    decideColors();
+    traverseScene();
+    placeAtOrigin();
+    return std::move(model_);
+  }
+
+ private:
+  [[noreturn]] void fail(std::string_view what) const {
+    throw ErrorException{badInput(name_, what)};
+  }
+
+  template <class T>
+  const T& element(const std::vector<T>& list, int index, std::string_view kind,
+                   std::string_view where) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= list.size())
+      fail(fmt::format("{}: {} {} does not exist (there are {})", where, kind, index, list.size()));
+    return list[static_cast<std::size_t>(index)];
+  }
+
+  // Reads accessor values as doubles, `components` per element; checks every byte range.
+  std::vector<double> readAccessor(int index, int components, std::string_view where) const {
+    const auto& accessor = element(gltf_.accessors, index, "accessor", where);
+    const std::string what = fmt::format("{} (accessor {})", where, index);
+    const int actual = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(accessor.type));
+    if (actual != components)
+      fail(fmt::format("{}: expected {} components per element, found {}", what, components,
+                       actual));
+    const std::size_t size = componentSize(accessor.componentType);
+    if (size == 0) fail(fmt::format("{}: invalid component type {}", what, accessor.componentType));
+    const std::size_t elementSize = size * static_cast<std::size_t>(components);
+    std::vector<double> values;
+    if (accessor.bufferView < 0) {
+      // All zeros plus sparse substitutions; bound the count by what the file could mean.
+      std::size_t bufferBytes = 0;
+      for (const auto& b : gltf_.buffers) bufferBytes += b.data.size();
+      if (!accessor.sparse.isSparse || accessor.count > 16 * bufferBytes + 1024)
+        fail(fmt::format("{}: {} elements without a bufferView", what, accessor.count));
+      values.assign(accessor.count * static_cast<std::size_t>(components), 0.0);
+    } else {
+      const auto& view = element(gltf_.bufferViews, accessor.bufferView, "bufferView", what);
+      const auto& buffer = element(gltf_.buffers, view.buffer, "buffer", what);
+      if (view.byteOffset > buffer.data.size() ||
+          view.byteLength > buffer.data.size() - view.byteOffset)
+        fail(fmt::format("{}: bufferView {} (bytes {}..{}) lies outside buffer {} ({} bytes)", what,
+                         accessor.bufferView, view.byteOffset, view.byteOffset + view.byteLength,
+                         view.buffer, buffer.data.size()));
+      const std::size_t stride = view.byteStride ? view.byteStride : elementSize;
+      if (stride < elementSize)
+        fail(fmt::format("{}: byteStride {} is smaller than an element ({} bytes)", what, stride,
+                         elementSize));
+      const bool fits =
+          accessor.count == 0 ||
+          (accessor.byteOffset <= view.byteLength &&
+           elementSize <= view.byteLength - accessor.byteOffset &&
+           accessor.count - 1 <= (view.byteLength - accessor.byteOffset - elementSize) / stride);
+      if (!fits) {
+        // GLB only: buffer 0 is the BIN chunk, so the file position is known.
+        const std::uint64_t at = binOffset_ != 0 && view.buffer == 0
+                                     ? binOffset_ + view.byteOffset + accessor.byteOffset
+                                     : 0;
+        fail(fmt::format(
+            "{}: {} elements of {} bytes (stride {}) starting at byte {} do not fit in "
+            "bufferView {} ({} bytes){}",
+            what, accessor.count, elementSize, stride, accessor.byteOffset, accessor.bufferView,
+            view.byteLength, at ? fmt::format(", file byte {}", at) : std::string()));
+      }
+      values.resize(accessor.count * static_cast<std::size_t>(components));
+      const unsigned char* base = buffer.data.data() + view.byteOffset + accessor.byteOffset;
+      for (std::size_t i = 0; i < accessor.count; ++i) {
+        for (int c = 0; c < components; ++c) {
+          values[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
+              loadComponent(base + i * stride + static_cast<std::size_t>(c) * size,
+                            accessor.componentType, accessor.normalized);
+        }
+      }
+    }
+    if (accessor.sparse.isSparse) applySparse(accessor, components, size, values, what);
+    return values;
+  }
+
+  void applySparse(const tinygltf::Accessor& accessor, int components, std::size_t size,
+                   std::vector<double>& values, const std::string& what) const {
+    const auto& sparse = accessor.sparse;
+    if (sparse.count < 0 || static_cast<std::size_t>(sparse.count) > accessor.count)
+      fail(fmt::format("{}: sparse count {} exceeds the element count {}", what, sparse.count,
+                       accessor.count));
+    const auto count = static_cast<std::size_t>(sparse.count);
+    auto range = [&](int viewIndex, int offset, std::size_t bytes) -> const unsigned char* {
+      const auto& view = element(gltf_.bufferViews, viewIndex, "bufferView", what);
+      const auto& buffer = element(gltf_.buffers, view.buffer, "buffer", what);
+      if (offset < 0 || view.byteOffset > buffer.data.size() ||
+          view.byteLength > buffer.data.size() - view.byteOffset ||
+          static_cast<std::size_t>(offset) > view.byteLength ||
+          bytes > view.byteLength - static_cast<std::size_t>(offset))
+        fail(fmt::format("{}: sparse data lies outside bufferView {}", what, viewIndex));
+      return buffer.data.data() + view.byteOffset + static_cast<std::size_t>(offset);
+    };
+    const std::size_t indexSize = componentSize(sparse.indices.componentType);
+    if (indexSize == 0 || sparse.indices.componentType == kByte ||
+        sparse.indices.componentType == kShort || sparse.indices.componentType == kFloat)
+      fail(fmt::format("{}: invalid sparse index type {}", what, sparse.indices.componentType));
+    const unsigned char* indices =
+        range(sparse.indices.bufferView, sparse.indices.byteOffset, count * indexSize);
+    const std::size_t elementSize = size * static_cast<std::size_t>(components);
+    const unsigned char* data =
+        range(sparse.values.bufferView, sparse.values.byteOffset, count * elementSize);
+    for (std::size_t i = 0; i < count; ++i) {
+      const auto target = static_cast<std::size_t>(
+          loadComponent(indices + i * indexSize, sparse.indices.componentType, false));
+      if (target >= accessor.count)
+        fail(fmt::format("{}: sparse index {} out of range", what, target));
+      for (int c = 0; c < components; ++c) {
+        values[target * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
+            loadComponent(data + i * elementSize + static_cast<std::size_t>(c) * size,
+                          accessor.componentType, accessor.normalized);
+      }
+    }
+  }
+
+  // The file's materials, in its order (objects refer to them by the same index). The base
+  // colour also goes into the vertex colours (decideColors), which every writer carries.
+  void readMaterials() {
+    for (const auto& m : gltf_.materials) {
+      Material material;
+      material.name = m.name;
+      const auto& pbr = m.pbrMetallicRoughness;
+      if (pbr.baseColorFactor.size() == 4)
+        for (std::size_t k = 0; k < 4; ++k)
+          material.baseColor[k] = static_cast<float>(pbr.baseColorFactor[k]);
+      material.metallic = static_cast<float>(pbr.metallicFactor);
+      material.roughness = static_cast<float>(pbr.roughnessFactor);
+      material.alphaMode = m.alphaMode == "BLEND"  ? AlphaMode::kBlend
+                           : m.alphaMode == "MASK" ? AlphaMode::kMask
+                                                   : AlphaMode::kOpaque;
+      material.alphaCutoff = static_cast<float>(m.alphaCutoff);
+      material.doubleSided = m.doubleSided;
+      if (m.emissiveFactor.size() == 3)
+        for (std::size_t k = 0; k < 3; ++k)
+          material.emissive[k] = static_cast<float>(m.emissiveFactor[k]);
+      model_.materials.push_back(std::move(material));
+    }
+  }
+
+  // Colours are kept when any drawn primitive has a material or COLOR_0.
+  void decideColors() {
+    for (const auto& mesh : gltf_.meshes) {
+      for (const auto& primitive : mesh.primitives) {
+        if (primitive.material >= 0 || primitive.attributes.count("COLOR_0")) withColors_ = true;
+      }
+    }
+  }
+
+  void traverseScene() {
+    std::vector<int> roots;
+    if (!gltf_.scenes.empty()) {
+      const int scene = gltf_.defaultScene >= 0 ? gltf_.defaultScene : 0;
+      roots = element(gltf_.scenes, scene, "scene", "scene").nodes;
+    } else {
+      // No scene: every node that is nobody's child is a root.
+      std::vector<bool> isChild(gltf_.nodes.size(), false);
+      for (const auto& node : gltf_.nodes) {
+        for (int child : node.children) {
+          if (child >= 0 && static_cast<std::size_t>(child) < isChild.size())
+            isChild[static_cast<std::size_t>(child)] = true;
+        }
+      }
+      for (std::size_t i = 0; i < gltf_.nodes.size(); ++i) {
+        if (!isChild[i]) roots.push_back(static_cast<int>(i));
+      }
+    }
+    visited_.assign(gltf_.nodes.size(), false);
+    // Iterative depth-first walk: a hostile file cannot blow the stack. Each entry carries its
+    // parent's transform and path (the node names from the root, "/"-separated).
+    struct Entry {
+      int index;
+      Mat4d parent;
+      std::string path;
+    };
+    std::vector<Entry> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, Mat4d{}, {}});
+    while (!stack.empty()) {
+      auto [index, parent, parentPath] = std::move(stack.back());
+      stack.pop_back();
+      const auto& node = element(gltf_.nodes, index, "node", "scene hierarchy");
+      if (visited_[static_cast<std::size_t>(index)])
+        fail(fmt::format("node {} appears twice in the hierarchy (a cycle or a shared child)",
+                         index));
+      visited_[static_cast<std::size_t>(index)] = true;
+      const Mat4d world = parent * localTransform(node);
+      const std::string name = node.name.empty() ? fmt::format("node {}", index) : node.name;
+      const std::string path = parentPath.empty() ? name : parentPath + "/" + name;
+      if (node.mesh >= 0) {
+        const std::size_t first = model_.objects.size();
+        addNode(index, node, world, path);
+        setLayer(node, first);
+      }
+      for (auto child = node.children.rbegin(); child != node.children.rend(); ++child)
+        stack.push_back({*child, world, path});
+    }
+  }
+
+  // A node's CAD layers (extras.layer, as lodforge's GLB writer keeps them) on the objects it
+  // added from `first` on.
+  void setLayer(const tinygltf::Node& node, std::size_t first) {
+    if (!node.extras.IsObject() || !node.extras.Has("layer")) return;
+    const tinygltf::Value& value = node.extras.Get("layer");
+    if (!value.IsString() || value.Get<std::string>().empty()) return;
+    const std::uint32_t layer = layers_.index(value.Get<std::string>());
+    for (std::size_t o = first; o < model_.objects.size(); ++o) model_.objects[o].layer = layer;
+  }
+
+  void addNode(int index, const tinygltf::Node& node, const Mat4d& world, const std::string& path) {
+    const auto& mesh = element(gltf_.meshes, node.mesh, "mesh", fmt::format("node {}", index));
+    std::string baseName = !node.name.empty()   ? node.name
+                           : !mesh.name.empty() ? mesh.name
+                                                : fmt::format("node {}", index);
+    const auto instancing = node.extensions.find("EXT_mesh_gpu_instancing");
+    if (instancing == node.extensions.end()) {
+      addObject(baseName, path, node.mesh, mesh, world);
+      return;
+    }
+    // GPU instancing: one object per instance, each with its own transform.
+    const tinygltf::Value& attributes = instancing->second.Get("attributes");
+    const std::string where = fmt::format("node {} EXT_mesh_gpu_instancing", index);
+    auto attribute = [&](const char* key, int components) -> std::vector<double> {
+      if (!attributes.Has(key)) return {};
+      return readAccessor(attributes.Get(key).GetNumberAsInt(), components, where);
+    };
+    const std::vector<double> t = attribute("TRANSLATION", 3);
+    const std::vector<double> r = attribute("ROTATION", 4);
+    const std::vector<double> s = attribute("SCALE", 3);
+    const std::size_t count = std::max({t.size() / 3, r.size() / 4, s.size() / 3});
+    if ((!t.empty() && t.size() / 3 != count) || (!r.empty() && r.size() / 4 != count) ||
+        (!s.empty() && s.size() / 3 != count))
+      fail(fmt::format("{}: attributes differ in count", where));
+    for (std::size_t i = 0; i < count; ++i) {
+      Mat4d local;
+      if (!t.empty()) local = Mat4d::translation({t[3 * i], t[3 * i + 1], t[3 * i + 2]});
+      if (!r.empty())
+        local = local * Mat4d::rotation(r[4 * i], r[4 * i + 1], r[4 * i + 2], r[4 * i + 3]);
+      if (!s.empty()) local = local * Mat4d::scale({s[3 * i], s[3 * i + 1], s[3 * i + 2]});
+      addObject(fmt::format("{}#{}", baseName, i), fmt::format("{}#{}", path, i), node.mesh, mesh,
+                world * local);
+    }
+  }
+
+  struct PrimitiveData {
+    std::vector<double> positions, normals, colors;  // 3, 3, 4 per vertex
+    std::vector<std::uint32_t> triangles;
+  };
+
+  void addObject(const std::string& name, const std::string& path, int meshIndex,
+                 const tinygltf::Mesh& mesh, const Mat4d& world) {
+    ModelBuilder builder(model_);
+    builder.beginObject(name, path);
+    const Mat4d normalMatrix = world.normalMatrix();
+    const bool mirrored = world.determinant3() < 0;  // winding flips under a mirror
+    for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
+      const auto& primitive = mesh.primitives[p];
+      const std::string where = fmt::format("mesh {} primitive {}", meshIndex, p);
+      const int mode = primitive.mode < 0 ? kModeTriangles : primitive.mode;
+      if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan)
+        continue;  // points, lines
+      PrimitiveData data = primitive.extensions.count("KHR_draco_mesh_compression")
+                               ? decodeDraco(primitive, where)
+                               : readPrimitive(primitive, mode, where);
+      const std::size_t vertexCount = data.positions.size() / 3;
+      const auto base =
+          static_cast<std::uint32_t>(model_.positions.size() - model_.objects.back().vertexOffset);
+      if (vertexCount > std::numeric_limits<std::uint32_t>::max() - base)
+        fail(fmt::format("{}: too many vertices in one object", where));
+      Vec4Color factor = baseColor(primitive.material, where);
+      for (std::size_t v = 0; v < vertexCount; ++v) {
+        const Vec3d local{data.positions[3 * v], data.positions[3 * v + 1],
+                          data.positions[3 * v + 2]};
+        if (!isFinite(local)) fail(fmt::format("{}: POSITION {} is not finite", where, v));
+        world_.push_back(world.transformPoint(local));
+        model_.positions.push_back({});  // filled by placeAtOrigin
+        if (!data.normals.empty()) {
+          const Vec3d n{data.normals[3 * v], data.normals[3 * v + 1], data.normals[3 * v + 2]};
+          if (!isFinite(n)) fail(fmt::format("{}: NORMAL {} is not finite", where, v));
+          normalsByVertex_.push_back(
+              toFloat(normalizeOr(normalMatrix.transformVector(n), Vec3d{})));
+        } else {
+          normalsByVertex_.push_back({});
+          missingNormals_ = true;
+        }
+        if (withColors_) {
+          double c[4] = {factor[0], factor[1], factor[2], factor[3]};
+          if (!data.colors.empty()) {
+            for (int k = 0; k < 4; ++k) c[k] *= data.colors[4 * v + static_cast<std::size_t>(k)];
+          }
+          auto channel = [](double x) {
+            return static_cast<std::uint8_t>(
+                std::lround(std::clamp(std::isfinite(x) ? x : 0.0, 0.0, 1.0) * 255));
+          };
+          model_.colors.push_back({channel(c[0]), channel(c[1]), channel(c[2]), channel(c[3])});
+        }
+      }
+      for (std::size_t t = 0; t + 2 < data.triangles.size(); t += 3) {
+        std::uint32_t a = data.triangles[t], b = data.triangles[t + 1], c = data.triangles[t + 2];
+        if (a >= vertexCount || b >= vertexCount || c >= vertexCount)
+          fail(fmt::format("{}: index {} out of range ({} vertices)", where, std::max({a, b, c}),
+                           vertexCount));
+        if (mirrored) std::swap(b, c);
+        model_.indices.insert(model_.indices.end(), {base + a, base + b, base + c});
+      }
+    }
+    // One material per object: its first drawn primitive's (the vertex colours keep the others'
+    // base colours).
+    for (const auto& primitive : mesh.primitives) {
+      if (primitive.material < 0 ||
+          static_cast<std::size_t>(primitive.material) >= model_.materials.size())
+        continue;
+      model_.objects.back().material = static_cast<std::uint32_t>(primitive.material);
+      break;
+    }
+    builder.endObject();
+  }
+
+  using Vec4Color = std::array<double, 4>;
+  Vec4Color baseColor(int material, std::string_view where) const {
+    if (material < 0) return {1, 1, 1, 1};
+    const auto& m = element(gltf_.materials, material, "material", where);
+    const auto& f = m.pbrMetallicRoughness.baseColorFactor;
+    if (f.size() != 4) return {1, 1, 1, 1};
+    return {f[0], f[1], f[2], f[3]};
+  }
+
+  PrimitiveData readPrimitive(const tinygltf::Primitive& primitive, int mode,
+                              const std::string& where) {
+    PrimitiveData data;
+    const auto position = primitive.attributes.find("POSITION");
+    if (position == primitive.attributes.end())
+      fail(fmt::format("{}: no POSITION attribute", where));
+    data.positions = readAccessor(position->second, 3, where + " POSITION");
+    const std::size_t vertexCount = data.positions.size() / 3;
+    if (auto normal = primitive.attributes.find("NORMAL"); normal != primitive.attributes.end()) {
+      data.normals = readAccessor(normal->second, 3, where + " NORMAL");
+      if (data.normals.size() != data.positions.size())
+        fail(fmt::format("{}: NORMAL and POSITION differ in count", where));
+    }
+    if (auto color = primitive.attributes.find("COLOR_0"); color != primitive.attributes.end()) {
+      const auto& accessor =
+          element(gltf_.accessors, color->second, "accessor", where + " COLOR_0");
+      const int components =
+          tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(accessor.type));
+      if (components != 3 && components != 4)
+        fail(fmt::format("{}: COLOR_0 must be VEC3 or VEC4", where));
+      const std::vector<double> raw = readAccessor(color->second, components, where + " COLOR_0");
+      if (raw.size() / static_cast<std::size_t>(components) != vertexCount)
+        fail(fmt::format("{}: COLOR_0 and POSITION differ in count", where));
+      data.colors.resize(4 * vertexCount, 1.0);
+      for (std::size_t v = 0; v < vertexCount; ++v) {
+        for (int k = 0; k < components; ++k)
+          data.colors[4 * v + static_cast<std::size_t>(k)] =
+              raw[v * static_cast<std::size_t>(components) + static_cast<std::size_t>(k)];
+      }
+    }
+    std::vector<std::uint32_t> indices;
+    if (primitive.indices >= 0) {
+      const auto& accessor =
+          element(gltf_.accessors, primitive.indices, "accessor", where + " indices");
+      if (accessor.componentType != kUnsignedByte && accessor.componentType != kUnsignedShort &&
+          accessor.componentType != kUnsignedInt)
+        fail(fmt::format("{}: indices must be unsigned integers", where));
+      const std::vector<double> raw = readAccessor(primitive.indices, 1, where + " indices");
+      indices.reserve(raw.size());
+      for (double i : raw) {
+        if (i >= static_cast<double>(vertexCount))
+          fail(fmt::format("{}: index {} out of range ({} vertices)", where, i, vertexCount));
+        indices.push_back(static_cast<std::uint32_t>(i));
+      }
+    } else {
+      if (vertexCount > std::numeric_limits<std::uint32_t>::max())
+        fail(fmt::format("{}: too many vertices", where));
+      indices.resize(vertexCount);
+      for (std::uint32_t i = 0; i < indices.size(); ++i) indices[i] = i;
+    }
+    data.triangles = toTriangles(indices, mode);
+    return data;
+  }
+
+  static std::vector<std::uint32_t> toTriangles(const std::vector<std::uint32_t>& indices,
+                                                int mode) {
+    if (mode == kModeTriangles) {
+      std::vector<std::uint32_t> triangles(
+          indices.begin(), indices.begin() + static_cast<std::ptrdiff_t>(indices.size() / 3 * 3));
+      return triangles;
+    }
+    std::vector<std::uint32_t> triangles;
+    for (std::size_t i = 2; i < indices.size(); ++i) {
+      if (mode == kModeFan) {
+        triangles.insert(triangles.end(), {indices[0], indices[i - 1], indices[i]});
+      } else if (i % 2 == 0) {  // strips alternate winding
+        triangles.insert(triangles.end(), {indices[i - 2], indices[i - 1], indices[i]});
+      } else {
+        triangles.insert(triangles.end(), {indices[i - 1], indices[i - 2], indices[i]});
+      }
+    }
+    return triangles;
+  }
+
+  PrimitiveData decodeDraco(const tinygltf::Primitive& primitive, const std::string& where) {
+    const tinygltf::Value& ext = primitive.extensions.at("KHR_draco_mesh_compression");
+    const std::string what = where + " KHR_draco_mesh_compression";
+    if (!ext.Has("bufferView") || !ext.Has("attributes"))
+      fail(fmt::format("{}: missing bufferView or attributes", what));
+    const int viewIndex = ext.Get("bufferView").GetNumberAsInt();
+    const auto& view = element(gltf_.bufferViews, viewIndex, "bufferView", what);
+    const auto& buffer = element(gltf_.buffers, view.buffer, "buffer", what);
+    if (view.byteOffset > buffer.data.size() ||
+        view.byteLength > buffer.data.size() - view.byteOffset)
+      fail(fmt::format("{}: bufferView {} lies outside its buffer", what, viewIndex));
+    draco::DecoderBuffer input;
+    input.Init(reinterpret_cast<const char*>(buffer.data.data() + view.byteOffset),
+               view.byteLength);
+    draco::Decoder decoder;
+    auto decoded = decoder.DecodeMeshFromBuffer(&input);
+    if (!decoded.ok())
+      fail(fmt::format("{}: Draco cannot decode: {}", what, decoded.status().error_msg_string()));
+    const std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
+    const tinygltf::Value& attributes = ext.Get("attributes");
+
+    auto read = [&](const char* semantic, int components, std::vector<double>& out) {
+      if (!attributes.Has(semantic)) return;
+      const auto id = static_cast<std::uint32_t>(attributes.Get(semantic).GetNumberAsInt());
+      const draco::PointAttribute* attribute = mesh->GetAttributeByUniqueId(id);
+      if (!attribute)
+        fail(fmt::format("{}: no Draco attribute with id {} for {}", what, id, semantic));
+      out.resize(mesh->num_points() * static_cast<std::size_t>(components), 1.0);
+      std::array<float, 4> value{};
+      for (draco::PointIndex i(0); i < mesh->num_points(); ++i) {
+        value.fill(1.0f);
+        const int have = std::min<int>(components, attribute->num_components());
+        if (!attribute->ConvertValue<float>(attribute->mapped_index(i),
+                                            static_cast<std::int8_t>(have), value.data()))
+          fail(fmt::format("{}: cannot convert {} of point {}", what, semantic, i.value()));
+        for (int k = 0; k < components; ++k)
+          out[i.value() * static_cast<std::size_t>(components) + static_cast<std::size_t>(k)] =
+              static_cast<double>(value[static_cast<std::size_t>(k)]);
+      }
+    };
+    PrimitiveData data;
+    read("POSITION", 3, data.positions);
+    if (data.positions.empty()) fail(fmt::format("{}: no POSITION attribute", what));
+    read("NORMAL", 3, data.normals);
+    read("COLOR_0", 4, data.colors);
+    data.triangles.reserve(mesh->num_faces() * 3);
+    for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f) {
+      const auto& face = mesh->face(f);
+      for (std::size_t k = 0; k < 3; ++k) data.triangles.push_back(face[k].value());
+    }
+    return data;
+  }
+
+  // World coordinates become float offsets from one double origin.
+  void placeAtOrigin() {
+    lodforge::placeAtOrigin(model_, world_);
+    // Normals only when every vertex has one; partial normals would mislead more than help.
+    if (!missingNormals_ && !normalsByVertex_.empty()) model_.normals = std::move(normalsByVertex_);
+  }
+
+  const tinygltf::Model& gltf_;
+  const std::string& name_;
+  std::uint64_t binOffset_;
+  Model model_;
+  std::vector<Vec3d> world_;
+  std::vector<Vec3f> normalsByVertex_;
+  std::vector<bool> visited_;
+  LayerTable layers_{model_.layers};
+  bool withColors_ = false;
+  bool missingNormals_ = false;
+};
+
+// Checks the GLB container before tinygltf does, so errors carry byte offsets.
+Status checkGlbContainer(std::span<const std::byte> bytes, const std::string& name,
+                         std::uint64_t& binOffset, std::uint64_t& binLength) {
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v;
+    std::memcpy(&v, bytes.data() + at, 4);
+    return v;
+  };
+  if (bytes.size() < 20)
+    return badInputAtByte(name, bytes.size(), "GLB ends inside its 20-byte header");
+  if (u32(4) != 2)
+    return badInputAtByte(name, 4, fmt::format("GLB version {} (expected 2)", u32(4)));
+  if (u32(8) != bytes.size())
+    return badInputAtByte(
+        name, 8, fmt::format("GLB header says {} bytes but the file has {}", u32(8), bytes.size()));
+  const std::uint64_t jsonLength = u32(12);
+  if (u32(16) != kChunkJson) return badInputAtByte(name, 16, "first GLB chunk is not JSON");
+  if (20 + jsonLength > bytes.size())
+    return badInputAtByte(
+        name, 12, fmt::format("JSON chunk of {} bytes runs past the end of the file", jsonLength));
+  binOffset = 20 + jsonLength + 8;
+  binLength = 0;
+  if (20 + jsonLength < bytes.size()) {
+    if (bytes.size() - (20 + jsonLength) < 8)
+      return badInputAtByte(name, 20 + jsonLength, "GLB ends inside a chunk header");
+    const std::uint64_t length = u32(20 + jsonLength);
+    if (length > bytes.size() - binOffset)
+      return badInputAtByte(
+          name, 20 + jsonLength,
+          fmt::format("BIN chunk of {} bytes runs past the end of the file", length));
+    if (u32(24 + jsonLength) == kChunkBin) binLength = length;
+  }
+  return {};
+}
+
+// Draco primitives name an indices accessor without a bufferView (the data is in the Draco
+// stream), which Debian's tinygltf, built without Draco, rejects. The reader takes indices from
+// the Draco stream anyway, so drop the reference before tinygltf sees it. Returns the rewritten
+// file, or nothing when no primitive is Draco-compressed.
+Result<std::optional<std::string>> withoutDracoIndices(std::span<const std::byte> bytes,
+                                                       const std::string& name, bool glb) {
+  const std::string_view all(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  std::uint32_t jsonLength = 0;
+  if (glb) std::memcpy(&jsonLength, bytes.data() + 12, 4);
+  const std::string_view text = glb ? all.substr(20, jsonLength) : all;
+  if (text.find("KHR_draco_mesh_compression") == std::string_view::npos)
+    return std::optional<std::string>();
+  nlohmann::json document = nlohmann::json::parse(text, nullptr, false);
+  if (document.is_discarded())
+    return badInputAtByte(name, glb ? 20 : 0, "the glTF JSON does not parse");
+  bool changed = false;
+  if (document.contains("meshes") && document["meshes"].is_array()) {
+    for (auto& mesh : document["meshes"]) {
+      if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array())
+        continue;
+      for (auto& primitive : mesh["primitives"]) {
+        if (primitive.is_object() && primitive.contains("extensions") &&
+            primitive["extensions"].is_object() &&
+            primitive["extensions"].contains("KHR_draco_mesh_compression") &&
+            primitive.contains("indices")) {
+          primitive.erase("indices");
+          changed = true;
+        }
+      }
+    }
+  }
+  if (!changed) return std::optional<std::string>();
+  std::string json = document.dump();
+  if (!glb) return std::optional<std::string>(std::move(json));
+  while (json.size() % 4) json += ' ';
+  const std::string_view rest = all.substr(20 + jsonLength);
+  std::string out(20, '\0');
+  const std::uint32_t header[5] = {kGlbMagic, 2,
+                                   static_cast<std::uint32_t>(20 + json.size() + rest.size()),
+                                   static_cast<std::uint32_t>(json.size()), kChunkJson};
+  std::memcpy(out.data(), header, 20);
+  out += json;
+  out += rest;
+  return std::optional<std::string>(std::move(out));
+}
+
+Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
+                    const std::string& baseDir, const GltfReadOptions& options) {
+  if (bytes.size() > std::numeric_limits<unsigned>::max())
+    return Error{ErrorKind::kLimit,
+                 fmt::format("{}: glTF files over 4 GiB are not supported", name)};
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skipImage, nullptr);
+  if (!options.allowExternalFiles) {
+    loader.SetFsCallbacks({refuseFileExists, keepPath, refuseRead, refuseWrite, nullptr});
+  }
+  tinygltf::Model gltf;
+  std::string errors, warnings;
+  std::uint64_t binOffset = 0, binLength = 0;
+  bool ok = false;
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  // tinygltf throws (nlohmann::json conversions of out-of-range numbers) on some bad files.
+  try {
+    std::uint32_t magic = 0;
+    if (bytes.size() >= 4) std::memcpy(&magic, bytes.data(), 4);
+    if (magic == kGlbMagic) {
+      LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset, binLength));
+      Result<std::optional<std::string>> rewritten = withoutDracoIndices(bytes, name, true);
+      if (!rewritten) return rewritten.status();
+      // Same BIN chunk, maybe a new JSON length: byte offsets reported are the original file's.
+      std::string copy = *rewritten
+                             ? std::move(**rewritten)
+                             : std::string(reinterpret_cast<const char*>(data), bytes.size());
+      const std::size_t size = copy.size();
+      copy.append(kTinygltfOverread, '\0');
+      ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings,
+                                       reinterpret_cast<const unsigned char*>(copy.data()),
+                                       static_cast<unsigned>(size), baseDir);
+      if (ok && !gltf.buffers.empty() && gltf.buffers[0].uri.empty() &&
+          gltf.buffers[0].data.size() > binLength)
+        return badInputAtByte(name, binOffset - 8,
+                              fmt::format("buffer 0 declares {} bytes but the BIN chunk holds {}",
+                                          gltf.buffers[0].data.size(), binLength));
+    } else {
+      const auto first = std::find_if(bytes.begin(), bytes.end(), [](std::byte b) {
+        return !std::isspace(static_cast<unsigned char>(b));
+      });
+      if (first == bytes.end() || *first != std::byte{'{'})
+        return badInputAtByte(name, 0, "neither GLB (magic 'glTF') nor glTF JSON");
+      Result<std::optional<std::string>> rewritten = withoutDracoIndices(bytes, name, false);
+      if (!rewritten) return rewritten.status();
+      const std::string_view text =
+          *rewritten ? std::string_view(**rewritten)
+                     : std::string_view(reinterpret_cast<const char*>(data), bytes.size());
+      ok = loader.LoadASCIIFromString(&gltf, &errors, &warnings, text.data(),
+                                      static_cast<unsigned>(text.size()), baseDir);
+    }
+  } catch (const std::exception& e) {
+    return badInput(name, fmt::format("tinygltf cannot parse the file: {}", e.what()));
+  }
+  if (!ok) {
+    while (!errors.empty() && (errors.back() == '\n' || errors.back() == ' ')) errors.pop_back();
+    for (char& c : errors) {
+      if (c == '\n') c = ';';
+    }
+    return badInput(name, errors.empty() ? std::string("tinygltf cannot parse the file") : errors);
+  }
+  try {
+    Loader builder(gltf, name, binOffset);
+    return builder.load();
+  } catch (const ErrorException& e) {
+    return e.error;
+  }
+}
+
+}  // namespace
+
+Result<Model> readGltf(const std::string& path, const GltfReadOptions& options) {
+  Result<std::string> text = readFileToString(path, std::numeric_limits<unsigned>::max());
+  if (!text) return text.status();
+  std::string baseDir = std::filesystem::path(path).parent_path().string();
+  const std::span<const std::byte> bytes(reinterpret_cast<const std::byte*>(text->data()),
+                                         text->size());
+  return parse(bytes, path, baseDir, options);
+}
+
+Result<Model> readGltfFromMemory(std::span<const std::byte> bytes, const std::string& name,
+                                 const GltfReadOptions& options) {
+  return parse(bytes, name, "", options);
+}
+
+}  // namespace lodforge

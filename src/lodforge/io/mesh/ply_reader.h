@@ -1,0 +1,136 @@
+// PLY reader: ascii, binary little- and big-endian, any property order, every PLY scalar type,
+// faces as lists of any count/index type (polygons fan-triangulated), triangle strips (a
+// 'tristrips' element), optional per-face object ids. PlyReader streams: it yields batches of
+// vertices or faces in file order, so a file larger than RAM is processed with a fixed amount of
+// memory. readPly builds a whole Model.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/model.h"
+#include "lodforge/core/status.h"
+#include "lodforge/io/points/point_extras.h"
+
+namespace lodforge {
+
+enum class PlyFormat : std::uint8_t { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
+enum class PlyType : std::uint8_t {
+  kInt8,
+  kUint8,
+  kInt16,
+  kUint16,
+  kInt32,
+  kUint32,
+  kFloat32,
+  kFloat64
+};
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::kFloat32;  // the item type for lists
+  bool isList = false;
+  PlyType countType = PlyType::kUint8;
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  PlyFormat format = PlyFormat::kAscii;
+  std::vector<PlyElement> elements;
+  std::vector<std::string> comments;
+  std::uint64_t dataOffset = 0;  // byte where element data starts
+
+  // What lodforge reads from it.
+  std::uint64_t vertexCount = 0;
+  // Faces, plus the triangles the strips make (0: no faces, a point cloud). Only reading strips
+  // tells how many triangles they make (restarts, degenerate joins), so opening a file with
+  // strips reads them once to count.
+  std::uint64_t faceCount = 0;
+  std::uint64_t stripCount = 0;  // strips in the 'tristrips' element
+  bool hasNormals = false;
+  bool hasColors = false;
+  bool hasObjectIds = false;
+  bool doublePositions = false;  // x y z stored as double: keep the double origin
+  // The vertex's other scalar properties (label, segment_index, …), with readExtras.
+  PointExtras extras;
+};
+
+struct PlyReadOptions {
+  std::size_t batchSize = 1 << 16;  // elements per batch
+  // A file that ends early is bad input. With this set, reading stops after the last complete
+  // element instead and truncation() tells where the file was cut.
+  bool salvageTruncated = false;
+  // Which elements to deliver; the others are skipped (binary fixed-size ones by seeking).
+  bool readVertices = true;
+  bool readFaces = true;
+  bool readExtras = false;  // deliver the vertices' other scalar properties (PlyBatch::extras)
+  std::vector<std::string>* warnings = nullptr;  // readPly adds what it salvaged, if anything
+  // Face properties recognised as an object (part) id, first match wins.
+  std::vector<std::string> objectIdProperties = {"object_id", "objectid", "obj_id",
+                                                 "part_id",   "object",   "part"};
+};
+
+struct PlyBatch {
+  enum class Kind : std::uint8_t { kVertices, kFaces };
+  Kind kind = Kind::kVertices;
+  // Index of the batch's first vertex or face in the file, and how many the batch has (faces,
+  // not triangles). Strips count as their triangles, numbered after the faces; a strip longer
+  // than a batch goes on in the next one.
+  std::uint64_t first = 0;
+  std::uint64_t count = 0;
+  // kVertices
+  std::vector<Vec3d> positions;
+  std::vector<Vec3f> normals;     // when the header has nx ny nz
+  std::vector<Rgba8> colors;      // when the header has red green blue
+  std::vector<std::byte> extras;  // header.extras.stride bytes per vertex, with readExtras
+  // kFaces: 3 indices per triangle (polygons fan-triangulated, strips with every triangle facing
+  // the way the first does), global vertex indices
+  std::vector<std::uint32_t> triangles;
+  std::vector<std::uint32_t> triangleObjects;  // per triangle, when the header has object ids
+};
+
+class PlyReader {
+ public:
+  static Result<PlyReader> open(const std::string& path, const PlyReadOptions& options = {});
+  static Result<PlyReader> fromMemory(std::span<const std::byte> bytes, std::string name,
+                                      const PlyReadOptions& options = {});
+  PlyReader(PlyReader&&) noexcept;
+  PlyReader& operator=(PlyReader&&) noexcept;
+  ~PlyReader();
+
+  const PlyHeader& header() const;
+  // Where a salvaged file was cut short (after next() returned false); empty if it was whole.
+  const std::optional<std::string>& truncation() const;
+  std::uint64_t bytesAfterHeader() const;
+  // Fills `batch` with the next vertices or faces; false when the file is done. Elements other
+  // than vertex and face are skipped.
+  Result<bool> next(PlyBatch& batch);
+
+ private:
+  struct State;
+  explicit PlyReader(std::unique_ptr<State> state);
+  static Result<PlyReader> start(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+// Reads a whole PLY into a Model: one object, or one per distinct object id when the faces carry
+// one (vertices shared between objects are duplicated so each object is self-contained).
+Result<Model> readPly(const std::string& path, const PlyReadOptions& options = {});
+Result<Model> readPlyFromMemory(std::span<const std::byte> bytes, const std::string& name,
+                                const PlyReadOptions& options = {});
+
+std::string_view plyTypeName(PlyType type);
+std::size_t plyTypeSize(PlyType type);
+std::string_view plyFormatName(PlyFormat format);
+
+}  // namespace lodforge

@@ -1,0 +1,116 @@
+#include "lodforge/io/points/point_reader.h"
+
+#include <variant>
+
+#include "lodforge/core/file.h"
+#include "lodforge/io/format_advice.h"
+#include "lodforge/io/points/las_reader.h"
+#include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/points/xyz_reader.h"
+
+namespace lodforge {
+
+bool isPointCloudPath(const std::string& path) {
+  const std::string ext = fileExtension(path);
+  return ext == "las" || ext == "laz" || ext == "xyz" || ext == "txt" || ext == "csv" ||
+         ext == "pts";
+}
+
+struct PointReader::State {
+  std::variant<LasReader, PlyReader, XyzReader> reader;
+  PointCloudInfo info;
+  PlyBatch plyBatch;
+};
+
+PointReader::PointReader(std::unique_ptr<State> state) : state_(std::move(state)) {}
+PointReader::PointReader(PointReader&&) noexcept = default;
+PointReader& PointReader::operator=(PointReader&&) noexcept = default;
+PointReader::~PointReader() = default;
+
+const PointCloudInfo& PointReader::info() const {
+  return state_->info;
+}
+
+std::optional<std::string> PointReader::truncation() const {
+  if (const auto* ply = std::get_if<PlyReader>(&state_->reader)) return ply->truncation();
+  return std::nullopt;
+}
+
+Result<PointReader> PointReader::open(const std::string& path, std::size_t batchSize,
+                                      bool salvageTruncated, bool extras) {
+  const std::string ext = fileExtension(path);
+  if (ext == "las" || ext == "laz") {
+    Result<LasReader> las = LasReader::open(path, batchSize);
+    if (las && !extras) las->skipExtraBytes();
+    if (!las) return las.status();
+    const LasHeader& h = las->header();
+    PointCloudInfo info;
+    info.format = fmt::format("{} {}.{}, point format {}",
+                              h.copc         ? "COPC"
+                              : h.compressed ? "LAZ"
+                                             : "LAS",
+                              h.versionMajor, h.versionMinor, h.pointFormat);
+    info.count = h.pointCount;
+    info.bounds = h.bounds;
+    info.crs = h.crs;
+    info.hasColors = h.hasColors;
+    info.attributes = h.attributes;
+    info.extras = h.extras;
+    if (!info.extras.fields.empty()) info.attributes |= kAttrExtras;
+    if (!h.extrasIgnored.empty()) info.warnings.push_back(h.extrasIgnored);
+    return PointReader(std::make_unique<State>(State{std::move(*las), std::move(info), {}}));
+  }
+  if (ext == "ply") {
+    PlyReadOptions options;
+    options.batchSize = batchSize;
+    options.readFaces = false;
+    options.readExtras = extras;
+    options.salvageTruncated = salvageTruncated;
+    Result<PlyReader> ply = PlyReader::open(path, options);
+    if (!ply) return ply.status();
+    const PlyHeader& h = ply->header();
+    PointCloudInfo info;
+    info.format = fmt::format("PLY {}", plyFormatName(h.format));
+    info.count = h.vertexCount;
+    info.hasNormals = h.hasNormals;
+    info.hasColors = h.hasColors;
+    info.extras = h.extras;
+    if (!info.extras.fields.empty()) info.attributes |= kAttrExtras;
+    return PointReader(std::make_unique<State>(State{std::move(*ply), std::move(info), {}}));
+  }
+  if (isPointCloudPath(path)) {
+    Result<XyzReader> xyz = XyzReader::open(path, batchSize);
+    if (!xyz) return xyz.status();
+    const XyzLayout& layout = xyz->layout();
+    PointCloudInfo info;
+    info.format = fmt::format(
+        "text, {} columns separated by {}", layout.columns,
+        layout.separator == ' ' ? std::string("spaces") : fmt::format("'{}'", layout.separator));
+    info.hasNormals = layout.normal >= 0;
+    info.hasColors = layout.red >= 0;
+    return PointReader(std::make_unique<State>(State{std::move(*xyz), std::move(info), {}}));
+  }
+  return unknownFormatError(path, kPointFormats);
+}
+
+Result<bool> PointReader::next(PointBatch& batch) {
+  State& s = *state_;
+  if (auto* las = std::get_if<LasReader>(&s.reader)) return las->next(batch);
+  if (auto* xyz = std::get_if<XyzReader>(&s.reader)) return xyz->next(batch);
+  // PLY: vertex batches only (faces are skipped by the reader's options).
+  PlyReader& ply = std::get<PlyReader>(s.reader);
+  batch.clear();
+  while (true) {
+    Result<bool> more = ply.next(s.plyBatch);
+    if (!more || !*more) return more;
+    if (s.plyBatch.kind != PlyBatch::Kind::kVertices) continue;
+    batch.first = s.plyBatch.first;
+    batch.positions = std::move(s.plyBatch.positions);
+    batch.normals = std::move(s.plyBatch.normals);
+    batch.colors = std::move(s.plyBatch.colors);
+    batch.extras = std::move(s.plyBatch.extras);
+    return true;
+  }
+}
+
+}  // namespace lodforge

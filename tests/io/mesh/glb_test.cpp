@@ -1,0 +1,304 @@
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <meshoptimizer.h>
+#include <nlohmann/json.hpp>
+
+#include "lodforge/core/mesh.h"
+#include "lodforge/core/random.h"
+#include "lodforge/io/mesh/glb_writer.h"
+#include "lodforge/io/mesh/gltf_reader.h"
+#include "lodforge/io/mesh/ply_reader.h"
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+struct Glb {
+  nlohmann::json document;
+  std::uint32_t totalLength = 0, jsonLength = 0, binLength = 0;
+};
+
+Glb parseGlb(const std::string& bytes) {
+  Glb glb;
+  std::uint32_t header[5];
+  std::memcpy(header, bytes.data(), 20);
+  EXPECT_EQ(header[0], 0x46546C67u);
+  EXPECT_EQ(header[1], 2u);
+  glb.totalLength = header[2];
+  glb.jsonLength = header[3];
+  glb.document = nlohmann::json::parse(bytes.substr(20, glb.jsonLength));
+  if (bytes.size() > 20 + glb.jsonLength)
+    std::memcpy(&glb.binLength, bytes.data() + 20 + glb.jsonLength, 4);
+  return glb;
+}
+
+Model randomModel(std::uint64_t seed, int objects, int verticesPerObject) {
+  Random random(seed);
+  Model model;
+  ModelBuilder builder(model);
+  for (int o = 0; o < objects; ++o) {
+    builder.beginObject(fmt::format("part-{}", o));
+    for (int v = 0; v < verticesPerObject; ++v) {
+      builder.addVertex({float(random.uniform(-3, 3)), float(random.uniform(-3, 3)),
+                         float(random.uniform(-3, 3))});
+      model.normals.push_back(normalizeOr(
+          Vec3f{float(random.uniform(-1, 1)), float(random.uniform(-1, 1)), 1}, Vec3f{}));
+      model.colors.push_back(
+          {std::uint8_t(random.below(256)), 100, std::uint8_t(random.below(256)), 255});
+    }
+    for (int t = 0; t < verticesPerObject; ++t) {
+      const auto a = std::uint32_t(random.below(std::uint64_t(verticesPerObject)));
+      builder.addTriangle(a, (a + 1) % std::uint32_t(verticesPerObject),
+                          (a + 2) % std::uint32_t(verticesPerObject));
+    }
+  }
+  builder.endObject();
+  return model;
+}
+
+TEST(GlbWrite, ModelRoundTripsThroughOurReader) {
+  Model model = randomModel(1, 4, 30);
+  model.origin = {637000, 5106000, 100};  // geo-scale: the root node carries the translation
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(model, dir.file("m.glb")).ok());
+  Result<Model> back = readGltf(dir.file("m.glb"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->objectCount(), 4u);
+  EXPECT_EQ(back->indices, model.indices);
+  EXPECT_EQ(back->colors, model.colors);
+  for (std::size_t o = 0; o < 4; ++o) EXPECT_EQ(back->objectName(o), model.objectName(o));
+  for (std::size_t v = 0; v < model.vertexCount(); ++v) {
+    const Vec3d a = model.origin + toDouble(model.positions[v]),
+                b = back->origin + toDouble(back->positions[v]);
+    ASSERT_NEAR(a.x, b.x, 1e-6);
+    ASSERT_NEAR(a.y, b.y, 1e-6);
+    ASSERT_NEAR(a.z, b.z, 1e-6);
+    ASSERT_NEAR(dot(back->normals[v], model.normals[v]), 1.0f, 1e-6f);
+  }
+}
+
+TEST(GlbWrite, LayoutIsAlignedWithBoundsAndTheRightIndexWidth) {
+  // One object needs 32-bit indices (70,000 vertices), the others 16-bit.
+  Model model = randomModel(2, 2, 100);
+  Model big = randomModel(3, 1, 70'000);
+  ModelBuilder builder(model);
+  builder.beginObject("big");
+  model.positions.insert(model.positions.end(), big.positions.begin(), big.positions.end());
+  model.normals.insert(model.normals.end(), big.normals.begin(), big.normals.end());
+  model.colors.insert(model.colors.end(), big.colors.begin(), big.colors.end());
+  model.indices.insert(model.indices.end(), big.indices.begin(), big.indices.end());
+  builder.beginObject("empty");  // no triangles: a node without a mesh
+  builder.endObject();
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(model, dir.file("m.glb")).ok());
+  const std::string bytes = test::readFile(dir.file("m.glb"));
+  const Glb glb = parseGlb(bytes);
+  EXPECT_EQ(glb.totalLength, bytes.size());
+  EXPECT_EQ(glb.jsonLength % 4, 0u);
+  EXPECT_EQ(glb.binLength % 4, 0u);
+  for (const auto& view : glb.document["bufferViews"])
+    EXPECT_EQ(view["byteOffset"].get<std::uint64_t>() % 4, 0u);
+  const auto& accessors = glb.document["accessors"];
+  const auto& meshes = glb.document["meshes"];
+  ASSERT_EQ(meshes.size(), 3u);
+  EXPECT_EQ(accessors[meshes[0]["primitives"][0]["indices"].get<int>()]["componentType"], 5123);
+  EXPECT_EQ(accessors[meshes[2]["primitives"][0]["indices"].get<int>()]["componentType"], 5125);
+  // POSITION min/max are the exact float bounds.
+  const auto& position = accessors[meshes[0]["primitives"][0]["attributes"]["POSITION"].get<int>()];
+  const Aabb bounds = computeBounds(model.objectPositions(0));
+  EXPECT_EQ(position["min"][0].get<float>(), bounds.min.x);
+  EXPECT_EQ(position["max"][2].get<float>(), bounds.max.z);
+  const auto& nodes = glb.document["nodes"];
+  EXPECT_FALSE(nodes[3].contains("mesh"));
+  EXPECT_EQ(nodes[3]["name"], "empty");
+}
+
+TEST(GlbWrite, MeshoptCompressedViewsDecodeToTheUncompressedBytes) {
+  // The glTF validator cannot look inside EXT_meshopt_compression; decode every view here and
+  // compare it with the same file written uncompressed.
+  test::TempDir dir;
+  for (const int vertices : {300, 70'000}) {  // 16- and 32-bit indices
+    const Model model = randomModel(11, 1, vertices);
+    ASSERT_TRUE(writeGlb(model, dir.file("plain.glb")).ok());
+    ASSERT_TRUE(writeGlb(model, dir.file("packed.glb"), {.meshoptCompression = true}).ok());
+    const std::string plainBytes = test::readFile(dir.file("plain.glb"));
+    const std::string packedBytes = test::readFile(dir.file("packed.glb"));
+    EXPECT_LT(packedBytes.size(), plainBytes.size());
+    const Glb plain = parseGlb(plainBytes), packed = parseGlb(packedBytes);
+    EXPECT_EQ(packed.document["extensionsRequired"][0], "EXT_meshopt_compression");
+    const auto& plainViews = plain.document["bufferViews"];
+    const auto& packedViews = packed.document["bufferViews"];
+    ASSERT_EQ(plainViews.size(), packedViews.size());
+    const char* plainBin = plainBytes.data() + 20 + plain.jsonLength + 8;
+    const char* packedBin = packedBytes.data() + 20 + packed.jsonLength + 8;
+    for (std::size_t v = 0; v < plainViews.size(); ++v) {
+      const auto& ext = packedViews[v]["extensions"]["EXT_meshopt_compression"];
+      const std::size_t count = ext["count"], stride = ext["byteStride"];
+      const std::size_t length = plainViews[v]["byteLength"];
+      ASSERT_EQ(count * stride, length);
+      std::vector<unsigned char> decoded(length);
+      const auto* source =
+          reinterpret_cast<const unsigned char*>(packedBin) + ext["byteOffset"].get<std::size_t>();
+      const std::size_t sourceLength = ext["byteLength"];
+      const int result =
+          ext["mode"] == "TRIANGLES"
+              ? meshopt_decodeIndexBuffer(decoded.data(), count, stride, source, sourceLength)
+              : meshopt_decodeVertexBuffer(decoded.data(), count, stride, source, sourceLength);
+      ASSERT_EQ(result, 0) << "view " << v;
+      const char* original = plainBin + plainViews[v]["byteOffset"].get<std::size_t>();
+      if (ext["mode"] == "ATTRIBUTES") {
+        EXPECT_EQ(std::memcmp(decoded.data(), original, length), 0) << "view " << v;
+        continue;
+      }
+      // The index codec may rotate a triangle's corners (winding kept): compare triangles.
+      const auto index = [&](const void* base, std::size_t i) -> std::uint32_t {
+        std::uint32_t value = 0;
+        std::memcpy(&value, static_cast<const char*>(base) + i * stride, stride);
+        return value;
+      };
+      for (std::size_t t = 0; t < count; t += 3) {
+        const std::array<std::uint32_t, 3> a = {index(original, t), index(original, t + 1),
+                                                index(original, t + 2)};
+        const std::array<std::uint32_t, 3> b = {
+            index(decoded.data(), t), index(decoded.data(), t + 1), index(decoded.data(), t + 2)};
+        const bool same =
+            b == a || b == std::array{a[1], a[2], a[0]} || b == std::array{a[2], a[0], a[1]};
+        ASSERT_TRUE(same) << "triangle " << t / 3;
+      }
+    }
+  }
+}
+
+TEST(GlbWrite, QuantizedMeshesReadBackWithinHalfAGridStep) {
+  // KHR_mesh_quantization: 16-bit positions on a grid over the mesh's box, 8-bit normals. Read
+  // back through our reader (which applies node transforms), every position is within half a
+  // step per axis and every normal within a degree; a mesh placed by its own transform keeps it.
+  const Model model = randomModel(21, 2, 2'000);
+  test::TempDir dir;
+  const Mat4d moved = Mat4d::translation({10, -4, 2}) * Mat4d::scale({2, 2, 2});
+  const auto write = [&](const std::string& path, bool quantized, bool meshopt) {
+    Result<GlbWriter> writer = GlbWriter::create(path, {.meshoptCompression = meshopt});
+    ASSERT_TRUE(writer.ok());
+    for (std::size_t o = 0; o < 2; ++o) {
+      GlbMeshData data;
+      data.positions = model.objectPositions(o);
+      const ObjectRecord& record = model.objects[o];
+      data.normals = std::span(model.normals).subspan(record.vertexOffset, record.vertexCount);
+      data.indices = model.objectIndices(o);
+      data.quantized = quantized;
+      Result<std::uint32_t> mesh = writer->addMesh(data, model.objectName(o));
+      ASSERT_TRUE(mesh.ok());
+      writer->addNode(model.objectName(o), *mesh, o == 1 ? &moved : nullptr);
+    }
+    ASSERT_TRUE(writer->finish().ok());
+  };
+  for (const bool meshopt : {false, true}) {
+    const std::string path = dir.file(meshopt ? "packed.glb" : "plain.glb");
+    write(path, true, meshopt);
+    write(dir.file("float.glb"), false, meshopt);
+    const std::string bytes = test::readFile(path);
+    const Glb glb = parseGlb(bytes);
+    EXPECT_EQ(glb.document["extensionsRequired"].back(), "KHR_mesh_quantization");
+    const auto& attributes = glb.document["meshes"][0]["primitives"][0]["attributes"];
+    const auto& position = glb.document["accessors"][attributes["POSITION"].get<int>()];
+    const auto& normal = glb.document["accessors"][attributes["NORMAL"].get<int>()];
+    EXPECT_EQ(position["componentType"], 5123);
+    EXPECT_EQ(normal["componentType"], 5120);
+    EXPECT_TRUE(normal["normalized"].get<bool>());
+    if (!meshopt) {  // padded elements: the views say their stride
+      EXPECT_EQ(glb.document["bufferViews"][position["bufferView"].get<int>()]["byteStride"], 8);
+      EXPECT_EQ(glb.document["bufferViews"][normal["bufferView"].get<int>()]["byteStride"], 4);
+    }
+    EXPECT_LT(static_cast<double>(bytes.size()),
+              0.75 * static_cast<double>(std::filesystem::file_size(dir.file("float.glb"))));
+    if (meshopt) continue;  // our reader does not decode meshopt (checked above for the codec)
+    Result<Model> back = readGltf(path);
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    ASSERT_EQ(back->objectCount(), 2u);
+    EXPECT_EQ(back->indices, model.indices);
+    for (std::size_t o = 0; o < 2; ++o) {
+      const Aabb box = computeBounds(model.objectPositions(o));
+      const double step = glbQuantizationStep(Aabbd{toDouble(box.min), toDouble(box.max)});
+      const double tolerance = (o == 1 ? 2.0 : 1.0) * (0.5 * step + 1e-5);
+      const ObjectRecord& record = model.objects[o];
+      for (std::uint32_t v = 0; v < record.vertexCount; ++v) {
+        const Vec3d original = toDouble(model.positions[record.vertexOffset + v]);
+        const Vec3d want = o == 1 ? moved.transformPoint(original) : original;
+        const Vec3d got = back->origin + toDouble(back->positions[record.vertexOffset + v]);
+        ASSERT_NEAR(got.x, want.x, tolerance) << "object " << o << " vertex " << v;
+        ASSERT_NEAR(got.y, want.y, tolerance);
+        ASSERT_NEAR(got.z, want.z, tolerance);
+        const Vec3f n = normalizeOr(back->normals[record.vertexOffset + v], Vec3f{});
+        ASSERT_GT(dot(n, model.normals[record.vertexOffset + v]), std::cos(1.0 * 3.14159265 / 180));
+      }
+    }
+  }
+}
+
+TEST(GlbWrite, SpillingToDiskGivesTheSameFile) {
+  const Model model = randomModel(4, 20, 500);
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(model, dir.file("memory.glb")).ok());
+  GlbWriteOptions spill;
+  spill.spillBytes = 4096;
+  ASSERT_TRUE(writeGlb(model, dir.file("spilled.glb"), spill).ok());
+  EXPECT_EQ(test::readFile(dir.file("memory.glb")), test::readFile(dir.file("spilled.glb")));
+  EXPECT_EQ(test::listFolder(dir.path()).size(), 2u);  // the spill file is gone
+}
+
+TEST(GlbWrite, InstancedMeshesAndTransforms) {
+  test::TempDir dir;
+  Result<GlbWriter> writer = GlbWriter::create(dir.file("inst.glb"));
+  ASSERT_TRUE(writer.ok());
+  const std::vector<Vec3f> positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<std::uint32_t> indices = {0, 1, 2};
+  const std::uint32_t red = writer->addMaterial({1, 0, 0, 1}, "red");
+  Result<std::uint32_t> mesh = writer->addMesh({positions, {}, {}, indices}, "tri", red);
+  ASSERT_TRUE(mesh.ok());
+  for (int i = 0; i < 3; ++i) {
+    const Mat4d place = Mat4d::translation({double(i) * 10, 0, 0});
+    writer->addNode(fmt::format("copy {}", i), *mesh, &place);
+  }
+  ASSERT_TRUE(writer->finish().ok());
+  Result<Model> back = readGltf(dir.file("inst.glb"));
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->objectCount(), 3u);
+  EXPECT_EQ(toDouble(back->objectPositions(2)[1]) + back->origin, (Vec3d{21, 0, 0}));
+  EXPECT_EQ(back->colors[0], (Rgba8{255, 0, 0, 255}));
+  const Glb glb = parseGlb(test::readFile(dir.file("inst.glb")));
+  EXPECT_EQ(glb.document["meshes"].size(), 1u);
+}
+
+TEST(GlbWrite, RealModelsRoundTrip) {
+  test::TempDir dir;
+  for (const char* file : {"meshes/horse.ply", "meshes/2CylinderEngine.glb"}) {
+    const std::string path = test::dataPath(file);
+    Result<Model> model = fileExtension(path) == "ply" ? readPly(path) : readGltf(path);
+    ASSERT_TRUE(model.ok()) << model.error().message;
+    ASSERT_TRUE(writeGlb(*model, dir.file("copy.glb")).ok());
+    Result<Model> back = readGltf(dir.file("copy.glb"));
+    ASSERT_TRUE(back.ok()) << back.error().message;
+    EXPECT_EQ(back->objectCount(), model->objectCount());
+    EXPECT_EQ(back->indices, model->indices);
+    EXPECT_EQ(back->positions.size(), model->positions.size());
+    for (std::size_t v = 0; v < model->vertexCount(); ++v) {
+      const Vec3d a = model->origin + toDouble(model->positions[v]),
+                  b = back->origin + toDouble(back->positions[v]);
+      ASSERT_LT(length(a - b), 1e-4 * (1 + length(a))) << file << " vertex " << v;
+    }
+  }
+}
+
+TEST(GlbWrite, UnwritableDestinationIsAnIoError) {
+  const Model model = randomModel(5, 1, 10);
+  const Status status = writeGlb(model, "/nonexistent-folder/out.glb");
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.kind(), ErrorKind::kIo);
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -1309,31 +1309,25 @@ TEST(CliTiles, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {
   EXPECT_NE(small.err.find("too small"), std::string::npos) << small.err;
 }
 
-// Starts lodforge with `args`, sends it Ctrl-C once `ready()` holds and checks that it stopped
-// with exit 1, naming --resume. False when it finished before it could be stopped.
-bool interruptWhen(const test::TempDir& dir, const std::vector<std::string>& args,
-                   const std::function<bool()>& ready) {
+// Runs lodforge with `args`, interrupted as Ctrl-C would at the durable step `at` ("node:6" is
+// the sixth tile node's summary, "run:2" the second run of reconstructed chunks: the
+// LODFORGE_INTERRUPT_AFTER hook of core/progress.h), and checks that it stopped with exit 1,
+// naming --resume.
+void interruptAfter(const test::TempDir& dir, const std::vector<std::string>& args,
+                    const std::string& at) {
+  ::setenv("LODFORGE_INTERRUPT_AFTER", at.c_str(), 1);
   const pid_t pid = spawnLodforge(args, dir.file(".stderr"));
-  bool started = false;
-  for (int i = 0; i < 3000 && !started; ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    started = ready();
-  }
-  EXPECT_TRUE(started);
-  ::kill(pid, SIGINT);
+  ::unsetenv("LODFORGE_INTERRUPT_AFTER");
   const Finished stopped = waitFor(pid);
   const std::string err = test::readFile(dir.file(".stderr"));
   std::remove(dir.file(".stderr").c_str());
-  if (stopped.code == 0) return false;
-  EXPECT_EQ(stopped.code, 1);
+  EXPECT_EQ(stopped.code, 1) << "the run was not interrupted after " << at << ": " << err;
   EXPECT_NE(err.find("--resume"), std::string::npos) << err;
-  return true;
 }
 
-// `tiles INPUT -o b ARGS…` stopped by Ctrl-C once its chunks are done and a few tiles written
-// (or, given `stopAt`, once that file exists in b.work), then run again with --resume: the
-// earlier work is reused (the output says `resumed`) and the tileset is byte for byte the one
-// an uninterrupted run (into a) writes.
+// `tiles INPUT -o b ARGS…` stopped as by Ctrl-C after its sixth tile node (or, given `stopAt`,
+// after that durable step), then run again with --resume: the earlier work is reused (the output
+// says `resumed`) and the tileset is byte for byte the one an uninterrupted run (into a) writes.
 void expectResumesToTheSameTileset(const test::TempDir& dir, const std::string& input,
                                    const std::vector<std::string>& more,
                                    const std::string& stopAt = "",
@@ -1343,15 +1337,7 @@ void expectResumesToTheSameTileset(const test::TempDir& dir, const std::string& 
   std::string whole = "-q --threads 1 tiles " + input + " -o " + dir.file("a");
   for (const std::string& a : more) whole += " " + a;
   ASSERT_EQ(lodforge(whole, dir).code, 0);
-  const std::filesystem::path nodes = dir.file("b.work/nodes");
-  const bool stopped = interruptWhen(dir, args, [&] {
-    std::error_code ignored;
-    return stopAt.empty() ? std::filesystem::exists(dir.file("b.work/state.json")) &&
-                                std::distance(std::filesystem::directory_iterator(nodes, ignored),
-                                              std::filesystem::directory_iterator{}) >= 6
-                          : std::filesystem::exists(dir.file("b.work/" + stopAt));
-  });
-  if (!stopped) GTEST_SKIP() << "the run finished before it could be interrupted";
+  interruptAfter(dir, args, stopAt.empty() ? "node:6" : stopAt);
   EXPECT_FALSE(std::filesystem::exists(dir.file("b")));
   if (stopAt.empty()) {
     EXPECT_GT(test::listFolder(dir.file("b.work/tileset/tiles")).size(), 0u);
@@ -1405,7 +1391,7 @@ TEST(CliTiles, AReconstructionStoppedHalfwayResumesToTheSameTileset) {
   ASSERT_EQ(lodforge("-q generate points --points 300K -o " + dir.file("p.ply"), dir).code, 0);
   expectResumesToTheSameTileset(dir, dir.file("p.ply"),
                                 {"--surface", "--voxel", "2", "--chunk-size", "24"},
-                                "surface/run-1.pieces", " resumed)");
+                                "run:1", " resumed)");
 }
 
 // reconstruct: Ctrl-C after some runs of chunks keeps OUTPUT.work and says so; --resume takes
@@ -1427,9 +1413,8 @@ TEST(CliReconstruct, AnInterruptedReconstructionResumesToTheSameMesh) {
   std::string whole;
   for (const std::string& a : args) whole += (a == dir.file("b.ply") ? dir.file("a.ply") : a) + " ";
   ASSERT_EQ(lodforge(whole, dir).code, 0);
-  if (!interruptWhen(dir, args,
-                     [&] { return std::filesystem::exists(dir.file("b.ply.work/run-2.pieces")); }))
-    GTEST_SKIP() << "the run finished before it could be interrupted";
+  interruptAfter(dir, args, "run:2");
+  EXPECT_TRUE(std::filesystem::exists(dir.file("b.ply.work/run-1.pieces")));
   EXPECT_FALSE(std::filesystem::exists(dir.file("b.ply")));
   std::string resume = "-v";
   for (std::size_t a = 1; a < args.size(); ++a) resume += " " + args[a];

@@ -4,6 +4,7 @@
 
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 
 #include <fmt/format.h>
 
@@ -58,6 +59,23 @@ bool cancelRequested() {
 Status checkCancelled() {
   if (!cancelRequested()) return {};
   return Error{ErrorKind::kCancelled, "cancelled"};
+}
+void checkpointReached(std::string_view kind) {
+  struct Interrupt {
+    std::string kind;
+    long after = 0;
+  };
+  static const Interrupt interrupt = [] {
+    const char* value = std::getenv("LODFORGE_INTERRUPT_AFTER");
+    const std::string_view spec = value ? value : "";
+    const std::size_t colon = spec.find(':');
+    if (colon == std::string_view::npos) return Interrupt{};
+    return Interrupt{std::string(spec.substr(0, colon)),
+                     std::strtol(std::string(spec.substr(colon + 1)).c_str(), nullptr, 10)};
+  }();
+  static std::atomic<long> reached{0};
+  if (interrupt.after > 0 && kind == interrupt.kind && reached.fetch_add(1) + 1 == interrupt.after)
+    requestCancel();
 }
 
 void setProgressMode(ProgressMode mode) {

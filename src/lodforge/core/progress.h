@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <mutex>
 #include <string>
+#include <string_view>
 
 #include "lodforge/core/status.h"
 
@@ -20,6 +21,11 @@ void clearCancel();
 bool cancelRequested();
 // An ErrorKind::kCancelled status when cancellation was requested, ok otherwise.
 Status checkCancelled();
+// Marks one durable step of resumable work done: `kind` is "node" (a tile node's summary) or
+// "run" (a run of reconstructed chunks). With LODFORGE_INTERRUPT_AFTER=KIND:N in the environment,
+// the N-th step of that kind requests cancellation as Ctrl-C would: the resume tests stop a run
+// at a known point instead of racing it.
+void checkpointReached(std::string_view kind);
 
 // Wall time since `start`, for the figures long work reports.
 inline double secondsSince(std::chrono::steady_clock::time_point start) {

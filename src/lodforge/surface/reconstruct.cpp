@@ -9,6 +9,7 @@
 #include <queue>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -517,7 +518,10 @@ Status makeRuns(const ReconstructState& state, const std::string& workDirectory,
     }
     KeptPieces tee(sink, writer ? &*writer : nullptr);
     LODFORGE_TRY(makeRun(state, r, workDirectory, options, tee, progress, stats));
-    if (writer) LODFORGE_TRY(writer->finish());
+    if (writer) {
+      LODFORGE_TRY(writer->finish());
+      checkpointReached("run");
+    }
     std::filesystem::remove(runPath(workDirectory, r), error);
   }
   progress.finish();

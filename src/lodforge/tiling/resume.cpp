@@ -3,7 +3,10 @@
 #include <fstream>
 #include <map>
 
+#include <nlohmann/json.hpp>
+
 #include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
 
 namespace lodforge {
 
@@ -147,7 +150,9 @@ Status writeNodeSummary(const OctreeNode& node) {
                                   {"lockedVertices", node.lockedVertices},
                                   {"droppedSegments", node.droppedSegments},
                                   {"features", node.features}};
-  return OutputFile::writeWhole(nodeSummaryPath(node.meshPath), summary.dump());
+  LODFORGE_TRY(OutputFile::writeWhole(nodeSummaryPath(node.meshPath), summary.dump()));
+  checkpointReached("node");
+  return {};
 }
 
 bool readNodeSummary(const std::string& path, OctreeNode& node) {

@@ -24,7 +24,7 @@ run() {
   if [[ $forked == *" $reader "* ]]; then
     # Fork mode's first merge steps over a seed that crashes: replay the seeds in one process
     # first, so a crash found before (null-surface.iges) fails again.
-    build/fuzz/fuzz/fuzz_"$reader" -runs=0 -rss_limit_mb=2048 -timeout=10 \
+    build/asan/fuzz/fuzz_"$reader" -runs=0 -rss_limit_mb=2048 -timeout=10 \
       -artifact_prefix=build/fuzz/artifacts/"$reader"- fuzz/corpus/"$reader" tests/data/malformed \
       > build/fuzz/"$reader".log 2>&1 || replay=$?
     mode=(-fork=1 -ignore_timeouts=1 -ignore_ooms=1)
@@ -32,7 +32,7 @@ run() {
     # and 71 (out of memory).
     ignored="oom-|timeout-" passing="0 70 71"
   fi
-  build/fuzz/fuzz/fuzz_"$reader" "${mode[@]}" -max_total_time="$seconds" -max_len=65536 \
+  build/asan/fuzz/fuzz_"$reader" "${mode[@]}" -max_total_time="$seconds" -max_len=65536 \
     -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 \
     -artifact_prefix=build/fuzz/artifacts/"$reader"- \
     "$work" fuzz/corpus/"$reader" tests/data/malformed >> build/fuzz/"$reader".log 2>&1 || rc=$?

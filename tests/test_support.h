@@ -16,15 +16,21 @@
 
 namespace lodforge::test {
 
+// The folders of the shared real models (../shared/data) and of tests/data, compiled into
+// test_support.cpp alone: the checkout's path in a define would make every test's object differ
+// from clone to clone, and the compiler cache could reuse none of them.
+const char* sharedDataDir();
+const char* testDataDir();
+
 // A real model from ../shared/data; the test fails (never skips) when it is missing.
 inline std::string dataPath(std::string_view relative) {
-  std::string path = std::string(LODFORGE_DATA_DIR) + "/" + std::string(relative);
+  std::string path = std::string(sharedDataDir()) + "/" + std::string(relative);
   EXPECT_TRUE(std::filesystem::exists(path)) << "missing shared test data: " << path;
   return path;
 }
 
 inline std::string testDataPath(std::string_view relative) {
-  return std::string(LODFORGE_TEST_DATA_DIR) + "/" + std::string(relative);
+  return std::string(testDataDir()) + "/" + std::string(relative);
 }
 
 // A fresh folder per test, removed afterwards.

@@ -15,6 +15,7 @@
 #include "lodforge/io/mesh/gltf_reader.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/simplify/builder.h"
+#include "test_support.h"
 
 namespace lodforge {
 namespace {
@@ -69,7 +70,7 @@ TEST(Tiles, HorseTilesetFollowsTheRules) {
   options.input.chunkSize = 0.05;  // the horse is ~0.2 m long: a few chunks per axis
   options.octree.errorSamples = 2000;
   Result<TilesStats> stats =
-      writeTiles(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply", out.string(), options);
+      writeTiles(test::dataPath("meshes/horse.ply"), out.string(), options);
   ASSERT_TRUE(stats.ok()) << stats.error().message;
   EXPECT_GE(stats->levels, 2);
   EXPECT_GT(stats->leaves, 8u);
@@ -97,7 +98,7 @@ TEST(Tiles, QuantizedContentsStayWithinTheErrorTheyAddToTheTileset) {
   TilesOptions options;
   options.input.chunkSize = 0.05;
   options.octree.errorSamples = 2000;
-  const std::string horse = std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply";
+  const std::string horse = test::dataPath("meshes/horse.ply");
   options.quantize = false;
   Result<TilesStats> plain = writeTiles(horse, (root / "float").string(), options);
   options.quantize = true;
@@ -154,7 +155,7 @@ TEST(Tiles, NeighbouringTilesAgreeOnTheNormalsOfTheirSharedVertices) {
     options.octree.errorSamples = 1000;
     options.quantize = false;
     Result<TilesStats> stats =
-        writeTiles(std::string(LODFORGE_DATA_DIR) + "/" + name, out.string(), options);
+        writeTiles(test::dataPath(name), out.string(), options);
     ASSERT_TRUE(stats.ok()) << stats.error().message;
     // Per level: position (to 1e-7) -> the normals every tile of that level gives it.
     std::map<std::pair<int, std::array<std::int64_t, 3>>, std::vector<Vec3f>> seen;
@@ -204,7 +205,7 @@ TEST(Tiles, ContentsAreInVertexCacheAndFetchOrder) {
   TilesOptions options;
   options.input.chunkSize = 0.05;
   options.octree.errorSamples = 1000;
-  const std::string horse = std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply";
+  const std::string horse = test::dataPath("meshes/horse.ply");
   ASSERT_TRUE(writeTiles(horse, out.string(), options).ok());
   Result<Model> input = readModel(horse);
   ASSERT_TRUE(input.ok());
@@ -322,7 +323,7 @@ TEST(Tiles, GeoreferencedByOriginOrByCrs) {
   placed.input.chunkSize = 0.05;
   placed.octree.errorSamples = 1000;
   placed.origin = Geodetic{8.5417, 47.3769, 408};
-  stats = writeTiles(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply",
+  stats = writeTiles(test::dataPath("meshes/horse.ply"),
                      (dir / "origin").string(), placed);
   ASSERT_TRUE(stats.ok()) << stats.error().message;
   std::ifstream in2(dir / "origin" / "tileset.json");
@@ -351,7 +352,7 @@ TEST(Tiles, RefusesToOverwriteADirectoryThatIsNotATileset) {
   fs::create_directories(dir);
   std::ofstream(dir / "precious.txt") << "keep me";
   Result<TilesStats> stats =
-      writeTiles(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply", dir.string(), {});
+      writeTiles(test::dataPath("meshes/horse.ply"), dir.string(), {});
   ASSERT_FALSE(stats.ok());
   EXPECT_EQ(stats.error().kind, ErrorKind::kUsage);
   EXPECT_TRUE(fs::exists(dir / "precious.txt"));

@@ -8,6 +8,7 @@
 #include "lodforge/core/random.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/tiling/chunk_store.h"
+#include "test_support.h"
 
 namespace lodforge {
 namespace {
@@ -135,7 +136,7 @@ TEST(CutTriangle, TrianglesInsideACellStayWholeAndDegenerateOnesVanish) {
 TEST(CutTriangle, TrianglesSharingAnEdgeGetBitIdenticalCutVertices) {
   // A closed surface cut into chunks and welded exactly is still closed: every cut vertex on a
   // shared edge came out the same from both triangles, and no T-junction appeared.
-  Result<Model> horse = readModel(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply");
+  Result<Model> horse = readModel(test::dataPath("meshes/horse.ply"));
   ASSERT_TRUE(horse.ok()) << horse.error().message;
   MeshPart welded;
   for (const Vec3f& p : horse->positions) welded.positions.push_back(horse->origin + toDouble(p));

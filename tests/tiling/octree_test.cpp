@@ -19,6 +19,7 @@
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/mesh/ply_writer.h"
 #include "lodforge/tiles/surface_input.h"
+#include "test_support.h"
 
 namespace lodforge {
 namespace {
@@ -46,7 +47,7 @@ MeshPart heightfield(int n) {
 }
 
 MeshPart horse() {
-  Result<Model> model = readModel(std::string(LODFORGE_DATA_DIR) + "/meshes/horse.ply");
+  Result<Model> model = readModel(test::dataPath("meshes/horse.ply"));
   EXPECT_TRUE(model.ok());
   MeshPart mesh;
   for (const Vec3f& p : model->positions) mesh.positions.push_back(model->origin + toDouble(p));

@@ -98,5 +98,19 @@ TEST(SignedDistance, TheSameBitsForAnyThreadCount) {
   EXPECT_GT(known, 500u);
 }
 
+#ifndef NDEBUG
+// A caller's bug is an assert where asserts are on (the sanitizer builds): a point without a
+// normal stops at the entry point instead of reading past the normals.
+TEST(SignedDistanceDeathTest, AssertsThatEveryPointHasANormal) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  Cloud cloud = plane(100, 1);
+  cloud.normals = std::vector<Vec3f>(50, Vec3f{0, 0, 1});
+  const VoxelGrid grid{{0, 0, -1}, 0.25, {17, 17, 17}};
+  CornerValues values{{0, 0, 0}, {17, 17, 17}, {}};
+  EXPECT_DEATH(signedDistances(grid, cloud.view(), {}, values),
+               "points.normals.size\\(\\) == points.positions.size\\(\\)");
+}
+#endif
+
 }  // namespace
 }  // namespace lodforge

@@ -1,6 +1,7 @@
 #include "lodforge/surface/cloud_file.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -153,6 +154,7 @@ class SampleGrid {
 
 Result<double> medianSpacingOfFile(const std::string& path, const CloudSummary& cloud,
                                    std::size_t samples) {
+  assert(samples > 0);
   if (cloud.count < 2) return 0.0;
   const std::uint64_t step = std::max<std::uint64_t>(1, cloud.count / samples);
   std::vector<CloudRecord> picked;

@@ -1,6 +1,7 @@
 #include "lodforge/surface/reconstruct.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -602,6 +603,8 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
                                             const std::string& name,
                                             const ReconstructOptions& options,
                                             std::vector<SurfacePiece>* pieces) {
+  assert(normals.empty() || normals.size() == positions.size());
+  assert(colors.empty() || colors.size() == positions.size());
   Aabbd bounds;
   for (const Vec3d& p : positions) bounds.add(p);
   LODFORGE_TRY(checkSurfaceExtent(positions.size(), bounds, name));

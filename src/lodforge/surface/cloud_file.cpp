@@ -4,7 +4,10 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
+#include <memory>
+#include <queue>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -108,6 +111,81 @@ Status rewriteNormals(const std::string& path,
     at += n * sizeof(CloudRecord);
     LODFORGE_TRY(checkCancelled());
   }
+  return {};
+}
+
+namespace {
+
+// An owned-normal file read back in blocks. Reading stops at the count written to it: a read
+// that fails or ends before it is an error here, not a point found without a normal later.
+class NormalStream {
+ public:
+  static Result<std::unique_ptr<NormalStream>> open(const OwnedNormalFile& file) {
+    std::FILE* handle = std::fopen(file.path.c_str(), "rb");
+    if (!handle) return ioErrorFromErrno(file.path, "open");
+    std::unique_ptr<NormalStream> stream(new NormalStream(file, handle));
+    LODFORGE_TRY(stream->refill());
+    return stream;
+  }
+  NormalStream(const NormalStream&) = delete;
+  NormalStream& operator=(const NormalStream&) = delete;
+  ~NormalStream() { std::fclose(file_); }
+  bool done() const { return at_ == got_; }
+  const OwnedNormal& head() const { return block_[at_]; }
+  Status pop() { return ++at_ == got_ ? refill() : Status{}; }
+
+ private:
+  NormalStream(const OwnedNormalFile& file, std::FILE* handle)
+      : path_(file.path), records_(file.records), file_(handle) {}
+  Status refill() {
+    at_ = 0;
+    const auto wanted =
+        static_cast<std::size_t>(std::min<std::uint64_t>(block_.size(), records_ - read_));
+    got_ = wanted == 0 ? 0 : std::fread(block_.data(), sizeof(OwnedNormal), wanted, file_);
+    read_ += got_;
+    if (got_ == wanted) return {};
+    if (std::ferror(file_)) return ioErrorFromErrno(path_, "read");
+    return Error{ErrorKind::kIo,
+                 fmt::format("{}: byte {}: the file ends after {} of its {} normals", path_,
+                             read_ * sizeof(OwnedNormal), read_, records_)};
+  }
+
+  std::string path_;
+  std::uint64_t records_ = 0, read_ = 0;
+  std::FILE* file_;
+  std::vector<OwnedNormal> block_ = std::vector<OwnedNormal>(4096);
+  std::size_t at_ = 0, got_ = 0;
+};
+
+}  // namespace
+
+Status mergeNormals(const std::string& cloudPath, const std::vector<OwnedNormalFile>& files) {
+  std::vector<std::unique_ptr<NormalStream>> streams;
+  for (const OwnedNormalFile& file : files) {
+    Result<std::unique_ptr<NormalStream>> stream = NormalStream::open(file);
+    if (!stream) return stream.status();
+    streams.push_back(std::move(*stream));
+  }
+  using Head = std::pair<std::uint64_t, std::size_t>;  // (id, stream)
+  std::priority_queue<Head, std::vector<Head>, std::greater<>> heads;
+  for (std::size_t s = 0; s < streams.size(); ++s)
+    if (!streams[s]->done()) heads.emplace(streams[s]->head().id, s);
+  LODFORGE_TRY(rewriteNormals(cloudPath, [&](std::span<CloudRecord> block) -> Status {
+    for (CloudRecord& record : block) {
+      if (heads.empty() || heads.top().first != record.id)
+        return Error{ErrorKind::kInternal,
+                     fmt::format("{}: point {} has no normal", cloudPath, record.id)};
+      const std::size_t from = heads.top().second;
+      heads.pop();
+      NormalStream& s = *streams[from];
+      record.normal = s.head().normal;
+      LODFORGE_TRY(s.pop());
+      if (!s.done()) heads.emplace(s.head().id, from);
+    }
+    return Status{};
+  }));
+  std::error_code ignored;
+  for (const OwnedNormalFile& file : files) std::filesystem::remove(file.path, ignored);
   return {};
 }
 

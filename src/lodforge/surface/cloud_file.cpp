@@ -41,7 +41,8 @@ Result<RecordWriter> RecordWriter::create(const std::string& path, std::size_t b
 Result<CloudSummary> copyCloud(const std::string& input, const std::string& path,
                                bool salvageTruncated,
                                const std::function<bool(Vec3d, Vec3d&)>& transform) {
-  Result<PointReader> reader = PointReader::open(input, 1 << 16, salvageTruncated, false);
+  Result<PointReader> reader =
+      PointReader::open(input, {.salvageTruncated = salvageTruncated, .readExtras = false});
   if (!reader) return reader.status();
   Result<RecordWriter> out = RecordWriter::create(path, std::size_t{4} << 20);
   if (!out) return out.status();

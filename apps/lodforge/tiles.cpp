@@ -12,8 +12,8 @@
 #include "lodforge/core/output_claim.h"
 #include "lodforge/core/units.h"
 #include "lodforge/io/format_advice.h"
-#include "lodforge/io/model_io.h"
 #include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/model_io.h"
 #include "lodforge/io/points/point_reader.h"
 #include "lodforge/surface/reconstruct.h"
 #include "lodforge/tiles/point_attributes.h"
@@ -292,7 +292,9 @@ Status runSurfaceTiles(const Global& global, const TilesCommand& options, TilesO
   tiles.input.chunkSize = 0;
   tiles.surface = *reconstruct;
   if (tiles.crs.empty() && !tiles.origin) {
-    Result<PointReader> reader = PointReader::open(options.input, 1, options.salvage, false);
+    Result<PointReader> reader = PointReader::open(
+        options.input,
+        {.batchPoints = 1, .salvageTruncated = options.salvage, .readExtras = false});
     if (reader) tiles.crs = reader->info().crs;
   }
   return runMeshTiles(global, options, tiles);

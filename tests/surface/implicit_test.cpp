@@ -67,13 +67,18 @@ TEST(SignedDistance, ACornerHasTheSameValueInEveryBox) {
   signedDistances(grid, cloud.view(), {}, whole);
   CornerValues part{{8, 5, 3}, {6, 7, 5}, {}};
   signedDistances(grid, cloud.view(), {}, part);
+  std::uint32_t known = 0;
   for (std::uint32_t k = 0; k < 5; ++k)
     for (std::uint32_t j = 0; j < 7; ++j)
       for (std::uint32_t i = 0; i < 6; ++i) {
         const float a = part.values[part.index(i, j, k)];
         const float b = whole.values[whole.index(8 + i, 5 + j, 3 + k)];
         EXPECT_EQ(std::memcmp(&a, &b, 4), 0) << i << ' ' << j << ' ' << k;
+        known += std::isfinite(a) ? 1 : 0;
       }
+  // NaN has the same bits as NaN: the corners within the radius of the points (every layer but
+  // the lowest, 0.65 below the plane) must have values, or the comparison proves nothing.
+  EXPECT_EQ(known, 4u * 7 * 6);
 }
 
 // The cells spread by one thread or shared by rows between several hold the same bits.
@@ -97,6 +102,20 @@ TEST(SignedDistance, TheSameBitsForAnyThreadCount) {
   for (const float v : a.values) known += std::isnan(v) ? 0 : 1;
   EXPECT_GT(known, 500u);
 }
+
+#ifndef NDEBUG
+// A caller's bug is an assert where asserts are on (the sanitizer builds): a point without a
+// normal stops at the entry point instead of reading past the normals.
+TEST(SignedDistanceDeathTest, AssertsThatEveryPointHasANormal) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  Cloud cloud = plane(100, 1);
+  cloud.normals = std::vector<Vec3f>(50, Vec3f{0, 0, 1});
+  const VoxelGrid grid{{0, 0, -1}, 0.25, {17, 17, 17}};
+  CornerValues values{{0, 0, 0}, {17, 17, 17}, {}};
+  EXPECT_DEATH(signedDistances(grid, cloud.view(), {}, values),
+               "points.normals.size\\(\\) == points.positions.size\\(\\)");
+}
+#endif
 
 }  // namespace
 }  // namespace lodforge

@@ -121,8 +121,8 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
                            const std::string& extrasPath, const PartitionOptions& options,
                            Partition& partition) {
   PointCloudInfo& info = partition.info;
-  Result<PointReader> reader =
-      PointReader::open(input, 1 << 16, options.salvageTruncated, options.carryExtras);
+  Result<PointReader> reader = PointReader::open(
+      input, {.salvageTruncated = options.salvageTruncated, .readExtras = options.carryExtras});
   if (!reader) return reader.status();
   info = reader->info();
   const std::size_t stride = info.extras.stride;

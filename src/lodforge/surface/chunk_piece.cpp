@@ -1,6 +1,7 @@
 #include "lodforge/surface/chunk_piece.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -239,6 +240,9 @@ SurfacePiece heldChunkPiece(const ChunkLayout& layout, std::uint64_t chunk,
                             std::span<const std::uint32_t> members,
                             std::span<const CloudRecord> records, const DistanceOptions& distance,
                             bool colors) {
+  assert(chunk < layout.chunkCount());
+  assert(std::is_sorted(members.begin(), members.end()) &&
+         (members.empty() || members.back() < records.size()));
   const ChunkCorners corners = cornersOf(layout, chunk);
   CornerSums sums(layout.grid, distance, corners.boxFirst, corners.boxSize);
   for (const std::uint32_t m : members) sums.add(records[m].position, records[m].normal);
@@ -257,6 +261,7 @@ SurfacePiece heldChunkPiece(const ChunkLayout& layout, std::uint64_t chunk,
 Result<SurfacePiece> streamedChunkPiece(const ChunkLayout& layout, std::uint64_t chunk,
                                         const std::string& runFile, const DistanceOptions& distance,
                                         bool colors) {
+  assert(chunk < layout.chunkCount());
   const ChunkCorners corners = cornersOf(layout, chunk);
   CornerSums sums(layout.grid, distance, corners.boxFirst, corners.boxSize);
   LODFORGE_TRY(forEachRecordBlock(runFile, [&](std::span<const CloudRecord> block) {

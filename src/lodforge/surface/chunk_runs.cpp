@@ -1,6 +1,7 @@
 #include "lodforge/surface/chunk_runs.h"
 
 #include <algorithm>
+#include <cassert>
 
 #include <fmt/format.h>
 
@@ -26,6 +27,7 @@ void forEachChunk(const ChunkLayout& layout, const ChunkBox& box, F&& each) {
 }  // namespace
 
 std::size_t ChunkRuns::runOf(std::uint64_t c) const {
+  assert(std::binary_search(chunks.begin(), chunks.end(), c));
   const auto entry =
       static_cast<std::size_t>(std::lower_bound(chunks.begin(), chunks.end(), c) - chunks.begin());
   return static_cast<std::size_t>(std::upper_bound(firstChunk.begin(), firstChunk.end(), entry) -
@@ -34,6 +36,7 @@ std::size_t ChunkRuns::runOf(std::uint64_t c) const {
 
 Result<ChunkRuns> planRuns(const std::string& cloudPath, const ChunkLayout& layout, double radius,
                            std::uint64_t runPoints) {
+  assert(radius >= 0);
   if (layout.chunkCount() > kMostChunks)
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: {} chunks of {}³ voxels are too many to plan (at most {}): use "
@@ -70,6 +73,7 @@ std::string runPath(const std::string& directory, std::size_t run) {
 
 Status writeRuns(const std::string& cloudPath, const ChunkLayout& layout, double radius,
                  const ChunkRuns& runs, const std::string& directory) {
+  assert(radius >= 0 && runs.points.size() == runs.chunks.size());
   std::vector<RecordWriter> writers;
   writers.reserve(runs.runCount());
   for (std::size_t r = 0; r < runs.runCount(); ++r) {

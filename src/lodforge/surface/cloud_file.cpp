@@ -1,9 +1,13 @@
 #include "lodforge/surface/cloud_file.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
+#include <memory>
+#include <queue>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -37,7 +41,8 @@ Result<RecordWriter> RecordWriter::create(const std::string& path, std::size_t b
 Result<CloudSummary> copyCloud(const std::string& input, const std::string& path,
                                bool salvageTruncated,
                                const std::function<bool(Vec3d, Vec3d&)>& transform) {
-  Result<PointReader> reader = PointReader::open(input, 1 << 16, salvageTruncated, false);
+  Result<PointReader> reader =
+      PointReader::open(input, {.salvageTruncated = salvageTruncated, .readExtras = false});
   if (!reader) return reader.status();
   Result<RecordWriter> out = RecordWriter::create(path, std::size_t{4} << 20);
   if (!out) return out.status();
@@ -112,6 +117,81 @@ Status rewriteNormals(const std::string& path,
 
 namespace {
 
+// An owned-normal file read back in blocks. Reading stops at the count written to it: a read
+// that fails or ends before it is an error here, not a point found without a normal later.
+class NormalStream {
+ public:
+  static Result<std::unique_ptr<NormalStream>> open(const OwnedNormalFile& file) {
+    std::FILE* handle = std::fopen(file.path.c_str(), "rb");
+    if (!handle) return ioErrorFromErrno(file.path, "open");
+    std::unique_ptr<NormalStream> stream(new NormalStream(file, handle));
+    LODFORGE_TRY(stream->refill());
+    return stream;
+  }
+  NormalStream(const NormalStream&) = delete;
+  NormalStream& operator=(const NormalStream&) = delete;
+  ~NormalStream() { std::fclose(file_); }
+  bool done() const { return at_ == got_; }
+  const OwnedNormal& head() const { return block_[at_]; }
+  Status pop() { return ++at_ == got_ ? refill() : Status{}; }
+
+ private:
+  NormalStream(const OwnedNormalFile& file, std::FILE* handle)
+      : path_(file.path), records_(file.records), file_(handle) {}
+  Status refill() {
+    at_ = 0;
+    const auto wanted =
+        static_cast<std::size_t>(std::min<std::uint64_t>(block_.size(), records_ - read_));
+    got_ = wanted == 0 ? 0 : std::fread(block_.data(), sizeof(OwnedNormal), wanted, file_);
+    read_ += got_;
+    if (got_ == wanted) return {};
+    if (std::ferror(file_)) return ioErrorFromErrno(path_, "read");
+    return Error{ErrorKind::kIo,
+                 fmt::format("{}: byte {}: the file ends after {} of its {} normals", path_,
+                             read_ * sizeof(OwnedNormal), read_, records_)};
+  }
+
+  std::string path_;
+  std::uint64_t records_ = 0, read_ = 0;
+  std::FILE* file_;
+  std::vector<OwnedNormal> block_ = std::vector<OwnedNormal>(4096);
+  std::size_t at_ = 0, got_ = 0;
+};
+
+}  // namespace
+
+Status mergeNormals(const std::string& cloudPath, const std::vector<OwnedNormalFile>& files) {
+  std::vector<std::unique_ptr<NormalStream>> streams;
+  for (const OwnedNormalFile& file : files) {
+    Result<std::unique_ptr<NormalStream>> stream = NormalStream::open(file);
+    if (!stream) return stream.status();
+    streams.push_back(std::move(*stream));
+  }
+  using Head = std::pair<std::uint64_t, std::size_t>;  // (id, stream)
+  std::priority_queue<Head, std::vector<Head>, std::greater<>> heads;
+  for (std::size_t s = 0; s < streams.size(); ++s)
+    if (!streams[s]->done()) heads.emplace(streams[s]->head().id, s);
+  LODFORGE_TRY(rewriteNormals(cloudPath, [&](std::span<CloudRecord> block) -> Status {
+    for (CloudRecord& record : block) {
+      if (heads.empty() || heads.top().first != record.id)
+        return Error{ErrorKind::kInternal,
+                     fmt::format("{}: point {} has no normal", cloudPath, record.id)};
+      const std::size_t from = heads.top().second;
+      heads.pop();
+      NormalStream& s = *streams[from];
+      record.normal = s.head().normal;
+      LODFORGE_TRY(s.pop());
+      if (!s.done()) heads.emplace(s.head().id, from);
+    }
+    return Status{};
+  }));
+  std::error_code ignored;
+  for (const OwnedNormalFile& file : files) std::filesystem::remove(file.path, ignored);
+  return {};
+}
+
+namespace {
+
 // Samples hashed into every cell of a coarse grid within one cell of them: a point then finds
 // every sample within `cell` of it with one look-up.
 class SampleGrid {
@@ -153,6 +233,7 @@ class SampleGrid {
 
 Result<double> medianSpacingOfFile(const std::string& path, const CloudSummary& cloud,
                                    std::size_t samples) {
+  assert(samples > 0);
   if (cloud.count < 2) return 0.0;
   const std::uint64_t step = std::max<std::uint64_t>(1, cloud.count / samples);
   std::vector<CloudRecord> picked;

@@ -1,6 +1,7 @@
 // The cloud as reconstruction works on it out of core: fixed records (input index, position,
 // normal, colour) in files of our own, read and written in blocks. The input is read once
-// into such a file (LAZ decodes once); runs of chunks get files of the records they need.
+// into such a file (LAZ decodes once); runs of chunks get files of the records they need, and
+// normals estimated run by run come back into it from files of their own.
 #pragma once
 
 #include <cstdint>
@@ -58,6 +59,25 @@ Result<std::vector<CloudRecord>> readRecords(const std::string& path);
 // Rewrites each record's normal in place: normals[i] for the i-th record (by file position).
 Status rewriteNormals(const std::string& path,
                       const std::function<Status(std::span<CloudRecord>)>& change);
+
+// A point's normal estimated by the run that owns it, for the record with that id.
+struct OwnedNormal {
+  std::uint64_t id = 0;
+  Vec3f normal;
+  std::uint32_t unused = 0;
+};
+static_assert(sizeof(OwnedNormal) == 24);
+
+// A file of OwnedNormal in id order, and how many were written to it.
+struct OwnedNormalFile {
+  std::string path;
+  std::uint64_t records = 0;
+};
+
+// Sets every record's normal in the record file from `files` (together one normal per record),
+// then removes them. A file that cannot be read, or holds fewer normals than were written to
+// it, is an I/O error naming it and where it ends.
+Status mergeNormals(const std::string& cloudPath, const std::vector<OwnedNormalFile>& files);
 
 // The median distance from a point to its nearest other point, over up to `samples` points
 // spread through the file (the same points and the same value as medianSpacing over the cloud in

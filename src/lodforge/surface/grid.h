@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <vector>
 
@@ -50,6 +51,7 @@ struct CornerValues {
   std::vector<float> values;
 
   std::size_t index(std::uint32_t i, std::uint32_t j, std::uint32_t k) const {
+    assert(i < size[0] && j < size[1] && k < size[2]);
     return (static_cast<std::size_t>(k) * size[1] + j) * size[0] + i;
   }
 };

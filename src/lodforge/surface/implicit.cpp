@@ -1,6 +1,7 @@
 #include "lodforge/surface/implicit.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -11,7 +12,9 @@ namespace lodforge {
 
 CornerSums::CornerSums(const VoxelGrid& grid, const DistanceOptions& options,
                        std::array<std::uint64_t, 3> first, std::array<std::uint32_t, 3> size)
-    : grid_(grid), options_(options), first_(first), size_(size) {}
+    : grid_(grid), options_(options), first_(first), size_(size) {
+  assert(grid.voxel > 0 && options.radius > 0);
+}
 
 namespace {
 
@@ -103,6 +106,7 @@ void CornerSums::spread(const std::array<std::int64_t, 3>& key, const Cell& cell
 }
 
 CornerValues CornerSums::values(int threads) const {
+  assert(threads >= 0);
   // The cells in global order (z, y, x): the order every corner adds them in.
   using Entry = std::pair<const std::array<std::int64_t, 3>, Cell>;
   std::vector<const Entry*> order;
@@ -150,6 +154,7 @@ CornerValues CornerSums::values(int threads) const {
 
 void signedDistances(const VoxelGrid& grid, const OrientedPoints& points,
                      const DistanceOptions& options, CornerValues& values) {
+  assert(points.normals.size() == points.positions.size());
   CornerSums sums(grid, options, values.first, values.size);
   for (std::size_t p = 0; p < points.positions.size(); ++p)
     sums.add(points.positions[p], points.normals[p]);

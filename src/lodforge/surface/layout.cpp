@@ -1,6 +1,7 @@
 #include "lodforge/surface/layout.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -8,6 +9,7 @@
 namespace lodforge {
 
 ChunkBox ChunkLayout::reach(const Vec3d& p, double radius) const {
+  assert(radius >= 0);
   ChunkBox box;
   const std::uint64_t size = n;
   const std::array<std::int64_t, 3> cell = pointCellOf(grid, p);
@@ -37,6 +39,8 @@ namespace {
 
 // A lattice edge's lower corner and its direction bits.
 std::array<std::uint64_t, 3> edgeCorner(std::uint64_t key, const VoxelGrid& grid, int& direction) {
+  // (Every edge query of the layout comes through here: a key names an edge of its lattice.)
+  assert(key / 7 < grid.corners[0] * grid.corners[1] * grid.corners[2]);
   direction = static_cast<int>(key % 7) + 1;
   std::uint64_t corner = key / 7;
   std::array<std::uint64_t, 3> at{};
@@ -94,6 +98,7 @@ Status checkSurfaceExtent(std::uint64_t points, const Aabbd& bounds, const std::
 
 Result<ChunkLayout> layOutChunks(const Aabbd& bounds, double voxel, std::uint32_t chunkVoxels,
                                  double radius, const std::string& name) {
+  assert(!bounds.empty() && radius >= 0);
   if (!(voxel > 0) || !std::isfinite(voxel))
     return badInput(name, "the points have no spacing to size voxels by: give --voxel");
   ChunkLayout layout;

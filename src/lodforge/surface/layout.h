@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <string>
 
@@ -25,9 +26,11 @@ struct ChunkLayout {
 
   std::uint64_t chunkCount() const { return chunks[0] * chunks[1] * chunks[2]; }
   std::uint64_t chunkIndex(std::uint64_t x, std::uint64_t y, std::uint64_t z) const {
+    assert(x < chunks[0] && y < chunks[1] && z < chunks[2]);
     return (z * chunks[1] + y) * chunks[0] + x;
   }
   std::array<std::uint64_t, 3> chunkAt(std::uint64_t c) const {
+    assert(c < chunkCount());
     return {c % chunks[0], (c / chunks[0]) % chunks[1], c / (chunks[0] * chunks[1])};
   }
   // The chunks holding a corner within `radius` voxels of p's point cell (pointCellOf): every

@@ -1,6 +1,7 @@
 #include "lodforge/surface/marching_tetrahedra.h"
 
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -145,17 +146,24 @@ class Polygonizer {
 
 std::uint64_t edgeKey(const VoxelGrid& grid, std::uint64_t i, std::uint64_t j, std::uint64_t k,
                       int d) {
+  assert(d >= 1 && d <= 7);
+  assert(i < grid.corners[0] && j < grid.corners[1] && k < grid.corners[2]);
   return ((k * grid.corners[1] + j) * grid.corners[0] + i) * 7 + static_cast<std::uint64_t>(d - 1);
 }
 
 SurfacePiece polygonize(const VoxelGrid& grid, const CornerValues& values,
                         std::array<std::uint64_t, 3> first, std::array<std::uint32_t, 3> size) {
+  assert(values.values.size() ==
+         static_cast<std::size_t>(values.size[0]) * values.size[1] * values.size[2]);
   SurfacePiece out;
   Polygonizer polygonizer(grid, values, out);
   if (size[0] == 0) {
     first = values.first;
     size = values.size;
   }
+  for (std::size_t a = 0; a < 3; ++a)
+    assert(size[a] > 0 && first[a] >= values.first[a] &&
+           first[a] - values.first[a] + size[a] <= values.size[a]);
   std::array<std::uint32_t, 3> lo{}, hi{};  // the cells' corner 000, local to `values`
   for (std::size_t a = 0; a < 3; ++a) {
     lo[a] = static_cast<std::uint32_t>(first[a] - values.first[a]);

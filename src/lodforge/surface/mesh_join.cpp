@@ -1,5 +1,6 @@
 #include "lodforge/surface/mesh_join.h"
 
+#include <cassert>
 #include <cstdio>
 #include <numeric>
 
@@ -12,6 +13,7 @@ namespace lodforge {
 // asked and no vertex on a chunk face (one that crosses a face may go on in the next chunk).
 std::vector<char> keptTriangles(const ChunkLayout& layout, const SurfacePiece& piece,
                                 std::uint64_t minTriangles, std::uint64_t& dropped) {
+  assert(piece.indices.size() % 3 == 0 && piece.edges.size() == piece.positions.size());
   const std::size_t triangles = piece.indices.size() / 3;
   std::vector<char> kept(triangles, 1);
   if (minTriangles == 0) return kept;
@@ -46,6 +48,11 @@ Status PieceJoiner::begin(const ChunkLayout& layout, bool) {
 }
 
 Status PieceJoiner::add(std::uint64_t chunk, const SurfacePiece& piece) {
+  // The wavefront forgets a face vertex once its last chunk is past: chunks come in order.
+  assert(chunk >= nextChunk_);
+  assert(piece.normals.size() == piece.positions.size());
+  assert(piece.colors.empty() || piece.colors.size() == piece.positions.size());
+  nextChunk_ = chunk + 1;
   const std::vector<char> kept = keptTriangles(layout_, piece, minTriangles_, dropped_);
   constexpr std::uint32_t kNone = ~0u;
   local_.assign(piece.positions.size(), kNone);
@@ -97,6 +104,7 @@ Status MemoryMeshOutput::vertex(const JoinedVertex& v) {
 }
 
 Status MemoryMeshOutput::triangles(std::span<const std::uint32_t> more) {
+  assert(more.size() % 3 == 0);
   indices.insert(indices.end(), more.begin(), more.end());
   return {};
 }
@@ -117,6 +125,7 @@ Status PlyMeshOutput::vertex(const JoinedVertex& v) {
 }
 
 Status PlyMeshOutput::triangles(std::span<const std::uint32_t> indices) {
+  assert(indices.size() % 3 == 0);
   indices_ += indices.size();
   return triangleFile_.writeSpan(indices);
 }

@@ -76,6 +76,7 @@ class PieceJoiner : public PieceSink {
   std::vector<std::uint32_t> local_;
   std::vector<std::uint32_t> triangleBuffer_;
   std::uint64_t vertices_ = 0, triangles_ = 0, dropped_ = 0;
+  std::uint64_t nextChunk_ = 0;  // the least chunk add() may take next
 };
 
 // Into memory.

@@ -1,6 +1,7 @@
 #include "lodforge/surface/normals.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <queue>
 
@@ -99,6 +100,7 @@ void propagate(std::span<const Vec3d> points, std::span<const std::uint32_t> knn
 
 std::vector<Vec3f> estimateNormals(std::span<const Vec3d> positions, const PointIndex& tree,
                                    const NormalOptions& options) {
+  assert(tree.leafOrder().size() == positions.size());
   std::vector<Vec3f> normals(positions.size(), Vec3f{0, 0, 1});
   if (positions.size() < 3) return normals;
   const std::size_t k = std::min<std::size_t>(
@@ -128,6 +130,7 @@ std::vector<Vec3f> estimateNormals(std::span<const Vec3d> positions, const Point
 
 double medianSpacing(std::span<const Vec3d> positions, const PointIndex& tree,
                      std::size_t samples) {
+  assert(tree.leafOrder().size() == positions.size() && samples > 0);
   if (positions.size() < 2) return 0;
   const std::size_t step = std::max<std::size_t>(1, positions.size() / samples);
   std::vector<double> gaps;

@@ -1,5 +1,7 @@
 #include "lodforge/surface/point_index.h"
 
+#include <cassert>
+
 #include <nanoflann.hpp>
 
 namespace lodforge {
@@ -35,6 +37,7 @@ PointIndex::~PointIndex() = default;
 
 std::size_t PointIndex::nearest(Vec3d q, std::size_t k, std::uint32_t* indices,
                                 double* distances2) const {
+  assert(indices != nullptr && distances2 != nullptr);
   const double at[3] = {q.x, q.y, q.z};
   return tree_->index.knnSearch(at, k, indices, distances2);
 }

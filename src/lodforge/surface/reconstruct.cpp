@@ -1,12 +1,12 @@
 #include "lodforge/surface/reconstruct.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <optional>
-#include <queue>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -184,35 +184,6 @@ Status estimateNormalsWhole(const std::string& cloudPath, const CloudSummary& cl
   });
 }
 
-struct OwnedNormal {
-  std::uint64_t id;
-  Vec3f normal;
-  std::uint32_t unused = 0;
-};
-
-// A run's owned normals, read back in id order.
-class NormalStream {
- public:
-  explicit NormalStream(std::FILE* file) : file_(file) { refill(); }
-  NormalStream(const NormalStream&) = delete;
-  NormalStream& operator=(const NormalStream&) = delete;
-  ~NormalStream() { std::fclose(file_); }
-  bool done() const { return at_ == got_; }
-  const OwnedNormal& head() const { return block_[at_]; }
-  void pop() {
-    if (++at_ == got_) refill();
-  }
-
- private:
-  void refill() {
-    got_ = std::fread(block_.data(), sizeof(OwnedNormal), block_.size(), file_);
-    at_ = 0;
-  }
-  std::FILE* file_;
-  std::vector<OwnedNormal> block_ = std::vector<OwnedNormal>(4096);
-  std::size_t at_ = 0, got_ = 0;
-};
-
 std::string normalsPath(const std::string& directory, std::size_t run) {
   return fmt::format("{}/run-{}.normals", directory, run);
 }
@@ -220,8 +191,9 @@ std::string normalsPath(const std::string& directory, std::size_t run) {
 // The normals of `records` from their neighbours among them; those of the points `owns` accepts
 // written to `path` in input order.
 template <class Owns>
-Status writeOwnedNormals(std::span<const CloudRecord> records, const NormalOptions& options,
-                         Owns&& owns, const std::string& path) {
+Result<OwnedNormalFile> writeOwnedNormals(std::span<const CloudRecord> records,
+                                          const NormalOptions& options, Owns&& owns,
+                                          const std::string& path) {
   std::vector<Vec3d> positions(records.size());
   for (std::size_t i = 0; i < positions.size(); ++i) positions[i] = records[i].position;
   std::vector<Vec3f> normals;
@@ -231,12 +203,15 @@ Status writeOwnedNormals(std::span<const CloudRecord> records, const NormalOptio
   }
   Result<OutputFile> out = OutputFile::create(path, 1 << 20);
   if (!out) return out.status();
+  OwnedNormalFile written{path, 0};
   for (std::size_t i = 0; i < positions.size(); ++i) {
     if (!owns(positions[i])) continue;
     const OwnedNormal owned{records[i].id, normals[i]};
     LODFORGE_TRY(out->write(&owned, sizeof owned));
+    ++written.records;
   }
-  return out->commit();
+  LODFORGE_TRY(out->commit());
+  return written;
 }
 
 // How many part files one pass over a dense run file writes (buffers of 64 KiB each: 4 MiB).
@@ -249,7 +224,7 @@ constexpr std::uint64_t kPartFilesAtOnce = 64;
 Status denseChunkNormals(const std::string& runFile, const ChunkLayout& layout, std::uint64_t chunk,
                          std::uint64_t points, std::uint64_t budget,
                          const ReconstructOptions& options, const std::string& partPath,
-                         std::vector<std::string>& paths) {
+                         std::vector<OwnedNormalFile>& files) {
   const std::uint64_t parts = (2 * points + budget - 1) / budget;
   // (At most a voxel's column a part.)
   const std::uint64_t across = std::min<std::uint64_t>(
@@ -304,47 +279,17 @@ Status denseChunkNormals(const std::string& runFile, const ChunkLayout& layout, 
     Result<std::vector<CloudRecord>> records = readRecords(recordsPath(part));
     if (!records) return records.status();
     std::remove(recordsPath(part).c_str());
-    paths.push_back(fmt::format("{}-{}-{}", partPath, i, j));
-    LODFORGE_TRY(writeOwnedNormals(
+    Result<OwnedNormalFile> written = writeOwnedNormals(
         *records, options.normals,
         [&](const Vec3d& p) {
           return layout.owner(p) == chunk && partAt(inChunk(p, 0), 0) == i &&
                  partAt(inChunk(p, 1), 1) == j;
         },
-        paths.back()));
+        fmt::format("{}-{}-{}", partPath, i, j));
+    if (!written) return written.status();
+    files.push_back(std::move(*written));
     LODFORGE_TRY(checkCancelled());
   }
-  return {};
-}
-
-// The owned normals' files merged into the record file in id order.
-Status mergeNormals(const std::string& cloudPath, const std::vector<std::string>& paths) {
-  std::vector<std::unique_ptr<NormalStream>> streams;
-  for (const std::string& path : paths) {
-    std::FILE* file = std::fopen(path.c_str(), "rb");
-    if (!file) return ioErrorFromErrno(path, "open");
-    streams.push_back(std::make_unique<NormalStream>(file));
-  }
-  using Head = std::pair<std::uint64_t, std::size_t>;  // (id, stream)
-  std::priority_queue<Head, std::vector<Head>, std::greater<>> heads;
-  for (std::size_t s = 0; s < streams.size(); ++s)
-    if (!streams[s]->done()) heads.emplace(streams[s]->head().id, s);
-  LODFORGE_TRY(rewriteNormals(cloudPath, [&](std::span<CloudRecord> block) -> Status {
-    for (CloudRecord& record : block) {
-      if (heads.empty() || heads.top().first != record.id)
-        return Error{ErrorKind::kInternal,
-                     fmt::format("{}: point {} has no normal", cloudPath, record.id)};
-      const std::size_t from = heads.top().second;
-      heads.pop();
-      NormalStream& s = *streams[from];
-      record.normal = s.head().normal;
-      s.pop();
-      if (!s.done()) heads.emplace(s.head().id, from);
-    }
-    return Status{};
-  }));
-  std::error_code ignored;
-  for (const std::string& path : paths) std::filesystem::remove(path, ignored);
   return {};
 }
 
@@ -356,28 +301,30 @@ Status estimateNormalsByRun(const std::string& cloudPath, const ChunkLayout& lay
                             const std::string& directory) {
   LODFORGE_TRY(writeRuns(cloudPath, layout, options.distance.radius + 1, runs, directory));
   const std::uint64_t budget = runBudget(layout, options);
-  std::vector<std::string> paths;
+  std::vector<OwnedNormalFile> files;
   Progress progress("reconstruct: normals", runs.runCount());
   for (std::size_t r = 0; r < runs.runCount(); ++r) {
     const std::string runFile = runPath(directory, r);
     if (isDenseRun(runs, r, budget)) {
       LODFORGE_TRY(denseChunkNormals(runFile, layout, runs.chunks[runs.firstChunk[r]],
                                      runs.points[runs.firstChunk[r]], budget, options,
-                                     normalsPath(directory, r), paths));
+                                     normalsPath(directory, r), files));
     } else {
       Result<std::vector<CloudRecord>> records = readRecords(runFile);
       if (!records) return records.status();
-      paths.push_back(normalsPath(directory, r));
-      LODFORGE_TRY(writeOwnedNormals(
+      Result<OwnedNormalFile> written = writeOwnedNormals(
           *records, options.normals,
-          [&](const Vec3d& p) { return runs.runOf(layout.owner(p)) == r; }, paths.back()));
+          [&](const Vec3d& p) { return runs.runOf(layout.owner(p)) == r; },
+          normalsPath(directory, r));
+      if (!written) return written.status();
+      files.push_back(std::move(*written));
     }
     std::remove(runFile.c_str());
     progress.advance(1);
     LODFORGE_TRY(checkCancelled());
   }
   progress.finish();
-  return mergeNormals(cloudPath, paths);
+  return mergeNormals(cloudPath, files);
 }
 
 // What the runs depend on: a resumed reconstruction takes earlier work only when this is
@@ -606,6 +553,8 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
                                             const std::string& name,
                                             const ReconstructOptions& options,
                                             std::vector<SurfacePiece>* pieces) {
+  assert(normals.empty() || normals.size() == positions.size());
+  assert(colors.empty() || colors.size() == positions.size());
   Aabbd bounds;
   for (const Vec3d& p : positions) bounds.add(p);
   LODFORGE_TRY(checkSurfaceExtent(positions.size(), bounds, name));

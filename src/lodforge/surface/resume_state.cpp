@@ -1,6 +1,7 @@
 #include "lodforge/surface/resume_state.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -106,6 +107,11 @@ Result<PieceWriter> PieceWriter::create(const std::string& path) {
 }
 
 Status PieceWriter::add(std::uint64_t chunk, const SurfacePiece& piece) {
+  // The header gives one count for every per-vertex array.
+  assert(piece.normals.size() == piece.positions.size() &&
+         piece.edges.size() == piece.positions.size());
+  assert(piece.colors.empty() || piece.colors.size() == piece.positions.size());
+  assert(piece.indices.size() % 3 == 0);
   const PieceHeader header{chunk, piece.positions.size(), piece.indices.size(),
                            piece.colors.empty() ? 0u : 1u};
   LODFORGE_TRY(file_.write(&header, sizeof header));

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cassert>
 #include <cstdint>
 
 #include <tbb/parallel_for.h>
@@ -13,6 +14,7 @@ namespace lodforge {
 
 // The threads to share rows between: `threads`, or the arena's for 0.
 inline int rowShareThreads(int threads) {
+  assert(threads >= 0);
   return threads == 0 ? std::max(1, tbb::this_task_arena::max_concurrency()) : threads;
 }
 

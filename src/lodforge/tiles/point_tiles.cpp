@@ -306,7 +306,8 @@ namespace {
 Result<std::optional<CrsToLocal>> localFrame(const std::string& input,
                                              const PointTilesOptions& options,
                                              PointTilesStats& stats, bool& hasNormals) {
-  Result<PointReader> probe = PointReader::open(input, 1, options.salvageTruncated);
+  Result<PointReader> probe =
+      PointReader::open(input, {.batchPoints = 1, .salvageTruncated = options.salvageTruncated});
   if (!probe) return probe.status();
   hasNormals = probe->info().hasNormals;
   stats.crs = !options.crs.empty() || options.origin ? options.crs : probe->info().crs;

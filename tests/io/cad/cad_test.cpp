@@ -26,6 +26,7 @@
 #include <gp_Trsf.hxx>
 
 #include <algorithm>
+#include <cstdlib>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -562,6 +563,23 @@ TEST(CadRead, AStackOverflowInsideOcctIsBadInput) {
   EXPECT_EQ(std::cout.rdbuf(), out);
   Result<Model> box = readCad(kSamples + "/step/screw.step");
   EXPECT_TRUE(box.ok()) << box.error().message;
+}
+
+// A place for the module that cannot be looked at ($LODFORGE_CAD_MODULE too long a name for the
+// system) is passed over, not an exception out of the reader: the module loads from the next
+// place. In a fresh process (the threadsafe style runs the test again), where nothing has loaded
+// the module yet.
+TEST(CadReadDeathTest, AModulePlaceThatCannotBeLookedAtIsPassedOver) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(
+      {
+        const std::string tooLong = "/tmp/" + std::string(300, 'x') + "/liblodforge_cad.so";
+        ::setenv("LODFORGE_CAD_MODULE", tooLong.c_str(), 1);
+        Result<Model> screw = readCad(kSamples + "/step/screw.step");
+        if (!screw.ok()) std::cerr << screw.error().message << '\n';
+        std::exit(screw.ok() ? 0 : 1);
+      },
+      ::testing::ExitedWithCode(0), "");
 }
 
 }  // namespace

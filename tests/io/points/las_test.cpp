@@ -517,7 +517,7 @@ TEST(LasExtraBytes, ADamagedRecordIsReadPastAndAnExtendedOneIsRead) {
   ASSERT_TRUE(*extended->next(batch));
   EXPECT_EQ(batch.extras.size(), 20u);
   // Without extras asked for, none come.
-  Result<PointReader> without = PointReader::open(dir.file("evlr.las"), 1 << 16, false, false);
+  Result<PointReader> without = PointReader::open(dir.file("evlr.las"), {.readExtras = false});
   ASSERT_TRUE(without.ok());
   EXPECT_TRUE(without->info().extras.fields.empty());
   ASSERT_TRUE(*without->next(batch));

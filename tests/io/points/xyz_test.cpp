@@ -85,21 +85,26 @@ TEST(XyzReader, MapsNamedColumnsAndUnitColours) {
   EXPECT_DOUBLE_EQ(r.positions[0].z, 1);
 }
 
+// Through PointReader, in batches of the size asked for.
 TEST(XyzReader, ReadsTheRealKitten) {
-  Result<PointReader> reader = PointReader::open(test::dataPath("points/kitten.xyz"));
+  Result<PointReader> reader =
+      PointReader::open(test::dataPath("points/kitten.xyz"), {.batchPoints = 1'000});
   ASSERT_TRUE(reader.ok()) << reader.error().message;
   EXPECT_TRUE(reader->info().hasNormals);
   EXPECT_FALSE(reader->info().hasColors);
-  std::size_t count = 0;
+  std::size_t count = 0, batches = 0;
   PointBatch batch;
   while (true) {
     Result<bool> more = reader->next(batch);
     ASSERT_TRUE(more.ok());
     if (!*more) break;
     count += batch.size();
+    ++batches;
+    EXPECT_LE(batch.size(), 1'000u);
     for (const Vec3f& n : batch.normals) EXPECT_NEAR(length(n), 1.0f, 1e-5f);
   }
   EXPECT_EQ(count, 5'210u);
+  EXPECT_EQ(batches, 6u);
 }
 
 void expectBad(const std::string& text, std::string_view position, std::string_view fragment) {

@@ -38,7 +38,12 @@ void* loadedModule(std::string& why) {
   static std::string reason;
   std::call_once(once, [] {
     for (const std::string& place : modulePlaces()) {
-      if (!std::filesystem::exists(place)) continue;
+      // The error_code overload: a place that cannot be looked at (a name too long, a loop of
+      // links) is a reason to report, not an exception out of the reader.
+      std::error_code error;
+      const bool there = std::filesystem::exists(place, error);
+      if (error) reason = fmt::format("{}: cannot look for it: {}", place, error.message());
+      if (!there) continue;
       module = dlopen(place.c_str(), RTLD_NOW | RTLD_LOCAL);
       if (module) return;
       reason = dlerror();

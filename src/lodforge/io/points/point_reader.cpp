@@ -4,8 +4,8 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/io/format_advice.h"
-#include "lodforge/io/points/las_reader.h"
 #include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/points/las_reader.h"
 #include "lodforge/io/points/xyz_reader.h"
 
 namespace lodforge {
@@ -36,12 +36,11 @@ std::optional<std::string> PointReader::truncation() const {
   return std::nullopt;
 }
 
-Result<PointReader> PointReader::open(const std::string& path, std::size_t batchSize,
-                                      bool salvageTruncated, bool extras) {
+Result<PointReader> PointReader::open(const std::string& path, const PointReadOptions& options) {
   const std::string ext = fileExtension(path);
   if (ext == "las" || ext == "laz") {
-    Result<LasReader> las = LasReader::open(path, batchSize);
-    if (las && !extras) las->skipExtraBytes();
+    Result<LasReader> las = LasReader::open(path, options.batchPoints);
+    if (las && !options.readExtras) las->skipExtraBytes();
     if (!las) return las.status();
     const LasHeader& h = las->header();
     PointCloudInfo info;
@@ -61,12 +60,10 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
     return PointReader(std::make_unique<State>(State{std::move(*las), std::move(info), {}}));
   }
   if (ext == "ply") {
-    PlyReadOptions options;
-    options.batchSize = batchSize;
-    options.readFaces = false;
-    options.readExtras = extras;
-    options.salvageTruncated = salvageTruncated;
-    Result<PlyReader> ply = PlyReader::open(path, options);
+    Result<PlyReader> ply = PlyReader::open(path, {.batchSize = options.batchPoints,
+                                                   .salvageTruncated = options.salvageTruncated,
+                                                   .readFaces = false,
+                                                   .readExtras = options.readExtras});
     if (!ply) return ply.status();
     const PlyHeader& h = ply->header();
     PointCloudInfo info;
@@ -79,7 +76,7 @@ Result<PointReader> PointReader::open(const std::string& path, std::size_t batch
     return PointReader(std::make_unique<State>(State{std::move(*ply), std::move(info), {}}));
   }
   if (isPointCloudPath(path)) {
-    Result<XyzReader> xyz = XyzReader::open(path, batchSize);
+    Result<XyzReader> xyz = XyzReader::open(path, options.batchPoints);
     if (!xyz) return xyz.status();
     const XyzLayout& layout = xyz->layout();
     PointCloudInfo info;

@@ -1,5 +1,6 @@
-// One streaming reader for every point format: LAS (.las; .laz is refused with advice), PLY
-// (the vertices of any PLY; faces are ignored), and XYZ/TXT/CSV/PTS text. Chosen by extension.
+// One streaming reader for every point format: LAS and LAZ (.las, .laz, COPC; io/points/laz
+// decodes LAZ), PLY (the vertices of any PLY; faces are ignored), and XYZ/TXT/CSV/PTS text.
+// Chosen by extension.
 #pragma once
 
 #include <cstdint>
@@ -29,13 +30,19 @@ struct PointCloudInfo {
 // either, so the caller decides.
 bool isPointCloudPath(const std::string& path);
 
+struct PointReadOptions {
+  std::size_t batchPoints = 1 << 16;  // points a batch holds at most
+  // A PLY cut short is read up to its last whole point (truncation() then says where it was
+  // cut); without, it is bad input.
+  bool salvageTruncated = false;
+  // Extra fields (LAS extra bytes, other PLY vertex properties) in the batches and in
+  // info().extras; without, both are empty.
+  bool readExtras = true;
+};
+
 class PointReader {
  public:
-  // With `salvageTruncated`, a PLY cut short is read up to its last whole point (truncation()
-  // then says where it was cut); otherwise it is bad input. Without `extras`, batches carry no
-  // extra fields (and info().extras is empty).
-  static Result<PointReader> open(const std::string& path, std::size_t batchSize = 1 << 16,
-                                  bool salvageTruncated = false, bool extras = true);
+  static Result<PointReader> open(const std::string& path, const PointReadOptions& options = {});
   PointReader(PointReader&&) noexcept;
   PointReader& operator=(PointReader&&) noexcept;
   ~PointReader();

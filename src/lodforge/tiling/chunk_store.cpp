@@ -1,7 +1,6 @@
 #include "lodforge/tiling/chunk_store.h"
 
 #include <algorithm>
-#include <bit>
 #include <cassert>
 #include <cmath>
 #include <cstdio>
@@ -14,24 +13,9 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/file.h"
+#include "lodforge/core/position_hash.h"
 
 namespace lodforge {
-
-namespace {
-
-// Bits of a coordinate with -0 folded into +0 (they compare equal, so they must hash equal).
-std::uint64_t coordinateBits(double v) {
-  return v == 0 ? 0 : std::bit_cast<std::uint64_t>(v);
-}
-
-std::uint64_t hashPosition(const Vec3d& p) {
-  std::uint64_t h = coordinateBits(p.x) * 0x9E3779B97F4A7C15ull;
-  h = (h ^ (h >> 29) ^ coordinateBits(p.y)) * 0xBF58476D1CE4E5B9ull;
-  h = (h ^ (h >> 32) ^ coordinateBits(p.z)) * 0x94D049BB133111EBull;
-  return h ^ (h >> 31);
-}
-
-}  // namespace
 
 void weldExact(MeshPart& mesh) {
   // A mesh of no objects (a scan: chunk records always carry the field) keeps no features.
@@ -50,7 +34,7 @@ void weldExact(MeshPart& mesh) {
   for (std::uint32_t v = 0; v < count; ++v) {
     const Vec3d& p = mesh.positions[v];
     const std::uint32_t feature = featureOf(v);
-    std::size_t slot = (hashPosition(p) ^ feature * 0x9E3779B97F4A7C15ull) & (capacity - 1);
+    std::size_t slot = (hashExactPosition(p) ^ feature * 0x9E3779B97F4A7C15ull) & (capacity - 1);
     while (table[slot] != ~0u &&
            !(mesh.positions[table[slot]] == p && featureOf(table[slot]) == feature))
       slot = (slot + 1) & (capacity - 1);

@@ -12,14 +12,11 @@
 namespace lodforge {
 
 std::string_view plyTypeName(PlyType type) {
-  static constexpr std::string_view kNames[] = {"char", "uchar", "short", "ushort",
-                                                "int",  "uint",  "float", "double"};
-  return kNames[static_cast<int>(type)];
+  return extraTypePlyName(extraTypeOf(type));
 }
 
 std::size_t plyTypeSize(PlyType type) {
-  static constexpr std::size_t kSizes[] = {1, 1, 2, 2, 4, 4, 4, 8};
-  return kSizes[static_cast<int>(type)];
+  return extraTypeSize(extraTypeOf(type));
 }
 
 bool plyTypeIsIntegral(PlyType type) {
@@ -43,16 +40,13 @@ namespace {
 constexpr std::size_t kMaxHeaderBytes = 1 << 20;
 constexpr std::size_t kMaxHeaderLine = 1 << 16;
 
+// A type by its PLY name ("uchar") or its sized one ("uint8"); PLY has no 64-bit integers.
 std::optional<PlyType> parseType(std::string_view name) {
-  static constexpr std::pair<std::string_view, PlyType> kTypes[] = {
-      {"char", PlyType::kInt8},      {"int8", PlyType::kInt8},       {"uchar", PlyType::kUint8},
-      {"uint8", PlyType::kUint8},    {"short", PlyType::kInt16},     {"int16", PlyType::kInt16},
-      {"ushort", PlyType::kUint16},  {"uint16", PlyType::kUint16},   {"int", PlyType::kInt32},
-      {"int32", PlyType::kInt32},    {"uint", PlyType::kUint32},     {"uint32", PlyType::kUint32},
-      {"float", PlyType::kFloat32},  {"float32", PlyType::kFloat32}, {"double", PlyType::kFloat64},
-      {"float64", PlyType::kFloat64}};
-  for (const auto& [n, t] : kTypes) {
-    if (n == name) return t;
+  for (int t = 0; t <= static_cast<int>(ExtraType::kFloat64); ++t) {
+    const auto type = static_cast<ExtraType>(t);
+    const std::string_view plyName = extraTypePlyName(type);
+    if (!plyName.empty() && (name == plyName || name == extraTypeName(type)))
+      return static_cast<PlyType>(type);
   }
   return std::nullopt;
 }
@@ -68,28 +62,6 @@ std::vector<std::string_view> splitWords(std::string_view line) {
     i = j;
   }
   return words;
-}
-
-ExtraType extraTypeOf(PlyType type) {
-  switch (type) {
-    case PlyType::kInt8:
-      return ExtraType::kInt8;
-    case PlyType::kUint8:
-      return ExtraType::kUint8;
-    case PlyType::kInt16:
-      return ExtraType::kInt16;
-    case PlyType::kUint16:
-      return ExtraType::kUint16;
-    case PlyType::kInt32:
-      return ExtraType::kInt32;
-    case PlyType::kUint32:
-      return ExtraType::kUint32;
-    case PlyType::kFloat32:
-      return ExtraType::kFloat32;
-    case PlyType::kFloat64:
-      return ExtraType::kFloat64;
-  }
-  return ExtraType::kFloat64;
 }
 
 int findProperty(const PlyElement& e, std::initializer_list<std::string_view> names) {

@@ -15,16 +15,21 @@
 namespace lodforge {
 
 enum class PlyFormat : std::uint8_t { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
+// The ExtraTypes (io/points/point_extras.h) PLY has, with their values, so that one table
+// names and sizes both (PLY has no 64-bit integers).
 enum class PlyType : std::uint8_t {
-  kInt8,
-  kUint8,
-  kInt16,
-  kUint16,
-  kInt32,
-  kUint32,
-  kFloat32,
-  kFloat64
+  kInt8 = static_cast<std::uint8_t>(ExtraType::kInt8),
+  kUint8 = static_cast<std::uint8_t>(ExtraType::kUint8),
+  kInt16 = static_cast<std::uint8_t>(ExtraType::kInt16),
+  kUint16 = static_cast<std::uint8_t>(ExtraType::kUint16),
+  kInt32 = static_cast<std::uint8_t>(ExtraType::kInt32),
+  kUint32 = static_cast<std::uint8_t>(ExtraType::kUint32),
+  kFloat32 = static_cast<std::uint8_t>(ExtraType::kFloat32),
+  kFloat64 = static_cast<std::uint8_t>(ExtraType::kFloat64)
 };
+constexpr ExtraType extraTypeOf(PlyType type) {
+  return static_cast<ExtraType>(type);
+}
 
 struct PlyProperty {
   std::string name;
@@ -60,7 +65,7 @@ struct PlyHeader {
   PointExtras extras;
 };
 
-std::string_view plyTypeName(PlyType type);
+std::string_view plyTypeName(PlyType type);  // PLY's own: "uchar", "float", …
 std::size_t plyTypeSize(PlyType type);
 std::string_view plyFormatName(PlyFormat format);
 bool plyTypeIsIntegral(PlyType type);

@@ -64,6 +64,121 @@ std::vector<std::string_view> splitWords(std::string_view line) {
   return words;
 }
 
+// The header's text, a line at a time: the magic line, then a keyword per line up to
+// 'end_header'. Errors name the line.
+class HeaderParser {
+ public:
+  HeaderParser(ByteSource& source, std::uint64_t& lineNumber)
+      : source_(source), lineNumber_(lineNumber) {}
+
+  PlyHeader parse() {
+    readMagic();
+    bool sawFormat = false;
+    while (nextLine()) {
+      const std::string_view keyword = words_[0];
+      if (keyword == "comment" || keyword == "obj_info") {
+        header_.comments.emplace_back(
+            std::string_view(line_).substr(std::min(line_.size(), keyword.size() + 1)));
+      } else if (keyword == "format") {
+        parseFormat();
+        sawFormat = true;
+      } else if (keyword == "element") {
+        parseElement();
+      } else if (keyword == "property") {
+        parseProperty();
+      } else {
+        fail(fmt::format("unknown header keyword '{}'", keyword.substr(0, 40)));
+      }
+    }
+    if (!sawFormat) fail("header has no 'format' line");
+    header_.dataOffset = source_.offset();
+    return std::move(header_);
+  }
+
+ private:
+  [[noreturn]] void fail(std::string_view what) const {
+    throw ErrorException{badInputAtLine(source_.name(), lineNumber_, what)};
+  }
+
+  void readMagic() {
+    if (!source_.readLine(line_, kMaxHeaderLine) || line_ != "ply") {
+      throw ErrorException{
+          badInputAtByte(source_.name(), 0, "not a PLY file: expected the magic line 'ply'")};
+    }
+    lineNumber_ = 1;
+  }
+
+  // The words of the next line that has any; false at 'end_header'.
+  bool nextLine() {
+    do {
+      if (source_.offset() > kMaxHeaderBytes) fail("header longer than 1 MiB");
+      if (!source_.readLine(line_, kMaxHeaderLine))
+        fail("file ends inside the header (no 'end_header')");
+      ++lineNumber_;
+      words_ = splitWords(line_);
+    } while (words_.empty());
+    return words_[0] != "end_header";
+  }
+
+  // format <type> 1.0
+  void parseFormat() {
+    if (words_.size() != 3) fail("expected 'format <type> 1.0'");
+    if (words_[1] == "ascii")
+      header_.format = PlyFormat::kAscii;
+    else if (words_[1] == "binary_little_endian")
+      header_.format = PlyFormat::kBinaryLittleEndian;
+    else if (words_[1] == "binary_big_endian")
+      header_.format = PlyFormat::kBinaryBigEndian;
+    else
+      fail(fmt::format("unknown format '{}'", words_[1]));
+    if (words_[2] != "1.0") fail(fmt::format("unsupported version '{}'", words_[2]));
+  }
+
+  // element <name> <count>
+  void parseElement() {
+    if (words_.size() != 3) fail("expected 'element <name> <count>'");
+    PlyElement e;
+    e.name = words_[1];
+    const auto [end, error] =
+        std::from_chars(words_[2].data(), words_[2].data() + words_[2].size(), e.count);
+    if (error != std::errc() || end != words_[2].data() + words_[2].size())
+      fail(fmt::format("element count '{}' is not a whole number", words_[2]));
+    header_.elements.push_back(std::move(e));
+  }
+
+  // property <type> <name>, or property list <count type> <item type> <name>
+  void parseProperty() {
+    if (header_.elements.empty()) fail("property before any element");
+    PlyProperty p;
+    if (words_.size() == 5 && words_[1] == "list") {
+      const auto countType = parseType(words_[2]);
+      const auto itemType = parseType(words_[3]);
+      if (!countType || !itemType) fail(fmt::format("unknown type in '{}'", line_));
+      if (!plyTypeIsIntegral(*countType)) fail("list count type must be an integer type");
+      p.isList = true;
+      p.countType = *countType;
+      p.type = *itemType;
+      p.name = words_[4];
+    } else if (words_.size() == 3) {
+      const auto type = parseType(words_[1]);
+      if (!type) fail(fmt::format("unknown type '{}'", words_[1]));
+      p.type = *type;
+      p.name = words_[2];
+    } else {
+      fail(
+          "expected 'property <type> <name>' or 'property list <count type> <item type> "
+          "<name>'");
+    }
+    header_.elements.back().properties.push_back(std::move(p));
+  }
+
+  ByteSource& source_;
+  std::uint64_t& lineNumber_;
+  std::string line_;
+  std::vector<std::string_view> words_;  // of line_
+  PlyHeader header_;
+};
+
 int findProperty(const PlyElement& e, std::initializer_list<std::string_view> names) {
   for (std::string_view name : names) {
     for (std::size_t i = 0; i < e.properties.size(); ++i) {
@@ -109,87 +224,7 @@ void planExtras(const PlyElement& vertex, PlyRoles& roles, PointExtras& extras) 
 }  // namespace
 
 PlyHeader parsePlyHeader(ByteSource& source, std::uint64_t& lineNumber) {
-  PlyHeader header;
-  std::string line;
-  const std::string& name = source.name();
-  auto at = [&](std::string_view what) { return badInputAtLine(name, lineNumber, what); };
-  if (!source.readLine(line, kMaxHeaderLine) || line != "ply") {
-    throw ErrorException{badInputAtByte(name, 0, "not a PLY file: expected the magic line 'ply'")};
-  }
-  lineNumber = 1;
-  bool sawFormat = false;
-  while (true) {
-    if (source.offset() > kMaxHeaderBytes) throw ErrorException{at("header longer than 1 MiB")};
-    if (!source.readLine(line, kMaxHeaderLine))
-      throw ErrorException{at("file ends inside the header (no 'end_header')")};
-    ++lineNumber;
-    const std::vector<std::string_view> words = splitWords(line);
-    if (words.empty()) continue;
-    const std::string_view keyword = words[0];
-    if (keyword == "end_header") break;
-    if (keyword == "comment" || keyword == "obj_info") {
-      header.comments.emplace_back(
-          std::string_view(line).substr(std::min(line.size(), keyword.size() + 1)));
-      continue;
-    }
-    if (keyword == "format") {
-      if (words.size() != 3) throw ErrorException{at("expected 'format <type> 1.0'")};
-      if (words[1] == "ascii")
-        header.format = PlyFormat::kAscii;
-      else if (words[1] == "binary_little_endian")
-        header.format = PlyFormat::kBinaryLittleEndian;
-      else if (words[1] == "binary_big_endian")
-        header.format = PlyFormat::kBinaryBigEndian;
-      else
-        throw ErrorException{at(fmt::format("unknown format '{}'", words[1]))};
-      if (words[2] != "1.0")
-        throw ErrorException{at(fmt::format("unsupported version '{}'", words[2]))};
-      sawFormat = true;
-      continue;
-    }
-    if (keyword == "element") {
-      if (words.size() != 3) throw ErrorException{at("expected 'element <name> <count>'")};
-      PlyElement e;
-      e.name = words[1];
-      const auto [end, error] =
-          std::from_chars(words[2].data(), words[2].data() + words[2].size(), e.count);
-      if (error != std::errc() || end != words[2].data() + words[2].size())
-        throw ErrorException{at(fmt::format("element count '{}' is not a whole number", words[2]))};
-      header.elements.push_back(std::move(e));
-      continue;
-    }
-    if (keyword == "property") {
-      if (header.elements.empty()) throw ErrorException{at("property before any element")};
-      PlyProperty p;
-      if (words.size() == 5 && words[1] == "list") {
-        const auto countType = parseType(words[2]);
-        const auto itemType = parseType(words[3]);
-        if (!countType || !itemType)
-          throw ErrorException{at(fmt::format("unknown type in '{}'", line))};
-        if (!plyTypeIsIntegral(*countType))
-          throw ErrorException{at("list count type must be an integer type")};
-        p.isList = true;
-        p.countType = *countType;
-        p.type = *itemType;
-        p.name = words[4];
-      } else if (words.size() == 3) {
-        const auto type = parseType(words[1]);
-        if (!type) throw ErrorException{at(fmt::format("unknown type '{}'", words[1]))};
-        p.type = *type;
-        p.name = words[2];
-      } else {
-        throw ErrorException{
-            at("expected 'property <type> <name>' or 'property list <count type> "
-               "<item type> <name>'")};
-      }
-      header.elements.back().properties.push_back(std::move(p));
-      continue;
-    }
-    throw ErrorException{at(fmt::format("unknown header keyword '{}'", keyword.substr(0, 40)))};
-  }
-  if (!sawFormat) throw ErrorException{at("header has no 'format' line")};
-  header.dataOffset = source.offset();
-  return header;
+  return HeaderParser(source, lineNumber).parse();
 }
 
 PlyRoles assignPlyRoles(PlyHeader& header, const std::string& name, bool readExtras,

@@ -15,9 +15,9 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
 #include "lodforge/io/format_advice.h"
-#include "lodforge/io/points/las_reader.h"
-#include "lodforge/io/model_io.h"
 #include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/model_io.h"
+#include "lodforge/io/points/las_reader.h"
 #include "lodforge/io/points/point_reader.h"
 #include "lodforge/points/cloud_file.h"
 #include "lodforge/simplify/package.h"
@@ -265,94 +265,101 @@ Status describePackage(const std::string& path, bool json) {
   return {};
 }
 
-// A point file: a LAS or LAZ header as it stands, then (unless `headerOnly`) every point read
-// for the lidar fields' ranges; text files are streamed to count their points and find their
-// bounds.
-Status describePointFile(const std::string& path, bool json, bool headerOnly) {
-  Result<std::uint64_t> bytes = fileSize(path);
-  if (!bytes) return bytes.status();
-  nlohmann::json j = {{"file", path}, {"fileBytes", *bytes}};
-  Aabbd bounds;
+// What `info` says of a point file: the JSON that --json prints (and the text is printed from),
+// with the point count and bounds beside it until they are added.
+struct PointFileFacts {
+  nlohmann::json j;
   std::uint64_t count = 0;
-  if (fileExtension(path) == "las" || fileExtension(path) == "laz") {
-    Result<LasHeader> header = LasReader::readHeader(path);
-    if (!header) return header.status();
-    const LasHeader& h = *header;
-    j["format"] = h.copc ? "COPC" : h.compressed ? "LAZ" : "LAS";
-    if (h.laz) {
-      const LazInfo& laz = *h.laz;
-      nlohmann::json items = nlohmann::json::array();
-      for (const LazItem& item : laz.items)
-        items.push_back(
-            {{"type", lazItemName(item.type)}, {"size", item.size}, {"version", item.version}});
-      j["laz"] = {{"compressor", static_cast<int>(laz.compressor)},
-                  {"chunkSize", laz.chunkSize},
-                  {"variableChunks", laz.chunkSize == kLazVariableChunks},
-                  {"items", items},
-                  {"description", describeLaz(laz)}};
-    }
-    j["version"] = fmt::format("{}.{}", h.versionMajor, h.versionMinor);
-    j["pointFormat"] = h.pointFormat;
-    j["recordLength"] = h.recordLength;
-    j["scale"] = {h.scale.x, h.scale.y, h.scale.z};
-    j["offset"] = {h.offset.x, h.offset.y, h.offset.z};
-    j["colors"] = h.hasColors;
-    if (h.hasColors && !h.compressed) j["colorBits"] = h.eightBitColors ? 8 : 16;
-    j["crs"] = h.crs;
-    j["software"] = h.generatingSoftware;
-    count = h.pointCount;
-    bounds = h.bounds;
-    if (!h.extrasIgnored.empty()) j["warnings"] = {h.extrasIgnored};
-    if (!headerOnly) {
-      Result<nlohmann::json> attributes = scanPointAttributes(path, *bytes);
-      if (!attributes) return attributes.status();
-      j["attributes"] = std::move(*attributes);
-    }
-  } else {
-    Result<PointReader> reader = PointReader::open(path);
-    if (!reader) return reader.status();
-    j["format"] = reader->info().format;
-    j["normals"] = reader->info().hasNormals;
-    j["colors"] = reader->info().hasColors;
-    PointBatch batch;
-    Progress progress("reading", *bytes, Progress::Unit::kBytes);
-    while (true) {
-      LODFORGE_TRY(checkCancelled());
-      Result<bool> more = reader->next(batch);
-      if (!more) return more.status();
-      if (!*more) break;
-      for (const Vec3d& p : batch.positions) bounds.add(p);
-      count += batch.size();
-    }
+  Aabbd bounds;
+};
+
+nlohmann::json lazJson(const LazInfo& laz) {
+  nlohmann::json items = nlohmann::json::array();
+  for (const LazItem& item : laz.items)
+    items.push_back(
+        {{"type", lazItemName(item.type)}, {"size", item.size}, {"version", item.version}});
+  return {{"compressor", static_cast<int>(laz.compressor)},
+          {"chunkSize", laz.chunkSize},
+          {"variableChunks", laz.chunkSize == kLazVariableChunks},
+          {"items", items},
+          {"description", describeLaz(laz)}};
+}
+
+// A LAS or LAZ header as it stands, then (unless `headerOnly`) every point read for the lidar
+// fields' ranges.
+Status readLasFacts(const std::string& path, std::uint64_t bytes, bool headerOnly,
+                    PointFileFacts& facts) {
+  Result<LasHeader> header = LasReader::readHeader(path);
+  if (!header) return header.status();
+  const LasHeader& h = *header;
+  nlohmann::json& j = facts.j;
+  j["format"] = h.copc ? "COPC" : h.compressed ? "LAZ" : "LAS";
+  if (h.laz) j["laz"] = lazJson(*h.laz);
+  j["version"] = fmt::format("{}.{}", h.versionMajor, h.versionMinor);
+  j["pointFormat"] = h.pointFormat;
+  j["recordLength"] = h.recordLength;
+  j["scale"] = {h.scale.x, h.scale.y, h.scale.z};
+  j["offset"] = {h.offset.x, h.offset.y, h.offset.z};
+  j["colors"] = h.hasColors;
+  if (h.hasColors && !h.compressed) j["colorBits"] = h.eightBitColors ? 8 : 16;
+  j["crs"] = h.crs;
+  j["software"] = h.generatingSoftware;
+  facts.count = h.pointCount;
+  facts.bounds = h.bounds;
+  if (!h.extrasIgnored.empty()) j["warnings"] = {h.extrasIgnored};
+  if (!headerOnly) {
+    Result<nlohmann::json> attributes = scanPointAttributes(path, bytes);
+    if (!attributes) return attributes.status();
+    j["attributes"] = std::move(*attributes);
   }
-  j["points"] = count;
-  if (!bounds.empty())
-    j["bounds"] = {{"min", {bounds.min.x, bounds.min.y, bounds.min.z}},
-                   {"max", {bounds.max.x, bounds.max.y, bounds.max.z}}};
-  if (json) {
-    fmt::print("{}\n", j.dump(2));
-    return {};
+  return {};
+}
+
+// Text files are streamed to count their points and find their bounds.
+Status streamPointFacts(const std::string& path, std::uint64_t bytes, PointFileFacts& facts) {
+  Result<PointReader> reader = PointReader::open(path);
+  if (!reader) return reader.status();
+  facts.j["format"] = reader->info().format;
+  facts.j["normals"] = reader->info().hasNormals;
+  facts.j["colors"] = reader->info().hasColors;
+  PointBatch batch;
+  Progress progress("reading", bytes, Progress::Unit::kBytes);
+  while (true) {
+    LODFORGE_TRY(checkCancelled());
+    Result<bool> more = reader->next(batch);
+    if (!more) return more.status();
+    if (!*more) break;
+    for (const Vec3d& p : batch.positions) facts.bounds.add(p);
+    facts.count += batch.size();
   }
+  return {};
+}
+
+// The format lines of a LAS or LAZ file: version, point format, compression, scale and offset.
+void printLasFormat(const nlohmann::json& j, std::uint64_t bytes) {
+  const std::string colors = !j["colors"].get<bool>() ? std::string()
+                             : j.contains("colorBits")
+                                 ? fmt::format(", {}-bit colours", j["colorBits"].get<int>())
+                                 : std::string(", colours");
+  fmt::print("format     {} {}, point format {} ({}-byte records{}) ({})\n",
+             j["format"].get<std::string>(), j["version"].get<std::string>(),
+             j["pointFormat"].get<int>(), j["recordLength"].get<int>(), colors, formatBytes(bytes));
+  if (j.contains("laz")) fmt::print("compressed {}\n", j["laz"]["description"].get<std::string>());
+  fmt::print("scale      {:.6g} {:.6g} {:.6g}, offset {:.10g} {:.10g} {:.10g}\n",
+             j["scale"][0].get<double>(), j["scale"][1].get<double>(), j["scale"][2].get<double>(),
+             j["offset"][0].get<double>(), j["offset"][1].get<double>(),
+             j["offset"][2].get<double>());
+}
+
+void printPointFile(const std::string& path, std::uint64_t bytes, const PointFileFacts& facts) {
+  const nlohmann::json& j = facts.j;
+  const Aabbd& bounds = facts.bounds;
   fmt::print("file       {}\n", path);
-  if (j.contains("version")) {
-    const std::string colors = !j["colors"].get<bool>() ? std::string()
-                               : j.contains("colorBits")
-                                   ? fmt::format(", {}-bit colours", j["colorBits"].get<int>())
-                                   : std::string(", colours");
-    fmt::print("format     {} {}, point format {} ({}-byte records{}) ({})\n",
-               j["format"].get<std::string>(), j["version"].get<std::string>(),
-               j["pointFormat"].get<int>(), j["recordLength"].get<int>(), colors,
-               formatBytes(*bytes));
-    if (j.contains("laz"))
-      fmt::print("compressed {}\n", j["laz"]["description"].get<std::string>());
-    fmt::print("scale      {:.6g} {:.6g} {:.6g}, offset {:.10g} {:.10g} {:.10g}\n",
-               j["scale"][0].get<double>(), j["scale"][1].get<double>(),
-               j["scale"][2].get<double>(), j["offset"][0].get<double>(),
-               j["offset"][1].get<double>(), j["offset"][2].get<double>());
-  } else {
-    fmt::print("format     {} ({})\n", j["format"].get<std::string>(), formatBytes(*bytes));
-  }
-  fmt::print("points     {}\n", formatCount(count));
+  if (j.contains("version"))
+    printLasFormat(j, bytes);
+  else
+    fmt::print("format     {} ({})\n", j["format"].get<std::string>(), formatBytes(bytes));
+  fmt::print("points     {}\n", formatCount(facts.count));
   if (!bounds.empty())
     fmt::print("bounds     min ({:.10g}, {:.10g}, {:.10g})  max ({:.10g}, {:.10g}, {:.10g})\n",
                bounds.min.x, bounds.min.y, bounds.min.z, bounds.max.x, bounds.max.y, bounds.max.z);
@@ -365,6 +372,27 @@ Status describePointFile(const std::string& path, bool json, bool headerOnly) {
   if (j.contains("warnings"))
     for (const auto& warning : j["warnings"])
       fmt::print("warning    {}\n", warning.get<std::string>());
+}
+
+// A point file: a LAS or LAZ header as it stands, then (unless `headerOnly`) every point read
+// for the lidar fields' ranges; text files are streamed to count their points and find their
+// bounds.
+Status describePointFile(const std::string& path, bool json, bool headerOnly) {
+  Result<std::uint64_t> bytes = fileSize(path);
+  if (!bytes) return bytes.status();
+  PointFileFacts facts;
+  facts.j = {{"file", path}, {"fileBytes", *bytes}};
+  const bool las = fileExtension(path) == "las" || fileExtension(path) == "laz";
+  LODFORGE_TRY(las ? readLasFacts(path, *bytes, headerOnly, facts)
+                   : streamPointFacts(path, *bytes, facts));
+  facts.j["points"] = facts.count;
+  if (!facts.bounds.empty())
+    facts.j["bounds"] = {{"min", {facts.bounds.min.x, facts.bounds.min.y, facts.bounds.min.z}},
+                         {"max", {facts.bounds.max.x, facts.bounds.max.y, facts.bounds.max.z}}};
+  if (json)
+    fmt::print("{}\n", facts.j.dump(2));
+  else
+    printPointFile(path, *bytes, facts);
   return {};
 }
 

@@ -185,35 +185,33 @@ void serveFile(const fs::path& root, const std::string& relative, const httplib:
       });
 }
 
-Status runServe(const Global& global, const ServeOptions& o) {
+// The folder `lodforge tiles -o` wrote, as an absolute path; a usage error for anything else.
+Result<fs::path> tilesetRoot(const std::string& directory) {
   std::error_code error;
-  const fs::path root = fs::weakly_canonical(o.directory, error);
+  const fs::path root = fs::weakly_canonical(directory, error);
   if (error || !fs::is_directory(root, error))
     return Error{
         ErrorKind::kUsage,
-        fmt::format("{}: not a directory; give the folder `lodforge tiles -o` wrote", o.directory)};
+        fmt::format("{}: not a directory; give the folder `lodforge tiles -o` wrote", directory)};
   if (!fs::is_regular_file(root / "tileset.json", error))
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: holds no tileset.json; give the folder `lodforge tiles -o` wrote",
-                             o.directory)};
-  const fs::path web = o.web.empty() ? findWebDirectory() : fs::path(o.web);
-  httplib::Server server;
-  Caches caches;
-  if (!server.is_valid()) return Error{ErrorKind::kIo, "cannot start the HTTP server"};
-  // A viewer keeps several connections alive; each holds a worker while it waits for its next
-  // request, so the pool is sized for many of them (the work per request is a file read).
+                             directory)};
+  return root;
+}
+
+// A viewer keeps several connections alive; each holds a worker while it waits for its next
+// request, so the pool is sized for many of them (the work per request is a file read).
+void sizeForViewers(httplib::Server& server) {
   server.new_task_queue = [] { return new httplib::ThreadPool(kWorkers); };
   server.set_keep_alive_max_count(1000);
   server.set_tcp_nodelay(true);  // headers and body go out as two writes: no Nagle wait
-  // cpp-httplib listens with a backlog of 5 (compiled in): 100 clients connecting at once see
-  // their SYNs dropped and retried a second or three later. Remember the socket, listen again
-  // with the system's maximum once it is bound (Linux takes a new backlog that way).
-  int listening = -1;
-  server.set_socket_options([&listening](socket_t socket) {
-    int yes = 1;
-    ::setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-    listening = socket;
-  });
+}
+
+// GET and HEAD only (with the CORS header if asked); the viewers at /cesium/ and /three/ (built
+// by `make` into web/dist), the tileset at /tiles/.
+void addRoutes(httplib::Server& server, const ServeOptions& o, const fs::path& root,
+               const fs::path& web, Caches& caches) {
   server.set_pre_routing_handler([&](const httplib::Request& request, httplib::Response& response) {
     if (request.method != "GET" && request.method != "HEAD") {
       response.status = 405;
@@ -224,7 +222,6 @@ Status runServe(const Global& global, const ServeOptions& o) {
     if (o.cors) response.set_header("Access-Control-Allow-Origin", "*");
     return httplib::Server::HandlerResponse::Unhandled;
   });
-  // The viewers at /cesium/ and /three/ (built by `make` into web/dist), the tileset at /tiles/.
   server.Get("/", [](const httplib::Request&, httplib::Response& response) {
     response.set_redirect("/cesium/");
   });
@@ -246,16 +243,38 @@ Status runServe(const Global& global, const ServeOptions& o) {
              [](const httplib::Request& request, httplib::Response& response) {
                response.set_redirect(request.path + "/");
              });
+}
+
+// One line per request on stderr, unless -q.
+void logRequests(httplib::Server& server, const Global& global) {
   server.set_logger([&global](const httplib::Request& request, const httplib::Response& response) {
     if (global.verbosity >= 0)
       fmt::print(stderr, "{} {} {} {} {}\n", request.remote_addr, request.method, request.path,
                  response.status, response.body.size());
+  });
+}
+
+// Binds the port (0: a free one) and returns it. cpp-httplib listens with a backlog of 5
+// (compiled in): 100 clients connecting at once see their SYNs dropped and retried a second or
+// three later. The socket is remembered in `listening` (which outlives the server) and listens
+// again with the system's maximum once it is bound (Linux takes a new backlog that way).
+Result<int> bindPort(httplib::Server& server, const ServeOptions& o, int& listening) {
+  server.set_socket_options([&listening](socket_t socket) {
+    int yes = 1;
+    ::setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    listening = socket;
   });
   const int port = o.port == 0 ? server.bind_to_any_port(o.host) : o.port;
   if (o.port != 0 && !server.bind_to_port(o.host, o.port))
     return Error{ErrorKind::kIo, fmt::format("cannot listen on {}:{} (in use?)", o.host, o.port)};
   if (port < 0) return Error{ErrorKind::kIo, fmt::format("cannot listen on {}", o.host)};
   if (listening >= 0) ::listen(listening, SOMAXCONN);
+  return port;
+}
+
+// Where the tileset and the viewers are, and a warning when other machines can reach them.
+void announce(const Global& global, const ServeOptions& o, const fs::path& root,
+              const fs::path& web, int port) {
   const std::string base = fmt::format("http://{}:{}", o.host, port);
   say(global, fmt::format("serving {} as {}/tiles/tileset.json", root.string(), base));
   if (web.empty())
@@ -266,7 +285,10 @@ Status runServe(const Global& global, const ServeOptions& o) {
   if (o.host != "127.0.0.1" && o.host != "localhost" && o.host != "::1")
     fmt::print(stderr, "lodforge: warning: listening on {}, reachable from other machines\n",
                o.host);
-  // Ctrl-C sets the cancel flag; this thread turns it into a clean stop.
+}
+
+// Serves until Ctrl-C, which sets the cancel flag; a watcher thread turns it into a clean stop.
+void serveUntilCancelled(httplib::Server& server) {
   std::atomic<bool> done{false};
   std::thread watcher([&] {
     while (!done.load()) {
@@ -280,6 +302,23 @@ Status runServe(const Global& global, const ServeOptions& o) {
   server.listen_after_bind();
   done = true;
   watcher.join();
+}
+
+Status runServe(const Global& global, const ServeOptions& o) {
+  Result<fs::path> root = tilesetRoot(o.directory);
+  if (!root) return root.status();
+  const fs::path web = o.web.empty() ? findWebDirectory() : fs::path(o.web);
+  httplib::Server server;
+  Caches caches;
+  if (!server.is_valid()) return Error{ErrorKind::kIo, "cannot start the HTTP server"};
+  sizeForViewers(server);
+  addRoutes(server, o, *root, web, caches);
+  logRequests(server, global);
+  int listening = -1;
+  Result<int> port = bindPort(server, o, listening);
+  if (!port) return port.status();
+  announce(global, o, *root, web, *port);
+  serveUntilCancelled(server);
   say(global, "stopped");
   return {};
 }

@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <utility>
 
 namespace lodforge {
@@ -440,6 +441,17 @@ Result<std::string> readFileToString(const std::string& path, std::uint64_t maxB
     return e.error;
   }
   return text;
+}
+
+Result<std::vector<std::byte>> readFileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return ioError(path, "cannot open");
+  const auto size = static_cast<std::size_t>(in.tellg());
+  std::vector<std::byte> bytes(size);
+  in.seekg(0);
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size)))
+    return ioError(path, "cannot read");
+  return bytes;
 }
 
 std::string fileExtension(const std::string& path) {

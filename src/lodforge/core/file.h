@@ -146,6 +146,8 @@ class MappedFile {
 };
 
 Result<std::string> readFileToString(const std::string& path, std::uint64_t maxBytes);
+// The file's bytes, read at once (work files read back whole: node meshes, chunks).
+Result<std::vector<std::byte>> readFileBytes(const std::string& path);
 Result<std::uint64_t> fileSize(const std::string& path);
 // Lower-cased extension without the dot ("glb", "ply"); empty when there is none.
 std::string fileExtension(const std::string& path);

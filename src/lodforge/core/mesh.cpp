@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cassert>
 #include <cmath>
 #include <numeric>
 #include <vector>
+
+#include "lodforge/core/position_hash.h"
 
 namespace lodforge {
 
@@ -31,22 +32,23 @@ std::uint64_t hashCell(const Cell& c) {
   return h;
 }
 
-// Welding groups vertices by cell: the exact bit pattern of the position, or the epsilon grid
-// cell. A flat open-addressing table maps a cell to the first representative in it; further
-// representatives of the same cell (attribute splits) chain through `next`.
-class CellTable {
+// Welding groups vertices by key: the exact position, or the epsilon grid cell. A flat
+// open-addressing table maps a key, by its hash, to the first representative with it; further
+// representatives of the same key (attribute splits) chain through `next`.
+class KeyTable {
  public:
-  explicit CellTable(std::size_t expected) {
+  explicit KeyTable(std::size_t expected) {
     std::size_t capacity = 16;
     while (capacity < expected * 2) capacity *= 2;
     slots_.assign(capacity, kEmpty);
     mask_ = capacity - 1;
   }
-  // Returns the slot holding `cell` (its value is kEmpty when the cell is new).
-  template <class CellOf>
-  std::uint32_t& find(const Cell& cell, const CellOf& cellOf) {
-    std::size_t i = hashCell(cell) & mask_;
-    while (slots_[i] != kEmpty && cellOf(slots_[i]) != cell) i = (i + 1) & mask_;
+  // Returns the slot holding the key of `hash` that `sameKey(representative)` recognises (its
+  // value is kEmpty when the key is new).
+  template <class SameKey>
+  std::uint32_t& find(std::uint64_t hash, const SameKey& sameKey) {
+    std::size_t i = hash & mask_;
+    while (slots_[i] != kEmpty && !sameKey(slots_[i])) i = (i + 1) & mask_;
     return slots_[i];
   }
   static constexpr std::uint32_t kEmpty = ~0u;
@@ -56,9 +58,37 @@ class CellTable {
   std::size_t mask_ = 0;
 };
 
-float canonical(float v) {
-  return v == 0.0f ? 0.0f : v;
-}  // -0 welds with +0
+// The keys of welding: with epsilon 0 a vertex's exact position (-0 == +0), else its cell in a
+// grid of epsilon-sized cells; and the representatives of each key.
+class WeldKeys {
+ public:
+  WeldKeys(std::span<const Vec3f> positions, float epsilon)
+      : positions_(positions),
+        exact_(epsilon == 0.0f),
+        inverseCell_(exact_ ? 0.0 : 1.0 / epsilon),
+        table_(positions.size()) {}
+  bool exact() const { return exact_; }
+  Cell cellOf(std::uint32_t v) const {
+    const Vec3f p = positions_[v];
+    return {static_cast<std::int64_t>(std::floor(p.x * inverseCell_)),
+            static_cast<std::int64_t>(std::floor(p.y * inverseCell_)),
+            static_cast<std::int64_t>(std::floor(p.z * inverseCell_))};
+  }
+  // The first representative of v's exact position, or of the grid cell `probe`.
+  std::uint32_t& first(std::uint32_t v, const Cell& probe) {
+    if (exact_) {
+      return table_.find(hashExactPosition(positions_[v]),
+                         [&](std::uint32_t r) { return positions_[r] == positions_[v]; });
+    }
+    return table_.find(hashCell(probe), [&](std::uint32_t r) { return cellOf(r) == probe; });
+  }
+
+ private:
+  std::span<const Vec3f> positions_;
+  bool exact_;
+  double inverseCell_;
+  KeyTable table_;
+};
 
 }  // namespace
 
@@ -70,23 +100,12 @@ std::uint32_t weldVertices(std::span<const Vec3f> positions, std::span<const Vec
   assert(!options.keepColorSplits || colors.size() == positions.size());
   assert(options.epsilon >= 0.0f);
 
-  const bool exact = options.epsilon == 0.0f;
-  const double inverseCell = exact ? 0.0 : 1.0 / options.epsilon;
+  WeldKeys keys(positions, options.epsilon);
+  const bool exact = keys.exact();
   const float epsilonSquared = options.epsilon * options.epsilon;
   const float cosLimit =
       static_cast<float>(std::cos(options.normalAngleDegrees * 3.14159265358979323846 / 180.0));
 
-  auto cellOf = [&](std::uint32_t v) -> Cell {
-    const Vec3f p = positions[v];
-    if (exact) {
-      return {std::bit_cast<std::int32_t>(canonical(p.x)),
-              std::bit_cast<std::int32_t>(canonical(p.y)),
-              std::bit_cast<std::int32_t>(canonical(p.z))};
-    }
-    return {static_cast<std::int64_t>(std::floor(p.x * inverseCell)),
-            static_cast<std::int64_t>(std::floor(p.y * inverseCell)),
-            static_cast<std::int64_t>(std::floor(p.z * inverseCell))};
-  };
   auto attributesMatch = [&](std::uint32_t a, std::uint32_t b) {
     if (options.keepColorSplits && colors[a] != colors[b]) return false;
     if (options.keepNormalSplits) {
@@ -97,26 +116,25 @@ std::uint32_t weldVertices(std::span<const Vec3f> positions, std::span<const Vec
     return true;
   };
   auto positionsMatch = [&](std::uint32_t a, std::uint32_t b) {
-    if (exact) return true;  // same exact cell means same position
+    if (exact) return true;  // the same exact key is the same position
     const Vec3f d = positions[a] - positions[b];
     return dot(d, d) <= epsilonSquared;
   };
 
   const auto vertexCount = static_cast<std::uint32_t>(positions.size());
-  CellTable table(positions.size());
-  std::vector<std::uint32_t> next(positions.size(), CellTable::kEmpty);
+  std::vector<std::uint32_t> next(positions.size(), KeyTable::kEmpty);
   std::uint32_t newCount = 0;
 
   for (std::uint32_t v = 0; v < vertexCount; ++v) {
-    const Cell cell = cellOf(v);
-    std::uint32_t match = CellTable::kEmpty;
-    // Exact welding looks in the vertex's own cell; epsilon welding in the 27 around it.
+    const Cell cell = exact ? Cell{} : keys.cellOf(v);
+    std::uint32_t match = KeyTable::kEmpty;
+    // Exact welding looks up the vertex's own position; epsilon welding the 27 cells around it.
     const int reach = exact ? 0 : 1;
-    for (int dx = -reach; dx <= reach && match == CellTable::kEmpty; ++dx) {
-      for (int dy = -reach; dy <= reach && match == CellTable::kEmpty; ++dy) {
-        for (int dz = -reach; dz <= reach && match == CellTable::kEmpty; ++dz) {
+    for (int dx = -reach; dx <= reach && match == KeyTable::kEmpty; ++dx) {
+      for (int dy = -reach; dy <= reach && match == KeyTable::kEmpty; ++dy) {
+        for (int dz = -reach; dz <= reach && match == KeyTable::kEmpty; ++dz) {
           const Cell probe{cell[0] + dx, cell[1] + dy, cell[2] + dz};
-          for (std::uint32_t r = table.find(probe, cellOf); r != CellTable::kEmpty; r = next[r]) {
+          for (std::uint32_t r = keys.first(v, probe); r != KeyTable::kEmpty; r = next[r]) {
             if (positionsMatch(v, r) && attributesMatch(v, r)) {
               match = r;
               break;
@@ -125,18 +143,18 @@ std::uint32_t weldVertices(std::span<const Vec3f> positions, std::span<const Vec
         }
       }
     }
-    if (match != CellTable::kEmpty) {
+    if (match != KeyTable::kEmpty) {
       remap[v] = remap[match];
       continue;
     }
     remap[v] = newCount++;
-    std::uint32_t& head = table.find(cell, cellOf);
+    std::uint32_t& head = keys.first(v, cell);
     // Append to the end of the chain so earlier representatives are preferred.
-    if (head == CellTable::kEmpty) {
+    if (head == KeyTable::kEmpty) {
       head = v;
     } else {
       std::uint32_t last = head;
-      while (next[last] != CellTable::kEmpty) last = next[last];
+      while (next[last] != KeyTable::kEmpty) last = next[last];
       next[last] = v;
     }
   }

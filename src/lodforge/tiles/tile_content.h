@@ -7,7 +7,7 @@
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
 #include "lodforge/tiling/chunk_input.h"
-#include "lodforge/tiling/chunk_store.h"
+#include "lodforge/tiling/mesh_part.h"
 #include "lodforge/tiling/octree.h"
 
 namespace lodforge {

@@ -1,7 +1,10 @@
 #include "lodforge/tiling/chunk_input.h"
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
+#include <span>
+#include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -67,103 +70,167 @@ PartTable partTable(const std::string& path, const Model& model, std::span<const
   return parts;
 }
 
-Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& options) {
-  ChunkInput input;
-  Result<Model> model = readInputModel(path, options.cad, input.warnings);
-  if (!model) return model.status();
-  input.inputTriangles = model->triangleCount();
-  if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");
-  input.colors = model->hasColors();
-  // Parts are named per vertex only when there is more than one.
-  // Scenes of nodes are assemblies (CAD, glTF, assimp's formats, packages); scans are not.
+// A model read whole, in the tileset's frame: what chunkModel cuts.
+struct PlacedModel {
+  Model model;
+  std::vector<Vec3d> world;    // its positions, through the transform if any
+  std::vector<Vec3f> normals;  // one per vertex, turned with the positions
+  bool features = false;       // its objects become parts (CutCorner::feature)
+};
+
+// Parts are named per vertex only when there is more than one. Scenes of nodes are assemblies
+// (CAD, glTF, assimp's formats, packages); scans are not.
+bool namesParts(const std::string& path, const Model& model, PartsMode parts) {
   const FileFormat format = formatFromPath(path);
   const bool assembly = format == FileFormat::kCad || format == FileFormat::kGlb ||
                         format == FileFormat::kGltf || format == FileFormat::kAssimp ||
                         fileExtension(path) == "lfp";
-  const bool features =
-      model->objectCount() > 1 &&
-      (options.parts == PartsMode::kOn || (options.parts == PartsMode::kAuto && assembly));
-  // World positions (through the transform, if any) and their bounds.
-  std::vector<Vec3d> world(model->vertexCount());
+  return model.objectCount() > 1 &&
+         (parts == PartsMode::kOn || (parts == PartsMode::kAuto && assembly));
+}
+
+// World positions, through the transform if any.
+Result<std::vector<Vec3d>> worldPositions(const std::string& path, const Model& model,
+                                          const ChunkInputOptions& options) {
+  std::vector<Vec3d> world(model.vertexCount());
   for (std::size_t v = 0; v < world.size(); ++v) {
-    world[v] = model->origin + toDouble(model->positions[v]);
+    world[v] = model.origin + toDouble(model.positions[v]);
     if (options.transform && !options.transform(world[v], world[v]))
       return badInput(path, fmt::format("vertex {}: cannot be transformed to the tileset's frame "
                                         "(outside the coordinate system?)",
                                         v));
-    input.bounds.add(world[v]);
   }
-  if (features) input.parts = partTable(path, *model, world);
-  // Normals: the model's, or area-weighted over each whole object; turned with the positions.
-  std::vector<Vec3f> normals = model->normals;
-  if (!model->hasNormals()) {
-    normals.resize(model->vertexCount());
-    for (std::size_t o = 0; o < model->objectCount(); ++o) {
-      const ObjectRecord& object = model->objects[o];
-      computeVertexNormals(model->objectPositions(o), model->objectIndices(o),
+  return world;
+}
+
+// Normals: the model's, or area-weighted over each whole object; turned with the positions.
+std::vector<Vec3f> worldNormals(const Model& model, std::span<const Vec3d> world,
+                                const ChunkInputOptions& options) {
+  std::vector<Vec3f> normals = model.normals;
+  if (!model.hasNormals()) {
+    normals.resize(model.vertexCount());
+    for (std::size_t o = 0; o < model.objectCount(); ++o) {
+      const ObjectRecord& object = model.objects[o];
+      computeVertexNormals(model.objectPositions(o), model.objectIndices(o),
                            std::span(normals).subspan(object.vertexOffset, object.vertexCount));
     }
   }
   if (options.transform) {
     for (std::size_t v = 0; v < world.size(); ++v)
-      normals[v] = transformNormal(options, model->origin + toDouble(model->positions[v]), world[v],
+      normals[v] = transformNormal(options, model.origin + toDouble(model.positions[v]), world[v],
                                    normals[v]);
   }
+  return normals;
+}
+
+// The leaf chunks' grid over the bounds: --chunk-size, or a size that fits where the triangles'
+// centroids are.
+Result<ChunkGrid> leafGrid(const PlacedModel& m, const ChunkInput& input,
+                           const ChunkInputOptions& options) {
   Result<double> fitted = chunkSizeFor(options, input.bounds, input.inputTriangles);
   if (!fitted) return fitted.status();
   double size = *fitted;
   if (options.chunkSize == 0) {
     size = fitChunkSize(input.bounds, size, leafTriangles(options, input.inputTriangles),
                         [&](const auto& add) {
-                          for (std::size_t o = 0; o < model->objectCount(); ++o) {
-                            const std::uint64_t offset = model->objects[o].vertexOffset;
-                            const auto indices = model->objectIndices(o);
+                          for (std::size_t o = 0; o < m.model.objectCount(); ++o) {
+                            const std::uint64_t offset = m.model.objects[o].vertexOffset;
+                            const auto indices = m.model.objectIndices(o);
                             for (std::size_t t = 0; t < indices.size(); t += 3)
-                              add((world[offset + indices[t]] + world[offset + indices[t + 1]] +
-                                   world[offset + indices[t + 2]]) *
+                              add((m.world[offset + indices[t]] + m.world[offset + indices[t + 1]] +
+                                   m.world[offset + indices[t + 2]]) *
                                       (1.0 / 3.0),
                                   1.0);
                           }
                         });
   }
-  const ChunkGrid grid = ChunkGrid::over(input.bounds, size);
-  input.chunks = std::make_unique<ChunkWriter>(grid, options.workDirectory + "/chunks",
-                                               options.chunkBufferBytes, options.keepInMemory);
-  Progress progress("tiles: chunks", input.inputTriangles);
-  std::vector<std::uint32_t> welded, weldedIndices, component;
-  std::vector<Aabbd> segmentBounds;
-  for (std::size_t o = 0; o < model->objectCount(); ++o) {
-    const ObjectRecord& object = model->objects[o];
-    const auto indices = model->objectIndices(o);
-    // Segments (§3.3): the object's connected components, over positions welded exactly so
-    // that attribute splits (a box's hard edges) do not break a part into faces.
-    welded.resize(object.vertexCount);
-    const std::uint32_t weldedCount = weldVertices(model->objectPositions(o), {}, {}, {}, welded);
-    weldedIndices.assign(indices.begin(), indices.end());
-    remapIndices(weldedIndices, welded);
-    component.resize(indices.size() / 3);
-    const std::uint32_t segments = connectedComponents(weldedCount, weldedIndices, component);
-    segmentBounds.assign(segments, Aabbd{});
+  return ChunkGrid::over(input.bounds, size);
+}
+
+// Segments (§3.3) of one object at a time: its connected components, over positions welded
+// exactly so that attribute splits (a box's hard edges) do not break a part into faces, and
+// their bounds.
+class ObjectSegments {
+ public:
+  void find(const PlacedModel& m, std::size_t o) {
+    const ObjectRecord& object = m.model.objects[o];
+    const auto indices = m.model.objectIndices(o);
+    welded_.resize(object.vertexCount);
+    const std::uint32_t weldedCount = weldVertices(m.model.objectPositions(o), {}, {}, {}, welded_);
+    weldedIndices_.assign(indices.begin(), indices.end());
+    remapIndices(weldedIndices_, welded_);
+    component_.resize(indices.size() / 3);
+    const std::uint32_t segments = connectedComponents(weldedCount, weldedIndices_, component_);
+    bounds_.assign(segments, Aabbd{});
     for (std::size_t t = 0; t < indices.size(); ++t)
-      segmentBounds[component[t / 3]].add(world[object.vertexOffset + indices[t]]);
+      bounds_[component_[t / 3]].add(m.world[object.vertexOffset + indices[t]]);
+  }
+  // The bounds of the segment of the object's triangle `t`.
+  const Aabbd& of(std::size_t t) const { return bounds_[component_[t]]; }
+
+ private:
+  std::vector<std::uint32_t> welded_, weldedIndices_, component_;
+  std::vector<Aabbd> bounds_;
+};
+
+// The corners of object `o`'s triangle over `corners` (its 3 indices) as chunk files take them.
+std::array<CutCorner, 3> cornersOf(const PlacedModel& m, std::size_t o,
+                                   std::span<const std::uint32_t> corners, bool colors) {
+  const std::uint64_t offset = m.model.objects[o].vertexOffset;
+  std::array<CutCorner, 3> triangle;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::uint32_t v = corners[k];
+    triangle[k].position = m.world[offset + v];
+    triangle[k].color = colors ? m.model.colors[offset + v] : Rgba8{255, 255, 255, 255};
+    triangle[k].normal = m.normals[offset + v];
+    triangle[k].source = offset + v;
+    triangle[k].feature = m.features ? static_cast<std::uint32_t>(o) : kNoFeature;
+  }
+  return triangle;
+}
+
+// Every object's triangles into the chunks, segment by segment (ChunkWriter::addSegmentTriangle).
+Status addObjects(const PlacedModel& m, ChunkInput& input) {
+  Progress progress("tiles: chunks", input.inputTriangles);
+  ObjectSegments segments;
+  for (std::size_t o = 0; o < m.model.objectCount(); ++o) {
+    segments.find(m, o);
+    const auto indices = m.model.objectIndices(o);
     for (std::size_t t = 0; t < indices.size(); t += 3) {
-      std::array<CutCorner, 3> triangle;
-      for (std::size_t k = 0; k < 3; ++k) {
-        const std::uint32_t v = indices[t + k];
-        triangle[k].position = world[object.vertexOffset + v];
-        triangle[k].color =
-            input.colors ? model->colors[object.vertexOffset + v] : Rgba8{255, 255, 255, 255};
-        triangle[k].normal = normals[object.vertexOffset + v];
-        triangle[k].source = object.vertexOffset + v;
-        triangle[k].feature = features ? static_cast<std::uint32_t>(o) : kNoFeature;
-      }
-      LODFORGE_TRY(input.chunks->addSegmentTriangle(segmentBounds[component[t / 3]], triangle));
+      LODFORGE_TRY(input.chunks->addSegmentTriangle(
+          segments.of(t / 3), cornersOf(m, o, indices.subspan(t, 3), input.colors)));
     }
     progress.advance(indices.size() / 3);
     LODFORGE_TRY(checkCancelled());
   }
   LODFORGE_TRY(input.chunks->flush());
   progress.finish();
+  return {};
+}
+
+// A model read whole: placed in the tileset's frame, its parts named, the leaf grid sized, its
+// objects cut into the chunks.
+Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& options) {
+  ChunkInput input;
+  Result<Model> read = readInputModel(path, options.cad, input.warnings);
+  if (!read) return read.status();
+  PlacedModel m;
+  m.model = std::move(*read);
+  input.inputTriangles = m.model.triangleCount();
+  if (input.inputTriangles == 0) return badInput(path, "the model has no triangles");
+  input.colors = m.model.hasColors();
+  m.features = namesParts(path, m.model, options.parts);
+  Result<std::vector<Vec3d>> world = worldPositions(path, m.model, options);
+  if (!world) return world.status();
+  m.world = std::move(*world);
+  for (const Vec3d& p : m.world) input.bounds.add(p);
+  if (m.features) input.parts = partTable(path, m.model, m.world);
+  m.normals = worldNormals(m.model, m.world, options);
+  Result<ChunkGrid> grid = leafGrid(m, input, options);
+  if (!grid) return grid.status();
+  input.chunks = std::make_unique<ChunkWriter>(*grid, options.workDirectory + "/chunks",
+                                               options.chunkBufferBytes, options.keepInMemory);
+  LODFORGE_TRY(addObjects(m, input));
   return input;
 }
 

@@ -1,8 +1,7 @@
 // Chunks on disk (large-meshes paper §3.3–3.4): the input streamed into the chunk grid, one
 // file per non-empty chunk, buffered in memory up to a budget and appended to disk when it is
 // reached (a block per append: the vertices since the last one, an input vertex once, and
-// triangles over them); and meshes (a chunk once welded, an octree node once simplified)
-// saved and reloaded on demand, so only the nodes being built are ever in memory.
+// triangles over them), and read back welded. Node meshes go to mesh files (mesh_file.h).
 #pragma once
 
 #include <array>
@@ -15,46 +14,14 @@
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
 #include "lodforge/tiling/chunk_grid.h"
+// Every work file of `lodforge tiles` from one include (their tests and fuzzer take them
+// together): a chunk loads welded (weld.h) as the mesh (mesh_part.h) that node mesh files hold
+// (mesh_file.h).
+#include "lodforge/tiling/mesh_file.h"
+#include "lodforge/tiling/mesh_part.h"
+#include "lodforge/tiling/weld.h"
 
 namespace lodforge {
-
-// An indexed mesh with exact (double) positions: what the octree passes between levels.
-struct MeshPart {
-  std::vector<Vec3d> positions;
-  std::vector<Rgba8> colors;   // empty or one per vertex
-  std::vector<Vec3f> normals;  // empty or one unit normal per vertex
-  // Empty or one per vertex: the input object (part) it belongs to, or kNoFeature. Vertices of
-  // different objects are never welded, so no triangle spans two objects.
-  std::vector<std::uint32_t> features;
-  std::vector<std::uint32_t> indices;
-
-  std::uint32_t vertexCount() const { return static_cast<std::uint32_t>(positions.size()); }
-  std::uint64_t triangleCount() const { return indices.size() / 3; }
-  std::uint64_t memoryBytes() const {
-    return positions.size() * sizeof(Vec3d) + colors.size() * sizeof(Rgba8) +
-           normals.size() * sizeof(Vec3f) +
-           (features.size() + indices.size()) * sizeof(std::uint32_t);
-  }
-};
-
-// Welds bit-identical positions of one object (cut vertices are made identical on purpose),
-// drops triangles that repeat a corner and vertices no triangle uses. The first vertex of a
-// group keeps its colour; the group's distinct normals are averaged (each once, so the result does
-// not depend on how often a vertex was stored). Features that are all kNoFeature are dropped.
-// Deterministic.
-void weldExact(MeshPart& mesh);
-
-// The mesh's features (kNoFeature left out), ascending, each once.
-std::vector<std::uint32_t> distinctFeatures(const MeshPart& mesh);
-
-// Appends `parts`, renumbering their indices.
-MeshPart concatenate(std::span<const MeshPart> parts);
-
-Status saveMesh(const MeshPart& mesh, const std::string& path);
-Result<MeshPart> loadMesh(const std::string& path);
-// The same from bytes in memory (`name` for messages): what loadMesh and loadChunk parse.
-Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& name);
-Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string& name);
 
 class ChunkWriter {
  public:
@@ -126,6 +93,8 @@ void cutSegmentTriangle(const ChunkGrid& grid, const Aabbd* segment,
 
 // A chunk file read back as a welded mesh.
 Result<MeshPart> loadChunk(const std::string& path);
+// The same from bytes in memory (`name` for messages): what loadChunk parses.
+Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string& name);
 
 // The cell of a cell index (inverse of ChunkGrid::cellIndex).
 ChunkCell cellOfIndex(const ChunkGrid& grid, std::uint64_t index);

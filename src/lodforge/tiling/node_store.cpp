@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "lodforge/tiling/mesh_file.h"
 #include "lodforge/tiling/resume.h"
 
 namespace lodforge {

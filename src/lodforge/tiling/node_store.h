@@ -8,7 +8,7 @@
 #include <string>
 
 #include "lodforge/core/status.h"
-#include "lodforge/tiling/chunk_store.h"
+#include "lodforge/tiling/mesh_part.h"
 #include "lodforge/tiling/octree.h"
 
 namespace lodforge {

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "lodforge/tiling/mesh_part.h"
 #include "lodforge/tiling/node_scheduler.h"
 #include "lodforge/tiling/node_store.h"
 #include "lodforge/tiling/simplify_node.h"

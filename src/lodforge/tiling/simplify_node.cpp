@@ -11,6 +11,7 @@
 #include "lodforge/core/distance.h"
 #include "lodforge/core/mesh.h"
 #include "lodforge/simplify/progressive.h"
+#include "lodforge/tiling/weld.h"
 
 namespace lodforge {
 namespace {

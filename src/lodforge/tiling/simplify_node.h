@@ -9,7 +9,7 @@
 
 #include "lodforge/core/math.h"
 #include "lodforge/tiling/chunk_grid.h"
-#include "lodforge/tiling/chunk_store.h"
+#include "lodforge/tiling/mesh_part.h"
 #include "lodforge/tiling/octree.h"
 
 namespace lodforge {

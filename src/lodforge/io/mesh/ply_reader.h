@@ -2,7 +2,8 @@
 // faces as lists of any count/index type (polygons fan-triangulated), triangle strips (a
 // 'tristrips' element), optional per-face object ids. PlyReader streams: it yields batches of
 // vertices or faces in file order, so a file larger than RAM is processed with a fixed amount of
-// memory. readPly builds a whole Model.
+// memory. readPly builds a whole Model. The header is ply_header.h; the data is read by
+// ply_records (values, vertices, faces) and ply_strips, objects split by ply_objects.
 #pragma once
 
 #include <cstdint>
@@ -15,55 +16,9 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/model.h"
 #include "lodforge/core/status.h"
-#include "lodforge/io/points/point_extras.h"
+#include "lodforge/io/mesh/ply_header.h"
 
 namespace lodforge {
-
-enum class PlyFormat : std::uint8_t { kAscii, kBinaryLittleEndian, kBinaryBigEndian };
-enum class PlyType : std::uint8_t {
-  kInt8,
-  kUint8,
-  kInt16,
-  kUint16,
-  kInt32,
-  kUint32,
-  kFloat32,
-  kFloat64
-};
-
-struct PlyProperty {
-  std::string name;
-  PlyType type = PlyType::kFloat32;  // the item type for lists
-  bool isList = false;
-  PlyType countType = PlyType::kUint8;
-};
-
-struct PlyElement {
-  std::string name;
-  std::uint64_t count = 0;
-  std::vector<PlyProperty> properties;
-};
-
-struct PlyHeader {
-  PlyFormat format = PlyFormat::kAscii;
-  std::vector<PlyElement> elements;
-  std::vector<std::string> comments;
-  std::uint64_t dataOffset = 0;  // byte where element data starts
-
-  // What lodforge reads from it.
-  std::uint64_t vertexCount = 0;
-  // Faces, plus the triangles the strips make (0: no faces, a point cloud). Only reading strips
-  // tells how many triangles they make (restarts, degenerate joins), so opening a file with
-  // strips reads them once to count.
-  std::uint64_t faceCount = 0;
-  std::uint64_t stripCount = 0;  // strips in the 'tristrips' element
-  bool hasNormals = false;
-  bool hasColors = false;
-  bool hasObjectIds = false;
-  bool doublePositions = false;  // x y z stored as double: keep the double origin
-  // The vertex's other scalar properties (label, segment_index, …), with readExtras.
-  PointExtras extras;
-};
 
 struct PlyReadOptions {
   std::size_t batchSize = 1 << 16;  // elements per batch
@@ -128,9 +83,5 @@ class PlyReader {
 Result<Model> readPly(const std::string& path, const PlyReadOptions& options = {});
 Result<Model> readPlyFromMemory(std::span<const std::byte> bytes, const std::string& name,
                                 const PlyReadOptions& options = {});
-
-std::string_view plyTypeName(PlyType type);
-std::size_t plyTypeSize(PlyType type);
-std::string_view plyFormatName(PlyFormat format);
 
 }  // namespace lodforge

@@ -25,6 +25,23 @@ constexpr std::array<ExtraType, 10> kLasTypes = {
     ExtraType::kUint32,  ExtraType::kInt32,  ExtraType::kUint64, ExtraType::kInt64,
     ExtraType::kFloat32, ExtraType::kFloat64};
 
+// Every scalar type's names and size, in ExtraType order.
+struct TypeRow {
+  const char* name;
+  std::string_view plyName;
+  std::size_t size;
+};
+constexpr std::array<TypeRow, 10> kTypes = {{{"int8", "char", 1},
+                                             {"uint8", "uchar", 1},
+                                             {"int16", "short", 2},
+                                             {"uint16", "ushort", 2},
+                                             {"int32", "int", 4},
+                                             {"uint32", "uint", 4},
+                                             {"int64", "", 8},
+                                             {"uint64", "", 8},
+                                             {"float32", "float", 4},
+                                             {"float64", "double", 8}}};
+
 bool isFloat(ExtraType type) {
   return type == ExtraType::kFloat32 || type == ExtraType::kFloat64;
 }
@@ -43,27 +60,15 @@ double anyValue(const std::byte* at, ExtraType type) {
 }  // namespace
 
 std::size_t extraTypeSize(ExtraType type) {
-  switch (type) {
-    case ExtraType::kInt8:
-    case ExtraType::kUint8:
-      return 1;
-    case ExtraType::kInt16:
-    case ExtraType::kUint16:
-      return 2;
-    case ExtraType::kInt32:
-    case ExtraType::kUint32:
-    case ExtraType::kFloat32:
-      return 4;
-    default:
-      return 8;
-  }
+  return kTypes[static_cast<std::size_t>(type)].size;
 }
 
 const char* extraTypeName(ExtraType type) {
-  static constexpr std::array<const char*, 10> kNames = {"int8",    "uint8",  "int16", "uint16",
-                                                         "int32",   "uint32", "int64", "uint64",
-                                                         "float32", "float64"};
-  return kNames[static_cast<std::size_t>(type)];
+  return kTypes[static_cast<std::size_t>(type)].name;
+}
+
+std::string_view extraTypePlyName(ExtraType type) {
+  return kTypes[static_cast<std::size_t>(type)].plyName;
 }
 
 bool fitsExtraType(double v, ExtraType type) {

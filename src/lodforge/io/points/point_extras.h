@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "lodforge/core/status.h"
@@ -26,8 +27,12 @@ enum class ExtraType : std::uint8_t {
   kFloat32,
   kFloat64
 };
+// From one table of every scalar type, for LAS extra bytes and PLY properties alike.
 std::size_t extraTypeSize(ExtraType type);
 const char* extraTypeName(ExtraType type);  // "uint16", …
+// PLY's own name for the type ("ushort" for kUint16, …); empty for the 64-bit integers, which
+// PLY has not.
+std::string_view extraTypePlyName(ExtraType type);
 
 struct ExtraField {
   std::string name;  // as the file names it

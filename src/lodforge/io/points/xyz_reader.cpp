@@ -88,6 +88,13 @@ struct XyzReader::State {
     }
     return false;
   }
+
+  // The steps of start(), over the first line of numbers (`text`, split into `fields`).
+  Result<bool> findFirstPoint(std::vector<std::string>& names);
+  Status columnsFromNames(const std::vector<std::string>& names);
+  Status columnsFromCount();
+  bool colorsInUnits() const;
+  double value(int column) const { return *number(fields[static_cast<std::size_t>(column)]); }
 };
 
 XyzReader::XyzReader(std::unique_ptr<State> state) : state_(std::move(state)) {}
@@ -116,97 +123,113 @@ Result<XyzReader> XyzReader::fromMemory(std::span<const std::byte> bytes, std::s
   return start(std::move(state));
 }
 
-Result<XyzReader> XyzReader::start(std::unique_ptr<State> state) try {
-  State& s = *state;
-  XyzLayout& layout = s.layout;
-  std::vector<std::string> names;
+// Reads up to the first line of numbers (false: the file has none), past comments, a PTS count
+// line and a line of column names, whose names go to `names` (lower case). CloudCompare writes
+// its column names as a comment: "//X,Y,Z,R,G,B".
+Result<bool> XyzReader::State::findFirstPoint(std::vector<std::string>& names) {
   while (true) {
-    if (!s.source->readLine(s.text)) return XyzReader(std::move(state));  // no points at all
-    ++s.line;
-    const std::string_view line = trim(s.text);
-    // CloudCompare writes its column names as a comment: "//X,Y,Z,R,G,B".
-    if (line.starts_with("//") && names.empty()) {
-      split(line.substr(2), detectSeparator(line), s.fields);
-      if (!s.fields.empty() && lower(s.fields[0]) == "x") {
-        for (std::string_view f : s.fields) names.push_back(lower(f));
+    if (!source->readLine(text)) return false;
+    ++line;
+    const std::string_view trimmed = trim(text);
+    if (trimmed.starts_with("//") && names.empty()) {
+      split(trimmed.substr(2), detectSeparator(trimmed), fields);
+      if (!fields.empty() && lower(fields[0]) == "x") {
+        for (std::string_view f : fields) names.push_back(lower(f));
       }
       continue;
     }
-    if (isComment(line)) continue;
-    layout.separator = detectSeparator(s.text);
-    split(s.text, layout.separator, s.fields);
-    const bool numeric = std::all_of(s.fields.begin(), s.fields.end(),
+    if (isComment(trimmed)) continue;
+    layout.separator = detectSeparator(text);
+    split(text, layout.separator, fields);
+    const bool numeric = std::all_of(fields.begin(), fields.end(),
                                      [](std::string_view f) { return number(f).has_value(); });
-    if (numeric && s.fields.size() == 1 && names.empty()) continue;  // a PTS count line
-    if (numeric) break;
-    if (!names.empty()) return s.fail("expected numbers after the line of column names");
-    for (std::string_view f : s.fields) names.push_back(lower(f));
+    if (numeric && fields.size() == 1 && names.empty()) continue;  // a PTS count line
+    if (numeric) return true;
+    if (!names.empty()) return fail("expected numbers after the line of column names");
+    for (std::string_view f : fields) names.push_back(lower(f));
   }
-  layout.columns = s.fields.size();
-  if (layout.columns > 64) return s.fail(fmt::format("{} columns: at most 64", layout.columns));
-  layout.hasHeader = !names.empty();
-  const auto value = [&](int column) {
-    return *number(s.fields[static_cast<std::size_t>(column)]);
+}
+
+// The columns by their names: x, y and z must be there; a colour or a normal where its three
+// columns stand in order.
+Status XyzReader::State::columnsFromNames(const std::vector<std::string>& names) {
+  if (names.size() != layout.columns)
+    return fail(fmt::format("{} values under {} column names", layout.columns, names.size()));
+  const auto find = [&](std::initializer_list<std::string_view> options) {
+    for (std::string_view o : options) {
+      const auto it = std::find(names.begin(), names.end(), o);
+      if (it != names.end()) return static_cast<int>(it - names.begin());
+    }
+    return -1;
   };
-  if (layout.hasHeader) {
-    if (names.size() != layout.columns)
-      return s.fail(fmt::format("{} values under {} column names", layout.columns, names.size()));
-    const auto find = [&](std::initializer_list<std::string_view> options) {
-      for (std::string_view o : options) {
-        const auto it = std::find(names.begin(), names.end(), o);
-        if (it != names.end()) return static_cast<int>(it - names.begin());
+  layout.x = find({"x", "easting"});
+  layout.y = find({"y", "northing"});
+  layout.z = find({"z", "elevation", "height"});
+  if (layout.x < 0 || layout.y < 0 || layout.z < 0)
+    return badInputAtLine(source->name(), 1, "the column names have no x, y and z");
+  const int red = find({"r", "red"}), green = find({"g", "green"}), blue = find({"b", "blue"});
+  if (red >= 0 && green == red + 1 && blue == red + 2) layout.red = red;
+  const int nx = find({"nx", "normal_x", "normalx"}), ny = find({"ny", "normal_y", "normaly"}),
+            nz = find({"nz", "normal_z", "normalz"});
+  if (nx >= 0 && ny == nx + 1 && nz == nx + 2) layout.normal = nx;
+  return {};
+}
+
+// The columns by their count, without names.
+Status XyzReader::State::columnsFromCount() {
+  switch (layout.columns) {
+    case 3:
+    case 4:
+      break;  // x y z [intensity]
+    case 6: {
+      // Colour or normal: colours are whole numbers and not all of them 0 or 1.
+      bool whole = true, aboveOne = false;
+      for (int c = 3; c < 6; ++c) {
+        whole = whole && value(c) == std::floor(value(c));
+        aboveOne = aboveOne || value(c) > 1;
       }
-      return -1;
-    };
-    layout.x = find({"x", "easting"});
-    layout.y = find({"y", "northing"});
-    layout.z = find({"z", "elevation", "height"});
-    if (layout.x < 0 || layout.y < 0 || layout.z < 0)
-      return badInputAtLine(s.source->name(), 1, "the column names have no x, y and z");
-    const int red = find({"r", "red"}), green = find({"g", "green"}), blue = find({"b", "blue"});
-    if (red >= 0 && green == red + 1 && blue == red + 2) layout.red = red;
-    const int nx = find({"nx", "normal_x", "normalx"}), ny = find({"ny", "normal_y", "normaly"}),
-              nz = find({"nz", "normal_z", "normalz"});
-    if (nx >= 0 && ny == nx + 1 && nz == nx + 2) layout.normal = nx;
-  } else {
-    switch (layout.columns) {
-      case 3:
-      case 4:
-        break;  // x y z [intensity]
-      case 6: {
-        // Colour or normal: colours are whole numbers and not all of them 0 or 1.
-        bool whole = true, aboveOne = false;
-        for (int c = 3; c < 6; ++c) {
-          whole = whole && value(c) == std::floor(value(c));
-          aboveOne = aboveOne || value(c) > 1;
-        }
-        (whole && aboveOne ? layout.red : layout.normal) = 3;
-        break;
-      }
-      case 7:
-        layout.red = 4;
-        break;  // PTS: x y z intensity r g b
-      case 9:
-        layout.red = 3;
-        layout.normal = 6;
-        break;
-      default:
-        return s.fail(
-            fmt::format("{} columns: expected 3 (x y z), 4 (x y z i), 6 (x y z r g b, or "
-                        "x y z nx ny nz), 7 (x y z i r g b) or 9 (x y z r g b nx ny nz), "
-                        "or a first line of column names",
-                        layout.columns));
+      (whole && aboveOne ? layout.red : layout.normal) = 3;
+      break;
     }
+    case 7:
+      layout.red = 4;
+      break;  // PTS: x y z intensity r g b
+    case 9:
+      layout.red = 3;
+      layout.normal = 6;
+      break;
+    default:
+      return fail(
+          fmt::format("{} columns: expected 3 (x y z), 4 (x y z i), 6 (x y z r g b, or "
+                      "x y z nx ny nz), 7 (x y z i r g b) or 9 (x y z r g b nx ny nz), "
+                      "or a first line of column names",
+                      layout.columns));
   }
-  if (layout.red >= 0) {
-    // 0–1 floats: all within [0, 1] and one at least a fraction (0 0 1 is ambiguous: 0–255).
-    bool within = true, fraction = false;
-    for (int c = layout.red; c < layout.red + 3; ++c) {
-      within = within && value(c) >= 0 && value(c) <= 1;
-      fraction = fraction || value(c) != std::floor(value(c));
-    }
-    layout.unitColors = within && fraction;
+  return {};
+}
+
+// 0–1 floats: all within [0, 1] and one at least a fraction (0 0 1 is ambiguous: 0–255).
+bool XyzReader::State::colorsInUnits() const {
+  bool within = true, fraction = false;
+  for (int c = layout.red; c < layout.red + 3; ++c) {
+    within = within && value(c) >= 0 && value(c) <= 1;
+    fraction = fraction || value(c) != std::floor(value(c));
   }
+  return within && fraction;
+}
+
+// The layout from the first line of numbers and the names before it, if any.
+Result<XyzReader> XyzReader::start(std::unique_ptr<State> state) try {
+  State& s = *state;
+  std::vector<std::string> names;
+  const Result<bool> found = s.findFirstPoint(names);
+  if (!found) return found.status();
+  if (!*found) return XyzReader(std::move(state));  // no points at all
+  s.layout.columns = s.fields.size();
+  if (s.layout.columns > 64) return s.fail(fmt::format("{} columns: at most 64", s.layout.columns));
+  s.layout.hasHeader = !names.empty();
+  LODFORGE_TRY(s.layout.hasHeader ? s.columnsFromNames(names) : s.columnsFromCount());
+  if (s.layout.red >= 0) s.layout.unitColors = s.colorsInUnits();
   s.pending = true;
   return XyzReader(std::move(state));
 } catch (const ErrorException& e) {

@@ -1,0 +1,21 @@
+// A mesh on disk (large-meshes paper §3.4): a node's mesh saved once it is built and loaded back
+// when its parent needs it, as a work file of `lodforge tiles` (`LFMESH3`: magic, five counts,
+// then each array of MeshPart as it is in memory). Read back checked: sizes against the counts,
+// indices against the vertex count.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <string>
+
+#include "lodforge/core/status.h"
+#include "lodforge/tiling/mesh_part.h"
+
+namespace lodforge {
+
+Status saveMesh(const MeshPart& mesh, const std::string& path);
+Result<MeshPart> loadMesh(const std::string& path);
+// The same from bytes in memory (`name` for messages): what loadMesh parses.
+Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& name);
+
+}  // namespace lodforge

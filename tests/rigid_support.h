@@ -1,4 +1,4 @@
-// Random point sets and rigid motions for the tests of repeated shapes (glb_instances, the
+// Random point sets and rigid motions for the tests of repeated shapes (core/instances, the
 // builder's shape cache).
 #pragma once
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "lodforge/core/math.h"
-#include "lodforge/simplify/glb_instances.h"
+#include "lodforge/core/instances.h"
 #include "lodforge/io/mesh/object_stream.h"
 #include "lodforge/simplify/progressive.h"
 

@@ -11,7 +11,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
-#include "lodforge/simplify/glb_instances.h"
+#include "lodforge/core/instances.h"
 
 namespace lodforge {
 

@@ -81,7 +81,7 @@ struct GlbWriteOptions {
   bool flatScene = false;
   // writeGlb: an object that is an earlier object's mesh moved rigidly (a CAD shape placed
   // again, a glTF mesh under several nodes) is written as that mesh under a node transform
-  // (findPlacements, glb_instances.h).
+  // (findPlacements, core/instances.h).
   bool shareMeshes = true;
 };
 

@@ -1,4 +1,4 @@
-// Repeated meshes found again in a model of world positions (glb_instances.h): the rigid fit on
+// Repeated meshes found again in a model of world positions (core/instances.h): the rigid fit on
 // random point sets moved by random motions, and real assemblies written once per shape.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -9,7 +9,7 @@
 #include <map>
 
 #include "lodforge/core/random.h"
-#include "lodforge/simplify/glb_instances.h"
+#include "lodforge/core/instances.h"
 #include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/io/model_io.h"
 #include "rigid_support.h"

@@ -1,4 +1,4 @@
-#include "lodforge/simplify/glb_instances.h"
+#include "lodforge/core/instances.h"
 
 #include <algorithm>
 #include <cmath>

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -992,6 +993,29 @@ TEST(CliServe, ServesATilesetWithTypesRangesAndCompression) {
     EXPECT_EQ(r->status, 200) << page;
     EXPECT_EQ(r->get_header_value("Content-Type"), "text/html; charset=utf-8");
   }
+  // A viewer's scripts go out gzipped, compressed once (never per request: brotli at its top
+  // quality took 10 s for CesiumJS on every page load), one gzip stream of the file.
+  r = http.Get("/cesium/");
+  ASSERT_TRUE(r);
+  std::smatch script;
+  const std::string page = r->body;
+  ASSERT_TRUE(std::regex_search(page, script, std::regex(R"(src="(/assets/[^"]+\.js)")"))) << page;
+  httplib::Client scripts("127.0.0.1", served.port());
+  scripts.set_decompress(false);
+  const auto first = scripts.Get(script[1].str(), {{"Accept-Encoding", "gzip, deflate, br"}});
+  const auto again = scripts.Get(script[1].str(), {{"Accept-Encoding", "gzip, deflate, br"}});
+  ASSERT_TRUE(first && again);
+  EXPECT_EQ(first->status, 200);
+  EXPECT_EQ(first->get_header_value("Content-Encoding"), "gzip");
+  EXPECT_EQ(first->get_header_value("Content-Type"), "application/javascript; charset=utf-8");
+  EXPECT_EQ(again->body, first->body);
+  scripts.set_decompress(true);
+  const auto decoded = scripts.Get(script[1].str(), {{"Accept-Encoding", "gzip"}});
+  const auto identity = scripts.Get(script[1].str());
+  ASSERT_TRUE(decoded && identity);
+  EXPECT_FALSE(identity->has_header("Content-Encoding"));
+  EXPECT_EQ(decoded->body, identity->body);
+  EXPECT_LT(first->body.size(), identity->body.size());
   // The first lines name the tileset's URL and the viewers.
   const std::string said = test::readFile(dir.file(".serve-out"));
   EXPECT_NE(said.find(fmt::format("as http://127.0.0.1:{}/tiles/tileset.json", served.port())),

@@ -87,13 +87,15 @@ async function checkParts(tab, viewer, mine) {
   await tab.waitForFunction(() => window.lodforge.parts.idle(), null, { timeout: 60000 });
   await tab.waitForTimeout(1000);
   const box = await tab.evaluate(() => { const r = document.querySelector('canvas').getBoundingClientRect(); return [r.width, r.height]; });
-  const hits = [];
+  // The whole grid in one call: each call into the page waits for the frame being drawn (a
+  // few hundred ms in software WebGL), the picks themselves take a few ms.
+  const grid = [];
   for (let j = 1; j < 16; ++j)
-    for (let i = 1; i < 24; ++i) {
-      const x = Math.round((box[0] * i) / 24), y = Math.round((box[1] * j) / 16);
-      const hit = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [x, y]);
-      if (hit) hits.push({ x, y, ...hit });
-    }
+    for (let i = 1; i < 24; ++i) grid.push([Math.round((box[0] * i) / 24), Math.round((box[1] * j) / 16)]);
+  const hits = (await tab.evaluate((points) => points.map(([x, y]) => {
+    const hit = window.lodforge.parts.pick(x, y);
+    return hit ? { x, y, ...hit } : null;
+  }), grid)).filter((h) => h);
   writeFileSync(path.join(outDir, `${viewer}-part.png`), await tab.screenshot());
   const others = hits.filter((h) => h.id !== known.id);
   console.log(`${viewer}: "${known.name}" (part ${known.id} of ${count}) found and isolated: ` +

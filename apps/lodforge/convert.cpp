@@ -11,10 +11,10 @@
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
-#include "lodforge/io/points/las_copy.h"
-#include "lodforge/io/model_io.h"
 #include "lodforge/io/mesh/ply_reader.h"
 #include "lodforge/io/mesh/stl_writer.h"
+#include "lodforge/io/model_io.h"
+#include "lodforge/io/points/las_copy.h"
 #include "outputs.h"
 
 namespace lodforge::cli {

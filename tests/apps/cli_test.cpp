@@ -1414,8 +1414,8 @@ TEST(CliTiles, AReconstructionStoppedHalfwayResumesToTheSameTileset) {
   test::TempDir dir;
   ASSERT_EQ(lodforge("-q generate points --points 300K -o " + dir.file("p.ply"), dir).code, 0);
   expectResumesToTheSameTileset(dir, dir.file("p.ply"),
-                                {"--surface", "--voxel", "2", "--chunk-size", "24"},
-                                "run:1", " resumed)");
+                                {"--surface", "--voxel", "2", "--chunk-size", "24"}, "run:1",
+                                " resumed)");
 }
 
 // reconstruct: Ctrl-C after some runs of chunks keeps OUTPUT.work and says so; --resume takes

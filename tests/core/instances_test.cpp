@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <map>
 
-#include "lodforge/core/random.h"
 #include "lodforge/core/instances.h"
+#include "lodforge/core/random.h"
 #include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/io/model_io.h"
 #include "rigid_support.h"

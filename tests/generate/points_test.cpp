@@ -6,8 +6,8 @@
 #include <map>
 
 #include "lodforge/core/threads.h"
-#include "lodforge/io/points/las_reader.h"
 #include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/points/las_reader.h"
 #include "test_support.h"
 
 namespace lodforge {

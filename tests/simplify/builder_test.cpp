@@ -2,9 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include "lodforge/core/instances.h"
 #include "lodforge/generate/cad.h"
 #include "lodforge/io/cad/cad_reader.h"
-#include "lodforge/core/instances.h"
 #include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/io/mesh/gltf_reader.h"
 #include "lodforge/io/mesh/ply_writer.h"

@@ -69,8 +69,7 @@ TEST(Tiles, HorseTilesetFollowsTheRules) {
   TilesOptions options;
   options.input.chunkSize = 0.05;  // the horse is ~0.2 m long: a few chunks per axis
   options.octree.errorSamples = 2000;
-  Result<TilesStats> stats =
-      writeTiles(test::dataPath("meshes/horse.ply"), out.string(), options);
+  Result<TilesStats> stats = writeTiles(test::dataPath("meshes/horse.ply"), out.string(), options);
   ASSERT_TRUE(stats.ok()) << stats.error().message;
   EXPECT_GE(stats->levels, 2);
   EXPECT_GT(stats->leaves, 8u);
@@ -154,8 +153,7 @@ TEST(Tiles, NeighbouringTilesAgreeOnTheNormalsOfTheirSharedVertices) {
     options.input.chunkSize = std::string(name).find("horse") != std::string::npos ? 0.04 : 0.03;
     options.octree.errorSamples = 1000;
     options.quantize = false;
-    Result<TilesStats> stats =
-        writeTiles(test::dataPath(name), out.string(), options);
+    Result<TilesStats> stats = writeTiles(test::dataPath(name), out.string(), options);
     ASSERT_TRUE(stats.ok()) << stats.error().message;
     // Per level: position (to 1e-7) -> the normals every tile of that level gives it.
     std::map<std::pair<int, std::array<std::int64_t, 3>>, std::vector<Vec3f>> seen;
@@ -323,8 +321,7 @@ TEST(Tiles, GeoreferencedByOriginOrByCrs) {
   placed.input.chunkSize = 0.05;
   placed.octree.errorSamples = 1000;
   placed.origin = Geodetic{8.5417, 47.3769, 408};
-  stats = writeTiles(test::dataPath("meshes/horse.ply"),
-                     (dir / "origin").string(), placed);
+  stats = writeTiles(test::dataPath("meshes/horse.ply"), (dir / "origin").string(), placed);
   ASSERT_TRUE(stats.ok()) << stats.error().message;
   std::ifstream in2(dir / "origin" / "tileset.json");
   const nlohmann::json horse = nlohmann::json::parse(in2);
@@ -351,8 +348,7 @@ TEST(Tiles, RefusesToOverwriteADirectoryThatIsNotATileset) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "precious.txt") << "keep me";
-  Result<TilesStats> stats =
-      writeTiles(test::dataPath("meshes/horse.ply"), dir.string(), {});
+  Result<TilesStats> stats = writeTiles(test::dataPath("meshes/horse.ply"), dir.string(), {});
   ASSERT_FALSE(stats.ok());
   EXPECT_EQ(stats.error().kind, ErrorKind::kUsage);
   EXPECT_TRUE(fs::exists(dir / "precious.txt"));

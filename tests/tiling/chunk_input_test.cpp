@@ -11,8 +11,8 @@
 
 #include "lodforge/core/mesh.h"
 #include "lodforge/generate/cad.h"
-#include "lodforge/io/model_io.h"
 #include "lodforge/io/mesh/ply_writer.h"
+#include "lodforge/io/model_io.h"
 #include "test_support.h"
 
 namespace lodforge {

@@ -16,8 +16,8 @@
 #include "lodforge/core/distance.h"
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
-#include "lodforge/io/model_io.h"
 #include "lodforge/io/mesh/ply_writer.h"
+#include "lodforge/io/model_io.h"
 #include "lodforge/tiles/surface_input.h"
 #include "test_support.h"
 

@@ -12,8 +12,8 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/terrain.h"
-#include "lodforge/io/points/las_writer.h"
 #include "lodforge/io/mesh/ply_writer.h"
+#include "lodforge/io/points/las_writer.h"
 
 namespace lodforge {
 

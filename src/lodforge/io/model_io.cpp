@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/file.h"
-#include "lodforge/io/mesh/assimp_reader.h"
 #include "lodforge/io/format_advice.h"
+#include "lodforge/io/mesh/assimp_reader.h"
 #include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/io/mesh/gltf_reader.h"
 #include "lodforge/io/mesh/obj_reader.h"

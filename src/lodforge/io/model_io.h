@@ -13,7 +13,8 @@
 namespace lodforge {
 
 // kCad: STEP, IGES or BREP, read through OpenCASCADE (io/cad/cad_reader.h); kAssimp: OFF, FBX,
-// Collada, 3DS, IFC and the other scenes assimp reads (io/mesh/assimp_reader.h). Neither is written.
+// Collada, 3DS, IFC and the other scenes assimp reads (io/mesh/assimp_reader.h). Neither is
+// written.
 enum class FileFormat : std::uint8_t { kUnknown, kPly, kObj, kStl, kGltf, kGlb, kCad, kAssimp };
 
 FileFormat formatFromPath(const std::string& path);

@@ -9,8 +9,8 @@
 #include <optional>
 #include <vector>
 
-#include "lodforge/core/math.h"
 #include "lodforge/core/instances.h"
+#include "lodforge/core/math.h"
 #include "lodforge/io/mesh/object_stream.h"
 #include "lodforge/simplify/progressive.h"
 

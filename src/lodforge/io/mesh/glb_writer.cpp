@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
-#include "lodforge/core/progress.h"
 #include "lodforge/core/instances.h"
+#include "lodforge/core/progress.h"
 
 namespace lodforge {
 

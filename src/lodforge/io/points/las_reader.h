@@ -1,8 +1,8 @@
 // LAS reader (ASPRS LAS 1.0–1.4, point formats 0–10, uncompressed): the header, the variable
 // length records that carry the coordinate system (OGC WKT, or GeoTIFF keys naming an EPSG
 // code), and the points streamed in batches with scale and offset applied in double precision.
-// LAZ (LASzip-compressed, COPC included) is decoded as it is read (io/points/laz/laz_reader): the records
-// come out as the LAS file of the same points would hold them.
+// LAZ (LASzip-compressed, COPC included) is decoded as it is read (io/points/laz/laz_reader): the
+// records come out as the LAS file of the same points would hold them.
 #pragma once
 
 #include <cstdint>

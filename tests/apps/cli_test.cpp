@@ -999,7 +999,8 @@ TEST(CliServe, ServesATilesetWithTypesRangesAndCompression) {
   ASSERT_TRUE(r);
   std::smatch script;
   const std::string page = r->body;
-  ASSERT_TRUE(std::regex_search(page, script, std::regex(R"(src="(/assets/[^"]+\.js)")"))) << page;
+  const std::regex scriptSource(R"re(src="(/assets/[^"]+\.js)")re");
+  ASSERT_TRUE(std::regex_search(page, script, scriptSource)) << page;
   httplib::Client scripts("127.0.0.1", served.port());
   scripts.set_decompress(false);
   const auto first = scripts.Get(script[1].str(), {{"Accept-Encoding", "gzip, deflate, br"}});

@@ -401,6 +401,70 @@ Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
   return OutputFile::writeWhole(path, tileset.dump(1));
 }
 
+// The blocks of the partition, each ranked as the partition makes it, while its points are in
+// memory (no block files written and read back), as many at once as the memory plan allows.
+struct RankedPartition {
+  Partition partition;
+  std::vector<BlockTiles> blocks;  // in the partition's block order
+};
+
+Result<RankedPartition> partitionAndRank(const std::string& input, const PointTilesOptions& options,
+                                         const PointMemoryPlan& plan,
+                                         const std::optional<CrsToLocal>& frame, bool hasNormals,
+                                         const std::string& workDirectory) {
+  PartitionOptions partitionOptions;
+  partitionOptions.blockSize = options.blockSize;
+  partitionOptions.workDirectory = workDirectory;
+  partitionOptions.salvageTruncated = options.salvageTruncated;
+  partitionOptions.carryExtras = (options.attributes & kAttrExtras) != 0;
+  partitionOptions.memoryBytes = plan.partitionBytes;
+  if (frame)
+    partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) { return frame->apply(in, out); };
+  std::mutex ranked;
+  std::map<std::string, BlockTiles> byName;
+  partitionOptions.blockSink = [&](std::span<CloudPoint> points, std::span<std::uint32_t> ids,
+                                   PointBlock& block) {
+    BlockTiles tiles;
+    LODFORGE_TRY(rankBlock(points, ids, block, hasNormals, options, workDirectory, tiles));
+    std::lock_guard lock(ranked);
+    byName[block.name] = std::move(tiles);
+    return Status{};
+  };
+  tbb::task_arena arena(plan.threads);
+  Result<Partition> partition =
+      arena.execute([&] { return partitionPoints(input, partitionOptions); });
+  if (!partition) return partition.status();
+  RankedPartition out{std::move(*partition), {}};
+  for (const PointBlock& b : out.partition.blocks)
+    out.blocks.push_back(std::move(byName.at(b.name)));
+  return out;
+}
+
+// What the partition read into the stats: counts, attributes, warnings (one more when the tiles
+// carry more vertex attributes than WebGL viewers draw), the deepest block.
+void noteStats(const Partition& partition, const PointTilesOptions& options,
+               PointTilesStats& stats) {
+  stats.points = partition.pointCount;
+  stats.attributes = partition.info.attributes & options.attributes;
+  stats.warnings = partition.info.warnings;
+  if (const std::size_t count = vertexAttributeCount(partition.info, stats.attributes);
+      count > kViewerVertexAttributes)
+    stats.warnings.push_back(fmt::format(
+        "the tiles carry {} vertex attributes; WebGL viewers (CesiumJS, three.js) draw at most "
+        "{}: choose fewer with --attributes",
+        count, kViewerVertexAttributes));
+  stats.blocks = partition.blocks.size();
+  for (const PointBlock& b : partition.blocks) stats.depth = std::max(stats.depth, depthOf(b));
+}
+
+// Where the root sits on Earth: the local frame of the CRS, or --origin's; none without either.
+std::optional<Mat4d> rootTransformOf(const std::optional<CrsToLocal>& frame,
+                                     const PointTilesOptions& options) {
+  if (frame) return frame->localToEcef();
+  if (options.origin) return eastNorthUpToEcef(*options.origin);
+  return std::nullopt;
+}
+
 }  // namespace
 
 Result<PointTilesStats> writePointTiles(const std::string& input,
@@ -421,67 +485,26 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   bool hasNormals = false;
   Result<std::optional<CrsToLocal>> frame = localFrame(input, options, stats, hasNormals);
   if (!frame) return frame.status();
-  PartitionOptions partitionOptions;
-  partitionOptions.blockSize = options.blockSize;
-  partitionOptions.workDirectory = work.path;
-  partitionOptions.salvageTruncated = options.salvageTruncated;
-  partitionOptions.carryExtras = (options.attributes & kAttrExtras) != 0;
-  partitionOptions.memoryBytes = plan->partitionBytes;
-  if (frame->has_value())
-    partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) {
-      return (*frame)->apply(in, out);
-    };
-  // Blocks are ranked as the partition makes them, while their points are in memory (no block
-  // files written and read back), as many at once as the memory plan allows.
-  std::mutex ranked;
-  std::map<std::string, BlockTiles> byName;
-  partitionOptions.blockSink = [&](std::span<CloudPoint> points, std::span<std::uint32_t> ids,
-                                   PointBlock& block) {
-    BlockTiles tiles;
-    LODFORGE_TRY(rankBlock(points, ids, block, hasNormals, options, work.path, tiles));
-    std::lock_guard lock(ranked);
-    byName[block.name] = std::move(tiles);
-    return Status{};
-  };
-  tbb::task_arena arena(plan->threads);
-  Result<Partition> partition =
-      arena.execute([&] { return partitionPoints(input, partitionOptions); });
-  if (!partition) return partition.status();
-  stats.points = partition->pointCount;
-  stats.attributes = partition->info.attributes & options.attributes;
-  stats.warnings = partition->info.warnings;
-  if (const std::size_t count = vertexAttributeCount(partition->info, stats.attributes);
-      count > kViewerVertexAttributes)
-    stats.warnings.push_back(fmt::format(
-        "the tiles carry {} vertex attributes; WebGL viewers (CesiumJS, three.js) draw at most "
-        "{}: choose fewer with --attributes",
-        count, kViewerVertexAttributes));
-  stats.blocks = partition->blocks.size();
-  std::vector<BlockTiles> blocks;
-  for (const PointBlock& b : partition->blocks) {
-    stats.depth = std::max(stats.depth, depthOf(b));
-    blocks.push_back(std::move(byName.at(b.name)));
-  }
-  Result<std::vector<float>> taus = toleranceSchedule(*partition, blocks, options, stats.depth);
+  Result<RankedPartition> ranked =
+      partitionAndRank(input, options, *plan, *frame, hasNormals, work.path);
+  if (!ranked) return ranked.status();
+  const Partition& partition = ranked->partition;
+  std::vector<BlockTiles>& blocks = ranked->blocks;
+  noteStats(partition, options, stats);
+  Result<std::vector<float>> taus = toleranceSchedule(partition, blocks, options, stats.depth);
   if (!taus) return taus.status();
-  LODFORGE_TRY(countLevels(*partition, *taus, blocks));
+  LODFORGE_TRY(countLevels(partition, *taus, blocks));
 
-  std::map<std::string, TileNode> nodes = tileTree(*partition, blocks);
+  std::map<std::string, TileNode> nodes = tileTree(partition, blocks);
   Result<std::uint64_t> tiles =
       writeContents(nodes, blocks, options,
-                    {partition->info.hasColors, partition->info.attributes & options.attributes,
-                     &partition->info.extras, partition->extrasPath},
+                    {partition.info.hasColors, partition.info.attributes & options.attributes,
+                     &partition.info.extras, partition.extrasPath},
                     staging.path);
   if (!tiles) return tiles.status();
   stats.tiles = *tiles;
-  std::optional<Mat4d> rootTransform;
-  if (frame->has_value()) {
-    rootTransform = (*frame)->localToEcef();
-  } else if (options.origin) {
-    rootTransform = eastNorthUpToEcef(*options.origin);
-  }
-  LODFORGE_TRY(
-      writePointTilesetJson(nodes, blocks, *taus, rootTransform, staging.path + "/tileset.json"));
+  LODFORGE_TRY(writePointTilesetJson(nodes, blocks, *taus, rootTransformOf(*frame, options),
+                                     staging.path + "/tileset.json"));
   stats.outputBytes = directoryBytes(staging.path);
 
   // Complete: replace the previous tileset, if any, by the new one.

@@ -8,8 +8,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 name=${1:?usage: build.sh release|asan}
 jobs=${JOBS:-2}
-# Clean clones (CI) reuse the compiler cache: paths are hashed relative to the checkout. Three
-# trees' objects fit in 10 GB (ccache's default of 5 keeps evicting the first tree built).
+# Clean clones (CI) reuse the compiler cache: paths are hashed relative to the checkout. 10 GB
+# holds both trees' objects with room for earlier versions of them.
 export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=1 CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-10G}
 case $name in
   release) args=(-DCMAKE_BUILD_TYPE=Release) ;;

@@ -1,8 +1,8 @@
 // `lodforge serve DIR`: a tileset directory and the browser viewers over HTTP (cpp-httplib).
 // GET and HEAD only, content types for what tilesets and the viewers hold, Range requests and
-// gzip for text (both from cpp-httplib), an opt-in CORS header, loopback unless told otherwise,
-// one log line per request, a clean stop on Ctrl-C. Paths are resolved inside their root:
-// "..", absolute paths and symlinks that lead out are refused.
+// compression for text (cpp-httplib; JSON and scripts gzipped once here), an opt-in CORS header,
+// loopback unless told otherwise, one log line per request, a clean stop on Ctrl-C. Paths are
+// resolved inside their root: "..", absolute paths and symlinks that lead out are refused.
 #include <atomic>
 #include <chrono>
 #include <cstdio>

@@ -640,7 +640,7 @@ TEST(CliReconstruct, MakesASurfaceAndRefusesWhatCannotBeOne) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
   // tiles --surface: the reconstruction's chunks tiled as the leaves, its work folder gone
   // afterwards.
-  o = lodforge("tiles " + dir.file("p.ply") + " --surface -o " + dir.file("t") + " --chunk-size 30",
+  o = lodforge("tiles " + dir.file("p.ply") + " --surface -o " + dir.file("t") + " --chunk-size 150",
                dir);
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_NE(o.out.find("reconstructed"), std::string::npos) << o.out;
@@ -1398,24 +1398,24 @@ void expectResumesToTheSameTileset(const test::TempDir& dir, const std::string& 
 
 TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
   test::TempDir dir;
-  ASSERT_EQ(lodforge("-q generate scan --triangles 1M -o " + dir.file("scan.ply"), dir).code, 0);
+  ASSERT_EQ(lodforge("-q generate scan --triangles 200K -o " + dir.file("scan.ply"), dir).code, 0);
   expectResumesToTheSameTileset(dir, dir.file("scan.ply"), {});
 }
 
 // tiles --surface resumes like any tileset: the reconstructed chunks are kept.
 TEST(CliTiles, AnInterruptedSurfaceResumesToTheSameTileset) {
   test::TempDir dir;
-  ASSERT_EQ(lodforge("-q generate points --points 200K -o " + dir.file("p.ply"), dir).code, 0);
-  expectResumesToTheSameTileset(dir, dir.file("p.ply"), {"--surface", "--voxel", "2"});
+  ASSERT_EQ(lodforge("-q generate points --points 50K -o " + dir.file("p.ply"), dir).code, 0);
+  expectResumesToTheSameTileset(dir, dir.file("p.ply"), {"--surface", "--voxel", "4"});
 }
 
 // Stopped during the reconstruction itself, tiles --surface --resume takes the runs of chunks
 // it finished (and not the leaf chunk files the stopped run had begun: see the helper).
 TEST(CliTiles, AReconstructionStoppedHalfwayResumesToTheSameTileset) {
   test::TempDir dir;
-  ASSERT_EQ(lodforge("-q generate points --points 300K -o " + dir.file("p.ply"), dir).code, 0);
+  ASSERT_EQ(lodforge("-q generate points --points 100K -o " + dir.file("p.ply"), dir).code, 0);
   expectResumesToTheSameTileset(dir, dir.file("p.ply"),
-                                {"--surface", "--voxel", "2", "--chunk-size", "24"}, "run:1",
+                                {"--surface", "--voxel", "6", "--chunk-size", "72"}, "run:1",
                                 " resumed)");
 }
 
@@ -1423,7 +1423,7 @@ TEST(CliTiles, AReconstructionStoppedHalfwayResumesToTheSameTileset) {
 // the finished runs and writes the bytes of an unbroken run, leaving nothing else behind.
 TEST(CliReconstruct, AnInterruptedReconstructionResumesToTheSameMesh) {
   test::TempDir dir;
-  ASSERT_EQ(lodforge("-q generate points --points 300K -o " + dir.file("p.ply"), dir).code, 0);
+  ASSERT_EQ(lodforge("-q generate points --points 50K -o " + dir.file("p.ply"), dir).code, 0);
   const std::vector<std::string> args = {"-q",
                                          "--threads",
                                          "1",
@@ -1434,7 +1434,7 @@ TEST(CliReconstruct, AnInterruptedReconstructionResumesToTheSameMesh) {
                                          "-o",
                                          dir.file("b.ply"),
                                          "--voxel",
-                                         "1"};
+                                         "4"};
   std::string whole;
   for (const std::string& a : args) whole += (a == dir.file("b.ply") ? dir.file("a.ply") : a) + " ";
   ASSERT_EQ(lodforge(whole, dir).code, 0);

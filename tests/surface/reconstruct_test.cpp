@@ -308,11 +308,11 @@ class StoppingSink : public PieceSink {
 // options start over.
 TEST(Reconstruct, AnInterruptedReconstructionResumesToTheSameMesh) {
   test::TempDir dir;
-  const std::string cloud = writeCloud(dir, "cloud.ply", terrainSamples(30'000, 150), false, true);
+  const std::string cloud = writeCloud(dir, "cloud.ply", terrainSamples(12'000, 95), false, true);
   ReconstructOptions options;
   options.voxel = 1.1;
   options.chunkVoxels = 9;
-  options.runPoints = 2'000;
+  options.runPoints = 800;
   options.normals.orientation = NormalOrientation::kUp;
   options.resumable = true;
   const auto reconstruct = [&](const std::string& work, MemoryMeshOutput& out, std::size_t stopAt) {
@@ -400,14 +400,14 @@ TEST(Reconstruct, TheSameMeshForAnyThreadCount) {
 // runs still join without a crack and stay on the surface.
 TEST(Reconstruct, NormalsEstimatedRunByRunJoinWithoutACrack) {
   test::TempDir dir;
-  const Sampled s = terrainSamples(30'000, 150);
+  const Sampled s = terrainSamples(12'000, 95);
   const std::string cloud = writeCloud(dir, "cloud.ply", s, false);
   ReconstructOptions options;
   options.voxel = 1.1;
   options.chunkVoxels = 9;
   options.normals.orientation = NormalOrientation::kUp;
   ASSERT_TRUE(reconstructToFile(cloud, dir.file("one.ply"), options).ok());
-  options.runPoints = 2'000;
+  options.runPoints = 800;
   Result<ReconstructStats> many = reconstructToFile(cloud, dir.file("many.ply"), options);
   ASSERT_TRUE(many.ok()) << many.error().message;
   EXPECT_TRUE(many->estimatedNormals);

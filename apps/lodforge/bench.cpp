@@ -71,10 +71,6 @@ struct BudgetRun {
   std::vector<FrameTimes> frames;
 };
 
-double milliseconds(std::chrono::steady_clock::duration d) {
-  return std::chrono::duration<double, std::milli>(d).count();
-}
-
 // One frame: select, then stream.
 Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const Camera& camera,
                             std::uint64_t budget, Selection& selection, StreamBuffer* buffer,

@@ -104,6 +104,10 @@ Status runGuarded(const Run& run) {
   }
 }
 
+double milliseconds(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration<double, std::milli>(d).count();
+}
+
 void say(const Global& global, const std::string& text) {
   if (global.verbosity >= 0) fmt::print("{}\n", text);
 }

@@ -2,6 +2,7 @@
 // subcommand reports its outcome (a Status that main turns into an exit code).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -40,6 +41,9 @@ Status checkMemoryLimit(const CLI::App& app, const CLI::Option& option, std::uin
 Status refusePointCloud(const std::string& input, std::string_view command);
 // Runs a subcommand; an exception that still escapes becomes an error (exit 1), never an abort.
 Status runGuarded(const Run& run);
+
+// A steady-clock duration in milliseconds, for the timings the commands print.
+double milliseconds(std::chrono::steady_clock::duration d);
 
 // Normal output (suppressed by -q) and verbose output (shown with -v).
 void say(const Global& global, const std::string& text);

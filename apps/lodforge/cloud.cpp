@@ -29,10 +29,6 @@ namespace lodforge::cli {
 
 namespace {
 
-double milliseconds(std::chrono::steady_clock::duration d) {
-  return std::chrono::duration<double, std::milli>(d).count();
-}
-
 // The gaze along a benchmark path: a circle around the screen's centre, one turn per 40 frames,
 // so the fovea sweeps over blocks and the pager works.
 void benchGaze(FoveaOptions& fovea, const Camera& camera, std::size_t frame) {

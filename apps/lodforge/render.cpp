@@ -38,10 +38,6 @@ struct RenderOptions : PathChoice {
   RenderOptions() { frames = 8; }
 };
 
-double milliseconds(std::chrono::steady_clock::duration d) {
-  return std::chrono::duration<double, std::milli>(d).count();
-}
-
 // The counts of the reference: every object at full detail.
 void fullDetail(const Package& package, Selection& selection) {
   const std::size_t n = package.objectCount();

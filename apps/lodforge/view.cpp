@@ -77,10 +77,6 @@ struct FrameFigures {
   std::uint64_t vertices = 0, triangles = 0, objects = 0;
 };
 
-double milliseconds(std::chrono::steady_clock::duration d) {
-  return std::chrono::duration<double, std::milli>(d).count();
-}
-
 // What the panel, the keys and the mouse change from frame to frame.
 struct ViewControls {
   std::uint64_t budget = 0;  // N, vertices

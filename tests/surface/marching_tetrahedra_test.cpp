@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "lodforge/core/mesh.h"
+
 namespace lodforge {
 namespace {
 
@@ -23,20 +25,6 @@ CornerValues sphereValues(const VoxelGrid& grid, std::array<std::uint64_t, 3> fi
   return v;
 }
 
-// Edges used by exactly one triangle (by vertex index).
-std::size_t boundaryEdges(const std::vector<std::uint32_t>& indices) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
-  for (std::size_t t = 0; t < indices.size(); t += 3)
-    for (int e = 0; e < 3; ++e) {
-      const std::uint32_t a = indices[t + static_cast<std::size_t>(e)],
-                          b = indices[t + static_cast<std::size_t>((e + 1) % 3)];
-      ++uses[{std::min(a, b), std::max(a, b)}];
-    }
-  std::size_t once = 0;
-  for (const auto& [edge, n] : uses) once += n == 1 ? 1 : 0;
-  return once;
-}
-
 // A sphere comes out closed, on the sphere to within the interpolation's error, every
 // triangle facing out.
 TEST(MarchingTetrahedra, ASphereIsClosedAndFacesOut) {
@@ -45,7 +33,7 @@ TEST(MarchingTetrahedra, ASphereIsClosedAndFacesOut) {
   const SurfacePiece piece =
       polygonize(grid, sphereValues(grid, {0, 0, 0}, {21, 21, 21}, centre, 0.7));
   ASSERT_GT(piece.indices.size(), 300u);
-  EXPECT_EQ(boundaryEdges(piece.indices), 0u);
+  EXPECT_EQ(countBoundaryEdges(piece.indices), 0u);
   for (const Vec3d& p : piece.positions) EXPECT_NEAR(length(p - centre), 0.7, 0.01);
   for (std::size_t t = 0; t < piece.indices.size(); t += 3) {
     const Vec3d a = piece.positions[piece.indices[t]], b = piece.positions[piece.indices[t + 1]],
@@ -80,7 +68,7 @@ TEST(MarchingTetrahedra, BoxesSharingAFaceShareItsVerticesBitForBit) {
     for (std::uint32_t i : piece->indices)
       joined.push_back(index.try_emplace(piece->edges[i], static_cast<std::uint32_t>(index.size()))
                            .first->second);
-  EXPECT_EQ(boundaryEdges(joined), 0u);
+  EXPECT_EQ(countBoundaryEdges(joined), 0u);
   const SurfacePiece whole =
       polygonize(grid, sphereValues(grid, {0, 0, 0}, {21, 21, 21}, centre, 0.66));
   EXPECT_EQ(joined.size(), whole.indices.size());
@@ -101,7 +89,7 @@ TEST(MarchingTetrahedra, UnknownCornersLeaveTheirCellsEmpty) {
     EXPECT_LE(p.x, 3.0);
     EXPECT_DOUBLE_EQ(p.z, 2.5);
   }
-  EXPECT_GT(boundaryEdges(piece.indices), 0u);
+  EXPECT_GT(countBoundaryEdges(piece.indices), 0u);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <tbb/task_arena.h>
 
 #include "lodforge/core/distance.h"
+#include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/terrain.h"
 #include "lodforge/io/mesh/ply_reader.h"
@@ -21,18 +22,6 @@
 
 namespace lodforge {
 namespace {
-
-std::size_t boundaryEdges(const std::vector<std::uint32_t>& indices) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
-  for (std::size_t t = 0; t < indices.size(); t += 3)
-    for (std::size_t e = 0; e < 3; ++e) {
-      const std::uint32_t a = indices[t + e], b = indices[t + (e + 1) % 3];
-      ++uses[{std::min(a, b), std::max(a, b)}];
-    }
-  std::size_t once = 0;
-  for (const auto& [edge, n] : uses) once += n == 1 ? 1 : 0;
-  return once;
-}
 
 std::vector<Vec3f> floats(const std::vector<Vec3d>& positions) {
   std::vector<Vec3f> out(positions.size());
@@ -167,7 +156,7 @@ TEST(Reconstruct, AClosedObjectWithoutNormalsComesBackClosedFacingOut) {
   Result<ReconstructedMesh> mesh = reconstructPoints(points, {}, {}, "sphere", options);
   ASSERT_TRUE(mesh.ok()) << mesh.error().message;
   ASSERT_GT(mesh->chunks, 1u);
-  EXPECT_EQ(boundaryEdges(mesh->indices), 0u);
+  EXPECT_EQ(countBoundaryEdges(mesh->indices), 0u);
   std::size_t outward = 0;
   for (std::size_t t = 0; t < mesh->indices.size(); t += 3) {
     const Vec3d a = mesh->positions[mesh->indices[t]], b = mesh->positions[mesh->indices[t + 1]],
@@ -194,7 +183,7 @@ TEST(Reconstruct, ManyChunksJoinWithoutACrack) {
       reconstructPoints(s.points, s.normals, {}, "t", options, &many);
   ASSERT_TRUE(chunked.ok());
   EXPECT_GT(chunked->chunks, 100u);
-  EXPECT_LE(boundaryEdges(chunked->indices), boundaryEdges(whole->indices));
+  EXPECT_LE(countBoundaryEdges(chunked->indices), countBoundaryEdges(whole->indices));
   EXPECT_EQ(chunked->indices.size(), whole->indices.size());
   EXPECT_EQ(chunked->positions.size(), whole->positions.size());
   std::map<std::uint64_t, Vec3d> first;
@@ -414,7 +403,7 @@ TEST(Reconstruct, NormalsEstimatedRunByRunJoinWithoutACrack) {
   EXPECT_GT(many->runs, 20u);
   Result<Model> a = readPly(dir.file("one.ply")), b = readPly(dir.file("many.ply"));
   ASSERT_TRUE(a.ok() && b.ok());
-  EXPECT_LE(boundaryEdges(b->indices), boundaryEdges(a->indices));
+  EXPECT_LE(countBoundaryEdges(b->indices), countBoundaryEdges(a->indices));
   EXPECT_NEAR(static_cast<double>(b->triangleCount()), static_cast<double>(a->triangleCount()),
               0.001 * static_cast<double>(a->triangleCount()));
   // Chunks denser than a run: their normals in parts, their distances streamed.
@@ -424,7 +413,7 @@ TEST(Reconstruct, NormalsEstimatedRunByRunJoinWithoutACrack) {
   EXPECT_GT(dense->streamedChunks, dense->runs / 2);
   Result<Model> c = readPly(dir.file("dense.ply"));
   ASSERT_TRUE(c.ok());
-  EXPECT_LE(boundaryEdges(c->indices), boundaryEdges(a->indices));
+  EXPECT_LE(countBoundaryEdges(c->indices), countBoundaryEdges(a->indices));
   EXPECT_NEAR(static_cast<double>(c->triangleCount()), static_cast<double>(a->triangleCount()),
               0.001 * static_cast<double>(a->triangleCount()));
 }

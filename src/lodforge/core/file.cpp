@@ -454,6 +454,10 @@ Result<std::vector<std::byte>> readFileBytes(const std::string& path) {
   return bytes;
 }
 
+std::string fileStem(const std::string& path) {
+  return std::filesystem::path(path).stem().string();
+}
+
 std::string fileExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   if (!ext.empty()) ext.erase(0, 1);

@@ -151,6 +151,8 @@ Result<std::vector<std::byte>> readFileBytes(const std::string& path);
 Result<std::uint64_t> fileSize(const std::string& path);
 // Lower-cased extension without the dot ("glb", "ply"); empty when there is none.
 std::string fileExtension(const std::string& path);
+// The file name without folder and extension ("scan" for "data/scan.ply").
+std::string fileStem(const std::string& path);
 // A temporary name beside `path` that no file holds now ("<path>.tmp-<pid>-<n>"), for the
 // rename-on-complete pattern.
 std::string temporaryPathFor(const std::string& path);

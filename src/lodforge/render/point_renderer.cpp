@@ -12,7 +12,7 @@ namespace lodforge {
 
 namespace {
 
-constexpr const char* kVertexShader = R"(#version 450 core
+constexpr const char* kPointVertexShader = R"(#version 450 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec4 color;
@@ -34,7 +34,7 @@ void main() {
 }
 )";
 
-constexpr const char* kFragmentShader = R"(#version 450 core
+constexpr const char* kPointFragmentShader = R"(#version 450 core
 in vec3 shade;
 out vec4 fragment;
 void main() {
@@ -68,8 +68,8 @@ PointRenderer::~PointRenderer() = default;
 
 Result<PointRenderer> PointRenderer::create() {
   auto state = std::make_unique<State>();
-  Result<Program> program =
-      Program::link({{GL_VERTEX_SHADER, kVertexShader}, {GL_FRAGMENT_SHADER, kFragmentShader}});
+  Result<Program> program = Program::link(
+      {{GL_VERTEX_SHADER, kPointVertexShader}, {GL_FRAGMENT_SHADER, kPointFragmentShader}});
   if (!program) return program.status();
   state->program = std::move(*program);
   glCreateVertexArrays(1, &state->vertexArray);

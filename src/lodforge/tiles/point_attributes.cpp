@@ -12,12 +12,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodforge/io/mesh/gltf_constants.h"
+
 namespace lodforge {
 
 namespace {
 
-constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123,
-              kFloat = 5126;
+using namespace gltf;  // the component types
 
 using Field = PointAttributeField;
 

@@ -7,10 +7,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lodforge/io/mesh/gltf_constants.h"
+
 namespace lodforge {
 namespace {
 
-constexpr int kUnsignedShort = 5123, kFloat = 5126;
+using namespace gltf;  // the component types
 
 // A STRING property's two views (EXT_structural_metadata): the UTF-8 bytes back to back and
 // UINT32 offsets, one per row plus the end. Null when every string is empty (a buffer view may

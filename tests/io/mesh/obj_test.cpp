@@ -8,7 +8,7 @@
 namespace lodforge {
 namespace {
 
-Result<Model> readText(const std::string& text) {
+Result<Model> readObjText(const std::string& text) {
   return readObjFromMemory(test::bytesOf(text), "test.obj");
 }
 
@@ -28,7 +28,7 @@ TEST(ObjRead, ObjectsAndGroupsBecomeObjects) {
       "o first\nf 1 2 3\nf 1 3 4\n"
       "g second\nf 1 2 5\n"
       "o third\nf -5 -4 -1\n";  // relative indices
-  Result<Model> model = readText(text);
+  Result<Model> model = readObjText(text);
   ASSERT_TRUE(model.ok()) << model.error().message;
   ASSERT_EQ(model->objectCount(), 3u);
   EXPECT_EQ(model->objectName(0), "first");
@@ -42,7 +42,7 @@ TEST(ObjRead, ObjectsAndGroupsBecomeObjects) {
 }
 
 TEST(ObjRead, PolygonsAreFanTriangulatedKeepingWinding) {
-  Result<Model> model = readText("v 0 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 0 2 0\nf 1 2 3 4 5\n");
+  Result<Model> model = readObjText("v 0 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 0 2 0\nf 1 2 3 4 5\n");
   ASSERT_TRUE(model.ok()) << model.error().message;
   EXPECT_EQ(model->triangleCount(), 3u);
   for (std::size_t t = 0; t < 3; ++t) {
@@ -58,7 +58,7 @@ TEST(ObjRead, NormalsColoursAndAttributeSplits) {
       "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nv 1 1 0 1 1 1\n"
       "vn 0 0 1\nvn 0 0 -1\n"
       "f 1//1 2//1 3//1\nf 2//2 4//2 3//2\n";
-  Result<Model> model = readText(text);
+  Result<Model> model = readObjText(text);
   ASSERT_TRUE(model.ok()) << model.error().message;
   EXPECT_EQ(model->vertexCount(), 6u);
   ASSERT_TRUE(model->hasNormals());
@@ -70,7 +70,7 @@ TEST(ObjRead, NormalsColoursAndAttributeSplits) {
 }
 
 TEST(ObjRead, MissingNormalsInAnObjectAreComputed) {
-  Result<Model> model = readText("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 1 0 0\nf 1//1 2 3\n");
+  Result<Model> model = readObjText("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 1 0 0\nf 1//1 2 3\n");
   ASSERT_TRUE(model.ok()) << model.error().message;
   ASSERT_TRUE(model->hasNormals());
   for (const Vec3f& n : model->normals) EXPECT_EQ(n, (Vec3f{0, 0, 1}));
@@ -113,7 +113,7 @@ TEST(ObjRoundTrip, WriterOutputReadsBack) {
 
 TEST(ObjRead, VerticesWithoutFacesAreOneObjectOfAllOfThem) {
   // As a PLY without faces reads: one object named after the file, no triangles.
-  Result<Model> model = readText("# points\nv 0 0 0\nv 1.5 2 3\nv -1 0 4\n");
+  Result<Model> model = readObjText("# points\nv 0 0 0\nv 1.5 2 3\nv -1 0 4\n");
   ASSERT_TRUE(model.ok()) << model.error().message;
   EXPECT_EQ(model->vertexCount(), 3u);
   EXPECT_EQ(model->triangleCount(), 0u);
@@ -124,16 +124,16 @@ TEST(ObjRead, VerticesWithoutFacesAreOneObjectOfAllOfThem) {
   EXPECT_FALSE(model->hasColors());
   EXPECT_TRUE(isConsistent(*model));
   // Vertex colours are kept.
-  Result<Model> colored = readText("v 0 0 0 1 0 0\nv 1 0 0 0 0 1\n");
+  Result<Model> colored = readObjText("v 0 0 0 1 0 0\nv 1 0 0 0 0 1\n");
   ASSERT_TRUE(colored.ok()) << colored.error().message;
   ASSERT_TRUE(colored->hasColors());
   EXPECT_EQ(colored->colors[1], (Rgba8{0, 0, 255, 255}));
   // Far from the origin: positions are kept relative to the model's origin.
-  Result<Model> far = readText("v 500000 4000000 10\nv 500001 4000000 10\n");
+  Result<Model> far = readObjText("v 500000 4000000 10\nv 500001 4000000 10\n");
   ASSERT_TRUE(far.ok()) << far.error().message;
   EXPECT_EQ(far->origin + toDouble(far->positions[1]), (Vec3d{500001, 4000000, 10}));
   // An empty file has no objects.
-  Result<Model> empty = readText("# nothing\n");
+  Result<Model> empty = readObjText("# nothing\n");
   ASSERT_TRUE(empty.ok());
   EXPECT_EQ(empty->objectCount(), 0u);
 }
@@ -154,7 +154,7 @@ TEST(ObjBadInput, AVertexFileCutAnywhereReadsItsWholeLinesOrNamesTheCutLine) {
       complete += words == 4;
       start = end + 1;
     }
-    Result<Model> model = readText(cut);
+    Result<Model> model = readObjText(cut);
     if (lines > complete) {  // the last line lacks a coordinate
       ASSERT_FALSE(model.ok()) << "cut at " << size;
       EXPECT_EQ(model.error().kind, ErrorKind::kBadInput);
@@ -188,7 +188,7 @@ TEST(ObjBadInput, ErrorsNameTheLine) {
              "test.obj:4: face refers to normal 4"},
         Case{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -7\n", "test.obj:4: face refers to vertex -3"},
         Case{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "line 4"}}) {
-    Result<Model> model = readText(c.text);
+    Result<Model> model = readObjText(c.text);
     ASSERT_FALSE(model.ok()) << c.text;
     EXPECT_EQ(model.error().kind, ErrorKind::kBadInput);
     EXPECT_NE(model.error().message.find(c.expected), std::string::npos) << model.error().message;

@@ -126,7 +126,7 @@ std::string encodePly(const PlySpec& spec) {
   return out;
 }
 
-Result<Model> readText(const std::string& text, const std::string& name = "test.ply") {
+Result<Model> readPlyText(const std::string& text, const std::string& name = "test.ply") {
   return readPlyFromMemory(test::bytesOf(text), name);
 }
 
@@ -164,7 +164,7 @@ TEST(PlyRead, EveryFormatAndScalarTypeGivesTheSameMesh) {
         const PlySpec spec =
             gridSpec(format, coordinate,
                      index == PlyType::kUint8 ? PlyType::kInt32 : PlyType::kUint8, index);
-        Result<Model> model = readText(encodePly(spec));
+        Result<Model> model = readPlyText(encodePly(spec));
         ASSERT_TRUE(model.ok()) << model.error().message << " format " << plyFormatName(format)
                                 << " type " << plyTypeName(coordinate);
         ASSERT_EQ(model->vertexCount(), 16u);
@@ -216,7 +216,7 @@ TEST(PlyRead, AnyPropertyOrderExtraPropertiesAndElementsAreSkipped) {
       encodeValue(text, format, PlyType::kFloat32, 0.25);
       if (format == PlyFormat::kAscii) text += "\n";
     }
-    Result<Model> model = readText(text);
+    Result<Model> model = readPlyText(text);
     ASSERT_TRUE(model.ok()) << model.error().message;
     ASSERT_EQ(model->vertexCount(), 3u);
     EXPECT_EQ(model->positions[1], (Vec3f{4, 5, 6}));
@@ -302,7 +302,7 @@ TEST(PlyRead, ColoursFromEveryChannelType) {
     PlySpec spec;
     spec.vertexProps = {{"x"}, {"y"}, {"z"}, {"red", c.type}, {"green", c.type}, {"blue", c.type}};
     spec.vertices = {{0, 0, 0, c.value, c.value, 0}};
-    Result<Model> model = readText(encodePly(spec));
+    Result<Model> model = readPlyText(encodePly(spec));
     ASSERT_TRUE(model.ok()) << model.error().message;
     ASSERT_TRUE(model->hasColors());
     EXPECT_EQ(model->colors[0], (Rgba8{c.expected, c.expected, 0, 255})) << plyTypeName(c.type);
@@ -315,7 +315,7 @@ TEST(PlyRead, ObjectIdsSplitFacesIntoSelfContainedObjects) {
   spec.faceProps.push_back({"object_id", PlyType::kUint32});
   // Quads alternate between objects 7 and 3: vertices on shared edges appear in both.
   for (std::size_t f = 0; f < spec.faces.size(); ++f) spec.faces[f].push_back({f % 2 ? 3.0 : 7.0});
-  Result<Model> model = readText(encodePly(spec));
+  Result<Model> model = readPlyText(encodePly(spec));
   ASSERT_TRUE(model.ok()) << model.error().message;
   ASSERT_EQ(model->objectCount(), 2u);
   EXPECT_EQ(model->objectName(0), "object 3");
@@ -538,7 +538,7 @@ std::multiset<std::array<std::uint32_t, 3>> orientedTriangles(
 }
 
 TEST(PlyStrips, ReadAsTheTrianglesOfTheSameMeshAsFacesFacingTheSameWay) {
-  Result<Model> faces = readText(encodePly(
+  Result<Model> faces = readPlyText(encodePly(
       gridSpec(PlyFormat::kAscii, PlyType::kFloat32, PlyType::kUint8, PlyType::kInt32, 4)));
   ASSERT_TRUE(faces.ok()) << faces.error().message;
   ASSERT_EQ(faces->triangleCount(), 32u);
@@ -551,7 +551,7 @@ TEST(PlyStrips, ReadAsTheTrianglesOfTheSameMeshAsFacesFacingTheSameWay) {
     for (const auto& [countType, indexType] : listTypes) {
       const std::string what = fmt::format("{}, list {} {}", plyFormatName(format),
                                            plyTypeName(countType), plyTypeName(indexType));
-      Result<Model> strips = readText(encodePly(stripSpec(format, countType, indexType)));
+      Result<Model> strips = readPlyText(encodePly(stripSpec(format, countType, indexType)));
       ASSERT_TRUE(strips.ok()) << strips.error().message << " (" << what << ")";
       EXPECT_EQ(strips->objectCount(), 1u) << what;
       EXPECT_EQ(strips->positions, faces->positions) << what;
@@ -570,7 +570,7 @@ TEST(PlyStrips, ReadAsTheTrianglesOfTheSameMeshAsFacesFacingTheSameWay) {
 TEST(PlyStrips, HeaderCountsTheirTrianglesAndBatchesStreamThem) {
   const std::string text =
       encodePly(stripSpec(PlyFormat::kBinaryBigEndian, PlyType::kUint8, PlyType::kInt32));
-  Result<Model> whole = readText(text);
+  Result<Model> whole = readPlyText(text);
   ASSERT_TRUE(whole.ok()) << whole.error().message;
   // Every reader's header counts them, also one for vertices only (a tileset's first pass): a
   // strip file is a mesh, not a point cloud.
@@ -621,7 +621,7 @@ TEST(PlyStrips, ACutStripIsRefusedOrSalvagedUpToItsLastWholeTriangle) {
     const std::string cut = format == PlyFormat::kAscii
                                 ? whole.substr(0, whole.rfind("16 22 17 23 18 24 19 \n"))
                                 : whole.substr(0, whole.size() - 4 * 7 + 2);
-    Result<Model> strict = readText(cut, "cut.ply");
+    Result<Model> strict = readPlyText(cut, "cut.ply");
     ASSERT_FALSE(strict.ok());
     EXPECT_EQ(strict.error().kind, ErrorKind::kBadInput);
     EXPECT_NE(strict.error().message.find("tristrips 1"), std::string::npos)
@@ -633,7 +633,7 @@ TEST(PlyStrips, ACutStripIsRefusedOrSalvagedUpToItsLastWholeTriangle) {
     Result<Model> salvaged = readPlyFromMemory(test::bytesOf(cut), "cut.ply", options);
     ASSERT_TRUE(salvaged.ok()) << salvaged.error().message;
     ASSERT_EQ(salvaged->triangleCount(), 25u) << plyFormatName(format);
-    Result<Model> full = readText(whole);
+    Result<Model> full = readPlyText(whole);
     ASSERT_TRUE(full.ok());
     EXPECT_TRUE(
         std::equal(salvaged->indices.begin(), salvaged->indices.end(), full->indices.begin()));
@@ -653,14 +653,14 @@ TEST(PlyStrips, ReadBesideFacesAndOtherPropertiesButNotBesideObjectIds) {
   Result<PlyReader> reader = PlyReader::fromMemory(test::bytesOf(text), "both.ply");
   ASSERT_TRUE(reader.ok()) << reader.error().message;
   EXPECT_EQ(reader->header().faceCount, 3u);  // 1 face and 2 strip triangles
-  Result<Model> model = readText(text);
+  Result<Model> model = readPlyText(text);
   ASSERT_TRUE(model.ok()) << model.error().message;
   EXPECT_EQ(model->indices, (std::vector<std::uint32_t>{0, 1, 2, 1, 3, 0, 0, 3, 2}));
 
   // Strips carry no object id: beside faces that do, their triangles would have no object.
   const std::string ids = fmt::format(fmt::runtime(header), "property int object_id\n") +
                           "3 0 1 2 7\n7 4 1 3 0 2 0.5\n1 0 0.25\n";
-  model = readText(ids);
+  model = readPlyText(ids);
   ASSERT_FALSE(model.ok());
   EXPECT_EQ(model.error().kind, ErrorKind::kUnsupported);
   EXPECT_NE(model.error().message.find("object ids and 'tristrips'"), std::string::npos)
@@ -791,7 +791,7 @@ TEST(PlyBadInput, EveryMalformationIsABadInputErrorWithAPosition) {
        "tristrips vertex indices must have an integer type"},
   };
   for (const BadCase& c : cases) {
-    Result<Model> model = readText(c.text, "bad.ply");
+    Result<Model> model = readPlyText(c.text, "bad.ply");
     ASSERT_FALSE(model.ok()) << c.name;
     EXPECT_EQ(model.error().kind, ErrorKind::kBadInput) << c.name;
     EXPECT_NE(model.error().message.find(c.expected), std::string::npos)
@@ -805,7 +805,7 @@ TEST(PlyBadInput, ByteOffsetsPointAtTheProblem) {
   const std::string header = binaryHeader(2, 0);
   const std::string text =
       header + floats({0, 0, 0, 1, std::numeric_limits<float>::quiet_NaN(), 0});
-  Result<Model> model = readText(text, "nan.ply");
+  Result<Model> model = readPlyText(text, "nan.ply");
   ASSERT_FALSE(model.ok());
   // The second vertex starts 12 bytes after the header.
   EXPECT_NE(model.error().message.find(fmt::format("byte {}", header.size() + 12)),

@@ -12,14 +12,12 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/instances.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/io/mesh/gltf_constants.h"
 
 namespace lodforge {
 
 namespace {
-constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
-constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123,
-              kUnsignedInt = 5125, kFloat = 5126;
-constexpr std::uint32_t kGlbMagic = 0x46546C67, kChunkJson = 0x4E4F534A, kChunkBin = 0x004E4942;
+using namespace gltf;  // the component types, buffer targets and chunk magics
 constexpr const char* kGenerator = "lodforge " LODFORGE_VERSION;
 std::size_t elementBytes(int componentType, std::string_view type) {
   const std::size_t component = componentType == kByte || componentType == kUnsignedByte     ? 1

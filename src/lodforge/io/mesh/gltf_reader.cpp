@@ -13,17 +13,14 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
+#include "lodforge/io/mesh/gltf_constants.h"
 
 namespace lodforge {
 
 namespace {
 
 constexpr int kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
-constexpr int kByte = 5120, kUnsignedByte = 5121, kShort = 5122, kUnsignedShort = 5123,
-              kUnsignedInt = 5125, kFloat = 5126;
-constexpr std::uint32_t kGlbMagic = 0x46546C67;  // "glTF"
-constexpr std::uint32_t kChunkJson = 0x4E4F534A;
-constexpr std::uint32_t kChunkBin = 0x004E4942;
+using namespace gltf;  // the component types and chunk magics
 // Debian's tinygltf (2.8) sizes the BIN chunk as everything after the JSON chunk, its 8-byte
 // header included, so it copies a buffer up to 8 bytes longer than the chunk from past the end
 // of the file. GLB is parsed from a copy with that many zero bytes after the end, and the

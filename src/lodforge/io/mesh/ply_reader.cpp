@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/mesh/ply_objects.h"
 #include "lodforge/io/mesh/ply_records.h"
@@ -157,10 +158,6 @@ Result<bool> PlyReader::next(PlyBatch& batch) {
 
 namespace {
 
-std::string stemOf(const std::string& name) {
-  return std::filesystem::path(name).stem().string();
-}
-
 Result<Model> readAll(PlyReader& reader, const std::string& name,
                       std::vector<std::string>* warnings) {
   const PlyHeader& header = reader.header();
@@ -227,7 +224,7 @@ Result<Model> readAll(PlyReader& reader, const std::string& name,
     return model;
   }
   ModelBuilder builder(model);
-  builder.beginObject(stemOf(name));
+  builder.beginObject(fileStem(name));
   model.positions = std::move(positions);
   model.normals = std::move(normals);
   model.colors = std::move(colors);

@@ -2,7 +2,6 @@
 
 #include <charconv>
 #include <cstring>
-#include <filesystem>
 #include <vector>
 
 #include "lodforge/core/file.h"
@@ -26,10 +25,6 @@ void appendWelded(Model& model, ModelBuilder& builder, std::string_view name,
   remapVertexAttribute<Vec3f>(soup, remap, std::span(model.positions).subspan(base));
   model.indices.insert(model.indices.end(), remap.begin(), remap.end());
   builder.endObject();
-}
-
-std::string stemOf(const std::string& name) {
-  return std::filesystem::path(name).stem().string();
 }
 
 Model readBinary(ByteSource& source) {
@@ -58,7 +53,7 @@ Model readBinary(ByteSource& source) {
   }
   Model model;
   ModelBuilder builder(model);
-  appendWelded(model, builder, stemOf(source.name()), soup);
+  appendWelded(model, builder, fileStem(source.name()), soup);
   return model;
 }
 
@@ -75,7 +70,7 @@ class AsciiStl {
       if (keyword.empty()) break;
       if (keyword != "solid") fail(fmt::format("expected 'solid', found '{}'", clip(keyword)));
       std::string name = restOfLine();
-      if (name.empty()) name = stemOf(source_.name());
+      if (name.empty()) name = fileStem(source_.name());
       soup.clear();
       readFacets(soup);
       appendWelded(model, builder, name, soup);

@@ -5,6 +5,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/io/points/las_format.h"
 #include "lodforge/io/points/las_reader.h"
 #include "lodforge/io/points/record_field.h"
 
@@ -12,7 +13,7 @@ namespace lodforge {
 
 namespace {
 
-constexpr std::size_t kVlrHeader = 54, kEvlrHeader = 60;
+using las::kEvlrHeader, las::kVlrHeader;
 
 // Records of compressed layouts: LASzip's, and COPC's info and hierarchy.
 bool describesCompression(const std::byte* recordHeader) {

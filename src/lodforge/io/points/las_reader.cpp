@@ -5,6 +5,7 @@
 #include <cstring>
 #include <optional>
 
+#include "lodforge/io/points/las_format.h"
 #include "lodforge/io/points/laz/laz_reader.h"
 #include "lodforge/io/points/record_field.h"
 
@@ -15,7 +16,7 @@ namespace {
 // Public header block: where each field sits (LAS 1.4 R15, Table 3; earlier versions are
 // prefixes of it).
 constexpr std::size_t kHeader12 = 227, kHeader13 = 235, kHeader14 = 375;
-constexpr std::size_t kVlrHeader = 54, kEvlrHeader = 60;
+using las::kEvlrHeader, las::kVlrHeader;
 constexpr std::uint16_t kWktRecord = 2112, kGeoKeyRecord = 34735, kExtraBytesRecord = 4;
 constexpr std::uint16_t kProjectedCsKey = 3072, kGeographicKey = 2048, kUserDefined = 32767;
 constexpr std::size_t kColorProbe = 1 << 16;  // points looked at to tell 8- from 16-bit colours

@@ -5,6 +5,8 @@
 #include <cstring>
 #include <vector>
 
+#include "lodforge/io/points/las_format.h"
+
 namespace lodforge {
 
 namespace {
@@ -16,7 +18,8 @@ void put(std::array<std::byte, 227>& bytes, std::size_t at, T value) {
 
 }  // namespace
 
-constexpr std::size_t kVlrHeader = 54, kDescriptor = 192;
+using las::kExtraDescriptor;
+using las::kVlrHeader;
 
 LasWriter::LasWriter(OutputFile out, Vec3d scale, Vec3d offset, std::string software,
                      PointExtras extras)
@@ -39,7 +42,7 @@ Result<LasWriter> LasWriter::create(const std::string& path, Vec3d scale, Vec3d 
     end += static_cast<std::uint32_t>(extraTypeSize(field.type));
   }
   if (end != extras.stride || kLasFormat3Size + extras.stride > 0xFFFF ||
-      kDescriptor * extras.fields.size() > 0xFFFF)
+      kExtraDescriptor * extras.fields.size() > 0xFFFF)
     return Error{ErrorKind::kInternal,
                  fmt::format("{}: {} extra bytes in {} fields do not make a LAS record", path,
                              extras.stride, extras.fields.size())};
@@ -54,7 +57,7 @@ Result<LasWriter> LasWriter::create(const std::string& path, Vec3d scale, Vec3d 
   std::vector<std::byte> record(kVlrHeader);
   std::memcpy(record.data() + 2, "LASF_Spec", 9);
   const std::uint16_t id = 4;
-  const auto length = static_cast<std::uint16_t>(kDescriptor * writer.extras_.fields.size());
+  const auto length = static_cast<std::uint16_t>(kExtraDescriptor * writer.extras_.fields.size());
   std::memcpy(record.data() + 18, &id, 2);
   std::memcpy(record.data() + 20, &length, 2);
   std::memcpy(record.data() + 22, "extra bytes", 11);
@@ -68,7 +71,7 @@ Result<LasWriter> LasWriter::create(const std::string& path, Vec3d scale, Vec3d 
 
 std::uint32_t LasWriter::pointOffset() const {
   if (extras_.stride == 0) return 227;
-  return static_cast<std::uint32_t>(227 + kVlrHeader + kDescriptor * extras_.fields.size());
+  return static_cast<std::uint32_t>(227 + kVlrHeader + kExtraDescriptor * extras_.fields.size());
 }
 
 // The public header block of LAS 1.2 (227 bytes; the Extra Bytes record, if any, follows).

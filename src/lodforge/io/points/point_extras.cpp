@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "lodforge/io/points/las_format.h"
 #include "lodforge/io/points/record_field.h"
 
 namespace lodforge {
@@ -14,7 +15,7 @@ namespace lodforge {
 namespace {
 
 // The Extra Bytes descriptor (LAS 1.4 R15, Table 24): where each field lies in its 192 bytes.
-constexpr std::size_t kDescriptor = 192;
+using las::kExtraDescriptor;
 constexpr std::size_t kTypeAt = 2, kOptionsAt = 3, kNameAt = 4, kNoDataAt = 40, kScaleAt = 112,
                       kOffsetAt = 136, kDescriptionAt = 160;
 constexpr std::uint8_t kHasNoData = 1, kHasScale = 8, kHasOffset = 16;
@@ -117,15 +118,15 @@ Result<PointExtras> parseLasExtraBytes(std::span<const std::byte> record, std::u
                                        const std::string& file, std::uint64_t at) {
   PointExtras extras;
   extras.stride = available;
-  if (record.size() % kDescriptor != 0)
+  if (record.size() % kExtraDescriptor != 0)
     return badInputAtByte(file, at,
                           fmt::format("the Extra Bytes record holds {} bytes, not a whole number "
                                       "of {}-byte descriptors",
-                                      record.size(), kDescriptor));
+                                      record.size(), kExtraDescriptor));
   std::uint32_t offset = 0;
-  for (std::size_t d = 0; d < record.size() / kDescriptor; ++d) {
-    const std::byte* e = record.data() + d * kDescriptor;
-    const std::uint64_t where = at + d * kDescriptor;
+  for (std::size_t d = 0; d < record.size() / kExtraDescriptor; ++d) {
+    const std::byte* e = record.data() + d * kExtraDescriptor;
+    const std::uint64_t where = at + d * kExtraDescriptor;
     const auto dataType = static_cast<std::size_t>(e[kTypeAt]);
     const auto options = static_cast<std::uint8_t>(e[kOptionsAt]);
     const std::string name = printableText(loadText(e + kNameAt, 32));
@@ -172,7 +173,7 @@ Result<PointExtras> parseLasExtraBytes(std::span<const std::byte> record, std::u
 }
 
 std::vector<std::byte> lasExtraBytesDescriptor(const ExtraField& field) {
-  std::vector<std::byte> d(kDescriptor);
+  std::vector<std::byte> d(kExtraDescriptor);
   std::size_t type = 0;
   while (kLasTypes[type] != field.type) ++type;
   d[kTypeAt] = static_cast<std::byte>(type + 1);

@@ -2,7 +2,8 @@
 # Configures and builds one of the project's builds under build/<name>:
 #   release  optimised library, command, tests and benchmarks (g++)
 #   asan     the sanitizer tree (clang++): the unit tests, the command and one libFuzzer target
-#            per reader, all under AddressSanitizer + UndefinedBehaviorSanitizer, compiled once
+#            per reader, all under AddressSanitizer + UndefinedBehaviorSanitizer (the fuzzers
+#            against a copy of the library with libFuzzer's coverage, the rest without it)
 #            (line tables only: a report still names file and line, at a fraction of -g's cost)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Compares what two lodforge binaries write for the same inputs, byte for byte: tilesets (meshes,
-# assemblies, point clouds), packages and extracts. For refactors that must not change output.
+# assemblies, point clouds from LAS, LAZ, COPC and XYZ, a STEP assembly, a reconstructed surface),
+# a reconstructed mesh, packages and extracts. For refactors that must not change output.
 #   scripts/compare-outputs.sh OLD_BINARY NEW_BINARY [WORK_DIR]
 # Point packages carry a random build id (and a checksum over it): up to 16 differing bytes per
 # .lfc/.seg file are expected, as between two runs of one binary.
@@ -25,6 +26,11 @@ run() {
   "$L" -q tiles "$data/points/autzen_trim.las" -o autzen-tiles
   "$L" -q tiles "$data/points/simple.las" -o simple-tiles --origin 7,50,10
   "$L" -q tiles "$data/points/kitten.xyz" -o kitten-tiles
+  "$L" -q tiles "$data/points/autzen_trim.laz" -o autzen-laz-tiles
+  "$L" -q tiles "$data/points/1.2-with-color.copc.laz" -o copc-tiles
+  "$L" -q tiles "$data/cad/as1_motor.step" -o step-tiles
+  "$L" -q --threads 1 tiles "$data/points/autzen_trim.laz" --surface -o surface-tiles --voxel 4
+  "$L" -q reconstruct "$data/points/kitten.xyz" -o kitten-surface.ply
   "$L" -q build cad.glb -o cad.lfp
   "$L" -q build "$data/meshes/horse.ply" -o horse.lfp
   "$L" -q extract cad.lfp --error 0.01 -o cad-e.ply

@@ -52,6 +52,47 @@ void fullDetail(const Package& package, Selection& selection) {
   }
 }
 
+// What one frame is drawn from, and what it draws with.
+struct FrameView {
+  const Camera& camera;
+  std::uint64_t budget;
+  ColorMode colorMode;
+};
+struct FrameTools {
+  FramePipeline& pipeline;
+  Framebuffer& target;
+  Selection& selection;
+};
+
+// One frame: selected (or every object at full detail), streamed, drawn and written to `png`;
+// its figures for render.json.
+Result<nlohmann::json> renderFrame(const RenderOptions& o, const Package& package,
+                                   const LodScene& scene, const FrameView& view,
+                                   const FrameTools& tools, const std::string& png) {
+  Selection& selection = tools.selection;
+  const auto start = std::chrono::steady_clock::now();
+  if (o.reference) {
+    fullDetail(package, selection);
+  } else {
+    selectTwoPass(scene, view.camera, view.budget,
+                  {.minT = o.minT, .firstPassOnly = o.firstPassOnly}, selection);
+  }
+  const auto selected = std::chrono::steady_clock::now();
+  auto stream = tools.pipeline.update(selection.vertexCounts, selection.triangleCounts);
+  if (!stream) return stream.status();
+  tools.target.bind();
+  tools.pipeline.draw(view.camera, {.colorMode = view.colorMode});
+  const PipelineTimings& t = tools.pipeline.timings();
+  LODFORGE_TRY(writePng(png, tools.target.read()));
+  return nlohmann::json{{"vertices", selection.totalVertices},
+                        {"triangles", selection.totalTriangles},
+                        {"selection_ms", milliseconds(selected - start)},
+                        {"generation_ms", t.streamMs + t.reformMs},
+                        {"upload_ms", t.uploadMs},
+                        {"render_ms", t.drawMs},
+                        {"bytes_read", stream->bytesRead}};
+}
+
 Status runRender(const Global& global, const RenderOptions& o) {
   const std::vector<std::string> inputs{o.input};
   LODFORGE_TRY(claimOutput(o.output, renderFolderOutput(), inputs));
@@ -96,30 +137,13 @@ Status runRender(const Global& global, const RenderOptions& o) {
   Progress progress("frames", cameras->size());
   for (std::size_t f = 0; f < cameras->size(); ++f) {
     LODFORGE_TRY(checkCancelled());
-    const Camera& camera = (*cameras)[f];
-    const auto start = std::chrono::steady_clock::now();
-    if (o.reference) {
-      fullDetail(*package, selection);
-    } else {
-      selectTwoPass(scene, camera, *budget, {.minT = o.minT, .firstPassOnly = o.firstPassOnly},
-                    selection);
-    }
-    const auto selected = std::chrono::steady_clock::now();
-    auto stream = pipeline->update(selection.vertexCounts, selection.triangleCounts);
-    if (!stream) return stream.status();
-    target->bind();
-    pipeline->draw(camera, {.colorMode = *colorMode});
-    const PipelineTimings& t = pipeline->timings();
     const std::string name = fmt::format("frame_{:04}.png", f);
-    LODFORGE_TRY(writePng((temporary / name).string(), target->read()));
-    frames.push_back({{"frame", name},
-                      {"vertices", selection.totalVertices},
-                      {"triangles", selection.totalTriangles},
-                      {"selection_ms", milliseconds(selected - start)},
-                      {"generation_ms", t.streamMs + t.reformMs},
-                      {"upload_ms", t.uploadMs},
-                      {"render_ms", t.drawMs},
-                      {"bytes_read", stream->bytesRead}});
+    Result<nlohmann::json> frame =
+        renderFrame(o, *package, scene, {(*cameras)[f], *budget, *colorMode},
+                    {*pipeline, *target, selection}, (temporary / name).string());
+    if (!frame) return frame.status();
+    (*frame)["frame"] = name;
+    frames.push_back(std::move(*frame));
     progress.advance(1);
   }
   progress.finish();

@@ -640,8 +640,8 @@ TEST(CliReconstruct, MakesASurfaceAndRefusesWhatCannotBeOne) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("bad.ply")));
   // tiles --surface: the reconstruction's chunks tiled as the leaves, its work folder gone
   // afterwards.
-  o = lodforge("tiles " + dir.file("p.ply") + " --surface -o " + dir.file("t") + " --chunk-size 150",
-               dir);
+  o = lodforge(
+      "tiles " + dir.file("p.ply") + " --surface -o " + dir.file("t") + " --chunk-size 150", dir);
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_NE(o.out.find("reconstructed"), std::string::npos) << o.out;
   EXPECT_TRUE(std::filesystem::exists(dir.file("t/tileset.json")));

@@ -30,8 +30,27 @@ const port = await new Promise((resolve, reject) => {
     if (m) resolve(Number(m[1]));
   });
   server.on('exit', (code) => reject(new Error(`lodforge serve exited with ${code}: ${serverLog}`)));
-  setTimeout(() => reject(new Error('lodforge serve did not start')), 20000);
+  // unref: a pending timer would keep node alive for its full 20 s after the test is done.
+  setTimeout(() => reject(new Error('lodforge serve did not start')), 20000).unref();
 });
+
+// Runs fn(arg) in the page, a change made through window.lodforge, and waits until the viewer
+// has drawn a frame after it (its own frame counter), not a fixed time. The CesiumJS page draws
+// only when something changed, so this also checks that each change asks for a frame.
+async function change(tab, fn, arg) {
+  const from = await tab.evaluate(() => window.lodforge.frames);
+  await tab.evaluate(fn, arg);
+  await drawnSince(tab, from);
+}
+
+async function drawnSince(tab, from) {
+  await tab.waitForFunction((n) => window.lodforge.frames > n, from, { timeout: 60000 });
+}
+
+// Two of the browser's animation frames: a viewer draws what it has pending in the next one.
+async function browserFrames(tab) {
+  await tab.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
+}
 
 // Each colour mode draws (covers the view) and draws differently from the mode before; hiding
 // every class leaves (almost) nothing, showing them again brings the points back.
@@ -40,8 +59,7 @@ async function checkColorModes(tab, viewer, coverage, firstPng, mine) {
   let previous = firstPng;
   const shots = [];
   for (const [i, mode] of modes.entries()) {
-    await tab.evaluate((m) => window.lodforge.setColorMode(m), mode);
-    await tab.waitForTimeout(1500);
+    await change(tab, (m) => window.lodforge.setColorMode(m), mode);
     const png = await tab.screenshot();
     writeFileSync(path.join(outDir, `${viewer}-${mode.replace(' ', '-')}.png`), png);
     const covered = await coverageOf(tab, png, [0x12, 0x15, 0x1a], 'panel');
@@ -54,13 +72,11 @@ async function checkColorModes(tab, viewer, coverage, firstPng, mine) {
   const classes = await tab.evaluate(() => window.lodforge.classes());
   if (classes.length === 0) mine('the legend lists no class');
   await tab.evaluate(() => window.lodforge.setColorMode('classification'));
-  await tab.evaluate((list) => { for (const c of list) window.lodforge.setClassVisible(c, false); }, classes);
-  await tab.waitForTimeout(1500);
+  await change(tab, (list) => { for (const c of list) window.lodforge.setClassVisible(c, false); }, classes);
   const hiddenPng = await tab.screenshot();
   writeFileSync(path.join(outDir, `${viewer}-classes-hidden.png`), hiddenPng);
   const hidden = await coverageOf(tab, hiddenPng, [0x12, 0x15, 0x1a], 'panel');
-  await tab.evaluate((list) => { for (const c of list) window.lodforge.setClassVisible(c, true); }, classes);
-  await tab.waitForTimeout(1500);
+  await change(tab, (list) => { for (const c of list) window.lodforge.setClassVisible(c, true); }, classes);
   const shown = await coverageOf(tab, await tab.screenshot(), [0x12, 0x15, 0x1a], 'panel');
   console.log(`${viewer}: colour modes: ${shots.join('; ')}; classes ${classes.join(',')} hidden: ` +
               `${(100 * hidden).toFixed(2)} % covered, shown again: ${(100 * shown).toFixed(1)} %`);
@@ -83,9 +99,9 @@ async function checkParts(tab, viewer, mine) {
   if (count !== parts.parts.length) mine(`the viewer has ${count} parts, parts.json ${parts.parts.length}`);
   const found = await tab.evaluate((name) => window.lodforge.parts.find(name), known.name);
   if (!found.includes(known.id)) mine(`finding "${known.name}" gave ${JSON.stringify(found)}`);
-  await tab.evaluate((id) => window.lodforge.parts.isolate(id), known.id);
+  await change(tab, (id) => window.lodforge.parts.isolate(id), known.id);
   await tab.waitForFunction(() => window.lodforge.parts.idle(), null, { timeout: 60000 });
-  await tab.waitForTimeout(1000);
+  await browserFrames(tab);
   const box = await tab.evaluate(() => { const r = document.querySelector('canvas').getBoundingClientRect(); return [r.width, r.height]; });
   // The whole grid in one call: each call into the page waits for the frame being drawn (a
   // few hundred ms in software WebGL), the picks themselves take a few ms.
@@ -112,15 +128,15 @@ async function checkParts(tab, viewer, mine) {
   if (clear.length === 0) { mine(`every pixel of part "${known.name}" lies under the panel`); return; }
   const hit = clear[Math.floor(clear.length / 2)];
   const box0 = await tab.evaluate(() => { const r = document.querySelector('canvas').getBoundingClientRect(); return [r.left, r.top]; });
+  const beforeClick = await tab.evaluate(() => window.lodforge.frames);
   await tab.mouse.click(box0[0] + hit.x, box0[1] + hit.y);
-  await tab.waitForTimeout(300);
+  await drawnSince(tab, beforeClick);
   const shown = await tab.evaluate(() => window.lodforge.parts.shown());
   if (!shown.includes(known.name) || !shown.includes(known.path))
     mine(`clicking part ${known.id} shows "${shown}", not its name "${known.name}" and path "${known.path}"`);
   if (parts.parts.some((p) => p.layer)) await checkLayers(tab, viewer, known, hit, shown, mine);
   await tab.evaluate(() => window.lodforge.parts.showAll());
-  await tab.evaluate((id) => window.lodforge.parts.hide(id), known.id);
-  await tab.waitForTimeout(1000);
+  await change(tab, (id) => window.lodforge.parts.hide(id), known.id);
   const after = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [hit.x, hit.y]);
   if (after && after.id === known.id) mine(`part ${known.id} is still picked after hiding it`);
   console.log(`${viewer}: a click shows "${shown}"; hidden, its pixel picks ${after ? `"${after.name}"` : 'nothing'}`);
@@ -137,13 +153,11 @@ async function checkLayers(tab, viewer, known, hit, shown, mine) {
   const name = known.layer.split('; ')[0];
   if (!layers.includes(name)) { mine(`the layer list ${JSON.stringify(layers)} lacks "${name}"`); return; }
   await tab.evaluate(() => window.lodforge.parts.showAll());
-  await tab.evaluate(([id, layer]) => { window.lodforge.parts.isolate(id); window.lodforge.parts.setLayer(layer, false); },
-                     [known.id, name]);
-  await tab.waitForTimeout(1000);
+  await change(tab, ([id, layer]) => { window.lodforge.parts.isolate(id); window.lodforge.parts.setLayer(layer, false); },
+               [known.id, name]);
   const off = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [hit.x, hit.y]);
   if (off && off.id === known.id) mine(`part ${known.id} is still picked with its layer "${name}" off`);
-  await tab.evaluate((layer) => window.lodforge.parts.setLayer(layer, true), name);
-  await tab.waitForTimeout(1000);
+  await change(tab, (layer) => window.lodforge.parts.setLayer(layer, true), name);
   const on = await tab.evaluate(([px, py]) => window.lodforge.parts.pick(px, py), [hit.x, hit.y]);
   if (!on || on.id !== known.id) mine(`part ${known.id} is not picked again with its layer "${name}" back on`);
   console.log(`${viewer}: part ${known.id} is on layer "${known.layer}" (${layers.length} layers); ` +
@@ -176,7 +190,9 @@ try {
     if (report.error) mine(`viewer: ${report.error}`);
     for (const f of report.failed) mine(`tile failed: ${f}`);
     if (report.tilesLoaded < 1) mine('no tile loaded');
-    await tab.waitForTimeout(1000);
+    // Loaded means drawn (CesiumJS says so in the frame that draws the last tile); two more
+    // animation frames give a viewer time to ask for a tile twice.
+    await browserFrames(tab);
     const twice = [...tileGets].filter(([, n]) => n > 1);
     if (viewer === 'three' && twice.length > 0) mine(`${twice.length} tile(s) downloaded more than once, e.g. ${twice[0][0]}`);
     const stats = await tab.evaluate(() => document.getElementById('stats').textContent);

@@ -6,7 +6,7 @@ import { boundsOf, loadParts, partsPanel } from '../parts_panel.js';
 import { CLASSES, classColor, colorModes, colorPanel, hexToRgb } from '../point_colors.js';
 
 const Cesium = window.Cesium;
-const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0 });
+const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0, frames: 0 });
 
 // The root tile's glTF: its primitive's attribute names, and the classes it holds (the root's
 // points are spread over the whole cloud, so its classes are the common ones).
@@ -82,7 +82,7 @@ function pointShader(modes, names) {
 }
 
 // Point tilesets with LAS fields get the mode picker and the legend.
-async function addColouring(tileset) {
+async function addColouring(scene, tileset) {
   const root = await rootContent(tileset);
   if (!root || !root.hasMetadata) return;
   const modes = colorModes(root.names);
@@ -95,9 +95,11 @@ async function addColouring(tileset) {
   let hidden = 0;
   const panel = colorPanel(modes, root.classes, (mode) => {
     shader.setUniform('u_mode', modes.indexOf(mode));
+    scene.requestRender();
   }, (value, visible) => {
     if (value < 31) hidden = visible ? hidden & ~(1 << value) : hidden | (1 << value);
     shader.setUniform('u_hidden', hidden);
+    scene.requestRender();
   });
   report.colorModes = modes;
   report.setColorMode = (mode) => panel.setMode(mode);
@@ -106,6 +108,7 @@ async function addColouring(tileset) {
     if (box) box.checked = visible;
     if (value < 31) hidden = visible ? hidden & ~(1 << value) : hidden | (1 << value);
     shader.setUniform('u_hidden', hidden);
+    scene.requestRender();
   };
   report.classes = () => [...root.classes];
 }
@@ -126,7 +129,10 @@ async function addParts(viewer, tileset) {
       highlighted.has(feature.getProperty('id')) ? highlight : Cesium.Color.WHITE, result),
   };
   tileset.style = style;
-  const restyle = () => tileset.makeStyleDirty();
+  const restyle = () => {
+    tileset.makeStyleDirty();
+    viewer.scene.requestRender();
+  };
   const panel = partsPanel(parts, {
     highlight: (ids) => { highlighted = new Set(ids); restyle(); },
     hide: (ids) => { hidden = new Set(ids); restyle(); },
@@ -176,6 +182,8 @@ async function main() {
     homeButton: false, sceneModePicker: false, navigationHelpButton: false, fullscreenButton: false,
     infoBox: false, selectionIndicator: false,
     terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false, skyAtmosphere: false,
+    // Draw only when something changed (the camera, a tile, a setting): an idle view costs no CPU.
+    requestRenderMode: true, maximumRenderTimeChange: Infinity,
   });
   // No imagery and no terrain: the globe would be a blank ball; the model alone is shown.
   viewer.scene.globe.show = false;
@@ -204,10 +212,14 @@ async function main() {
       drawnSummary(drawn.tiles, report.tilesLoaded, drawn.points, drawn.triangles) +
       ` · ${formatBytes(tileset.totalMemoryUsageInBytes)} in tiles`;
     report.drawn = drawn;
+    report.frames += 1;
     drawn = { tiles: 0, triangles: 0, points: 0 };
   });
-  onScreenSpaceError((pixels) => { tileset.maximumScreenSpaceError = pixels; });
-  await addColouring(tileset);
+  onScreenSpaceError((pixels) => {
+    tileset.maximumScreenSpaceError = pixels;
+    viewer.scene.requestRender();
+  });
+  await addColouring(viewer.scene, tileset);
   await addParts(viewer, tileset);
   await viewer.flyTo(tileset, { duration: 0 });
 }

@@ -11,7 +11,7 @@ import { drawnSummary, formatBytes, formatCount, onScreenSpaceError } from '../f
 import { boundsOf, loadParts, partsPanel } from '../parts_panel.js';
 import { classColor, colorModes, colorPanel, intensityGrey, ramp } from '../point_colors.js';
 
-const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0 });
+const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0, frames: 0 });
 
 // Point tiles coloured by a LAS field: each loaded Points object keeps its own colours and is
 // recoloured on the CPU (RGBA; a hidden class gets alpha 0, which alphaTest discards).
@@ -324,6 +324,7 @@ function main() {
     camera.updateMatrixWorld();
     tiles.update();
     renderer.render(scene, camera);
+    report.frames += 1;
     const info = renderer.info;
     const points = info.render.points;
     stats.textContent =

@@ -1,6 +1,8 @@
 #include "lodforge/tiling/chunk_grid.h"
 
 #include <cmath>
+#include <set>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -130,6 +132,54 @@ TEST(CutTriangle, TrianglesInsideACellStayWholeAndDegenerateOnesVanish) {
     ASSERT_EQ(cells.size(), 1u) << i;
     EXPECT_EQ(cells[0], grid.cellOf((t[0].position + t[1].position + t[2].position) / 3.0));
     for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(corners[k].position, t[k].position) << i;
+  }
+}
+
+// A polygon piece of n corners becomes n − 2 triangles fanned from a corner, not n around its
+// centroid: a triangle cut by one plane is 3 triangles (a triangle and a quad), not 5. Where a
+// corner's fan would hold a flat triangle (two cuts on one edge leave corners in line) another
+// corner is the apex; every piece still has area and no new corner appears.
+TEST(CutTriangle, APolygonPieceIsFannedFromACornerIntoNMinusTwoTriangles) {
+  Aabbd box;
+  box.add(Vec3d{0, 0, 0});
+  box.add(Vec3d{4, 4, 4});
+  const ChunkGrid grid = ChunkGrid::over(box, 2);
+  std::vector<ChunkCell> cells;
+  std::vector<CutCorner> corners;
+  std::array<CutCorner, 3> t;
+  t[0].position = {0.5, 0.5, 1};
+  t[1].position = {3.5, 0.5, 1};
+  t[2].position = {0.5, 1.5, 1};
+  cutTriangle(grid, t, cells, corners);  // the x = 2 plane cuts it: a quad and a triangle
+  EXPECT_EQ(cells.size(), 3u);
+  // Cut on both axes near a corner: pieces of up to 5 corners, two cuts on the long edge.
+  t[0].position = {0.2, 0.2, 1};
+  t[1].position = {3.8, 1.0, 1};
+  t[2].position = {1.0, 3.8, 1};
+  cells.clear();
+  corners.clear();
+  cutTriangle(grid, t, cells, corners);
+  const std::set<std::tuple<double, double, double>> before = [&] {
+    std::set<std::tuple<double, double, double>> seen;
+    for (const CutCorner& c : corners) seen.emplace(c.position.x, c.position.y, c.position.z);
+    return seen;
+  }();
+  double sum = 0;
+  for (std::size_t p = 0; p < cells.size(); ++p) {
+    const double a =
+        area(corners[3 * p].position, corners[3 * p + 1].position, corners[3 * p + 2].position);
+    EXPECT_GT(a, 0) << "piece " << p;
+    sum += a;
+  }
+  EXPECT_NEAR(sum, area(t[0].position, t[1].position, t[2].position), 1e-12);
+  // 4 pieces (one per cell it crosses) of 3 + 4 + 4 + 5 corners or so: far fewer triangles
+  // than a centroid fan's one per corner, and no centroid among the corners.
+  EXPECT_LE(cells.size(), 8u);
+  for (const auto& [x, y, z] : before) {
+    const bool onPlane = x == 2 || y == 2;
+    const bool original = Vec3d{x, y, z} == t[0].position || Vec3d{x, y, z} == t[1].position ||
+                          Vec3d{x, y, z} == t[2].position;
+    EXPECT_TRUE(onPlane || original) << x << " " << y << " " << z << " is a new inner corner";
   }
 }
 

@@ -1,5 +1,6 @@
 #include "lodforge/tiling/chunk_input.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +14,7 @@
 #include "lodforge/generate/cad.h"
 #include "lodforge/io/mesh/ply_writer.h"
 #include "lodforge/io/model_io.h"
+#include "lodforge/tiling/chunk_sizing.h"
 #include "test_support.h"
 
 namespace lodforge {
@@ -200,6 +202,28 @@ TEST(ChunkInput, SmallSegmentsStayWholeAndLargeOnesAreCut) {
     EXPECT_GT(large, 0u);
     EXPECT_GT(input->chunks->triangleCount(), input->inputTriangles);
   }
+}
+
+// A real CAD assembly (the STEP motor: dense small parts beside long-sliver plates): leaf
+// chunks of about the target, not hundreds of slivers. Before, a triangle-weighted mean load
+// halved the chunk edge down to 94 chunks of median 240 triangles holding 1.93 x the input
+// (each cut triangle a centroid fan); now a few chunks of about 2 K hold little more than it.
+TEST(ChunkInput, ACadAssemblyMakesLeafChunksOfAboutTheTargetNotSlivers) {
+  test::TempDir dir;
+  ChunkInputOptions options;
+  options.workDirectory = dir.file("work");
+  Result<ChunkInput> input = chunkInput(test::dataPath("cad/as1_motor.step"), options);
+  ASSERT_TRUE(input.ok()) << input.error().message;
+  const auto counts = input->chunks->triangleCounts();
+  std::vector<std::uint64_t> sizes;
+  for (const auto& [cell, count] : counts) sizes.push_back(count);
+  std::sort(sizes.begin(), sizes.end());
+  ASSERT_FALSE(sizes.empty());
+  const std::uint64_t target = leafTriangles(options, input->inputTriangles);
+  EXPECT_LE(sizes.size(), 2 * input->inputTriangles / target) << "chunks";
+  EXPECT_GE(sizes[sizes.size() / 2], target / 2) << "median chunk";
+  EXPECT_LE(input->chunks->triangleCount(), input->inputTriangles * 13 / 10)
+      << input->inputTriangles << " triangles in";
 }
 
 TEST(ChunkInput, AFaceOutsideTheVerticesIsBadInputNamingTheFile) {

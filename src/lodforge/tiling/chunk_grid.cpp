@@ -149,19 +149,43 @@ struct Emitter {
                              unique[0].feature};
     const ChunkCell cell = grid.cellOf(centroid.position);
     if (unique.size() == 3) {
-      const Vec3d normal =
-          cross(unique[1].position - unique[0].position, unique[2].position - unique[0].position);
-      if (normal.x == 0 && normal.y == 0 && normal.z == 0) return;  // no area
+      if (!hasArea(unique[0], unique[1], unique[2])) return;
       cells.push_back(cell);
       corners.insert(corners.end(), unique.begin(), unique.end());
       return;
     }
-    for (std::size_t i = 0; i < unique.size(); ++i) {
+    fan(unique, centroid, cell);
+  }
+
+  // A piece of a convex triangle is convex: n − 2 triangles fanned from a corner none of whose
+  // triangles is flat (a cut on an edge leaves corners in line), else n around the centroid.
+  // The fan adds no corner on an edge, so the pieces still meet without T-junctions.
+  void fan(const Polygon& piece, const CutCorner& centroid, ChunkCell cell) {
+    const std::size_t count = piece.size();
+    for (std::size_t k = 0; k < count; ++k) {
+      bool flat = false;
+      for (std::size_t i = 1; i + 1 < count && !flat; ++i)
+        flat = !hasArea(piece[k], piece[(k + i) % count], piece[(k + i + 1) % count]);
+      if (flat) continue;
+      for (std::size_t i = 1; i + 1 < count; ++i) {
+        cells.push_back(cell);
+        corners.push_back(piece[k]);
+        corners.push_back(piece[(k + i) % count]);
+        corners.push_back(piece[(k + i + 1) % count]);
+      }
+      return;
+    }
+    for (std::size_t i = 0; i < count; ++i) {
       cells.push_back(cell);
       corners.push_back(centroid);
-      corners.push_back(unique[i]);
-      corners.push_back(unique[(i + 1) % unique.size()]);
+      corners.push_back(piece[i]);
+      corners.push_back(piece[(i + 1) % count]);
     }
+  }
+
+  static bool hasArea(const CutCorner& a, const CutCorner& b, const CutCorner& c) {
+    const Vec3d normal = cross(b.position - a.position, c.position - a.position);
+    return normal.x != 0 || normal.y != 0 || normal.z != 0;
   }
 
   // Cuts at the planes of `axis` inside the polygon, then the next axis for each part.

@@ -24,9 +24,10 @@ namespace {
 
 // A model file, or a progressive package (.lfp) at full detail: every object's mesh as it was
 // before simplification.
-Result<Model> readInputModel(const std::string& path, const CadReadOptions& cad,
+Result<Model> readInputModel(const std::string& path, const CadReadOptions& cad, bool salvage,
                              std::vector<std::string>& warnings) {
-  if (fileExtension(path) != "lfp") return readModel(path, {.warnings = &warnings, .cad = cad});
+  if (fileExtension(path) != "lfp")
+    return readModel(path, {.salvageTruncated = salvage, .warnings = &warnings, .cad = cad});
   Result<Package> package = Package::open(path);
   if (!package) return package.status();
   return extractModel(*package, vertexCountsForRatio(*package, 1.0));
@@ -131,18 +132,21 @@ Result<ChunkGrid> leafGrid(const PlacedModel& m, const ChunkInput& input,
   if (!fitted) return fitted.status();
   double size = *fitted;
   if (options.chunkSize == 0) {
-    size = fitChunkSize(input.bounds, size, leafTriangles(options, input.inputTriangles),
-                        [&](const auto& add) {
-                          for (std::size_t o = 0; o < m.model.objectCount(); ++o) {
-                            const std::uint64_t offset = m.model.objects[o].vertexOffset;
-                            const auto indices = m.model.objectIndices(o);
-                            for (std::size_t t = 0; t < indices.size(); t += 3)
-                              add((m.world[offset + indices[t]] + m.world[offset + indices[t + 1]] +
-                                   m.world[offset + indices[t + 2]]) *
-                                      (1.0 / 3.0),
-                                  1.0);
-                          }
-                        });
+    // --levels asks for leaves at least that small (chunkSizeFor).
+    const double fit =
+        fitChunkSize(input.bounds, leafTriangles(options, input.inputTriangles),
+                     options.trianglesPerChunk, [&](const auto& add) {
+                       for (std::size_t o = 0; o < m.model.objectCount(); ++o) {
+                         const std::uint64_t offset = m.model.objects[o].vertexOffset;
+                         const auto indices = m.model.objectIndices(o);
+                         for (std::size_t t = 0; t < indices.size(); t += 3)
+                           add((m.world[offset + indices[t]] + m.world[offset + indices[t + 1]] +
+                                m.world[offset + indices[t + 2]]) *
+                                   (1.0 / 3.0),
+                               1.0);
+                       }
+                     });
+    size = options.levels > 0 ? std::min(size, fit) : fit;
   }
   return ChunkGrid::over(input.bounds, size);
 }
@@ -212,7 +216,7 @@ Status addObjects(const PlacedModel& m, ChunkInput& input) {
 // objects cut into the chunks.
 Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& options) {
   ChunkInput input;
-  Result<Model> read = readInputModel(path, options.cad, input.warnings);
+  Result<Model> read = readInputModel(path, options.cad, options.salvageTruncated, input.warnings);
   if (!read) return read.status();
   PlacedModel m;
   m.model = std::move(*read);

@@ -41,8 +41,9 @@ struct ChunkInputOptions {
   // Applied to every input position before anything else (a CRS to a local frame); false:
   // the point cannot be transformed, which is bad input.
   std::function<bool(Vec3d, Vec3d&)> transform;
-  bool salvageTruncated = false;  // a PLY cut short: read up to its last whole element
-  CadReadOptions cad;             // tessellation of a CAD input
+  // A PLY cut short: read up to its last whole element; a STEP or IFC: what it holds.
+  bool salvageTruncated = false;
+  CadReadOptions cad;  // tessellation of a CAD input
   PartsMode parts = PartsMode::kAuto;
   int levels = 0;  // levels the octree must be able to build above the leaves (0: any)
 };

@@ -352,11 +352,13 @@ Result<ChunkGrid> PlyChunking::chunkGrid() const {
   if (!fitted) return fitted.status();
   double size = *fitted;
   if (options_.chunkSize == 0 && header_.hasObjectIds) {
-    size = fitChunkSize(input_.bounds, size, leafTriangles(options_, header_.faceCount),
-                        [&](const auto& add) {
-                          for (const auto& [id, object] : objects_)
-                            add(object.bounds.center(), static_cast<double>(object.triangles));
-                        });
+    const double fit =
+        fitChunkSize(input_.bounds, leafTriangles(options_, header_.faceCount),
+                     options_.trianglesPerChunk, [&](const auto& add) {
+                       for (const auto& [id, object] : objects_)
+                         add(object.bounds.center(), static_cast<double>(object.triangles));
+                     });
+    size = options_.levels > 0 ? std::min(size, fit) : fit;  // --levels: at least that small
   }
   return ChunkGrid::over(input_.bounds, size);
 }

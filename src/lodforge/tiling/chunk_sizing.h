@@ -3,6 +3,8 @@
 // carried through the input transform, and running on a limited number of threads.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <unordered_map>
 
@@ -34,25 +36,34 @@ std::uint64_t leafTriangles(const ChunkInputOptions& options, std::uint64_t tria
 Result<double> chunkSizeFor(const ChunkInputOptions& options, const Aabbd& bounds,
                             std::uint64_t triangles);
 
-// The surface estimate of ChunkGrid::sizeFor, halved while the chunk a triangle lands in holds
-// on average more than 1.5 x the target (parts clustered in a volume, as in a CAD assembly,
-// crowd into far fewer chunks than a surface would). `visit(add)` calls add(point, triangles)
-// for where the triangles are: each triangle's centroid, or each object's centre.
+// The largest chunk edge, from the longest side down by steps of 2^(1/3), at which the chunks
+// that hold triangles hold on average at most 1.5 x `perChunk` and none more than 1.5 x
+// `mostPerChunk` (what memory allows a chunk). Parts clustered in a volume, as in a CAD
+// assembly, crowd into far fewer chunks than a surface would; a few dense clusters do not drive
+// the rest into slivers of leaves (halving while a triangle-weighted mean stayed high made
+// leaves of a few hundred triangles, each cut triangle a fan of five). `visit(add)` calls
+// add(point, triangles) for where the triangles are: each triangle's centroid, or each
+// object's centre.
 template <class Visit>
-double fitChunkSize(const Aabbd& bounds, double size, std::uint64_t perChunk, const Visit& visit) {
-  const double smallest = bounds.longestSide() / 4096;
+double fitChunkSize(const Aabbd& bounds, std::uint64_t perChunk, std::uint64_t mostPerChunk,
+                    const Visit& visit) {
+  const double longest = std::max(bounds.longestSide(), 1e-9), smallest = longest / 4096;
+  const double step = std::cbrt(2.0);
   std::unordered_map<std::uint64_t, double> load;
-  while (size / 2 >= smallest) {
+  double size = longest;
+  for (; size / step >= smallest; size /= step) {
     const ChunkGrid grid = ChunkGrid::over(bounds, size);
     load.clear();
     visit([&](Vec3d p, double triangles) { load[grid.cellIndex(grid.cellOf(p))] += triangles; });
-    double squares = 0, triangles = 0;
+    double triangles = 0, fullest = 0;
     for (const auto& [cell, count] : load) {
-      squares += count * count;
       triangles += count;
+      fullest = std::max(fullest, count);
     }
-    if (squares / triangles <= 1.5 * static_cast<double>(perChunk)) break;
-    size /= 2;
+    if (load.empty() ||
+        (triangles / static_cast<double>(load.size()) <= 1.5 * static_cast<double>(perChunk) &&
+         fullest <= 1.5 * static_cast<double>(mostPerChunk)))
+      break;
   }
   return size;
 }

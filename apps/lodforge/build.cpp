@@ -32,7 +32,8 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
                   "Interior edges collapse the cheaper way, or as Eq. 1 says (paper: lower index "
                   "into higher)")
       ->check(CLI::IsMember({"cheaper", "paper"}));
-  sub->add_flag("--salvage", options->salvage, "Keep what a truncated PLY holds up to the cut");
+  sub->add_flag("--salvage", options->salvage,
+                "Keep what a truncated PLY, STEP or IFC holds up to the cut");
   sub->add_flag(
       "--no-instances", options->noInstances,
       "Simplify every object on its own, even one that repeats an earlier object's shape");
@@ -53,7 +54,7 @@ void addBuild(CLI::App& app, const Global& global, Run& run) {
       build.memoryLimit = global.memoryLimit;
       build.read.salvageTruncated = options->salvage;
       build.placeRepeatedShapes = !options->noInstances;
-      Result<CadReadOptions> cad = cadOptions(options->cad);
+      Result<CadReadOptions> cad = cadOptions(options->cad, global);
       if (!cad) return cad.status();
       build.read.cad = *cad;
       std::vector<std::string> warnings;

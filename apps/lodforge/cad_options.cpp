@@ -22,8 +22,9 @@ void addCadOptions(CLI::App& sub, CadCommand& options) {
                "without it they are left out");
 }
 
-Result<CadReadOptions> cadOptions(const CadCommand& options) {
+Result<CadReadOptions> cadOptions(const CadCommand& options, const Global& global) {
   CadReadOptions cad;
+  cad.listLost = global.verbosity > 0;
   cad.angleDegrees = options.angle;
   cad.codePage = options.codePage;
   cad.hidden = options.hidden;

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli.h"
 #include "lodforge/core/status.h"
 #include "lodforge/io/cad/cad_reader.h"
 
@@ -21,6 +22,6 @@ struct CadCommand {
 void addCadOptions(CLI::App& sub, CadCommand& options);
 
 // "0.002" is relative to each part's size; "0.1mm", "2cm" or "0.05m" is a length.
-Result<CadReadOptions> cadOptions(const CadCommand& options);
+Result<CadReadOptions> cadOptions(const CadCommand& options, const Global& global);
 
 }  // namespace lodforge::cli

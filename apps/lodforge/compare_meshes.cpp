@@ -9,6 +9,7 @@
 #include "lodforge/core/distance.h"
 #include "lodforge/core/file.h"
 #include "lodforge/io/model_io.h"
+#include "lodforge/io/points/point_reader.h"
 #include "outputs.h"
 
 namespace lodforge::cli {
@@ -33,14 +34,35 @@ Flat flatten(const Model& model, Vec3d origin) {
   return flat;
 }
 
+bool isGeometryPath(const std::string& path) {
+  return formatFromPath(path) != FileFormat::kUnknown || isPointCloudPath(path);
+}
+
+// Each side must be a surface: a point cloud (an .xyz, a LAS) has no triangles to measure, and
+// a PNG beside a mesh is neither comparison.
+Status checkSurfacePath(const std::string& path) {
+  if (formatFromPath(path) == FileFormat::kUnknown && isPointCloudPath(path))
+    return badInput(path,
+                    "a point cloud: it has no triangles to measure (compare measures the "
+                    "distance between two surfaces)");
+  if (formatFromPath(path) == FileFormat::kUnknown)
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: not a mesh; compare takes two meshes, or two PNG files or "
+                             "folders of them",
+                             path)};
+  return {};
+}
+
 }  // namespace
 
 bool isMeshComparison(const std::string& a, const std::string& b) {
-  return formatFromPath(a) != FileFormat::kUnknown && formatFromPath(b) != FileFormat::kUnknown;
+  return isGeometryPath(a) || isGeometryPath(b);
 }
 
 Status runCompareMeshes(const Global& global, const std::string& a, const std::string& b,
                         std::uint32_t samples, const std::string& json) {
+  LODFORGE_TRY(checkSurfacePath(a));
+  LODFORGE_TRY(checkSurfacePath(b));
   LODFORGE_TRY(claimIfGiven(json, jsonOutput(), {a, b}));
   Result<Model> first = readModel(a);
   if (!first) return first.status();

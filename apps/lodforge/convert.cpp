@@ -44,12 +44,20 @@ bool isLasPath(const std::string& path) {
   return ext == "las" || ext == "laz";
 }
 
-// LAZ (or LAS) in, plain LAS out.
+// What copying LAS takes at most: the program and one LAZ chunk decoded at a time (measured
+// peak on autzen_trim.laz, 50,000-point chunks, with room for chunks of up to a million).
+constexpr std::uint64_t kLasCopyBytes = std::uint64_t{64} << 20;
+
+// LAZ (or LAS) in, plain LAS out, streamed: within any --memory-limit from kLasCopyBytes up.
 Status convertToLas(const Global& global, const std::string& input, const std::string& output) {
   const auto start = std::chrono::steady_clock::now();
   if (!isLasPath(input))
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: convert writes .las from .laz or .las input only", output)};
+  if (global.memoryLimit > 0 && global.memoryLimit < kLasCopyBytes)
+    return Error{ErrorKind::kLimit,
+                 fmt::format("--memory-limit {} is too small to copy LAS points: at least {}",
+                             formatBytes(global.memoryLimit), formatBytes(kLasCopyBytes))};
   LODFORGE_TRY(claimOutput(output, modelFileOutput(output), std::vector<std::string>{input}));
   Result<LasCopyReport> report = writeUncompressedLas(input, output);
   if (!report) return report.status();
@@ -89,7 +97,7 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
       ->check(CLI::NonNegativeNumber);
   sub->add_flag("--stl-ascii", options->stlAscii, "Write ascii STL instead of binary");
   sub->add_flag("--salvage", options->salvage,
-                "Keep what a truncated PLY holds up to the cut (with a warning)");
+                "Keep what a truncated PLY, STEP or IFC holds up to the cut (with a warning)");
   addCadOptions(*sub, options->cad);
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
@@ -97,15 +105,18 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
       if (fileExtension(options->output) == "las")
         return convertToLas(global, options->input, options->output);
       if (!canWrite(formatFromPath(options->output)))
-        return Error{
-            ErrorKind::kUsage,
-            fmt::format("{}: cannot write this format (lodforge writes .ply .glb .obj .stl)",
-                        options->output)};
+        return Error{ErrorKind::kUsage,
+                     fmt::format("{}: convert does not write {} (it writes .ply .glb .obj .stl "
+                                 "models, and .las from .las or .laz point clouds)",
+                                 options->output,
+                                 fileExtension(options->output) == "laz"
+                                     ? std::string("LAZ (compressed LAS)")
+                                     : std::string("this format"))};
       LODFORGE_TRY(refusePointCloud(options->input, "convert"));
       LODFORGE_TRY(claimOutput(options->output, modelFileOutput(options->output),
                                std::vector<std::string>{options->input}));
       LODFORGE_TRY(checkMemory(options->input, global.memoryLimit));
-      Result<CadReadOptions> cad = cadOptions(options->cad);
+      Result<CadReadOptions> cad = cadOptions(options->cad, global);
       if (!cad) return cad.status();
       std::vector<std::string> warnings;
       Result<Model> model =
@@ -113,6 +124,9 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
                     {.salvageTruncated = options->salvage, .warnings = &warnings, .cad = *cad});
       for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
       if (!model) return model.status();
+      // As tiles and build: a model without triangles is nothing to convert (an empty file).
+      if (model->triangleCount() == 0)
+        return badInput(options->input, "the model has no triangles: nothing to convert");
       if (options->weld) {
         WeldOptions weld;
         weld.epsilon = options->weldEpsilon;

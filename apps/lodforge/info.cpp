@@ -100,11 +100,14 @@ nlohmann::json layerCounts(const Model& model) {
 }
 
 Result<Summary> summarizeLoaded(const std::string& path, FileFormat format,
-                                const CadReadOptions& cadOptions) {
+                                CadReadOptions cadOptions, bool salvage) {
   std::vector<std::string> warnings;
   CadReadStats cad;
+  cadOptions.salvageTruncated = salvage;
   Result<Model> model =
-      format == FileFormat::kCad ? readCad(path, cadOptions, &warnings, &cad) : readModel(path);
+      format == FileFormat::kCad
+          ? readCad(path, cadOptions, &warnings, &cad)
+          : readModel(path, {.salvageTruncated = salvage, .warnings = &warnings, .cad = {}});
   for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
   if (!model) return model.status();
   Summary s;
@@ -385,6 +388,7 @@ Status describePointFile(const std::string& path, bool json, bool headerOnly) {
   const bool las = fileExtension(path) == "las" || fileExtension(path) == "laz";
   LODFORGE_TRY(las ? readLasFacts(path, *bytes, headerOnly, facts)
                    : streamPointFacts(path, *bytes, facts));
+  if (facts.count == 0 && !las) return badInput(path, "holds no points");
   facts.j["points"] = facts.count;
   if (!facts.bounds.empty())
     facts.j["bounds"] = {{"min", {facts.bounds.min.x, facts.bounds.min.y, facts.bounds.min.z}},
@@ -454,15 +458,15 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
   CLI::App* sub = app.add_subcommand("info", "Print a file's format, counts, bounds and load cost");
   sub->add_option(
          "FILE", options->path,
-         "A .ply .obj .stl .gltf .glb model, a .step .iges .brep CAD file, a .las .xyz .txt .csv "
-         ".pts point file, or a .lfp or .lfc package")
+         "A .ply .obj .stl .gltf .glb model, a .step .iges .brep CAD file, a .las .laz .xyz .txt "
+         ".csv .pts point file, or a .lfp or .lfc package")
       ->required();
   sub->add_flag("--json", options->json, "Print JSON instead of text");
   sub->add_flag("--header-only", options->headerOnly,
                 "LAS and LAZ: the header alone, without reading the points for the ranges of "
                 "their fields");
   sub->add_flag("--salvage", options->salvage,
-                "Read a truncated PLY up to the cut (with a warning)");
+                "Read a truncated PLY, STEP or IFC up to the cut (with a warning)");
   addCadOptions(*sub, options->cad);
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
@@ -479,12 +483,15 @@ void addInfo(CLI::App& app, const Global& global, Run& run) {
       const FileFormat format = formatFromPath(options->path);
       Result<std::uint64_t> bytes = fileSize(options->path);
       if (!bytes) return bytes.status();
-      Result<CadReadOptions> cad = cadOptions(options->cad);
+      Result<CadReadOptions> cad = cadOptions(options->cad, global);
       if (!cad) return cad.status();
-      Result<Summary> summary = format == FileFormat::kPly
-                                    ? summarizePly(options->path, options->salvage)
-                                    : summarizeLoaded(options->path, format, *cad);
+      Result<Summary> summary =
+          format == FileFormat::kPly
+              ? summarizePly(options->path, options->salvage)
+              : summarizeLoaded(options->path, format, *cad, options->salvage);
       if (!summary) return summary.status();
+      if (summary->vertices == 0)
+        return badInput(options->path, "holds no vertices: neither a mesh nor a point set");
       summary->fileBytes = *bytes;
       if (options->json)
         fmt::print("{}\n", toJson(options->path, *summary).dump(2));

@@ -144,9 +144,16 @@ void printPointAttributes(const nlohmann::json& attributes) {
     }
   }
   if (!attributes.contains("classification")) return;
+  // JSON keys are text ("11" < "2"): the classes are listed by their number.
+  std::vector<std::pair<int, const nlohmann::json*>> classes;
   for (const auto& [value, entry] : attributes["classification"].items())
+    classes.emplace_back(std::stoi(value), &entry);
+  std::sort(classes.begin(), classes.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [value, entry] : classes)
     fmt::print("class {:<9}{} points, {}\n", value,
-               formatCount(entry["points"].get<std::uint64_t>()), entry["name"].get<std::string>());
+               formatCount((*entry)["points"].get<std::uint64_t>()),
+               (*entry)["name"].get<std::string>());
 }
 
 }  // namespace lodforge::cli

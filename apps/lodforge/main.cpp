@@ -25,8 +25,9 @@ int main(int argc, char** argv) {
       "-q,--quiet", [&] { global.verbosity = -1; }, "Only errors (no progress, no summary)");
   CLI::Option* memoryLimit =
       cli::addByteSizeOption(app, "--memory-limit", global.memoryLimit,
-                             "Memory the command may use (e.g. 2G); taken by tiles, points, build "
-                             "and convert, which refuse a limit too small to work with");
+                             "Memory the command may use (e.g. 2G); taken by tiles, points, build, "
+                             "convert and reconstruct, which refuse a limit too small to work "
+                             "with (exit 1, naming the least that works)");
 
   cli::Run run;
   cli::addInfo(app, global, run);

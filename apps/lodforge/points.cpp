@@ -24,7 +24,7 @@ void addPoints(CLI::App& app, const Global& global, Run& run) {
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
       "points", "Build a point package (.lfc): blocks, clustering LODs, segment files");
-  sub->add_option("INPUT", options->input, "A .las .ply .xyz .txt .csv or .pts point cloud")
+  sub->add_option("INPUT", options->input, "A .las .laz .ply .xyz .txt .csv or .pts point cloud")
       ->required();
   sub->add_option("-o,--output", options->output,
                   "The .lfc package to write (segment files go "

@@ -217,6 +217,25 @@ void sizeForViewers(httplib::Server& server) {
   server.set_tcp_nodelay(true);  // headers and body go out as two writes: no Nagle wait
 }
 
+// The size of the file a request's path names (a tile or a viewer's file), if it is one.
+std::optional<std::uint64_t> servedSize(const fs::path& root, const fs::path& web,
+                                        const std::string& path) {
+  const auto sizeIn = [](const fs::path& folder,
+                         const std::string& relative) -> std::optional<std::uint64_t> {
+    if (folder.empty()) return std::nullopt;
+    const ResolvedPath resolved = resolveInside(folder, relative);
+    std::error_code error;
+    const std::uint64_t size = resolved.status == 200 ? fs::file_size(resolved.path, error) : 0;
+    if (resolved.status != 200 || error) return std::nullopt;
+    return size;
+  };
+  if (path.starts_with("/tiles/")) return sizeIn(root, path.substr(7));
+  for (const std::string_view viewer : {"/cesium/", "/three/", "/assets/"})
+    if (path.starts_with(viewer))
+      return sizeIn(web, path.substr(1) + (path.ends_with('/') ? "index.html" : ""));
+  return std::nullopt;
+}
+
 // GET and HEAD only (with the CORS header if asked); the viewers at /cesium/ and /three/ (built
 // by `make` into web/dist), the tileset at /tiles/.
 void addRoutes(httplib::Server& server, const ServeOptions& o, const fs::path& root,
@@ -231,6 +250,18 @@ void addRoutes(httplib::Server& server, const ServeOptions& o, const fs::path& r
     if (o.cors) response.set_header("Access-Control-Allow-Origin", "*");
     return httplib::Server::HandlerResponse::Unhandled;
   });
+  // cpp-httplib answers a Range it cannot parse ("bytes=10-5") with 416 itself, before any
+  // route: the file's size goes with it here, as RFC 9110 §15.5.17 asks.
+  const httplib::Server::HandlerWithResponse withSize = [&](const httplib::Request& request,
+                                                            httplib::Response& response) {
+    if (response.status != 416 || response.has_header("Content-Range"))
+      return httplib::Server::HandlerResponse::Unhandled;
+    const std::optional<std::uint64_t> size = servedSize(root, web, request.path);
+    if (!size) return httplib::Server::HandlerResponse::Unhandled;
+    response.set_header("Content-Range", fmt::format("bytes */{}", *size));
+    return httplib::Server::HandlerResponse::Handled;
+  };
+  server.set_error_handler(withSize);
   server.Get("/", [](const httplib::Request&, httplib::Response& response) {
     response.set_redirect("/cesium/");
   });

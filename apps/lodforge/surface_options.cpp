@@ -37,8 +37,9 @@ Result<NormalOptions> parseOrientation(const std::string& text, const std::strin
 
 void addSurfaceOptions(CLI::App& sub, SurfaceCommand& options) {
   sub.add_option("--voxel", options.reconstruct.voxel,
-                 "Surface: voxel edge in the cloud's units (default: twice the median point "
-                 "spacing)")
+                 "Surface: voxel edge in the cloud's units, as `info` gives its bounds (feet for "
+                 "a CRS in feet, also when the tiles are placed on Earth); 0 or left out: twice "
+                 "the median point spacing")
       ->check(CLI::NonNegativeNumber);
   sub.add_option("--radius", options.reconstruct.distance.radius,
                  "Surface: points within this many voxels of a corner set its distance (default 3)")

@@ -78,16 +78,17 @@ struct TilesCommand {
 void addTilesOptions(CLI::App& sub, TilesCommand& options) {
   sub.add_option("INPUT", options.input,
                  "A .ply .obj .stl .gltf or .glb mesh or assembly, a .step .iges .brep CAD file, "
-                 "an .lfp package, or a point cloud (.las .xyz .txt .csv .pts, or a PLY without "
-                 "faces)")
+                 "an .lfp package, or a point cloud (.las .laz .xyz .txt .csv .pts, or a PLY "
+                 "without faces)")
       ->required();
   sub.add_option("-o,--output", options.output, "The tileset directory to write")->required();
   sub.add_option("--chunk-size", options.chunkSize,
-                 "Edge of a leaf chunk in model units (default: about 64K triangles per leaf)")
+                 "Meshes: edge of a leaf chunk in model units (default: about 64K triangles per "
+                 "leaf); with --surface, in the cloud's units (default 64 voxels)")
       ->check(CLI::NonNegativeNumber);
   sub.add_option("--levels", options.levels,
-                 "Levels above the leaves; leaves are made small enough for them (default: "
-                 "up to one root)")
+                 "Meshes: levels above the leaves; leaves are made small enough for them "
+                 "(default: up to one root)")
       ->check(CLI::NonNegativeNumber);
   sub.add_option("--reduction", options.reduction,
                  "Share of its children's triangles a parent tile keeps (default 0.2)")
@@ -133,9 +134,10 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
   addSurfaceOptions(sub, options.surfaceOptions);
   addCadOptions(sub, options.cad);
   sub.add_flag("--salvage", options.salvage,
-               "Read a PLY cut short up to its last whole element (with a warning)");
+               "Read a PLY, STEP or IFC cut short up to the cut (with a warning)");
   sub.add_flag("--resume", options.resume,
-               "Continue an interrupted run from OUTPUT.work (same input and options)");
+               "Meshes and --surface: continue an interrupted run from OUTPUT.work (same input "
+               "and options)");
 }
 
 // The command line as the mesh pipeline's options.
@@ -143,7 +145,7 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
   TilesOptions tiles;
   tiles.input.chunkSize = options.chunkSize;
   tiles.input.salvageTruncated = options.salvage;
-  Result<CadReadOptions> cad = cadOptions(options.cad);
+  Result<CadReadOptions> cad = cadOptions(options.cad, global);
   if (!cad) return cad.status();
   tiles.input.cad = *cad;
   tiles.octree.levels = options.levels;
@@ -215,8 +217,8 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
     say(global,
         fmt::format("reconstructed {} triangles from {} points (voxel {:g}, chunks of {} voxels, "
                     "{} runs{}{}{})",
-                    formatCount(surface.triangles), formatCount(surface.points), surface.grid.voxel,
-                    surface.chunkVoxels, surface.runs,
+                    formatCount(surface.triangles), formatCount(surface.points),
+                    surface.grid.voxel / surface.unitScale, surface.chunkVoxels, surface.runs,
                     surface.resumedRuns > 0 ? fmt::format(", {} resumed", surface.resumedRuns) : "",
                     surface.estimatedNormals ? ", normals estimated" : "",
                     surface.droppedPieces > 0
@@ -296,6 +298,7 @@ Status runSurfaceTiles(const Global& global, const TilesCommand& options, TilesO
         options.input,
         {.batchPoints = 1, .salvageTruncated = options.salvage, .readExtras = false});
     if (reader) tiles.crs = reader->info().crs;
+    tiles.crsFrom = fmt::format("the coordinate system in {}", options.input);
   }
   return runMeshTiles(global, options, tiles);
 }

@@ -22,6 +22,10 @@ TEST(Units, CountsUseDecimalMultiples) {
   EXPECT_EQ(parseCount("1G"), 1'000'000'000u);
   EXPECT_EQ(parseCount("2.5M"), 2'500'000u);
   EXPECT_EQ(parseCount("1000000"), 1'000'000u);
+  // A count is whole: 1.5 threads or 2.5 points is refused, not rounded.
+  for (const char* fraction : {"1.5", "0.5", "2.0005K"})
+    EXPECT_FALSE(parseCount(fraction).has_value()) << fraction;
+  EXPECT_EQ(parseByteSize("0.5K"), 512u);  // sizes are rounded to the byte
 }
 
 TEST(Units, RejectsWhatIsNotASize) {

@@ -201,6 +201,11 @@ try {
     writeFileSync(shot, png);
     // Share of pixels that differ from the page's background (#12151a) and the panel.
     const coverage = await coverageOf(tab, png, [0x12, 0x15, 0x1a], 'panel');
+    // Each viewer opens on the whole tileset: every corner of the root's box on screen.
+    const view = await tab.evaluate(() => [window.innerWidth, window.innerHeight, window.lodforge.rootCorners()]);
+    const off = view[2].filter((c) => !c || c[0] < 0 || c[1] < 0 || c[0] > view[0] || c[1] > view[1]);
+    if (view[2].length === 0) mine('the viewer gives no corner of the root box');
+    if (off.length > 0) mine(`${off.length} of the root box's ${view[2].length} corners are off screen: ${JSON.stringify(off[0])}`);
     console.log(`${viewer}: ${report.tilesLoaded} tiles loaded, "${stats}", model covers ${(100 * coverage).toFixed(1)} % (${shot})`);
     if (coverage < minCoverage) mine(`the model covers ${(100 * coverage).toFixed(2)} % of the view`);
     if (report.colorModes) await checkColorModes(tab, viewer, coverage, png, mine);

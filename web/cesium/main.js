@@ -195,9 +195,13 @@ async function main() {
     pointCloudShading: { attenuation: true, maximumAttenuation: 6 },
   });
   viewer.scene.primitives.add(tileset);
+  frameTileset(viewer, tileset);
+  report.rootCorners = () => rootCorners(viewer, tileset);
   tileset.tileFailed.addEventListener((e) => report.failed.push(`${e.url}: ${e.message}`));
   tileset.tileLoad.addEventListener(() => { report.tilesLoaded += 1; });
-  tileset.allTilesLoaded.addEventListener(() => { report.loaded = true; });
+  // Loaded: every tile the view needs, once the panels are set up too (the tiles may be in first).
+  let setUp = false;
+  tileset.allTilesLoaded.addEventListener(() => { if (setUp) report.loaded = true; });
   // What is drawn this frame: tiles, and their triangles or points.
   let drawn = { tiles: 0, triangles: 0, points: 0 };
   tileset.tileVisible.addEventListener((tile) => {
@@ -221,7 +225,47 @@ async function main() {
   });
   await addColouring(viewer.scene, tileset);
   await addParts(viewer, tileset);
-  await viewer.flyTo(tileset, { duration: 0 });
+  setUp = true;
+  if (tileset.tilesLoaded) report.loaded = true;
+}
+
+// The camera looks down at 45 degrees from where the root's bounding sphere just fills the
+// narrower field of view, so the whole tileset is on screen when it opens (viewer.flyTo
+// zoomed into big tilesets: an airborne cloud opened on a few trees at ground level).
+function frameTileset(viewer, tileset) {
+  const sphere = tileset.boundingSphere;
+  // Cesium's `fov` is the wider of the two angles; `fovy` the vertical.
+  const frustum = viewer.camera.frustum;
+  const half = Math.min(frustum.fov, frustum.fovy) / 2;
+  const range = (1.05 * sphere.radius) / Math.sin(half);
+  viewer.camera.flyToBoundingSphere(sphere, {
+    duration: 0,
+    offset: new Cesium.HeadingPitchRange(0, -Math.PI / 4, range),
+  });
+}
+
+// For tests: the root's bounding box corners in CSS pixels of the canvas (null: behind the
+// camera).
+function rootCorners(viewer, tileset) {
+  const volume = tileset.root.boundingVolume.boundingVolume;
+  const corners = [];
+  if (volume instanceof Cesium.OrientedBoundingBox) {
+    const axes = [0, 1, 2].map((c) => Cesium.Matrix3.getColumn(volume.halfAxes, c, new Cesium.Cartesian3()));
+    for (let i = 0; i < 8; ++i) {
+      const corner = Cesium.Cartesian3.clone(volume.center);
+      for (let a = 0; a < 3; ++a) {
+        const step = Cesium.Cartesian3.multiplyByScalar(axes[a], (i >> a) & 1 ? 1 : -1, new Cesium.Cartesian3());
+        Cesium.Cartesian3.add(corner, step, corner);
+      }
+      corners.push(corner);
+    }
+  } else {
+    corners.push(tileset.boundingSphere.center);
+  }
+  return corners.map((c) => {
+    const p = Cesium.SceneTransforms.worldToWindowCoordinates(viewer.scene, c);
+    return p ? [p.x, p.y] : null;
+  });
 }
 
 main().catch((e) => { report.error = String((e && e.stack) || e); });

@@ -293,6 +293,24 @@ function main() {
     colouring.heights = [sphere.center.y - sphere.radius, sphere.center.y + sphere.radius];
     return true;
   };
+  // For tests: the root's bounding box corners in CSS pixels (null: behind the camera).
+  report.rootCorners = () => {
+    const root = tiles.rootTileSet && tiles.rootTileSet.root;
+    const box = root && root.boundingVolume && root.boundingVolume.box;
+    if (!box) return [];
+    const toTiles = root.transform ? new THREE.Matrix4().fromArray(root.transform) : new THREE.Matrix4();
+    const corners = [];
+    for (let i = 0; i < 8; ++i) {
+      const corner = new THREE.Vector3(box[0], box[1], box[2]);
+      for (let a = 0; a < 3; ++a) {
+        const sign = (i >> a) & 1 ? 1 : -1;
+        corner.add(new THREE.Vector3(box[3 + 3 * a], box[4 + 3 * a], box[5 + 3 * a]).multiplyScalar(sign));
+      }
+      const ndc = corner.applyMatrix4(toTiles).applyMatrix4(tiles.group.matrixWorld).project(camera);
+      corners.push(ndc.z > 1 ? null : [((ndc.x + 1) / 2) * window.innerWidth, ((1 - ndc.y) / 2) * window.innerHeight]);
+    }
+    return corners;
+  };
   tiles.addEventListener('load-model', (e) => {
     report.tilesLoaded += 1;
     e.scene.traverse((o) => { if (o.isPoints) preparePoints(o); });

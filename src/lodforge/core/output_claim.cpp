@@ -1,12 +1,16 @@
 #include "lodforge/core/output_claim.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <filesystem>
+#include <vector>
 
 namespace lodforge {
 
@@ -113,7 +117,46 @@ Status claimOutput(const std::string& output, const OutputKind& kind,
                    std::span<const std::string> inputs) {
   LODFORGE_TRY(refuseInputs(output, kind, inputs));
   LODFORGE_TRY(refuseForeign(output, kind));
-  return checkWritableParent(output);
+  LODFORGE_TRY(checkWritableParent(output));
+  removeDeadLeftovers(output);
+  return {};
+}
+
+std::optional<int> leftoverProcess(std::string_view name, std::string_view output) {
+  if (!name.starts_with(output) || name.size() <= output.size() || name[output.size()] != '.')
+    return std::nullopt;
+  std::string_view rest = name.substr(output.size() + 1);
+  if (rest.starts_with("work.")) rest.remove_prefix(5);
+  if (!rest.starts_with("tmp-")) return std::nullopt;
+  rest.remove_prefix(4);
+  int pid = 0;
+  const auto [afterPid, error] = std::from_chars(rest.data(), rest.data() + rest.size(), pid);
+  if (error != std::errc() || pid <= 0 || afterPid == rest.data() + rest.size() || *afterPid != '-')
+    return std::nullopt;
+  const char* n = afterPid + 1;
+  const char* end = rest.data() + rest.size();
+  if (n == end || !std::isdigit(static_cast<unsigned char>(*n))) return std::nullopt;
+  while (n != end && std::isdigit(static_cast<unsigned char>(*n))) ++n;
+  if (n != end && *n != '.') return std::nullopt;
+  return pid;
+}
+
+std::size_t removeDeadLeftovers(const std::string& output) {
+  fs::path path(output);
+  while (!path.empty() && path.filename().empty()) path = path.parent_path();  // "dir/"
+  const std::string base = path.filename().string();
+  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  std::error_code error;
+  std::vector<fs::path> dead;
+  for (fs::directory_iterator it(parent, error), end; !error && it != end; it.increment(error)) {
+    const std::optional<int> pid = leftoverProcess(it->path().filename().string(), base);
+    // kill(pid, 0) fails with ESRCH only when no such process runs (EPERM: it runs, not ours).
+    if (pid && *pid != ::getpid() && ::kill(*pid, 0) != 0 && errno == ESRCH)
+      dead.push_back(it->path());
+  }
+  std::size_t removed = 0;
+  for (const fs::path& p : dead) removed += fs::remove_all(p, error) > 0 ? 1u : 0u;
+  return removed;
 }
 
 bool isWorkDirectory(const std::string& path) {

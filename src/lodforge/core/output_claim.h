@@ -4,7 +4,9 @@
 // exit 2), and a place that cannot be written is an I/O error (exit 1) — all before any work.
 #pragma once
 
+#include <cstddef>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -33,6 +35,14 @@ Status refuseDirectoryInput(const std::string& path);
 // missing parent directories and checks that the parent can be written.
 Status claimOutput(const std::string& output, const OutputKind& kind,
                    std::span<const std::string> inputs);
+
+// The leftovers of an earlier run at `output` killed before it could clean up (SIGKILL, a power
+// cut): the names lodforge gives its temporaries there ("OUTPUT.tmp-PID-N…", and
+// "OUTPUT.work.tmp-PID-N…" for work directories) whose process PID no longer runs. Removes them
+// (claimOutput does) and returns how many; anything else, and a running process's, is left.
+std::size_t removeDeadLeftovers(const std::string& output);
+// The PID in a temporary's `name` made for `output` (a file name, no folder), if it is one.
+std::optional<int> leftoverProcess(std::string_view name, std::string_view output);
 
 // Work directories with stable names (kept for --resume) carry a marker file; one without it is
 // the user's and is refused. Creates the directory (with its marker) when it does not exist.

@@ -10,7 +10,8 @@ namespace lodforge {
 
 namespace {
 
-std::optional<std::uint64_t> parseScaled(std::string_view text, double base) {
+// `whole`: a value that is not a whole number (a count of 1.5) is refused, not rounded.
+std::optional<std::uint64_t> parseScaled(std::string_view text, double base, bool whole) {
   while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back())))
     text.remove_suffix(1);
   while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front())))
@@ -56,16 +57,17 @@ std::optional<std::uint64_t> parseScaled(std::string_view text, double base) {
   if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
   const double scaled = value * multiplier;
   if (!std::isfinite(scaled) || scaled < 0 || scaled > 1.8e19) return std::nullopt;
+  if (whole && scaled != std::floor(scaled)) return std::nullopt;
   return static_cast<std::uint64_t>(std::llround(scaled));
 }
 
 }  // namespace
 
 std::optional<std::uint64_t> parseByteSize(std::string_view text) {
-  return parseScaled(text, 1024);
+  return parseScaled(text, 1024, false);
 }
 std::optional<std::uint64_t> parseCount(std::string_view text) {
-  return parseScaled(text, 1000);
+  return parseScaled(text, 1000, true);
 }
 
 std::string formatBytes(std::uint64_t bytes) {

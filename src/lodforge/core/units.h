@@ -9,7 +9,9 @@
 
 namespace lodforge {
 
+// "512M", "2GiB", "1.5K" (binary multiples, rounded to the byte).
 std::optional<std::uint64_t> parseByteSize(std::string_view text);
+// "10K", "2.5M", "1000" (decimal multiples); a value that is not whole ("1.5") is refused.
 std::optional<std::uint64_t> parseCount(std::string_view text);
 
 // "1.5 GiB", "312 KiB", "17 B".

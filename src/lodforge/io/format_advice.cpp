@@ -14,12 +14,14 @@ struct Advice {
   std::string_view how;
 };
 
-constexpr std::string_view kMeshHow =
-    "convert it to .ply, .obj or .glb first, e.g. with MeshLab, Blender or assimp "
-    "(`assimp export IN OUT.glb`)";
-
-constexpr std::array<Advice, 5> kAdvice = {{
-    {" wrl vrml vtk vtp usd usdz ", "a mesh format", kMeshHow},
+// Only tools that read the format: Debian's assimp reads none of these.
+constexpr std::array<Advice, 7> kAdvice = {{
+    {" wrl vrml ", "a VRML scene",
+     "export it as .glb, .ply or .obj first, e.g. with MeshLab or Blender (File > Import > "
+     "X3D/VRML)"},
+    {" vtk vtp ", "a VTK mesh", "save it as .ply first, e.g. with ParaView (File > Save Data)"},
+    {" usd usda usdc usdz ", "a USD scene",
+     "export it as .glb first, e.g. with Blender (File > Export > glTF 2.0)"},
     {" pcd ", "a PCL point cloud",
      "save it as .ply or as text .xyz first, e.g. with `pcl_pcd2ply` or CloudCompare"},
     {" e57 ", "an E57 scan",

@@ -13,7 +13,7 @@ namespace lodforge {
 inline constexpr std::string_view kMeshFormats =
     ".ply .obj .stl .gltf .glb meshes, .step .stp .iges .igs .brep CAD models and .off .fbx .dae "
     ".3ds .3mf .ifc .x3d (assimp) scenes";
-inline constexpr std::string_view kPointFormats = ".las .ply .xyz .txt .csv .pts point clouds";
+inline constexpr std::string_view kPointFormats = ".las .laz .ply .xyz .txt .csv .pts point clouds";
 
 // A usage error (exit 2): "PATH: unknown format (this command reads READS)", or for a known
 // extension "PATH: a STEP CAD model, which lodforge does not read yet: ADVICE".

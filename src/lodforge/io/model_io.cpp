@@ -13,6 +13,7 @@
 #include "lodforge/io/mesh/ply_writer.h"
 #include "lodforge/io/mesh/stl_reader.h"
 #include "lodforge/io/mesh/stl_writer.h"
+#include "lodforge/io/part21.h"
 
 namespace lodforge {
 
@@ -73,9 +74,15 @@ Result<Model> readModel(const std::string& path, const ReadOptions& options) {
     case FileFormat::kGltf:
     case FileFormat::kGlb:
       return readGltf(path);
-    case FileFormat::kCad:
-      return readCad(path, options.cad, options.warnings);
+    case FileFormat::kCad: {
+      CadReadOptions cad = options.cad;
+      cad.salvageTruncated = cad.salvageTruncated || options.salvageTruncated;
+      return readCad(path, cad, options.warnings);
+    }
     case FileFormat::kAssimp:
+      // IFC is an ISO 10303-21 exchange structure, whose end assimp does not check.
+      if (fileExtension(path) == "ifc")
+        LODFORGE_TRY(checkPart21Whole(path, options.salvageTruncated, options.warnings));
       return readAssimp(path);
     case FileFormat::kUnknown:
       break;

@@ -23,7 +23,8 @@ bool canRead(FileFormat format);
 bool canWrite(FileFormat format);
 
 struct ReadOptions {
-  // Keep what a truncated PLY holds up to the cut instead of refusing it (adds a warning).
+  // Keep what a truncated PLY, STEP or IFC holds up to the cut instead of refusing it (adds a
+  // warning).
   bool salvageTruncated = false;
   std::vector<std::string>* warnings = nullptr;
   CadReadOptions cad;  // tessellation of CAD files

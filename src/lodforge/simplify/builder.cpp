@@ -119,7 +119,6 @@ void count(const Built& b, BuildStats& stats) {
 
 Result<BuildStats> build(const std::string& input, ObjectStream& stream, const std::string& output,
                          const BuildOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
   if (options.memoryLimit && options.memoryLimit < kFixedBytes + (std::uint64_t{4} << 20)) {
     return Error{
         ErrorKind::kLimit,
@@ -180,7 +179,6 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
   if (!size) return size.status();
   stats.packageBytes = *size;
   stats.shapeCacheBytes = shapes.bytes();
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 
@@ -188,17 +186,25 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
 
 Result<BuildStats> buildPackage(const std::string& input, const std::string& output,
                                 const BuildOptions& options) {
+  // The time of the whole build: a CAD file is read and tessellated when its stream opens.
+  const auto start = std::chrono::steady_clock::now();
+  const auto timed = [&](Result<BuildStats> stats) {
+    if (stats)
+      stats->seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return stats;
+  };
   ObjectStreamOptions streamOptions{options.read, false};
   Result<std::unique_ptr<ObjectStream>> stream = openObjectStream(input, streamOptions);
   if (!stream) return stream.status();
   Result<BuildStats> stats = build(input, **stream, output, options);
-  if (stats.ok() || stats.error().kind != ErrorKind::kUnsupported) return stats;
+  if (stats.ok() || stats.error().kind != ErrorKind::kUnsupported) return timed(std::move(stats));
   // The PLY's objects are not grouped: load it whole instead of streaming (objects get grouped
   // by the reader), as long as it fits.
   streamOptions.load = true;
   stream = openObjectStream(input, streamOptions);
   if (!stream) return stream.status();
-  return build(input, **stream, output, options);
+  return timed(build(input, **stream, output, options));
 }
 
 }  // namespace lodforge

@@ -30,6 +30,18 @@ Vec3f transformedNormal(const std::function<bool(Vec3d, Vec3d&)>& transform, Vec
   return normalizeOr(toFloat(tip - to), normal);
 }
 
+// The local length of one input unit at `from` (placed at `to`): along x for a projected CRS,
+// along z where x is in degrees (a geographic CRS: its heights are in metres or feet).
+double unitScaleAt(const std::function<bool(Vec3d, Vec3d&)>& transform, Vec3d from, Vec3d to) {
+  Vec3d step;
+  if (!transform(from + Vec3d{1, 0, 0}, step)) return 1;
+  const double along = length(step - to);
+  if (along > 1e-3 && along < 1e3) return along;
+  if (!transform(from + Vec3d{0, 0, 1}, step)) return 1;
+  const double up = length(step - to);
+  return up > 0 && std::isfinite(up) ? up : 1;
+}
+
 }  // namespace
 
 Result<RecordWriter> RecordWriter::create(const std::string& path, std::size_t bufferBytes) {
@@ -68,6 +80,7 @@ Result<CloudSummary> copyCloud(const std::string& input, const std::string& path
                                              batch.positions[i].z));
         if (!batch.normals.empty())
           r.normal = transformedNormal(transform, batch.positions[i], r.position, r.normal);
+        if (r.id == 0) cloud.unitScale = unitScaleAt(transform, batch.positions[i], r.position);
       }
       cloud.bounds.add(r.position);
       if (!batch.colors.empty()) r.color = batch.colors[i];

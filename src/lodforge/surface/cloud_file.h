@@ -28,6 +28,9 @@ struct CloudSummary {
   std::uint64_t count = 0;
   Aabbd bounds;
   bool hasNormals = false, hasColors = false;
+  // The local frame's length of one of the input's units (0.3048 for a CRS in feet; 1 without
+  // a transform): lengths the user gives in the cloud's units are multiplied by it.
+  double unitScale = 1;
 };
 
 // Reads `input` (any point format) into the record file `path`, normals made unit (+z where the

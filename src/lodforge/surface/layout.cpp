@@ -96,6 +96,22 @@ Status checkSurfaceExtent(std::uint64_t points, const Aabbd& bounds, const std::
   return {};
 }
 
+Status checkVoxelFits(const Aabbd& bounds, double voxel, double unitScale,
+                      const std::string& name) {
+  assert(unitScale > 0);
+  const Vec3d size = bounds.max - bounds.min;
+  const double longest = std::max({size.x, size.y, size.z});
+  if (voxel <= longest / 4) return {};
+  const auto units = [&](double v) { return v / unitScale; };
+  return Error{ErrorKind::kUsage,
+               fmt::format("{}: --voxel {:g} is more than a quarter of the cloud, which is "
+                           "{:.4g} × {:.4g} × {:.4g}: a surface needs voxels across it; give "
+                           "--voxel {:.4g} or less, or leave it out (twice the points' median "
+                           "spacing)",
+                           name, units(voxel), units(size.x), units(size.y), units(size.z),
+                           units(longest / 4))};
+}
+
 Result<ChunkLayout> layOutChunks(const Aabbd& bounds, double voxel, std::uint32_t chunkVoxels,
                                  double radius, const std::string& name) {
   assert(!bounds.empty() && radius >= 0);

@@ -55,5 +55,9 @@ Result<ChunkLayout> layOutChunks(const Aabbd& bounds, double voxel, std::uint32_
 
 // Bad input for a surface: fewer than 4 points, or all on a line or at one position.
 Status checkSurfaceExtent(std::uint64_t points, const Aabbd& bounds, const std::string& name);
+// A voxel the user gave must fit a quarter of the cloud's longest side (a larger one makes a
+// handful of triangles far bigger than the cloud); a usage error says the size and a voxel that
+// works, in the cloud's units (`unitScale`: the frame's length of one, CloudSummary).
+Status checkVoxelFits(const Aabbd& bounds, double voxel, double unitScale, const std::string& name);
 
 }  // namespace lodforge

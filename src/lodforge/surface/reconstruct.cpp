@@ -63,12 +63,14 @@ int threads() {
 Status checkChunkFits(const ChunkLayout& layout, const ReconstructOptions& options,
                       const std::string& name) {
   const std::uint64_t grids = gridBytes(layout.n) * static_cast<std::uint64_t>(threads());
+  // A limit too small is a limit (exit 1), as in every command, with the least that works.
   if (options.memoryLimit > 0 && grids > options.memoryLimit / 2)
-    return Error{ErrorKind::kUsage,
+    return Error{ErrorKind::kLimit,
                  fmt::format("{}: {} chunks of {}³ voxels in flight need {} of grid, more than "
-                             "half of --memory-limit {}: use a smaller --chunk-size",
+                             "half of --memory-limit {}: give at least --memory-limit {}, or a "
+                             "smaller --chunk-size",
                              name, threads(), layout.n, formatBytes(grids),
-                             formatBytes(options.memoryLimit))};
+                             formatBytes(options.memoryLimit), formatBytes(2 * grids))};
   return {};
 }
 
@@ -81,13 +83,14 @@ std::uint64_t runBudget(const ChunkLayout& layout, const ReconstructOptions& opt
   return std::max<std::uint64_t>(10'000, left / kBytesPerRunPoint);
 }
 
-double voxelFor(const ReconstructOptions& options, double spacing) {
-  return options.voxel > 0 ? options.voxel : 2 * spacing;
+// The options' lengths are in the cloud's units; `unitScale` makes them the frame's.
+double voxelFor(const ReconstructOptions& options, double spacing, double unitScale) {
+  return options.voxel > 0 ? options.voxel * unitScale : 2 * spacing;
 }
 
-std::uint32_t chunkVoxelsFor(const ReconstructOptions& options, double voxel) {
+std::uint32_t chunkVoxelsFor(const ReconstructOptions& options, double voxel, double unitScale) {
   if (options.chunkLength <= 0) return options.chunkVoxels;
-  const double n = std::round(options.chunkLength / voxel);
+  const double n = std::round(options.chunkLength * unitScale / voxel);
   return static_cast<std::uint32_t>(std::clamp(n, 4.0, 4096.0));
 }
 
@@ -386,9 +389,12 @@ Result<ReconstructState> sortIntoRuns(const std::string& input, const std::strin
     if (!measured) return measured.status();
     spacing = *measured;
   }
-  const double voxel = voxelFor(options, spacing);
-  Result<ChunkLayout> layout = layOutChunks(cloud->bounds, voxel, chunkVoxelsFor(options, voxel),
-                                            options.distance.radius, input);
+  const double voxel = voxelFor(options, spacing, cloud->unitScale);
+  if (options.voxel > 0)
+    LODFORGE_TRY(checkVoxelFits(cloud->bounds, voxel, cloud->unitScale, input));
+  Result<ChunkLayout> layout =
+      layOutChunks(cloud->bounds, voxel, chunkVoxelsFor(options, voxel, cloud->unitScale),
+                   options.distance.radius, input);
   if (!layout) return layout.status();
   LODFORGE_TRY(checkChunkFits(*layout, options, input));
   const double reach = options.distance.radius + 1;
@@ -405,8 +411,8 @@ Result<ReconstructState> sortIntoRuns(const std::string& input, const std::strin
   LODFORGE_TRY(writeRuns(cloudPath, *layout, reach, *runs, workDirectory));
   std::error_code error;
   std::filesystem::remove(cloudPath, error);
-  return ReconstructState{*layout, std::move(*runs), cloud->count, cloud->hasColors,
-                          !cloud->hasNormals};
+  return ReconstructState{*layout,          std::move(*runs),   cloud->count,
+                          cloud->hasColors, !cloud->hasNormals, cloud->unitScale};
 }
 
 // Passes each piece on and keeps it in the run's pieces file.
@@ -494,6 +500,7 @@ Result<ReconstructStats> reconstructPieces(const std::string& input,
   }
   ReconstructStats stats;
   stats.grid = state->layout.grid;
+  stats.unitScale = state->unitScale;
   stats.chunkVoxels = state->layout.n;
   stats.points = state->points;
   stats.chunks = state->layout.chunkCount();
@@ -561,9 +568,10 @@ Result<ReconstructedMesh> reconstructPoints(std::vector<Vec3d> positions,
   std::optional<PointIndex> index;
   if (options.voxel <= 0 || normals.empty()) index.emplace(positions);
   const double spacing = options.voxel > 0 ? 0 : medianSpacing(positions, *index);
-  const double voxel = voxelFor(options, spacing);
+  const double voxel = voxelFor(options, spacing, 1);
+  if (options.voxel > 0) LODFORGE_TRY(checkVoxelFits(bounds, voxel, 1, name));
   Result<ChunkLayout> layout =
-      layOutChunks(bounds, voxel, chunkVoxelsFor(options, voxel), options.distance.radius, name);
+      layOutChunks(bounds, voxel, chunkVoxelsFor(options, voxel, 1), options.distance.radius, name);
   if (!layout) return layout.status();
   LODFORGE_TRY(checkChunkFits(*layout, options, name));
   ReconstructedMesh mesh;

@@ -28,9 +28,11 @@
 namespace lodforge {
 
 struct ReconstructOptions {
-  double voxel = 0;                // metres; 0: twice the median spacing of the points
+  // Lengths in the cloud's own units (feet for a CRS in feet), also when `transform` places the
+  // points in a local frame in metres: they are scaled with the points.
+  double voxel = 0;                // 0: twice the median spacing of the points
   std::uint32_t chunkVoxels = 64;  // N: voxels along a chunk's edge
-  double chunkLength = 0;          // metres; when > 0, N is this over the voxel (at least 4)
+  double chunkLength = 0;          // when > 0, N is this over the voxel (at least 4)
   DistanceOptions distance;        // radius in voxels, fewest points near a corner
   NormalOptions normals;           // for points without normals
   std::uint64_t memoryLimit = 0;   // bytes, 0: the default budget (kDefaultRunPoints a run)
@@ -53,7 +55,8 @@ struct ReconstructOptions {
 constexpr std::uint64_t kDefaultRunPoints = 200'000;
 
 struct ReconstructStats {
-  VoxelGrid grid;
+  VoxelGrid grid;        // in the frame the points were placed in (local metres with a transform)
+  double unitScale = 1;  // that frame's length of one of the cloud's units (CloudSummary)
   std::uint32_t chunkVoxels = 0;
   std::uint64_t points = 0, chunks = 0, runs = 0, vertices = 0, triangles = 0;
   std::uint64_t droppedPieces = 0;

@@ -13,7 +13,7 @@ namespace lodforge {
 
 namespace {
 
-constexpr int kStateFormat = 1;
+constexpr int kStateFormat = 2;  // 2: the unit scale (lengths in the cloud's units)
 
 struct PieceHeader {
   std::uint64_t chunk = 0, vertices = 0, indices = 0, colors = 0;
@@ -63,7 +63,8 @@ Status saveReconstructState(const std::string& path, const nlohmann::json& ident
                                {"firstChunk", state.runs.firstChunk},
                                {"points", state.points},
                                {"hasColors", state.hasColors},
-                               {"estimatedNormals", state.estimatedNormals}};
+                               {"estimatedNormals", state.estimatedNormals},
+                               {"unitScale", state.unitScale}};
   // (A path that is not UTF-8 is kept with its bad bytes replaced: it then resumes nothing.)
   return OutputFile::writeWhole(
       path, json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
@@ -90,6 +91,7 @@ std::optional<ReconstructState> loadReconstructState(const std::string& path,
     state.points = json.at("points").get<std::uint64_t>();
     state.hasColors = json.at("hasColors").get<bool>();
     state.estimatedNormals = json.at("estimatedNormals").get<bool>();
+    state.unitScale = json.at("unitScale").get<double>();
     return wellFormed(state) ? std::optional(std::move(state)) : std::nullopt;
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;

@@ -24,6 +24,7 @@ struct ReconstructState {
   ChunkRuns runs;
   std::uint64_t points = 0;
   bool hasColors = false, estimatedNormals = false;
+  double unitScale = 1;  // the frame's length of one of the cloud's units (CloudSummary)
 };
 
 // The state file in a reconstruction's work directory.

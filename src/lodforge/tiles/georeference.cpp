@@ -31,6 +31,76 @@ Mat4d inverseRigid(const Mat4d& m) {
   return out;
 }
 
+// A 2D projected CRS says nothing of heights, and PROJ takes them as metres; a LAS file in a
+// CRS in feet stores them in feet, as its x and y. Heights are then taken in the CRS's linear
+// unit (0.3048 for a foot); a CRS with a vertical part (compound, 3D) says its own.
+double heightScaleOf(PJ_CONTEXT* context, const std::string& crs) {
+  PJ* object = proj_create(context, crs.c_str());
+  if (object == nullptr) return 1;
+  double factor = 1;
+  if (proj_get_type(object) == PJ_TYPE_PROJECTED_CRS) {
+    if (PJ* cs = proj_crs_get_coordinate_system(context, object)) {
+      if (proj_cs_get_axis_count(context, cs) == 2 &&
+          !proj_cs_get_axis_info(context, cs, 0, nullptr, nullptr, nullptr, &factor, nullptr,
+                                 nullptr, nullptr))
+        factor = 1;
+      proj_destroy(cs);
+    }
+  }
+  proj_destroy(object);
+  return factor > 0 && std::isfinite(factor) ? factor : 1;
+}
+
+// What to do about a CRS that cannot be the data's.
+constexpr const char* kPlacementFix =
+    "give the data's coordinate system with --crs EPSG:N, or place it with --origin "
+    "LON,LAT,HEIGHT";
+
+// The CRS's name as PROJ gives it ("NAD83 / UTM zone 10N"), else the text as given, shortened
+// (a WKT runs to kilobytes).
+std::string crsName(PJ_CONTEXT* context, const std::string& crs) {
+  std::string name;
+  if (PJ* object = proj_create(context, crs.c_str())) {
+    if (const char* n = proj_get_name(object)) name = n;
+    proj_destroy(object);
+  }
+  if (name.empty()) name = crs.size() > 60 ? crs.substr(0, 57) + "..." : crs;
+  return name;
+}
+
+// The sample placed by the CRS lies near the Earth's surface, and not far outside the CRS's
+// area of use where PROJ knows it (a UTM zone may be used a little beyond its 6 degrees).
+Status checkPlausible(PJ_CONTEXT* context, const std::string& crs, const std::string& named,
+                      Vec3d sample, const Geodetic& at) {
+  constexpr double kDeepest = -20'000, kHighest = 100'000, kAreaMargin = 5;  // metres, degrees
+  if (at.height < kDeepest || at.height > kHighest)
+    return Error{
+        ErrorKind::kBadInput,
+        fmt::format("{} puts the input point ({}, {}, {}) {:.0f} km {} the Earth's "
+                    "surface (at {:.4f}, {:.4f}): it cannot be the data's; {}",
+                    named, sample.x, sample.y, sample.z, std::abs(at.height) / 1000,
+                    at.height < 0 ? "under" : "over", at.longitude, at.latitude, kPlacementFix)};
+  PJ* object = proj_create(context, crs.c_str());
+  double west = 0, south = 0, east = 0, north = 0;
+  const bool known = object != nullptr &&
+                     proj_get_area_of_use(context, object, &west, &south, &east, &north, nullptr) &&
+                     west > -1000;
+  if (object) proj_destroy(object);
+  if (!known) return {};
+  const bool wraps = west > east;  // an area across the antimeridian
+  const double lon = at.longitude;
+  const bool inLongitude = wraps ? lon >= west - kAreaMargin || lon <= east + kAreaMargin
+                                 : lon >= west - kAreaMargin && lon <= east + kAreaMargin;
+  if (inLongitude && at.latitude >= south - kAreaMargin && at.latitude <= north + kAreaMargin)
+    return {};
+  return Error{ErrorKind::kBadInput,
+               fmt::format("{} puts the input point ({}, {}, {}) at {:.4f}, {:.4f}, far outside "
+                           "the area it is for ({:g} to {:g} east, {:g} to {:g} north): it "
+                           "cannot be the data's; {}",
+                           named, sample.x, sample.y, sample.z, at.longitude, at.latitude, west,
+                           east, south, north, kPlacementFix)};
+}
+
 }  // namespace
 
 Vec3d geodeticToEcef(const Geodetic& g) {
@@ -74,6 +144,7 @@ Result<Geodetic> parseOrigin(const std::string& text) {
 struct CrsToLocal::Projection {
   PJ_CONTEXT* context = nullptr;
   PJ* toEcef = nullptr;
+  double heightScale = 1;  // metres per input height unit (heightScaleOf)
   ~Projection() {
     if (toEcef != nullptr) proj_destroy(toEcef);
     if (context != nullptr) proj_context_destroy(context);
@@ -84,27 +155,31 @@ CrsToLocal::CrsToLocal(CrsToLocal&&) noexcept = default;
 CrsToLocal& CrsToLocal::operator=(CrsToLocal&&) noexcept = default;
 CrsToLocal::~CrsToLocal() = default;
 
-Result<CrsToLocal> CrsToLocal::create(const std::string& crs, Vec3d sample) {
+Result<CrsToLocal> CrsToLocal::create(const std::string& crs, Vec3d sample,
+                                      const std::string& from) {
   CrsToLocal out;
   out.projection_ = std::make_unique<Projection>();
   Projection& p = *out.projection_;
   p.context = proj_context_create();
   proj_log_level(p.context, PJ_LOG_NONE);
+  const std::string named = fmt::format("{} ({})", from, crsName(p.context, crs));
   PJ* raw = proj_create_crs_to_crs(p.context, crs.c_str(), "EPSG:4978", nullptr);
   if (raw == nullptr)
     return Error{ErrorKind::kUsage,
-                 fmt::format("--crs {}: PROJ does not know this coordinate system", crs)};
+                 fmt::format("{}: PROJ does not know this coordinate system", named)};
   // x = easting (or longitude), y = northing (or latitude), whatever the CRS's axis order.
   p.toEcef = proj_normalize_for_visualization(p.context, raw);
   proj_destroy(raw);
   if (p.toEcef == nullptr)
-    return Error{ErrorKind::kUsage, fmt::format("--crs {}: cannot transform it to ECEF", crs)};
+    return Error{ErrorKind::kUsage, fmt::format("{}: cannot transform it to ECEF", named)};
+  p.heightScale = heightScaleOf(p.context, crs);
   // The frame's origin: the sample point, on the ellipsoid.
-  PJ_COORD c = proj_trans(p.toEcef, PJ_FWD, proj_coord(sample.x, sample.y, sample.z, 0));
+  PJ_COORD c =
+      proj_trans(p.toEcef, PJ_FWD, proj_coord(sample.x, sample.y, sample.z * p.heightScale, 0));
   if (!std::isfinite(c.xyz.x))
     return Error{ErrorKind::kBadInput,
-                 fmt::format("--crs {}: the input point ({}, {}, {}) is outside it", crs, sample.x,
-                             sample.y, sample.z)};
+                 fmt::format("{}: the input point ({}, {}, {}) is outside it; {}", named, sample.x,
+                             sample.y, sample.z, kPlacementFix)};
   const double x = c.xyz.x, y = c.xyz.y, z = c.xyz.z;
   // ECEF to geodetic by Bowring's iteration (converges to well under a millimetre here).
   const double lon = std::atan2(y, x), r = std::hypot(x, y);
@@ -115,13 +190,15 @@ Result<CrsToLocal> CrsToLocal::create(const std::string& crs, Vec3d sample) {
     lat = std::atan2(z, r * (1 - kEccentricity2 * n / (n + height)));
   }
   out.origin_ = {lon * 180 / std::numbers::pi, lat * 180 / std::numbers::pi, height};
+  LODFORGE_TRY(checkPlausible(p.context, crs, named, sample, out.origin_));
   out.localToEcef_ = eastNorthUpToEcef(out.origin_);
   out.ecefToLocal_ = inverseRigid(out.localToEcef_);
   return out;
 }
 
 bool CrsToLocal::apply(Vec3d in, Vec3d& out) const {
-  const PJ_COORD c = proj_trans(projection_->toEcef, PJ_FWD, proj_coord(in.x, in.y, in.z, 0));
+  const PJ_COORD c = proj_trans(projection_->toEcef, PJ_FWD,
+                                proj_coord(in.x, in.y, in.z * projection_->heightScale, 0));
   if (!std::isfinite(c.xyz.x) || !std::isfinite(c.xyz.y) || !std::isfinite(c.xyz.z)) return false;
   out = ecefToLocal_.transformPoint({c.xyz.x, c.xyz.y, c.xyz.z});
   return true;

@@ -27,13 +27,18 @@ Result<Geodetic> parseOrigin(const std::string& text);
 class CrsToLocal {
  public:
   // `sample` is any input point (e.g. the first vertex): the frame's origin is that point on
-  // the ellipsoid, so tile coordinates stay small.
-  static Result<CrsToLocal> create(const std::string& crs, Vec3d sample);
+  // the ellipsoid, so tile coordinates stay small. A CRS that puts the sample far from the
+  // Earth's surface (more than 20 km under it or 100 km over it), or far outside the area PROJ
+  // says the CRS is for, cannot be the data's: bad input. `from` says where the CRS came from
+  // in messages ("--crs", "the CRS in scan.laz").
+  static Result<CrsToLocal> create(const std::string& crs, Vec3d sample,
+                                   const std::string& from = "--crs");
   CrsToLocal(CrsToLocal&&) noexcept;
   CrsToLocal& operator=(CrsToLocal&&) noexcept;
   ~CrsToLocal();
 
-  // Input point to local ENU metres; false if PROJ cannot transform it.
+  // Input point to local ENU metres; false if PROJ cannot transform it. Heights in a 2D
+  // projected CRS are in its linear unit (feet for a CRS in feet), as LAS stores them.
   bool apply(Vec3d in, Vec3d& out) const;
   const Mat4d& localToEcef() const { return localToEcef_; }
   const Geodetic& origin() const { return origin_; }

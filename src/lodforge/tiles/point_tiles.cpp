@@ -316,7 +316,9 @@ Result<std::optional<CrsToLocal>> localFrame(const std::string& input,
   Result<bool> some = probe->next(first);
   if (!some) return some.status();
   if (!*some) return badInput(input, "the file has no points");
-  Result<CrsToLocal> created = CrsToLocal::create(stats.crs, first.positions.front());
+  const std::string from =
+      options.crs.empty() ? fmt::format("the coordinate system in {}", input) : "--crs";
+  Result<CrsToLocal> created = CrsToLocal::create(stats.crs, first.positions.front(), from);
   if (!created) return created.status();
   return std::optional<CrsToLocal>(std::move(*created));
 }

@@ -126,7 +126,7 @@ Result<ChunkInput> surfaceChunkInput(const std::string& path, const ChunkInputOp
   stats = *made;
   stats.triangles = sink.triangles();
   stats.droppedPieces = sink.droppedPieces();
-  if (sink.triangles() == 0) return noSurface(path, stats.grid.voxel);
+  if (sink.triangles() == 0) return noSurface(path, stats.grid.voxel / stats.unitScale);
   ChunkInput input;
   input.chunks = sink.take();
   LODFORGE_TRY(input.chunks->flush());

@@ -67,12 +67,13 @@ struct LazyCrs {
   std::optional<CrsToLocal> transform;
   Status error;
 };
-std::shared_ptr<LazyCrs> attachCrs(const std::string& crs, ChunkInputOptions& input) {
+std::shared_ptr<LazyCrs> attachCrs(const std::string& crs, const std::string& from,
+                                   ChunkInputOptions& input) {
   auto lazy = std::make_shared<LazyCrs>(LazyCrs{crs, std::nullopt, {}});
   if (crs.empty()) return lazy;
-  input.transform = [lazy](Vec3d in, Vec3d& out) {
+  input.transform = [lazy, from](Vec3d in, Vec3d& out) {
     if (!lazy->transform) {
-      Result<CrsToLocal> created = CrsToLocal::create(lazy->crs, in);
+      Result<CrsToLocal> created = CrsToLocal::create(lazy->crs, in, from);
       if (!created) {
         lazy->error = created.status();
         return false;
@@ -240,7 +241,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   LODFORGE_TRY(
       planTilesMemory(options.memory, options.memoryLimit, options.threads, input, octree));
   stats.threads = octree.threads;
-  const std::shared_ptr<const LazyCrs> crs = attachCrs(options.crs, input);
+  const std::shared_ptr<const LazyCrs> crs = attachCrs(options.crs, options.crsFrom, input);
 
   Result<ChunkInput> chunked =
       chunkOrResume(path, options, input, octree, place, *crs, stats.resumed, stats.surface);

@@ -35,6 +35,7 @@ struct TilesOptions {
   // input in this CRS ("EPSG:32633"), placed through PROJ.
   std::optional<Geodetic> origin;
   std::string crs;
+  std::string crsFrom = "--crs";    // where `crs` came from, for messages ("the CRS in x.laz")
   bool meshoptCompression = false;  // --compress meshopt: EXT_meshopt_compression contents
   bool quantize = true;             // KHR_mesh_quantization where it is invisible (tileQuantized)
   // A point cloud: its surface reconstructed chunk by chunk into the leaves (surface_input.h).

@@ -270,8 +270,19 @@ TEST(CadRead, CyrillicNamesArriveAsUtf8) {
     ASSERT_TRUE(model->hasColors()) << path;
     EXPECT_EQ(model->colors[model->objects[0].vertexOffset], (Rgba8{255, 0, 0, 255})) << path;
   }
-  // Without the code page the legacy bytes are not these names.
-  Result<Model> unknown = readCad(legacy);
+  // Without the code page the legacy bytes are not UTF-8: their code page is guessed from them
+  // (Cyrillic words are runs of high bytes), and a warning says so; UTF-8 given reads them as
+  // UTF-8, garbled.
+  std::vector<std::string> warnings;
+  Result<Model> guessed = readCad(legacy, {}, &warnings);
+  ASSERT_TRUE(guessed.ok()) << guessed.error().message;
+  EXPECT_EQ(guessed->objectName(1), "Крышка");
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("read as CP1251, which their bytes suggest"), std::string::npos)
+      << warnings[0];
+  CadReadOptions utf8Given;
+  utf8Given.codePage = "UTF8";
+  Result<Model> unknown = readCad(legacy, utf8Given);
   ASSERT_TRUE(unknown.ok()) << unknown.error().message;
   EXPECT_NE(unknown->objectName(1), "Крышка");
 }

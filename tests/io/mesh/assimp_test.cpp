@@ -143,6 +143,10 @@ TEST(AssimpRead, OffQuadsBecomeTriangles) {
     EXPECT_FLOAT_EQ(static_cast<float>(model->origin[k]) + box.max[k], 1.0f);
   }
   EXPECT_TRUE(isConsistent(*model));
+  // OFF has no colours: assimp's grey DefaultMaterial is no colour of the file's.
+  EXPECT_TRUE(model->colors.empty());
+  EXPECT_TRUE(model->materials.empty());
+  EXPECT_EQ(model->objects[0].material, kNoMaterial);
 }
 
 // Files assimp cannot read are bad input naming the file; a scene without triangles too.

@@ -524,6 +524,49 @@ TEST(LasExtraBytes, ADamagedRecordIsReadPastAndAnExtendedOneIsRead) {
   EXPECT_TRUE(batch.extras.empty());
 }
 
+// PDAL writes an Extra Bytes record per dimension: every record's descriptors, in file order,
+// make up the layout (Deviation at byte 0, confidence at byte 2), not the last record alone.
+TEST(LasExtraBytes, EveryRecordsDescriptorsInOrderMakeTheLayout) {
+  test::TempDir dir;
+  const std::vector<LasPoint> points = somePoints(70, 1);
+  std::string las = makeLas(4, 6, points,
+                            {{"LASF_Spec", 4, descriptor(3, 0, "Deviation")},
+                             {"LASF_Projection", 2112, "LOCAL_CS[\"x\"]"},
+                             {"LASF_Spec", 4, descriptor(1, 0, "confidence")}},
+                            {}, {0.01, 0.01, 0.01}, {1000, 2000, 0}, 3);
+  const std::size_t first = las.size() - points.size() * 33, stride = 33;  // format 6: 30 + 3
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    put<std::uint16_t>(las, first + i * stride + 30, static_cast<std::uint16_t>(100 * i));
+    put<std::uint8_t>(las, first + i * stride + 32, static_cast<std::uint8_t>(1 + i % 65));
+  }
+  test::writeFile(dir.file("pdal.las"), las);
+  Result<PointReader> reader = PointReader::open(dir.file("pdal.las"));
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  const PointExtras& extras = reader->info().extras;
+  ASSERT_EQ(extras.fields.size(), 2u);
+  EXPECT_EQ(extras.stride, 3u);
+  EXPECT_EQ(extras.fields[0].name, "Deviation");
+  EXPECT_EQ(extras.fields[0].offset, 0u);
+  EXPECT_EQ(extras.fields[1].name, "confidence");
+  EXPECT_EQ(extras.fields[1].offset, 2u);
+  EXPECT_EQ(extras.fields[1].type, ExtraType::kUint8);
+  PointBatch batch;
+  std::vector<std::byte> all;
+  while (*reader->next(batch)) all.insert(all.end(), batch.extras.begin(), batch.extras.end());
+  ASSERT_EQ(all.size(), points.size() * 3);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_EQ(extraValue(all.data() + 3 * i, extras.fields[0]), 100.0 * i);
+    EXPECT_EQ(extraValue(all.data() + 3 * i, extras.fields[1]), 1.0 + i % 65);
+  }
+  // Two records that together describe more bytes than the points have: the second is named.
+  const std::string deviation = descriptor(3, 0, "Deviation"), range = descriptor(5, 0, "range");
+  const LasExtraRecord records[] = {{bytesOf(deviation), 400}, {bytesOf(range), 700}};
+  Result<PointExtras> bad = parseLasExtraBytes(records, 3, "f.las");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("byte 700"), std::string::npos) << bad.error().message;
+  EXPECT_NE(bad.error().message.find("\"range\" end at byte 6"), std::string::npos);
+}
+
 // What the writer describes, the reader reads back: the fields and each point's bytes.
 TEST(LasExtraBytes, WrittenAndReadBackWithEveryPoint) {
   test::TempDir dir;

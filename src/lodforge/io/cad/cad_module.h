@@ -10,7 +10,7 @@
 
 namespace lodforge::cad {
 
-inline constexpr int kModuleVersion = 7;  // bumped when these structs change
+inline constexpr int kModuleVersion = 8;  // bumped when these structs change
 inline constexpr const char* kReadSymbol = "lodforge_cad_read";
 inline constexpr const char* kWriteSymbol = "lodforge_cad_write";
 
@@ -59,9 +59,12 @@ struct Result {
   int status = 0;
   std::string error;
   std::vector<std::string> warnings;  // without the path
-  std::vector<double> positions;      // xyz per vertex, metres (STEP, IGES) or the file's unit
-  std::vector<float> normals;         // xyz per vertex
-  std::vector<std::uint8_t> colors;   // rgba per vertex (sRGB), when `coloured`
+  // The entities OCCT failed to read or to transfer ("#123: its reason"), in the file's order:
+  // what a damaged file lost.
+  std::vector<std::string> lost;
+  std::vector<double> positions;     // xyz per vertex, metres (STEP, IGES) or the file's unit
+  std::vector<float> normals;        // xyz per vertex
+  std::vector<std::uint8_t> colors;  // rgba per vertex (sRGB), when `coloured`
   bool coloured = false;
   std::vector<std::uint32_t> indices;  // 3 per triangle, local to the instance
   std::vector<Instance> instances;

@@ -13,6 +13,8 @@
 #include <IGESControl_Controller.hxx>
 #include <IGESData_IGESEntity.hxx>
 #include <IMeshTools_Parameters.hxx>
+#include <Interface_Check.hxx>
+#include <Interface_CheckIterator.hxx>
 #include <Interface_InterfaceModel.hxx>
 #include <Interface_Static.hxx>
 #include <Message.hxx>
@@ -219,19 +221,49 @@ Failure badFile(std::string_view what) {
   return {1, reason(occt().messages->take(), what)};
 }
 
-// One XDE reader (STEP's or IGES's) over the file into `doc`, lengths in metres.
+// The entities of `checks` that failed, as "#N: OCCT's first reason", appended to `lost` (a
+// check on the whole file is "file"); one entity once.
+void keepFails(const Interface_CheckIterator& checks,
+               const Handle(Interface_InterfaceModel) & model, std::vector<std::string>& lost) {
+  for (checks.Start(); checks.More(); checks.Next()) {
+    const Handle(Interface_Check)& check = checks.Value();
+    if (check.IsNull() || check->NbFails() == 0) continue;
+    std::string label = checks.Number() == 0 ? "file" : fmt::format("entity {}", checks.Number());
+    if (!model.IsNull() && check->HasEntity())
+      if (const Handle(TCollection_HAsciiString) name = model->StringLabel(check->Entity());
+          !name.IsNull())
+        label = name->ToCString();
+    std::string line = fmt::format("{}: {}", label, check->CFail(1));
+    if (std::find(lost.begin(), lost.end(), line) == lost.end()) lost.push_back(std::move(line));
+  }
+}
+
+XSControl_WorkSession& session(STEPCAFControl_Reader& reader) {
+  return *reader.ChangeReader().WS();
+}
+XSControl_WorkSession& session(IGESCAFControl_Reader& reader) {
+  return *reader.WS();
+}
+
+// One XDE reader (STEP's or IGES's) over the file into `doc`, lengths in metres; what OCCT
+// failed to read or transfer goes to `lost`.
 template <class Reader>
 std::optional<Failure> transfer(Reader& reader, const std::string& path, std::string_view format,
-                                Handle(TDocStd_Document) & doc) {
+                                Handle(TDocStd_Document) & doc, std::vector<std::string>& lost) {
   reader.SetColorMode(true);
   reader.SetNameMode(true);
   reader.SetLayerMode(true);
   if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
     return badFile(fmt::format("not {} file OCCT can read", format));
+  XSControl_WorkSession& work = session(reader);
+  keepFails(work.ModelCheckList(), work.Model(), lost);
   if (reader.NbRootsForTransfer() == 0)
     return badFile(fmt::format("{} file with no shape in it", format));
   XCAFDoc_DocumentTool::SetLengthUnit(doc, 1.0);  // shapes in metres
   if (!reader.Transfer(doc)) return badFile("OCCT could not transfer its shapes");
+  if (const Handle(XSControl_TransferReader) transferred = work.TransferReader();
+      !transferred.IsNull() && !transferred->TransientProcess().IsNull())
+    keepFails(transferred->TransientProcess()->CheckList(true), work.Model(), lost);
   return {};
 }
 
@@ -259,10 +291,11 @@ void hideBlankedRoots(IGESCAFControl_Reader& reader, const Handle(TDocStd_Docume
 
 // The STEP or IGES file into `doc`; a failure's message, or nothing.
 std::optional<Failure> readStepOrIges(const std::string& path, CadFormat format,
-                                      const Request& request, Handle(TDocStd_Document) & doc) {
+                                      const Request& request, Handle(TDocStd_Document) & doc,
+                                      std::vector<std::string>& lost) {
   if (format == CadFormat::kIges) {
     IGESCAFControl_Reader reader;
-    std::optional<Failure> failed = transfer(reader, path, "an IGES", doc);
+    std::optional<Failure> failed = transfer(reader, path, "an IGES", doc, lost);
     if (!failed) hideBlankedRoots(reader, doc);
     return failed;
   }
@@ -272,7 +305,7 @@ std::optional<Failure> readStepOrIges(const std::string& path, CadFormat format,
                                   "CP1251, CP1252, SJIS, GB)",
                                   page)};
   STEPCAFControl_Reader reader;
-  return transfer(reader, path, "a STEP", doc);
+  return transfer(reader, path, "a STEP", doc, lost);
 }
 
 std::optional<Failure> readBrep(const std::string& path, Handle(TDocStd_Document) & doc) {
@@ -306,13 +339,14 @@ std::optional<Failure> readBrep(const std::string& path, Handle(TDocStd_Document
 }
 
 // The file into an XDE document (assembly tree, names, colours, layers).
-std::optional<Failure> readDocument(const Request& request, Handle(TDocStd_Document) & doc) {
+std::optional<Failure> readDocument(const Request& request, Handle(TDocStd_Document) & doc,
+                                    std::vector<std::string>& lost) {
   const CadFormat format = cadFormat(request.path);
   XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
   occt().messages->take();
   std::optional<Failure> failed = format == CadFormat::kBrep
                                       ? readBrep(request.path, doc)
-                                      : readStepOrIges(request.path, format, request, doc);
+                                      : readStepOrIges(request.path, format, request, doc, lost);
   if (failed) return failed;
   TDF_LabelSequence roots;
   XCAFDoc_DocumentTool::ShapeTool(doc->Main())->GetFreeShapes(roots);
@@ -615,7 +649,7 @@ std::string describe(const Standard_Failure& failure) {
 // One read at a time (OCCT's reader statics and the signal handlers are process-wide).
 void read(const Request& request, Result& out) {
   Handle(TDocStd_Document) doc;
-  if (std::optional<Failure> failed = readDocument(request, doc)) {
+  if (std::optional<Failure> failed = readDocument(request, doc, out.lost)) {
     out.status = failed->status;
     out.error = failed->message;
     if (!doc.IsNull()) XCAFApp_Application::GetApplication()->Close(doc);

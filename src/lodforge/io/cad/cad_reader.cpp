@@ -14,6 +14,8 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/cad/cad_module.h"
+#include "lodforge/io/cad/step_names.h"
+#include "lodforge/io/part21.h"
 
 namespace lodforge {
 namespace {
@@ -104,6 +106,45 @@ Model toModel(const cad::Result& read) {
   return model;
 }
 
+// The code page of a STEP file whose names are not UTF-8 (none given): the one their bytes make
+// clear, else UTF-8 with a warning that names --code-page. Empty: UTF-8.
+Result<std::string> codePageOf(const std::string& path, std::vector<std::string>* warnings) {
+  Result<StepStrings> strings = scanStepStrings(path);
+  if (!strings) return strings.status();
+  if (strings->notUtf8 == 0) return std::string();
+  if (warnings && !strings->guess.empty())
+    warnings->push_back(fmt::format(
+        "{}: {} of its names are not UTF-8 (e.g. '{}'): read as {}, which their bytes suggest; "
+        "--code-page gives another",
+        path, strings->notUtf8, strings->example, strings->guess));
+  if (warnings && strings->guess.empty())
+    warnings->push_back(fmt::format(
+        "{}: {} of its names are not UTF-8 (e.g. '{}') and show garbled: give the file's code "
+        "page with --code-page (e.g. CP1251, CP1252, SJIS, GB)",
+        path, strings->notUtf8, strings->example));
+  return strings->guess;
+}
+
+// A damaged file's losses: the count and the first entities, or (`each`) every one with OCCT's
+// reason. The shapes read stand without them, so the model is incomplete: said, not hidden.
+void warnLost(const std::string& path, const std::vector<std::string>& lost, bool each,
+              std::vector<std::string>& warnings) {
+  if (lost.empty()) return;
+  if (each) {
+    for (const std::string& entity : lost)
+      warnings.push_back(fmt::format("{}: OCCT could not read {}", path, entity));
+    return;
+  }
+  std::string first;
+  for (std::size_t i = 0; i < std::min<std::size_t>(lost.size(), 5); ++i)
+    first += (i > 0 ? ", " : "") + lost[i].substr(0, lost[i].find(':'));
+  warnings.push_back(fmt::format(
+      "{}: damaged: OCCT could not read or transfer {} entit{} ({}{}); "
+      "the model lacks what they held (-v lists them with OCCT's "
+      "reasons)",
+      path, lost.size(), lost.size() == 1 ? "y" : "ies", first, lost.size() > 5 ? ", …" : ""));
+}
+
 }  // namespace
 
 Status cadModuleSymbol(const char* symbol, void*& entry) {
@@ -134,6 +175,15 @@ Result<Model> readCad(const std::string& path, const CadReadOptions& options,
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error))
     return ioError(path, "cannot open: no such file");
+  std::string codePage = options.codePage;
+  if (const std::string ext = fileExtension(path); ext == "step" || ext == "stp") {
+    LODFORGE_TRY(checkPart21Whole(path, options.salvageTruncated, warnings));
+    if (codePage.empty()) {
+      Result<std::string> page = codePageOf(path, warnings);
+      if (!page) return page.status();
+      codePage = *page;
+    }
+  }
   void* entry = nullptr;
   LODFORGE_TRY(cadModuleSymbol(cad::kReadSymbol, entry));
   const auto module = reinterpret_cast<cad::ReadFunction>(entry);
@@ -141,11 +191,12 @@ Result<Model> readCad(const std::string& path, const CadReadOptions& options,
                              .deflection = options.deflection,
                              .absoluteDeflection = options.absoluteDeflection,
                              .angleDegrees = options.angleDegrees,
-                             .codePage = options.codePage,
+                             .codePage = codePage,
                              .hidden = options.hidden};
   cad::Result read;
   module(cad::kModuleVersion, request, read);
   if (warnings) {
+    warnLost(path, read.lost, options.listLost, *warnings);
     for (const std::string& w : read.warnings) warnings->push_back(fmt::format("{}: {}", path, w));
     if (read.hidden > 0 && read.status == 0)
       warnings->push_back(fmt::format(

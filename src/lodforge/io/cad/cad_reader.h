@@ -27,6 +27,11 @@ struct CadReadOptions {
   // Keep the parts the file hides: a product or instance marked invisible (STEP's INVISIBILITY)
   // or on a hidden layer. Without it they are left out, as the CAD system shows the model.
   bool hidden = false;
+  // What a damaged file lost (the entities OCCT failed to read or transfer): one warning per
+  // entity with OCCT's reason (-v), else one warning with the count and the first few.
+  bool listLost = false;
+  // A STEP file cut short (no END-ISO-10303-21;) is read with a warning instead of refused.
+  bool salvageTruncated = false;
 };
 
 struct CadReadStats {

@@ -83,15 +83,27 @@ std::uint8_t channel(double x) {
       std::lround(std::clamp(std::isfinite(x) ? x : 0.0, 0.0, 1.0) * 255));
 }
 
+// assimp's grey stand-in for a mesh the file gives no material: unnamed or "DefaultMaterial",
+// diffuse 0.6 grey (or none), no texture.
+bool isStandIn(const aiMaterial& m) {
+  aiString name;
+  const bool named = m.Get(AI_MATKEY_NAME, name) == AI_SUCCESS && name.length > 0 &&
+                     std::string_view(name.C_Str()) != AI_DEFAULT_MATERIAL_NAME;
+  aiColor4D diffuse(0.6f, 0.6f, 0.6f, 1.0f);
+  m.Get(AI_MATKEY_COLOR_DIFFUSE, diffuse);
+  const bool grey = diffuse.r == 0.6f && diffuse.g == 0.6f && diffuse.b == 0.6f && diffuse.a == 1;
+  return !named && grey && m.GetTextureCount(aiTextureType_DIFFUSE) == 0 &&
+         m.GetTextureCount(aiTextureType_BASE_COLOR) == 0;
+}
+
 // The scene's node tree walked from the root, every mesh reference an object.
 class SceneConverter {
  public:
   SceneConverter(const aiScene& scene, const std::string& path) : scene_(scene), path_(path) {}
 
   Result<Model> convert() {
-    for (unsigned m = 0; m < scene_.mNumMaterials; ++m)
-      model_.materials.push_back(convertMaterial(*scene_.mMaterials[m]));
-    withColors_ = scene_.mNumMaterials > 0 ||
+    convertMaterials();
+    withColors_ = !model_.materials.empty() ||
                   std::any_of(scene_.mMeshes, scene_.mMeshes + scene_.mNumMeshes,
                               [](const aiMesh* mesh) { return mesh->HasVertexColors(0); });
     walk();
@@ -108,6 +120,18 @@ class SceneConverter {
     Mat4d parent;
     std::string path;  // of the parent
   };
+
+  // The file's materials. assimp gives a mesh without one a grey stand-in of its own (OFF's
+  // loader an unnamed one, the others "DefaultMaterial"): no colour of the file's, so it is left
+  // out (an OFF file has no colours, and says none).
+  void convertMaterials() {
+    materialOf_.assign(scene_.mNumMaterials, kNoMaterial);
+    for (unsigned m = 0; m < scene_.mNumMaterials; ++m) {
+      if (isStandIn(*scene_.mMaterials[m])) continue;
+      materialOf_[m] = static_cast<std::uint32_t>(model_.materials.size());
+      model_.materials.push_back(convertMaterial(*scene_.mMaterials[m]));
+    }
+  }
 
   // Depth first, children in file order. assimp's root is its own container: its name starts
   // no path unless it draws meshes itself.
@@ -141,12 +165,13 @@ class SceneConverter {
     const aiMesh& mesh = *scene_.mMeshes[meshIndex];
     ModelBuilder builder(model_);
     builder.beginObject(name, path);
-    if (mesh.mMaterialIndex < model_.materials.size())
-      model_.objects.back().material = mesh.mMaterialIndex;
+    const std::uint32_t material =
+        mesh.mMaterialIndex < materialOf_.size() ? materialOf_[mesh.mMaterialIndex] : kNoMaterial;
+    model_.objects.back().material = material;
     const Mat4d normalMatrix = world.normalMatrix();
     const bool mirrored = world.determinant3() < 0;
-    const std::array<float, 4> factor = mesh.mMaterialIndex < model_.materials.size()
-                                            ? model_.materials[mesh.mMaterialIndex].baseColor
+    const std::array<float, 4> factor = material != kNoMaterial
+                                            ? model_.materials[material].baseColor
                                             : std::array<float, 4>{1, 1, 1, 1};
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       const aiVector3D& p = mesh.mVertices[v];
@@ -194,6 +219,7 @@ class SceneConverter {
   Model model_;
   std::vector<Vec3d> world_;
   std::vector<Vec3f> normals_;
+  std::vector<std::uint32_t> materialOf_;  // a scene material's index in the model's, or none
   bool withColors_ = false;
   bool missingNormals_ = false;
   std::string problem_;  // the first thing wrong with the scene

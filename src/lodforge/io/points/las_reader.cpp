@@ -115,13 +115,15 @@ struct LasReader::State {
   std::vector<std::byte> lazRecord;  // the LASzip record's data, and where it lies
   std::uint64_t lazAt = 0;
   std::optional<LazPointStream> lazPoints;  // LAZ: the decoded point records
+  // The Extra Bytes records (VLRs, then EVLRs), each with the byte its data starts at.
+  std::vector<std::pair<std::vector<std::byte>, std::uint64_t>> extraRecords;
 
   Status readHeader(std::vector<std::byte>& bytes);
   Status readScalesAndBounds(std::span<const std::byte> bytes);
   Status checkPointData() const;
   Status readRecords(CrsRecords& crs);
   Status readExtendedRecords(CrsRecords& crs);
-  void readExtraBytes(std::span<const std::byte> record, std::uint64_t at);
+  void readExtraBytes();
   Status probeColorDepth();
   Status readLazRecord();
   Result<LazPointStream> openLazPoints() const;
@@ -307,17 +309,22 @@ Status LasReader::State::readRecords(CrsRecords& crs) {
       lazAt = at + kVlrHeader;
     }
     if (user == "copc" && id == 1) header.copc = true;
-    if (user == "LASF_Spec" && id == kExtraBytesRecord) readExtraBytes(record, at + kVlrHeader);
+    if (user == "LASF_Spec" && id == kExtraBytesRecord)
+      extraRecords.emplace_back(record, at + kVlrHeader);
   }
   return {};
 }
 
-// The Extra Bytes record: what the bytes past the point format's hold. A damaged one never
-// fails the file: its extra bytes are then not carried, and extrasIgnored says why.
-void LasReader::State::readExtraBytes(std::span<const std::byte> record, std::uint64_t at) {
+// The Extra Bytes records: what the bytes past the point format's hold, every record's
+// descriptors in file order. A damaged one never fails the file: the extra bytes are then not
+// carried, and extrasIgnored says why.
+void LasReader::State::readExtraBytes() {
   LasHeader& h = header;
+  if (extraRecords.empty()) return;
   const auto available = static_cast<std::uint32_t>(h.recordLength - lasRecordSize(h.pointFormat));
-  Result<PointExtras> extras = parseLasExtraBytes(record, available, source->name(), at);
+  std::vector<LasExtraRecord> described;
+  for (const auto& [data, at] : extraRecords) described.push_back({data, at});
+  Result<PointExtras> extras = parseLasExtraBytes(described, available, source->name());
   if (!extras) {
     // The points themselves are fine: read them without the extra bytes, and say why.
     h.extras = {};
@@ -362,7 +369,7 @@ Status LasReader::State::readExtendedRecords(CrsRecords& crs) {
                length < (std::uint64_t{1} << 24)) {
       record.resize(length);
       extra->read(record.data(), record.size());
-      readExtraBytes(record, at + kEvlrHeader);
+      extraRecords.emplace_back(record, at + kEvlrHeader);
     } else {
       extra->skip(length);
     }
@@ -451,6 +458,7 @@ Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
   CrsRecords crs;
   LODFORGE_TRY(state->readRecords(crs));
   LODFORGE_TRY(state->readExtendedRecords(crs));
+  state->readExtraBytes();
   state->header.crs = crs.crs();
   LODFORGE_TRY(state->readLazRecord());
   ByteSource& source = *state->source;

@@ -114,62 +114,81 @@ double extraRaw(const std::byte* point, const ExtraField& field) {
   return 0;
 }
 
-Result<PointExtras> parseLasExtraBytes(std::span<const std::byte> record, std::uint32_t available,
-                                       const std::string& file, std::uint64_t at) {
+namespace {
+
+// One descriptor `e` (at byte `where` of the file): its fields from byte `offset` of a point's
+// extra bytes on, appended to `extras`; `offset` moves past them.
+Status takeDescriptor(const std::byte* e, std::uint64_t where, std::uint32_t& offset,
+                      std::uint32_t available, const std::string& file, PointExtras& extras) {
+  const auto dataType = static_cast<std::size_t>(e[kTypeAt]);
+  const auto options = static_cast<std::uint8_t>(e[kOptionsAt]);
+  const std::string name = printableText(loadText(e + kNameAt, 32));
+  if (dataType > 30)
+    return badInputAtByte(
+        file, where + kTypeAt,
+        fmt::format("extra bytes \"{}\": data type {} is not one of 0 to 30", name, dataType));
+  // Undocumented bytes: `options` says how many; they are carried but not named.
+  const ExtraType base = kLasTypes[dataType == 0 ? 0 : (dataType - 1) % 10];
+  const std::size_t elements = dataType == 0 ? 0 : 1 + (dataType - 1) / 10;
+  const std::uint32_t bytes = dataType == 0
+                                  ? std::uint32_t{options}
+                                  : static_cast<std::uint32_t>(elements * extraTypeSize(base));
+  if (offset + bytes > available)
+    return badInputAtByte(file, where,
+                          fmt::format("extra bytes \"{}\" end at byte {} of a point's extra "
+                                      "bytes, but the records have {}",
+                                      name, offset + bytes, available));
+  for (std::size_t k = 0; k < elements; ++k) {
+    ExtraField field;
+    field.name = elements == 1 ? name : fmt::format("{}[{}]", name, k);
+    field.description = printableText(loadText(e + kDescriptionAt, 32));
+    field.type = base;
+    field.offset = offset + static_cast<std::uint32_t>(k * extraTypeSize(base));
+    if ((options & kHasScale) != 0) field.scale = loadField<double>(e + kScaleAt + 8 * k);
+    if ((options & kHasOffset) != 0) field.add = loadField<double>(e + kOffsetAt + 8 * k);
+    // A no-data value the type cannot hold matches no point: dropped. A float's is taken as
+    // the float it would be stored as, so that it matches.
+    if ((options & kHasNoData) != 0) {
+      const double noData = anyValue(e + kNoDataAt + 8 * k, base);
+      if (fitsExtraType(noData, base))
+        field.noData = base == ExtraType::kFloat32 ? static_cast<float>(noData) : noData;
+    }
+    if (!std::isfinite(field.scale) || field.scale == 0 || !std::isfinite(field.add))
+      return badInputAtByte(file, where + kScaleAt,
+                            fmt::format("extra bytes \"{}\": scale {} and offset {} are not "
+                                        "finite (a zero scale neither)",
+                                        field.name, field.scale, field.add));
+    extras.fields.push_back(std::move(field));
+  }
+  offset += bytes;
+  return {};
+}
+
+}  // namespace
+
+Result<PointExtras> parseLasExtraBytes(std::span<const LasExtraRecord> records,
+                                       std::uint32_t available, const std::string& file) {
   PointExtras extras;
   extras.stride = available;
-  if (record.size() % kExtraDescriptor != 0)
-    return badInputAtByte(file, at,
-                          fmt::format("the Extra Bytes record holds {} bytes, not a whole number "
-                                      "of {}-byte descriptors",
-                                      record.size(), kExtraDescriptor));
-  std::uint32_t offset = 0;
-  for (std::size_t d = 0; d < record.size() / kExtraDescriptor; ++d) {
-    const std::byte* e = record.data() + d * kExtraDescriptor;
-    const std::uint64_t where = at + d * kExtraDescriptor;
-    const auto dataType = static_cast<std::size_t>(e[kTypeAt]);
-    const auto options = static_cast<std::uint8_t>(e[kOptionsAt]);
-    const std::string name = printableText(loadText(e + kNameAt, 32));
-    if (dataType > 30)
-      return badInputAtByte(
-          file, where + kTypeAt,
-          fmt::format("extra bytes \"{}\": data type {} is not one of 0 to 30", name, dataType));
-    // Undocumented bytes: `options` says how many; they are carried but not named.
-    const ExtraType base = kLasTypes[dataType == 0 ? 0 : (dataType - 1) % 10];
-    const std::size_t elements = dataType == 0 ? 0 : 1 + (dataType - 1) / 10;
-    const std::uint32_t bytes = dataType == 0
-                                    ? std::uint32_t{options}
-                                    : static_cast<std::uint32_t>(elements * extraTypeSize(base));
-    if (offset + bytes > available)
-      return badInputAtByte(file, where,
-                            fmt::format("extra bytes \"{}\" end at byte {} of a point's extra "
-                                        "bytes, but the records have {}",
-                                        name, offset + bytes, available));
-    for (std::size_t k = 0; k < elements; ++k) {
-      ExtraField field;
-      field.name = elements == 1 ? name : fmt::format("{}[{}]", name, k);
-      field.description = printableText(loadText(e + kDescriptionAt, 32));
-      field.type = base;
-      field.offset = offset + static_cast<std::uint32_t>(k * extraTypeSize(base));
-      if ((options & kHasScale) != 0) field.scale = loadField<double>(e + kScaleAt + 8 * k);
-      if ((options & kHasOffset) != 0) field.add = loadField<double>(e + kOffsetAt + 8 * k);
-      // A no-data value the type cannot hold matches no point: dropped. A float's is taken as
-      // the float it would be stored as, so that it matches.
-      if ((options & kHasNoData) != 0) {
-        const double noData = anyValue(e + kNoDataAt + 8 * k, base);
-        if (fitsExtraType(noData, base))
-          field.noData = base == ExtraType::kFloat32 ? static_cast<float>(noData) : noData;
-      }
-      if (!std::isfinite(field.scale) || field.scale == 0 || !std::isfinite(field.add))
-        return badInputAtByte(file, where + kScaleAt,
-                              fmt::format("extra bytes \"{}\": scale {} and offset {} are not "
-                                          "finite (a zero scale neither)",
-                                          field.name, field.scale, field.add));
-      extras.fields.push_back(std::move(field));
-    }
-    offset += bytes;
+  std::uint32_t offset = 0;  // where the next descriptor's bytes start in a point's extra bytes
+  for (const LasExtraRecord& record : records) {
+    if (record.data.size() % kExtraDescriptor != 0)
+      return badInputAtByte(file, record.at,
+                            fmt::format("the Extra Bytes record holds {} bytes, not a whole "
+                                        "number of {}-byte descriptors",
+                                        record.data.size(), kExtraDescriptor));
+    for (std::size_t d = 0; d < record.data.size() / kExtraDescriptor; ++d)
+      LODFORGE_TRY(takeDescriptor(record.data.data() + d * kExtraDescriptor,
+                                  record.at + d * kExtraDescriptor, offset, available, file,
+                                  extras));
   }
   return extras;
+}
+
+Result<PointExtras> parseLasExtraBytes(std::span<const std::byte> record, std::uint32_t available,
+                                       const std::string& file, std::uint64_t at) {
+  const LasExtraRecord one{record, at};
+  return parseLasExtraBytes(std::span(&one, 1), available, file);
 }
 
 std::vector<std::byte> lasExtraBytesDescriptor(const ExtraField& field) {

@@ -62,10 +62,21 @@ inline double extraValue(const std::byte* point, const ExtraField& field) {
   return extraRaw(point, field) * field.scale + field.add;
 }
 
-// The fields of a LAS file's Extra Bytes record (192-byte descriptors) over the `available`
-// bytes each record has past its point format's. Undocumented bytes (type 0) are skipped over,
-// LAS 1.3's two- and three-element types become a field per element ("name[1]"); bad input
-// names the file, the byte `at` of the record and the descriptor.
+// One Extra Bytes record's data (a VLR's or an EVLR's) and the byte of the file it starts at.
+struct LasExtraRecord {
+  std::span<const std::byte> data;
+  std::uint64_t at = 0;
+};
+
+// The fields of a LAS file's Extra Bytes records (192-byte descriptors) over the `available`
+// bytes each point record has past its point format's. A file may describe its extra bytes in
+// several records (PDAL writes one per dimension): their descriptors, in file order, make up
+// the layout. Undocumented bytes (type 0) are skipped over, LAS 1.3's two- and three-element
+// types become a field per element ("name[1]"); bad input names the file, the byte of the
+// record and the descriptor.
+Result<PointExtras> parseLasExtraBytes(std::span<const LasExtraRecord> records,
+                                       std::uint32_t available, const std::string& file);
+// One record, starting at byte `at` of the file.
 Result<PointExtras> parseLasExtraBytes(std::span<const std::byte> record, std::uint32_t available,
                                        const std::string& file, std::uint64_t at);
 

@@ -35,7 +35,10 @@ struct RenderOptions : PathChoice {
   bool gpuReform = false;
   bool gpuStream = false;  // §3.3 on the GPU: Δ upload, compute reassembly, GPU reformation
 
-  RenderOptions() { frames = 8; }
+  RenderOptions() {
+    frames = 8;
+    path = "framed";  // pictures fill the frame; bench and view keep the fixed-radius orbit
+  }
 };
 
 // The counts of the reference: every object at full detail.
@@ -175,7 +178,9 @@ void addRender(CLI::App& app, const Global& global, Run& run) {
   sub->add_option("PACKAGE", o->input, "A .lfp package")->required();
   sub->add_option("-o,--output", o->output, "Folder for frame_NNNN.png and render.json")
       ->required();
-  sub->add_option("--path", o->path, "orbit, fly, or a camera path JSON file (docs/formats.md)")
+  sub->add_option("--path", o->path,
+                  "framed (an orbit that fills the frame with the model), orbit (a fixed "
+                  "radius), fly, or a camera path JSON file (docs/formats.md)")
       ->capture_default_str();
   sub->add_option("--frames", o->frames, "Frames along the path (a file's path is cut to this)")
       ->capture_default_str()

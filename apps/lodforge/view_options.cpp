@@ -63,6 +63,22 @@ Aabbd packageBounds(const Package& package) {
   return bounds;
 }
 
+namespace {
+
+// The corners of every object's box (relative to the package origin), for framing.
+std::vector<Vec3d> objectCorners(const Package& package) {
+  std::vector<Vec3d> corners;
+  corners.reserve(8 * package.objectCount());
+  for (const PackageObject& o : package.objects())
+    for (int i = 0; i < 8; ++i)
+      corners.push_back({(i & 1) ? o.boundsMax[0] : o.boundsMin[0],
+                         (i & 2) ? o.boundsMax[1] : o.boundsMin[1],
+                         (i & 4) ? o.boundsMax[2] : o.boundsMin[2]});
+  return corners;
+}
+
+}  // namespace
+
 Result<std::vector<Camera>> cameraPath(const PathChoice& choice, const Package& package) {
   std::uint32_t width = 0, height = 0;
   LODFORGE_TRY(parseSize(choice.size, width, height));
@@ -70,6 +86,7 @@ Result<std::vector<Camera>> cameraPath(const PathChoice& choice, const Package& 
   const PathOptions options{
       .frames = choice.frames, .width = width, .height = height, .fovYDegrees = choice.fovY};
   if (choice.path == "orbit") return orbitPath(bounds, options);
+  if (choice.path == "framed") return framedOrbitPath(bounds, objectCorners(package), options);
   if (choice.path == "fly") return flyThroughPath(bounds, options);
   auto cameras = readCameraPath(choice.path, package.origin(), bounds);
   if (cameras && cameras->size() > choice.frames) cameras->resize(choice.frames);

@@ -36,6 +36,39 @@ TEST(Path, OrbitCirclesTheModelAndSeesAllOfIt) {
   EXPECT_GT(length(cameras.back().position - cameras.front().position), 0.1);
 }
 
+// The framed orbit keeps every corner of the box on screen and fills the frame: in each frame
+// the farthest corner from the middle is at 90 % of the half-width or half-height, where the
+// fixed-radius orbit leaves the box smaller (here 82 % at the least).
+TEST(Path, FramedOrbitFillsTheFrameFromEverySide) {
+  const PathOptions options{.frames = 12, .width = 640, .height = 480};
+  const auto framed = framedOrbitPath(kBounds, {}, options);
+  const auto orbit = orbitPath(kBounds, options);
+  ASSERT_EQ(framed.size(), 12u);
+  double orbitFill = 1;
+  for (std::size_t f = 0; f < framed.size(); ++f) {
+    const auto fill = [&](const Camera& c) {
+      const ViewProjection v(c);
+      double most = 0;
+      for (int corner = 0; corner < 8; ++corner) {
+        const Vec3d p{(corner & 1) ? kBounds.max.x : kBounds.min.x,
+                      (corner & 2) ? kBounds.max.y : kBounds.min.y,
+                      (corner & 4) ? kBounds.max.z : kBounds.min.z};
+        const Vec3d d = p - c.position;
+        const double z = dot(d, c.forward);
+        EXPECT_GT(z, c.nearPlane);
+        most = std::max(
+            {most, std::abs(dot(d, c.right())) / z / v.tanX, std::abs(dot(d, c.up)) / z / v.tanY});
+      }
+      return most;
+    };
+    EXPECT_NEAR(fill(framed[f]), 0.9, 1e-6) << "frame " << f;
+    // The same directions as the orbit.
+    EXPECT_NEAR(dot(framed[f].forward, orbit[f].forward), 1, 1e-9) << "frame " << f;
+    orbitFill = std::min(orbitFill, fill(orbit[f]));
+  }
+  EXPECT_LT(orbitFill, 0.9) << "the fixed orbit leaves the box smaller in some frame";
+}
+
 TEST(Path, FlyThroughRunsAlongTheLongestHorizontalAxis) {
   const auto cameras = flyThroughPath(kBounds, {.frames = 30});
   ASSERT_EQ(cameras.size(), 30u);

@@ -79,6 +79,54 @@ std::vector<Camera> orbitPath(const Aabbd& bounds, const PathOptions& options) {
   return cameras;
 }
 
+// The distance from the centre of `bounds` along `toEye` (unit) at which every one of `points`
+// lies in the middle `fill` of the frame: per point, the depth its offset from the centre needs
+// in x and in y (x ≤ fill · tan(half angle) · depth).
+double framingDistance(const Aabbd& bounds, std::span<const Vec3d> points, Vec3d toEye,
+                       const PathOptions& options, double fill) {
+  const Vec3d forward = toEye * -1.0;
+  const Vec3d right = normalizeOr(cross(forward, Vec3d{0, 0, 1}), Vec3d{1, 0, 0});
+  const Vec3d up = cross(right, forward);
+  const double tanY = std::tan(options.fovYDegrees * kDegree / 2);
+  const double tanX = tanY * static_cast<double>(options.width) /
+                      static_cast<double>(std::max<std::uint32_t>(1, options.height));
+  double distance = 1e-3 * diagonal(bounds);
+  for (const Vec3d& point : points) {
+    const Vec3d c = point - bounds.center();
+    const double nearer = dot(c, toEye);
+    distance = std::max({distance, nearer + std::abs(dot(c, right)) / (fill * tanX),
+                         nearer + std::abs(dot(c, up)) / (fill * tanY)});
+  }
+  return distance;
+}
+
+std::vector<Camera> framedOrbitPath(const Aabbd& bounds, std::span<const Vec3d> points,
+                                    const PathOptions& options) {
+  std::vector<Vec3d> corners;
+  if (points.empty()) {
+    for (int i = 0; i < 8; ++i)
+      corners.push_back({(i & 1) ? bounds.max.x : bounds.min.x,
+                         (i & 2) ? bounds.max.y : bounds.min.y,
+                         (i & 4) ? bounds.max.z : bounds.min.z});
+    points = corners;
+  }
+  const Vec3d centre = bounds.center();
+  const double elevation = 25.0 * kDegree;
+  std::vector<Camera> cameras;
+  cameras.reserve(options.frames);
+  for (std::size_t i = 0; i < options.frames; ++i) {
+    const double azimuth = 2.0 * std::numbers::pi * phase(i, options.frames);
+    const Vec3d toEye{std::cos(elevation) * std::cos(azimuth),
+                      std::cos(elevation) * std::sin(azimuth), std::sin(elevation)};
+    const Vec3d eye = centre + toEye * framingDistance(bounds, points, toEye, options, 0.9);
+    Camera camera =
+        Camera::lookAt(eye, centre, {0, 0, 1}, options.fovYDegrees, options.width, options.height);
+    fitClipPlanes(camera, bounds);
+    cameras.push_back(camera);
+  }
+  return cameras;
+}
+
 std::vector<Camera> flyThroughPath(const Aabbd& bounds, const PathOptions& options) {
   // Along the longest horizontal axis at mid height, from 10 % before the model to 10 % past
   // it, swaying ±20° so that objects enter and leave the view from the sides too.

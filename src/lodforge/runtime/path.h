@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,12 @@ struct PathOptions {
 // Cameras in the coordinates of `bounds` (for a package: relative to its origin).
 std::vector<Camera> orbitPath(const Aabbd& bounds, const PathOptions& options);
 std::vector<Camera> flyThroughPath(const Aabbd& bounds, const PathOptions& options);
+// The orbit's directions round the centre of `bounds`, each frame as near as keeps every one of
+// `points` (the corners of the objects' boxes; none: of `bounds`) in the middle 90 % of the
+// frame: the model fills the picture from every side, whatever its shape (`render`'s default;
+// `orbit` keeps a fixed radius, 0.9 × the diagonal, for timings comparable across models).
+std::vector<Camera> framedOrbitPath(const Aabbd& bounds, std::span<const Vec3d> points,
+                                    const PathOptions& options);
 
 // Reads a recorded path; positions are in model coordinates and `origin` (the package origin)
 // is subtracted. Frames without near/far get planes fitted to `bounds` (origin-relative).

@@ -44,8 +44,8 @@ bool isLasPath(const std::string& path) {
   return ext == "las" || ext == "laz";
 }
 
-// What copying LAS takes at most: the program and one LAZ chunk decoded at a time (measured
-// peak on autzen_trim.laz, 50,000-point chunks, with room for chunks of up to a million).
+// What copying LAS takes at most: the program and one LAZ chunk decoded at a time (peak RSS
+// 36 MiB on autzen_trim.laz, 50,000-point chunks; the rest is room for larger chunks).
 constexpr std::uint64_t kLasCopyBytes = std::uint64_t{64} << 20;
 
 // LAZ (or LAS) in, plain LAS out, streamed: within any --memory-limit from kLasCopyBytes up.

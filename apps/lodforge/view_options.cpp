@@ -69,11 +69,12 @@ namespace {
 std::vector<Vec3d> objectCorners(const Package& package) {
   std::vector<Vec3d> corners;
   corners.reserve(8 * package.objectCount());
-  for (const PackageObject& o : package.objects())
-    for (int i = 0; i < 8; ++i)
-      corners.push_back({(i & 1) ? o.boundsMax[0] : o.boundsMin[0],
-                         (i & 2) ? o.boundsMax[1] : o.boundsMin[1],
-                         (i & 4) ? o.boundsMax[2] : o.boundsMin[2]});
+  for (const PackageObject& o : package.objects()) {
+    Aabbd box;
+    box.add(Vec3d{o.boundsMin[0], o.boundsMin[1], o.boundsMin[2]});
+    box.add(Vec3d{o.boundsMax[0], o.boundsMax[1], o.boundsMax[2]});
+    for (int i = 0; i < 8; ++i) corners.push_back(box.corner(i));
+  }
   return corners;
 }
 

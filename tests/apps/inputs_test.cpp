@@ -178,12 +178,10 @@ TEST(DamagedInput, ACoordinateSystemThatPutsTheDataUndergroundIsRefused) {
   EXPECT_NE(o.err.find("--crs (WGS 84)"), std::string::npos) << o.err;
   EXPECT_EQ(o.err.find("the coordinate system in"), std::string::npos) << o.err;
   // A CRS whose area of use (Switzerland) the points land far outside of.
-  o = lodforge("tiles " + test::dataPath("points/simple.las") + " --crs EPSG:2056 -o " +
-                   dir.file("v"),
-               dir);
+  o = lodforge(
+      "tiles " + test::dataPath("points/simple.las") + " --crs EPSG:2056 -o " + dir.file("v"), dir);
   EXPECT_EQ(o.code, 2) << o.err;
-  EXPECT_NE(o.err.find("--crs (CH1903+ / LV95) puts the input point"), std::string::npos)
-      << o.err;
+  EXPECT_NE(o.err.find("--crs (CH1903+ / LV95) puts the input point"), std::string::npos) << o.err;
   EXPECT_NE(o.err.find("far outside the area it is for (5.96 to 10.49 east"), std::string::npos)
       << o.err;
 }

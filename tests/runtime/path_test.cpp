@@ -21,9 +21,7 @@ TEST(Path, OrbitCirclesTheModelAndSeesAllOfIt) {
     // The whole box is in front, inside the clip range, and on screen.
     const ViewProjection v(c);
     for (int corner = 0; corner < 8; ++corner) {
-      const Vec3d p{(corner & 1) ? kBounds.max.x : kBounds.min.x,
-                    (corner & 2) ? kBounds.max.y : kBounds.min.y,
-                    (corner & 4) ? kBounds.max.z : kBounds.min.z};
+      const Vec3d p = kBounds.corner(corner);
       const Vec3d d = p - c.position;
       const double z = dot(d, c.forward);
       EXPECT_GT(z, c.nearPlane);
@@ -50,9 +48,7 @@ TEST(Path, FramedOrbitFillsTheFrameFromEverySide) {
       const ViewProjection v(c);
       double most = 0;
       for (int corner = 0; corner < 8; ++corner) {
-        const Vec3d p{(corner & 1) ? kBounds.max.x : kBounds.min.x,
-                      (corner & 2) ? kBounds.max.y : kBounds.min.y,
-                      (corner & 4) ? kBounds.max.z : kBounds.min.z};
+        const Vec3d p = kBounds.corner(corner);
         const Vec3d d = p - c.position;
         const double z = dot(d, c.forward);
         EXPECT_GT(z, c.nearPlane);

@@ -99,6 +99,10 @@ struct Box3 {
     add(b.max);
   }
   constexpr Vec3<T> center() const { return (min + max) * T(0.5); }
+  // Corner i of the 8: bit 0 picks max.x, bit 1 max.y, bit 2 max.z.
+  constexpr Vec3<T> corner(int i) const {
+    return {(i & 1) ? max.x : min.x, (i & 2) ? max.y : min.y, (i & 4) ? max.z : min.z};
+  }
   constexpr Vec3<T> size() const { return empty() ? Vec3<T>{} : max - min; }
   constexpr T longestSide() const {
     const Vec3<T> s = size();

@@ -61,16 +61,22 @@ void fitClipPlanes(Camera& camera, const Aabbd& bounds) {
   camera.farPlane = d * 10.0 + length(camera.position - bounds.center());
 }
 
-std::vector<Camera> orbitPath(const Aabbd& bounds, const PathOptions& options) {
+namespace {
+
+// The orbit's frames: round the centre of `bounds` 25° above it, each `distance(toEye)` from
+// the centre along the unit direction to the eye.
+template <class Distance>
+std::vector<Camera> orbitFrames(const Aabbd& bounds, const PathOptions& options,
+                                const Distance& distance) {
   const Vec3d centre = bounds.center();
-  const double radius = 0.9 * diagonal(bounds), elevation = 25.0 * kDegree;
+  const double elevation = 25.0 * kDegree;
   std::vector<Camera> cameras;
   cameras.reserve(options.frames);
   for (std::size_t i = 0; i < options.frames; ++i) {
     const double azimuth = 2.0 * std::numbers::pi * phase(i, options.frames);
-    const Vec3d eye = centre + Vec3d{std::cos(elevation) * std::cos(azimuth),
-                                     std::cos(elevation) * std::sin(azimuth), std::sin(elevation)} *
-                                   radius;
+    const Vec3d toEye{std::cos(elevation) * std::cos(azimuth),
+                      std::cos(elevation) * std::sin(azimuth), std::sin(elevation)};
+    const Vec3d eye = centre + toEye * distance(toEye);
     Camera camera =
         Camera::lookAt(eye, centre, {0, 0, 1}, options.fovYDegrees, options.width, options.height);
     fitClipPlanes(camera, bounds);
@@ -100,31 +106,23 @@ double framingDistance(const Aabbd& bounds, std::span<const Vec3d> points, Vec3d
   return distance;
 }
 
+}  // namespace
+
+std::vector<Camera> orbitPath(const Aabbd& bounds, const PathOptions& options) {
+  const double radius = 0.9 * diagonal(bounds);
+  return orbitFrames(bounds, options, [radius](Vec3d) { return radius; });
+}
+
 std::vector<Camera> framedOrbitPath(const Aabbd& bounds, std::span<const Vec3d> points,
                                     const PathOptions& options) {
   std::vector<Vec3d> corners;
   if (points.empty()) {
-    for (int i = 0; i < 8; ++i)
-      corners.push_back({(i & 1) ? bounds.max.x : bounds.min.x,
-                         (i & 2) ? bounds.max.y : bounds.min.y,
-                         (i & 4) ? bounds.max.z : bounds.min.z});
+    for (int i = 0; i < 8; ++i) corners.push_back(bounds.corner(i));
     points = corners;
   }
-  const Vec3d centre = bounds.center();
-  const double elevation = 25.0 * kDegree;
-  std::vector<Camera> cameras;
-  cameras.reserve(options.frames);
-  for (std::size_t i = 0; i < options.frames; ++i) {
-    const double azimuth = 2.0 * std::numbers::pi * phase(i, options.frames);
-    const Vec3d toEye{std::cos(elevation) * std::cos(azimuth),
-                      std::cos(elevation) * std::sin(azimuth), std::sin(elevation)};
-    const Vec3d eye = centre + toEye * framingDistance(bounds, points, toEye, options, 0.9);
-    Camera camera =
-        Camera::lookAt(eye, centre, {0, 0, 1}, options.fovYDegrees, options.width, options.height);
-    fitClipPlanes(camera, bounds);
-    cameras.push_back(camera);
-  }
-  return cameras;
+  return orbitFrames(bounds, options, [&](Vec3d toEye) {
+    return framingDistance(bounds, points, toEye, options, 0.9);
+  });
 }
 
 std::vector<Camera> flyThroughPath(const Aabbd& bounds, const PathOptions& options) {

@@ -34,12 +34,12 @@ Mat4d inverseRigid(const Mat4d& m) {
 // A 2D projected CRS says nothing of heights, and PROJ takes them as metres; a LAS file in a
 // CRS in feet stores them in feet, as its x and y. Heights are then taken in the CRS's linear
 // unit (0.3048 for a foot); a CRS with a vertical part (compound, 3D) says its own.
-double heightScaleOf(PJ_CONTEXT* context, const std::string& crs) {
-  PJ* object = proj_create(context, crs.c_str());
-  if (object == nullptr) return 1;
+// `source` is the CRS as PROJ reads it (null: it does not).
+double heightScaleOf(PJ_CONTEXT* context, PJ* source) {
+  if (source == nullptr) return 1;
   double factor = 1;
-  if (proj_get_type(object) == PJ_TYPE_PROJECTED_CRS) {
-    if (PJ* cs = proj_crs_get_coordinate_system(context, object)) {
+  if (proj_get_type(source) == PJ_TYPE_PROJECTED_CRS) {
+    if (PJ* cs = proj_crs_get_coordinate_system(context, source)) {
       if (proj_cs_get_axis_count(context, cs) == 2 &&
           !proj_cs_get_axis_info(context, cs, 0, nullptr, nullptr, nullptr, &factor, nullptr,
                                  nullptr, nullptr))
@@ -47,7 +47,6 @@ double heightScaleOf(PJ_CONTEXT* context, const std::string& crs) {
       proj_destroy(cs);
     }
   }
-  proj_destroy(object);
   return factor > 0 && std::isfinite(factor) ? factor : 1;
 }
 
@@ -58,20 +57,18 @@ constexpr const char* kPlacementFix =
 
 // The CRS's name as PROJ gives it ("NAD83 / UTM zone 10N"), else the text as given, shortened
 // (a WKT runs to kilobytes).
-std::string crsName(PJ_CONTEXT* context, const std::string& crs) {
+std::string crsName(PJ* source, const std::string& crs) {
   std::string name;
-  if (PJ* object = proj_create(context, crs.c_str())) {
-    if (const char* n = proj_get_name(object)) name = n;
-    proj_destroy(object);
-  }
+  if (source != nullptr)
+    if (const char* n = proj_get_name(source)) name = n;
   if (name.empty()) name = crs.size() > 60 ? crs.substr(0, 57) + "..." : crs;
   return name;
 }
 
 // The sample placed by the CRS lies near the Earth's surface, and not far outside the CRS's
 // area of use where PROJ knows it (a UTM zone may be used a little beyond its 6 degrees).
-Status checkPlausible(PJ_CONTEXT* context, const std::string& crs, const std::string& named,
-                      Vec3d sample, const Geodetic& at) {
+Status checkPlausible(PJ_CONTEXT* context, PJ* source, const std::string& named, Vec3d sample,
+                      const Geodetic& at) {
   constexpr double kDeepest = -20'000, kHighest = 100'000, kAreaMargin = 5;  // metres, degrees
   if (at.height < kDeepest || at.height > kHighest)
     return Error{
@@ -80,12 +77,10 @@ Status checkPlausible(PJ_CONTEXT* context, const std::string& crs, const std::st
                     "surface (at {:.4f}, {:.4f}): it cannot be the data's; {}",
                     named, sample.x, sample.y, sample.z, std::abs(at.height) / 1000,
                     at.height < 0 ? "under" : "over", at.longitude, at.latitude, kPlacementFix)};
-  PJ* object = proj_create(context, crs.c_str());
   double west = 0, south = 0, east = 0, north = 0;
-  const bool known = object != nullptr &&
-                     proj_get_area_of_use(context, object, &west, &south, &east, &north, nullptr) &&
+  const bool known = source != nullptr &&
+                     proj_get_area_of_use(context, source, &west, &south, &east, &north, nullptr) &&
                      west > -1000;
-  if (object) proj_destroy(object);
   if (!known) return {};
   const bool wraps = west > east;  // an area across the antimeridian
   const double lon = at.longitude;
@@ -143,10 +138,12 @@ Result<Geodetic> parseOrigin(const std::string& text) {
 
 struct CrsToLocal::Projection {
   PJ_CONTEXT* context = nullptr;
+  PJ* source = nullptr;  // the input's CRS as PROJ reads it, for its name, unit and area
   PJ* toEcef = nullptr;
   double heightScale = 1;  // metres per input height unit (heightScaleOf)
   ~Projection() {
     if (toEcef != nullptr) proj_destroy(toEcef);
+    if (source != nullptr) proj_destroy(source);
     if (context != nullptr) proj_context_destroy(context);
   }
 };
@@ -162,7 +159,8 @@ Result<CrsToLocal> CrsToLocal::create(const std::string& crs, Vec3d sample,
   Projection& p = *out.projection_;
   p.context = proj_context_create();
   proj_log_level(p.context, PJ_LOG_NONE);
-  const std::string named = fmt::format("{} ({})", from, crsName(p.context, crs));
+  p.source = proj_create(p.context, crs.c_str());
+  const std::string named = fmt::format("{} ({})", from, crsName(p.source, crs));
   PJ* raw = proj_create_crs_to_crs(p.context, crs.c_str(), "EPSG:4978", nullptr);
   if (raw == nullptr)
     return Error{ErrorKind::kUsage,
@@ -172,7 +170,7 @@ Result<CrsToLocal> CrsToLocal::create(const std::string& crs, Vec3d sample,
   proj_destroy(raw);
   if (p.toEcef == nullptr)
     return Error{ErrorKind::kUsage, fmt::format("{}: cannot transform it to ECEF", named)};
-  p.heightScale = heightScaleOf(p.context, crs);
+  p.heightScale = heightScaleOf(p.context, p.source);
   // The frame's origin: the sample point, on the ellipsoid.
   PJ_COORD c =
       proj_trans(p.toEcef, PJ_FWD, proj_coord(sample.x, sample.y, sample.z * p.heightScale, 0));
@@ -190,7 +188,7 @@ Result<CrsToLocal> CrsToLocal::create(const std::string& crs, Vec3d sample,
     lat = std::atan2(z, r * (1 - kEccentricity2 * n / (n + height)));
   }
   out.origin_ = {lon * 180 / std::numbers::pi, lat * 180 / std::numbers::pi, height};
-  LODFORGE_TRY(checkPlausible(p.context, crs, named, sample, out.origin_));
+  LODFORGE_TRY(checkPlausible(p.context, p.source, named, sample, out.origin_));
   out.localToEcef_ = eastNorthUpToEcef(out.origin_);
   out.ecefToLocal_ = inverseRigid(out.localToEcef_);
   return out;

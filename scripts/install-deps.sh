@@ -14,6 +14,8 @@ packages=(
   libtbb-dev nlohmann-json3-dev libcli11-dev libspdlog-dev libfmt-dev libtinygltf-dev
   libtinyobjloader-dev libmeshoptimizer-dev libdraco-dev libnanoflann-dev libeigen3-dev libproj-dev
   libstb-dev libcpp-httplib-dev zlib1g-dev libxxhash-dev
+  # textures: JPEG (libjpeg-turbo) and WebP codecs; Debian's textured test models
+  libjpeg62-turbo-dev libwebp-dev assimp-testmodels
   # CAD: OpenCASCADE's data exchange (STEP, IGES, BREP through XDE); fontconfig is a link
   # dependency of its CMake config; occt-misc holds its sample files, used as test data
   libocct-data-exchange-dev libfontconfig1-dev occt-misc

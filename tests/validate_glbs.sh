@@ -3,7 +3,7 @@
 # real models in ../shared/data, the generated CAD assembly, a generated scan, levels extracted
 # from a progressive package, 3D Tiles contents (the horse, a scan, an assembly's package, point
 # clouds from a LAS, a LAZ, a COPC, a LAS with extra bytes and a PLY, and a surface
-# reconstructed from points), and CAD files read through OpenCASCADE.
+# reconstructed from points), CAD files read through OpenCASCADE, and textured models.
 # Fails on any error.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
@@ -28,8 +28,11 @@ done
 "$lodforge" -q convert "$data/cad/as1_motor.step" -o "$out/motor-step.glb"
 "$lodforge" -q convert /usr/share/opencascade/data/iges/bearing.iges -o "$out/bearing-iges.glb"
 "$lodforge" -q convert /usr/share/opencascade/data/occ/Ball.brep -o "$out/ball-brep.glb"
+# Textured models: an OBJ whose MTL names five JPEGs, a GLB with an embedded PNG.
+"$lodforge" -q convert "$data/textured/spider/spider.obj" -o "$out/spider-textured.glb"
+"$lodforge" -q convert "$data/textured/BoxTextured.glb" -o "$out/box-textured.glb"
 count=$(ls "$out"/*.glb | wc -l)
-want=$(( $(ls "$data"/meshes | wc -l) + 9 ))
+want=$(( $(ls "$data"/meshes | wc -l) + 11 ))
 [[ $count -eq $want ]] || { echo "expected $want GLBs, found $count" >&2; exit 1; }
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse-tiles" --chunk-size 0.05 --no-quantization
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan-tiles" --chunk-size 60 --compress meshopt

@@ -10,6 +10,7 @@
 #include "cad_options.h"
 #include "cli.h"
 #include "info_attributes.h"
+#include "info_textures.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/output_claim.h"
 #include "lodforge/core/progress.h"
@@ -31,11 +32,12 @@ struct Summary {
   std::string encoding;  // e.g. PLY's binary_little_endian
   std::uint64_t fileBytes = 0;
   std::uint64_t vertices = 0, triangles = 0, objects = 0;
-  bool normals = false, colors = false;
+  bool normals = false, colors = false, uvs = false;
   Aabbd bounds;  // world coordinates
   std::uint64_t memoryBytes = 0;
-  nlohmann::json extras;  // a PLY's other vertex properties (ExtraRanges::json)
-  nlohmann::json cad;     // a CAD file's part tree: shapes, instances, depth, names
+  nlohmann::json extras;    // a PLY's other vertex properties (ExtraRanges::json)
+  nlohmann::json cad;       // a CAD file's part tree: shapes, instances, depth, names
+  nlohmann::json textures;  // materials and images (info_textures.h)
 };
 
 Result<Summary> summarizePly(const std::string& path, bool salvage) {
@@ -120,6 +122,8 @@ Result<Summary> summarizeLoaded(const std::string& path, FileFormat format,
   s.objects = model->objectCount();
   s.normals = model->hasNormals();
   s.colors = model->hasColors();
+  s.uvs = model->hasUvs();
+  s.textures = textureSummary(*model);
   const Aabb local = model->bounds();
   if (!local.empty()) {
     s.bounds.add(model->origin + toDouble(local.min));
@@ -130,10 +134,17 @@ Result<Summary> summarizeLoaded(const std::string& path, FileFormat format,
 }
 
 nlohmann::json toJson(const std::string& path, const Summary& s) {
-  nlohmann::json j = {
-      {"file", path},           {"format", s.format},       {"fileBytes", s.fileBytes},
-      {"vertices", s.vertices}, {"triangles", s.triangles}, {"objects", s.objects},
-      {"normals", s.normals},   {"colors", s.colors},       {"memoryBytes", s.memoryBytes}};
+  nlohmann::json j = {{"file", path},
+                      {"format", s.format},
+                      {"fileBytes", s.fileBytes},
+                      {"vertices", s.vertices},
+                      {"triangles", s.triangles},
+                      {"objects", s.objects},
+                      {"normals", s.normals},
+                      {"colors", s.colors},
+                      {"memoryBytes", s.memoryBytes},
+                      {"uvs", s.uvs}};
+  if (!s.textures.empty()) j["textures"] = s.textures;
   if (!s.encoding.empty()) j["encoding"] = s.encoding;
   if (!s.extras.empty()) j["attributes"] = {{"extras", s.extras}};
   if (!s.cad.empty()) j["cad"] = s.cad;
@@ -151,6 +162,7 @@ void print(const std::string& path, const Summary& s) {
   std::string attributes;
   if (s.normals) attributes += "normals";
   if (s.colors) attributes += attributes.empty() ? "colors" : ", colors";
+  if (s.uvs) attributes += attributes.empty() ? "texture coordinates" : ", texture coordinates";
   fmt::print("vertices   {}{}\n", formatCount(s.vertices),
              attributes.empty() ? "" : " (" + attributes + ")");
   fmt::print("triangles  {}\n", formatCount(s.triangles));
@@ -166,6 +178,7 @@ void print(const std::string& path, const Summary& s) {
   }
   fmt::print("memory     {} to load\n", formatBytes(s.memoryBytes));
   if (!s.extras.empty()) printPointAttributes({{"extras", s.extras}});
+  printTextures(s.textures);
   if (s.cad.empty()) return;
   const auto hidden = s.cad["hidden"].get<std::uint64_t>();
   fmt::print("parts      {} shapes placed {} times, assembly depth {}{}\n",

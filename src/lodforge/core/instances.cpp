@@ -1,6 +1,7 @@
 #include "lodforge/core/instances.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
@@ -66,6 +67,8 @@ PlacementKey placementKey(const MeshView& mesh, double relativeTolerance) {
   for (const Rgba8 c : mesh.colors)
     h = mix(h, (std::uint64_t{c.r} << 24) | (std::uint64_t{c.g} << 16) | (std::uint64_t{c.b} << 8) |
                    c.a);
+  for (const Vec2f uv : mesh.uvs)
+    h = mix(mix(h, std::bit_cast<std::uint32_t>(uv.x)), std::bit_cast<std::uint32_t>(uv.y));
   key.signature = h;
   if (mesh.positions.empty()) return key;
   Vec3d centre;
@@ -90,7 +93,7 @@ PlacementKey placementKey(const MeshView& mesh, double relativeTolerance) {
 std::optional<Mat4d> placementOf(const MeshView& source, const MeshView& mesh, double tolerance) {
   if (source.material != mesh.material || !std::ranges::equal(source.indices, mesh.indices) ||
       !std::ranges::equal(source.colors, mesh.colors) ||
-      source.normals.size() != mesh.normals.size())
+      !std::ranges::equal(source.uvs, mesh.uvs) || source.normals.size() != mesh.normals.size())
     return std::nullopt;
   const auto motion = fitRigidMotion(source.positions, mesh.positions, tolerance);
   if (!motion) return std::nullopt;
@@ -154,6 +157,7 @@ std::vector<Placement> findPlacements(const Model& model, double relativeToleran
       mesh.normals = std::span(model.normals).subspan(r.vertexOffset, r.vertexCount);
     if (model.hasColors())
       mesh.colors = std::span(model.colors).subspan(r.vertexOffset, r.vertexCount);
+    if (model.hasUvs()) mesh.uvs = std::span(model.uvs).subspan(r.vertexOffset, r.vertexCount);
     return mesh;
   };
   std::vector<Placement> placements(model.objectCount());

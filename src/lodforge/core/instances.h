@@ -39,10 +39,11 @@ struct MeshView {
   std::span<const Rgba8> colors;
   std::span<const std::uint32_t> indices;  // local
   std::uint32_t material = kNoMaterial;
+  std::span<const Vec2f> uvs = {};  // a placement keeps its texture coordinates exactly
 };
 
 // What a search for a mesh's placement needs: what two placements of one mesh share exactly
-// (counts, material, triangles, colours) hashed, its spread (the RMS distance of its vertices
+// (counts, material, triangles, colours, UVs) hashed, its spread (the RMS distance of its vertices
 // from their centroid, which a rigid motion keeps), and how far a placed vertex may lie from the
 // moved source (`relativeTolerance` of the mesh's size, never less than float rounding at its
 // distance from the origin).

@@ -14,4 +14,22 @@ const char* alphaModeName(AlphaMode mode) {
   return "OPAQUE";
 }
 
+int wrapModeCode(TextureWrap wrap) {
+  switch (wrap) {
+    case TextureWrap::kMirror:
+      return 33648;
+    case TextureWrap::kClamp:
+      return 33071;
+    case TextureWrap::kRepeat:
+      break;
+  }
+  return 10497;
+}
+
+TextureWrap wrapModeOf(int code) {
+  if (code == 33648) return TextureWrap::kMirror;
+  if (code == 33071) return TextureWrap::kClamp;
+  return TextureWrap::kRepeat;
+}
+
 }  // namespace lodforge

@@ -9,6 +9,11 @@
 namespace lodforge {
 
 enum class AlphaMode : std::uint8_t { kOpaque, kMask, kBlend };
+// What a texture does outside [0, 1] (glTF's sampler wrapS/wrapT).
+enum class TextureWrap : std::uint8_t { kRepeat, kMirror, kClamp };
+
+// A material without a base-colour texture (Material::baseColorImage).
+inline constexpr std::uint32_t kNoImage = ~0u;
 
 struct Material {
   std::string name;
@@ -19,6 +24,10 @@ struct Material {
   float alphaCutoff = 0.5f;  // kMask only
   bool doubleSided = false;
   std::array<float, 3> emissive{0, 0, 0};  // linear RGB
+  // The base-colour texture (glTF's baseColorTexture, OBJ's map_Kd): into Model::images,
+  // sampled at the model's uvs and multiplied by baseColor; kNoImage for none.
+  std::uint32_t baseColorImage = kNoImage;
+  TextureWrap wrapS = TextureWrap::kRepeat, wrapT = TextureWrap::kRepeat;
 
   bool operator==(const Material&) const = default;
 };
@@ -30,5 +39,9 @@ inline constexpr std::uint32_t kNoLayer = ~0u;
 
 // glTF's name of an alpha mode ("OPAQUE", "MASK", "BLEND").
 const char* alphaModeName(AlphaMode mode);
+// glTF's sampler code of a wrap mode (10497 REPEAT, 33648 MIRRORED_REPEAT, 33071 CLAMP_TO_EDGE).
+int wrapModeCode(TextureWrap wrap);
+// The wrap mode of a glTF sampler code (REPEAT for an unknown one, glTF's default).
+TextureWrap wrapModeOf(int code);
 
 }  // namespace lodforge

@@ -74,6 +74,12 @@ inline long roundToLong(float x) {
   return static_cast<long>(d + (d >= 0 ? 0.5 : -0.5));
 }
 
+// A texture coordinate (glTF's TEXCOORD: u right, v down from the image's top-left corner).
+struct Vec2f {
+  float x = 0, y = 0;
+  friend constexpr bool operator==(Vec2f, Vec2f) = default;
+};
+
 struct Rgba8 {
   std::uint8_t r = 255, g = 255, b = 255, a = 255;
   friend constexpr bool operator==(Rgba8, Rgba8) = default;

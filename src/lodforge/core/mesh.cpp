@@ -94,8 +94,9 @@ class WeldKeys {
 
 std::uint32_t weldVertices(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
                            std::span<const Rgba8> colors, const WeldOptions& options,
-                           std::span<std::uint32_t> remap) {
+                           std::span<std::uint32_t> remap, std::span<const Vec2f> uvs) {
   assert(remap.size() == positions.size());
+  assert(uvs.empty() || uvs.size() == positions.size());
   assert(!options.keepNormalSplits || normals.size() == positions.size());
   assert(!options.keepColorSplits || colors.size() == positions.size());
   assert(options.epsilon >= 0.0f);
@@ -108,6 +109,7 @@ std::uint32_t weldVertices(std::span<const Vec3f> positions, std::span<const Vec
 
   auto attributesMatch = [&](std::uint32_t a, std::uint32_t b) {
     if (options.keepColorSplits && colors[a] != colors[b]) return false;
+    if (!uvs.empty() && uvs[a] != uvs[b]) return false;
     if (options.keepNormalSplits) {
       const Vec3f na = normalizeOr(normals[a], Vec3f{});
       const Vec3f nb = normalizeOr(normals[b], Vec3f{});

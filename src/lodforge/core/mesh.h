@@ -24,11 +24,12 @@ struct WeldOptions {
 
 // Finds vertices that can be merged. Writes remap[v] = new index of vertex v (dense, in order of
 // first occurrence) and returns the new vertex count. `normals` and `colors` may be empty; they
-// are consulted only when the options ask to keep their splits. Deterministic: a vertex merges
-// into the earliest earlier representative it matches.
+// are consulted only when the options ask to keep their splits. Vertices whose texture
+// coordinates (`uvs`, empty or one per vertex) differ always stay apart: a UV seam is two
+// vertices. Deterministic: a vertex merges into the earliest earlier representative it matches.
 std::uint32_t weldVertices(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
                            std::span<const Rgba8> colors, const WeldOptions& options,
-                           std::span<std::uint32_t> remap);
+                           std::span<std::uint32_t> remap, std::span<const Vec2f> uvs = {});
 
 // out[remap[v]] = in[v] for every v (the representative's value wins: it is written last when
 // scanning backwards). `out` has the new vertex count.

@@ -26,8 +26,11 @@ std::uint64_t modelMemoryBytes(std::uint64_t vertexCount, std::uint64_t triangle
 }
 
 std::uint64_t Model::memoryBytes() const {
+  std::uint64_t imageBytes = 0;
+  for (const ImageSource& image : images) imageBytes += image.bytes.size();
   return modelMemoryBytes(vertexCount(), triangleCount(), objectCount(), hasNormals(), hasColors(),
-                          names.size() + paths.size());
+                          names.size() + paths.size()) +
+         uvs.size() * sizeof(Vec2f) + imageBytes;
 }
 
 void ModelBuilder::beginObject(std::string_view name, std::string_view path) {
@@ -111,6 +114,7 @@ void weldModel(Model& model, const WeldOptions& options) {
   out.paths = std::move(model.paths);
   out.materials = std::move(model.materials);
   out.layers = std::move(model.layers);
+  out.images = std::move(model.images);
   out.objects.reserve(model.objects.size());
   std::vector<std::uint32_t> remap;
   for (std::size_t o = 0; o < model.objects.size(); ++o) {
@@ -124,11 +128,15 @@ void weldModel(Model& model, const WeldOptions& options) {
         model.hasColors()
             ? std::span<const Rgba8>(model.colors).subspan(in.vertexOffset, in.vertexCount)
             : std::span<const Rgba8>();
+    const auto uvs =
+        model.hasUvs() ? std::span<const Vec2f>(model.uvs).subspan(in.vertexOffset, in.vertexCount)
+                       : std::span<const Vec2f>();
     remap.resize(in.vertexCount);
     WeldOptions objectOptions = options;
     objectOptions.keepNormalSplits = options.keepNormalSplits && !normals.empty();
     objectOptions.keepColorSplits = options.keepColorSplits && !colors.empty();
-    const std::uint32_t unique = weldVertices(positions, normals, colors, objectOptions, remap);
+    const std::uint32_t unique =
+        weldVertices(positions, normals, colors, objectOptions, remap, uvs);
 
     ObjectRecord record = in;
     record.vertexOffset = out.positions.size();
@@ -143,6 +151,10 @@ void weldModel(Model& model, const WeldOptions& options) {
     if (!colors.empty()) {
       out.colors.resize(out.positions.size());
       remapVertexAttribute(colors, remap, std::span(out.colors).subspan(record.vertexOffset));
+    }
+    if (!uvs.empty()) {
+      out.uvs.resize(out.positions.size());
+      remapVertexAttribute(uvs, remap, std::span(out.uvs).subspan(record.vertexOffset));
     }
     const auto indices = model.objectIndices(o);
     const std::size_t first = out.indices.size();
@@ -159,6 +171,37 @@ void weldModel(Model& model, const WeldOptions& options) {
   model = std::move(out);
 }
 
+void dropUnusedMaterials(Model& model) {
+  std::vector<std::uint32_t> materialIndex(model.materials.size(), kNoMaterial);
+  for (const ObjectRecord& o : model.objects) {
+    if (o.material != kNoMaterial) materialIndex[o.material] = 0;
+  }
+  std::vector<Material> materials;
+  std::vector<std::uint32_t> imageIndex(model.images.size(), kNoImage);
+  for (std::size_t m = 0; m < model.materials.size(); ++m) {
+    if (materialIndex[m] == kNoMaterial) continue;
+    materialIndex[m] = static_cast<std::uint32_t>(materials.size());
+    materials.push_back(std::move(model.materials[m]));
+    if (materials.back().baseColorImage != kNoImage)
+      imageIndex[materials.back().baseColorImage] = 0;
+  }
+  std::vector<ImageSource> images;
+  for (std::size_t i = 0; i < model.images.size(); ++i) {
+    if (imageIndex[i] == kNoImage) continue;
+    imageIndex[i] = static_cast<std::uint32_t>(images.size());
+    images.push_back(std::move(model.images[i]));
+  }
+  for (Material& material : materials) {
+    if (material.baseColorImage != kNoImage)
+      material.baseColorImage = imageIndex[material.baseColorImage];
+  }
+  for (ObjectRecord& o : model.objects) {
+    if (o.material != kNoMaterial) o.material = materialIndex[o.material];
+  }
+  model.materials = std::move(materials);
+  model.images = std::move(images);
+}
+
 bool isConsistent(const Model& model, std::string* why) {
   auto fail = [&](std::string message) {
     if (why) *why = std::move(message);
@@ -169,6 +212,13 @@ bool isConsistent(const Model& model, std::string* why) {
     return fail("normals and positions differ in count");
   if (!model.colors.empty() && model.colors.size() != model.positions.size())
     return fail("colors and positions differ in count");
+  if (!model.uvs.empty() && model.uvs.size() != model.positions.size())
+    return fail("texture coordinates and positions differ in count");
+  for (std::size_t m = 0; m < model.materials.size(); ++m) {
+    const std::uint32_t image = model.materials[m].baseColorImage;
+    if (image != kNoImage && image >= model.images.size())
+      return fail(fmt::format("material {} image out of range", m));
+  }
   std::uint64_t nextVertex = 0, nextTriangle = 0;
   for (std::size_t i = 0; i < model.objects.size(); ++i) {
     const ObjectRecord& o = model.objects[i];

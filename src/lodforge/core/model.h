@@ -6,7 +6,9 @@
 //   geo-scale coordinates keep millimetres.
 // - triangle indices are local to their object: triangle t of object o refers to vertices
 //   objects[o].vertexOffset + indices[3t + k].
-// - normals and colors are either empty or one per vertex.
+// - normals, colors and uvs are either empty or one per vertex.
+// - an object with a textured material (Material::baseColorImage) has that one material for all
+//   its triangles: readers split a mesh whose parts use different textures into objects.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +18,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "lodforge/core/image_source.h"
 #include "lodforge/core/material.h"
 #include "lodforge/core/math.h"
 
@@ -43,6 +46,7 @@ struct Model {
   std::vector<Vec3f> positions;
   std::vector<Vec3f> normals;          // empty or one per vertex
   std::vector<Rgba8> colors;           // empty or one per vertex
+  std::vector<Vec2f> uvs;              // empty or one per vertex: the base-colour texture's
   std::vector<std::uint32_t> indices;  // 3 per triangle, local to the object
   std::vector<ObjectRecord> objects;
   std::string names;                // all object names, back to back
@@ -51,12 +55,14 @@ struct Model {
   // CAD layers objects are on, by name ("fasteners", or "a; b" for an object on two): a table
   // like materials.
   std::vector<std::string> layers;
+  std::vector<ImageSource> images;  // what materials' textures refer to, still encoded
 
   std::uint64_t vertexCount() const { return positions.size(); }
   std::uint64_t triangleCount() const { return indices.size() / 3; }
   std::uint64_t objectCount() const { return objects.size(); }
   bool hasNormals() const { return !normals.empty(); }
   bool hasColors() const { return !colors.empty(); }
+  bool hasUvs() const { return !uvs.empty(); }
 
   std::string_view objectName(std::size_t object) const {
     const ObjectRecord& o = objects[object];
@@ -133,6 +139,10 @@ void placeAtOrigin(Model& model, std::span<const Vec3d> world);
 // degenerate (repeated corners). Objects stay separate: nothing welds across objects.
 struct WeldOptions;
 void weldModel(Model& model, const WeldOptions& options);
+
+// Removes the materials no object uses and the images no material uses, renumbering the rest
+// in their order.
+void dropUnusedMaterials(Model& model);
 
 // Checks the invariants above (sizes, offsets, index ranges); for tests and debug builds.
 bool isConsistent(const Model& model, std::string* why = nullptr);

@@ -35,10 +35,6 @@ struct PartMesh {
   }
 };
 
-struct Vec2f {
-  float x = 0, y = 0;
-};
-
 // Box centred at the origin, each face an n x n grid.
 void addBox(PartMesh& mesh, Vec3f size, int subdivisions);
 // Smooth cylinder side around z from z0 to z1; normals point out (or in, for a bore).

@@ -68,12 +68,12 @@ Result<Model> readModel(const std::string& path, const ReadOptions& options) {
       return readPly(path, ply);
     }
     case FileFormat::kObj:
-      return readObj(path);
+      return readObj(path, options.warnings);
     case FileFormat::kStl:
       return readStl(path);
     case FileFormat::kGltf:
     case FileFormat::kGlb:
-      return readGltf(path);
+      return readGltf(path, {.warnings = options.warnings});
     case FileFormat::kCad: {
       CadReadOptions cad = options.cad;
       cad.salvageTruncated = cad.salvageTruncated || options.salvageTruncated;

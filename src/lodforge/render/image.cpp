@@ -7,7 +7,7 @@
 #include <cstring>
 
 #include "lodforge/core/file.h"
-#include "lodforge/render/stb_png.h"
+#include "lodforge/io/image/stb_image.h"
 
 namespace lodforge {
 
@@ -64,7 +64,7 @@ Result<Image> readPngFromMemory(std::span<const std::byte> bytes, const std::str
   int width = 0, height = 0;
   std::string why;
   // The header's size before decoding: a few bytes must not make us allocate gigabytes.
-  if (!stb::pngInfo(bytes, width, height, why))
+  if (int channels = 0; !stb::imageInfo(bytes, width, height, channels, why))
     return Error{ErrorKind::kBadInput,
                  fmt::format("{}: cannot read the PNG header ({})", name, why)};
   if (width <= 0 || height <= 0 ||
@@ -73,7 +73,7 @@ Result<Image> readPngFromMemory(std::span<const std::byte> bytes, const std::str
                  fmt::format("{}: PNG of {}x{} pixels is larger than {} megapixels", name, width,
                              height, maxPixels / 1000000)};
   Image image;
-  if (!stb::decodePng(bytes, width, height, image.rgba, why))
+  if (!stb::decodeImage(bytes, width, height, image.rgba, why))
     return Error{ErrorKind::kBadInput, fmt::format("{}: cannot decode PNG ({})", name, why)};
   image.width = static_cast<std::uint32_t>(width);
   image.height = static_cast<std::uint32_t>(height);

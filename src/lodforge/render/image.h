@@ -8,18 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "lodforge/core/image.h"
 #include "lodforge/core/status.h"
 
 namespace lodforge {
-
-struct Image {
-  std::uint32_t width = 0, height = 0;
-  std::vector<std::uint8_t> rgba;  // 4 per pixel, rows top to bottom
-
-  Image() = default;
-  Image(std::uint32_t w, std::uint32_t h) : width(w), height(h), rgba(std::size_t{w} * h * 4) {}
-  std::size_t pixelCount() const { return std::size_t{width} * height; }
-};
 
 // A PNG of any channel count becomes RGBA8; a file that is not a PNG is kBadInput naming it.
 Result<Image> readPng(const std::string& path);

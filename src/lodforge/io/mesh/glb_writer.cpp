@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -12,6 +14,7 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/instances.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/mesh/gltf_constants.h"
 
 namespace lodforge {
@@ -23,7 +26,7 @@ std::size_t elementBytes(int componentType, std::string_view type) {
   const std::size_t component = componentType == kByte || componentType == kUnsignedByte     ? 1
                                 : componentType == kShort || componentType == kUnsignedShort ? 2
                                                                                              : 4;
-  const std::size_t components = type == "SCALAR" ? 1 : type == "VEC3" ? 3 : 4;
+  const std::size_t components = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : 4;
   return component * components;
 }
 
@@ -41,6 +44,10 @@ struct GlbWriter::State {
   nlohmann::json bufferViews = nlohmann::json::array();
   nlohmann::json meshes = nlohmann::json::array();
   nlohmann::json materials = nlohmann::json::array();
+  nlohmann::json images = nlohmann::json::array();
+  nlohmann::json samplers = nlohmann::json::array();
+  nlohmann::json textures = nlohmann::json::array();
+  bool webp = false;  // a texture uses EXT_texture_webp
   nlohmann::json nodes = nlohmann::json::array();
   std::string structuralMetadata;  // EXT_structural_metadata at the root, when set
   bool meshFeatures = false;       // a primitive uses EXT_mesh_features
@@ -58,6 +65,7 @@ struct GlbWriter::State {
   Status addFloatAttributes(const GlbMeshData& mesh, const Aabb& bounds,
                             nlohmann::json& attributes);
   Status addColors(const GlbMeshData& mesh, nlohmann::json& attributes);
+  Status addUvs(const GlbMeshData& mesh, nlohmann::json& attributes);
   Status addExtraAttributes(const GlbMeshData& mesh, nlohmann::json& attributes);
   Result<std::uint32_t> addIndices(const GlbMeshData& mesh);
   // A primitive over `attributes` drawing the mesh's indices with `material` (default: white).
@@ -179,11 +187,12 @@ std::uint32_t GlbWriter::addMaterial(const std::array<float, 4>& baseColor, std:
   return static_cast<std::uint32_t>(state_->materials.size() - 1);
 }
 
-std::uint32_t GlbWriter::addMaterial(const Material& m) {
+std::uint32_t GlbWriter::addMaterial(const Material& m, std::optional<std::uint32_t> texture) {
   nlohmann::json material = {{"pbrMetallicRoughness",
                               {{"baseColorFactor", m.baseColor},
                                {"metallicFactor", m.metallic},
                                {"roughnessFactor", m.roughness}}}};
+  if (texture) material["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", *texture}};
   if (m.doubleSided) material["doubleSided"] = true;
   if (m.alphaMode != AlphaMode::kOpaque) material["alphaMode"] = alphaModeName(m.alphaMode);
   if (m.alphaMode == AlphaMode::kMask) material["alphaCutoff"] = m.alphaCutoff;
@@ -271,6 +280,43 @@ Status GlbWriter::State::addColors(const GlbMeshData& mesh, nlohmann::json& attr
   return {};
 }
 
+Status GlbWriter::State::addUvs(const GlbMeshData& mesh, nlohmann::json& attributes) {
+  if (mesh.uvs.empty()) return {};
+  Result<std::uint32_t> uv =
+      addAccessor(mesh.uvs.data(), mesh.uvs.size_bytes(), mesh.uvs.size(), kFloat, "VEC2",
+                  kArrayBuffer, false, nullptr, nullptr, sizeof(Vec2f));
+  if (!uv) return uv.status();
+  attributes["TEXCOORD_0"] = *uv;
+  return {};
+}
+
+Result<std::uint32_t> GlbWriter::addTexture(std::span<const std::byte> encoded, ImageFormat format,
+                                            TextureWrap wrapS, TextureWrap wrapT) {
+  assert(format != ImageFormat::kUnknown && !encoded.empty());
+  State& s = *state_;
+  Result<std::uint32_t> view = addBufferView(encoded);
+  if (!view) return view.status();
+  s.images.push_back({{"bufferView", *view}, {"mimeType", std::string(mimeTypeOf(format))}});
+  const nlohmann::json sampler = {{"magFilter", 9729},  // LINEAR
+                                  {"minFilter", 9987},  // LINEAR_MIPMAP_LINEAR
+                                  {"wrapS", wrapModeCode(wrapS)},
+                                  {"wrapT", wrapModeCode(wrapT)}};
+  auto found = std::find(s.samplers.begin(), s.samplers.end(), sampler);
+  if (found == s.samplers.end()) {
+    s.samplers.push_back(sampler);
+    found = s.samplers.end() - 1;
+  }
+  nlohmann::json texture = {{"sampler", found - s.samplers.begin()}};
+  if (format == ImageFormat::kWebp) {
+    texture["extensions"]["EXT_texture_webp"] = {{"source", s.images.size() - 1}};
+    s.webp = true;
+  } else {
+    texture["source"] = s.images.size() - 1;
+  }
+  s.textures.push_back(std::move(texture));
+  return static_cast<std::uint32_t>(s.textures.size() - 1);
+}
+
 Status GlbWriter::State::addExtraAttributes(const GlbMeshData& mesh, nlohmann::json& attributes) {
   const std::size_t vertexCount = mesh.positions.size();
   for (const GlbVertexAttribute& extra : mesh.extraAttributes) {
@@ -328,6 +374,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
                      : (!mesh.indices.empty() && mesh.indices.size() % 3 == 0));
   assert(mesh.normals.empty() || mesh.normals.size() == mesh.positions.size());
   assert(mesh.colors.empty() || mesh.colors.size() == mesh.positions.size());
+  assert(mesh.uvs.empty() || mesh.uvs.size() == mesh.positions.size());
   Aabb bounds;
   for (const Vec3f& p : mesh.positions) bounds.add(p);
   nlohmann::json attributes;
@@ -337,6 +384,7 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
     LODFORGE_TRY(s.addFloatAttributes(mesh, bounds, attributes));
   }
   LODFORGE_TRY(s.addColors(mesh, attributes));
+  LODFORGE_TRY(s.addUvs(mesh, attributes));
   LODFORGE_TRY(s.addExtraAttributes(mesh, attributes));
   // One primitive, or one per group of indices (each with its material) over the same vertices.
   const GlbPrimitive whole{static_cast<std::uint32_t>(mesh.indices.size()), material};
@@ -483,6 +531,16 @@ Status GlbWriter::finish() {
     }
   }
   if (!s.materials.empty()) document["materials"] = std::move(s.materials);
+  if (!s.textures.empty()) {
+    document["images"] = std::move(s.images);
+    document["samplers"] = std::move(s.samplers);
+    document["textures"] = std::move(s.textures);
+    // Every texture is WebP (no fallback image): a viewer without the extension draws nothing.
+    if (s.webp) {
+      document["extensionsUsed"].push_back("EXT_texture_webp");
+      document["extensionsRequired"].push_back("EXT_texture_webp");
+    }
+  }
   if (!s.structuralMetadata.empty()) {
     document["extensions"]["EXT_structural_metadata"] = nlohmann::json::parse(s.structuralMetadata);
     document["extensionsUsed"].push_back("EXT_structural_metadata");
@@ -563,6 +621,42 @@ class AssemblyNodes {
   std::unordered_map<std::string, std::uint32_t> nodes_;
 };
 
+// The model's images as the GLB's textures: each written once, embedded (a file's bytes read
+// when first used), one texture per image and wrap modes.
+class ModelTextures {
+ public:
+  ModelTextures(const Model& model, GlbWriter& writer) : model_(model), writer_(writer) {}
+
+  bool textured(std::uint32_t material) const {
+    return material < model_.materials.size() &&
+           model_.materials[material].baseColorImage != kNoImage;
+  }
+
+  Result<std::optional<std::uint32_t>> of(const Material& material) {
+    if (material.baseColorImage == kNoImage) return std::optional<std::uint32_t>();
+    const auto key = std::tuple(material.baseColorImage, material.wrapS, material.wrapT);
+    if (const auto found = textures_.find(key); found != textures_.end())
+      return std::optional(found->second);
+    const ImageSource& image = model_.images[material.baseColorImage];
+    Result<std::vector<std::byte>> bytes = imageBytes(image);
+    if (!bytes) return bytes.status();
+    const ImageFormat format = imageFormatOf(*bytes);
+    if (format == ImageFormat::kUnknown)
+      return badInput(image.embedded() ? image.name : image.path,
+                      "texture image: not a JPEG, PNG or WebP image");
+    Result<std::uint32_t> texture =
+        writer_.addTexture(*bytes, format, material.wrapS, material.wrapT);
+    if (!texture) return texture.status();
+    textures_.emplace(key, *texture);
+    return std::optional(*texture);
+  }
+
+ private:
+  const Model& model_;
+  GlbWriter& writer_;
+  std::map<std::tuple<std::uint32_t, TextureWrap, TextureWrap>, std::uint32_t> textures_;
+};
+
 // The first path component every object's path starts with, followed by more ("" if none).
 std::string_view sharedFirstComponent(const Model& model) {
   std::string_view shared;
@@ -585,12 +679,16 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
   // The model's materials, written when used; their base colour is in the vertex colours when
   // there are any (readers bake it in), so it is white there.
   std::vector<std::optional<std::uint32_t>> materials(model.materials.size());
+  ModelTextures textures(model, *writer);
+  Status textureStatus;
   const auto materialOf = [&](std::uint32_t m) -> std::optional<std::uint32_t> {
     if (m >= materials.size()) return std::nullopt;
     if (!materials[m]) {
       Material material = model.materials[m];
       if (model.hasColors()) material.baseColor = {1, 1, 1, 1};
-      materials[m] = writer->addMaterial(material);
+      Result<std::optional<std::uint32_t>> texture = textures.of(material);
+      if (!texture) textureStatus = texture.status();
+      materials[m] = writer->addMaterial(material, texture ? *texture : std::nullopt);
     }
     return materials[m];
   };
@@ -613,9 +711,13 @@ Status writeGlb(const Model& model, const std::string& path, const GlbWriteOptio
         data.normals = std::span(model.normals).subspan(record.vertexOffset, record.vertexCount);
       if (model.hasColors())
         data.colors = std::span(model.colors).subspan(record.vertexOffset, record.vertexCount);
+      const std::optional<std::uint32_t> material = materialOf(record.material);
+      LODFORGE_TRY(textureStatus);
+      // Texture coordinates go with a texture; an object without one draws no image.
+      if (model.hasUvs() && textures.textured(record.material))
+        data.uvs = std::span(model.uvs).subspan(record.vertexOffset, record.vertexCount);
       data.indices = model.objectIndices(o);
-      Result<std::uint32_t> added =
-          writer->addMesh(data, model.objectName(o), materialOf(record.material));
+      Result<std::uint32_t> added = writer->addMesh(data, model.objectName(o), material);
       if (!added) return added.status();
       mesh = *added;
     }

@@ -60,6 +60,7 @@ struct GlbMeshData {
   // Empty: one primitive with addMesh's material. Otherwise the indices in groups, one primitive
   // each, all over the same vertex attributes (a tile's parts grouped by material).
   std::span<const GlbPrimitive> primitives = {};
+  std::span<const Vec2f> uvs = {};  // empty or one per vertex: TEXCOORD_0
 };
 
 // The grid step of a quantised mesh inside `bounds`: its longest side over 65535.
@@ -94,8 +95,15 @@ class GlbWriter {
 
   // A material with this base colour (linear RGBA); index for addMesh.
   std::uint32_t addMaterial(const std::array<float, 4>& baseColor, std::string_view name = {});
-  // A material as the input described it.
-  std::uint32_t addMaterial(const Material& material);
+  // A material as the input described it, drawing `texture` (addTexture's) as its base colour
+  // at TEXCOORD_0 when given (its baseColorImage is not looked at).
+  std::uint32_t addMaterial(const Material& material,
+                            std::optional<std::uint32_t> texture = std::nullopt);
+  // An encoded image (JPEG, PNG or WebP: EXT_texture_webp, required) in the binary chunk with a
+  // sampler of these wrap modes (linear filtering, mipmaps); returns the texture's index.
+  Result<std::uint32_t> addTexture(std::span<const std::byte> encoded, ImageFormat format,
+                                   TextureWrap wrapS = TextureWrap::kRepeat,
+                                   TextureWrap wrapT = TextureWrap::kRepeat);
   // Writes the mesh's data; returns its mesh index for addNode. Empty meshes are refused (assert).
   Result<std::uint32_t> addMesh(const GlbMeshData& mesh, std::string_view name = {},
                                 std::optional<std::uint32_t> material = std::nullopt);

@@ -14,6 +14,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/io/mesh/gltf_constants.h"
+#include "lodforge/io/mesh/gltf_textures.h"
 
 namespace lodforge {
 
@@ -104,19 +105,15 @@ bool refuseRead(std::vector<unsigned char>*, std::string* err, const std::string
 bool refuseWrite(std::string*, const std::string&, const std::vector<unsigned char>&, void*) {
   return false;
 }
-// Images are never decoded: lodforge reads geometry and colours, not textures.
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-               const unsigned char*, int, void*) {
-  return true;
-}
-
 class Loader {
  public:
-  Loader(const tinygltf::Model& gltf, const std::string& name, std::uint64_t binOffset)
-      : gltf_(gltf), name_(name), binOffset_(binOffset) {}
+  Loader(const tinygltf::Model& gltf, const std::string& name, std::uint64_t binOffset,
+         const std::string& baseDir, std::vector<std::string>* warnings)
+      : gltf_(gltf), name_(name), binOffset_(binOffset), baseDir_(baseDir), warnings_(warnings) {}
 
   Model load() {
     readMaterials();
+    texturing_ = readGltfTextures(gltf_, baseDir_, name_, model_, warnings_);
     decideColors();
     traverseScene();
     placeAtOrigin();
@@ -260,11 +257,13 @@ class Loader {
     }
   }
 
-  // Colours are kept when any drawn primitive has a material or COLOR_0.
+  // Colours are kept when any drawn primitive has a material or COLOR_0, texture coordinates
+  // when any has a texture.
   void decideColors() {
     for (const auto& mesh : gltf_.meshes) {
       for (const auto& primitive : mesh.primitives) {
         if (primitive.material >= 0 || primitive.attributes.count("COLOR_0")) withColors_ = true;
+        if (texturing_.textured(primitive.material)) withUvs_ = true;
       }
     }
   }
@@ -364,77 +363,127 @@ class Loader {
   }
 
   struct PrimitiveData {
-    std::vector<double> positions, normals, colors;  // 3, 3, 4 per vertex
+    std::vector<double> positions, normals, colors, uvs;  // 3, 3, 4, 2 per vertex
     std::vector<std::uint32_t> triangles;
   };
 
+  // A mesh whose primitives use a texture and another material becomes an object per material
+  // (named "name (material)"): an object with a texture has one material (model.h).
+  std::vector<std::vector<std::size_t>> primitiveGroups(const tinygltf::Mesh& mesh) const {
+    std::vector<int> materials;
+    bool textured = false;
+    for (const auto& primitive : mesh.primitives) {
+      textured = textured || texturing_.textured(primitive.material);
+      if (std::find(materials.begin(), materials.end(), primitive.material) == materials.end())
+        materials.push_back(primitive.material);
+    }
+    if (!textured || materials.size() < 2) {
+      std::vector<std::size_t> all(mesh.primitives.size());
+      for (std::size_t p = 0; p < all.size(); ++p) all[p] = p;
+      return {all};
+    }
+    std::vector<std::vector<std::size_t>> groups(materials.size());
+    for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
+      const auto g = std::find(materials.begin(), materials.end(), mesh.primitives[p].material) -
+                     materials.begin();
+      groups[static_cast<std::size_t>(g)].push_back(p);
+    }
+    return groups;
+  }
+
+  std::string groupName(const std::string& name, const tinygltf::Mesh& mesh,
+                        const std::vector<std::size_t>& group, bool split) const {
+    if (!split) return name;
+    const int material = mesh.primitives[group.front()].material;
+    if (material < 0) return name;
+    const std::string& label = gltf_.materials[static_cast<std::size_t>(material)].name;
+    return fmt::format("{} ({})", name,
+                       label.empty() ? fmt::format("material {}", material) : label);
+  }
+
   void addObject(const std::string& name, const std::string& path, int meshIndex,
                  const tinygltf::Mesh& mesh, const Mat4d& world) {
-    ModelBuilder builder(model_);
-    builder.beginObject(name, path);
-    const Mat4d normalMatrix = world.normalMatrix();
+    const std::vector<std::vector<std::size_t>> groups = primitiveGroups(mesh);
+    for (const std::vector<std::size_t>& group : groups) {
+      ModelBuilder builder(model_);
+      builder.beginObject(groupName(name, mesh, group, groups.size() > 1), path);
+      for (std::size_t p : group) addPrimitive(meshIndex, mesh, p, world);
+      // One material per object: its first drawn primitive's (the vertex colours keep the
+      // others' base colours).
+      for (std::size_t p : group) {
+        const int material = mesh.primitives[p].material;
+        if (material < 0 || static_cast<std::size_t>(material) >= model_.materials.size()) continue;
+        model_.objects.back().material = static_cast<std::uint32_t>(material);
+        break;
+      }
+      builder.endObject();
+    }
+  }
+
+  void addPrimitive(int meshIndex, const tinygltf::Mesh& mesh, std::size_t p, const Mat4d& world) {
+    const auto& primitive = mesh.primitives[p];
+    const std::string where = fmt::format("mesh {} primitive {}", meshIndex, p);
+    const int mode = primitive.mode < 0 ? kModeTriangles : primitive.mode;
+    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) return;  // points, lines
+    PrimitiveData data = primitive.extensions.count("KHR_draco_mesh_compression")
+                             ? decodeDraco(primitive, where)
+                             : readPrimitive(primitive, mode, where);
+    const std::size_t vertexCount = data.positions.size() / 3;
+    const auto base =
+        static_cast<std::uint32_t>(model_.positions.size() - model_.objects.back().vertexOffset);
+    if (vertexCount > std::numeric_limits<std::uint32_t>::max() - base)
+      fail(fmt::format("{}: too many vertices in one object", where));
+    addVertices(data, world, primitive.material, where);
     const bool mirrored = world.determinant3() < 0;  // winding flips under a mirror
-    for (std::size_t p = 0; p < mesh.primitives.size(); ++p) {
-      const auto& primitive = mesh.primitives[p];
-      const std::string where = fmt::format("mesh {} primitive {}", meshIndex, p);
-      const int mode = primitive.mode < 0 ? kModeTriangles : primitive.mode;
-      if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan)
-        continue;  // points, lines
-      PrimitiveData data = primitive.extensions.count("KHR_draco_mesh_compression")
-                               ? decodeDraco(primitive, where)
-                               : readPrimitive(primitive, mode, where);
-      const std::size_t vertexCount = data.positions.size() / 3;
-      const auto base =
-          static_cast<std::uint32_t>(model_.positions.size() - model_.objects.back().vertexOffset);
-      if (vertexCount > std::numeric_limits<std::uint32_t>::max() - base)
-        fail(fmt::format("{}: too many vertices in one object", where));
-      Vec4Color factor = baseColor(primitive.material, where);
-      for (std::size_t v = 0; v < vertexCount; ++v) {
-        const Vec3d local{data.positions[3 * v], data.positions[3 * v + 1],
-                          data.positions[3 * v + 2]};
-        if (!isFinite(local)) fail(fmt::format("{}: POSITION {} is not finite", where, v));
-        world_.push_back(world.transformPoint(local));
-        model_.positions.push_back({});  // filled by placeAtOrigin
-        if (!data.normals.empty()) {
-          const Vec3d n{data.normals[3 * v], data.normals[3 * v + 1], data.normals[3 * v + 2]};
-          if (!isFinite(n)) fail(fmt::format("{}: NORMAL {} is not finite", where, v));
-          normalsByVertex_.push_back(
-              toFloat(normalizeOr(normalMatrix.transformVector(n), Vec3d{})));
-        } else {
-          normalsByVertex_.push_back({});
-          missingNormals_ = true;
-        }
-        if (withColors_) {
-          double c[4] = {factor[0], factor[1], factor[2], factor[3]};
-          if (!data.colors.empty()) {
-            for (int k = 0; k < 4; ++k) c[k] *= data.colors[4 * v + static_cast<std::size_t>(k)];
-          }
-          auto channel = [](double x) {
-            return static_cast<std::uint8_t>(
-                std::lround(std::clamp(std::isfinite(x) ? x : 0.0, 0.0, 1.0) * 255));
-          };
-          model_.colors.push_back({channel(c[0]), channel(c[1]), channel(c[2]), channel(c[3])});
-        }
+    for (std::size_t t = 0; t + 2 < data.triangles.size(); t += 3) {
+      std::uint32_t a = data.triangles[t], b = data.triangles[t + 1], c = data.triangles[t + 2];
+      if (a >= vertexCount || b >= vertexCount || c >= vertexCount)
+        fail(fmt::format("{}: index {} out of range ({} vertices)", where, std::max({a, b, c}),
+                         vertexCount));
+      if (mirrored) std::swap(b, c);
+      model_.indices.insert(model_.indices.end(), {base + a, base + b, base + c});
+    }
+  }
+
+  void addVertices(const PrimitiveData& data, const Mat4d& world, int material,
+                   const std::string& where) {
+    const Mat4d normalMatrix = world.normalMatrix();
+    const Vec4Color factor = baseColor(material, where);
+    const std::size_t vertexCount = data.positions.size() / 3;
+    for (std::size_t v = 0; v < vertexCount; ++v) {
+      const Vec3d local{data.positions[3 * v], data.positions[3 * v + 1],
+                        data.positions[3 * v + 2]};
+      if (!isFinite(local)) fail(fmt::format("{}: POSITION {} is not finite", where, v));
+      world_.push_back(world.transformPoint(local));
+      model_.positions.push_back({});  // filled by placeAtOrigin
+      if (!data.normals.empty()) {
+        const Vec3d n{data.normals[3 * v], data.normals[3 * v + 1], data.normals[3 * v + 2]};
+        if (!isFinite(n)) fail(fmt::format("{}: NORMAL {} is not finite", where, v));
+        normalsByVertex_.push_back(toFloat(normalizeOr(normalMatrix.transformVector(n), Vec3d{})));
+      } else {
+        normalsByVertex_.push_back({});
+        missingNormals_ = true;
       }
-      for (std::size_t t = 0; t + 2 < data.triangles.size(); t += 3) {
-        std::uint32_t a = data.triangles[t], b = data.triangles[t + 1], c = data.triangles[t + 2];
-        if (a >= vertexCount || b >= vertexCount || c >= vertexCount)
-          fail(fmt::format("{}: index {} out of range ({} vertices)", where, std::max({a, b, c}),
-                           vertexCount));
-        if (mirrored) std::swap(b, c);
-        model_.indices.insert(model_.indices.end(), {base + a, base + b, base + c});
+      if (withColors_) model_.colors.push_back(vertexColor(data, factor, v));
+      if (withUvs_) {
+        model_.uvs.push_back(
+            data.uvs.empty() ? Vec2f{}
+                             : texturing_.apply(material, data.uvs[2 * v], data.uvs[2 * v + 1]));
       }
     }
-    // One material per object: its first drawn primitive's (the vertex colours keep the others'
-    // base colours).
-    for (const auto& primitive : mesh.primitives) {
-      if (primitive.material < 0 ||
-          static_cast<std::size_t>(primitive.material) >= model_.materials.size())
-        continue;
-      model_.objects.back().material = static_cast<std::uint32_t>(primitive.material);
-      break;
+  }
+
+  static Rgba8 vertexColor(const PrimitiveData& data, const std::array<double, 4>& factor,
+                           std::size_t v) {
+    double c[4] = {factor[0], factor[1], factor[2], factor[3]};
+    if (!data.colors.empty()) {
+      for (int k = 0; k < 4; ++k) c[k] *= data.colors[4 * v + static_cast<std::size_t>(k)];
     }
-    builder.endObject();
+    auto channel = [](double x) {
+      return static_cast<std::uint8_t>(
+          std::lround(std::clamp(std::isfinite(x) ? x : 0.0, 0.0, 1.0) * 255));
+    };
+    return {channel(c[0]), channel(c[1]), channel(c[2]), channel(c[3])};
   }
 
   using Vec4Color = std::array<double, 4>;
@@ -476,6 +525,7 @@ class Loader {
               raw[v * static_cast<std::size_t>(components) + static_cast<std::size_t>(k)];
       }
     }
+    data.uvs = readUvs(primitive, vertexCount, where);
     std::vector<std::uint32_t> indices;
     if (primitive.indices >= 0) {
       const auto& accessor =
@@ -498,6 +548,31 @@ class Loader {
     }
     data.triangles = toTriangles(indices, mode);
     return data;
+  }
+
+  // The TEXCOORD set the primitive's texture reads (2 per vertex), or nothing when it has no
+  // texture; a textured primitive without them is a warning (its texture's corner is drawn).
+  std::vector<double> readUvs(const tinygltf::Primitive& primitive, std::size_t vertexCount,
+                              const std::string& where) {
+    if (!texturing_.textured(primitive.material)) return {};
+    const std::string semantic = fmt::format(
+        "TEXCOORD_{}", texturing_.texCoord[static_cast<std::size_t>(primitive.material)]);
+    const auto found = primitive.attributes.find(semantic);
+    if (found == primitive.attributes.end()) {
+      if (warnings_)
+        warnings_->push_back(
+            fmt::format("{}: {}: a textured primitive without {}; it is drawn in "
+                        "its texture's corner colour",
+                        name_, where, semantic));
+      return {};
+    }
+    std::vector<double> uvs = readAccessor(found->second, 2, where + " " + semantic);
+    if (uvs.size() != 2 * vertexCount)
+      fail(fmt::format("{}: {} and POSITION differ in count", where, semantic));
+    for (double& x : uvs) {
+      if (!std::isfinite(x)) x = 0;
+    }
+    return uvs;
   }
 
   static std::vector<std::uint32_t> toTriangles(const std::vector<std::uint32_t>& indices,
@@ -565,6 +640,11 @@ class Loader {
     if (data.positions.empty()) fail(fmt::format("{}: no POSITION attribute", what));
     read("NORMAL", 3, data.normals);
     read("COLOR_0", 4, data.colors);
+    if (texturing_.textured(primitive.material))
+      read(fmt::format("TEXCOORD_{}",
+                       texturing_.texCoord[static_cast<std::size_t>(primitive.material)])
+               .c_str(),
+           2, data.uvs);
     data.triangles.reserve(mesh->num_faces() * 3);
     for (draco::FaceIndex f(0); f < mesh->num_faces(); ++f) {
       const auto& face = mesh->face(f);
@@ -583,12 +663,16 @@ class Loader {
   const tinygltf::Model& gltf_;
   const std::string& name_;
   std::uint64_t binOffset_;
+  std::string baseDir_;  // where external images lie; empty: none may be read
+  std::vector<std::string>* warnings_;
+  GltfTexturing texturing_;
   Model model_;
   std::vector<Vec3d> world_;
   std::vector<Vec3f> normalsByVertex_;
   std::vector<bool> visited_;
   LayerTable layers_{model_.layers};
   bool withColors_ = false;
+  bool withUvs_ = false;
   bool missingNormals_ = false;
 };
 
@@ -679,7 +763,7 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
     return Error{ErrorKind::kLimit,
                  fmt::format("{}: glTF files over 4 GiB are not supported", name)};
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skipImage, nullptr);
+  loader.SetImageLoader(keepEncodedImage, nullptr);
   if (!options.allowExternalFiles) {
     loader.SetFsCallbacks({refuseFileExists, keepPath, refuseRead, refuseWrite, nullptr});
   }
@@ -735,7 +819,8 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
     return badInput(name, errors.empty() ? std::string("tinygltf cannot parse the file") : errors);
   }
   try {
-    Loader builder(gltf, name, binOffset);
+    Loader builder(gltf, name, binOffset, options.allowExternalFiles ? baseDir : std::string(),
+                   options.warnings);
     return builder.load();
   } catch (const ErrorException& e) {
     return e.error;
@@ -748,6 +833,7 @@ Result<Model> readGltf(const std::string& path, const GltfReadOptions& options) 
   Result<std::string> text = readFileToString(path, std::numeric_limits<unsigned>::max());
   if (!text) return text.status();
   std::string baseDir = std::filesystem::path(path).parent_path().string();
+  if (baseDir.empty()) baseDir = ".";
   const std::span<const std::byte> bytes(reinterpret_cast<const std::byte*>(text->data()),
                                          text->size());
   return parse(bytes, path, baseDir, options);

@@ -12,6 +12,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/mesh.h"
+#include "lodforge/io/mesh/obj_materials.h"
 
 namespace lodforge {
 
@@ -81,13 +82,15 @@ std::uint64_t lineOfFace(std::string_view text, std::uint64_t face) {
 }
 
 struct CornerKey {
-  int vertex, normal, material;
+  int vertex, normal, texcoord, material;
   bool operator==(const CornerKey&) const = default;
 };
+
 struct CornerHash {
   std::size_t operator()(const CornerKey& k) const {
     std::uint64_t h = static_cast<std::uint32_t>(k.vertex);
     h = h * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint32_t>(k.normal);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint32_t>(k.texcoord);
     h = h * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint32_t>(k.material);
     return static_cast<std::size_t>(h ^ (h >> 29));
   }
@@ -149,98 +152,167 @@ Result<ParsedObj> parseObj(const std::string& text, const std::string& name,
 struct FaceSummary {
   std::uint64_t faces = 0;
   bool anyNormal = false;
-  bool anyColor = false;  // vertex colours, or a face with a known material
+  bool anyColor = false;               // vertex colours, or a face with a known material
+  bool anyTextured = false;            // a face whose material has a texture
+  std::uint64_t cornersWithoutUv = 0;  // corners of textured faces without `vt`
 };
 
 Result<FaceSummary> checkFaces(const std::string& text, const std::string& name,
-                               const ParsedObj& obj) {
+                               const ParsedObj& obj, const ObjTextures& textures) {
   const int vertexCount = static_cast<int>(obj.attrib.vertices.size() / 3);
   const int normalCount = static_cast<int>(obj.attrib.normals.size() / 3);
+  const int texcoordCount = static_cast<int>(obj.attrib.texcoords.size() / 2);
   FaceSummary summary;
   summary.anyColor = !obj.attrib.colors.empty();
+  auto refuse = [&](std::string_view what, std::string_view plural, int index, int count) {
+    return badInputAtLine(
+        name, lineOfFace(text, summary.faces),
+        fmt::format("face refers to {} {} but the file has {} {}", what, index + 1, count, plural));
+  };
   for (const tinyobj::shape_t& shape : obj.shapes) {
     std::size_t corner = 0;
     for (std::size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f, ++summary.faces) {
+      const int material = shape.mesh.material_ids.empty() ? -1 : shape.mesh.material_ids[f];
+      const bool textured = textures.textured(material);
+      summary.anyTextured = summary.anyTextured || textured;
       for (unsigned k = 0; k < shape.mesh.num_face_vertices[f]; ++k, ++corner) {
         const tinyobj::index_t& index = shape.mesh.indices[corner];
-        if (index.vertex_index < 0 || index.vertex_index >= vertexCount) {
-          return badInputAtLine(name, lineOfFace(text, summary.faces),
-                                fmt::format("face refers to vertex {} but the file has {} vertices",
-                                            index.vertex_index + 1, vertexCount));
-        }
-        if (index.normal_index >= normalCount) {
-          return badInputAtLine(name, lineOfFace(text, summary.faces),
-                                fmt::format("face refers to normal {} but the file has {} normals",
-                                            index.normal_index + 1, normalCount));
-        }
+        if (index.vertex_index < 0 || index.vertex_index >= vertexCount)
+          return refuse("vertex", "vertices", index.vertex_index, vertexCount);
+        if (index.normal_index >= normalCount)
+          return refuse("normal", "normals", index.normal_index, normalCount);
+        if (index.texcoord_index >= texcoordCount)
+          return refuse("texture coordinate", "texture coordinates", index.texcoord_index,
+                        texcoordCount);
         summary.anyNormal = summary.anyNormal || index.normal_index >= 0;
+        if (textured && index.texcoord_index < 0) ++summary.cornersWithoutUv;
       }
-      if (!shape.mesh.material_ids.empty() && shape.mesh.material_ids[f] >= 0 &&
-          static_cast<std::size_t>(shape.mesh.material_ids[f]) < obj.materials.size()) {
+      if (material >= 0 && static_cast<std::size_t>(material) < obj.materials.size())
         summary.anyColor = true;
-      }
     }
   }
   return summary;
 }
 
-// One shape as one object: a vertex per distinct (position, normal, material colour) corner,
-// polygons fan-triangulated; smooth normals for the whole object where some corners lack `vn`.
-void addShape(Model& model, ModelBuilder& builder, const ParsedObj& obj, std::size_t s,
-              const FaceSummary& summary) {
-  const tinyobj::attrib_t& attrib = obj.attrib;
-  const tinyobj::mesh_t& mesh = obj.shapes[s].mesh;
+// A shape's faces that become one object: all of them, or those of one textured material.
+struct FaceGroup {
+  std::string name;
+  std::vector<std::uint32_t> faces;
+};
+
+// A shape that uses a texture and another material splits into an object per textured
+// material (named "shape (material)") and one of its other faces: an object with a texture has
+// one material (model.h).
+std::vector<FaceGroup> groupFaces(const ParsedObj& obj, std::size_t s,
+                                  const ObjTextures& textures) {
+  const tinyobj::shape_t& shape = obj.shapes[s];
+  const std::string name = shape.name.empty() ? fmt::format("object {}", s) : shape.name;
+  const auto& ids = shape.mesh.material_ids;
+  const std::size_t faceCount = shape.mesh.num_face_vertices.size();
+  auto groupOf = [&](std::size_t f) {
+    return textures.textured(ids.empty() ? -1 : ids[f]) ? ids[f] : -1;
+  };
+  std::vector<int> order;  // textured materials (or -1) in order of first use
+  for (std::size_t f = 0; f < faceCount; ++f) {
+    if (std::find(order.begin(), order.end(), groupOf(f)) == order.end())
+      order.push_back(groupOf(f));
+  }
+  std::vector<FaceGroup> groups(order.size());
+  for (std::size_t g = 0; g < order.size(); ++g) {
+    groups[g].name =
+        order.size() == 1 || order[g] < 0
+            ? name
+            : fmt::format("{} ({})", name, obj.materials[static_cast<std::size_t>(order[g])].name);
+  }
+  for (std::size_t f = 0; f < faceCount; ++f) {
+    const auto g =
+        static_cast<std::size_t>(std::find(order.begin(), order.end(), groupOf(f)) - order.begin());
+    groups[g].faces.push_back(static_cast<std::uint32_t>(f));
+  }
+  return groups;
+}
+
+// Where the OBJ's parts go, for one object being built.
+struct ObjContext {
+  const ParsedObj& obj;
+  const FaceSummary& summary;
+  const ObjTextures& textures;
+};
+
+// Appends the vertex of one corner: position, normal (flagging a missing one), colour, UV.
+void addCorner(Model& model, const ObjContext& context, const tinyobj::index_t& index, int material,
+               bool& allNormals) {
+  const tinyobj::attrib_t& attrib = context.obj.attrib;
   const bool vertexColors = !attrib.colors.empty();
-  builder.beginObject(obj.shapes[s].name.empty() ? fmt::format("object {}", s)
-                                                 : obj.shapes[s].name);
+  const bool textured = context.textures.textured(material);
+  const bool materialColor = !vertexColors && !textured && material >= 0 &&
+                             static_cast<std::size_t>(material) < context.obj.materials.size();
+  const auto v = static_cast<std::size_t>(index.vertex_index);
+  const Vec3d p{attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]};
+  model.positions.push_back(toFloat(p - model.origin));
+  if (context.summary.anyNormal) {
+    Vec3f n{};
+    if (index.normal_index >= 0) {
+      const auto i = static_cast<std::size_t>(index.normal_index);
+      n = {static_cast<float>(attrib.normals[3 * i]), static_cast<float>(attrib.normals[3 * i + 1]),
+           static_cast<float>(attrib.normals[3 * i + 2])};
+    } else {
+      allNormals = false;
+    }
+    model.normals.push_back(n);
+  }
+  if (context.summary.anyColor) {
+    Rgba8 color;  // white: a texture's own colour, or no colour at all
+    if (vertexColors) {
+      color = toRgba(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]);
+    } else if (materialColor) {
+      const auto& kd = context.obj.materials[static_cast<std::size_t>(material)].diffuse;
+      color = toRgba(kd[0], kd[1], kd[2]);
+    }
+    model.colors.push_back(color);
+  }
+  if (context.summary.anyTextured) {
+    Vec2f uv;
+    if (textured && index.texcoord_index >= 0) {
+      const auto t = static_cast<std::size_t>(index.texcoord_index);
+      uv = context.textures.toUv(material, static_cast<float>(attrib.texcoords[2 * t]),
+                                 static_cast<float>(attrib.texcoords[2 * t + 1]));
+    }
+    model.uvs.push_back(uv);
+  }
+}
+
+// One group of a shape's faces as one object: a vertex per distinct (position, normal, UV,
+// material colour) corner, polygons fan-triangulated; smooth normals for the whole object
+// where some corners lack `vn`.
+void addGroup(Model& model, ModelBuilder& builder, const ObjContext& context,
+              const tinyobj::mesh_t& mesh, std::span<const std::size_t> firstCorner,
+              const FaceGroup& group) {
+  builder.beginObject(group.name);
   const std::size_t firstVertex = model.positions.size();
   std::unordered_map<CornerKey, std::uint32_t, CornerHash> local;
   bool allNormals = true;
-  std::size_t corner = 0;
   std::vector<std::uint32_t> polygon;
-  for (std::size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
+  for (std::uint32_t f : group.faces) {
     const int material = mesh.material_ids.empty() ? -1 : mesh.material_ids[f];
-    const bool materialColor =
-        !vertexColors && material >= 0 && static_cast<std::size_t>(material) < obj.materials.size();
+    if (context.textures.textured(material))
+      model.objects.back().material = context.textures.material[static_cast<std::size_t>(material)];
+    const bool keepsMaterial = context.obj.attrib.colors.empty();
     polygon.clear();
-    for (unsigned k = 0; k < mesh.num_face_vertices[f]; ++k, ++corner) {
+    for (std::size_t corner = firstCorner[f]; corner < firstCorner[f + 1]; ++corner) {
       const tinyobj::index_t& index = mesh.indices[corner];
-      const CornerKey key{index.vertex_index, index.normal_index, materialColor ? material : -1};
+      const CornerKey key{index.vertex_index, index.normal_index, index.texcoord_index,
+                          keepsMaterial ? material : -1};
       auto [it, inserted] =
           local.try_emplace(key, static_cast<std::uint32_t>(model.positions.size() - firstVertex));
       polygon.push_back(it->second);
-      if (!inserted) continue;
-      const auto v = static_cast<std::size_t>(index.vertex_index);
-      const Vec3d p{attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]};
-      model.positions.push_back(toFloat(p - model.origin));
-      if (summary.anyNormal) {
-        Vec3f n{};
-        if (index.normal_index >= 0) {
-          const auto i = static_cast<std::size_t>(index.normal_index);
-          n = {static_cast<float>(attrib.normals[3 * i]),
-               static_cast<float>(attrib.normals[3 * i + 1]),
-               static_cast<float>(attrib.normals[3 * i + 2])};
-        } else {
-          allNormals = false;
-        }
-        model.normals.push_back(n);
-      }
-      if (summary.anyColor) {
-        Rgba8 color;
-        if (vertexColors) {
-          color = toRgba(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]);
-        } else if (materialColor) {
-          const auto& kd = obj.materials[static_cast<std::size_t>(material)].diffuse;
-          color = toRgba(kd[0], kd[1], kd[2]);
-        }
-        model.colors.push_back(color);
-      }
+      if (inserted) addCorner(model, context, index, material, allNormals);
     }
     for (std::size_t k = 2; k < polygon.size(); ++k)
       model.indices.insert(model.indices.end(), {polygon[0], polygon[k - 1], polygon[k]});
   }
   builder.endObject();
-  if (summary.anyNormal && !allNormals) {
+  if (context.summary.anyNormal && !allNormals) {
     const std::size_t o = model.objects.size() - 1;
     computeVertexNormals(
         model.objectPositions(o), model.objectIndices(o),
@@ -248,44 +320,79 @@ void addShape(Model& model, ModelBuilder& builder, const ParsedObj& obj, std::si
   }
 }
 
-Result<Model> build(const std::string& text, const std::string& name, const std::string& baseDir) {
+void addShape(Model& model, ModelBuilder& builder, const ObjContext& context, std::size_t s) {
+  const tinyobj::mesh_t& mesh = context.obj.shapes[s].mesh;
+  std::vector<std::size_t> firstCorner(mesh.num_face_vertices.size() + 1, 0);
+  for (std::size_t f = 0; f < mesh.num_face_vertices.size(); ++f)
+    firstCorner[f + 1] = firstCorner[f] + mesh.num_face_vertices[f];
+  for (const FaceGroup& group : groupFaces(context.obj, s, context.textures))
+    addGroup(model, builder, context, mesh, firstCorner, group);
+}
+
+// Where textures may lie: beside the OBJ, and beside each material library it names.
+std::vector<std::string> textureDirectories(std::string_view text, const std::string& baseDir) {
+  std::vector<std::string> directories{baseDir};
+  forEachLine(text, [&](std::uint64_t, const std::vector<std::string_view>& words) {
+    if (words.size() >= 2 && words[0] == "mtllib") {
+      const std::string library(words[1].data(), words.back().data() + words.back().size());
+      const std::string parent = std::filesystem::path(baseDir + library).parent_path().string();
+      if (!parent.empty() && parent + "/" != baseDir) directories.push_back(parent + "/");
+    }
+    return true;
+  });
+  return directories;
+}
+
+Result<Model> build(const std::string& text, const std::string& name, const std::string& baseDir,
+                    std::vector<std::string>* warnings) {
   LODFORGE_TRY(checkCoordinates(text, name));
   Result<ParsedObj> obj = parseObj(text, name, baseDir);
   if (!obj) return obj.status();
-  Result<FaceSummary> summary = checkFaces(text, name, *obj);
+  Model model;
+  const ObjTextures textures =
+      baseDir.empty()
+          ? ObjTextures{}
+          : resolveObjTextures(obj->materials, textureDirectories(text, baseDir), model, warnings);
+  Result<FaceSummary> summary = checkFaces(text, name, *obj, textures);
   if (!summary) return summary.status();
+  if (summary->cornersWithoutUv > 0 && warnings)
+    warnings->push_back(
+        fmt::format("{}: {} corners of textured faces have no texture coordinate "
+                    "(vt); they sample the texture's corner",
+                    name, summary->cornersWithoutUv));
   // World positions in double, then one origin for the model.
   Aabbd world;
   const std::vector<tinyobj::real_t>& vertices = obj->attrib.vertices;
   for (std::size_t v = 0; v + 2 < vertices.size(); v += 3)
     world.add(Vec3d{vertices[v], vertices[v + 1], vertices[v + 2]});
-  Model model;
   model.origin = chooseOrigin(world);
   if (summary->faces == 0) {
     addVerticesOnly(model, obj->attrib, name);
     return model;
   }
   ModelBuilder builder(model);
+  const ObjContext context{*obj, *summary, textures};
   for (std::size_t s = 0; s < obj->shapes.size(); ++s) {
     if (obj->shapes[s].mesh.num_face_vertices.empty()) continue;  // lines or points only
-    addShape(model, builder, *obj, s, *summary);
+    addShape(model, builder, context, s);
   }
+  dropUnusedMaterials(model);
   return model;
 }
 
 }  // namespace
 
-Result<Model> readObj(const std::string& path) {
+Result<Model> readObj(const std::string& path, std::vector<std::string>* warnings) {
   Result<std::string> text = readFileToString(path, std::uint64_t{1} << 40);
   if (!text) return text.status();
   std::string baseDir = std::filesystem::path(path).parent_path().string();
   if (baseDir.empty()) baseDir = ".";
-  return build(*text, path, baseDir + "/");
+  return build(*text, path, baseDir + "/", warnings);
 }
 
 Result<Model> readObjFromMemory(std::span<const std::byte> bytes, const std::string& name) {
   const std::string text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-  return build(text, name, "");
+  return build(text, name, "", nullptr);
 }
 
 }  // namespace lodforge

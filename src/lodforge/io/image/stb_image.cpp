@@ -1,10 +1,11 @@
-#include "lodforge/render/stb_png.h"
+#include "lodforge/io/image/stb_image.h"
 
 #include <cstring>
 
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
+#define STBI_ONLY_JPEG
 #define STBI_NO_STDIO
 #define STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -14,8 +15,8 @@
 
 namespace lodforge::stb {
 
-bool pngInfo(std::span<const std::byte> bytes, int& width, int& height, std::string& why) {
-  int channels = 0;
+bool imageInfo(std::span<const std::byte> bytes, int& width, int& height, int& channels,
+               std::string& why) {
   if (stbi_info_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()),
                             static_cast<int>(bytes.size()), &width, &height, &channels))
     return true;
@@ -23,8 +24,8 @@ bool pngInfo(std::span<const std::byte> bytes, int& width, int& height, std::str
   return false;
 }
 
-bool decodePng(std::span<const std::byte> bytes, int& width, int& height,
-               std::vector<std::uint8_t>& rgba, std::string& why) {
+bool decodeImage(std::span<const std::byte> bytes, int& width, int& height,
+                 std::vector<std::uint8_t>& rgba, std::string& why) {
   int channels = 0;
   stbi_uc* pixels =
       stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()),

@@ -1,0 +1,131 @@
+#include "lodforge/io/mesh/obj_materials.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <system_error>
+
+#include <fmt/format.h>
+
+#include "lodforge/io/image/image_codec.h"
+
+namespace lodforge {
+namespace {
+
+std::string trimmed(std::string_view s) {
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
+    s.remove_suffix(1);
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  return std::string(s);
+}
+
+bool isFile(const std::string& path) {
+  std::error_code error;
+  return std::filesystem::is_regular_file(path, error);
+}
+
+// Windows exports write ".\tex.jpg" or "C:\Users\me\tex.jpg".
+bool isWindowsAbsolute(std::string_view name) {
+  return name.size() > 2 && name[1] == ':' && (name[2] == '\\' || name[2] == '/');
+}
+
+// The texture's file, or empty. `guessed` is set when only its file name matched.
+std::string findTexture(const std::string& name, const std::vector<std::string>& directories,
+                        bool& guessed) {
+  std::string slashed = name;
+  std::replace(slashed.begin(), slashed.end(), '\\', '/');
+  const bool absolute = slashed.starts_with('/') || isWindowsAbsolute(name);
+  if (absolute && !isWindowsAbsolute(name) && isFile(slashed)) return slashed;
+  if (!absolute) {
+    for (const std::string& directory : directories) {
+      for (const std::string& candidate : {directory + name, directory + slashed}) {
+        if (isFile(candidate)) return std::filesystem::path(candidate).lexically_normal().string();
+      }
+    }
+  }
+  // A path from another machine: the file of that name beside the OBJ or its library.
+  const std::string file = std::filesystem::path(slashed).filename().string();
+  for (const std::string& directory : directories) {
+    if (!file.empty() && isFile(directory + file)) {
+      guessed = true;
+      return std::filesystem::path(directory + file).lexically_normal().string();
+    }
+  }
+  return {};
+}
+
+// The image of `path` in the model's table (one entry however many materials use it), or the
+// reason it cannot be used.
+Result<std::uint32_t> imageOf(const std::string& path, const std::string& name, Model& model,
+                              std::map<std::string, std::uint32_t>& known) {
+  if (const auto it = known.find(path); it != known.end()) return it->second;
+  ImageSource image;
+  image.name = name;
+  image.path = path;
+  LODFORGE_TRY(probeImage(image));
+  const auto index = static_cast<std::uint32_t>(model.images.size());
+  model.images.push_back(std::move(image));
+  known.emplace(path, index);
+  return index;
+}
+
+Material texturedMaterial(const tinyobj::material_t& mtl, std::uint32_t image) {
+  Material material;
+  material.name = mtl.name;
+  // The texture holds the colour: Kd (often a grey default of the exporter) would darken it.
+  material.baseColor = {1, 1, 1, 1};
+  material.baseColorImage = image;
+  material.roughness = 1;
+  material.doubleSided = true;  // as untextured OBJ meshes are drawn (GlbWriteOptions)
+  if (mtl.diffuse_texopt.clamp) material.wrapS = material.wrapT = TextureWrap::kClamp;
+  return material;
+}
+
+}  // namespace
+
+Vec2f ObjTextures::toUv(int mtl, float u, float v) const {
+  const std::array<float, 4>& t = transform[static_cast<std::size_t>(mtl)];
+  return {u * t[0] + t[2], 1.0f - (v * t[1] + t[3])};
+}
+
+ObjTextures resolveObjTextures(std::vector<tinyobj::material_t>& materials,
+                               const std::vector<std::string>& searchDirectories, Model& model,
+                               std::vector<std::string>* warnings) {
+  ObjTextures textures;
+  textures.material.assign(materials.size(), kNoMaterial);
+  textures.transform.assign(materials.size(), {1, 1, 0, 0});
+  std::map<std::string, std::uint32_t> known;
+  auto warn = [&](std::string message) {
+    if (warnings) warnings->push_back(std::move(message));
+  };
+  for (std::size_t m = 0; m < materials.size(); ++m) {
+    tinyobj::material_t& mtl = materials[m];
+    const std::string name = trimmed(mtl.diffuse_texname);
+    if (name.empty()) continue;
+    bool guessed = false;
+    const std::string path = findTexture(name, searchDirectories, guessed);
+    Result<std::uint32_t> image =
+        path.empty() ? Result<std::uint32_t>(badInput(name, "texture image not found"))
+                     : imageOf(path, name, model, known);
+    if (!image) {
+      warn(fmt::format("material '{}': {}; the material is drawn grey", mtl.name,
+                       image.status().error().message));
+      for (auto& channel : mtl.diffuse) channel = 0.5f;
+      continue;
+    }
+    if (guessed)
+      warn(
+          fmt::format("material '{}': texture '{}' is not there; the file of that name beside the "
+                      "model is used ({})",
+                      mtl.name, name, path));
+    textures.material[m] = static_cast<std::uint32_t>(model.materials.size());
+    model.materials.push_back(texturedMaterial(mtl, *image));
+    const auto& o = mtl.diffuse_texopt.origin_offset;
+    const auto& s = mtl.diffuse_texopt.scale;
+    textures.transform[m] = {static_cast<float>(s[0]), static_cast<float>(s[1]),
+                             static_cast<float>(o[0]), static_cast<float>(o[1])};
+  }
+  return textures;
+}
+
+}  // namespace lodforge

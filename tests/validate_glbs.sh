@@ -47,9 +47,13 @@ want=$(( $(ls "$data"/meshes | wc -l) + 11 ))
 "$lodforge" -q generate points --points 60K -o "$out/points.ply"
 "$lodforge" -q tiles "$out/points.ply" --surface -o "$out/surface-tiles" --chunk-size 100
 "$lodforge" -q tiles "$out/points.ply" -o "$out/points-tiles" --block-size 10K --no-quantization --compress meshopt
+# Textured tiles: charts re-baked into each tile's own pages (JPEG, and WebP for the box).
+"$lodforge" -q tiles "$data/textured/spider/spider.obj" -o "$out/spider-tiles" --chunk-size 40
+"$lodforge" -q tiles "$data/textured/BoxTextured.glb" -o "$out/box-tiles" --texture-format webp
 tiles=$(ls "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb | wc -l)
 [[ $tiles -ge 20 ]] || { echo "expected at least 20 tile GLBs, found $tiles" >&2; exit 1; }
 node "$here/js/validate-gltf.mjs" "$out"/*.glb "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb \
   "$out"/cad-tiles/tiles/*.glb "$out"/autzen-tiles/tiles/*.glb "$out"/points-tiles/tiles/*.glb \
   "$out"/autzen-laz-tiles/tiles/*.glb "$out"/copc-tiles/tiles/*.glb "$out"/extra-tiles/tiles/*.glb \
-  "$out"/surface-tiles/tiles/*.glb "$out"/step-tiles/tiles/*.glb
+  "$out"/surface-tiles/tiles/*.glb "$out"/step-tiles/tiles/*.glb "$out"/spider-tiles/tiles/*.glb \
+  "$out"/box-tiles/tiles/*.glb

@@ -70,6 +70,9 @@ struct TilesCommand {
   std::uint64_t tilePoints = 50'000;
   std::string attributes = "all";
   bool salvage = false;
+  std::uint32_t textureSize = 4096;
+  std::string textureFormat = "jpeg";
+  int textureQuality = 85;
   bool surface = false;  // point clouds: reconstruct a surface and tile it as a mesh
   SurfaceCommand surfaceOptions;
   CadCommand cad;
@@ -118,6 +121,17 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
                  "glTF, FBX/DAE/IFC and .lfp inputs of several objects), on (any input of "
                  "several objects, which keeps objects from welding together), or off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
+  sub.add_option("--texture-size", options.textureSize,
+                 "Textured meshes: a tile texture page's side at most, in texels (a tile whose "
+                 "texels need more gets several pages; default 4096)")
+      ->check(CLI::Range(64u, 16384u));
+  sub.add_option("--texture-format", options.textureFormat,
+                 "Textured meshes: jpeg (default; PNG where the source has alpha), png, or webp "
+                 "(EXT_texture_webp: viewers without it draw no texture)")
+      ->check(CLI::IsMember({"jpeg", "png", "webp"}));
+  sub.add_option("--texture-quality", options.textureQuality,
+                 "Textured meshes: JPEG or WebP quality, 1 to 100 (default 85)")
+      ->check(CLI::Range(1, 100));
   addCountOption(sub, "--block-size", options.blockSize,
                  "Point clouds: most points per leaf tile (a block of the partition; default 50K)");
   addCountOption(sub, "--tile-points", options.tilePoints,
@@ -160,6 +174,11 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
   tiles.crs = options.crs;
   tiles.meshoptCompression = options.compress == "meshopt";
   tiles.quantize = !options.noQuantization;
+  tiles.atlas.maxSize = options.textureSize;
+  tiles.textureEncoding = {.format = options.textureFormat == "png"    ? ImageFormat::kPng
+                                     : options.textureFormat == "webp" ? ImageFormat::kWebp
+                                                                       : ImageFormat::kJpeg,
+                           .quality = options.textureQuality};
   tiles.input.parts = options.parts == "on"    ? PartsMode::kOn
                       : options.parts == "off" ? PartsMode::kOff
                                                : PartsMode::kAuto;

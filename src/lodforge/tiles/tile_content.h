@@ -17,12 +17,17 @@ namespace lodforge {
 // colours when asked and the mesh has them, each vertex's part (tile_features.h) when the mesh
 // has features and `parts` names them; triangles
 // ordered for the vertex cache and vertices for fetch (meshoptimizer), optionally
-// meshopt-compressed.
+// meshopt-compressed; textured triangles with the tile's own texture pages.
+struct TileTexturing;
 struct TileContentOptions {
   bool colors = true;
   bool meshoptCompression = false;
   bool quantize = false;  // KHR_mesh_quantization over the tile's box
   const PartTable* parts = nullptr;
+  // A textured input's: the tile's texture is baked for its level (0: a leaf, the source's
+  // resolution) into pages of its own (tile_texture.h).
+  const TileTexturing* texturing = nullptr;
+  std::uint32_t level = 0;
 };
 Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path,
                         const TileContentOptions& options = {});

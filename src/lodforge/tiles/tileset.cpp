@@ -13,6 +13,7 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/tiles/surface_input.h"
+#include "lodforge/tiles/tile_texture.h"
 #include "lodforge/tiles/tileset_output.h"
 #include "lodforge/tiles/tileset_parts.h"
 #include "lodforge/tiling/resume.h"
@@ -159,13 +160,16 @@ Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& op
   if (!fresh) return crs.error.ok() ? fresh.status() : crs.error;
   if (options.origin) fresh->frame = eastNorthUpToEcef(*options.origin);
   if (crs.transform) fresh->frame = crs.transform->localToEcef();
-  if (!input.keepInMemory) LODFORGE_TRY(saveChunkState(statePath, identity, *fresh));
+  // (A textured input's images are not in the state: its build cannot be resumed yet.)
+  if (!input.keepInMemory && fresh->textures.empty())
+    LODFORGE_TRY(saveChunkState(statePath, identity, *fresh));
   return fresh;
 }
 
 // The octree over the chunks, each tile written into the staged tileset as soon as it is built.
 Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& options,
-                                const OctreeOptions& octree, const std::string& tilesetDirectory) {
+                                const OctreeOptions& octree, const std::string& tilesetDirectory,
+                                const TileTexturing* texturing) {
   return buildOctree(
       *chunked.chunks, octree, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
         if (mesh.triangleCount() == 0) return {};
@@ -173,8 +177,25 @@ Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& o
                                 {.colors = chunked.colors,
                                  .meshoptCompression = options.meshoptCompression,
                                  .quantize = options.quantize && tileQuantized(node),
-                                 .parts = &chunked.parts});
+                                 .parts = &chunked.parts,
+                                 .texturing = texturing,
+                                 .level = static_cast<std::uint32_t>(node.level)});
       });
+}
+
+// A textured input's images as pyramids in the work directory, for every tile to bake from.
+Result<std::optional<TexturePyramid>> buildPyramids(const ChunkInput& chunked,
+                                                    const std::string& workDirectory,
+                                                    const TilesOptions& options) {
+  if (chunked.textures.empty()) return std::optional<TexturePyramid>();
+  const std::string directory = workDirectory + "/textures";
+  std::error_code error;
+  fs::create_directories(directory, error);
+  if (error) return ioError(directory, fmt::format("cannot create: {}", error.message()));
+  Result<TexturePyramid> pyramid =
+      TexturePyramid::build(chunked.textures.images, directory, options.textureCacheBytes);
+  if (!pyramid) return pyramid.status();
+  return std::optional(std::move(*pyramid));
 }
 
 void countChunks(const ChunkInput& chunked, TilesStats& stats) {
@@ -250,7 +271,12 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   stats.chunkSeconds = secondsSince(start);
 
   octree.resume = stats.resumed;
-  Result<OctreeResult> tree = buildTiles(*chunked, options, octree, place.staging.path);
+  Result<std::optional<TexturePyramid>> pyramid = buildPyramids(*chunked, workDirectory, options);
+  if (!pyramid) return pyramid.status();
+  TileTexturing texturing{&chunked->textures, *pyramid ? &**pyramid : nullptr, options.atlas,
+                          options.textureEncoding};
+  Result<OctreeResult> tree =
+      buildTiles(*chunked, options, octree, place.staging.path, *pyramid ? &texturing : nullptr);
   if (!tree) return tree.status();
   const std::string partsUri = chunked->parts.empty() ? "" : kPartsFileName;
   LODFORGE_TRY(writeTilesetJson(*tree, place.staging.path + "/tileset.json", chunked->frame,

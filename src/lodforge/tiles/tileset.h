@@ -11,9 +11,11 @@
 #include <string>
 
 #include "lodforge/core/status.h"
+#include "lodforge/io/image/image_codec.h"
 #include "lodforge/surface/reconstruct.h"
 #include "lodforge/tiles/georeference.h"
 #include "lodforge/tiles/memory_plan.h"
+#include "lodforge/tiles/tile_atlas.h"
 #include "lodforge/tiles/tile_content.h"
 #include "lodforge/tiles/tileset_json.h"
 #include "lodforge/tiling/chunk_input.h"
@@ -40,6 +42,11 @@ struct TilesOptions {
   bool quantize = true;             // KHR_mesh_quantization where it is invisible (tileQuantized)
   // A point cloud: its surface reconstructed chunk by chunk into the leaves (surface_input.h).
   std::optional<ReconstructOptions> surface;
+  // A textured input's: tile texture pages (size cap, gutters), their encoding, and the bytes
+  // of source-image blocks held for baking them.
+  AtlasOptions atlas;
+  ImageEncodeOptions textureEncoding{.format = ImageFormat::kJpeg, .quality = 85};
+  std::uint64_t textureCacheBytes = std::uint64_t{64} << 20;
 };
 
 struct TilesStats {

@@ -79,6 +79,8 @@ CutCorner crossing(const CutCorner& p, const CutCorner& q, int axis, double coor
   const auto f = static_cast<float>(t);
   out.normal = normalizeOr(a.normal + (b.normal - a.normal) * f, a.normal);
   out.feature = a.feature;
+  out.uv = {a.uv.x + (b.uv.x - a.uv.x) * f, a.uv.y + (b.uv.y - a.uv.y) * f};
+  out.material = a.material;
   return out;
 }
 
@@ -132,8 +134,10 @@ struct Emitter {
     Vec3d sum{};
     Vec3f normalSum{};
     std::array<double, 4> colorSum{};
+    double uSum = 0, vSum = 0;
     for (const CutCorner& c : unique) {
       sum = sum + c.position;
+      uSum += c.uv.x, vSum += c.uv.y;
       normalSum = normalSum + c.normal;
       colorSum[0] += c.color.r, colorSum[1] += c.color.g;
       colorSum[2] += c.color.b, colorSum[3] += c.color.a;
@@ -146,7 +150,9 @@ struct Emitter {
                               static_cast<std::uint8_t>(std::lround(colorSum[3] / n))},
                              normalizeOr(normalSum, unique[0].normal),
                              CutCorner::kNoSource,
-                             unique[0].feature};
+                             unique[0].feature,
+                             {static_cast<float>(uSum / n), static_cast<float>(vSum / n)},
+                             unique[0].material};
     const ChunkCell cell = grid.cellOf(centroid.position);
     if (unique.size() == 3) {
       if (!hasArea(unique[0], unique[1], unique[2])) return;

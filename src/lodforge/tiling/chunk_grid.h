@@ -56,6 +56,10 @@ struct CutCorner {
   Vec3f normal;
   std::uint64_t source = kNoSource;
   std::uint32_t feature = kNoFeature;
+  // A textured input's texture coordinate and material (into ChunkInput::textures; kNoMaterial
+  // for a corner of no texture): a vertex of each side of a UV seam.
+  Vec2f uv{};
+  std::uint32_t material = ~0u;
 };
 
 // Cuts one triangle at every grid plane it crosses and returns the pieces, each inside one cell:

@@ -181,6 +181,9 @@ class ObjectSegments {
 std::array<CutCorner, 3> cornersOf(const PlacedModel& m, std::size_t o,
                                    std::span<const std::uint32_t> corners, bool colors) {
   const std::uint64_t offset = m.model.objects[o].vertexOffset;
+  const std::uint32_t material = m.model.objects[o].material;
+  const bool textured = m.model.hasUvs() && material != kNoMaterial &&
+                        m.model.materials[material].baseColorImage != kNoImage;
   std::array<CutCorner, 3> triangle;
   for (std::size_t k = 0; k < 3; ++k) {
     const std::uint32_t v = corners[k];
@@ -189,6 +192,10 @@ std::array<CutCorner, 3> cornersOf(const PlacedModel& m, std::size_t o,
     triangle[k].normal = m.normals[offset + v];
     triangle[k].source = offset + v;
     triangle[k].feature = m.features ? static_cast<std::uint32_t>(o) : kNoFeature;
+    if (textured) {
+      triangle[k].uv = m.model.uvs[offset + v];
+      triangle[k].material = material;
+    }
   }
   return triangle;
 }
@@ -234,6 +241,10 @@ Result<ChunkInput> chunkModel(const std::string& path, const ChunkInputOptions& 
   if (!grid) return grid.status();
   input.chunks = std::make_unique<ChunkWriter>(*grid, options.workDirectory + "/chunks",
                                                options.chunkBufferBytes, options.keepInMemory);
+  if (m.model.hasUvs() && !m.model.images.empty()) {
+    input.chunks->setTextured(true);
+    input.textures = {m.model.materials, std::move(m.model.images)};
+  }
   LODFORGE_TRY(addObjects(m, input));
   return input;
 }

@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "lodforge/core/image_source.h"
 #include "lodforge/core/material.h"
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
@@ -64,6 +65,15 @@ struct PartTable {
   bool empty() const { return names.empty(); }
 };
 
+// A textured input's materials and images (the model's tables): what corners' materials
+// (CutCorner::material) refer to. Empty for an input without textures.
+struct TextureTable {
+  std::vector<Material> materials;
+  std::vector<ImageSource> images;
+
+  bool empty() const { return images.empty(); }
+};
+
 struct ChunkInput {
   std::unique_ptr<ChunkWriter> chunks;
   std::uint64_t inputTriangles = 0;
@@ -74,6 +84,7 @@ struct ChunkInput {
   std::optional<std::string> truncation;  // where a salvaged PLY was cut short
   std::vector<std::string> warnings;      // the reader's (a CAD part that did not mesh)
   PartTable parts;
+  TextureTable textures;
 };
 
 Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options);

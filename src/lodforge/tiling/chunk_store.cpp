@@ -19,13 +19,21 @@ namespace lodforge {
 namespace {
 
 // A chunk file is a run of blocks, one per append: magic, vertex count, triangle count (u32
-// each), the vertex records, then three u32 indices per triangle into the block's records.
+// each), the vertex records, then three u32 indices per triangle into the block's records. A
+// textured input's blocks ("LFCT") have longer records.
 constexpr char kBlockMagic[4] = {'L', 'F', 'C', 'K'};
+constexpr char kTexturedBlockMagic[4] = {'L', 'F', 'C', 'T'};
 constexpr std::size_t kBlockHeaderBytes = sizeof kBlockMagic + 2 * sizeof(std::uint32_t);
-// A vertex record: position (3 doubles), colour, normal (octahedral, 2 x 16 bits), feature.
+// A vertex record: position (3 doubles), colour, normal (octahedral, 2 x 16 bits), feature; in
+// a textured block then its texture coordinate (2 floats) and material.
 constexpr std::size_t kCornerBytes = 3 * sizeof(double) + sizeof(Rgba8) + 2 * sizeof(std::uint32_t);
+constexpr std::size_t kTexturedCornerBytes = kCornerBytes + sizeof(Vec2f) + sizeof(std::uint32_t);
 
-void writeRecord(std::byte* out, const CutCorner& corner) {
+std::size_t cornerBytes(bool textured) {
+  return textured ? kTexturedCornerBytes : kCornerBytes;
+}
+
+void writeRecord(std::byte* out, const CutCorner& corner, bool textured) {
   const double xyz[3] = {corner.position.x, corner.position.y, corner.position.z};
   const std::uint32_t normal = encodeNormal(corner.normal);
   std::memcpy(out, xyz, sizeof xyz);
@@ -33,17 +41,30 @@ void writeRecord(std::byte* out, const CutCorner& corner) {
   std::memcpy(out + sizeof xyz + sizeof(Rgba8), &normal, sizeof normal);
   std::memcpy(out + sizeof xyz + sizeof(Rgba8) + sizeof normal, &corner.feature,
               sizeof corner.feature);
+  if (!textured) return;
+  std::memcpy(out + kCornerBytes, &corner.uv, sizeof(Vec2f));
+  std::memcpy(out + kCornerBytes + sizeof(Vec2f), &corner.material, sizeof corner.material);
 }
 
 // Appends the vertex records in `bytes` (a whole number of them) to the mesh.
-void appendRecords(std::span<const std::byte> bytes, MeshPart& mesh) {
-  const std::size_t first = mesh.positions.size(), count = bytes.size() / kCornerBytes;
+void appendRecords(std::span<const std::byte> bytes, MeshPart& mesh, bool textured) {
+  const std::size_t size = cornerBytes(textured);
+  const std::size_t first = mesh.positions.size(), count = bytes.size() / size;
   mesh.positions.resize(first + count);
   mesh.colors.resize(first + count);
   mesh.normals.resize(first + count);
   mesh.features.resize(first + count);
+  if (textured) {
+    mesh.uvs.resize(first + count);
+    mesh.materials.resize(first + count);
+  }
   for (std::size_t i = 0; i < count; ++i) {
-    const std::byte* at = bytes.data() + i * kCornerBytes;
+    const std::byte* at = bytes.data() + i * size;
+    if (textured) {
+      std::memcpy(&mesh.uvs[first + i], at + kCornerBytes, sizeof(Vec2f));
+      std::memcpy(&mesh.materials[first + i], at + kCornerBytes + sizeof(Vec2f),
+                  sizeof(std::uint32_t));
+    }
     double xyz[3];
     std::uint32_t normal;
     std::memcpy(xyz, at, sizeof xyz);
@@ -117,10 +138,11 @@ Status ChunkWriter::add(const ChunkCell& cell, std::span<const CutCorner, 3> cor
 std::uint32_t ChunkWriter::vertexOf(Buffer& buffer, const CutCorner& corner) {
   const auto addRecord = [&] {
     const std::size_t at = buffer.vertices.size();
-    buffer.vertices.resize(at + kCornerBytes);
-    writeRecord(buffer.vertices.data() + at, corner);
-    buffered_ += kCornerBytes;
-    return static_cast<std::uint32_t>(at / kCornerBytes);
+    const std::size_t size = cornerBytes(textured_);
+    buffer.vertices.resize(at + size);
+    writeRecord(buffer.vertices.data() + at, corner, textured_);
+    buffered_ += size;
+    return static_cast<std::uint32_t>(at / size);
   };
   if (corner.source == CutCorner::kNoSource) return addRecord();  // made by a cut: weld later
   constexpr std::uint32_t kRun = 64, kNoRecord = ~0u;
@@ -197,9 +219,9 @@ Status ChunkWriter::flush() {
     if (buffer.indices.empty()) continue;
     std::byte header[kBlockHeaderBytes];
     const std::uint32_t counts[2] = {
-        static_cast<std::uint32_t>(buffer.vertices.size() / kCornerBytes),
+        static_cast<std::uint32_t>(buffer.vertices.size() / cornerBytes(textured_)),
         static_cast<std::uint32_t>(buffer.indices.size() / 3)};
-    std::memcpy(header, kBlockMagic, sizeof kBlockMagic);
+    std::memcpy(header, textured_ ? kTexturedBlockMagic : kBlockMagic, sizeof kBlockMagic);
     std::memcpy(header + sizeof kBlockMagic, counts, sizeof counts);
     LODFORGE_TRY(appendTo(chunkPath(cellOfIndex(grid_, index)),
                           {std::span<const std::byte>(header), buffer.vertices,
@@ -217,11 +239,15 @@ Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string&
   while (at < bytes.size()) {
     if (bytes.size() - at < kBlockHeaderBytes)
       return badInputAtByte(name, at, "chunk file ends inside a block header");
-    if (std::memcmp(bytes.data() + at, kBlockMagic, sizeof kBlockMagic) != 0)
+    const bool textured =
+        std::memcmp(bytes.data() + at, kTexturedBlockMagic, sizeof kBlockMagic) == 0;
+    if (!textured && std::memcmp(bytes.data() + at, kBlockMagic, sizeof kBlockMagic) != 0)
       return badInputAtByte(name, at, "not a chunk block (work file of `lodforge tiles`)");
+    if (at > 0 && textured != !mesh.uvs.empty())
+      return badInputAtByte(name, at, "chunk blocks with and without textures in one file");
     std::uint32_t counts[2];
     std::memcpy(counts, bytes.data() + at + sizeof kBlockMagic, sizeof counts);
-    const std::uint64_t recordBytes = std::uint64_t{counts[0]} * kCornerBytes;
+    const std::uint64_t recordBytes = std::uint64_t{counts[0]} * cornerBytes(textured);
     const std::uint64_t indexCount = 3 * std::uint64_t{counts[1]};
     const std::uint64_t rest = bytes.size() - at - kBlockHeaderBytes;
     if (recordBytes > rest || indexCount > (rest - recordBytes) / sizeof(std::uint32_t))
@@ -230,7 +256,7 @@ Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string&
       return badInputAtByte(name, at, "chunk file holds more than 2^32 vertices");
     const auto base = static_cast<std::uint32_t>(mesh.positions.size());
     const std::byte* records = bytes.data() + at + kBlockHeaderBytes;
-    appendRecords(std::span(records, static_cast<std::size_t>(recordBytes)), mesh);
+    appendRecords(std::span(records, static_cast<std::size_t>(recordBytes)), mesh, textured);
     const std::byte* indices = records + recordBytes;
     for (std::uint64_t i = 0; i < indexCount; ++i) {
       std::uint32_t v;
@@ -256,7 +282,7 @@ Result<MeshPart> ChunkWriter::load(const ChunkCell& cell) const {
   const auto it = buffers_.find(grid_.cellIndex(cell));
   if (it == buffers_.end()) return loadChunk(chunkPath(cell));
   MeshPart mesh;
-  appendRecords(it->second.vertices, mesh);
+  appendRecords(it->second.vertices, mesh, textured_);
   mesh.indices = it->second.indices;
   weldExact(mesh);
   return mesh;

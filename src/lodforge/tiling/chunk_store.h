@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <map>
 #include <span>
@@ -34,6 +35,14 @@ class ChunkWriter {
   static ChunkWriter reopen(ChunkGrid grid, std::string directory,
                             std::map<std::uint64_t, std::uint64_t> counts);
 
+  // Records carry each corner's texture coordinate and material (a textured input): set before
+  // the first triangle is added.
+  void setTextured(bool textured) {
+    assert(triangles_ == 0);
+    textured_ = textured;
+  }
+  bool textured() const { return textured_; }
+
   // One triangle piece (3 corners) for `cell`.
   Status add(const ChunkCell& cell, std::span<const CutCorner, 3> corners);
   // A whole triangle: cut at the grid planes it crosses, each piece added to its chunk.
@@ -59,6 +68,7 @@ class ChunkWriter {
   std::string directory_;
   std::uint64_t bufferBytes_ = 0, buffered_ = 0, triangles_ = 0;
   bool keepInMemory_ = false;
+  bool textured_ = false;
   // A chunk's pieces since the last flush: vertex records and triangles over them, and where
   // each input vertex's record is. Input vertices arrive in runs of nearby numbers (a scan's
   // rows, looked up again a row later), so the lookup is by runs of 64 numbers: an

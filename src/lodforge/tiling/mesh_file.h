@@ -1,5 +1,5 @@
 // A mesh on disk (large-meshes paper §3.4): a node's mesh saved once it is built and loaded back
-// when its parent needs it, as a work file of `lodforge tiles` (`LFMESH3`: magic, five counts,
+// when its parent needs it, as a work file of `lodforge tiles` (`LFMESH4`: magic, seven counts,
 // then each array of MeshPart as it is in memory). Read back checked: sizes against the counts,
 // indices against the vertex count.
 #pragma once

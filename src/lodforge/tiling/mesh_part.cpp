@@ -20,6 +20,8 @@ MeshPart concatenate(std::span<const MeshPart> parts) {
       std::any_of(parts.begin(), parts.end(), [](const MeshPart& p) { return !p.normals.empty(); });
   const bool features = std::any_of(parts.begin(), parts.end(),
                                     [](const MeshPart& p) { return !p.features.empty(); });
+  const bool textured =
+      std::any_of(parts.begin(), parts.end(), [](const MeshPart& p) { return !p.uvs.empty(); });
   for (const MeshPart& part : parts) {
     const std::uint32_t base = out.vertexCount();
     out.positions.insert(out.positions.end(), part.positions.begin(), part.positions.end());
@@ -42,6 +44,15 @@ MeshPart concatenate(std::span<const MeshPart> parts) {
         out.features.resize(out.positions.size(), kNoFeature);
       } else {
         out.features.insert(out.features.end(), part.features.begin(), part.features.end());
+      }
+    }
+    if (textured) {
+      if (part.uvs.empty()) {
+        out.uvs.resize(out.positions.size());
+        out.materials.resize(out.positions.size(), ~0u);
+      } else {
+        out.uvs.insert(out.uvs.end(), part.uvs.begin(), part.uvs.end());
+        out.materials.insert(out.materials.end(), part.materials.begin(), part.materials.end());
       }
     }
     for (std::uint32_t i : part.indices) out.indices.push_back(base + i);

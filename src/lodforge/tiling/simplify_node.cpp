@@ -101,6 +101,52 @@ double removedVertexBound(std::span<const Vec3f> input, std::span<const Vec3f> p
   return std::sqrt(worst);
 }
 
+// Appends vertex `v` of `from` (every per-vertex array it has) to `to`.
+void appendVertex(const MeshPart& from, std::uint32_t v, MeshPart& to) {
+  to.positions.push_back(from.positions[v]);
+  if (!from.colors.empty()) to.colors.push_back(from.colors[v]);
+  if (!from.normals.empty()) to.normals.push_back(from.normals[v]);
+  if (!from.features.empty()) to.features.push_back(from.features[v]);
+  if (!from.uvs.empty()) {
+    to.uvs.push_back(from.uvs[v]);
+    to.materials.push_back(from.materials[v]);
+  }
+}
+
+// Per vertex, the first vertex at its position: the two vertices of a UV seam (welding keeps
+// them apart) are one point of the surface. Empty for an untextured mesh (every vertex its own).
+std::vector<std::uint32_t> positionRepresentatives(const MeshPart& mesh) {
+  if (mesh.uvs.empty()) return {};
+  std::vector<std::uint32_t> order(mesh.vertexCount());
+  for (std::uint32_t v = 0; v < order.size(); ++v) order[v] = v;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const Vec3d &p = mesh.positions[a], &q = mesh.positions[b];
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    return p.z != q.z ? p.z < q.z : a < b;
+  });
+  std::vector<std::uint32_t> first(mesh.vertexCount());
+  for (std::size_t i = 0; i < order.size();) {
+    std::size_t j = i + 1;
+    while (j < order.size() && mesh.positions[order[j]] == mesh.positions[order[i]]) ++j;
+    for (std::size_t k = i; k < j; ++k) first[order[k]] = order[i];
+    i = j;
+  }
+  return first;
+}
+
+// The vertices on a UV seam (a position other vertices share). They are locked, so a seam never
+// moves off itself and two charts never mix; the charts' insides simplify.
+std::vector<std::uint8_t> onUvSeams(std::span<const std::uint32_t> representative,
+                                    std::size_t vertexCount) {
+  std::vector<std::uint8_t> flags(vertexCount, 0);
+  std::vector<std::uint32_t> members(representative.size(), 0);
+  for (std::uint32_t r : representative) ++members[r];
+  for (std::size_t v = 0; v < representative.size(); ++v)
+    flags[v] = members[representative[v]] > 1 ? 1 : 0;
+  return flags;
+}
+
 struct Dropped {
   std::uint64_t segments = 0;
   double error = 0;  // bound on the distance from any dropped point to what remains
@@ -116,8 +162,13 @@ Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border,
                           std::span<const std::uint8_t> shared, std::uint64_t target,
                           Vec3d center) {
   if (mesh.triangleCount() <= target) return {};
+  // Components of the surface, not of its charts: joined across UV seams.
+  const std::vector<std::uint32_t> samePosition = positionRepresentatives(mesh);
+  std::vector<std::uint32_t> joined(mesh.indices);
+  if (!samePosition.empty())
+    for (std::uint32_t& v : joined) v = samePosition[v];
   std::vector<std::uint32_t> component(mesh.triangleCount());
-  const std::uint32_t count = connectedComponents(mesh.vertexCount(), mesh.indices, component);
+  const std::uint32_t count = connectedComponents(mesh.vertexCount(), joined, component);
   if (count < 2) return {};
   std::vector<Aabbd> bounds(count);
   std::vector<std::uint64_t> triangles(count, 0);
@@ -161,10 +212,7 @@ Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border,
       std::uint32_t& to = remap[mesh.indices[t + k]];
       if (to == ~0u) {
         to = kept.vertexCount();
-        kept.positions.push_back(mesh.positions[mesh.indices[t + k]]);
-        if (!mesh.colors.empty()) kept.colors.push_back(mesh.colors[mesh.indices[t + k]]);
-        if (!mesh.normals.empty()) kept.normals.push_back(mesh.normals[mesh.indices[t + k]]);
-        if (!mesh.features.empty()) kept.features.push_back(mesh.features[mesh.indices[t + k]]);
+        appendVertex(mesh, mesh.indices[t + k], kept);
         keptBorder.push_back(border[mesh.indices[t + k]]);
       }
       kept.indices.push_back(to);
@@ -214,20 +262,14 @@ SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& gri
   // Only the node's outer faces are shared with other tiles: vertices there never move. The
   // input's own rims (and seams inside the node) may simplify, along themselves.
   const std::vector<std::uint8_t> outer = onOuterFaces(merged, grid, node);
-  simplify.locked = outer;
+  std::vector<std::uint8_t> locked =
+      onUvSeams(positionRepresentatives(merged), merged.vertexCount());
+  for (std::size_t v = 0; v < locked.size(); ++v) locked[v] |= outer[v];
+  simplify.locked = locked;
   simplify.collapseBorders = true;
   SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
   MeshPart mesh;
-  mesh.positions.resize(simplified.vertices.size());
-  if (!merged.colors.empty()) mesh.colors.resize(simplified.vertices.size());
-  if (!merged.normals.empty()) mesh.normals.resize(simplified.vertices.size());
-  if (!merged.features.empty()) mesh.features.resize(simplified.vertices.size());
-  for (std::size_t i = 0; i < simplified.vertices.size(); ++i) {
-    mesh.positions[i] = merged.positions[simplified.vertices[i]];
-    if (!mesh.colors.empty()) mesh.colors[i] = merged.colors[simplified.vertices[i]];
-    if (!mesh.normals.empty()) mesh.normals[i] = merged.normals[simplified.vertices[i]];
-    if (!mesh.features.empty()) mesh.features[i] = merged.features[simplified.vertices[i]];
-  }
+  for (std::uint32_t v : simplified.vertices) appendVertex(merged, v, mesh);
   mesh.indices = simplified.indices;
   // Geometric error: measured against the children's geometry, plus what they already
   // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it

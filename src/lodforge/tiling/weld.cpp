@@ -21,13 +21,18 @@ void weldExact(MeshPart& mesh) {
   std::vector<std::uint32_t> table(capacity, ~0u);
   std::vector<std::uint32_t> representative(count);
   const bool features = !mesh.features.empty();
+  const bool textured = !mesh.uvs.empty();
   const auto featureOf = [&](std::uint32_t v) { return features ? mesh.features[v] : kNoFeature; };
+  // Texture coordinates and material must match too: a UV seam stays two vertices.
+  const auto sameTexel = [&](std::uint32_t a, std::uint32_t b) {
+    return !textured || (mesh.uvs[a] == mesh.uvs[b] && mesh.materials[a] == mesh.materials[b]);
+  };
   for (std::uint32_t v = 0; v < count; ++v) {
     const Vec3d& p = mesh.positions[v];
     const std::uint32_t feature = featureOf(v);
     std::size_t slot = (hashExactPosition(p) ^ feature * 0x9E3779B97F4A7C15ull) & (capacity - 1);
-    while (table[slot] != ~0u &&
-           !(mesh.positions[table[slot]] == p && featureOf(table[slot]) == feature))
+    while (table[slot] != ~0u && !(mesh.positions[table[slot]] == p &&
+                                   featureOf(table[slot]) == feature && sameTexel(table[slot], v)))
       slot = (slot + 1) & (capacity - 1);
     if (table[slot] == ~0u) table[slot] = v;
     representative[v] = table[slot];
@@ -53,6 +58,8 @@ void weldExact(MeshPart& mesh) {
   std::vector<Rgba8> colors(mesh.colors.empty() ? 0 : next);
   std::vector<Vec3f> normals(mesh.normals.empty() ? 0 : next);
   std::vector<std::uint32_t> featureOfVertex(features ? next : 0);
+  std::vector<Vec2f> uvs(textured ? next : 0);
+  std::vector<std::uint32_t> materials(textured ? next : 0);
   // The members of each group whose normals were summed, as a list through `summedNext`.
   std::vector<std::uint32_t> summedHead(normals.empty() ? 0 : next, ~0u);
   std::vector<std::uint32_t> summedNext(normals.empty() ? 0 : count, ~0u);
@@ -74,6 +81,10 @@ void weldExact(MeshPart& mesh) {
     positions[remap[v]] = mesh.positions[v];
     if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
     if (features) featureOfVertex[remap[v]] = mesh.features[v];
+    if (textured) {
+      uvs[remap[v]] = mesh.uvs[v];
+      materials[remap[v]] = mesh.materials[v];
+    }
   }
   for (std::size_t v = 0; v < normals.size(); ++v)
     normals[v] = normalizeOr(normals[v], Vec3f{0, 0, 1});
@@ -81,6 +92,8 @@ void weldExact(MeshPart& mesh) {
   mesh.colors = std::move(colors);
   mesh.normals = std::move(normals);
   mesh.features = std::move(featureOfVertex);
+  mesh.uvs = std::move(uvs);
+  mesh.materials = std::move(materials);
 }
 
 }  // namespace lodforge

@@ -1,0 +1,50 @@
+// A tile's own textures (re-baked at each level): its triangles grouped into charts (the
+// pieces of surface whose texture coordinates run on without a seam), each chart's texels
+// copied from its source image's mip level for the tile's level — texel for texel, so a leaf
+// keeps the source's full resolution and each level up half the texels per side — into pages
+// of at most `maxSize` per side, packed with gutters, the empty space filled by pulling in the
+// charts' own colours (so no mip level of a page samples black or a background), and new texture
+// coordinates into the pages.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "lodforge/core/image.h"
+#include "lodforge/core/status.h"
+#include "lodforge/tiles/texture_pyramid.h"
+#include "lodforge/tiling/chunk_input.h"
+#include "lodforge/tiling/mesh_part.h"
+
+namespace lodforge {
+
+struct AtlasOptions {
+  std::uint32_t maxSize = 4096;  // a page's side at most (texels): more texels make more pages
+  std::uint32_t gutter = 2;      // texels of a chart's own border colour around it, at least
+};
+
+struct AtlasPage {
+  std::uint32_t material = 0;  // the source material (into TextureTable::materials)
+  Image image;
+};
+
+struct TileAtlas {
+  std::vector<AtlasPage> pages;
+  // Per vertex of the mesh: its texture coordinate in its page, and the page (~0u: a vertex of
+  // no texture).
+  std::vector<Vec2f> uvs;
+  std::vector<std::uint32_t> pageOf;
+  std::uint64_t charts = 0;
+  std::uint64_t shrunkCharts = 0;  // charts larger than a page, taken from a coarser level
+};
+
+// `level` 0 is a leaf: the source's own texels.
+Result<TileAtlas> bakeTileAtlas(const MeshPart& mesh, const TextureTable& table,
+                                const TexturePyramid& pyramid, std::uint32_t level,
+                                const AtlasOptions& options = {});
+
+// Fills the texels `mask` leaves out (0) from those it keeps, by pulling coarser averages of the
+// kept ones down (push-pull): every texel ends up a colour of the nearby charts.
+void fillEmptyTexels(Image& image, std::vector<std::uint8_t>& mask);
+
+}  // namespace lodforge

@@ -1,0 +1,55 @@
+#include "lodforge/tiles/tile_texture.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace lodforge {
+
+ImageEncodeOptions pageEncoding(const TileTexturing& texturing, const AtlasPage& page) {
+  ImageEncodeOptions encode = texturing.encode;
+  const Material& material = texturing.table->materials[page.material];
+  const bool alpha = texturing.table->images[material.baseColorImage].hasAlpha();
+  if (encode.format == ImageFormat::kJpeg && alpha) encode.format = ImageFormat::kPng;
+  return encode;
+}
+
+Result<std::vector<GlbPrimitive>> addTilePages(GlbWriter& writer, const TileAtlas& atlas,
+                                               std::span<const std::uint32_t> pageOfVertex,
+                                               std::span<std::uint32_t> indices,
+                                               const TileTexturing& texturing, bool vertexColors) {
+  std::vector<std::optional<std::uint32_t>> materials(atlas.pages.size());
+  for (std::size_t p = 0; p < atlas.pages.size(); ++p) {
+    const AtlasPage& page = atlas.pages[p];
+    const ImageEncodeOptions encode = pageEncoding(texturing, page);
+    Result<std::vector<std::byte>> bytes = encodeImage(page.image, encode);
+    if (!bytes) return bytes.status();
+    Material material = texturing.table->materials[page.material];
+    // The page holds the chart texels only: what lies outside [0, 1] was baked in already.
+    Result<std::uint32_t> texture =
+        writer.addTexture(*bytes, encode.format, TextureWrap::kClamp, TextureWrap::kClamp);
+    if (!texture) return texture.status();
+    if (vertexColors) material.baseColor = {1, 1, 1, 1};
+    materials[p] = writer.addMaterial(material, *texture);
+  }
+  const std::size_t triangles = indices.size() / 3;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> order(triangles);  // page, triangle
+  for (std::size_t t = 0; t < triangles; ++t)
+    order[t] = {pageOfVertex[indices[3 * t]], static_cast<std::uint32_t>(t)};
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  const std::vector<std::uint32_t> before(indices.begin(), indices.end());
+  std::vector<GlbPrimitive> groups;
+  std::uint32_t current = 0;
+  for (std::size_t i = 0; i < triangles; ++i) {
+    const auto [page, t] = order[i];
+    for (std::size_t k = 0; k < 3; ++k) indices[3 * i + k] = before[3 * std::size_t{t} + k];
+    if (groups.empty() || page != current) {
+      current = page;
+      groups.push_back({0, page < materials.size() ? materials[page] : std::nullopt});
+    }
+    groups.back().indexCount += 3;
+  }
+  return groups;
+}
+
+}  // namespace lodforge

@@ -1,6 +1,6 @@
 // The work files of `lodforge tiles` (node meshes, chunk soups) on any bytes: the first byte picks
 // the reader. Either a bad-input error naming the file, or a mesh whose every index is in range
-// and whose colours, normals and features match its vertices.
+// and whose colours, normals, features, texture coordinates and materials match its vertices.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -27,6 +27,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!part->colors.empty() && part->colors.size() != part->positions.size()) std::abort();
   if (!part->normals.empty() && part->normals.size() != part->positions.size()) std::abort();
   if (!part->features.empty() && part->features.size() != part->positions.size()) std::abort();
+  if (!part->uvs.empty() && part->uvs.size() != part->positions.size()) std::abort();
+  if (part->materials.size() != part->uvs.size()) std::abort();
   for (std::uint32_t i : part->indices) {
     if (i >= part->positions.size()) std::abort();
   }

@@ -50,10 +50,13 @@ want=$(( $(ls "$data"/meshes | wc -l) + 11 ))
 # Textured tiles: charts re-baked into each tile's own pages (JPEG, and WebP for the box).
 "$lodforge" -q tiles "$data/textured/spider/spider.obj" -o "$out/spider-tiles" --chunk-size 40
 "$lodforge" -q tiles "$data/textured/BoxTextured.glb" -o "$out/box-tiles" --texture-format webp
+# A generated textured scan (MeshLab's textured PLY: four JPEG atlases), streamed.
+"$lodforge" -q generate scan --triangles 20K --texture 256 --atlases 4 -o "$out/scan-textured.ply"
+"$lodforge" -q tiles "$out/scan-textured.ply" -o "$out/scan-textured-tiles" --chunk-size 150
 tiles=$(ls "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb | wc -l)
 [[ $tiles -ge 20 ]] || { echo "expected at least 20 tile GLBs, found $tiles" >&2; exit 1; }
 node "$here/js/validate-gltf.mjs" "$out"/*.glb "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb \
   "$out"/cad-tiles/tiles/*.glb "$out"/autzen-tiles/tiles/*.glb "$out"/points-tiles/tiles/*.glb \
   "$out"/autzen-laz-tiles/tiles/*.glb "$out"/copc-tiles/tiles/*.glb "$out"/extra-tiles/tiles/*.glb \
   "$out"/surface-tiles/tiles/*.glb "$out"/step-tiles/tiles/*.glb "$out"/spider-tiles/tiles/*.glb \
-  "$out"/box-tiles/tiles/*.glb
+  "$out"/box-tiles/tiles/*.glb "$out"/scan-textured-tiles/tiles/*.glb

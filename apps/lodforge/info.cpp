@@ -17,6 +17,7 @@
 #include "lodforge/core/units.h"
 #include "lodforge/io/format_advice.h"
 #include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/mesh/ply_textures.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/points/las_reader.h"
 #include "lodforge/io/points/point_reader.h"
@@ -53,6 +54,16 @@ Result<Summary> summarizePly(const std::string& path, bool salvage) {
   s.encoding = std::string(plyFormatName(header.format));
   s.normals = header.hasNormals;
   s.colors = header.hasColors;
+  s.uvs = header.hasUvs || header.hasFaceUvs;
+  if (plyTextured(header)) {
+    std::vector<std::string> warnings;
+    PlyTextures textures = readPlyTextures(header, path, &warnings);
+    for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
+    Model table;
+    table.materials = std::move(textures.materials);
+    table.images = std::move(textures.images);
+    s.textures = textureSummary(table);
+  }
   std::unordered_set<std::uint32_t> ids;
   PlyBatch batch;
   Progress progress("reading", header.vertexCount + header.faceCount);

@@ -8,6 +8,7 @@
 
 #include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/io/mesh/gltf_reader.h"
+#include "lodforge/io/mesh/ply_writer.h"
 #include "lodforge/tiles/tileset.h"
 #include "test_support.h"
 
@@ -81,13 +82,13 @@ bool wellInside(double u, std::uint32_t size) {
   return t > 0.1 && t < 0.9;
 }
 
-TEST(TileTexture, EveryTileRebakesTheSourceTexelForTexelAtItsLevel) {
-  test::TempDir dir;
-  ASSERT_TRUE(writeGlb(texturedPlane(64), dir.file("plane.glb")).ok());
+// Tiles `input` and checks every tile: points inside each triangle sample, in the tile's
+// texture, the texel of the source's mip level for the tile's level.
+void expectRebakedTexelForTexel(const std::string& input, const test::TempDir& dir) {
   TilesOptions options;
   options.input.chunkSize = 2.6;  // 4 x 4 leaves, two levels above them
   options.textureEncoding = {.format = ImageFormat::kPng};
-  Result<TilesStats> stats = writeTiles(dir.file("plane.glb"), dir.file("tiles"), options);
+  Result<TilesStats> stats = writeTiles(input, dir.file("tiles"), options);
   ASSERT_TRUE(stats.ok()) << stats.error().message;
   ASSERT_GE(stats->levels, 2);
   // The source's mip levels, as the pyramid makes them.
@@ -105,7 +106,6 @@ TEST(TileTexture, EveryTileRebakesTheSourceTexelForTexelAtItsLevel) {
     ASSERT_TRUE(page.ok());
     ASSERT_TRUE(tile->hasUvs());
     ++tiles;
-    // Points inside each triangle: the tile's texture there is the source level's texel.
     const Image& source = levels[level];
     for (std::size_t o = 0; o < tile->objectCount(); ++o) {
       const auto indices = tile->objectIndices(o);
@@ -135,6 +135,34 @@ TEST(TileTexture, EveryTileRebakesTheSourceTexelForTexelAtItsLevel) {
   }
   EXPECT_EQ(tiles, stats->tiles);
   EXPECT_GT(compared, 2000u);
+}
+
+TEST(TileTexture, EveryTileRebakesTheSourceTexelForTexelAtItsLevel) {
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(texturedPlane(64), dir.file("plane.glb")).ok());
+  expectRebakedTexelForTexel(dir.file("plane.glb"), dir);
+}
+
+TEST(TileTexture, AStreamedPlyIsRebakedTheSameWay) {
+  // The plane as MeshLab writes a textured PLY: corner coordinates per face, the texture beside.
+  test::TempDir dir;
+  const Model plane = texturedPlane(64);
+  test::writeFile(dir.file("checker.png"),
+                  std::string_view(reinterpret_cast<const char*>(plane.images[0].bytes.data()),
+                                   plane.images[0].bytes.size()));
+  PlyLayout layout{.vertexCount = plane.vertexCount(),
+                   .faceCount = plane.triangleCount(),
+                   .faceUvs = true,
+                   .comments = {"TextureFile checker.png"}};
+  Result<PlyWriter> writer = PlyWriter::create(dir.file("plane.ply"), layout);
+  ASSERT_TRUE(writer.ok());
+  ASSERT_TRUE(writer->writeVertices(plane.positions, {}, {}).ok());
+  std::vector<Vec2f> corners;
+  for (std::uint32_t v : plane.indices) corners.push_back(plane.uvs[v]);
+  const std::vector<std::uint32_t> textures(plane.triangleCount(), 0);
+  ASSERT_TRUE(writer->writeTriangles(plane.indices, {}, corners, textures).ok());
+  ASSERT_TRUE(writer->finish().ok());
+  expectRebakedTexelForTexel(dir.file("plane.ply"), dir);
 }
 
 TEST(TileTexture, PagesOfASourceWithAlphaArePng) {

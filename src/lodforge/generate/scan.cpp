@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <vector>
 
 #include <tbb/parallel_for.h>
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/generate/scan_texture.h"
 #include "lodforge/generate/terrain.h"
 #include "lodforge/io/mesh/ply_writer.h"
 
@@ -76,6 +78,8 @@ class GridWalk {
   }
 
   std::uint64_t row() const { return row_ - 1; }  // the vertex row step() just produced
+  // The cells of finishedTriangles(), in their order: cell row row() - 1.
+  const std::vector<CellTriangle>& finishedCells() const { return current_; }
   const std::vector<std::uint32_t>& rowIndex() const { return upperIndex_; }
   const std::vector<std::uint32_t>& finishedTriangles() const { return finished_; }
   std::uint64_t vertexCount() const { return vertexCount_; }
@@ -161,6 +165,44 @@ class RowBlock {
   std::vector<Rgba8> colors_;
 };
 
+// The atlases, drawn and written one at a time, and the PLY comments that name them.
+Status writeAtlases(const ScanOptions& options, const ScanAtlasLayout& atlases, double cell,
+                    const std::string& path, std::vector<std::string>& comments) {
+  Progress progress("scan: textures", atlases.count());
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  for (std::uint32_t region = 0; region < atlases.count(); ++region) {
+    LODFORGE_TRY(checkCancelled());
+    const std::string name = scanAtlasName(path, region);
+    const Image image = drawScanAtlas(options.seed, atlases, region, cell, options.textureSize);
+    LODFORGE_TRY(writeScanAtlas(image, (folder / name).string()));
+    comments.push_back("TextureFile " + name);
+    progress.advance(1);
+  }
+  progress.finish();
+  return {};
+}
+
+// Each finished triangle's atlas (the region of its cell) and its corners' coordinates in it.
+void cornerTextures(const GridWalk& walk, const ScanAtlasLayout& atlases,
+                    std::vector<Vec2f>& cornerUvs, std::vector<std::uint32_t>& textures) {
+  cornerUvs.clear();
+  textures.clear();
+  const std::uint64_t cellRow = walk.row() - 1;
+  for (const CellTriangle& t : walk.finishedCells()) {
+    const std::uint32_t column = std::min({t[0].column, t[1].column, t[2].column});
+    const std::uint32_t region = atlases.regionOf(column, cellRow);
+    const std::array<std::uint64_t, 4> cells = atlases.cells(region);
+    textures.push_back(region);
+    for (const Corner& c : t) {
+      const double u =
+          static_cast<double>(c.column - cells[0]) / static_cast<double>(cells[1] - cells[0]);
+      const double v = static_cast<double>(cellRow + c.upper - cells[2]) /
+                       static_cast<double>(cells[3] - cells[2]);
+      cornerUvs.push_back({static_cast<float>(u), static_cast<float>(v)});
+    }
+  }
+}
+
 }  // namespace
 
 Result<GenerateStats> generateScan(const ScanOptions& options, const std::string& path) {
@@ -176,11 +218,10 @@ Result<GenerateStats> generateScan(const ScanOptions& options, const std::string
   const Terrain terrain(options.seed, options.width, depth, cell);
 
   // Pass 1: count the vertices the triangles use (cheap: no heights evaluated).
-  std::uint64_t vertexCount = 0;
+  std::uint64_t vertexCount = 0, cellRows = 0;
   {
     GridWalk walk(terrain, columns, cell, options.triangles);
-    while (walk.step()) {
-    }
+    while (walk.step()) cellRows = walk.row();
     vertexCount = walk.vertexCount();
   }
   if (vertexCount > 0xFFFFFFFFull) {
@@ -188,13 +229,17 @@ Result<GenerateStats> generateScan(const ScanOptions& options, const std::string
                  fmt::format("{} vertices exceed PLY's 32-bit indices", vertexCount)};
   }
 
+  const bool textured = options.textureSize > 0;
+  const ScanAtlasLayout atlases = ScanAtlasLayout::of(options.atlases, columns, cellRows);
   PlyLayout layout;
   layout.vertexCount = vertexCount;
   layout.faceCount = options.triangles;
   layout.normals = true;
-  layout.colors = true;
+  layout.colors = !textured;
+  layout.faceUvs = textured;
   layout.comments = {fmt::format("lodforge generate scan --triangles {} --seed {}",
                                  options.triangles, options.seed)};
+  if (textured) LODFORGE_TRY(writeAtlases(options, atlases, cell, path, layout.comments));
   Result<PlyWriter> writer = PlyWriter::create(path, layout);
   if (!writer) return writer.status();
 
@@ -204,6 +249,8 @@ Result<GenerateStats> generateScan(const ScanOptions& options, const std::string
   Progress progress("scan", options.triangles);
   std::vector<Vec3f> positions, normals;
   std::vector<Rgba8> colors;
+  std::vector<Vec2f> cornerUvs;
+  std::vector<std::uint32_t> textures;
   while (walk.step()) {
     const std::uint64_t row = walk.row();
     if (!block.holds(row)) {
@@ -218,10 +265,11 @@ Result<GenerateStats> generateScan(const ScanOptions& options, const std::string
       if (index[c] == kUnused) continue;
       positions.push_back(toFloat(block.position(row, c)));
       normals.push_back(block.normal(row, c));
-      colors.push_back(block.color(row, c));
+      if (!textured) colors.push_back(block.color(row, c));
     }
     LODFORGE_TRY(writer->writeVertices(positions, normals, colors));
-    LODFORGE_TRY(writer->writeTriangles(walk.finishedTriangles()));
+    if (textured) cornerTextures(walk, atlases, cornerUvs, textures);
+    LODFORGE_TRY(writer->writeTriangles(walk.finishedTriangles(), {}, cornerUvs, textures));
     progress.advance(walk.finishedTriangles().size() / 3);
   }
   progress.finish();

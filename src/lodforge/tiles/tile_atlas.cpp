@@ -26,13 +26,16 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t v) {
 
 // Per vertex, its chart (the textured triangles joined through shared vertices), numbered in
 // order of first vertex; kNone for a vertex of no textured triangle.
-std::vector<std::uint32_t> chartOfVertex(const MeshPart& mesh, std::uint32_t& count) {
+std::vector<std::uint32_t> chartOfVertex(const MeshPart& mesh, const TextureTable& table,
+                                         std::uint32_t& count) {
   std::vector<std::uint32_t> parent(mesh.vertexCount());
   std::iota(parent.begin(), parent.end(), 0u);
   std::vector<std::uint8_t> textured(mesh.vertexCount(), 0);
   for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
     const std::uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
-    if (mesh.materials[a] == kNone) continue;
+    const std::uint32_t material = mesh.materials[a];
+    if (material >= table.materials.size() || table.materials[material].baseColorImage == kNoImage)
+      continue;  // (work files are checked: a material of no image draws untextured)
     textured[a] = textured[b] = textured[c] = 1;
     parent[findRoot(parent, b)] = findRoot(parent, a);
     parent[findRoot(parent, c)] = findRoot(parent, a);
@@ -55,8 +58,11 @@ std::vector<Chart> describeCharts(const MeshPart& mesh, const TextureTable& tabl
   for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
     if (chartOf[v] == kNone) continue;
     Chart& c = charts[chartOf[v]];
-    c.material = mesh.materials[v];
-    c.image = table.materials[c.material].baseColorImage;
+    const std::uint32_t material = mesh.materials[v];
+    if (material < table.materials.size() && table.materials[material].baseColorImage != kNoImage) {
+      c.material = material;
+      c.image = table.materials[material].baseColorImage;
+    }
     c.umin = std::min(c.umin, mesh.uvs[v].x), c.umax = std::max(c.umax, mesh.uvs[v].x);
     c.vmin = std::min(c.vmin, mesh.uvs[v].y), c.vmax = std::max(c.vmax, mesh.uvs[v].y);
   }
@@ -157,7 +163,7 @@ Result<TileAtlas> bakeTileAtlas(const MeshPart& mesh, const TextureTable& table,
   assert(options.maxSize >= 4 + 2 * options.gutter);
   TileAtlas atlas;
   std::uint32_t count = 0;
-  const std::vector<std::uint32_t> chartOf = chartOfVertex(mesh, count);
+  const std::vector<std::uint32_t> chartOf = chartOfVertex(mesh, table, count);
   std::vector<Chart> charts = describeCharts(mesh, table, chartOf, count);
   atlas.charts = count;
   std::vector<std::vector<std::uint32_t>> byMaterial(table.materials.size());

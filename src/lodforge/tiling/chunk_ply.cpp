@@ -18,6 +18,7 @@
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/mesh/ply_reader.h"
+#include "lodforge/io/mesh/ply_textures.h"
 #include "lodforge/tiling/chunk_grid.h"
 #include "lodforge/tiling/chunk_sizing.h"
 
@@ -25,9 +26,11 @@ namespace lodforge {
 namespace {
 
 // A vertex in the work file: position (3 doubles), colour, normal (3 floats; a sum of face
-// normals while a normals pass accumulates it).
+// normals while a normals pass accumulates it); for a textured file then its texture
+// coordinate (2 floats).
 constexpr std::size_t kVertexBytes = 3 * sizeof(double) + sizeof(Rgba8) + 3 * sizeof(float);
 constexpr std::size_t kNormalOffset = 3 * sizeof(double) + sizeof(Rgba8);
+constexpr std::size_t kUvBytes = sizeof(Vec2f);
 constexpr std::uint64_t kBlockVertices = 1 << 14;
 
 // Corners of the faces, fetched from the vertex work file through a direct-mapped cache of
@@ -35,8 +38,9 @@ constexpr std::uint64_t kBlockVertices = 1 << 14;
 // changed by addNormal are written back when evicted and by flush().
 class VertexCache {
  public:
-  VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes) : fd_(fd), vertices_(vertices) {
-    const std::uint64_t blockBytes = kBlockVertices * kVertexBytes;
+  VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes, std::size_t recordBytes)
+      : fd_(fd), vertices_(vertices), recordBytes_(recordBytes) {
+    const std::uint64_t blockBytes = kBlockVertices * recordBytes_;
     slots_ = std::max<std::uint64_t>(4, bytes / blockBytes);
     data_.resize(slots_ * blockBytes);
     tags_.assign(slots_, ~std::uint64_t{0});
@@ -53,6 +57,7 @@ class VertexCache {
     std::memcpy(normal, at + kNormalOffset, sizeof normal);
     out.position = {xyz[0], xyz[1], xyz[2]};
     out.normal = normalizeOr(Vec3f{normal[0], normal[1], normal[2]}, Vec3f{0, 0, 1});
+    if (recordBytes_ > kVertexBytes) std::memcpy(&out.uv, at + kVertexBytes, kUvBytes);
     out.source = vertex;
     return true;
   }
@@ -79,17 +84,17 @@ class VertexCache {
     if (vertex >= vertices_) return nullptr;
     const std::uint64_t block = vertex / kBlockVertices;
     const std::uint64_t slot = block % slots_;
-    std::byte* base = data_.data() + slot * kBlockVertices * kVertexBytes;
+    std::byte* base = data_.data() + slot * kBlockVertices * recordBytes_;
     if (tags_[slot] != block) {
       if (dirty_[slot] != 0 && !writeBack(slot)) return nullptr;
       const std::uint64_t first = block * kBlockVertices;
-      const auto wanted = static_cast<std::size_t>(blockVertices(block) * kVertexBytes);
-      if (::pread(fd_, base, wanted, static_cast<off_t>(first * kVertexBytes)) !=
+      const auto wanted = static_cast<std::size_t>(blockVertices(block) * recordBytes_);
+      if (::pread(fd_, base, wanted, static_cast<off_t>(first * recordBytes_)) !=
           static_cast<ssize_t>(wanted))
         return nullptr;
       tags_[slot] = block;
     }
-    return base + (vertex % kBlockVertices) * kVertexBytes;
+    return base + (vertex % kBlockVertices) * recordBytes_;
   }
 
   std::uint64_t blockVertices(std::uint64_t block) const {
@@ -98,9 +103,9 @@ class VertexCache {
 
   bool writeBack(std::uint64_t slot) {
     const std::uint64_t block = tags_[slot];
-    const auto bytes = static_cast<std::size_t>(blockVertices(block) * kVertexBytes);
-    const std::byte* base = data_.data() + slot * kBlockVertices * kVertexBytes;
-    if (::pwrite(fd_, base, bytes, static_cast<off_t>(block * kBlockVertices * kVertexBytes)) !=
+    const auto bytes = static_cast<std::size_t>(blockVertices(block) * recordBytes_);
+    const std::byte* base = data_.data() + slot * kBlockVertices * recordBytes_;
+    if (::pwrite(fd_, base, bytes, static_cast<off_t>(block * kBlockVertices * recordBytes_)) !=
         static_cast<ssize_t>(bytes))
       return false;
     dirty_[slot] = 0;
@@ -108,7 +113,9 @@ class VertexCache {
   }
 
   int fd_;
-  std::uint64_t vertices_, slots_ = 0;
+  std::uint64_t vertices_;
+  std::size_t recordBytes_;
+  std::uint64_t slots_ = 0;
   std::vector<std::byte> data_;
   std::vector<std::uint64_t> tags_;
   std::vector<std::uint8_t> dirty_;
@@ -171,6 +178,7 @@ class PlyChunking {
   std::shared_ptr<PlyBatch> readVertexBatch(tbb::flow_control& control);
   void writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>& buffer);
   Status fetch(const PlyBatch& batch, std::size_t t, std::array<CutCorner, 3>& triangle);
+  void texture(const PlyBatch& batch, std::size_t t, std::array<CutCorner, 3>& triangle) const;
   PlyReadOptions faceReading() const;
   Result<ChunkGrid> chunkGrid() const;
   std::shared_ptr<FaceBatch> readFaceBatch(tbb::flow_control& control);
@@ -180,6 +188,7 @@ class PlyChunking {
   const std::string& path_;
   const ChunkInputOptions& options_;
   const std::string vertexPath_;
+  std::size_t recordBytes_ = kVertexBytes;  // more with a texture coordinate per vertex
   std::optional<PlyReader> vertices_, faces_;
   PlyHeader header_;
   int fd_ = -1;
@@ -206,6 +215,18 @@ Status PlyChunking::openVertices() {
   header_ = vertices_->header();
   if (header_.faceCount == 0) return badInput(path_, "no faces: a tileset needs a mesh");
   input_.colors = header_.hasColors;
+  if (plyTextured(header_)) {
+    PlyTextures textures = readPlyTextures(header_, path_, &input_.warnings);
+    // A texture that cannot be read draws grey: in the vertex colours.
+    for (const Material& m : textures.materials) input_.colors |= m.baseColorImage == kNoImage;
+    input_.textures = {std::move(textures.materials), std::move(textures.images)};
+    recordBytes_ = kVertexBytes + (header_.hasUvs ? kUvBytes : 0);
+  } else if (header_.hasUvs || header_.hasFaceUvs) {
+    input_.warnings.push_back(
+        fmt::format("{}: texture coordinates but no texture (no 'comment "
+                    "TextureFile' line): drawn without one",
+                    path_));
+  }
   fd_ = ::open(vertexPath_.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
   if (fd_ < 0) return ioErrorFromErrno(vertexPath_, "create");
   return {};
@@ -232,7 +253,7 @@ Status PlyChunking::copyVertices() {
   LODFORGE_TRY(failure_.status());
   progress_->finish();
   if (input_.bounds.empty()) return badInput(path_, "no vertices");
-  cache_.emplace(fd_, header_.vertexCount, options_.vertexCacheBytes);
+  cache_.emplace(fd_, header_.vertexCount, options_.vertexCacheBytes, recordBytes_);
   return {};
 }
 
@@ -257,7 +278,7 @@ std::shared_ptr<PlyBatch> PlyChunking::readVertexBatch(tbb::flow_control& contro
 
 void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>& buffer) {
   if (failure_.failed()) return;
-  buffer.resize(batch.positions.size() * kVertexBytes);
+  buffer.resize(batch.positions.size() * recordBytes_);
   for (std::size_t i = 0; i < batch.positions.size(); ++i) {
     Vec3d p = batch.positions[i];
     if (options_.transform && !options_.transform(batch.positions[i], p)) {
@@ -275,10 +296,14 @@ void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>
                         ? Vec3f{}
                         : transformNormal(options_, batch.positions[i], p, batch.normals[i]);
     const float normal[3] = {n.x, n.y, n.z};
-    std::byte* record = buffer.data() + i * kVertexBytes;
+    std::byte* record = buffer.data() + i * recordBytes_;
     std::memcpy(record, xyz, sizeof xyz);
     std::memcpy(record + sizeof xyz, &color, sizeof color);
     std::memcpy(record + kNormalOffset, normal, sizeof normal);
+    if (recordBytes_ > kVertexBytes) {
+      const Vec2f uv = batch.uvs.empty() ? Vec2f{} : batch.uvs[i];
+      std::memcpy(record + kVertexBytes, &uv, kUvBytes);
+    }
   }
   if (::write(fd_, buffer.data(), buffer.size()) != static_cast<ssize_t>(buffer.size())) {
     failure_.fail(batch.first, ioErrorFromErrno(vertexPath_, "write"));
@@ -296,6 +321,26 @@ Status PlyChunking::fetch(const PlyBatch& batch, std::size_t t,
                                          batch.first, batch.triangles[t + k]));
   }
   return {};
+}
+
+// A textured file's corners: the face's texture, and its corner coordinates when it has them
+// (a vertex then has one per face: corners are not shared by file vertex, welding joins them).
+void PlyChunking::texture(const PlyBatch& batch, std::size_t t,
+                          std::array<CutCorner, 3>& triangle) const {
+  const std::uint32_t texture = batch.triangleTextures.empty() ? 0 : batch.triangleTextures[t / 3];
+  const auto& materials = input_.textures.materials;
+  // A texture that could not be read (warned about) draws grey; a texnumber past the files
+  // draws untextured.
+  const bool drawn = texture < materials.size() && materials[texture].baseColorImage != kNoImage;
+  const bool grey = texture < materials.size() && !drawn;
+  for (std::size_t k = 0; k < 3; ++k) {
+    triangle[k].material = drawn ? texture : ~0u;
+    if (grey) triangle[k].color = {128, 128, 128, 255};
+    if (!batch.cornerUvs.empty()) {
+      triangle[k].uv = batch.cornerUvs[t + k];
+      triangle[k].source = CutCorner::kNoSource;
+    }
+  }
 }
 
 PlyReadOptions PlyChunking::faceReading() const {
@@ -373,6 +418,7 @@ Status PlyChunking::cutFaces() {
   grid_ = *grid;
   input_.chunks = std::make_unique<ChunkWriter>(*grid_, options_.workDirectory + "/chunks",
                                                 options_.chunkBufferBytes, options_.keepInMemory);
+  input_.chunks->setTextured(!input_.textures.empty());
   Result<PlyReader> faces = PlyReader::open(path_, faceReading());
   if (!faces) return faces.status();
   faces_ = std::move(*faces);
@@ -421,6 +467,7 @@ std::shared_ptr<FaceBatch> PlyChunking::readFaceBatch(tbb::flow_control& control
       std::array<CutCorner, 3> triangle;
       if (status = fetch(batch_, t, triangle); !status.ok())
         return failure_.fail(batch_.first, std::move(status), &control), nullptr;
+      if (!input_.textures.empty()) texture(batch_, t, triangle);
       std::copy(triangle.begin(), triangle.end(), next->corners.data() + t);
       if (header_.hasObjectIds) {
         const auto found = objects_.find(batch_.triangleObjects[t / 3]);

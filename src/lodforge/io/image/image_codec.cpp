@@ -116,8 +116,8 @@ Result<Image> decodeStb(std::span<const std::byte> bytes, const std::string& nam
   return image;
 }
 
-bool encodeJpegInto(const Image& image, int quality, unsigned char*& out, unsigned long& size,
-                    JpegError& error) {
+bool encodeJpegInto(const Image& image, int quality, const std::string& comment,
+                    unsigned char*& out, unsigned long& size, JpegError& error) {
   jpeg_compress_struct info;
   info.err = jpeg_std_error(&error.manager);
   error.manager.error_exit = jpegErrorExit;
@@ -134,6 +134,9 @@ bool encodeJpegInto(const Image& image, int quality, unsigned char*& out, unsign
   jpeg_set_defaults(&info);
   jpeg_set_quality(&info, quality, TRUE);
   jpeg_start_compress(&info, TRUE);
+  if (!comment.empty())
+    jpeg_write_marker(&info, JPEG_COM, reinterpret_cast<const JOCTET*>(comment.data()),
+                      static_cast<unsigned>(comment.size()));
   while (info.next_scanline < info.image_height) {
     auto* row =
         const_cast<JSAMPROW>(image.rgba.data() + std::size_t{info.next_scanline} * image.width * 4);
@@ -228,7 +231,7 @@ Result<std::vector<std::byte>> encodeImage(const Image& image, const ImageEncode
     unsigned char* out = nullptr;
     unsigned long size = 0;
     JpegError error{};
-    const bool ok = encodeJpegInto(image, quality, out, size, error);
+    const bool ok = encodeJpegInto(image, quality, options.comment, out, size, error);
     std::vector<std::byte> bytes = ok ? copyOf(out, size) : std::vector<std::byte>();
     std::free(out);
     if (!ok) return Error{ErrorKind::kInternal, fmt::format("JPEG encoding: {}", error.message)};

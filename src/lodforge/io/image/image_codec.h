@@ -30,7 +30,8 @@ Result<Image> decodeImage(const ImageSource& image, std::uint64_t maxPixels = kM
 
 struct ImageEncodeOptions {
   ImageFormat format = ImageFormat::kJpeg;
-  int quality = 90;  // JPEG and WebP, 1..100 (PNG is lossless)
+  int quality = 90;     // JPEG and WebP, 1..100 (PNG is lossless)
+  std::string comment{};  // JPEG: a COM marker with this text (empty: none)
 };
 // JPEG drops alpha (a texture with alpha goes to PNG or WebP: the caller decides).
 Result<std::vector<std::byte>> encodeImage(const Image& image, const ImageEncodeOptions& options);

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "lodforge/io/image/image_codec.h"
+#include "lodforge/io/image/texture_files.h"
 
 namespace lodforge {
 namespace {
@@ -17,41 +18,6 @@ std::string trimmed(std::string_view s) {
     s.remove_suffix(1);
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   return std::string(s);
-}
-
-bool isFile(const std::string& path) {
-  std::error_code error;
-  return std::filesystem::is_regular_file(path, error);
-}
-
-// Windows exports write ".\tex.jpg" or "C:\Users\me\tex.jpg".
-bool isWindowsAbsolute(std::string_view name) {
-  return name.size() > 2 && name[1] == ':' && (name[2] == '\\' || name[2] == '/');
-}
-
-// The texture's file, or empty. `guessed` is set when only its file name matched.
-std::string findTexture(const std::string& name, const std::vector<std::string>& directories,
-                        bool& guessed) {
-  std::string slashed = name;
-  std::replace(slashed.begin(), slashed.end(), '\\', '/');
-  const bool absolute = slashed.starts_with('/') || isWindowsAbsolute(name);
-  if (absolute && !isWindowsAbsolute(name) && isFile(slashed)) return slashed;
-  if (!absolute) {
-    for (const std::string& directory : directories) {
-      for (const std::string& candidate : {directory + name, directory + slashed}) {
-        if (isFile(candidate)) return std::filesystem::path(candidate).lexically_normal().string();
-      }
-    }
-  }
-  // A path from another machine: the file of that name beside the OBJ or its library.
-  const std::string file = std::filesystem::path(slashed).filename().string();
-  for (const std::string& directory : directories) {
-    if (!file.empty() && isFile(directory + file)) {
-      guessed = true;
-      return std::filesystem::path(directory + file).lexically_normal().string();
-    }
-  }
-  return {};
 }
 
 // The image of `path` in the model's table (one entry however many materials use it), or the
@@ -103,7 +69,7 @@ ObjTextures resolveObjTextures(std::vector<tinyobj::material_t>& materials,
     const std::string name = trimmed(mtl.diffuse_texname);
     if (name.empty()) continue;
     bool guessed = false;
-    const std::string path = findTexture(name, searchDirectories, guessed);
+    const std::string path = findTextureFile(name, searchDirectories, guessed);
     Result<std::uint32_t> image =
         path.empty() ? Result<std::uint32_t>(badInput(name, "texture image not found"))
                      : imageOf(path, name, model, known);

@@ -188,6 +188,20 @@ int findProperty(const PlyElement& e, std::initializer_list<std::string_view> na
   return -1;
 }
 
+// A vertex's texture coordinates, under the names exporters give them (scalars only).
+void assignUvRoles(const PlyElement& v, PlyRoles& roles) {
+  for (const auto& [u, w] :
+       {std::pair{"s", "t"}, std::pair{"u", "v"}, std::pair{"texture_u", "texture_v"},
+        std::pair{"texture_s", "texture_t"}}) {
+    const int a = findProperty(v, {u}), b = findProperty(v, {w});
+    if (a < 0 || b < 0 || v.properties[static_cast<std::size_t>(a)].isList ||
+        v.properties[static_cast<std::size_t>(b)].isList)
+      continue;
+    roles.u = a, roles.v = b;
+    return;
+  }
+}
+
 // The vertex index list of a face or strip element.
 int indexListRole(const std::string& file, const PlyElement& e) {
   const int role = findProperty(e, {"vertex_indices", "vertex_index"});
@@ -205,8 +219,9 @@ int indexListRole(const std::string& file, const PlyElement& e) {
 // The vertex's scalar properties that are not a position, normal or colour, packed one after
 // the other in their own types.
 void planExtras(const PlyElement& vertex, PlyRoles& roles, PointExtras& extras) {
-  const std::array<int, 10> known = {roles.x,  roles.y,   roles.z,     roles.nx,   roles.ny,
-                                     roles.nz, roles.red, roles.green, roles.blue, roles.alpha};
+  const std::array<int, 12> known = {roles.x,    roles.y,     roles.z,   roles.nx,
+                                     roles.ny,   roles.nz,    roles.red, roles.green,
+                                     roles.blue, roles.alpha, roles.u,   roles.v};
   for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
     const PlyProperty& p = vertex.properties[i];
     if (p.isList || std::find(known.begin(), known.end(), static_cast<int>(i)) != known.end())
@@ -262,6 +277,11 @@ PlyRoles assignPlyRoles(PlyHeader& header, const std::string& name, bool readExt
   header.vertexCount = v.count;
   header.hasNormals = roles.nx >= 0 && roles.ny >= 0 && roles.nz >= 0;
   header.hasColors = roles.red >= 0 && roles.green >= 0 && roles.blue >= 0;
+  assignUvRoles(v, roles);
+  header.hasUvs = roles.u >= 0 && roles.v >= 0;
+  for (const std::string& comment : header.comments) {
+    if (comment.starts_with("TextureFile ")) header.textureFiles.push_back(comment.substr(12));
+  }
   if (readExtras) planExtras(v, roles, header.extras);
   header.doublePositions =
       v.properties[static_cast<std::size_t>(roles.x)].type == PlyType::kFloat64;
@@ -281,17 +301,26 @@ PlyRoles assignPlyRoles(PlyHeader& header, const std::string& name, bool readExt
     }
     header.faceCount = f.count;
     header.hasObjectIds = roles.objectId >= 0;
+    roles.faceTexcoords = findProperty(f, {"texcoord"});
+    if (roles.faceTexcoords >= 0 &&
+        !f.properties[static_cast<std::size_t>(roles.faceTexcoords)].isList)
+      roles.faceTexcoords = -1;
+    roles.texnumber = findProperty(f, {"texnumber"});
+    if (roles.texnumber >= 0 && f.properties[static_cast<std::size_t>(roles.texnumber)].isList)
+      roles.texnumber = -1;
+    header.hasFaceUvs = roles.faceTexcoords >= 0;
+    header.hasTextureNumbers = roles.texnumber >= 0;
   }
   if (roles.stripElement >= 0) {
     const PlyElement& s = header.elements[static_cast<std::size_t>(roles.stripElement)];
     roles.stripIndices = indexListRole(name, s);
     header.stripCount = s.count;
-    // Strips carry no object id: their triangles would belong to no object.
-    if (header.hasObjectIds) {
+    // Strips carry no object id or texture: their triangles would belong to no object.
+    if (header.hasObjectIds || header.hasFaceUvs || header.hasTextureNumbers) {
       throw ErrorException{Error{
           ErrorKind::kUnsupported,
-          fmt::format("{}: faces with object ids and 'tristrips' in one file are not supported",
-                      name)}};
+          fmt::format("{}: faces with {} and 'tristrips' in one file are not supported", name,
+                      header.hasObjectIds ? "object ids" : "textures")}};
     }
   }
   return roles;

@@ -60,6 +60,13 @@ struct PlyHeader {
   bool hasNormals = false;
   bool hasColors = false;
   bool hasObjectIds = false;
+  // Texture coordinates per vertex (s t, u v, texture_u texture_v) or per face corner (a
+  // 'texcoord' list, 2 per corner), the face's texture (a 'texnumber' into textureFiles), and
+  // the images MeshLab and OpenDroneMap name in "comment TextureFile NAME" lines, in order.
+  bool hasUvs = false;
+  bool hasFaceUvs = false;
+  bool hasTextureNumbers = false;
+  std::vector<std::string> textureFiles;
   bool doublePositions = false;  // x y z stored as double: keep the double origin
   // The vertex's other scalar properties (label, segment_index, …), with readExtras.
   PointExtras extras;
@@ -82,6 +89,8 @@ struct PlyRoles {
   int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1;
   int red = -1, green = -1, blue = -1, alpha = -1;
   int faceIndices = -1, objectId = -1;
+  int u = -1, v = -1;                        // vertex texture coordinates
+  int faceTexcoords = -1, texnumber = -1;    // per-face corner coordinates, texture index
   int stripElement = -1, stripIndices = -1;  // 'tristrips' and its index list
   std::vector<int> extras;                   // vertex properties carried as extra fields
 };

@@ -8,6 +8,7 @@
 #include "lodforge/io/mesh/ply_objects.h"
 #include "lodforge/io/mesh/ply_records.h"
 #include "lodforge/io/mesh/ply_strips.h"
+#include "lodforge/io/mesh/ply_textures.h"
 
 namespace lodforge {
 
@@ -29,6 +30,9 @@ bool PlyReader::State::next(PlyBatch& batch) {
   batch.extras.clear();
   batch.triangles.clear();
   batch.triangleObjects.clear();
+  batch.uvs.clear();
+  batch.cornerUvs.clear();
+  batch.triangleTextures.clear();
   batch.count = 0;
   bool reading = false, readingStrips = false;
   try {
@@ -158,24 +162,29 @@ Result<bool> PlyReader::next(PlyBatch& batch) {
 
 namespace {
 
-Result<Model> readAll(PlyReader& reader, const std::string& name,
-                      std::vector<std::string>* warnings) {
-  const PlyHeader& header = reader.header();
-  std::vector<Vec3f> positions;
-  std::vector<Vec3f> normals;
+// What a whole read gathers, before it becomes a model.
+struct Gathered {
+  std::vector<Vec3f> positions, normals;
   std::vector<Rgba8> colors;
-  std::vector<std::uint32_t> triangles;
-  std::vector<std::uint32_t> triangleObjects;
+  std::vector<Vec2f> uvs, cornerUvs;
+  std::vector<std::uint32_t> triangles, triangleObjects, triangleTextures;
+};
+
+template <class T>
+void append(std::vector<T>& to, const std::vector<T>& from) {
+  to.insert(to.end(), from.begin(), from.end());
+}
+
+Status gather(PlyReader& reader, const std::string& name, Model& model, Gathered& g) {
+  const PlyHeader& header = reader.header();
   // Counts were checked against the file size, except when salvaging: bound them here too.
   const std::uint64_t dataBytes = reader.bytesAfterHeader();
   const std::uint64_t vertexGuess =
       std::min(header.vertexCount, dataBytes / 3 + 1);  // 3 x int8 at least
-  positions.reserve(vertexGuess);
-  if (header.hasNormals) normals.reserve(vertexGuess);
-  if (header.hasColors) colors.reserve(vertexGuess);
-  triangles.reserve(3 * std::min(header.faceCount, dataBytes / 4 + 1));
-
-  Model model;
+  g.positions.reserve(vertexGuess);
+  if (header.hasNormals) g.normals.reserve(vertexGuess);
+  if (header.hasColors) g.colors.reserve(vertexGuess);
+  g.triangles.reserve(3 * std::min(header.faceCount, dataBytes / 4 + 1));
   bool originChosen = false;
   PlyBatch batch;
   Progress progress("reading " + std::filesystem::path(name).filename().string(),
@@ -193,42 +202,73 @@ Result<Model> readAll(PlyReader& reader, const std::string& name,
         model.origin = chooseOrigin(first);
         originChosen = true;
       }
-      for (const Vec3d& p : batch.positions) positions.push_back(toFloat(p - model.origin));
-      normals.insert(normals.end(), batch.normals.begin(), batch.normals.end());
-      colors.insert(colors.end(), batch.colors.begin(), batch.colors.end());
+      for (const Vec3d& p : batch.positions) g.positions.push_back(toFloat(p - model.origin));
+      append(g.normals, batch.normals);
+      append(g.colors, batch.colors);
+      append(g.uvs, batch.uvs);
     } else {
-      triangles.insert(triangles.end(), batch.triangles.begin(), batch.triangles.end());
-      triangleObjects.insert(triangleObjects.end(), batch.triangleObjects.begin(),
-                             batch.triangleObjects.end());
+      append(g.triangles, batch.triangles);
+      append(g.triangleObjects, batch.triangleObjects);
+      append(g.cornerUvs, batch.cornerUvs);
+      append(g.triangleTextures, batch.triangleTextures);
     }
     progress.advance(batch.count);
   }
   progress.finish();
+  return {};
+}
+
+// Salvaged: faces that come before a cut-short vertex list may name missing vertices.
+void dropMissingVertices(Gathered& g) {
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < g.triangles.size() / 3; ++t) {
+    if (std::max({g.triangles[3 * t], g.triangles[3 * t + 1], g.triangles[3 * t + 2]}) >=
+        g.positions.size())
+      continue;
+    std::copy_n(&g.triangles[3 * t], 3, &g.triangles[3 * kept]);
+    if (!g.triangleObjects.empty()) g.triangleObjects[kept] = g.triangleObjects[t];
+    if (!g.triangleTextures.empty()) g.triangleTextures[kept] = g.triangleTextures[t];
+    if (!g.cornerUvs.empty()) std::copy_n(&g.cornerUvs[3 * t], 3, &g.cornerUvs[3 * kept]);
+    ++kept;
+  }
+  g.triangles.resize(3 * kept);
+  if (!g.triangleObjects.empty()) g.triangleObjects.resize(kept);
+  if (!g.triangleTextures.empty()) g.triangleTextures.resize(kept);
+  if (!g.cornerUvs.empty()) g.cornerUvs.resize(3 * kept);
+}
+
+Result<Model> readAll(PlyReader& reader, const std::string& name,
+                      std::vector<std::string>* warnings) {
+  const PlyHeader& header = reader.header();
+  Model model;
+  Gathered g;
+  LODFORGE_TRY(gather(reader, name, model, g));
   if (reader.truncation()) {
     if (warnings) warnings->push_back(*reader.truncation() + "; kept what came before");
-    // Salvaged: faces that come before a cut-short vertex list may name missing vertices.
-    std::size_t kept = 0;
-    for (std::size_t t = 0; t < triangles.size() / 3; ++t) {
-      if (std::max({triangles[3 * t], triangles[3 * t + 1], triangles[3 * t + 2]}) >=
-          positions.size())
-        continue;
-      std::copy_n(&triangles[3 * t], 3, &triangles[3 * kept]);
-      if (!triangleObjects.empty()) triangleObjects[kept] = triangleObjects[t];
-      ++kept;
-    }
-    triangles.resize(3 * kept);
-    if (!triangleObjects.empty()) triangleObjects.resize(kept);
+    dropMissingVertices(g);
   }
+  if (plyTextured(header)) {
+    LODFORGE_TRY(addTexturedPly(model,
+                                {g.positions, g.normals, g.colors, g.uvs, g.triangles, g.cornerUvs,
+                                 g.triangleTextures, g.triangleObjects},
+                                readPlyTextures(header, name, warnings), name));
+    return model;
+  }
+  if ((header.hasUvs || header.hasFaceUvs) && warnings)
+    warnings->push_back(
+        fmt::format("{}: texture coordinates but no texture (no 'comment "
+                    "TextureFile' line): drawn without one",
+                    name));
   if (header.hasObjectIds) {
-    splitPlyObjects(model, positions, normals, colors, triangles, triangleObjects);
+    splitPlyObjects(model, g.positions, g.normals, g.colors, g.triangles, g.triangleObjects);
     return model;
   }
   ModelBuilder builder(model);
   builder.beginObject(fileStem(name));
-  model.positions = std::move(positions);
-  model.normals = std::move(normals);
-  model.colors = std::move(colors);
-  model.indices = std::move(triangles);
+  model.positions = std::move(g.positions);
+  model.normals = std::move(g.normals);
+  model.colors = std::move(g.colors);
+  model.indices = std::move(g.triangles);
   builder.endObject();
   return model;
 }

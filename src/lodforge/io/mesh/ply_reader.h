@@ -48,10 +48,14 @@ struct PlyBatch {
   std::vector<Vec3f> normals;     // when the header has nx ny nz
   std::vector<Rgba8> colors;      // when the header has red green blue
   std::vector<std::byte> extras;  // header.extras.stride bytes per vertex, with readExtras
+  std::vector<Vec2f> uvs;         // when the header has vertex texture coordinates (glTF's way
+                                  // up: v = 1 - t)
   // kFaces: 3 indices per triangle (polygons fan-triangulated, strips with every triangle facing
   // the way the first does), global vertex indices
   std::vector<std::uint32_t> triangles;
-  std::vector<std::uint32_t> triangleObjects;  // per triangle, when the header has object ids
+  std::vector<std::uint32_t> triangleObjects;   // per triangle, when the header has object ids
+  std::vector<Vec2f> cornerUvs;                 // 3 per triangle, when faces have a 'texcoord' list
+  std::vector<std::uint32_t> triangleTextures;  // per triangle, when faces have a 'texnumber'
 };
 
 class PlyReader {

@@ -222,6 +222,12 @@ void PlyRecords::readVertex(PlyBatch& batch) {
     batch.colors.push_back(
         {channel(roles.red), channel(roles.green), channel(roles.blue), channel(roles.alpha)});
   }
+  if (header.hasUvs) {
+    const Vec2f uv{static_cast<float>(value(roles.u)), static_cast<float>(1.0 - value(roles.v))};
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
+      fail(fmt::format("vertex {}: texture coordinate is not finite", elementDone));
+    batch.uvs.push_back(uv);
+  }
   if (!roles.extras.empty()) {
     const std::size_t at = batch.extras.size();
     batch.extras.resize(at + header.extras.stride);
@@ -240,7 +246,8 @@ void PlyRecords::readVertex(PlyBatch& batch) {
 void PlyRecords::readFace(PlyBatch& batch) {
   const PlyElement& e = header.elements[element];
   beginElement();
-  std::uint32_t objectId = 0;
+  std::uint32_t objectId = 0, texture = 0;
+  faceUvs.clear();
   const std::size_t firstCorner = batch.triangles.size();
   faceFirstCorner = firstCorner;
   std::uint64_t corners = 0;
@@ -276,15 +283,48 @@ void PlyRecords::readFace(PlyBatch& batch) {
       if (raw < 0 || raw > std::numeric_limits<std::uint32_t>::max())
         fail(fmt::format("face {}: object id {} out of range", elementDone, raw));
       objectId = static_cast<std::uint32_t>(raw);
+    } else if (static_cast<int>(i) == roles.faceTexcoords) {
+      readFaceTexcoords(e, p);
+    } else if (static_cast<int>(i) == roles.texnumber) {
+      const double raw = readNumber(e, p, p.type);
+      if (raw < 0 || raw > std::numeric_limits<std::uint32_t>::max())
+        fail(fmt::format("face {}: texnumber {} out of range", elementDone, raw));
+      texture = static_cast<std::uint32_t>(raw);
     } else {
       skipProperty(e, p);
     }
   }
   // Faces with fewer than 3 corners carry no area and yield no triangles.
-  if (header.hasObjectIds) {
-    const std::size_t triangles = (batch.triangles.size() - firstCorner) / 3;
+  const std::size_t triangles = (batch.triangles.size() - firstCorner) / 3;
+  if (header.hasObjectIds)
     batch.triangleObjects.insert(batch.triangleObjects.end(), triangles, objectId);
+  if (header.hasTextureNumbers)
+    batch.triangleTextures.insert(batch.triangleTextures.end(), triangles, texture);
+  if (header.hasFaceUvs) addCornerUvs(batch, corners, triangles);
+}
+
+// A face's 'texcoord' list: 2 numbers per corner (checked against the corners once both are
+// read, in addCornerUvs).
+void PlyRecords::readFaceTexcoords(const PlyElement& e, const PlyProperty& p) {
+  const std::uint64_t count = readListCount(e, p);
+  if (count > 2 * kMaxPolygon)
+    fail(fmt::format("face {}: {} texture coordinates", elementDone, count));
+  for (std::uint64_t k = 0; k < count; ++k) {
+    const double x = readNumber(e, p, p.type);
+    if (!std::isfinite(x))
+      fail(fmt::format("face {}: texture coordinate is not finite", elementDone));
+    faceUvs.push_back(static_cast<float>(k % 2 == 0 ? x : 1.0 - x));
   }
+}
+
+// The face's corner coordinates fanned as its triangles are.
+void PlyRecords::addCornerUvs(PlyBatch& batch, std::uint64_t corners, std::size_t triangles) {
+  if (faceUvs.size() != 2 * corners)
+    fail(fmt::format("face {}: {} texture coordinates for {} corners (2 each)", elementDone,
+                     faceUvs.size(), corners));
+  const auto uv = [&](std::size_t k) { return Vec2f{faceUvs[2 * k], faceUvs[2 * k + 1]}; };
+  for (std::size_t t = 0; t < triangles; ++t)
+    batch.cornerUvs.insert(batch.cornerUvs.end(), {uv(0), uv(t + 1), uv(t + 2)});
 }
 
 void PlyRecords::skipElement(const PlyElement& e) {

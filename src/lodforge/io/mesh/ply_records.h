@@ -107,6 +107,9 @@ struct PlyRecords {
 
   void readVertex(PlyBatch& batch);
   void readFace(PlyBatch& batch);
+  std::vector<float> faceUvs;  // scratch: a face's 'texcoord' list (v turned to glTF's way)
+  void readFaceTexcoords(const PlyElement& e, const PlyProperty& p);
+  void addCornerUvs(PlyBatch& batch, std::uint64_t corners, std::size_t triangles);
   void skipElement(const PlyElement& e);
 };
 

@@ -48,6 +48,7 @@ Result<PlyWriter> PlyWriter::create(const std::string& path, const PlyLayout& la
     header +=
         fmt::format("element face {}\nproperty list uchar uint vertex_indices\n", layout.faceCount);
     if (layout.objectIds) header += "property uint object_id\n";
+    if (layout.faceUvs) header += "property list uchar float texcoord\nproperty int texnumber\n";
   }
   header += "end_header\n";
   if (Status s = file->writeAt(0, header.data(), header.size()); !s.ok()) return s;
@@ -87,10 +88,14 @@ Status PlyWriter::writeVertices(std::span<const Vec3f> positions, std::span<cons
 }
 
 Status PlyWriter::writeTriangles(std::span<const std::uint32_t> indices,
-                                 std::span<const std::uint32_t> objectIds) {
+                                 std::span<const std::uint32_t> objectIds,
+                                 std::span<const Vec2f> cornerUvs,
+                                 std::span<const std::uint32_t> textures) {
   assert(indices.size() % 3 == 0);
   const std::size_t triangles = indices.size() / 3;
   assert(objectIds.size() == (layout_.objectIds ? triangles : 0));
+  assert(cornerUvs.size() == (layout_.faceUvs ? 3 * triangles : 0));
+  assert(textures.size() == (layout_.faceUvs ? triangles : 0));
   if (facesWritten_ + triangles > layout_.faceCount) {
     return Error{ErrorKind::kInternal, fmt::format("{}: more faces than the {} declared",
                                                    file_.path(), layout_.faceCount)};
@@ -102,6 +107,14 @@ Status PlyWriter::writeTriangles(std::span<const std::uint32_t> indices,
     append(out, indices[3 * t + 1]);
     append(out, indices[3 * t + 2]);
     if (layout_.objectIds) append(out, objectIds[t]);
+    if (layout_.faceUvs) {
+      append(out, std::uint8_t{6});
+      for (std::size_t k = 0; k < 3; ++k) {
+        append(out, cornerUvs[3 * t + k].x);
+        append(out, 1.0f - cornerUvs[3 * t + k].y);
+      }
+      append(out, static_cast<std::int32_t>(textures[t]));
+    }
     if (out.size() >= kSectionBuffer) LODFORGE_TRY(flush(faces_));
   }
   facesWritten_ += triangles;

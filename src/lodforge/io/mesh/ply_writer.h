@@ -19,9 +19,12 @@ struct PlyLayout {
   std::uint64_t faceCount = 0;  // triangles; no face element when 0 (a point cloud)
   bool normals = false;
   bool colors = false;
-  bool objectIds = false;        // an "object_id" uint property per face
+  bool objectIds = false;  // an "object_id" uint property per face
+  // MeshLab's textured faces: a "texcoord" list of 6 floats (OpenGL's way up, t = 1 - v) and a
+  // "texnumber" int per face, into "comment TextureFile" lines the caller puts in `comments`.
+  bool faceUvs = false;
   bool doublePositions = false;  // x y z as double (origin added back), for geo-scale models
-  std::vector<std::string> comments;
+  std::vector<std::string> comments{};
 };
 
 class PlyWriter {
@@ -32,9 +35,12 @@ class PlyWriter {
   // normals/colors must be given iff the layout has them.
   Status writeVertices(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
                        std::span<const Rgba8> colors, Vec3d origin = {});
-  // Global vertex indices, 3 per triangle; objectIds per triangle iff the layout has them.
+  // Global vertex indices, 3 per triangle; objectIds per triangle iff the layout has them;
+  // cornerUvs (3 per triangle, glTF's way up) and textures (per triangle) iff it has faceUvs.
   Status writeTriangles(std::span<const std::uint32_t> indices,
-                        std::span<const std::uint32_t> objectIds = {});
+                        std::span<const std::uint32_t> objectIds = {},
+                        std::span<const Vec2f> cornerUvs = {},
+                        std::span<const std::uint32_t> textures = {});
   // Checks that the declared counts were written, then renames the file into place.
   Status finish();
   std::uint64_t fileBytes() const { return faceStart_ + layout_.faceCount * faceStride(); }
@@ -47,7 +53,9 @@ class PlyWriter {
   };
   PlyWriter(OutputFile file, PlyLayout layout, std::uint64_t vertexStart);
   std::size_t vertexStride() const;
-  std::size_t faceStride() const { return layout_.objectIds ? 17 : 13; }
+  std::size_t faceStride() const {
+    return 13u + (layout_.objectIds ? 4u : 0u) + (layout_.faceUvs ? 1u + 24u + 4u : 0u);
+  }
   Status flush(Section& section);
 
   OutputFile file_;

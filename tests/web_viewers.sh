@@ -4,7 +4,8 @@
 # georeferenced, meshopt-compressed), a point tileset (a LAS placed from its own CRS) and the
 # surface reconstructed from a LAZ scan (tiles --surface, placed from the file's CRS), and a STEP
 # assembly whose parts are picked, found, highlighted and hidden in both viewers, and a generated
-# STEP assembly whose parts are also hidden by CAD layer.
+# STEP assembly whose parts are also hidden by CAD layer, and a textured OBJ (a red and blue
+# checker) whose texture both viewers must draw.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -13,10 +14,14 @@ here=$(cd "$(dirname "$0")" && pwd)
 [[ -d $here/js/node_modules/playwright-core ]] ||
   { echo "playwright-core is not installed: run scripts/install-deps.sh" >&2; exit 1; }
 rm -rf "$out" && mkdir -p "$out/horse-shots" "$out/autzen-shots" "$out/surface-shots" "$out/motor-shots" \
-  "$out/layers-shots"
+  "$out/layers-shots" "$out/checker-shots"
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse" --chunk-size 0.05 \
   --origin 8.5417,47.3769,408 --compress meshopt
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/horse" "$out/horse-shots" --min-coverage 0.03
+"$lodforge" -q tiles "$here/data/textured/checker-plane.obj" -o "$out/checker" --chunk-size 30 \
+  --origin 8.5417,47.3769,408
+node "$here/js/web-viewers.mjs" "$lodforge" "$out/checker" "$out/checker-shots" --min-coverage 0.1 \
+  --texture-hues 0.2
 "$lodforge" -q tiles "$data/points/autzen_trim.las" -o "$out/autzen" --block-size 20K --tile-points 10K
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/autzen" "$out/autzen-shots" --min-coverage 0.03
 "$lodforge" -q tiles "$data/points/autzen_trim.laz" --surface -o "$out/surface" --voxel 4 --chunk-size 100

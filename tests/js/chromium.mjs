@@ -62,6 +62,35 @@ export async function coverageOf(tab, png, background, skipId = null) {
   }, { data: png.toString('base64'), background, skipId });
 }
 
+// Shares of the pixels (outside the element `skipId`) that are clearly red and clearly blue:
+// the colours of a red and blue texture, which untextured geometry (white or grey, lit) never
+// shows, whatever the lighting does to their brightness.
+export async function hueSharesOf(tab, png, skipId = null) {
+  return tab.evaluate(async ({ data, skipId }) => {
+    const image = new Image();
+    image.src = 'data:image/png;base64,' + data;
+    await image.decode();
+    const canvas = document.createElement('canvas');
+    canvas.width = image.width;
+    canvas.height = image.height;
+    const g = canvas.getContext('2d');
+    g.drawImage(image, 0, 0);
+    const skip = skipId ? document.getElementById(skipId).getBoundingClientRect() : null;
+    const p = g.getImageData(0, 0, image.width, image.height).data;
+    let red = 0, blue = 0, counted = 0;
+    for (let y = 0; y < image.height; y++) {
+      for (let x = 0; x < image.width; x++) {
+        if (skip && x <= skip.right && y <= skip.bottom) continue;
+        const i = 4 * (y * image.width + x);
+        counted++;
+        if (p[i] > 50 && p[i] > 2 * p[i + 1] && p[i] > 2 * p[i + 2]) red++;
+        if (p[i + 2] > 50 && p[i + 2] > 2 * p[i] && p[i + 2] > 1.5 * p[i + 1]) blue++;
+      }
+    }
+    return { red: red / counted, blue: blue / counted };
+  }, { data: png.toString('base64'), skipId });
+}
+
 // Share of pixels outside the element `skipId` that differ between two screenshots of a tab.
 export async function differenceOf(tab, pngA, pngB, skipId = null) {
   return tab.evaluate(async ({ a, b, skipId }) => {

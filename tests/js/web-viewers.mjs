@@ -4,15 +4,20 @@
 // screenshot in which the model covers too little. A point tileset with LAS fields is drawn in
 // every colour mode the panel offers (each must cover the view and differ from the one before),
 // and hiding every class in the legend must empty the view.
-//   node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage 0.02]
+// With --texture-hues, the tileset's texture is red and blue: both colours must show.
+//   node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage 0.02] [--texture-hues F]
 import { spawn } from 'node:child_process';
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { coverageOf, differenceOf, keepLocal, launchChromium } from './chromium.mjs';
+import { coverageOf, differenceOf, hueSharesOf, keepLocal, launchChromium } from './chromium.mjs';
 
 const [lodforge, tilesetDir, outDir] = process.argv.slice(2);
 const coverageArg = process.argv.indexOf('--min-coverage');
 const minCoverage = coverageArg > 0 ? Number(process.argv[coverageArg + 1]) : 0.02;
+// A tileset of a red and blue texture: each colour must cover at least this share of the
+// model's pixels.
+const huesArg = process.argv.indexOf('--texture-hues');
+const minHue = huesArg > 0 ? Number(process.argv[huesArg + 1]) : 0;
 if (!lodforge || !tilesetDir || !outDir) {
   console.error('usage: node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage F]');
   process.exit(2);
@@ -208,6 +213,13 @@ try {
     if (off.length > 0) mine(`${off.length} of the root box's ${view[2].length} corners are off screen: ${JSON.stringify(off[0])}`);
     console.log(`${viewer}: ${report.tilesLoaded} tiles loaded, "${stats}", model covers ${(100 * coverage).toFixed(1)} % (${shot})`);
     if (coverage < minCoverage) mine(`the model covers ${(100 * coverage).toFixed(2)} % of the view`);
+    if (minHue > 0) {
+      const hues = await hueSharesOf(tab, png, 'panel');
+      const red = hues.red / coverage, blue = hues.blue / coverage;
+      console.log(`${viewer}: the texture's red is ${(100 * red).toFixed(1)} % of the model's pixels, its blue ${(100 * blue).toFixed(1)} %`);
+      if (red < minHue || blue < minHue)
+        mine(`the texture is not drawn: red ${(100 * red).toFixed(2)} %, blue ${(100 * blue).toFixed(2)} % of the model's pixels`);
+    }
     if (report.colorModes) await checkColorModes(tab, viewer, coverage, png, mine);
     if (existsSync(path.join(tilesetDir, 'parts.json'))) {
       if (!report.parts) mine('the tileset has parts.json, the viewer offers no parts');

@@ -134,6 +134,11 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
         weld.keepColorSplits = model->hasColors();
         weldModel(*model, weld);
       }
+      if (formatFromPath(options->output) == FileFormat::kStl && !model->images.empty())
+        fmt::print(stderr,
+                   "lodforge: warning: STL holds no textures: the {} image(s) of {} are left "
+                   "out (GLB, OBJ and PLY keep them)\n",
+                   model->images.size(), options->input);
       const Status written = formatFromPath(options->output) == FileFormat::kStl
                                  ? writeStl(*model, options->output, {options->stlAscii})
                                  : writeModel(*model, options->output);

@@ -88,8 +88,9 @@ void addGenerate(CLI::App& app, const Global& global, Run& run) {
                     "Texture atlases of this many texels a side instead of vertex colours: 1K, "
                     "4K, 8K or a number (photo-like JPEGs beside the PLY, named in its "
                     "TextureFile comments)")
-        ->transform(CLI::Transformer({{"1K", "1024"}, {"2K", "2048"}, {"4K", "4096"},
-                                      {"8K", "8192"}, {"16K", "16384"}}, CLI::ignore_case))
+        ->transform(CLI::Transformer(
+            {{"1K", "1024"}, {"2K", "2048"}, {"4K", "4096"}, {"8K", "8192"}, {"16K", "16384"}},
+            CLI::ignore_case))
         ->check(CLI::Range(16u, 16384u));
     sub->add_option("--atlases", options->scan.atlases,
                     "With --texture: how many atlases over the scan (default 16)")

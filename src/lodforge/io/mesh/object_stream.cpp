@@ -216,6 +216,12 @@ Result<std::unique_ptr<ObjectStream>> openObjectStream(const std::string& path,
   }
   Result<Model> model = readModel(path, options.read);
   if (!model) return model.status();
+  // Progressive packages hold geometry and colours only.
+  if (!model->images.empty() && options.read.warnings)
+    options.read.warnings->push_back(
+        fmt::format("{}: its {} texture image(s) are left out: progressive packages do not carry "
+                    "textures yet (`tiles` and `convert` to GLB, OBJ or PLY keep them)",
+                    path, model->images.size()));
   return std::unique_ptr<ObjectStream>(new ModelStream(std::move(model.value())));
 }
 

@@ -317,10 +317,10 @@ PlyRoles assignPlyRoles(PlyHeader& header, const std::string& name, bool readExt
     header.stripCount = s.count;
     // Strips carry no object id or texture: their triangles would belong to no object.
     if (header.hasObjectIds || header.hasFaceUvs || header.hasTextureNumbers) {
-      throw ErrorException{Error{
-          ErrorKind::kUnsupported,
-          fmt::format("{}: faces with {} and 'tristrips' in one file are not supported", name,
-                      header.hasObjectIds ? "object ids" : "textures")}};
+      throw ErrorException{
+          Error{ErrorKind::kUnsupported,
+                fmt::format("{}: faces with {} and 'tristrips' in one file are not supported", name,
+                            header.hasObjectIds ? "object ids" : "textures")}};
     }
   }
   return roles;

@@ -53,9 +53,10 @@ struct PlyBatch {
   // kFaces: 3 indices per triangle (polygons fan-triangulated, strips with every triangle facing
   // the way the first does), global vertex indices
   std::vector<std::uint32_t> triangles;
-  std::vector<std::uint32_t> triangleObjects;   // per triangle, when the header has object ids
-  std::vector<Vec2f> cornerUvs;                 // 3 per triangle, when faces have a 'texcoord' list
-  std::vector<std::uint32_t> triangleTextures;  // per triangle, when faces have a 'texnumber'
+  std::vector<std::uint32_t> triangleObjects;  // per triangle, when the header has object ids
+  std::vector<Vec2f> cornerUvs;                // 3 per triangle, when faces have a 'texcoord' list
+  // Per triangle, when faces have a 'texnumber' (~0u: -1 in the file, a face of no texture).
+  std::vector<std::uint32_t> triangleTextures;
 };
 
 class PlyReader {

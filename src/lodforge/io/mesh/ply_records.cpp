@@ -286,10 +286,11 @@ void PlyRecords::readFace(PlyBatch& batch) {
     } else if (static_cast<int>(i) == roles.faceTexcoords) {
       readFaceTexcoords(e, p);
     } else if (static_cast<int>(i) == roles.texnumber) {
+      // -1: a face of no texture (MeshLab's way).
       const double raw = readNumber(e, p, p.type);
-      if (raw < 0 || raw > std::numeric_limits<std::uint32_t>::max())
+      if (raw < -1 || raw >= std::numeric_limits<std::uint32_t>::max())
         fail(fmt::format("face {}: texnumber {} out of range", elementDone, raw));
-      texture = static_cast<std::uint32_t>(raw);
+      texture = raw < 0 ? ~0u : static_cast<std::uint32_t>(raw);
     } else {
       skipProperty(e, p);
     }

@@ -103,7 +103,7 @@ Status addTexturedPly(Model& model, const PlyTexturedData& data, PlyTextures tex
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::uint32_t>> groups;
   for (std::size_t t = 0; t < triangleCount; ++t) {
     const std::uint32_t texture = data.triangleTextures.empty() ? 0 : data.triangleTextures[t];
-    if (texture >= textures.materials.size())
+    if (texture >= textures.materials.size() && texture != ~0u)
       return badInput(name, fmt::format("face {}: texnumber {} but the file names {} textures "
                                         "(comment TextureFile)",
                                         t, texture, textures.materials.size()));
@@ -115,9 +115,10 @@ Status addTexturedPly(Model& model, const PlyTexturedData& data, PlyTextures tex
   for (const auto& [key, members] : groups) {
     const std::string base =
         data.triangleObjects.empty() ? stem : fmt::format("object {}", key.first);
-    const std::string label = textures.materials[key.second].name;
-    addGroup(model, data, members, firstMaterial + key.second,
-             textures.materials.size() > 1 ? fmt::format("{} ({})", base, label) : base);
+    const bool none = key.second == ~0u;  // faces of no texture
+    const std::string label = none ? "untextured" : textures.materials[key.second].name;
+    addGroup(model, data, members, none ? kNoMaterial : firstMaterial + key.second,
+             textures.materials.size() > 1 || none ? fmt::format("{} ({})", base, label) : base);
   }
   const std::uint32_t firstImage = static_cast<std::uint32_t>(model.images.size());
   for (Material& m : textures.materials) {

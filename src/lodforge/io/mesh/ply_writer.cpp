@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "lodforge/core/progress.h"
+#include "lodforge/io/mesh/texture_export.h"
 
 namespace lodforge {
 
@@ -146,12 +147,21 @@ Status writePly(const Model& model, const std::string& path) {
   layout.colors = model.hasColors();
   layout.objectIds = model.objectCount() > 1;
   layout.doublePositions = model.origin != Vec3d{};
+  // Textures: the images beside the PLY, named in TextureFile comments; faces carry their
+  // corners' coordinates and their image (texnumber, -1 for none).
+  layout.faceUvs = model.hasUvs() && !model.images.empty();
+  if (layout.faceUvs) {
+    Result<std::vector<std::string>> images = writeImagesBeside(model, path);
+    if (!images) return images.status();
+    for (const std::string& name : *images) layout.comments.push_back("TextureFile " + name);
+  }
   Result<PlyWriter> writer = PlyWriter::create(path, layout);
   if (!writer) return writer.status();
   LODFORGE_TRY(writer->writeVertices(model.positions, model.normals, model.colors, model.origin));
   // Faces per object: local indices become global, the object's index becomes its id.
   std::vector<std::uint32_t> global;
-  std::vector<std::uint32_t> ids;
+  std::vector<std::uint32_t> ids, textures;
+  std::vector<Vec2f> corners;
   Progress progress("writing " + path, model.triangleCount());
   for (std::size_t o = 0; o < model.objectCount(); ++o) {
     if (o % 1024 == 0) LODFORGE_TRY(checkCancelled());
@@ -161,7 +171,15 @@ Status writePly(const Model& model, const std::string& path) {
     for (std::size_t i = 0; i < indices.size(); ++i)
       global[i] = static_cast<std::uint32_t>(indices[i] + record.vertexOffset);
     if (layout.objectIds) ids.assign(record.triangleCount, static_cast<std::uint32_t>(o));
-    LODFORGE_TRY(writer->writeTriangles(global, ids));
+    if (layout.faceUvs) {
+      const std::uint32_t m = record.material;
+      const std::uint32_t image =
+          m < model.materials.size() ? model.materials[m].baseColorImage : kNoImage;
+      textures.assign(record.triangleCount, image);  // kNoImage is -1 as an int
+      corners.clear();
+      for (std::uint32_t v : global) corners.push_back(model.uvs[v]);
+    }
+    LODFORGE_TRY(writer->writeTriangles(global, ids, corners, textures));
     progress.advance(record.triangleCount);
   }
   progress.finish();

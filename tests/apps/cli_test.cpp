@@ -1348,6 +1348,33 @@ TEST(CliTiles, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {
   EXPECT_NE(small.err.find("too small"), std::string::npos) << small.err;
 }
 
+TEST(CliTiles, TexturedStaysUnderItsMemoryLimitWithImagesLargerThanIt) {
+#ifdef LODFORGE_SANITIZED
+  GTEST_SKIP() << "peak RSS means nothing under ASan; the release build checks it";
+#endif
+  // 16 atlases of 4K: 1 GiB of texels decoded, four times the limit.
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate scan --triangles 20K --texture 4K --atlases 16 -o " +
+                         dir.file("scan.ply"),
+                     dir)
+                .code,
+            0);
+  constexpr std::uint64_t kLimit = 256ull << 20;
+  const Finished run = waitFor(spawnLodforge(
+      {"-q", "--memory-limit", "256M", "tiles", dir.file("scan.ply"), "-o", dir.file("tiles")}));
+  ASSERT_EQ(run.code, 0);
+  EXPECT_LT(run.peak, kLimit) << "peak RSS " << run.peak / (1 << 20) << " MiB";
+  // Every tile drew from the atlases: each has a texture of its own.
+  std::size_t tiles = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.file("tiles/tiles"))) {
+    const nlohmann::json tile = info(entry.path().string(), dir);
+    ASSERT_TRUE(tile.contains("textures")) << entry.path();
+    EXPECT_GE(tile["textures"]["images"].size(), 1u);
+    ++tiles;
+  }
+  EXPECT_GE(tiles, 10u);
+}
+
 // Runs lodforge with `args`, interrupted as Ctrl-C would at the durable step `at` ("node:6" is
 // the sixth tile node's summary, "run:2" the second run of reconstructed chunks: the
 // LODFORGE_INTERRUPT_AFTER hook of core/progress.h), and checks that it stopped with exit 1,

@@ -34,25 +34,29 @@ float fractal(double x, double y, double longest, int octaves, std::uint64_t see
   return sum;
 }
 
-// Ground as a photo of it might look: grass, dry grass, soil and rock patches, with texture at
-// every scale down to `texel` metres.
-std::array<float, 3> ground(double x, double y, double texel, std::uint64_t seed) {
+// The ground's colour before detail: grass, dry grass, soil and rock patches by large-scale
+// noise (smooth: drawn on a coarse grid and interpolated).
+std::array<float, 3> patches(double x, double y, std::uint64_t seed) {
   const float patch = fractal(x, y, 160, 4, seed);
   const float dry = fractal(x + 911, y + 377, 60, 3, seed);
-  const int fineOctaves = std::clamp(static_cast<int>(std::log2(8 / std::max(texel, 1e-4))), 1, 8);
-  const float detail = fractal(x, y, 8, fineOctaves, seed + 1);
-  std::array<float, 3> grass{0.24f, 0.36f, 0.12f}, hay{0.55f, 0.50f, 0.28f},
+  const std::array<float, 3> grass{0.24f, 0.36f, 0.12f}, hay{0.55f, 0.50f, 0.28f},
       soil{0.42f, 0.31f, 0.20f}, rock{0.52f, 0.50f, 0.47f};
   const float w = std::clamp(0.5f + 1.5f * dry, 0.0f, 1.0f);
   const float r = std::clamp(2.5f * (patch - 0.15f), 0.0f, 1.0f);
   const float s = std::clamp(2.5f * (-patch - 0.2f), 0.0f, 1.0f);
   std::array<float, 3> c{};
-  for (std::size_t k = 0; k < 3; ++k) {
-    const float field = grass[k] * (1 - w) + hay[k] * w;
-    c[k] = (field * (1 - r) + rock[k] * r) * (1 - s) + soil[k] * s;
-    c[k] *= 1.0f + 0.45f * detail;
-  }
+  for (std::size_t k = 0; k < 3; ++k)
+    c[k] = ((grass[k] * (1 - w) + hay[k] * w) * (1 - r) + rock[k] * r) * (1 - s) + soil[k] * s;
   return c;
+}
+
+// Grain at the texel: a hash of the texel, as a photo's noise.
+float grain(std::uint64_t x, std::uint64_t y, std::uint64_t seed) {
+  std::uint64_t h = (x * 0x9E3779B97F4A7C15ull) ^ (y * 0xC2B2AE3D27D4EB4Full) ^ seed;
+  h ^= h >> 31;
+  h *= 0xBF58476D1CE4E5B9ull;
+  h ^= h >> 29;
+  return static_cast<float>(h & 0xFFFF) / 65535.0f - 0.5f;
 }
 
 }  // namespace
@@ -95,13 +99,36 @@ Image drawScanAtlas(std::uint64_t seed, const ScanAtlasLayout& layout, std::uint
   const double u0 = static_cast<double>(cells[0]) * cell, v0 = static_cast<double>(cells[2]) * cell;
   const double du = static_cast<double>(cells[1] - cells[0]) * cell / size;
   const double dv = static_cast<double>(cells[3] - cells[2]) * cell / size;
+  // The patches on a grid of every 16th texel, interpolated between.
+  constexpr std::uint32_t kStep = 16;
+  const std::uint32_t grid = size / kStep + 2;
+  std::vector<std::array<float, 3>> coarse(std::size_t{grid} * grid);
+  tbb::parallel_for(std::uint32_t{0}, grid, [&](std::uint32_t j) {
+    for (std::uint32_t i = 0; i < grid; ++i)
+      coarse[std::size_t{j} * grid + i] = patches(u0 + i * kStep * du, v0 + j * kStep * dv, seed);
+  });
   Image image(size, size);
   tbb::parallel_for(std::uint32_t{0}, size, [&](std::uint32_t y) {
+    const std::uint32_t j = y / kStep;
+    const float fy = static_cast<float>(y % kStep) / kStep;
     for (std::uint32_t x = 0; x < size; ++x) {
-      const std::array<float, 3> c = ground(u0 + (x + 0.5) * du, v0 + (y + 0.5) * dv, du, seed);
+      const std::uint32_t i = x / kStep;
+      const float fx = static_cast<float>(x % kStep) / kStep;
+      const auto& a = coarse[std::size_t{j} * grid + i];
+      const auto& b = coarse[std::size_t{j} * grid + i + 1];
+      const auto& c = coarse[std::size_t{j + 1} * grid + i];
+      const auto& d = coarse[std::size_t{j + 1} * grid + i + 1];
+      const double wx = u0 + (x + 0.5) * du, wy = v0 + (y + 0.5) * dv;
+      // Detail: clumps a few texels across, then grain at the texel.
+      const float detail = 0.35f * noise(wx / (4 * du), wy / (4 * dv), 9, seed) +
+                           0.25f * grain(cells[0] * size + x, cells[2] * size + y, seed);
       std::uint8_t* p = &image.rgba[4 * (std::size_t{y} * size + x)];
-      for (std::size_t k = 0; k < 3; ++k)
-        p[k] = static_cast<std::uint8_t>(std::lround(std::clamp(c[k], 0.0f, 1.0f) * 255));
+      for (std::size_t k = 0; k < 3; ++k) {
+        const float base =
+            (a[k] * (1 - fx) + b[k] * fx) * (1 - fy) + (c[k] * (1 - fx) + d[k] * fx) * fy;
+        p[k] = static_cast<std::uint8_t>(
+            std::lround(std::clamp(base * (1.0f + detail), 0.0f, 1.0f) * 255));
+      }
       p[3] = 255;
     }
   });

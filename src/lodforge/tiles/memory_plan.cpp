@@ -54,4 +54,18 @@ Status planTilesMemory(TilesMemory mode, std::uint64_t memoryLimit, int threads,
   return {};
 }
 
+TexturePlan planTextureMemory(std::uint64_t memoryLimit, int threads, std::uint32_t maxPageSide,
+                              std::uint64_t cacheBytes) {
+  TexturePlan plan{maxPageSide, cacheBytes, 0};
+  if (memoryLimit == 0) return plan;
+  constexpr std::uint64_t kProgram = std::uint64_t{32} << 20;  // as planTilesMemory
+  const std::uint64_t usable = memoryLimit > kProgram ? memoryLimit - kProgram : 0;
+  plan.cacheBytes = std::min(cacheBytes, usable / 16);
+  const std::uint64_t perThread = usable / 8 / static_cast<std::uint64_t>(std::max(threads, 1));
+  while (plan.pageSide > 256 && atlasPageBytes(plan.pageSide) > perThread) plan.pageSide /= 2;
+  // A PNG or WebP source is decoded whole before its pyramid is built (a JPEG streams).
+  plan.wholeImageBytes = usable / 2;
+  return plan;
+}
+
 }  // namespace lodforge

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "lodforge/core/status.h"
+#include "lodforge/tiles/tile_atlas.h"
 #include "lodforge/tiling/chunk_input.h"
 #include "lodforge/tiling/octree.h"
 
@@ -20,5 +21,17 @@ enum class TilesMemory : std::uint8_t { kMinimal, kModerate, kUnbounded };
 // (kLimit) with the least that works.
 Status planTilesMemory(TilesMemory mode, std::uint64_t memoryLimit, int threads,
                        ChunkInputOptions& input, OctreeOptions& octree);
+
+// A textured input's share under `memoryLimit` (0: none; `threads` nodes in flight): the block
+// cache of the source images gets a sixteenth of what is usable, and each thread's page baking an
+// eighth, so a texture page's side (`maxPageSide`, the --texture-size asked for) comes down by
+// powers of two until a page fits: a tile then takes more pages rather than blurring.
+struct TexturePlan {
+  std::uint32_t pageSide = 4096;
+  std::uint64_t cacheBytes = std::uint64_t{64} << 20;
+  std::uint64_t wholeImageBytes = 0;  // the most an image decoded whole may take (0: any)
+};
+TexturePlan planTextureMemory(std::uint64_t memoryLimit, int threads, std::uint32_t maxPageSide,
+                              std::uint64_t cacheBytes);
 
 }  // namespace lodforge

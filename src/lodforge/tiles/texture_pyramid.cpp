@@ -10,6 +10,7 @@
 #include <cstring>
 #include <list>
 #include <mutex>
+#include <optional>
 #include <unordered_map>
 
 #include <fmt/format.h>
@@ -60,44 +61,126 @@ std::uint32_t blocksFor(std::uint32_t texels) {
   return (texels + kPyramidBlock - 1) / kPyramidBlock;
 }
 
-// Appends a level's blocks (row-major, each whole, padded with its edge texels) to `file`.
-Status writeLevel(const Image& image, OutputFile& file, std::vector<std::uint8_t>& block) {
-  block.resize(kBlockBytes);
-  for (std::uint32_t by = 0; by < blocksFor(image.height); ++by) {
-    for (std::uint32_t bx = 0; bx < blocksFor(image.width); ++bx) {
-      for (std::uint32_t y = 0; y < kPyramidBlock; ++y) {
-        const std::uint32_t sy = std::min(by * kPyramidBlock + y, image.height - 1);
-        for (std::uint32_t x = 0; x < kPyramidBlock; ++x) {
-          const std::uint32_t sx = std::min(bx * kPyramidBlock + x, image.width - 1);
-          std::memcpy(block.data() + 4 * (std::size_t{y} * kPyramidBlock + x),
-                      image.rgba.data() + 4 * (std::size_t{sy} * image.width + sx), 4);
-        }
-      }
-      LODFORGE_TRY(file.write(block.data(), block.size()));
-    }
+// The levels of an image of this size, and where each one's blocks start in its file.
+std::vector<Level> levelsOf(std::uint32_t width, std::uint32_t height) {
+  std::vector<Level> levels;
+  std::uint64_t offset = 0;
+  while (true) {
+    const Level level{width, height, blocksFor(width), blocksFor(height), offset};
+    levels.push_back(level);
+    offset += std::uint64_t{level.blocksX} * level.blocksY * kBlockBytes;
+    if (width == 1 && height == 1) break;
+    width = std::max(1u, width / 2), height = std::max(1u, height / 2);
   }
-  return {};
+  return levels;
 }
 
+// Builds the pyramid from the image's rows as they are decoded, as halveImage would level by
+// level: each level holds a band of one block row, written out when full, and the row waiting
+// for its pair to make a row of the level above. A few rows in memory, whatever the image.
+class PyramidWriter {
+ public:
+  PyramidWriter(OutputFile& file, std::vector<Level> levels)
+      : file_(file), levels_(std::move(levels)), state_(levels_.size()) {
+    for (std::size_t l = 0; l < levels_.size(); ++l) {
+      state_[l].band.resize(std::size_t{kPyramidBlock} * levels_[l].width * 4);
+      state_[l].pending.resize(std::size_t{levels_[l].width} * 4);
+    }
+  }
+
+  Status push(std::size_t l, const std::uint8_t* row) {
+    const Level& level = levels_[l];
+    LevelState& s = state_[l];
+    const std::uint32_t y = s.rows++;
+    std::copy_n(row, std::size_t{level.width} * 4,
+                s.band.data() + std::size_t{y % kPyramidBlock} * level.width * 4);
+    if (y % kPyramidBlock == kPyramidBlock - 1 || y + 1 == level.height)
+      LODFORGE_TRY(writeBand(l, y / kPyramidBlock, y % kPyramidBlock + 1));
+    if (l + 1 == levels_.size()) return {};
+    // Rows 2k and 2k + 1 make row k above (a lone row makes it alone; an odd last row none).
+    if (level.height == 1) return push(l + 1, halveRow(l, row, row));
+    if (y % 2 == 0) {
+      std::copy_n(row, std::size_t{level.width} * 4, s.pending.data());
+      return {};
+    }
+    return push(l + 1, halveRow(l, s.pending.data(), row));
+  }
+
+  bool complete() const {
+    for (std::size_t l = 0; l < levels_.size(); ++l)
+      if (state_[l].rows != levels_[l].height) return false;
+    return true;
+  }
+
+ private:
+  struct LevelState {
+    std::uint32_t rows = 0;
+    std::vector<std::uint8_t> band, pending, half;
+  };
+
+  const std::uint8_t* halveRow(std::size_t l, const std::uint8_t* a, const std::uint8_t* b) {
+    const Srgb& table = srgb();
+    const std::uint32_t w = levels_[l].width, out = levels_[l + 1].width;
+    std::vector<std::uint8_t>& half = state_[l].half;
+    half.resize(std::size_t{out} * 4);
+    for (std::uint32_t x = 0; x < out; ++x) {
+      const std::size_t x0 = 4 * std::size_t{std::min(2 * x, w - 1)};
+      const std::size_t x1 = 4 * std::size_t{std::min(2 * x + 1, w - 1)};
+      const std::uint8_t* q[4] = {a + x0, a + x1, b + x0, b + x1};
+      for (std::size_t c = 0; c < 3; ++c) {
+        float sum = 0;
+        for (const std::uint8_t* p : q) sum += table.toLinear[p[c]];
+        half[4 * x + c] = table.fromLinear[static_cast<std::size_t>(std::lround(sum / 4 * 4095))];
+      }
+      half[4 * x + 3] = static_cast<std::uint8_t>((q[0][3] + q[1][3] + q[2][3] + q[3][3] + 2) / 4);
+    }
+    return half.data();
+  }
+
+  // A band of `rows` rows as a row of whole blocks (padded with the edge texels).
+  Status writeBand(std::size_t l, std::uint32_t by, std::uint32_t rows) {
+    const Level& level = levels_[l];
+    const std::vector<std::uint8_t>& band = state_[l].band;
+    block_.resize(kBlockBytes);
+    for (std::uint32_t bx = 0; bx < level.blocksX; ++bx) {
+      for (std::uint32_t y = 0; y < kPyramidBlock; ++y) {
+        const std::uint32_t sy = std::min(y, rows - 1);
+        for (std::uint32_t x = 0; x < kPyramidBlock; ++x) {
+          const std::uint32_t sx = std::min(bx * kPyramidBlock + x, level.width - 1);
+          std::memcpy(block_.data() + 4 * (std::size_t{y} * kPyramidBlock + x),
+                      band.data() + 4 * (std::size_t{sy} * level.width + sx), 4);
+        }
+      }
+      const std::uint64_t at =
+          level.offset + (std::uint64_t{by} * level.blocksX + bx) * kBlockBytes;
+      LODFORGE_TRY(file_.writeAt(at, block_.data(), block_.size()));
+    }
+    return {};
+  }
+
+  OutputFile& file_;
+  std::vector<Level> levels_;
+  std::vector<LevelState> state_;
+  std::vector<std::uint8_t> block_;
+};
+
 Result<Pyramid> buildOne(const ImageSource& source, const std::string& path) {
-  Result<Image> decoded = decodeImage(source);
-  if (!decoded) return decoded.status();
-  Result<OutputFile> file = OutputFile::create(path, std::size_t{1} << 20);
+  Result<OutputFile> file = OutputFile::create(path);
   if (!file) return file.status();
   Pyramid pyramid;
   pyramid.path = path;
-  Image level = std::move(*decoded);
-  std::vector<std::uint8_t> block;
-  std::uint64_t offset = 0;
-  while (true) {
-    Level entry{level.width, level.height, blocksFor(level.width), blocksFor(level.height), offset};
-    pyramid.levels.push_back(entry);
-    LODFORGE_TRY(writeLevel(level, *file, block));
-    offset += std::uint64_t{entry.blocksX} * entry.blocksY * kBlockBytes;
-    if (level.width == 1 && level.height == 1) break;
-    level = halveImage(level);
-    LODFORGE_TRY(checkCancelled());
-  }
+  std::optional<PyramidWriter> writer;
+  LODFORGE_TRY(decodeImageRows(
+      source, kMaxTexturePixels,
+      [&](std::uint32_t width, std::uint32_t height) -> Status {
+        pyramid.levels = levelsOf(width, height);
+        writer.emplace(*file, pyramid.levels);
+        return {};
+      },
+      [&](const std::uint8_t* row) { return writer->push(0, row); }));
+  if (!writer || !writer->complete())
+    return Error{ErrorKind::kInternal, fmt::format("{}: the pyramid is incomplete", path)};
+  writer.reset();
   LODFORGE_TRY(file->commit());
   pyramid.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (pyramid.fd < 0) return ioErrorFromErrno(path, "open");

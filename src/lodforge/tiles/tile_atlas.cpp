@@ -10,14 +10,7 @@ namespace {
 
 constexpr std::uint32_t kNone = ~0u;
 
-struct Chart {
-  std::uint32_t material = 0, image = 0;
-  float umin = 1e30f, vmin = 1e30f, umax = -1e30f, vmax = -1e30f;
-  std::uint32_t level = 0;
-  std::int64_t x0 = 0, y0 = 0;  // the rectangle's corner in its level's texels (gutter included)
-  std::uint32_t w = 0, h = 0;
-  std::uint32_t page = 0, ax = 0, ay = 0;  // where it lies in its page
-};
+using Chart = AtlasChart;
 
 std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t v) {
   while (parent[v] != v) v = parent[v] = parent[parent[v]];
@@ -133,22 +126,21 @@ void packCharts(std::vector<Chart>& charts, std::span<const std::uint32_t> membe
   }
 }
 
-// Copies each chart's texels from the pyramid into its page.
-Status bakeCharts(const std::vector<Chart>& charts, const TextureTable& table,
-                  const TexturePyramid& pyramid, TileAtlas& atlas,
-                  std::vector<std::vector<std::uint8_t>>& masks) {
+// Copies the page's charts' texels from the pyramid into it.
+Status bakeCharts(const std::vector<Chart>& charts, std::size_t p, const TextureTable& table,
+                  const TexturePyramid& pyramid, Image& page, std::vector<std::uint8_t>& mask) {
   std::vector<std::uint8_t> texels;
   for (const Chart& c : charts) {
+    if (c.page != p) continue;
     const Material& material = table.materials[c.material];
     texels.resize(std::size_t{c.w} * c.h * 4);
     LODFORGE_TRY(pyramid.read(c.image, c.level, c.x0, c.y0, c.w, c.h, material.wrapS,
                               material.wrapT, texels.data()));
-    Image& page = atlas.pages[c.page].image;
     for (std::uint32_t row = 0; row < c.h; ++row) {
       const std::size_t at = std::size_t{c.ay + row} * page.width + c.ax;
       std::copy_n(texels.data() + 4 * std::size_t{row} * c.w, 4 * std::size_t{c.w},
                   page.rgba.data() + 4 * at);
-      std::fill_n(masks[c.page].data() + at, c.w, std::uint8_t{1});
+      std::fill_n(mask.data() + at, c.w, std::uint8_t{1});
     }
   }
   return {};
@@ -156,9 +148,9 @@ Status bakeCharts(const std::vector<Chart>& charts, const TextureTable& table,
 
 }  // namespace
 
-Result<TileAtlas> bakeTileAtlas(const MeshPart& mesh, const TextureTable& table,
-                                const TexturePyramid& pyramid, std::uint32_t level,
-                                const AtlasOptions& options) {
+TileAtlas layoutTileAtlas(const MeshPart& mesh, const TextureTable& table,
+                          const TexturePyramid& pyramid, std::uint32_t level,
+                          const AtlasOptions& options) {
   assert(mesh.uvs.size() == mesh.vertexCount() && mesh.materials.size() == mesh.vertexCount());
   assert(options.maxSize >= 4 + 2 * options.gutter);
   TileAtlas atlas;
@@ -175,85 +167,115 @@ Result<TileAtlas> bakeTileAtlas(const MeshPart& mesh, const TextureTable& table,
   for (const std::vector<std::uint32_t>& members : byMaterial) {
     if (!members.empty()) packCharts(charts, members, options.maxSize, sizes);
   }
-  std::vector<std::vector<std::uint8_t>> masks;
-  for (const PageSize& size : sizes) {
-    atlas.pages.push_back({size.material, Image(size.width, size.height)});
-    masks.emplace_back(std::size_t{size.width} * size.height, 0);
-  }
-  LODFORGE_TRY(bakeCharts(charts, table, pyramid, atlas, masks));
-  for (std::size_t p = 0; p < atlas.pages.size(); ++p)
-    fillEmptyTexels(atlas.pages[p].image, masks[p]);
+  for (const PageSize& size : sizes)
+    atlas.pages.push_back({size.material, size.width, size.height, {}});
   // Texture coordinates into the pages: texel for texel of the chart's level.
   atlas.uvs.assign(mesh.vertexCount(), Vec2f{});
   atlas.pageOf.assign(mesh.vertexCount(), kNone);
   for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
     if (chartOf[v] == kNone) continue;
     const Chart& c = charts[chartOf[v]];
-    const Image& page = atlas.pages[c.page].image;
+    const AtlasPage& page = atlas.pages[c.page];
     const double w = pyramid.width(c.image, c.level), h = pyramid.height(c.image, c.level);
     atlas.uvs[v] = {
         static_cast<float>((mesh.uvs[v].x * w - static_cast<double>(c.x0) + c.ax) / page.width),
         static_cast<float>((mesh.uvs[v].y * h - static_cast<double>(c.y0) + c.ay) / page.height)};
     atlas.pageOf[v] = c.page;
   }
+  atlas.layout = std::move(charts);
   return atlas;
 }
 
+Status bakeAtlasPage(TileAtlas& atlas, std::size_t page, const TextureTable& table,
+                     const TexturePyramid& pyramid) {
+  AtlasPage& p = atlas.pages[page];
+  p.image = Image(p.width, p.height);
+  std::vector<std::uint8_t> mask(p.image.pixelCount(), 0);
+  LODFORGE_TRY(bakeCharts(atlas.layout, page, table, pyramid, p.image, mask));
+  fillEmptyTexels(p.image, mask);
+  return {};
+}
+
+Result<TileAtlas> bakeTileAtlas(const MeshPart& mesh, const TextureTable& table,
+                                const TexturePyramid& pyramid, std::uint32_t level,
+                                const AtlasOptions& options) {
+  TileAtlas atlas = layoutTileAtlas(mesh, table, pyramid, level, options);
+  for (std::size_t p = 0; p < atlas.pages.size(); ++p)
+    LODFORGE_TRY(bakeAtlasPage(atlas, p, table, pyramid));
+  return atlas;
+}
+
+namespace {
+
+// A level of the fill pyramid: each texel the mean colour of the kept texels below it and how
+// many there were (saturating: a weight, not a count). 4 bytes a texel, at half the size of the
+// level below: the whole pyramid takes a third of a byte per page texel.
+struct FillLevel {
+  std::uint32_t w = 0, h = 0;
+  std::vector<std::array<std::uint8_t, 4>> texels;  // r, g, b, weight
+};
+
+// Pull: the level above `fine`, from a level given as colours and weights.
+template <class Fine>
+FillLevel pull(std::uint32_t w, std::uint32_t h, Fine&& fine) {
+  FillLevel coarse{(w + 1) / 2, (h + 1) / 2, {}};
+  coarse.texels.resize(std::size_t{coarse.w} * coarse.h);
+  for (std::uint32_t y = 0; y < coarse.h; ++y)
+    for (std::uint32_t x = 0; x < coarse.w; ++x) {
+      std::uint32_t sum[3] = {0, 0, 0}, weight = 0;
+      for (std::uint32_t dy = 0; dy < 2; ++dy)
+        for (std::uint32_t dx = 0; dx < 2; ++dx) {
+          if (2 * x + dx >= w || 2 * y + dy >= h) continue;
+          const std::array<std::uint8_t, 4> t = fine(2 * x + dx, 2 * y + dy);
+          for (std::size_t c = 0; c < 3; ++c) sum[c] += std::uint32_t{t[c]} * t[3];
+          weight += t[3];
+        }
+      std::array<std::uint8_t, 4>& out = coarse.texels[std::size_t{y} * coarse.w + x];
+      for (std::size_t c = 0; c < 3; ++c)
+        out[c] = weight > 0 ? static_cast<std::uint8_t>((sum[c] + weight / 2) / weight) : 0;
+      out[3] = static_cast<std::uint8_t>(std::min<std::uint32_t>(weight, 255));
+    }
+  return coarse;
+}
+
+}  // namespace
+
 void fillEmptyTexels(Image& image, std::vector<std::uint8_t>& mask) {
   assert(mask.size() == image.pixelCount());
-  // Pull: averages of the kept texels, level by level, down to 1 x 1.
-  struct Level {
-    std::uint32_t w, h;
-    std::vector<float> rgba;  // premultiplied by the weight in [3]
-  };
-  std::vector<Level> levels;
-  Level base{image.width, image.height, std::vector<float>(image.pixelCount() * 4, 0.0f)};
-  for (std::size_t i = 0; i < image.pixelCount(); ++i) {
-    if (mask[i] == 0) continue;
-    for (std::size_t c = 0; c < 3; ++c) base.rgba[4 * i + c] = image.rgba[4 * i + c];
-    base.rgba[4 * i + 3] = 1;
-  }
-  levels.push_back(std::move(base));
+  if (image.pixelCount() == 0) return;
+  std::vector<FillLevel> levels;
+  levels.push_back(pull(image.width, image.height, [&](std::uint32_t x, std::uint32_t y) {
+    const std::size_t i = std::size_t{y} * image.width + x;
+    const std::uint8_t* p = &image.rgba[4 * i];
+    return std::array<std::uint8_t, 4>{p[0], p[1], p[2], static_cast<std::uint8_t>(mask[i] != 0)};
+  }));
   while (levels.back().w > 1 || levels.back().h > 1) {
-    const Level& fine = levels.back();
-    Level coarse{(fine.w + 1) / 2, (fine.h + 1) / 2, {}};
-    coarse.rgba.assign(std::size_t{coarse.w} * coarse.h * 4, 0.0f);
-    for (std::uint32_t y = 0; y < fine.h; ++y)
-      for (std::uint32_t x = 0; x < fine.w; ++x)
-        for (std::size_t c = 0; c < 4; ++c)
-          coarse.rgba[4 * (std::size_t{y / 2} * coarse.w + x / 2) + c] +=
-              fine.rgba[4 * (std::size_t{y} * fine.w + x) + c];
-    levels.push_back(std::move(coarse));
+    const FillLevel& fine = levels.back();
+    levels.push_back(pull(fine.w, fine.h, [&fine](std::uint32_t x, std::uint32_t y) {
+      return fine.texels[std::size_t{y} * fine.w + x];
+    }));
   }
-  // Push: an empty texel takes its coarser level's (filled) average.
-  float* top = levels.back().rgba.data();
-  if (top[3] > 0)
-    for (int c = 0; c < 3; ++c) top[c] /= top[3];
+  // Push: an empty texel takes the (filled) texel above it, from the top down.
   for (std::size_t l = levels.size() - 1; l-- > 0;) {
-    Level& fine = levels[l];
-    const Level& coarse = levels[l + 1];
-    for (std::uint32_t y = 0; y < fine.h; ++y) {
+    FillLevel& fine = levels[l];
+    const FillLevel& coarse = levels[l + 1];
+    for (std::uint32_t y = 0; y < fine.h; ++y)
       for (std::uint32_t x = 0; x < fine.w; ++x) {
-        float* f = &fine.rgba[4 * (std::size_t{y} * fine.w + x)];
-        if (f[3] > 0) {
-          for (int c = 0; c < 3; ++c) f[c] /= f[3];
-        } else {
-          const float* g = &coarse.rgba[4 * (std::size_t{y / 2} * coarse.w + x / 2)];
-          for (int c = 0; c < 3; ++c) f[c] = g[c];
-        }
-        f[3] = 1;
+        std::array<std::uint8_t, 4>& t = fine.texels[std::size_t{y} * fine.w + x];
+        if (t[3] == 0) t = coarse.texels[std::size_t{y / 2} * coarse.w + x / 2];
+        t[3] = 1;
       }
+  }
+  const FillLevel& first = levels.front();
+  for (std::uint32_t y = 0; y < image.height; ++y)
+    for (std::uint32_t x = 0; x < image.width; ++x) {
+      const std::size_t i = std::size_t{y} * image.width + x;
+      if (mask[i] != 0) continue;
+      const std::array<std::uint8_t, 4>& t = first.texels[std::size_t{y / 2} * first.w + x / 2];
+      std::copy_n(t.data(), 3, &image.rgba[4 * i]);
+      image.rgba[4 * i + 3] = 255;
+      mask[i] = 1;
     }
-  }
-  const Level& filled = levels.front();
-  for (std::size_t i = 0; i < image.pixelCount(); ++i) {
-    if (mask[i] != 0) continue;
-    for (std::size_t c = 0; c < 3; ++c)
-      image.rgba[4 * i + c] =
-          static_cast<std::uint8_t>(std::lround(std::clamp(filled.rgba[4 * i + c], 0.0f, 255.0f)));
-    image.rgba[4 * i + 3] = 255;
-    mask[i] = 1;
-  }
 }
 
 }  // namespace lodforge

@@ -25,11 +25,24 @@ struct AtlasOptions {
 
 struct AtlasPage {
   std::uint32_t material = 0;  // the source material (into TextureTable::materials)
-  Image image;
+  std::uint32_t width = 0, height = 0;
+  Image image;  // empty until baked (bakeAtlasPage)
+};
+
+// Where a chart's texels come from and go: its source image's level and the rectangle there
+// (gutters included), and its place in its page.
+struct AtlasChart {
+  std::uint32_t material = 0, image = 0;
+  float umin = 1e30f, vmin = 1e30f, umax = -1e30f, vmax = -1e30f;
+  std::uint32_t level = 0;
+  std::int64_t x0 = 0, y0 = 0;
+  std::uint32_t w = 0, h = 0;
+  std::uint32_t page = 0, ax = 0, ay = 0;
 };
 
 struct TileAtlas {
   std::vector<AtlasPage> pages;
+  std::vector<AtlasChart> layout;  // each chart: where its texels come from and go
   // Per vertex of the mesh: its texture coordinate in its page, and the page (~0u: a vertex of
   // no texture).
   std::vector<Vec2f> uvs;
@@ -38,10 +51,23 @@ struct TileAtlas {
   std::uint64_t shrunkCharts = 0;  // charts larger than a page, taken from a coarser level
 };
 
-// `level` 0 is a leaf: the source's own texels.
+// The charts, their places and the new texture coordinates, pages not yet baked. `level` 0 is
+// a leaf: the source's own texels.
+TileAtlas layoutTileAtlas(const MeshPart& mesh, const TextureTable& table,
+                          const TexturePyramid& pyramid, std::uint32_t level,
+                          const AtlasOptions& options = {});
+// Bakes page `page`'s texels (one page in memory at a time: the caller encodes it and clears
+// its image before the next).
+Status bakeAtlasPage(TileAtlas& atlas, std::size_t page, const TextureTable& table,
+                     const TexturePyramid& pyramid);
+// Both: every page baked.
 Result<TileAtlas> bakeTileAtlas(const MeshPart& mesh, const TextureTable& table,
                                 const TexturePyramid& pyramid, std::uint32_t level,
                                 const AtlasOptions& options = {});
+// Bytes baking a page of `side` x `side` texels takes at most (texels, mask, fill, encoding).
+inline std::uint64_t atlasPageBytes(std::uint32_t side) {
+  return std::uint64_t{side} * side * 6;
+}
 
 // Fills the texels `mask` leaves out (0) from those it keeps, by pulling coarser averages of the
 // kept ones down (push-pull): every texel ends up a colour of the nearby charts.

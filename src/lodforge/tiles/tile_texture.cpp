@@ -13,15 +13,18 @@ ImageEncodeOptions pageEncoding(const TileTexturing& texturing, const AtlasPage&
   return encode;
 }
 
-Result<std::vector<GlbPrimitive>> addTilePages(GlbWriter& writer, const TileAtlas& atlas,
+Result<std::vector<GlbPrimitive>> addTilePages(GlbWriter& writer, TileAtlas& atlas,
                                                std::span<const std::uint32_t> pageOfVertex,
                                                std::span<std::uint32_t> indices,
                                                const TileTexturing& texturing, bool vertexColors) {
   std::vector<std::optional<std::uint32_t>> materials(atlas.pages.size());
   for (std::size_t p = 0; p < atlas.pages.size(); ++p) {
-    const AtlasPage& page = atlas.pages[p];
+    AtlasPage& page = atlas.pages[p];
+    if (page.image.pixelCount() == 0)
+      LODFORGE_TRY(bakeAtlasPage(atlas, p, *texturing.table, *texturing.pyramid));
     const ImageEncodeOptions encode = pageEncoding(texturing, page);
     Result<std::vector<std::byte>> bytes = encodeImage(page.image, encode);
+    page.image = Image();  // the next page's texels take its place
     if (!bytes) return bytes.status();
     Material material = texturing.table->materials[page.material];
     // The page holds the chart texels only: what lies outside [0, 1] was baked in already.

@@ -24,9 +24,10 @@ struct TileTexturing {
 // The encoding of one page: WebP as asked; otherwise JPEG, or PNG when the source has alpha.
 ImageEncodeOptions pageEncoding(const TileTexturing& texturing, const AtlasPage& page);
 
-// Writes the pages and their materials, reorders `indices` (a triangle's page is its first
+// Bakes, encodes and writes the pages one at a time (one page's texels in memory) and their
+// materials, reorders `indices` (a triangle's page is its first
 // corner's, from `pageOfVertex`) stably by page, and returns one primitive per group.
-Result<std::vector<GlbPrimitive>> addTilePages(GlbWriter& writer, const TileAtlas& atlas,
+Result<std::vector<GlbPrimitive>> addTilePages(GlbWriter& writer, TileAtlas& atlas,
                                                std::span<const std::uint32_t> pageOfVertex,
                                                std::span<std::uint32_t> indices,
                                                const TileTexturing& texturing, bool vertexColors);

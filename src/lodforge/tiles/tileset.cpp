@@ -12,6 +12,7 @@
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/core/units.h"
 #include "lodforge/tiles/surface_input.h"
 #include "lodforge/tiles/tile_texture.h"
 #include "lodforge/tiles/tileset_output.h"
@@ -186,14 +187,25 @@ Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& o
 // A textured input's images as pyramids in the work directory, for every tile to bake from.
 Result<std::optional<TexturePyramid>> buildPyramids(const ChunkInput& chunked,
                                                     const std::string& workDirectory,
-                                                    const TilesOptions& options) {
+                                                    const TexturePlan& plan) {
   if (chunked.textures.empty()) return std::optional<TexturePyramid>();
+  for (const ImageSource& image : chunked.textures.images) {
+    if (image.format == ImageFormat::kJpeg || plan.wholeImageBytes == 0 ||
+        image.decodedBytes() <= plan.wholeImageBytes)
+      continue;
+    return Error{ErrorKind::kLimit,
+                 fmt::format("{}: a {} image of {}x{} is decoded whole ({}), more than "
+                             "--memory-limit leaves for it ({}); a JPEG is decoded row by row",
+                             image.embedded() ? image.name : image.path,
+                             imageFormatName(image.format), image.width, image.height,
+                             formatBytes(image.decodedBytes()), formatBytes(plan.wholeImageBytes))};
+  }
   const std::string directory = workDirectory + "/textures";
   std::error_code error;
   fs::create_directories(directory, error);
   if (error) return ioError(directory, fmt::format("cannot create: {}", error.message()));
   Result<TexturePyramid> pyramid =
-      TexturePyramid::build(chunked.textures.images, directory, options.textureCacheBytes);
+      TexturePyramid::build(chunked.textures.images, directory, plan.cacheBytes);
   if (!pyramid) return pyramid.status();
   return std::optional(std::move(*pyramid));
 }
@@ -271,9 +283,13 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   stats.chunkSeconds = secondsSince(start);
 
   octree.resume = stats.resumed;
-  Result<std::optional<TexturePyramid>> pyramid = buildPyramids(*chunked, workDirectory, options);
+  const TexturePlan plan = planTextureMemory(options.memoryLimit, octree.threads,
+                                             options.atlas.maxSize, options.textureCacheBytes);
+  Result<std::optional<TexturePyramid>> pyramid = buildPyramids(*chunked, workDirectory, plan);
   if (!pyramid) return pyramid.status();
-  TileTexturing texturing{&chunked->textures, *pyramid ? &**pyramid : nullptr, options.atlas,
+  AtlasOptions atlas = options.atlas;
+  atlas.maxSize = plan.pageSide;
+  TileTexturing texturing{&chunked->textures, *pyramid ? &**pyramid : nullptr, atlas,
                           options.textureEncoding};
   Result<OctreeResult> tree =
       buildTiles(*chunked, options, octree, place.staging.path, *pyramid ? &texturing : nullptr);

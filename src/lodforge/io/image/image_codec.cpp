@@ -77,6 +77,53 @@ bool decodeJpegInto(std::span<const std::byte> bytes, Image& out, std::uint64_t 
   return error.manager.num_warnings == 0;
 }
 
+// Streams a JPEG's rows (from memory or a file) to `row`; libjpeg's errors jump back here, past
+// libjpeg's frames only. The callbacks' status is kept in `failed`.
+bool decodeJpegRows(std::span<const std::byte> bytes, std::FILE* file, std::uint64_t maxPixels,
+                    const std::function<Status(std::uint32_t, std::uint32_t)>& begin,
+                    const std::function<Status(const std::uint8_t*)>& row, JpegError& error,
+                    Status& failed, std::vector<std::uint8_t>& scanline) {
+  // (Everything this function changes after setjmp lives in the caller: a local changed there
+  // would hold no defined value after the jump.)
+  jpeg_decompress_struct info;
+  info.err = jpeg_std_error(&error.manager);
+  error.manager.error_exit = jpegErrorExit;
+  error.manager.emit_message = jpegWarning;
+  if (setjmp(error.jump)) {
+    jpeg_destroy_decompress(&info);
+    return false;
+  }
+  jpeg_create_decompress(&info);
+  if (file != nullptr) {
+    jpeg_stdio_src(&info, file);
+  } else {
+    jpeg_mem_src(&info, reinterpret_cast<const unsigned char*>(bytes.data()),
+                 static_cast<unsigned long>(bytes.size()));
+  }
+  jpeg_read_header(&info, TRUE);
+  if (std::uint64_t{info.image_width} * info.image_height > maxPixels) {
+    std::snprintf(error.message, sizeof error.message, "%ux%u pixels is more than %llu megapixels",
+                  info.image_width, info.image_height,
+                  static_cast<unsigned long long>(maxPixels / 1000000));
+    jpeg_destroy_decompress(&info);
+    return false;
+  }
+  info.out_color_space = JCS_EXT_RGBA;
+  jpeg_start_decompress(&info);
+  failed = begin(info.output_width, info.output_height);
+  scanline.resize(std::size_t{info.output_width} * 4);
+  while (failed.ok() && info.output_scanline < info.output_height) {
+    JSAMPROW at = scanline.data();
+    jpeg_read_scanlines(&info, &at, 1);
+    // Damage shows as a warning: stop at it rather than hand on grey rows.
+    if (error.manager.num_warnings > 0) break;
+    failed = row(scanline.data());
+  }
+  if (failed.ok() && error.manager.num_warnings == 0) jpeg_finish_decompress(&info);
+  jpeg_destroy_decompress(&info);
+  return error.manager.num_warnings == 0;
+}
+
 Result<Image> decodeJpeg(std::span<const std::byte> bytes, const std::string& name,
                          std::uint64_t maxPixels) {
   Image image;
@@ -222,6 +269,35 @@ Result<Image> decodeImage(const ImageSource& image, std::uint64_t maxPixels) {
   Result<std::vector<std::byte>> bytes = imageBytes(image);
   if (!bytes) return bytes.status();
   return decodeImage(*bytes, describe(image), maxPixels);
+}
+
+Status decodeImageRows(const ImageSource& image, std::uint64_t maxPixels,
+                       const std::function<Status(std::uint32_t, std::uint32_t)>& begin,
+                       const std::function<Status(const std::uint8_t*)>& row) {
+  if (image.format != ImageFormat::kJpeg) {
+    Result<Image> whole = decodeImage(image, maxPixels);
+    if (!whole) return whole.status();
+    LODFORGE_TRY(begin(whole->width, whole->height));
+    for (std::uint32_t y = 0; y < whole->height; ++y)
+      LODFORGE_TRY(row(whole->rgba.data() + std::size_t{y} * whole->width * 4));
+    return {};
+  }
+  std::FILE* file = nullptr;
+  if (!image.embedded()) {
+    file = std::fopen(image.path.c_str(), "rb");
+    if (file == nullptr)
+      return badInput(image.path, fmt::format("texture image: {}", std::strerror(errno)));
+  }
+  JpegError error{};
+  Status failed;
+  std::vector<std::uint8_t> scanline;
+  const bool ok = decodeJpegRows(image.bytes, file, maxPixels, begin, row, error, failed, scanline);
+  if (file != nullptr) std::fclose(file);
+  LODFORGE_TRY(failed);
+  if (!ok)
+    return badInput(describe(image),
+                    fmt::format("cannot decode the JPEG image ({})", error.message));
+  return {};
 }
 
 Result<std::vector<std::byte>> encodeImage(const Image& image, const ImageEncodeOptions& options) {

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -27,6 +28,14 @@ Result<std::vector<std::byte>> imageBytes(const ImageSource& image);
 Result<Image> decodeImage(std::span<const std::byte> bytes, const std::string& name,
                           std::uint64_t maxPixels = kMaxTexturePixels);
 Result<Image> decodeImage(const ImageSource& image, std::uint64_t maxPixels = kMaxTexturePixels);
+
+// The texels of an image row by row (RGBA8, top to bottom): `begin` gets the size first, then
+// `row` each row. A JPEG is decoded as it is read (a few rows in memory, whatever its size);
+// PNG and WebP are decoded whole first. A failure of `begin` or `row` stops decoding and is
+// returned.
+Status decodeImageRows(const ImageSource& image, std::uint64_t maxPixels,
+                       const std::function<Status(std::uint32_t, std::uint32_t)>& begin,
+                       const std::function<Status(const std::uint8_t*)>& row);
 
 struct ImageEncodeOptions {
   ImageFormat format = ImageFormat::kJpeg;

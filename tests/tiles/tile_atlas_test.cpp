@@ -181,7 +181,7 @@ TEST(TileAtlas, NoMipLevelOfAPageHasAnEmptyTexel) {
   }
 }
 
-TEST(TileAtlas, MoreTexelsThanAPageMakeMorePagesAndAChartLargerThanOneIsShrunk) {
+TEST(TileAtlas, MoreTexelsThanAPageMakeMorePagesAndALargerChartIsSplit) {
   Scene scene;
   MeshPart mesh;
   addChart(mesh, 0, 0.0f, 0.0f, 0.6f, 0.6f);  // 39 x 39 texels with gutters each
@@ -198,12 +198,50 @@ TEST(TileAtlas, MoreTexelsThanAPageMakeMorePagesAndAChartLargerThanOneIsShrunk) 
   expectTexelExact(mesh, *atlas, scene.source, 0, 25, TextureWrap::kRepeat);
   expectTexelExact(mesh, *atlas, scene.source, 25, 50, TextureWrap::kRepeat);
 
+  // A chart wider than a page is split into pieces of a page, at full resolution, its border
+  // vertices doubled; each triangle's texels still those of the source, one for one.
   MeshPart wide;
-  addChart(wide, 0, 0.0f, 0.0f, 3.0f, 0.5f);  // 192 texels wide: over any 64-texel page
+  addChart(wide, 0, 0.0f, 0.0f, 3.0f, 0.5f, 12);  // 192 texels wide: over any 64-texel page
   atlas = bakeTileAtlas(wide, scene.table, *scene.pyramid, 0, {.maxSize = 64, .gutter = 2});
   ASSERT_TRUE(atlas.ok());
-  EXPECT_EQ(atlas->shrunkCharts, 1u);
-  EXPECT_LE(atlas->pages[0].image.width, 64u);
+  EXPECT_EQ(atlas->shrunkCharts, 0u);
+  EXPECT_GT(atlas->charts, 3u);
+  EXPECT_GT(atlas->vertexSource.size(), wide.vertexCount());
+  for (const AtlasPage& page : atlas->pages) EXPECT_LE(page.image.width, 64u);
+  for (std::size_t t = 0; t < atlas->indices.size(); t += 3) {
+    const Image& page = atlas->pages[atlas->pageOf[atlas->indices[t]]].image;
+    double offset[3][2];
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t v = atlas->indices[t + k];
+      ASSERT_EQ(atlas->pageOf[v], atlas->pageOf[atlas->indices[t]]);
+      const Vec2f uv = wide.uvs[atlas->vertexSource[v]];
+      offset[k][0] = atlas->uvs[v].x * page.width - uv.x * kSize;
+      offset[k][1] = atlas->uvs[v].y * page.height - uv.y * kSize;
+      ASSERT_NEAR(offset[k][0], std::round(offset[k][0]), 1e-3);
+      ASSERT_NEAR(offset[k][0], offset[0][0], 1e-3);
+      ASSERT_NEAR(offset[k][1], offset[0][1], 1e-3);
+    }
+    // The texel under the triangle's centre, in the page and in the (repeated) source.
+    double u = 0, v = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      u += wide.uvs[atlas->vertexSource[atlas->indices[t + k]]].x / 3.0;
+      v += wide.uvs[atlas->vertexSource[atlas->indices[t + k]]].y / 3.0;
+    }
+    const auto sx = static_cast<std::int64_t>(std::floor(u * kSize));
+    const auto sy = static_cast<std::int64_t>(std::floor(v * kSize));
+    const auto px = sx + static_cast<std::int64_t>(std::round(offset[0][0]));
+    const auto py = sy + static_cast<std::int64_t>(std::round(offset[0][1]));
+    ASSERT_EQ(0, std::memcmp(texel(page, px, py),
+                             texel(scene.source, wrapTexel(sx, kSize, TextureWrap::kRepeat),
+                                   wrapTexel(sy, kSize, TextureWrap::kRepeat)),
+                             4));
+  }
+  // A texture repeated too often to split finer is taken from a coarser level instead.
+  MeshPart huge;
+  addChart(huge, 0, 0.0f, 0.0f, 300.0f, 0.5f, 2);
+  atlas = bakeTileAtlas(huge, scene.table, *scene.pyramid, 0, {.maxSize = 64, .gutter = 2});
+  ASSERT_TRUE(atlas.ok());
+  EXPECT_GT(atlas->shrunkCharts, 0u);
 }
 
 TEST(TileAtlas, UntexturedTrianglesHaveNoPage) {

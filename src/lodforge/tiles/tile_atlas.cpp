@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <numeric>
+#include <unordered_map>
 
 namespace lodforge {
 namespace {
@@ -17,49 +18,102 @@ std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t v) {
   return v;
 }
 
-// Per vertex, its chart (the textured triangles joined through shared vertices), numbered in
-// order of first vertex; kNone for a vertex of no textured triangle.
-std::vector<std::uint32_t> chartOfVertex(const MeshPart& mesh, const TextureTable& table,
-                                         std::uint32_t& count) {
+bool texturedTriangle(const MeshPart& mesh, const TextureTable& table, std::size_t t) {
+  const std::uint32_t material = mesh.materials[mesh.indices[t]];
+  // (Work files are checked: a material of no image draws untextured.)
+  return material < table.materials.size() && table.materials[material].baseColorImage != kNoImage;
+}
+
+// Per triangle, its chart (the textured triangles joined through shared vertices), numbered
+// in order of first triangle; kNone for a triangle of no texture.
+std::vector<std::uint32_t> chartOfTriangle(const MeshPart& mesh, const TextureTable& table,
+                                           std::uint32_t& count) {
   std::vector<std::uint32_t> parent(mesh.vertexCount());
   std::iota(parent.begin(), parent.end(), 0u);
-  std::vector<std::uint8_t> textured(mesh.vertexCount(), 0);
   for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    if (!texturedTriangle(mesh, table, t)) continue;
     const std::uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
-    const std::uint32_t material = mesh.materials[a];
-    if (material >= table.materials.size() || table.materials[material].baseColorImage == kNoImage)
-      continue;  // (work files are checked: a material of no image draws untextured)
-    textured[a] = textured[b] = textured[c] = 1;
     parent[findRoot(parent, b)] = findRoot(parent, a);
     parent[findRoot(parent, c)] = findRoot(parent, a);
   }
-  std::vector<std::uint32_t> chart(mesh.vertexCount(), kNone), number(mesh.vertexCount(), kNone);
+  std::vector<std::uint32_t> chart(mesh.indices.size() / 3, kNone),
+      number(mesh.vertexCount(), kNone);
   count = 0;
-  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
-    if (textured[v] == 0) continue;
-    std::uint32_t& n = number[findRoot(parent, v)];
+  for (std::size_t t = 0; t < chart.size(); ++t) {
+    if (!texturedTriangle(mesh, table, 3 * t)) continue;
+    std::uint32_t& n = number[findRoot(parent, mesh.indices[3 * t])];
     if (n == kNone) n = count++;
-    chart[v] = n;
+    chart[t] = n;
   }
   return chart;
 }
 
-// Each chart's material, image and texture-coordinate bounds.
+// Each chart's material, image and texture-coordinate bounds, from its triangles' corners.
 std::vector<Chart> describeCharts(const MeshPart& mesh, const TextureTable& table,
                                   std::span<const std::uint32_t> chartOf, std::uint32_t count) {
   std::vector<Chart> charts(count);
-  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
-    if (chartOf[v] == kNone) continue;
-    Chart& c = charts[chartOf[v]];
-    const std::uint32_t material = mesh.materials[v];
-    if (material < table.materials.size() && table.materials[material].baseColorImage != kNoImage) {
-      c.material = material;
-      c.image = table.materials[material].baseColorImage;
+  for (std::size_t t = 0; t < chartOf.size(); ++t) {
+    if (chartOf[t] == kNone) continue;
+    Chart& c = charts[chartOf[t]];
+    c.material = mesh.materials[mesh.indices[3 * t]];
+    c.image = table.materials[c.material].baseColorImage;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Vec2f uv = mesh.uvs[mesh.indices[3 * t + k]];
+      c.umin = std::min(c.umin, uv.x), c.umax = std::max(c.umax, uv.x);
+      c.vmin = std::min(c.vmin, uv.y), c.vmax = std::max(c.vmax, uv.y);
     }
-    c.umin = std::min(c.umin, mesh.uvs[v].x), c.umax = std::max(c.umax, mesh.uvs[v].x);
-    c.vmin = std::min(c.vmin, mesh.uvs[v].y), c.vmax = std::max(c.vmax, mesh.uvs[v].y);
   }
   return charts;
+}
+
+// A chart whose texels at `level` are more than a page splits into pieces of a page each, by
+// where its triangles' centres fall in a grid over its texture coordinates: the finest level
+// keeps every texel (more pages) instead of a coarser level's (a blur). Renumbers `chartOf`.
+std::uint32_t splitLargeCharts(const MeshPart& mesh, const TextureTable& table,
+                               const TexturePyramid& pyramid, std::uint32_t level,
+                               const AtlasOptions& options, std::vector<Chart>& charts,
+                               std::vector<std::uint32_t>& chartOf) {
+  // A cell's side in texels: a page less the gutters and a texel of rounding on each side.
+  const double cell = std::max(1.0, double(options.maxSize) - 2.0 * options.gutter - 4.0);
+  std::vector<std::uint32_t> first(charts.size() + 1, 0);  // first new chart of each
+  std::vector<std::array<std::uint32_t, 2>> grid(charts.size(), {1, 1});
+  for (std::size_t c = 0; c < charts.size(); ++c) {
+    const Chart& chart = charts[c];
+    const std::uint32_t l = std::min(level, pyramid.levels(chart.image) - 1);
+    const double w = double(chart.umax - chart.umin) * pyramid.width(chart.image, l);
+    const double h = double(chart.vmax - chart.vmin) * pyramid.height(chart.image, l);
+    // (A chart of a texture repeated thousands of times is not cut finer than 64 x 64 pieces.)
+    grid[c] = {static_cast<std::uint32_t>(std::clamp(std::ceil(w / cell), 1.0, 64.0)),
+               static_cast<std::uint32_t>(std::clamp(std::ceil(h / cell), 1.0, 64.0))};
+    first[c + 1] = first[c] + grid[c][0] * grid[c][1];
+  }
+  if (first.back() == charts.size()) return static_cast<std::uint32_t>(charts.size());
+  for (std::size_t t = 0; t < chartOf.size(); ++t) {
+    if (chartOf[t] == kNone) continue;
+    const Chart& chart = charts[chartOf[t]];
+    const auto [across, along] = grid[chartOf[t]];
+    Vec2f centre{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      centre.x += mesh.uvs[mesh.indices[3 * t + k]].x / 3;
+      centre.y += mesh.uvs[mesh.indices[3 * t + k]].y / 3;
+    }
+    const auto piece = [](float x, float lo, float hi, std::uint32_t n) {
+      const double f = hi > lo ? (x - lo) / (hi - lo) : 0.0;
+      return std::min(n - 1, static_cast<std::uint32_t>(std::max(0.0, f * n)));
+    };
+    chartOf[t] = first[chartOf[t]] + piece(centre.y, chart.vmin, chart.vmax, along) * across +
+                 piece(centre.x, chart.umin, chart.umax, across);
+  }
+  // Pieces no triangle fell in are left out of the numbering.
+  std::vector<std::uint32_t> renumber(first.back(), kNone);
+  std::uint32_t count = 0;
+  for (std::uint32_t& c : chartOf) {
+    if (c == kNone) continue;
+    if (renumber[c] == kNone) renumber[c] = count++;
+    c = renumber[c];
+  }
+  charts = describeCharts(mesh, table, chartOf, count);
+  return count;
 }
 
 // The chart's rectangle at the tile's level, or the first coarser level whose rectangle fits a
@@ -148,15 +202,40 @@ Status bakeCharts(const std::vector<Chart>& charts, std::size_t p, const Texture
 
 }  // namespace
 
+// The tile's vertices as the atlas needs them: a vertex of several charts (where a large chart
+// was split) once per chart, each extra one a copy of its source vertex appended after the
+// mesh's; the triangles over them.
+void splitSharedVertices(const MeshPart& mesh, std::span<const std::uint32_t> chartOf,
+                         TileAtlas& atlas) {
+  std::vector<std::uint32_t> owner(mesh.vertexCount(), kNone);  // the chart a vertex went to
+  std::unordered_map<std::uint64_t, std::uint32_t> copies;      // (vertex, chart) -> copy
+  atlas.indices.assign(mesh.indices.begin(), mesh.indices.end());
+  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) atlas.vertexSource.push_back(v);
+  for (std::size_t t = 0; t < chartOf.size(); ++t) {
+    if (chartOf[t] == kNone) continue;
+    for (std::size_t k = 0; k < 3; ++k) {
+      std::uint32_t& v = atlas.indices[3 * t + k];
+      if (owner[v] == kNone) owner[v] = chartOf[t];
+      if (owner[v] == chartOf[t]) continue;
+      const std::uint64_t key = (std::uint64_t{v} << 32) | chartOf[t];
+      const auto [it, added] =
+          copies.try_emplace(key, static_cast<std::uint32_t>(atlas.vertexSource.size()));
+      if (added) atlas.vertexSource.push_back(v);
+      v = it->second;
+    }
+  }
+}
+
 TileAtlas layoutTileAtlas(const MeshPart& mesh, const TextureTable& table,
                           const TexturePyramid& pyramid, std::uint32_t level,
                           const AtlasOptions& options) {
   assert(mesh.uvs.size() == mesh.vertexCount() && mesh.materials.size() == mesh.vertexCount());
-  assert(options.maxSize >= 4 + 2 * options.gutter);
+  assert(options.maxSize >= 16 + 2 * options.gutter);
   TileAtlas atlas;
   std::uint32_t count = 0;
-  const std::vector<std::uint32_t> chartOf = chartOfVertex(mesh, table, count);
+  std::vector<std::uint32_t> chartOf = chartOfTriangle(mesh, table, count);
   std::vector<Chart> charts = describeCharts(mesh, table, chartOf, count);
+  count = splitLargeCharts(mesh, table, pyramid, level, options, charts, chartOf);
   atlas.charts = count;
   std::vector<std::vector<std::uint32_t>> byMaterial(table.materials.size());
   for (std::uint32_t c = 0; c < count; ++c) {
@@ -169,18 +248,23 @@ TileAtlas layoutTileAtlas(const MeshPart& mesh, const TextureTable& table,
   }
   for (const PageSize& size : sizes)
     atlas.pages.push_back({size.material, size.width, size.height, {}});
+  splitSharedVertices(mesh, chartOf, atlas);
   // Texture coordinates into the pages: texel for texel of the chart's level.
-  atlas.uvs.assign(mesh.vertexCount(), Vec2f{});
-  atlas.pageOf.assign(mesh.vertexCount(), kNone);
-  for (std::uint32_t v = 0; v < mesh.vertexCount(); ++v) {
-    if (chartOf[v] == kNone) continue;
-    const Chart& c = charts[chartOf[v]];
+  atlas.uvs.assign(atlas.vertexSource.size(), Vec2f{});
+  atlas.pageOf.assign(atlas.vertexSource.size(), kNone);
+  for (std::size_t t = 0; t < chartOf.size(); ++t) {
+    if (chartOf[t] == kNone) continue;
+    const Chart& c = charts[chartOf[t]];
     const AtlasPage& page = atlas.pages[c.page];
     const double w = pyramid.width(c.image, c.level), h = pyramid.height(c.image, c.level);
-    atlas.uvs[v] = {
-        static_cast<float>((mesh.uvs[v].x * w - static_cast<double>(c.x0) + c.ax) / page.width),
-        static_cast<float>((mesh.uvs[v].y * h - static_cast<double>(c.y0) + c.ay) / page.height)};
-    atlas.pageOf[v] = c.page;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t v = atlas.indices[3 * t + k];
+      const Vec2f uv = mesh.uvs[atlas.vertexSource[v]];
+      atlas.uvs[v] = {
+          static_cast<float>((uv.x * w - static_cast<double>(c.x0) + c.ax) / page.width),
+          static_cast<float>((uv.y * h - static_cast<double>(c.y0) + c.ay) / page.height)};
+      atlas.pageOf[v] = c.page;
+    }
   }
   atlas.layout = std::move(charts);
   return atlas;

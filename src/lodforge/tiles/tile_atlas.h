@@ -1,5 +1,6 @@
 // A tile's own textures (re-baked at each level): its triangles grouped into charts (the
-// pieces of surface whose texture coordinates run on without a seam), each chart's texels
+// pieces of surface whose texture coordinates run on without a seam; one larger than a page
+// split into pieces of a page, its border vertices then doubled), each chart's texels
 // copied from its source image's mip level for the tile's level — texel for texel, so a leaf
 // keeps the source's full resolution and each level up half the texels per side — into pages
 // of at most `maxSize` per side, packed with gutters, the empty space filled by pulling in the
@@ -41,14 +42,18 @@ struct AtlasChart {
 };
 
 struct TileAtlas {
+  // The tile's vertices: the mesh's, then copies of those on the borders of a chart the atlas
+  // split (vertexSource: the mesh vertex each one is), and its triangles over them.
+  std::vector<std::uint32_t> vertexSource;
+  std::vector<std::uint32_t> indices;
   std::vector<AtlasPage> pages;
   std::vector<AtlasChart> layout;  // each chart: where its texels come from and go
-  // Per vertex of the mesh: its texture coordinate in its page, and the page (~0u: a vertex of
-  // no texture).
+  // Per vertex (of vertexSource): its texture coordinate in its page, and the page (~0u: a
+  // vertex of no texture).
   std::vector<Vec2f> uvs;
   std::vector<std::uint32_t> pageOf;
   std::uint64_t charts = 0;
-  std::uint64_t shrunkCharts = 0;  // charts larger than a page, taken from a coarser level
+  std::uint64_t shrunkCharts = 0;  // charts a page cannot hold even split, from a coarser level
 };
 
 // The charts, their places and the new texture coordinates, pages not yet baked. `level` 0 is

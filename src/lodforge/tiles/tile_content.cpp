@@ -13,18 +13,40 @@
 
 namespace lodforge {
 
-Status writeTileContent(const MeshPart& mesh, const Aabbd& bounds, const std::string& path,
+namespace {
+
+// The tile's mesh as its atlas has it: a vertex the atlas doubled (on a split chart's border)
+// copied, the triangles over the copies.
+MeshPart expandedFor(const MeshPart& mesh, const TileAtlas& atlas) {
+  MeshPart out;
+  const auto copy = [&](const auto& from, auto& to) {
+    if (from.empty()) return;
+    to.reserve(atlas.vertexSource.size());
+    for (std::uint32_t v : atlas.vertexSource) to.push_back(from[v]);
+  };
+  copy(mesh.positions, out.positions);
+  copy(mesh.colors, out.colors);
+  copy(mesh.normals, out.normals);
+  copy(mesh.features, out.features);
+  out.indices = atlas.indices;
+  return out;
+}
+
+}  // namespace
+
+Status writeTileContent(const MeshPart& input, const Aabbd& bounds, const std::string& path,
                         const TileContentOptions& options) {
   const Vec3d center = bounds.center();
-  const bool textured = options.texturing != nullptr && !mesh.uvs.empty();
+  const bool textured = options.texturing != nullptr && !input.uvs.empty();
+  // Laid out now; each page is baked as it is written (addTilePages).
   TileAtlas atlas;
+  MeshPart expanded;
   if (textured) {
-    Result<TileAtlas> baked =
-        bakeTileAtlas(mesh, *options.texturing->table, *options.texturing->pyramid, options.level,
-                      options.texturing->atlas);
-    if (!baked) return baked.status();
-    atlas = std::move(*baked);
+    atlas = layoutTileAtlas(input, *options.texturing->table, *options.texturing->pyramid,
+                            options.level, options.texturing->atlas);
+    expanded = expandedFor(input, atlas);
   }
+  const MeshPart& mesh = textured ? expanded : input;
   // Triangles in vertex-cache order, then vertices in first-use order (faster to draw, and what
   // the meshopt codec compresses best). The FIFO variant (Tipsify) is 2-3x faster than
   // meshopt_optimizeVertexCache, as good on scan tiles (ACMR 0.60 vs 0.63 for a 16-entry FIFO),

@@ -124,6 +124,28 @@ bool decodeJpegRows(std::span<const std::byte> bytes, std::FILE* file, std::uint
   return error.manager.num_warnings == 0;
 }
 
+// A JPEG's size and components from its header (libjpeg reads up to the frame header).
+bool readJpegHeader(std::span<const std::byte> bytes, int& width, int& height, int& channels,
+                    JpegError& error) {
+  jpeg_decompress_struct info;
+  info.err = jpeg_std_error(&error.manager);
+  error.manager.error_exit = jpegErrorExit;
+  error.manager.emit_message = jpegWarning;
+  if (setjmp(error.jump)) {
+    jpeg_destroy_decompress(&info);
+    return false;
+  }
+  jpeg_create_decompress(&info);
+  jpeg_mem_src(&info, reinterpret_cast<const unsigned char*>(bytes.data()),
+               static_cast<unsigned long>(bytes.size()));
+  jpeg_read_header(&info, TRUE);
+  width = static_cast<int>(info.image_width);
+  height = static_cast<int>(info.image_height);
+  channels = info.num_components;
+  jpeg_destroy_decompress(&info);
+  return error.manager.num_warnings == 0;
+}
+
 Result<Image> decodeJpeg(std::span<const std::byte> bytes, const std::string& name,
                          std::uint64_t maxPixels) {
   Image image;
@@ -215,7 +237,11 @@ Status probeBytes(ImageSource& image, std::span<const std::byte> bytes) {
     height = features.height;
     channels = features.has_alpha ? 4 : 3;
     why = "cannot read the WebP header";
-  } else if (image.format != ImageFormat::kUnknown) {
+  } else if (image.format == ImageFormat::kJpeg) {
+    JpegError error{};
+    ok = readJpegHeader(bytes, width, height, channels, error);
+    why = fmt::format("cannot read the JPEG header ({})", error.message);
+  } else if (image.format == ImageFormat::kPng) {
     ok = stb::imageInfo(bytes, width, height, channels, why);
   }
   if (!ok || width <= 0 || height <= 0)

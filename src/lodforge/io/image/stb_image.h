@@ -1,6 +1,7 @@
-// stb's image decoder (PNG and JPEG) and PNG encoder (Debian's libstb-dev header), compiled in
-// stb_image.cpp: the fuzzers' sanitizers then see inside the decoder, and nothing clashes with
-// libstb's own copy.
+// stb's PNG decoder and encoder (Debian's libstb-dev header), compiled in stb_image.cpp: the
+// fuzzers' sanitizers then see inside the decoder, and nothing clashes with libstb's own copy.
+// (Its JPEG decoder is left out: the fuzzer found it reading past a Huffman table; JPEG goes
+// through libjpeg-turbo, image_codec.h.)
 #pragma once
 
 #include <cstdint>
@@ -12,10 +13,10 @@
 namespace lodforge::stb {
 
 // The header's size and channel count without decoding; false (with stb's reason) if it is not
-// a PNG or JPEG stb can read.
+// a PNG stb can read.
 bool imageInfo(std::span<const std::byte> bytes, int& width, int& height, int& channels,
                std::string& why);
-// RGBA8 pixels of a PNG or JPEG; false (with stb's reason) on a decoding failure.
+// RGBA8 pixels of a PNG; false (with stb's reason) on a decoding failure.
 bool decodeImage(std::span<const std::byte> bytes, int& width, int& height,
                  std::vector<std::uint8_t>& rgba, std::string& why);
 // Encoded bytes go to `sink` in pieces; false if encoding failed.

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad, instances or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad, instances, textures or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -505,6 +505,33 @@ instances_section() {
 }
 if [[ ${BENCH_ONLY:-} == instances ]]; then instances_section; exit 0; fi
 
+# Textured scans (16 atlases of 4K, MeshLab's textured PLY) through tiles under a 512 MB limit:
+# wall, peak RSS, input and output bytes, and each level's bytes against the level below.
+textures_section() {
+  echo
+  echo "== tiles: textured scans, 16 x 4K atlases, --memory-limit 512M"
+  printf '| %-10s | %8s | %9s | %9s | %9s | %-44s |
+' triangles wall "peak RSS" input output "bytes per level (leaves first; % of the level below)"
+  printf '|%s|%s|%s|%s|%s|%s|
+' ------------ ---------- ----------- ----------- ----------- ----------------------------------------------
+  local sizes=(2M)
+  [[ ${BENCH_LARGE:-0} == 1 ]] && sizes+=(20M)
+  for n in "${sizes[@]}"; do
+    rm -rf "$work/tex" && mkdir -p "$work/tex"
+    "$lodforge" -q generate scan --triangles "$n" --texture 4K --atlases 16 -o "$work/tex/scan.ply"
+    local result levels
+    result=$(timed "$lodforge" -q --memory-limit 512M tiles "$work/tex/scan.ply" -o "$work/tex/tiles")
+    levels=$(for l in 0 1 2 3 4 5 6; do
+      ls "$work"/tex/tiles/tiles/"$l"-*.glb > /dev/null 2>&1 || break
+      du -cb "$work"/tex/tiles/tiles/"$l"-*.glb | tail -1 | cut -f1
+    done | awk '{ if (NR > 1) printf " / %.1f MB (%d %%)", $1 / 1e6, 100 * $1 / prev; else printf "%.1f MB", $1 / 1e6; prev = $1 }')
+    printf '| %-10s | %7ss | %5d MiB | %9s | %9s | %-44s |\n' "$n" "${result% *}" $((${result#* } / 1024)) \
+      "$(du -sh --exclude=tiles "$work/tex" | cut -f1)" "$(du -sh "$work/tex/tiles" | cut -f1)" "$levels"
+  done
+  rm -rf "$work/tex"
+}
+if [[ ${BENCH_ONLY:-} == textures ]]; then textures_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -532,5 +559,6 @@ surface_section
 surface_tiles_section
 cad_section
 instances_section
+textures_section
 render_section
 runtime_section

@@ -83,7 +83,7 @@ Result<Model> readModel(const std::string& path, const ReadOptions& options) {
       // IFC is an ISO 10303-21 exchange structure, whose end assimp does not check.
       if (fileExtension(path) == "ifc")
         LODFORGE_TRY(checkPart21Whole(path, options.salvageTruncated, options.warnings));
-      return readAssimp(path);
+      return readAssimp(path, options.warnings);
     case FileFormat::kUnknown:
       break;
   }

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "lodforge/core/file.h"
+#include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/image/stb_image.h"
 
 namespace lodforge {
@@ -16,39 +17,6 @@ Result<Image> readPng(const std::string& path) {
   if (!file) return file.status();
   return readPngFromMemory(file->bytes(), path);
 }
-
-namespace {
-
-std::uint32_t bigEndian32(const std::byte* p) {
-  return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 |
-         std::uint32_t(p[3]);
-}
-
-// The chunk structure (length, type, data, CRC) must fit the file: stb trusts an IDAT's length
-// and would allocate up to 2 GiB for a few bytes of input.
-Status checkChunks(std::span<const std::byte> bytes, const std::string& name) {
-  std::size_t at = 8;
-  while (at < bytes.size()) {
-    if (bytes.size() - at < 12)
-      return Error{ErrorKind::kBadInput,
-                   fmt::format("{}: PNG chunk at byte {} is cut off (12 bytes of length, type and "
-                               "CRC needed, {} left)",
-                               name, at, bytes.size() - at)};
-    const std::uint32_t length = bigEndian32(bytes.data() + at);
-    if (length > bytes.size() - at - 12)
-      return Error{ErrorKind::kBadInput,
-                   fmt::format("{}: PNG chunk at byte {} claims {} bytes of data, beyond the end "
-                               "of the file ({} bytes)",
-                               name, at, length, bytes.size())};
-    const bool end = std::memcmp(bytes.data() + at + 4, "IEND", 4) == 0;
-    at += 12 + std::size_t{length};
-    if (end) return {};
-  }
-  return Error{ErrorKind::kBadInput,
-               fmt::format("{}: PNG ends at byte {} without an IEND chunk", name, bytes.size())};
-}
-
-}  // namespace
 
 Result<Image> readPngFromMemory(std::span<const std::byte> bytes, const std::string& name,
                                 std::uint64_t maxPixels) {
@@ -60,7 +28,7 @@ Result<Image> readPngFromMemory(std::span<const std::byte> bytes, const std::str
                  fmt::format("{}: not a PNG (no PNG signature at byte 0)", name)};
   if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     return Error{ErrorKind::kBadInput, fmt::format("{}: PNG larger than 2 GiB", name)};
-  LODFORGE_TRY(checkChunks(bytes, name));
+  LODFORGE_TRY(checkPngChunks(bytes, name));
   int width = 0, height = 0;
   std::string why;
   // The header's size before decoding: a few bytes must not make us allocate gigabytes.

@@ -169,8 +169,38 @@ Result<Image> decodeWebp(std::span<const std::byte> bytes, const std::string& na
   return image;
 }
 
+std::uint32_t bigEndian32(const std::byte* p) {
+  return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 |
+         std::uint32_t(p[3]);
+}
+
+// The chunk structure (length, type, data, CRC) must fit the file: stb trusts an IDAT's length
+// and would allocate up to 2 GiB for a few bytes of input.
+Status pngChunksFit(std::span<const std::byte> bytes, const std::string& name) {
+  std::size_t at = 8;
+  while (at < bytes.size()) {
+    if (bytes.size() - at < 12)
+      return Error{ErrorKind::kBadInput,
+                   fmt::format("{}: PNG chunk at byte {} is cut off (12 bytes of length, type and "
+                               "CRC needed, {} left)",
+                               name, at, bytes.size() - at)};
+    const std::uint32_t length = bigEndian32(bytes.data() + at);
+    if (length > bytes.size() - at - 12)
+      return Error{ErrorKind::kBadInput,
+                   fmt::format("{}: PNG chunk at byte {} claims {} bytes of data, beyond the end "
+                               "of the file ({} bytes)",
+                               name, at, length, bytes.size())};
+    const bool end = std::memcmp(bytes.data() + at + 4, "IEND", 4) == 0;
+    at += 12 + std::size_t{length};
+    if (end) return {};
+  }
+  return Error{ErrorKind::kBadInput,
+               fmt::format("{}: PNG ends at byte {} without an IEND chunk", name, bytes.size())};
+}
+
 Result<Image> decodeStb(std::span<const std::byte> bytes, const std::string& name,
                         std::uint64_t maxPixels) {
+  LODFORGE_TRY(pngChunksFit(bytes, name));
   int width = 0, height = 0, channels = 0;
   std::string why;
   if (!stb::imageInfo(bytes, width, height, channels, why))
@@ -253,6 +283,10 @@ Status probeBytes(ImageSource& image, std::span<const std::byte> bytes) {
 }
 
 }  // namespace
+
+Status checkPngChunks(std::span<const std::byte> bytes, const std::string& name) {
+  return pngChunksFit(bytes, name);
+}
 
 Result<std::vector<std::byte>> imageBytes(const ImageSource& image) {
   if (image.embedded()) return image.bytes;

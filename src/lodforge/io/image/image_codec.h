@@ -22,6 +22,10 @@ inline constexpr std::uint64_t kMaxTexturePixels = 300'000'000;
 // Fills `image`'s format, width, height and channels from its file's (or embedded bytes')
 // header. kBadInput naming the image when it is missing, unreadable or not JPEG, PNG or WebP.
 Status probeImage(ImageSource& image);
+// A PNG's chunks (length, type, data, CRC) fit its bytes and end with IEND: stb trusts an
+// IDAT's length and would allocate up to 2 GiB for a few bytes of input. kBadInput naming the
+// chunk otherwise.
+Status checkPngChunks(std::span<const std::byte> bytes, const std::string& name);
 // The encoded bytes of an image: its embedded bytes, or its file read whole.
 Result<std::vector<std::byte>> imageBytes(const ImageSource& image);
 // The texels of an encoded image, as RGBA8 (grey and RGB gain alpha 255). `name` for messages.

@@ -1,6 +1,7 @@
 // Where a texture a model names lies: relative to the model (or its material library), with
 // Windows separators taken as folders, and a path from another machine ("C:\Users\…\a.jpg",
-// "/home/…/a.jpg") looked for beside the model by its file name.
+// "/home/…/a.jpg") or a name in another case ("TEST.PNG" for test.png, as Windows exports have
+// it) looked for beside the model by its file name.
 #pragma once
 
 #include <string>

@@ -14,6 +14,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/io/mesh/assimp_textures.h"
 
 namespace lodforge {
 
@@ -99,10 +100,16 @@ bool isStandIn(const aiMaterial& m) {
 // The scene's node tree walked from the root, every mesh reference an object.
 class SceneConverter {
  public:
-  SceneConverter(const aiScene& scene, const std::string& path) : scene_(scene), path_(path) {}
+  SceneConverter(const aiScene& scene, const std::string& path, std::vector<std::string>* warnings)
+      : scene_(scene), path_(path), warnings_(warnings) {}
 
   Result<Model> convert() {
     convertMaterials();
+    // (From memory, for the fuzzer: no texture file beside it to read.)
+    if (warnings_ != nullptr || scene_.mNumTextures > 0)
+      texturing_ = readAssimpTextures(scene_, materialOf_, path_, model_, warnings_);
+    withUvs_ = std::any_of(texturing_.uvChannel.begin(), texturing_.uvChannel.end(),
+                           [](int channel) { return channel >= 0; });
     withColors_ = !model_.materials.empty() ||
                   std::any_of(scene_.mMeshes, scene_.mMeshes + scene_.mNumMeshes,
                               [](const aiMesh* mesh) { return mesh->HasVertexColors(0); });
@@ -188,6 +195,7 @@ class SceneConverter {
         normals_.push_back({});
         missingNormals_ = true;
       }
+      if (withUvs_) model_.uvs.push_back(uvOf(mesh, material, v));
       if (withColors_) {
         std::array<double, 4> c = {factor[0], factor[1], factor[2], factor[3]};
         if (mesh.HasVertexColors(0)) {
@@ -208,6 +216,18 @@ class SceneConverter {
     builder.endObject();
   }
 
+  // A vertex's coordinate in its material's texture (assimp's origin is bottom left: v turned
+  // to glTF's way); a mesh without that channel samples the texture's corner.
+  Vec2f uvOf(const aiMesh& mesh, std::uint32_t material, unsigned v) const {
+    if (!texturing_.textured(material)) return {};
+    const auto channel = static_cast<unsigned>(texturing_.uvChannel[material]);
+    if (channel >= AI_MAX_NUMBER_OF_TEXTURECOORDS || mesh.mTextureCoords[channel] == nullptr)
+      return {};
+    const aiVector3D& uv = mesh.mTextureCoords[channel][v];
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return {};
+    return {uv.x, 1.0f - uv.y};
+  }
+
   void placeAtOrigin() {
     lodforge::placeAtOrigin(model_, world_);
     // Normals only when every vertex has one, as the glTF reader keeps them.
@@ -220,7 +240,10 @@ class SceneConverter {
   std::vector<Vec3d> world_;
   std::vector<Vec3f> normals_;
   std::vector<std::uint32_t> materialOf_;  // a scene material's index in the model's, or none
+  std::vector<std::string>* warnings_;
+  AssimpTexturing texturing_;
   bool withColors_ = false;
+  bool withUvs_ = false;
   bool missingNormals_ = false;
   std::string problem_;  // the first thing wrong with the scene
 };
@@ -235,7 +258,7 @@ namespace {
 
 // Reads with `read(importer, flags)` (from a file or from memory) and converts the scene.
 template <class Read>
-Result<Model> import(const std::string& name, Read&& read) {
+Result<Model> import(const std::string& name, std::vector<std::string>* warnings, Read&& read) {
   try {
     Assimp::Importer importer;
     importer.SetProgressHandler(new CancelOnInterrupt);  // the importer owns and deletes it
@@ -248,7 +271,7 @@ Result<Model> import(const std::string& name, Read&& read) {
     if (!scene) return badInput(name, fmt::format("assimp: {}", importer.GetErrorString()));
     if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || !scene->mRootNode)
       return badInput(name, "assimp read an incomplete scene (no node tree)");
-    return SceneConverter(*scene, name).convert();
+    return SceneConverter(*scene, name, warnings).convert();
   } catch (const std::exception& e) {
     return badInput(name, fmt::format("assimp: {}", e.what()));
   }
@@ -256,17 +279,18 @@ Result<Model> import(const std::string& name, Read&& read) {
 
 }  // namespace
 
-Result<Model> readAssimp(const std::string& path) {
+Result<Model> readAssimp(const std::string& path, std::vector<std::string>* warnings) {
   Result<std::uint64_t> size = fileSize(path);  // a missing file says so, not assimp's words
   if (!size) return size.status();
-  return import(path, [&](Assimp::Importer& importer, unsigned flags) {
-    return importer.ReadFile(path, flags);
-  });
+  std::vector<std::string> ignored;
+  return import(
+      path, warnings ? warnings : &ignored,
+      [&](Assimp::Importer& importer, unsigned flags) { return importer.ReadFile(path, flags); });
 }
 
 Result<Model> readAssimpFromMemory(std::span<const std::byte> bytes, const std::string& name) {
   const std::string hint = fileExtension(name);
-  return import(name, [&](Assimp::Importer& importer, unsigned flags) {
+  return import(name, nullptr, [&](Assimp::Importer& importer, unsigned flags) {
     return importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, hint.c_str());
   });
 }

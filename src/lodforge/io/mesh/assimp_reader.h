@@ -9,6 +9,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "lodforge/core/model.h"
 #include "lodforge/core/status.h"
@@ -18,7 +19,9 @@ namespace lodforge {
 // Whether the extension is one assimp reads for us (lower case, without the dot).
 bool isAssimpExtension(std::string_view extension);
 
-Result<Model> readAssimp(const std::string& path);
+// Base-colour textures (files beside it, or embedded) and their UVs too (assimp_textures.h);
+// one that cannot be read is a warning.
+Result<Model> readAssimp(const std::string& path, std::vector<std::string>* warnings = nullptr);
 // The same from bytes in memory; `name` names them in errors and its extension picks the format
 // (the fuzzer).
 Result<Model> readAssimpFromMemory(std::span<const std::byte> bytes, const std::string& name);

@@ -165,6 +165,52 @@ TEST(TileTexture, AStreamedPlyIsRebakedTheSameWay) {
   expectRebakedTexelForTexel(dir.file("plane.ply"), dir);
 }
 
+// Two quads of one streamed PLY sharing an edge (vertex coordinates per vertex), one red and
+// one blue texture: every tile's pages keep each face's own texture.
+TEST(TileTexture, AStreamedVertexSharedByTwoTexturesKeepsEach) {
+  test::TempDir dir;
+  for (const auto& [name, rgb] :
+       {std::pair{"red.png", std::array<std::uint8_t, 3>{220, 20, 20}},
+        std::pair{"blue.png", std::array<std::uint8_t, 3>{20, 20, 220}}}) {
+    Image image(8, 8);
+    for (std::size_t i = 0; i < image.pixelCount(); ++i) {
+      std::copy(rgb.begin(), rgb.end(), &image.rgba[4 * i]);
+      image.rgba[4 * i + 3] = 255;
+    }
+    Result<std::vector<std::byte>> png = encodeImage(image, {.format = ImageFormat::kPng});
+    ASSERT_TRUE(png.ok());
+    test::writeFile(dir.file(name),
+                    std::string_view(reinterpret_cast<const char*>(png->data()), png->size()));
+  }
+  const std::string header =
+      "ply\nformat ascii 1.0\ncomment TextureFile red.png\ncomment TextureFile blue.png\n"
+      "element vertex 6\nproperty float x\nproperty float y\nproperty float z\nproperty float s\n"
+      "property float t\nelement face 4\nproperty list uchar int vertex_indices\n"
+      "property int texnumber\nend_header\n"
+      "0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n2 0 0 0 0\n2 1 0 0 1\n";
+  test::writeFile(dir.file("two.ply"), header + "3 0 1 2 0\n3 0 2 3 0\n3 1 4 5 1\n3 1 5 2 1\n");
+  Result<TilesStats> stats = writeTiles(dir.file("two.ply"), dir.file("tiles"), {});
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  Result<Model> tile = readGltf(dir.file("tiles/tiles/0-0-0-0.glb"));
+  ASSERT_TRUE(tile.ok());
+  ASSERT_EQ(tile->images.size(), 2u);  // red and blue, each with its faces
+  std::size_t red = 0, blue = 0;
+  for (const ImageSource& image : tile->images) {
+    Result<Image> texels = decodeImage(image);
+    ASSERT_TRUE(texels.ok());
+    (texels->rgba[0] > texels->rgba[2] ? red : blue) += 1;
+  }
+  EXPECT_EQ(red, 1u);
+  EXPECT_EQ(blue, 1u);
+  // A texnumber past the TextureFile lines is refused streamed as it is read whole.
+  test::writeFile(dir.file("stray.ply"), header + "3 0 1 2 0\n3 0 2 3 0\n3 1 4 5 2\n3 1 5 2 1\n");
+  Result<TilesStats> stray = writeTiles(dir.file("stray.ply"), dir.file("stray"), {});
+  ASSERT_FALSE(stray.ok());
+  EXPECT_NE(stray.error().message.find("texnumber 2 but the file names 2 textures"),
+            std::string::npos)
+      << stray.error().message;
+}
+
 TEST(TileTexture, PagesOfASourceWithAlphaArePng) {
   TextureTable table;
   table.images.push_back(ImageSource{

@@ -1,8 +1,10 @@
 #include "lodforge/tiling/chunk_store.h"
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -214,6 +216,44 @@ TEST(ChunkFile, RefusesDamageWithItsPosition) {
   index[index.size() - 4] = static_cast<char>(200);  // the last triangle's last corner
   refused(index, "index out of range");
   refused(bytes + bytes.substr(0, 6), "inside a block header");
+  // A position that is no number (it would reach sorts and casts).
+  std::string nan = bytes;
+  const double notANumber = std::nan("");
+  std::memcpy(nan.data() + 12, &notANumber, sizeof notANumber);  // the first record's x
+  refused(nan, "not a finite number");
+}
+
+TEST(ChunkFile, TexturedRecordsCarryCoordinatesAndMaterialsAndRefuseDamage) {
+  test::TempDir dir;
+  Aabbd box;
+  box.add(Vec3d{0, 0, 0});
+  box.add(Vec3d{10, 10, 10});
+  ChunkWriter writer(ChunkGrid::over(box, 20), dir.file("chunks"), 1 << 20);
+  writer.setTextured(true);
+  std::array<CutCorner, 3> triangle;
+  for (std::size_t k = 0; k < 3; ++k) {
+    triangle[k].position = {double(k == 1), double(k == 2), 0};
+    triangle[k].uv = {0.25f * float(k), 0.5f};
+    triangle[k].material = 7;
+  }
+  ASSERT_TRUE(writer.addTriangle(triangle).ok());
+  ASSERT_TRUE(writer.flush().ok());
+  const std::string path = writer.chunkPath({0, 0, 0});
+  Result<MeshPart> back = loadChunk(path);
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->uvs.size(), 3u);
+  EXPECT_EQ(back->uvs[2], (Vec2f{0.5f, 0.5f}));
+  EXPECT_EQ(back->materials[0], 7u);
+  // A texture coordinate that is no number is damage.
+  std::string bytes = test::readFile(path);
+  const float infinite = std::numeric_limits<float>::infinity();
+  std::memcpy(bytes.data() + 12 + 40, &infinite, sizeof infinite);  // the first record's u
+  std::ofstream(dir.file("bad.tri"), std::ios::binary) << bytes;
+  Result<MeshPart> bad = loadChunk(dir.file("bad.tri"));
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("texture coordinate is not a finite number"),
+            std::string::npos)
+      << bad.error().message;
 }
 
 }  // namespace

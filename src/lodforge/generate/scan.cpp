@@ -170,6 +170,9 @@ Status writeAtlases(const ScanOptions& options, const ScanAtlasLayout& atlases, 
                     const std::string& path, std::vector<std::string>& comments) {
   Progress progress("scan: textures", atlases.count());
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  // Every place checked before any atlas is drawn: a refusal leaves nothing written.
+  for (std::uint32_t region = 0; region < atlases.count(); ++region)
+    LODFORGE_TRY(checkScanAtlasPlace((folder / scanAtlasName(path, region)).string()));
   for (std::uint32_t region = 0; region < atlases.count(); ++region) {
     LODFORGE_TRY(checkCancelled());
     const std::string name = scanAtlasName(path, region);

@@ -139,20 +139,22 @@ std::string scanAtlasName(const std::string& plyPath, std::uint32_t region) {
   return fmt::format("{}_atlas_{:02}.jpg", std::filesystem::path(plyPath).stem().string(), region);
 }
 
-Status writeScanAtlas(const Image& image, const std::string& path) {
+Status checkScanAtlasPlace(const std::string& path) {
   std::error_code error;
-  if (std::filesystem::exists(path, error)) {
-    // The mark sits in the first bytes (after the start and JFIF markers).
-    std::string head(256, '\0');
-    std::FILE* in = std::fopen(path.c_str(), "rb");
-    head.resize(in ? std::fread(head.data(), 1, head.size(), in) : 0);
-    if (in) std::fclose(in);
-    const bool ours = head.starts_with("\xFF\xD8") && head.find(kAtlasMark) != std::string::npos;
-    if (!ours)
-      return Error{
-          ErrorKind::kUsage,
-          fmt::format("{}: exists and is not an atlas lodforge generated; not replaced", path)};
-  }
+  if (!std::filesystem::exists(path, error)) return {};
+  // The mark sits in the first bytes (after the start and JFIF markers).
+  std::string head(256, '\0');
+  std::FILE* in = std::fopen(path.c_str(), "rb");
+  head.resize(in ? std::fread(head.data(), 1, head.size(), in) : 0);
+  if (in) std::fclose(in);
+  if (head.starts_with("\xFF\xD8") && head.find(kAtlasMark) != std::string::npos) return {};
+  return Error{
+      ErrorKind::kUsage,
+      fmt::format("{}: exists and is not an atlas lodforge generated; not replaced", path)};
+}
+
+Status writeScanAtlas(const Image& image, const std::string& path) {
+  LODFORGE_TRY(checkScanAtlasPlace(path));
   Result<std::vector<std::byte>> jpeg = encodeImage(
       image, {.format = ImageFormat::kJpeg, .quality = 90, .comment = std::string(kAtlasMark)});
   if (!jpeg) return jpeg.status();

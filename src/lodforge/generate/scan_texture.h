@@ -35,6 +35,9 @@ Image drawScanAtlas(std::uint64_t seed, const ScanAtlasLayout& layout, std::uint
 // "scan_atlas_03.jpg" beside "scan.ply": the name the PLY's comment gives and the file.
 std::string scanAtlasName(const std::string& plyPath, std::uint32_t region);
 
+// Whether an atlas may be written at `path`: nothing there, or an atlas of ours (kUsage
+// naming it otherwise).
+Status checkScanAtlasPlace(const std::string& path);
 // Writes the region's image as a JPEG (quality 90, marked as lodforge's so that a later run
 // may replace it; a file there that is not one of ours is refused).
 Status writeScanAtlas(const Image& image, const std::string& path);

@@ -75,7 +75,7 @@ std::uint32_t splitLargeCharts(const MeshPart& mesh, const TextureTable& table,
                                std::vector<std::uint32_t>& chartOf) {
   // A cell's side in texels: a page less the gutters and a texel of rounding on each side.
   const double cell = std::max(1.0, double(options.maxSize) - 2.0 * options.gutter - 4.0);
-  std::vector<std::uint32_t> first(charts.size() + 1, 0);  // first new chart of each
+  std::vector<std::uint64_t> first(charts.size() + 1, 0);  // first new chart of each
   std::vector<std::array<std::uint32_t, 2>> grid(charts.size(), {1, 1});
   for (std::size_t c = 0; c < charts.size(); ++c) {
     const Chart& chart = charts[c];
@@ -85,9 +85,11 @@ std::uint32_t splitLargeCharts(const MeshPart& mesh, const TextureTable& table,
     // (A chart of a texture repeated thousands of times is not cut finer than 64 x 64 pieces.)
     grid[c] = {static_cast<std::uint32_t>(std::clamp(std::ceil(w / cell), 1.0, 64.0)),
                static_cast<std::uint32_t>(std::clamp(std::ceil(h / cell), 1.0, 64.0))};
-    first[c + 1] = first[c] + grid[c][0] * grid[c][1];
+    first[c + 1] = first[c] + std::uint64_t{grid[c][0]} * grid[c][1];
   }
-  if (first.back() == charts.size()) return static_cast<std::uint32_t>(charts.size());
+  // (More pieces than a tile has triangles cannot be: each holds one. Past that, nothing splits.)
+  if (first.back() == charts.size() || first.back() > chartOf.size())
+    return static_cast<std::uint32_t>(charts.size());
   for (std::size_t t = 0; t < chartOf.size(); ++t) {
     if (chartOf[t] == kNone) continue;
     const Chart& chart = charts[chartOf[t]];
@@ -101,7 +103,8 @@ std::uint32_t splitLargeCharts(const MeshPart& mesh, const TextureTable& table,
       const double f = hi > lo ? (x - lo) / (hi - lo) : 0.0;
       return std::min(n - 1, static_cast<std::uint32_t>(std::max(0.0, f * n)));
     };
-    chartOf[t] = first[chartOf[t]] + piece(centre.y, chart.vmin, chart.vmax, along) * across +
+    chartOf[t] = static_cast<std::uint32_t>(first[chartOf[t]]) +
+                 piece(centre.y, chart.vmin, chart.vmax, along) * across +
                  piece(centre.x, chart.umin, chart.umax, across);
   }
   // Pieces no triangle fell in are left out of the numbering.
@@ -124,9 +127,11 @@ bool placeInLevel(Chart& c, const TexturePyramid& pyramid, std::uint32_t level,
   for (c.level = std::min(level, top);; ++c.level) {
     const double w = pyramid.width(c.image, c.level), h = pyramid.height(c.image, c.level);
     const double g = options.gutter;
-    c.x0 = static_cast<std::int64_t>(std::floor(c.umin * w - g));
-    c.y0 = static_cast<std::int64_t>(std::floor(c.vmin * h - g));
-    const double x1 = std::ceil(c.umax * w + g), y1 = std::ceil(c.vmax * h + g);
+    // (Work files are checked finite; a texture repeated a million times is no chart to copy.)
+    const auto bounded = [](float x) { return std::clamp(static_cast<double>(x), -1e6, 1e6); };
+    c.x0 = static_cast<std::int64_t>(std::floor(bounded(c.umin) * w - g));
+    c.y0 = static_cast<std::int64_t>(std::floor(bounded(c.vmin) * h - g));
+    const double x1 = std::ceil(bounded(c.umax) * w + g), y1 = std::ceil(bounded(c.vmax) * h + g);
     const double cw = std::max(x1 - static_cast<double>(c.x0), 1.0);
     const double ch = std::max(y1 - static_cast<double>(c.y0), 1.0);
     if ((cw <= options.maxSize && ch <= options.maxSize) || c.level == top) {
@@ -293,7 +298,7 @@ namespace {
 
 // A level of the fill pyramid: each texel the mean colour of the kept texels below it and how
 // many there were (saturating: a weight, not a count). 4 bytes a texel, at half the size of the
-// level below: the whole pyramid takes a third of a byte per page texel.
+// level below: the whole pyramid takes 4/3 of a byte per page texel.
 struct FillLevel {
   std::uint32_t w = 0, h = 0;
   std::vector<std::array<std::uint8_t, 4>> texels;  // r, g, b, weight

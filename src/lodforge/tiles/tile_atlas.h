@@ -69,9 +69,10 @@ Status bakeAtlasPage(TileAtlas& atlas, std::size_t page, const TextureTable& tab
 Result<TileAtlas> bakeTileAtlas(const MeshPart& mesh, const TextureTable& table,
                                 const TexturePyramid& pyramid, std::uint32_t level,
                                 const AtlasOptions& options = {});
-// Bytes baking a page of `side` x `side` texels takes at most (texels, mask, fill, encoding).
+// Bytes baking a page of `side` x `side` texels takes at most: its texels (4), mask (1), a
+// chart's texels read from the pyramid (up to a page, 4) and the fill's levels (4/3 at most).
 inline std::uint64_t atlasPageBytes(std::uint32_t side) {
-  return std::uint64_t{side} * side * 6;
+  return std::uint64_t{side} * side * 11;
 }
 
 // Fills the texels `mask` leaves out (0) from those it keeps, by pulling coarser averages of the

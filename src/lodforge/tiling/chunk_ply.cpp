@@ -178,7 +178,7 @@ class PlyChunking {
   std::shared_ptr<PlyBatch> readVertexBatch(tbb::flow_control& control);
   void writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>& buffer);
   Status fetch(const PlyBatch& batch, std::size_t t, std::array<CutCorner, 3>& triangle);
-  void texture(const PlyBatch& batch, std::size_t t, std::array<CutCorner, 3>& triangle) const;
+  Status texture(const PlyBatch& batch, std::size_t t, std::array<CutCorner, 3>& triangle) const;
   PlyReadOptions faceReading() const;
   Result<ChunkGrid> chunkGrid() const;
   std::shared_ptr<FaceBatch> readFaceBatch(tbb::flow_control& control);
@@ -323,24 +323,26 @@ Status PlyChunking::fetch(const PlyBatch& batch, std::size_t t,
   return {};
 }
 
-// A textured file's corners: the face's texture, and its corner coordinates when it has them
-// (a vertex then has one per face: corners are not shared by file vertex, welding joins them).
-void PlyChunking::texture(const PlyBatch& batch, std::size_t t,
-                          std::array<CutCorner, 3>& triangle) const {
+// A textured file's corners: the face's texture, and its corners' coordinates when it has
+// them. Corners are not shared by file vertex (a vertex may have other coordinates or another
+// texture in another face): welding joins the equal ones. A texture that could not be read
+// (warned about) draws grey; a texnumber past the files is refused, as the whole read does.
+Status PlyChunking::texture(const PlyBatch& batch, std::size_t t,
+                            std::array<CutCorner, 3>& triangle) const {
   const std::uint32_t texture = batch.triangleTextures.empty() ? 0 : batch.triangleTextures[t / 3];
   const auto& materials = input_.textures.materials;
-  // A texture that could not be read (warned about) draws grey; a texnumber past the files
-  // draws untextured.
-  const bool drawn = texture < materials.size() && materials[texture].baseColorImage != kNoImage;
-  const bool grey = texture < materials.size() && !drawn;
+  if (texture != ~0u && texture >= materials.size())
+    return badInput(path_, fmt::format("face {}: texnumber {} but the file names {} textures "
+                                       "(comment TextureFile)",
+                                       batch.first + t / 3, texture, materials.size()));
+  const bool drawn = texture != ~0u && materials[texture].baseColorImage != kNoImage;
   for (std::size_t k = 0; k < 3; ++k) {
     triangle[k].material = drawn ? texture : ~0u;
-    if (grey) triangle[k].color = {128, 128, 128, 255};
-    if (!batch.cornerUvs.empty()) {
-      triangle[k].uv = batch.cornerUvs[t + k];
-      triangle[k].source = CutCorner::kNoSource;
-    }
+    triangle[k].source = CutCorner::kNoSource;
+    if (texture != ~0u && !drawn) triangle[k].color = {128, 128, 128, 255};
+    if (!batch.cornerUvs.empty()) triangle[k].uv = batch.cornerUvs[t + k];
   }
+  return {};
 }
 
 PlyReadOptions PlyChunking::faceReading() const {
@@ -467,7 +469,10 @@ std::shared_ptr<FaceBatch> PlyChunking::readFaceBatch(tbb::flow_control& control
       std::array<CutCorner, 3> triangle;
       if (status = fetch(batch_, t, triangle); !status.ok())
         return failure_.fail(batch_.first, std::move(status), &control), nullptr;
-      if (!input_.textures.empty()) texture(batch_, t, triangle);
+      if (!input_.textures.materials.empty()) {
+        if (status = texture(batch_, t, triangle); !status.ok())
+          return failure_.fail(batch_.first, std::move(status), &control), nullptr;
+      }
       std::copy(triangle.begin(), triangle.end(), next->corners.data() + t);
       if (header_.hasObjectIds) {
         const auto found = objects_.find(batch_.triangleObjects[t / 3]);

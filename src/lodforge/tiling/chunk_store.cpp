@@ -268,6 +268,8 @@ Result<MeshPart> parseChunk(std::span<const std::byte> bytes, const std::string&
     }
     at += kBlockHeaderBytes + static_cast<std::size_t>(recordBytes + 4 * indexCount);
   }
+  // Positions and texture coordinates feed sorts and casts: damage must not reach them.
+  LODFORGE_TRY(checkFinite(mesh, name));
   weldExact(mesh);
   return mesh;
 }

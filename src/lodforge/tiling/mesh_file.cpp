@@ -1,5 +1,6 @@
 #include "lodforge/tiling/mesh_file.h"
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
@@ -15,6 +16,16 @@ constexpr char kMeshMagic[8] = {'L', 'F', 'M', 'E', 'S', 'H', '4', '\0'};
 constexpr int kArrays = 7;
 
 }  // namespace
+
+Status checkFinite(const MeshPart& mesh, const std::string& name) {
+  for (const Vec3d& p : mesh.positions)
+    if (!isFinite(p))
+      return badInput(name, "a position is not a finite number (damaged work file?)");
+  for (const Vec2f& uv : mesh.uvs)
+    if (!(std::abs(uv.x) < 1e30f && std::abs(uv.y) < 1e30f))
+      return badInput(name, "a texture coordinate is not a finite number (damaged work file?)");
+  return {};
+}
 
 Status saveMesh(const MeshPart& mesh, const std::string& path) {
   Result<OutputFile> out = OutputFile::create(path, std::size_t{1} << 20);
@@ -88,6 +99,7 @@ Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& 
       return badInputAtByte(name, static_cast<std::uint64_t>(indicesAt - bytes.data()) + 4 * i,
                             "mesh file index out of range");
   }
+  LODFORGE_TRY(checkFinite(mesh, name));
   return mesh;
 }
 

@@ -14,6 +14,10 @@
 namespace lodforge {
 
 Status saveMesh(const MeshPart& mesh, const std::string& path);
+// kBadInput naming `name` when a position or texture coordinate is not a finite number: what
+// both work-file parsers check before the mesh goes on.
+Status checkFinite(const MeshPart& mesh, const std::string& name);
+
 Result<MeshPart> loadMesh(const std::string& path);
 // The same from bytes in memory (`name` for messages): what loadMesh parses.
 Result<MeshPart> parseMesh(std::span<const std::byte> bytes, const std::string& name);

@@ -139,6 +139,14 @@ TEST(ObjMaterials, TexturedCornersWithoutCoordinatesAreCounted) {
       dir.file("bad.obj"),
       "mtllib scene.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nusemtl tex\nf 1/1 2/2 3/1\n");
   Result<Model> bad = readObj(dir.file("bad.obj"), &warnings);
+  // A coordinate beyond a float's range is no coordinate.
+  test::writeFile(
+      dir.file("huge.obj"),
+      "mtllib scene.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 1e39 0\nusemtl tex\nf 1/1 2/1 3/1\n");
+  Result<Model> huge = readObj(dir.file("huge.obj"), &warnings);
+  ASSERT_FALSE(huge.ok());
+  EXPECT_NE(huge.error().message.find("huge.obj:5: expected a finite number"), std::string::npos)
+      << huge.error().message;
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("bad.obj:7: face refers to texture coordinate 2"),
             std::string::npos)

@@ -73,6 +73,11 @@ TEST(TextureExport, AFileInAnImagesPlaceIsNeverReplacedAndNothingIsWritten) {
   EXPECT_EQ(test::readFile(dir.file("mine_texture2.jpg")), "not an image of the model");
   // Checked before anything was written: no other image, no library, no OBJ.
   EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"mine_texture2.jpg"});
+  // A foreign material library likewise: no image written before it is found.
+  std::filesystem::remove(dir.file("mine_texture2.jpg"));
+  test::writeFile(dir.file("mine.mtl"), "newmtl theirs\n");
+  ASSERT_FALSE(writeModel(*spider, dir.file("mine.obj")).ok());
+  EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"mine.mtl"});
 }
 
 }  // namespace

@@ -25,10 +25,17 @@ struct TextureReading {
 };
 
 // The image a texture draws: its source, or EXT_texture_webp's; -1 if none.
+// A JSON value as a small non-negative index, or -1 (tinygltf's GetNumberAsInt casts any double).
+int indexOf(const tinygltf::Value& value) {
+  if (!value.IsNumber()) return -1;
+  const double x = value.GetNumberAsDouble();
+  return x >= 0 && x < 1e9 && x == std::floor(x) ? static_cast<int>(x) : -1;
+}
+
 int sourceOf(const tinygltf::Texture& texture) {
   if (const auto webp = texture.extensions.find("EXT_texture_webp");
       webp != texture.extensions.end() && webp->second.Has("source"))
-    return webp->second.Get("source").GetNumberAsInt();
+    return indexOf(webp->second.Get("source"));
   return texture.source;
 }
 
@@ -127,12 +134,12 @@ bool readTexture(TextureReading& reading, std::size_t m, GltfTexturing& out) {
     target.wrapS = wrapModeOf(sampler.wrapS);
     target.wrapT = wrapModeOf(sampler.wrapT);
   }
-  out.texCoord[m] = info.texCoord;
+  out.texCoord[m] = std::max(info.texCoord, 0);
   if (const auto ext = info.extensions.find("KHR_texture_transform");
       ext != info.extensions.end()) {
     out.transform[m] = transformOf(ext->second);
-    if (ext->second.Has("texCoord") && ext->second.Get("texCoord").IsNumber())
-      out.texCoord[m] = ext->second.Get("texCoord").GetNumberAsInt();
+    if (ext->second.Has("texCoord") && indexOf(ext->second.Get("texCoord")) >= 0)
+      out.texCoord[m] = indexOf(ext->second.Get("texCoord"));
   }
   return true;
 }

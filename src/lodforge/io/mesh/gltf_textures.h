@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -25,10 +26,11 @@ struct GltfTexturing {
     return material >= 0 && static_cast<std::size_t>(material) < texCoord.size() &&
            texCoord[static_cast<std::size_t>(material)] >= 0;
   }
+  // (A result beyond a float's range is no coordinate: 0.)
   Vec2f apply(int material, double u, double v) const {
     const auto& t = transform[static_cast<std::size_t>(material)];
-    return {static_cast<float>(t[0] * u + t[1] * v + t[2]),
-            static_cast<float>(t[3] * u + t[4] * v + t[5])};
+    const auto fit = [](double x) { return std::abs(x) < 1e30 ? static_cast<float>(x) : 0.0f; };
+    return {fit(t[0] * u + t[1] * v + t[2]), fit(t[3] * u + t[4] * v + t[5])};
   }
 };
 

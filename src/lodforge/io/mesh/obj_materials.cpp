@@ -1,6 +1,7 @@
 #include "lodforge/io/mesh/obj_materials.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <system_error>
@@ -88,8 +89,14 @@ ObjTextures resolveObjTextures(std::vector<tinyobj::material_t>& materials,
     model.materials.push_back(texturedMaterial(mtl, *image));
     const auto& o = mtl.diffuse_texopt.origin_offset;
     const auto& s = mtl.diffuse_texopt.scale;
-    textures.transform[m] = {static_cast<float>(s[0]), static_cast<float>(s[1]),
-                             static_cast<float>(o[0]), static_cast<float>(o[1])};
+    // (An option that is no usable number leaves the map as it is, said.)
+    const auto usable = [](double x) { return std::isfinite(x) && std::abs(x) < 1e6; };
+    if (usable(s[0]) && usable(s[1]) && usable(o[0]) && usable(o[1])) {
+      textures.transform[m] = {static_cast<float>(s[0]), static_cast<float>(s[1]),
+                               static_cast<float>(o[0]), static_cast<float>(o[1])};
+    } else {
+      warn(fmt::format("material '{}': map_Kd's -s or -o is no usable number; ignored", mtl.name));
+    }
   }
   return textures;
 }

@@ -46,16 +46,21 @@ void forEachLine(std::string_view text, Fn&& fn) {
 Status checkCoordinates(std::string_view text, const std::string& name) {
   Status status;
   forEachLine(text, [&](std::uint64_t line, const std::vector<std::string_view>& words) {
-    if (words.empty() || (words[0] != "v" && words[0] != "vn")) return true;
-    if (words.size() < 4) {
-      status = badInputAtLine(name, line, fmt::format("'{}' needs three coordinates", words[0]));
+    if (words.empty() || (words[0] != "v" && words[0] != "vn" && words[0] != "vt")) return true;
+    const bool texture = words[0] == "vt";
+    if (words.size() < (texture ? 2u : 4u)) {
+      status = badInputAtLine(
+          name, line,
+          fmt::format("'{}' needs {} coordinates", words[0], texture ? "two" : "three"));
       return false;
     }
-    for (std::size_t i = 1; i < words.size() && i <= 6; ++i) {
+    for (std::size_t i = 1; i < words.size() && i <= (texture ? 3u : 6u); ++i) {
       double value = 0;
       const std::string_view w = words[i];
       const auto [end, error] = std::from_chars(w.data(), w.data() + w.size(), value);
-      if (error != std::errc() || end != w.data() + w.size() || !std::isfinite(value)) {
+      // (Texture coordinates are floats: one beyond a float's range is no coordinate either.)
+      if (error != std::errc() || end != w.data() + w.size() || !std::isfinite(value) ||
+          (texture && std::abs(value) > 1e30)) {
         status = badInputAtLine(
             name, line, fmt::format("expected a finite number, found '{}'", w.substr(0, 40)));
         return false;

@@ -14,7 +14,8 @@ namespace {
 // image written beside too); "" when the model has no texture.
 Result<std::string> writeMaterials(const Model& model, const std::string& path) {
   if (!model.hasUvs() || model.images.empty()) return std::string();
-  Result<std::vector<std::string>> images = writeImagesBeside(model, path);
+  SideFiles files;
+  Result<std::vector<std::string>> images = addImagesBeside(model, path, files);
   if (!images) return images.status();
   std::string mtl = "# written by lodforge\n";
   for (std::size_t m = 0; m < model.materials.size(); ++m) {
@@ -28,7 +29,8 @@ Result<std::string> writeMaterials(const Model& model, const std::string& path) 
     }
   }
   const std::string name = std::filesystem::path(path).stem().string() + ".mtl";
-  LODFORGE_TRY(writeSideFile((std::filesystem::path(path).parent_path() / name).string(), mtl));
+  files.add((std::filesystem::path(path).parent_path() / name).string(), std::move(mtl));
+  LODFORGE_TRY(files.writeAll());
   return name;
 }
 

@@ -223,10 +223,11 @@ void PlyRecords::readVertex(PlyBatch& batch) {
         {channel(roles.red), channel(roles.green), channel(roles.blue), channel(roles.alpha)});
   }
   if (header.hasUvs) {
-    const Vec2f uv{static_cast<float>(value(roles.u)), static_cast<float>(1.0 - value(roles.v))};
-    if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
-      fail(fmt::format("vertex {}: texture coordinate is not finite", elementDone));
-    batch.uvs.push_back(uv);
+    const double u = value(roles.u), v = 1.0 - value(roles.v);
+    // (Checked in double: a float cast of a value beyond its range is undefined.)
+    if (!(std::abs(u) < 1e30 && std::abs(v) < 1e30))
+      fail(fmt::format("vertex {}: texture coordinate is not a finite number", elementDone));
+    batch.uvs.push_back({static_cast<float>(u), static_cast<float>(v)});
   }
   if (!roles.extras.empty()) {
     const std::size_t at = batch.extras.size();
@@ -280,7 +281,7 @@ void PlyRecords::readFace(PlyBatch& batch) {
       }
     } else if (static_cast<int>(i) == roles.objectId) {
       const double raw = readNumber(e, p, p.type);
-      if (raw < 0 || raw > std::numeric_limits<std::uint32_t>::max())
+      if (!(raw >= 0 && raw <= std::numeric_limits<std::uint32_t>::max()))  // NaN too
         fail(fmt::format("face {}: object id {} out of range", elementDone, raw));
       objectId = static_cast<std::uint32_t>(raw);
     } else if (static_cast<int>(i) == roles.faceTexcoords) {
@@ -288,7 +289,7 @@ void PlyRecords::readFace(PlyBatch& batch) {
     } else if (static_cast<int>(i) == roles.texnumber) {
       // -1: a face of no texture (MeshLab's way).
       const double raw = readNumber(e, p, p.type);
-      if (raw < -1 || raw >= std::numeric_limits<std::uint32_t>::max())
+      if (!(raw >= -1 && raw < std::numeric_limits<std::uint32_t>::max()))  // NaN too
         fail(fmt::format("face {}: texnumber {} out of range", elementDone, raw));
       texture = raw < 0 ? ~0u : static_cast<std::uint32_t>(raw);
     } else {
@@ -312,8 +313,8 @@ void PlyRecords::readFaceTexcoords(const PlyElement& e, const PlyProperty& p) {
     fail(fmt::format("face {}: {} texture coordinates", elementDone, count));
   for (std::uint64_t k = 0; k < count; ++k) {
     const double x = readNumber(e, p, p.type);
-    if (!std::isfinite(x))
-      fail(fmt::format("face {}: texture coordinate is not finite", elementDone));
+    if (!(std::abs(x) < 1e30))  // NaN and values past a float's range too
+      fail(fmt::format("face {}: texture coordinate is not a finite number", elementDone));
     faceUvs.push_back(static_cast<float>(k % 2 == 0 ? x : 1.0 - x));
   }
 }

@@ -151,8 +151,10 @@ Status writePly(const Model& model, const std::string& path) {
   // corners' coordinates and their image (texnumber, -1 for none).
   layout.faceUvs = model.hasUvs() && !model.images.empty();
   if (layout.faceUvs) {
-    Result<std::vector<std::string>> images = writeImagesBeside(model, path);
+    SideFiles files;
+    Result<std::vector<std::string>> images = addImagesBeside(model, path, files);
     if (!images) return images.status();
+    LODFORGE_TRY(files.writeAll());
     for (const std::string& name : *images) layout.comments.push_back("TextureFile " + name);
   }
   Result<PlyWriter> writer = PlyWriter::create(path, layout);

@@ -47,35 +47,29 @@ Status writeWhole(const std::string& path, std::string_view text) {
 
 }  // namespace
 
-Status writeSideFile(const std::string& path, std::string_view text) {
-  Result<bool> needed = sideFileNeeded(path, text);
-  if (!needed) return needed.status();
-  return *needed ? writeWhole(path, text) : Status{};
+Status SideFiles::writeAll() const {
+  std::vector<bool> needed;
+  for (const auto& [path, bytes] : files_) {
+    Result<bool> write = sideFileNeeded(path, bytes);
+    if (!write) return write.status();
+    needed.push_back(*write);
+  }
+  for (std::size_t i = 0; i < files_.size(); ++i)
+    if (needed[i]) LODFORGE_TRY(writeWhole(files_[i].first, files_[i].second));
+  return {};
 }
 
-Result<std::vector<std::string>> writeImagesBeside(const Model& model, const std::string& path) {
+Result<std::vector<std::string>> addImagesBeside(const Model& model, const std::string& path,
+                                                 SideFiles& files) {
   const std::filesystem::path target(path);
   const std::string stem = target.stem().string();
   std::vector<std::string> names;
-  std::vector<std::vector<std::byte>> contents;
-  std::vector<bool> needed;
-  // Every name checked before any is written: a refusal leaves nothing half done.
   for (std::size_t i = 0; i < model.images.size(); ++i) {
     Result<std::vector<std::byte>> bytes = imageBytes(model.images[i]);
     if (!bytes) return bytes.status();
     names.push_back(fmt::format("{}_texture{}.{}", stem, i, extensionOf(imageFormatOf(*bytes))));
-    const std::string file = (target.parent_path() / names.back()).string();
-    Result<bool> write = sideFileNeeded(
-        file, std::string_view(reinterpret_cast<const char*>(bytes->data()), bytes->size()));
-    if (!write) return write.status();
-    needed.push_back(*write);
-    contents.push_back(std::move(*bytes));
-  }
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (!needed[i]) continue;
-    LODFORGE_TRY(writeWhole(
-        (target.parent_path() / names[i]).string(),
-        std::string_view(reinterpret_cast<const char*>(contents[i].data()), contents[i].size())));
+    files.add((target.parent_path() / names.back()).string(),
+              std::string(reinterpret_cast<const char*>(bytes->data()), bytes->size()));
   }
   return names;
 }

@@ -41,89 +41,93 @@ Status timed(const Global& global, const std::string& path, Generate&& generate)
   return {};
 }
 
+void addGenerateCad(CLI::App* generate, const Global& global, Run& run) {
+  struct Options {
+    CadOptions cad;
+    std::string output;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = generate->add_subcommand(
+      "cad", "A CAD-like assembly of many parts (GLB or PLY with object ids)");
+  addCountOption(*sub, "--objects", options->cad.objects, "Number of parts (default 10K)");
+  sub->add_option("--seed", options->cad.seed, "Random seed (same seed, same file)");
+  sub->add_option("--detail", options->cad.detail, "Tessellation density factor (default 1)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option(
+      "-o,--output", options->output,
+      "Output .glb, .ply or .step (B-rep through OpenCASCADE; default cad.glb, cad.ply above "
+      "100K parts)");
+  sub->callback([&global, &run, options] {
+    if (options->output.empty())
+      options->output = options->cad.objects > 100'000 ? "cad.ply" : "cad.glb";
+    run = [&global, options] {
+      return timed(global, options->output,
+                   [&] { return generateCad(options->cad, options->output); });
+    };
+  });
+}
+
+void addGenerateScan(CLI::App* generate, const Global& global, Run& run) {
+  struct Options {
+    ScanOptions scan;
+    std::string output = "scan.ply";
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub =
+      generate->add_subcommand("scan", "One connected scanned surface of N triangles (PLY)");
+  addCountOption(*sub, "--triangles", options->scan.triangles, "Number of triangles (default 1M)");
+  sub->add_option("--seed", options->scan.seed, "Random seed");
+  sub->add_option("--texture", options->scan.textureSize,
+                  "Texture atlases of this many texels a side instead of vertex colours: 1K, "
+                  "4K, 8K or a number (photo-like JPEGs beside the PLY, named in its "
+                  "TextureFile comments)")
+      ->transform(CLI::Transformer(
+          {{"1K", "1024"}, {"2K", "2048"}, {"4K", "4096"}, {"8K", "8192"}, {"16K", "16384"}},
+          CLI::ignore_case))
+      ->check(CLI::Range(16u, 16384u));
+  sub->add_option("--atlases", options->scan.atlases,
+                  "With --texture: how many atlases over the scan (default 16)")
+      ->check(CLI::Range(1u, 1024u));
+  sub->add_option("-o,--output", options->output, "Output .ply (default scan.ply)");
+  sub->callback([&global, &run, options] {
+    run = [&global, options] {
+      return timed(global, options->output,
+                   [&] { return generateScan(options->scan, options->output); });
+    };
+  });
+}
+
+void addGeneratePoints(CLI::App* generate, const Global& global, Run& run) {
+  struct Options {
+    PointsOptions points;
+    std::string output = "points.ply";
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = generate->add_subcommand(
+      "points", "A scanned-surface point cloud of N points (PLY, or LAS with lidar attributes)");
+  addCountOption(*sub, "--points", options->points.points, "Number of points (default 1M)");
+  sub->add_option("--seed", options->points.seed, "Random seed");
+  sub->add_option("-o,--output", options->output, "Output .ply or .las (default points.ply)");
+  sub->add_flag("--extra-bytes", options->points.extraBytes,
+                "LAS: add described extra bytes (height above ground, echo width, range, "
+                "amplitude)");
+  sub->callback([&global, &run, options] {
+    run = [&global, options] {
+      return timed(global, options->output,
+                   [&] { return generatePoints(options->points, options->output); });
+    };
+  });
+}
+
 }  // namespace
 
 void addGenerate(CLI::App& app, const Global& global, Run& run) {
   CLI::App* generate =
       app.add_subcommand("generate", "Write a synthetic model: cad, scan or points");
   generate->require_subcommand(1);
-
-  {
-    struct Options {
-      CadOptions cad;
-      std::string output;
-    };
-    auto options = std::make_shared<Options>();
-    CLI::App* sub = generate->add_subcommand(
-        "cad", "A CAD-like assembly of many parts (GLB or PLY with object ids)");
-    addCountOption(*sub, "--objects", options->cad.objects, "Number of parts (default 10K)");
-    sub->add_option("--seed", options->cad.seed, "Random seed (same seed, same file)");
-    sub->add_option("--detail", options->cad.detail, "Tessellation density factor (default 1)")
-        ->check(CLI::PositiveNumber);
-    sub->add_option(
-        "-o,--output", options->output,
-        "Output .glb, .ply or .step (B-rep through OpenCASCADE; default cad.glb, cad.ply above "
-        "100K parts)");
-    sub->callback([&global, &run, options] {
-      if (options->output.empty())
-        options->output = options->cad.objects > 100'000 ? "cad.ply" : "cad.glb";
-      run = [&global, options] {
-        return timed(global, options->output,
-                     [&] { return generateCad(options->cad, options->output); });
-      };
-    });
-  }
-  {
-    struct Options {
-      ScanOptions scan;
-      std::string output = "scan.ply";
-    };
-    auto options = std::make_shared<Options>();
-    CLI::App* sub =
-        generate->add_subcommand("scan", "One connected scanned surface of N triangles (PLY)");
-    addCountOption(*sub, "--triangles", options->scan.triangles,
-                   "Number of triangles (default 1M)");
-    sub->add_option("--seed", options->scan.seed, "Random seed");
-    sub->add_option("--texture", options->scan.textureSize,
-                    "Texture atlases of this many texels a side instead of vertex colours: 1K, "
-                    "4K, 8K or a number (photo-like JPEGs beside the PLY, named in its "
-                    "TextureFile comments)")
-        ->transform(CLI::Transformer(
-            {{"1K", "1024"}, {"2K", "2048"}, {"4K", "4096"}, {"8K", "8192"}, {"16K", "16384"}},
-            CLI::ignore_case))
-        ->check(CLI::Range(16u, 16384u));
-    sub->add_option("--atlases", options->scan.atlases,
-                    "With --texture: how many atlases over the scan (default 16)")
-        ->check(CLI::Range(1u, 1024u));
-    sub->add_option("-o,--output", options->output, "Output .ply (default scan.ply)");
-    sub->callback([&global, &run, options] {
-      run = [&global, options] {
-        return timed(global, options->output,
-                     [&] { return generateScan(options->scan, options->output); });
-      };
-    });
-  }
-  {
-    struct Options {
-      PointsOptions points;
-      std::string output = "points.ply";
-    };
-    auto options = std::make_shared<Options>();
-    CLI::App* sub = generate->add_subcommand(
-        "points", "A scanned-surface point cloud of N points (PLY, or LAS with lidar attributes)");
-    addCountOption(*sub, "--points", options->points.points, "Number of points (default 1M)");
-    sub->add_option("--seed", options->points.seed, "Random seed");
-    sub->add_option("-o,--output", options->output, "Output .ply or .las (default points.ply)");
-    sub->add_flag("--extra-bytes", options->points.extraBytes,
-                  "LAS: add described extra bytes (height above ground, echo width, range, "
-                  "amplitude)");
-    sub->callback([&global, &run, options] {
-      run = [&global, options] {
-        return timed(global, options->output,
-                     [&] { return generatePoints(options->points, options->output); });
-      };
-    });
-  }
+  addGenerateCad(generate, global, run);
+  addGenerateScan(generate, global, run);
+  addGeneratePoints(generate, global, run);
 }
 
 }  // namespace lodforge::cli

@@ -33,9 +33,11 @@ export async function keepLocal(tab, report) {
   });
 }
 
-// Share of a screenshot's pixels that differ from the `background` colour ([r, g, b]; a summed
-// difference over 30), leaving out the element `skipId` covers (a stats panel), if given.
-export async function coverageOf(tab, png, background, skipId = null) {
+// Shares of a screenshot's pixels (leaving out the element `skipId` covers, a stats panel, if
+// given): `lit`, those that differ from the `background` colour ([r, g, b]; a summed difference
+// over 30); `red` and `blue`, those clearly of that hue (a red and blue texture's colours, which
+// untextured geometry, white or grey and lit, never shows, whatever the lighting).
+async function pixelSharesOf(tab, png, background, skipId) {
   return tab.evaluate(async ({ data, background, skipId }) => {
     const image = new Image();
     image.src = 'data:image/png;base64,' + data;
@@ -46,49 +48,31 @@ export async function coverageOf(tab, png, background, skipId = null) {
     const g = canvas.getContext('2d');
     g.drawImage(image, 0, 0);
     const skip = skipId ? document.getElementById(skipId).getBoundingClientRect() : null;
-    const pixels = g.getImageData(0, 0, image.width, image.height).data;
-    let lit = 0, counted = 0;
-    for (let y = 0; y < image.height; y++) {
-      for (let x = 0; x < image.width; x++) {
-        if (skip && x <= skip.right && y <= skip.bottom) continue;
-        const i = 4 * (y * image.width + x);
-        counted++;
-        const difference = Math.abs(pixels[i] - background[0]) +
-            Math.abs(pixels[i + 1] - background[1]) + Math.abs(pixels[i + 2] - background[2]);
-        if (difference > 30) lit++;
-      }
-    }
-    return lit / counted;
-  }, { data: png.toString('base64'), background, skipId });
-}
-
-// Shares of the pixels (outside the element `skipId`) that are clearly red and clearly blue:
-// the colours of a red and blue texture, which untextured geometry (white or grey, lit) never
-// shows, whatever the lighting does to their brightness.
-export async function hueSharesOf(tab, png, skipId = null) {
-  return tab.evaluate(async ({ data, skipId }) => {
-    const image = new Image();
-    image.src = 'data:image/png;base64,' + data;
-    await image.decode();
-    const canvas = document.createElement('canvas');
-    canvas.width = image.width;
-    canvas.height = image.height;
-    const g = canvas.getContext('2d');
-    g.drawImage(image, 0, 0);
-    const skip = skipId ? document.getElementById(skipId).getBoundingClientRect() : null;
     const p = g.getImageData(0, 0, image.width, image.height).data;
-    let red = 0, blue = 0, counted = 0;
+    let lit = 0, red = 0, blue = 0, counted = 0;
     for (let y = 0; y < image.height; y++) {
       for (let x = 0; x < image.width; x++) {
         if (skip && x <= skip.right && y <= skip.bottom) continue;
         const i = 4 * (y * image.width + x);
         counted++;
+        const difference = Math.abs(p[i] - background[0]) + Math.abs(p[i + 1] - background[1]) +
+            Math.abs(p[i + 2] - background[2]);
+        if (difference > 30) lit++;
         if (p[i] > 50 && p[i] > 2 * p[i + 1] && p[i] > 2 * p[i + 2]) red++;
         if (p[i + 2] > 50 && p[i + 2] > 2 * p[i] && p[i + 2] > 1.5 * p[i + 1]) blue++;
       }
     }
-    return { red: red / counted, blue: blue / counted };
-  }, { data: png.toString('base64'), skipId });
+    return { lit: lit / counted, red: red / counted, blue: blue / counted };
+  }, { data: png.toString('base64'), background, skipId });
+}
+
+export async function coverageOf(tab, png, background, skipId = null) {
+  return (await pixelSharesOf(tab, png, background, skipId)).lit;
+}
+
+export async function hueSharesOf(tab, png, skipId = null) {
+  const { red, blue } = await pixelSharesOf(tab, png, [0, 0, 0], skipId);
+  return { red, blue };
 }
 
 // Share of pixels outside the element `skipId` that differ between two screenshots of a tab.

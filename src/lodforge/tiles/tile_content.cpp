@@ -32,6 +32,60 @@ MeshPart expandedFor(const MeshPart& mesh, const TileAtlas& atlas) {
   return out;
 }
 
+// A tile's vertex arrays as its GLB holds them: relative to its centre, y-up, in fetch order.
+struct TileArrays {
+  std::vector<Vec3f> positions, normals;
+  std::vector<Rgba8> colors;
+  std::vector<std::uint32_t> features, indices;
+  std::vector<Vec2f> uvs;
+  std::vector<std::uint32_t> pageOf;  // textured: each vertex's atlas page
+};
+
+// Triangles in vertex-cache order, then vertices in first-use order (faster to draw, and what
+// the meshopt codec compresses best). The FIFO variant (Tipsify) is 2-3x faster than
+// meshopt_optimizeVertexCache, as good on scan tiles (ACMR 0.60 vs 0.63 for a 16-entry FIFO),
+// and tile writing was ~10 % of a build. Returns each vertex's new place (~0u: unused).
+std::vector<std::uint32_t> fetchOrder(const MeshPart& mesh, TileArrays& out, std::size_t& used) {
+  constexpr std::size_t kCacheSize = 16;
+  out.indices.resize(mesh.indices.size());
+  meshopt_optimizeVertexCacheFifo(out.indices.data(), mesh.indices.data(), mesh.indices.size(),
+                                  mesh.positions.size(), kCacheSize);
+  std::vector<std::uint32_t> remap(mesh.positions.size());
+  used = meshopt_optimizeVertexFetchRemap(remap.data(), out.indices.data(), out.indices.size(),
+                                          mesh.positions.size());
+  meshopt_remapIndexBuffer(out.indices.data(), out.indices.data(), out.indices.size(),
+                           remap.data());
+  return remap;
+}
+
+TileArrays tileArrays(const MeshPart& mesh, Vec3d center, bool colors, bool features,
+                      const TileAtlas* atlas) {
+  TileArrays out;
+  std::size_t used = 0;
+  const std::vector<std::uint32_t> remap = fetchOrder(mesh, out, used);
+  out.positions.resize(used);
+  out.normals.resize(used);
+  out.colors.resize(colors && !mesh.colors.empty() ? used : 0);
+  out.features.resize(features ? used : 0);
+  out.uvs.resize(atlas ? used : 0);
+  out.pageOf.resize(atlas ? used : 0);
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const std::uint32_t to = remap[v];
+    if (to == ~0u) continue;
+    out.positions[to] = toFloat(mesh.positions[v] - center);
+    if (atlas) out.uvs[to] = atlas->uvs[v], out.pageOf[to] = atlas->pageOf[v];
+    if (features) out.features[to] = mesh.features[v];
+    if (!out.colors.empty()) out.colors[to] = mesh.colors[v];
+    if (!mesh.normals.empty()) out.normals[to] = mesh.normals[v];
+  }
+  // The input's normals, the same in every tile that holds a vertex; from this mesh alone only
+  // when there are none (which leaves shading seams along tile borders).
+  if (mesh.normals.empty()) computeVertexNormals(out.positions, out.indices, out.normals);
+  for (Vec3f& p : out.positions) p = toYUp(p);
+  for (Vec3f& n : out.normals) n = toYUp(n);
+  return out;
+}
+
 }  // namespace
 
 Status writeTileContent(const MeshPart& input, const Aabbd& bounds, const std::string& path,
@@ -47,21 +101,6 @@ Status writeTileContent(const MeshPart& input, const Aabbd& bounds, const std::s
     expanded = expandedFor(input, atlas);
   }
   const MeshPart& mesh = textured ? expanded : input;
-  // Triangles in vertex-cache order, then vertices in first-use order (faster to draw, and what
-  // the meshopt codec compresses best). The FIFO variant (Tipsify) is 2-3x faster than
-  // meshopt_optimizeVertexCache, as good on scan tiles (ACMR 0.60 vs 0.63 for a 16-entry FIFO),
-  // and tile writing was ~10 % of a build.
-  constexpr std::size_t kCacheSize = 16;
-  std::vector<std::uint32_t> indices(mesh.indices.size());
-  meshopt_optimizeVertexCacheFifo(indices.data(), mesh.indices.data(), mesh.indices.size(),
-                                  mesh.positions.size(), kCacheSize);
-  std::vector<std::uint32_t> remap(mesh.positions.size());
-  const std::size_t used = meshopt_optimizeVertexFetchRemap(remap.data(), indices.data(),
-                                                            indices.size(), mesh.positions.size());
-  meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
-  std::vector<Vec3f> positions(used);
-  std::vector<Rgba8> colors(options.colors && !mesh.colors.empty() ? used : 0);
-  std::vector<Vec3f> normals(used);
   const bool features =
       options.parts != nullptr && !options.parts->empty() && !mesh.features.empty();
   // Features come from work files: one that names no part is damage, not a row to read past.
@@ -70,25 +109,8 @@ Status writeTileContent(const MeshPart& input, const Aabbd& bounds, const std::s
       if (f >= options.parts->size())
         return badInput(path, fmt::format("tile mesh names part {} of {} (damaged work file?)", f,
                                           options.parts->size()));
-  std::vector<std::uint32_t> vertexFeatures(features ? used : 0);
-  std::vector<Vec2f> uvs(textured ? used : 0);
-  std::vector<std::uint32_t> pageOf(textured ? used : 0);
-  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
-    if (remap[v] == ~0u) continue;
-    positions[remap[v]] = toFloat(mesh.positions[v] - center);
-    if (textured) {
-      uvs[remap[v]] = atlas.uvs[v];
-      pageOf[remap[v]] = atlas.pageOf[v];
-    }
-    if (features) vertexFeatures[remap[v]] = mesh.features[v];
-    if (!colors.empty()) colors[remap[v]] = mesh.colors[v];
-    if (!mesh.normals.empty()) normals[remap[v]] = mesh.normals[v];
-  }
-  // The input's normals, the same in every tile that holds a vertex; from this mesh alone only
-  // when there are none (which leaves shading seams along tile borders).
-  if (mesh.normals.empty()) computeVertexNormals(positions, indices, normals);
-  for (Vec3f& p : positions) p = toYUp(p);
-  for (Vec3f& n : normals) n = toYUp(n);
+  TileArrays arrays =
+      tileArrays(mesh, center, options.colors, features, textured ? &atlas : nullptr);
   // A tile of parts has its one node straight in the scene: 3d-tiles-renderer 0.4's
   // EXT_mesh_features loader fails on a node without a mesh (the root that holds the centre).
   Result<GlbWriter> writer =
@@ -96,30 +118,29 @@ Status writeTileContent(const MeshPart& input, const Aabbd& bounds, const std::s
                                .meshoptCompression = options.meshoptCompression,
                                .flatScene = features});
   if (!writer) return writer.status();
-  GlbMeshData data{positions, normals, colors, indices, options.quantize};
-  data.uvs = uvs;
+  GlbMeshData data{arrays.positions, arrays.normals, arrays.colors, arrays.indices,
+                   options.quantize};
+  data.uvs = arrays.uvs;
   std::vector<std::byte> featureStorage;
   std::vector<GlbVertexAttribute> extra;
   std::vector<GlbPrimitive> primitives;
   if (features) {
-    const TileFeatures tile = tileFeatures(vertexFeatures);
+    const TileFeatures tile = tileFeatures(arrays.features);
     extra.push_back(featureIdAttribute(tile.rows, featureStorage));
     LODFORGE_TRY(addPartTable(*writer, *options.parts, tile.parts));
     data.extraAttributes = extra;
     data.featureIds = GlbFeatureIds{static_cast<std::uint32_t>(tile.parts.size()), 0};
-    if (!textured) {
-      primitives =
-          groupByMaterial(*writer, *options.parts, vertexFeatures, indices, !colors.empty());
-      data.primitives = primitives;
-    }
+    if (!textured)
+      primitives = groupByMaterial(*writer, *options.parts, arrays.features, arrays.indices,
+                                   !arrays.colors.empty());
   }
   if (textured) {
-    Result<std::vector<GlbPrimitive>> pages =
-        addTilePages(*writer, atlas, pageOf, indices, *options.texturing, !colors.empty());
+    Result<std::vector<GlbPrimitive>> pages = addTilePages(
+        *writer, atlas, arrays.pageOf, arrays.indices, *options.texturing, !arrays.colors.empty());
     if (!pages) return pages.status();
     primitives = std::move(*pages);
-    data.primitives = primitives;
   }
+  data.primitives = primitives;
   Result<std::uint32_t> glbMesh = writer->addMesh(data, "tile");
   if (!glbMesh) return glbMesh.status();
   if (features) {

@@ -66,38 +66,44 @@ GlbVertexAttribute featureIdAttribute(std::span<const std::uint32_t> rows,
   return {"_FEATURE_ID_0", narrow ? kUnsignedShort : kFloat, storage};
 }
 
-std::vector<GlbPrimitive> groupByMaterial(GlbWriter& writer, const PartTable& table,
-                                          std::span<const std::uint32_t> vertexFeatures,
-                                          std::span<std::uint32_t> indices, bool vertexColors) {
-  const auto materialOf = [&](std::size_t triangle) {
-    const std::uint32_t part = vertexFeatures[indices[3 * triangle]];
-    return part < table.materials.size() ? table.materials[part] : kNoMaterial;
-  };
+std::vector<TriangleGroup> groupTriangles(std::span<std::uint32_t> indices,
+                                          std::span<const std::uint32_t> keyOf) {
   const std::size_t triangles = indices.size() / 3;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> order(triangles);  // material, triangle
-  for (std::size_t t = 0; t < triangles; ++t)
-    order[t] = {materialOf(t), static_cast<std::uint32_t>(t)};
+  assert(keyOf.size() == triangles);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> order(triangles);  // key, triangle
+  for (std::size_t t = 0; t < triangles; ++t) order[t] = {keyOf[t], static_cast<std::uint32_t>(t)};
   std::stable_sort(order.begin(), order.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   const std::vector<std::uint32_t> before(indices.begin(), indices.end());
-  std::vector<GlbPrimitive> groups;
-  std::uint32_t current = 0;
+  std::vector<TriangleGroup> groups;
   for (std::size_t i = 0; i < triangles; ++i) {
-    const auto [material, t] = order[i];
+    const auto [key, t] = order[i];
     for (std::size_t k = 0; k < 3; ++k) indices[3 * i + k] = before[3 * std::size_t{t} + k];
-    if (groups.empty() || material != current) {
-      current = material;
-      std::optional<std::uint32_t> written;
-      if (material < table.materialTable.size()) {
-        Material m = table.materialTable[material];
-        if (vertexColors) m.baseColor = {1, 1, 1, 1};
-        written = writer.addMaterial(m);
-      }
-      groups.push_back({0, written});
-    }
+    if (groups.empty() || key != groups.back().key) groups.push_back({key, 0});
     groups.back().indexCount += 3;
   }
   return groups;
+}
+
+std::vector<GlbPrimitive> groupByMaterial(GlbWriter& writer, const PartTable& table,
+                                          std::span<const std::uint32_t> vertexFeatures,
+                                          std::span<std::uint32_t> indices, bool vertexColors) {
+  std::vector<std::uint32_t> materialOf(indices.size() / 3);
+  for (std::size_t t = 0; t < materialOf.size(); ++t) {
+    const std::uint32_t part = vertexFeatures[indices[3 * t]];
+    materialOf[t] = part < table.materials.size() ? table.materials[part] : kNoMaterial;
+  }
+  std::vector<GlbPrimitive> primitives;
+  for (const TriangleGroup& group : groupTriangles(indices, materialOf)) {
+    std::optional<std::uint32_t> written;
+    if (group.key < table.materialTable.size()) {
+      Material m = table.materialTable[group.key];
+      if (vertexColors) m.baseColor = {1, 1, 1, 1};
+      written = writer.addMaterial(m);
+    }
+    primitives.push_back({group.indexCount, written});
+  }
+  return primitives;
 }
 
 Status addPartTable(GlbWriter& writer, const PartTable& table,

@@ -32,6 +32,16 @@ GlbVertexAttribute featureIdAttribute(std::span<const std::uint32_t> rows,
 Status addPartTable(GlbWriter& writer, const PartTable& table,
                     std::span<const std::uint32_t> parts);
 
+// A group of triangles: their key and how many indices they take.
+struct TriangleGroup {
+  std::uint32_t key = 0;
+  std::uint32_t indexCount = 0;
+};
+// Reorders the triangles (`indices`, in place) stably by `keyOf` (one per triangle, cache order
+// kept within a key) and returns the groups in key order.
+std::vector<TriangleGroup> groupTriangles(std::span<std::uint32_t> indices,
+                                          std::span<const std::uint32_t> keyOf);
+
 // The tile's triangles (`indices`, reordered in place) grouped by their part's material, stably
 // (cache order is kept within a group), each group a primitive with its material added to the
 // writer; parts without one share the writer's default. With `vertexColors` the base colour is

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "lodforge/tiles/tile_features.h"
+
 namespace lodforge {
 
 ImageEncodeOptions pageEncoding(const TileTexturing& texturing, const AtlasPage& page) {
@@ -34,25 +36,13 @@ Result<std::vector<GlbPrimitive>> addTilePages(GlbWriter& writer, TileAtlas& atl
     if (vertexColors) material.baseColor = {1, 1, 1, 1};
     materials[p] = writer.addMaterial(material, *texture);
   }
-  const std::size_t triangles = indices.size() / 3;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> order(triangles);  // page, triangle
-  for (std::size_t t = 0; t < triangles; ++t)
-    order[t] = {pageOfVertex[indices[3 * t]], static_cast<std::uint32_t>(t)};
-  std::stable_sort(order.begin(), order.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
-  const std::vector<std::uint32_t> before(indices.begin(), indices.end());
-  std::vector<GlbPrimitive> groups;
-  std::uint32_t current = 0;
-  for (std::size_t i = 0; i < triangles; ++i) {
-    const auto [page, t] = order[i];
-    for (std::size_t k = 0; k < 3; ++k) indices[3 * i + k] = before[3 * std::size_t{t} + k];
-    if (groups.empty() || page != current) {
-      current = page;
-      groups.push_back({0, page < materials.size() ? materials[page] : std::nullopt});
-    }
-    groups.back().indexCount += 3;
-  }
-  return groups;
+  std::vector<std::uint32_t> pageOf(indices.size() / 3);
+  for (std::size_t t = 0; t < pageOf.size(); ++t) pageOf[t] = pageOfVertex[indices[3 * t]];
+  std::vector<GlbPrimitive> primitives;
+  for (const TriangleGroup& group : groupTriangles(indices, pageOf))
+    primitives.push_back(
+        {group.indexCount, group.key < materials.size() ? materials[group.key] : std::nullopt});
+  return primitives;
 }
 
 }  // namespace lodforge

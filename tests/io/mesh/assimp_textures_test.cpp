@@ -18,12 +18,6 @@ std::string testModel(std::string_view relative) {
   return path;
 }
 
-bool said(const std::vector<std::string>& warnings, std::string_view what) {
-  for (const std::string& w : warnings)
-    if (w.find(what) != std::string::npos) return true;
-  return false;
-}
-
 TEST(AssimpTextures, AnFbxWithItsTextureEmbedded) {
   std::vector<std::string> warnings;
   Result<Model> box =
@@ -46,19 +40,20 @@ TEST(AssimpTextures, AFileInAnotherCaseIsFoundWithAWarningAndAMissingOneIsSaid) 
   ASSERT_TRUE(cube.ok());
   ASSERT_EQ(cube->images.size(), 1u);  // "TEST.PNG" is test.png beside it
   EXPECT_EQ(std::filesystem::path(cube->images[0].path).filename(), "test.png");
-  EXPECT_TRUE(said(warnings, "TEST.PNG")) << (warnings.empty() ? "" : warnings[0]);
+  EXPECT_TRUE(test::anyContains(warnings, "TEST.PNG")) << (warnings.empty() ? "" : warnings[0]);
   // The spider's FBX names its textures on a Windows drive that is not here.
   warnings.clear();
   Result<Model> spider = readAssimp(testModel("FBX/spider.fbx"), &warnings);
   ASSERT_TRUE(spider.ok());
   EXPECT_TRUE(spider->images.empty());
-  EXPECT_TRUE(said(warnings, "drwood2.jpg") || said(warnings, "drkwood2.jpg"));
-  EXPECT_TRUE(said(warnings, "drawn without its texture"));
+  EXPECT_TRUE(test::anyContains(warnings, "drwood2.jpg") ||
+              test::anyContains(warnings, "drkwood2.jpg"));
+  EXPECT_TRUE(test::anyContains(warnings, "drawn without its texture"));
   // A TGA (Collada's duck) is no image we read: said, not drawn wrong.
   warnings.clear();
   Result<Model> duck = readAssimp(testModel("Collada/duck.dae"), &warnings);
   ASSERT_TRUE(duck.ok());
-  EXPECT_TRUE(said(warnings, "duckCM.tga"));
+  EXPECT_TRUE(test::anyContains(warnings, "duckCM.tga"));
 }
 
 }  // namespace

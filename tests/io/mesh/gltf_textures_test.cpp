@@ -8,24 +8,10 @@
 #include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/io/mesh/gltf_reader.h"
-#include "test_support.h"
+#include "texture_support.h"
 
 namespace lodforge {
 namespace {
-
-std::vector<std::byte> pngOf(std::uint32_t width, std::uint32_t height) {
-  Image image(width, height);
-  for (std::size_t i = 0; i < image.rgba.size(); ++i)
-    image.rgba[i] = static_cast<std::uint8_t>(i * 13);
-  Result<std::vector<std::byte>> png = encodeImage(image, {.format = ImageFormat::kPng});
-  EXPECT_TRUE(png.ok());
-  return png.ok() ? *png : std::vector<std::byte>{};
-}
-
-void writeBytes(const std::string& path, std::span<const std::byte> bytes) {
-  test::writeFile(path,
-                  std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
-}
 
 // One triangle with two TEXCOORD sets in geo.bin; the material's texture reads set 1 through a
 // KHR_texture_transform (offset (0.5, 0), a quarter turn, scale (2, 3)) and wraps mirror/clamp.
@@ -41,7 +27,7 @@ struct TransformedTriangle {
     std::memcpy(bin.data() + 36, uv0, sizeof uv0);
     std::memcpy(bin.data() + 60, uv1.data(), sizeof uv1);
     test::writeFile(dir.file("geo.bin"), bin);
-    if (withImage) writeBytes(dir.file("tex.png"), pngOf(8, 4));
+    if (withImage) test::writeBytes(dir.file("tex.png"), test::patternPng(8, 4));
     test::writeFile(dir.file("scene.gltf"), fmt::format(R"({{
   "asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
   "nodes": [{{"mesh": 0, "name": "tri"}}],

@@ -4,27 +4,10 @@
 
 #include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/mesh/obj_reader.h"
-#include "test_support.h"
+#include "texture_support.h"
 
 namespace lodforge {
 namespace {
-
-// A small PNG texture file of `width` x `height`.
-void writeTexture(const std::string& path, std::uint32_t width = 16, std::uint32_t height = 8) {
-  Image image(width, height);
-  for (std::size_t i = 0; i < image.rgba.size(); ++i)
-    image.rgba[i] = static_cast<std::uint8_t>(i * 7);
-  Result<std::vector<std::byte>> png = encodeImage(image, {.format = ImageFormat::kPng});
-  ASSERT_TRUE(png.ok());
-  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-  test::writeFile(path, std::string_view(reinterpret_cast<const char*>(png->data()), png->size()));
-}
-
-bool mentions(const std::vector<std::string>& warnings, std::string_view what) {
-  for (const std::string& w : warnings)
-    if (w.find(what) != std::string::npos) return true;
-  return false;
-}
 
 // One textured quad (material `tex`) and one triangle of an untextured material (`plain`).
 constexpr std::string_view kQuadObj =
@@ -56,7 +39,7 @@ TEST(ObjMaterials, SpiderFindsItsWindowsPathedTexturesBesideTheFile) {
 
 TEST(ObjMaterials, MapOptionsSpacesAndALibraryInAFolder) {
   test::TempDir dir;
-  writeTexture(dir.file("mats/tex dir/my tex.png"), 32, 16);
+  test::writePatternPng(dir.file("mats/tex dir/my tex.png"), 32, 16);
   test::writeFile(dir.file("mats/scene.mtl"),
                   "newmtl tex\nKd 0.3 0.3 0.3\nmap_Kd -s 2 2 1 -o 0.5 0.25 0 tex dir/my tex.png  \n"
                   "newmtl plain\nKd 1 0 0\n");
@@ -100,9 +83,9 @@ TEST(ObjMaterials, AMissingOrBrokenTextureIsAWarningAndAGreyMaterial) {
     Result<Model> model = readObj(dir.file("scene.obj"), &warnings);
     ASSERT_TRUE(model.ok()) << model.error().message;
     ASSERT_EQ(warnings.size(), 1u);
-    EXPECT_TRUE(mentions(warnings, "photo.png")) << warnings[0];
-    EXPECT_TRUE(mentions(warnings, "grey")) << warnings[0];
-    EXPECT_TRUE(mentions(warnings, broken ? "not a JPEG, PNG or WebP" : "not found"))
+    EXPECT_TRUE(test::anyContains(warnings, "photo.png")) << warnings[0];
+    EXPECT_TRUE(test::anyContains(warnings, "grey")) << warnings[0];
+    EXPECT_TRUE(test::anyContains(warnings, broken ? "not a JPEG, PNG or WebP" : "not found"))
         << warnings[0];
     EXPECT_TRUE(model->images.empty());
     EXPECT_FALSE(model->hasUvs());
@@ -112,7 +95,7 @@ TEST(ObjMaterials, AMissingOrBrokenTextureIsAWarningAndAGreyMaterial) {
 
 TEST(ObjMaterials, AnAbsolutePathFromAnotherMachineIsFoundBesideTheFileWithAWarning) {
   test::TempDir dir;
-  writeTexture(dir.file("photo.png"));
+  test::writePatternPng(dir.file("photo.png"));
   test::writeFile(dir.file("scene.mtl"),
                   "newmtl tex\nmap_Kd C:\\Users\\someone\\Desktop\\photo.png\nnewmtl plain\n");
   test::writeFile(dir.file("scene.obj"), kQuadObj);
@@ -121,19 +104,21 @@ TEST(ObjMaterials, AnAbsolutePathFromAnotherMachineIsFoundBesideTheFileWithAWarn
   ASSERT_TRUE(model.ok());
   ASSERT_EQ(model->images.size(), 1u);
   EXPECT_EQ(model->images[0].path, dir.file("photo.png"));
-  EXPECT_TRUE(mentions(warnings, "beside the model")) << (warnings.empty() ? "" : warnings[0]);
+  EXPECT_TRUE(test::anyContains(warnings, "beside the model"))
+      << (warnings.empty() ? "" : warnings[0]);
 }
 
 TEST(ObjMaterials, TexturedCornersWithoutCoordinatesAreCounted) {
   test::TempDir dir;
-  writeTexture(dir.file("photo.png"));
+  test::writePatternPng(dir.file("photo.png"));
   test::writeFile(dir.file("scene.mtl"), "newmtl tex\nmap_Kd photo.png\n");
   test::writeFile(dir.file("scene.obj"),
                   "mtllib scene.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nusemtl tex\nf 1/1 2 3\n");
   std::vector<std::string> warnings;
   Result<Model> model = readObj(dir.file("scene.obj"), &warnings);
   ASSERT_TRUE(model.ok());
-  EXPECT_TRUE(mentions(warnings, "2 corners of textured faces have no texture coordinate"));
+  EXPECT_TRUE(
+      test::anyContains(warnings, "2 corners of textured faces have no texture coordinate"));
   // An index past the file's vt lines is bad input, positioned.
   test::writeFile(
       dir.file("bad.obj"),

@@ -5,24 +5,10 @@
 #include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/mesh/ply_reader.h"
 #include "lodforge/io/mesh/ply_writer.h"
-#include "test_support.h"
+#include "texture_support.h"
 
 namespace lodforge {
 namespace {
-
-void writePng(const std::string& path) {
-  Image image(8, 8);
-  for (std::size_t i = 0; i < image.rgba.size(); ++i) image.rgba[i] = static_cast<std::uint8_t>(i);
-  Result<std::vector<std::byte>> png = encodeImage(image, {.format = ImageFormat::kPng});
-  ASSERT_TRUE(png.ok());
-  test::writeFile(path, std::string_view(reinterpret_cast<const char*>(png->data()), png->size()));
-}
-
-bool warned(const std::vector<std::string>& warnings, std::string_view what) {
-  for (const std::string& w : warnings)
-    if (w.find(what) != std::string::npos) return true;
-  return false;
-}
 
 constexpr std::string_view kVertexUvPly =
     "ply\nformat ascii 1.0\ncomment TextureFile photo.png\nelement vertex 4\n"
@@ -32,7 +18,7 @@ constexpr std::string_view kVertexUvPly =
 
 TEST(PlyTextures, VertexCoordinatesAndATextureFile) {
   test::TempDir dir;
-  writePng(dir.file("photo.png"));
+  test::writePatternPng(dir.file("photo.png"), 8, 8);
   test::writeFile(dir.file("quad.ply"), kVertexUvPly);
   std::vector<std::string> warnings;
   Result<Model> model = readPly(dir.file("quad.ply"), {.warnings = &warnings});
@@ -50,8 +36,8 @@ TEST(PlyTextures, VertexCoordinatesAndATextureFile) {
 
 TEST(PlyTextures, FaceCoordinatesAndTexnumbersMakeAnObjectPerTexture) {
   test::TempDir dir;
-  writePng(dir.file("a.png"));
-  writePng(dir.file("b.png"));
+  test::writePatternPng(dir.file("a.png"), 8, 8);
+  test::writePatternPng(dir.file("b.png"), 8, 8);
   PlyLayout layout{.vertexCount = 4, .faceCount = 2, .faceUvs = true};
   layout.comments = {"TextureFile a.png", "TextureFile b.png"};
   Result<PlyWriter> writer = PlyWriter::create(dir.file("two.ply"), layout);
@@ -89,8 +75,8 @@ TEST(PlyTextures, MissingTexturesStrayNumbersAndBadListsAreSaid) {
   std::vector<std::string> warnings;
   Result<Model> model = readPly(dir.file("quad.ply"), {.warnings = &warnings});
   ASSERT_TRUE(model.ok());
-  EXPECT_TRUE(warned(warnings, "photo.png")) << (warnings.empty() ? "" : warnings[0]);
-  EXPECT_TRUE(warned(warnings, "grey"));
+  EXPECT_TRUE(test::anyContains(warnings, "photo.png")) << (warnings.empty() ? "" : warnings[0]);
+  EXPECT_TRUE(test::anyContains(warnings, "grey"));
   EXPECT_TRUE(model->images.empty());
   EXPECT_EQ(model->materials[model->objects[0].material].baseColor[0], 0.5f);
   // Coordinates without a texture file: a warning.
@@ -99,7 +85,7 @@ TEST(PlyTextures, MissingTexturesStrayNumbersAndBadListsAreSaid) {
   test::writeFile(dir.file("plain.ply"), plain);
   warnings.clear();
   ASSERT_TRUE(readPly(dir.file("plain.ply"), {.warnings = &warnings}).ok());
-  EXPECT_TRUE(warned(warnings, "no 'comment TextureFile' line"));
+  EXPECT_TRUE(test::anyContains(warnings, "no 'comment TextureFile' line"));
   // A texnumber past the files, and a texcoord list of the wrong length: bad input, named.
   const std::string faces =
       "ply\nformat ascii 1.0\ncomment TextureFile photo.png\nelement vertex 3\nproperty float x\n"

@@ -42,41 +42,6 @@ void jpegWarning(j_common_ptr info, int level) {
   if (error->manager.num_warnings++ == 0) (*info->err->format_message)(info, error->message);
 }
 
-bool decodeJpegInto(std::span<const std::byte> bytes, Image& out, std::uint64_t maxPixels,
-                    JpegError& error) {
-  jpeg_decompress_struct info;
-  info.err = jpeg_std_error(&error.manager);
-  error.manager.error_exit = jpegErrorExit;
-  error.manager.emit_message = jpegWarning;
-  if (setjmp(error.jump)) {
-    jpeg_destroy_decompress(&info);
-    return false;
-  }
-  jpeg_create_decompress(&info);
-  jpeg_mem_src(&info, reinterpret_cast<const unsigned char*>(bytes.data()),
-               static_cast<unsigned long>(bytes.size()));
-  jpeg_read_header(&info, TRUE);
-  if (std::uint64_t{info.image_width} * info.image_height > maxPixels) {
-    std::snprintf(error.message, sizeof error.message, "%ux%u pixels is more than %llu megapixels",
-                  info.image_width, info.image_height,
-                  static_cast<unsigned long long>(maxPixels / 1000000));
-    jpeg_destroy_decompress(&info);
-    return false;
-  }
-  info.out_color_space = JCS_EXT_RGBA;
-  jpeg_start_decompress(&info);
-  out.width = info.output_width;
-  out.height = info.output_height;
-  out.rgba.resize(out.pixelCount() * 4);
-  while (info.output_scanline < info.output_height) {
-    JSAMPROW row = out.rgba.data() + std::size_t{info.output_scanline} * out.width * 4;
-    jpeg_read_scanlines(&info, &row, 1);
-  }
-  jpeg_finish_decompress(&info);
-  jpeg_destroy_decompress(&info);
-  return error.manager.num_warnings == 0;
-}
-
 // Streams a JPEG's rows (from memory or a file) to `row`; libjpeg's errors jump back here, past
 // libjpeg's frames only. The callbacks' status is kept in `failed`.
 bool decodeJpegRows(std::span<const std::byte> bytes, std::FILE* file, std::uint64_t maxPixels,
@@ -146,12 +111,28 @@ bool readJpegHeader(std::span<const std::byte> bytes, int& width, int& height, i
   return error.manager.num_warnings == 0;
 }
 
+// A whole JPEG: its rows (decodeJpegRows) gathered into one image.
 Result<Image> decodeJpeg(std::span<const std::byte> bytes, const std::string& name,
                          std::uint64_t maxPixels) {
   Image image;
+  std::size_t row = 0;
   JpegError error{};
-  if (!decodeJpegInto(bytes, image, maxPixels, error))
-    return badInput(name, fmt::format("cannot decode the JPEG image ({})", error.message));
+  Status failed;
+  std::vector<std::uint8_t> scanline;
+  const bool ok = decodeJpegRows(
+      bytes, nullptr, maxPixels,
+      [&](std::uint32_t width, std::uint32_t height) -> Status {
+        image = Image(width, height);
+        return {};
+      },
+      [&](const std::uint8_t* pixels) -> Status {
+        std::copy_n(pixels, std::size_t{image.width} * 4,
+                    image.rgba.data() + row++ * image.width * 4);
+        return {};
+      },
+      error, failed, scanline);
+  LODFORGE_TRY(failed);
+  if (!ok) return badInput(name, fmt::format("cannot decode the JPEG image ({})", error.message));
   return image;
 }
 

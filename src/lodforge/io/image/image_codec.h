@@ -43,7 +43,7 @@ Status decodeImageRows(const ImageSource& image, std::uint64_t maxPixels,
 
 struct ImageEncodeOptions {
   ImageFormat format = ImageFormat::kJpeg;
-  int quality = 90;     // JPEG and WebP, 1..100 (PNG is lossless)
+  int quality = 90;       // JPEG and WebP, 1..100 (PNG is lossless)
   std::string comment{};  // JPEG: a COM marker with this text (empty: none)
 };
 // JPEG drops alpha (a texture with alpha goes to PNG or WebP: the caller decides).

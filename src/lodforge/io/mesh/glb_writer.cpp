@@ -66,6 +66,12 @@ struct GlbWriter::State {
                             nlohmann::json& attributes);
   Status addColors(const GlbMeshData& mesh, nlohmann::json& attributes);
   Status addUvs(const GlbMeshData& mesh, nlohmann::json& attributes);
+  // finish()'s steps: the scene, the geometry's and the appearance's parts of the document,
+  // and the file.
+  nlohmann::json sceneDocument();
+  void addGeometry(nlohmann::json& document);
+  void addAppearance(nlohmann::json& document);
+  Status writeFile(const std::string& json);
   Status addExtraAttributes(const GlbMeshData& mesh, nlohmann::json& attributes);
   Result<std::uint32_t> addIndices(const GlbMeshData& mesh);
   // A primitive over `attributes` drawing the mesh's indices with `material` (default: white).
@@ -491,73 +497,78 @@ std::uint64_t GlbWriter::binaryBytes() const {
   return state_->binaryBytes;
 }
 
-Status GlbWriter::finish() {
-  State& s = *state_;
-  assert(!s.options.flatScene || !s.rootTranslation);
-  for (std::size_t n = 0; n < s.children.size(); ++n)
-    if (!s.children[n].empty()) s.nodes[n]["children"] = s.children[n];
+// The node tree with the root node (or, flat, without it) and the scene over it.
+nlohmann::json GlbWriter::State::sceneDocument() {
+  assert(!options.flatScene || !rootTranslation);
+  for (std::size_t n = 0; n < children.size(); ++n)
+    if (!children[n].empty()) nodes[n]["children"] = children[n];
   // The root node holds every object node, and the origin offset if there is one.
-  nlohmann::json root = {{"name", s.rootName}};
-  if (!s.rootChildren.empty()) root["children"] = s.rootChildren;
-  if (s.rootTranslation && *s.rootTranslation != Vec3d{})
-    root["translation"] = {s.rootTranslation->x, s.rootTranslation->y, s.rootTranslation->z};
-  nlohmann::json sceneNodes = s.rootChildren;
-  if (!s.options.flatScene) {
-    s.nodes.push_back(std::move(root));
-    sceneNodes = {s.nodes.size() - 1};
+  nlohmann::json root = {{"name", rootName}};
+  if (!rootChildren.empty()) root["children"] = rootChildren;
+  if (rootTranslation && *rootTranslation != Vec3d{})
+    root["translation"] = {rootTranslation->x, rootTranslation->y, rootTranslation->z};
+  nlohmann::json sceneNodes = rootChildren;
+  if (!options.flatScene) {
+    nodes.push_back(std::move(root));
+    sceneNodes = {nodes.size() - 1};
   }
-  nlohmann::json document = {{"asset", {{"version", "2.0"}, {"generator", kGenerator}}},
-                             {"scene", 0},
-                             {"scenes", {{{"nodes", sceneNodes}}}},
-                             {"nodes", std::move(s.nodes)}};
-  if (!s.meshes.empty()) {
-    document["meshes"] = std::move(s.meshes);
-    document["accessors"] = std::move(s.accessors);
-    document["bufferViews"] = std::move(s.bufferViews);
-    document["buffers"] = {{{"byteLength", s.binaryBytes}}};
-    if (s.options.meshoptCompression) {
-      // The views describe an uncompressed buffer that exists only once decoded.
-      document["buffers"].push_back(
-          {{"byteLength", s.fallbackBytes},
-           {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
-      document["extensionsUsed"].push_back("EXT_meshopt_compression");
-      document["extensionsRequired"].push_back("EXT_meshopt_compression");
-    }
-    const bool quantized = std::any_of(s.dequantize.begin(), s.dequantize.end(),
-                                       [](const auto& grid) { return grid.has_value(); });
-    if (quantized) {
-      document["extensionsUsed"].push_back("KHR_mesh_quantization");
-      document["extensionsRequired"].push_back("KHR_mesh_quantization");
-    }
+  return {{"asset", {{"version", "2.0"}, {"generator", kGenerator}}},
+          {"scene", 0},
+          {"scenes", {{{"nodes", sceneNodes}}}},
+          {"nodes", std::move(nodes)}};
+}
+
+void GlbWriter::State::addGeometry(nlohmann::json& document) {
+  if (meshes.empty()) return;
+  document["meshes"] = std::move(meshes);
+  document["accessors"] = std::move(accessors);
+  document["bufferViews"] = std::move(bufferViews);
+  document["buffers"] = {{{"byteLength", binaryBytes}}};
+  if (options.meshoptCompression) {
+    // The views describe an uncompressed buffer that exists only once decoded.
+    document["buffers"].push_back(
+        {{"byteLength", fallbackBytes},
+         {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}});
+    document["extensionsUsed"].push_back("EXT_meshopt_compression");
+    document["extensionsRequired"].push_back("EXT_meshopt_compression");
   }
-  if (!s.materials.empty()) document["materials"] = std::move(s.materials);
-  if (!s.textures.empty()) {
-    document["images"] = std::move(s.images);
-    document["samplers"] = std::move(s.samplers);
-    document["textures"] = std::move(s.textures);
+  const bool quantized = std::any_of(dequantize.begin(), dequantize.end(),
+                                     [](const auto& grid) { return grid.has_value(); });
+  if (quantized) {
+    document["extensionsUsed"].push_back("KHR_mesh_quantization");
+    document["extensionsRequired"].push_back("KHR_mesh_quantization");
+  }
+}
+
+void GlbWriter::State::addAppearance(nlohmann::json& document) {
+  if (!materials.empty()) document["materials"] = std::move(materials);
+  if (!textures.empty()) {
+    document["images"] = std::move(images);
+    document["samplers"] = std::move(samplers);
+    document["textures"] = std::move(textures);
     // Every texture is WebP (no fallback image): a viewer without the extension draws nothing.
-    if (s.webp) {
+    if (webp) {
       document["extensionsUsed"].push_back("EXT_texture_webp");
       document["extensionsRequired"].push_back("EXT_texture_webp");
     }
   }
-  if (!s.structuralMetadata.empty()) {
-    document["extensions"]["EXT_structural_metadata"] = nlohmann::json::parse(s.structuralMetadata);
+  if (!structuralMetadata.empty()) {
+    document["extensions"]["EXT_structural_metadata"] = nlohmann::json::parse(structuralMetadata);
     document["extensionsUsed"].push_back("EXT_structural_metadata");
   }
-  if (s.meshFeatures) document["extensionsUsed"].push_back("EXT_mesh_features");
-  // (Names come from inputs and may not be UTF-8: replaced rather than thrown on.)
-  std::string json = document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  while (json.size() % 4 != 0) json += ' ';
+  if (meshFeatures) document["extensionsUsed"].push_back("EXT_mesh_features");
+}
 
-  const bool hasBinary = s.binaryBytes > 0;
-  const std::uint64_t total = 12 + 8 + json.size() + (hasBinary ? 8 + s.binaryBytes : 0);
+// Header, JSON chunk and binary chunk (the spilled part copied in first), under a temporary name.
+Status GlbWriter::State::writeFile(const std::string& json) {
+  const bool hasBinary = binaryBytes > 0;
+  const std::uint64_t total = 12 + 8 + json.size() + (hasBinary ? 8 + binaryBytes : 0);
   if (total > 0xFFFFFFFFull) {
     return Error{
         ErrorKind::kLimit,
-        fmt::format("{}: GLB would be {} bytes; the format's limit is 4 GiB", s.path, total)};
+        fmt::format("{}: GLB would be {} bytes; the format's limit is 4 GiB", path, total)};
   }
-  Result<OutputFile> out = OutputFile::create(s.path);
+  Result<OutputFile> out = OutputFile::create(path);
   if (!out) return out.status();
   const std::uint32_t header[3] = {kGlbMagic, 2, static_cast<std::uint32_t>(total)};
   const std::uint32_t jsonChunk[2] = {static_cast<std::uint32_t>(json.size()), kChunkJson};
@@ -565,20 +576,31 @@ Status GlbWriter::finish() {
   LODFORGE_TRY(out->write(jsonChunk, sizeof jsonChunk));
   LODFORGE_TRY(out->write(json.data(), json.size()));
   if (hasBinary) {
-    const std::uint32_t binChunk[2] = {static_cast<std::uint32_t>(s.binaryBytes), kChunkBin};
+    const std::uint32_t binChunk[2] = {static_cast<std::uint32_t>(binaryBytes), kChunkBin};
     LODFORGE_TRY(out->write(binChunk, sizeof binChunk));
-    if (s.spill) {
+    if (spill) {
       // The spilled part is committed to a side file, copied in, then removed.
-      const std::uint64_t spilled = s.spill->bytesWritten();
-      LODFORGE_TRY(s.spill->commit());
-      s.spill.reset();
-      Status copied = out->appendFileContents(s.spillPath, spilled);
-      ::remove(s.spillPath.c_str());
+      const std::uint64_t spilled = spill->bytesWritten();
+      LODFORGE_TRY(spill->commit());
+      spill.reset();
+      Status copied = out->appendFileContents(spillPath, spilled);
+      ::remove(spillPath.c_str());
       LODFORGE_TRY(copied);
     }
-    LODFORGE_TRY(out->write(s.binary.data(), s.binary.size()));
+    LODFORGE_TRY(out->write(binary.data(), binary.size()));
   }
   return out->commit();
+}
+
+Status GlbWriter::finish() {
+  State& s = *state_;
+  nlohmann::json document = s.sceneDocument();
+  s.addGeometry(document);
+  s.addAppearance(document);
+  // (Names come from inputs and may not be UTF-8: replaced rather than thrown on.)
+  std::string json = document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  while (json.size() % 4 != 0) json += ' ';
+  return s.writeFile(json);
 }
 
 namespace {

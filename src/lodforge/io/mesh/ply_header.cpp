@@ -242,6 +242,32 @@ PlyHeader parsePlyHeader(ByteSource& source, std::uint64_t& lineNumber) {
   return HeaderParser(source, lineNumber).parse();
 }
 
+namespace {
+
+// A face's roles: its index list, object id (the first candidate that is a scalar), corner
+// texture coordinates (a list) and texture number (a scalar).
+void assignFaceRoles(PlyHeader& header, const std::string& name,
+                     std::span<const std::string> objectIdProperties, PlyRoles& roles) {
+  const PlyElement& f = header.elements[static_cast<std::size_t>(roles.faceElement)];
+  const auto isList = [&](int role) { return f.properties[static_cast<std::size_t>(role)].isList; };
+  roles.faceIndices = indexListRole(name, f);
+  for (const std::string& candidate : objectIdProperties) {
+    roles.objectId = findProperty(f, {candidate});
+    if (roles.objectId >= 0 && !isList(roles.objectId)) break;
+    roles.objectId = -1;
+  }
+  header.faceCount = f.count;
+  header.hasObjectIds = roles.objectId >= 0;
+  roles.faceTexcoords = findProperty(f, {"texcoord"});
+  if (roles.faceTexcoords >= 0 && !isList(roles.faceTexcoords)) roles.faceTexcoords = -1;
+  roles.texnumber = findProperty(f, {"texnumber"});
+  if (roles.texnumber >= 0 && isList(roles.texnumber)) roles.texnumber = -1;
+  header.hasFaceUvs = roles.faceTexcoords >= 0;
+  header.hasTextureNumbers = roles.texnumber >= 0;
+}
+
+}  // namespace
+
 PlyRoles assignPlyRoles(PlyHeader& header, const std::string& name, bool readExtras,
                         std::span<const std::string> objectIdProperties) {
   PlyRoles roles;
@@ -290,27 +316,7 @@ PlyRoles assignPlyRoles(PlyHeader& header, const std::string& name, bool readExt
                                                     "vertices per file",
                                                     header.vertexCount))};
   }
-  if (roles.faceElement >= 0) {
-    const PlyElement& f = header.elements[static_cast<std::size_t>(roles.faceElement)];
-    roles.faceIndices = indexListRole(name, f);
-    for (const std::string& candidate : objectIdProperties) {
-      roles.objectId = findProperty(f, {candidate});
-      if (roles.objectId >= 0 && !f.properties[static_cast<std::size_t>(roles.objectId)].isList)
-        break;
-      roles.objectId = -1;
-    }
-    header.faceCount = f.count;
-    header.hasObjectIds = roles.objectId >= 0;
-    roles.faceTexcoords = findProperty(f, {"texcoord"});
-    if (roles.faceTexcoords >= 0 &&
-        !f.properties[static_cast<std::size_t>(roles.faceTexcoords)].isList)
-      roles.faceTexcoords = -1;
-    roles.texnumber = findProperty(f, {"texnumber"});
-    if (roles.texnumber >= 0 && f.properties[static_cast<std::size_t>(roles.texnumber)].isList)
-      roles.texnumber = -1;
-    header.hasFaceUvs = roles.faceTexcoords >= 0;
-    header.hasTextureNumbers = roles.texnumber >= 0;
-  }
+  if (roles.faceElement >= 0) assignFaceRoles(header, name, objectIdProperties, roles);
   if (roles.stripElement >= 0) {
     const PlyElement& s = header.elements[static_cast<std::size_t>(roles.stripElement)];
     roles.stripIndices = indexListRole(name, s);

@@ -96,6 +96,41 @@ TEST(Quadric, PairEvaluationEqualsSingleEvaluationToTheBit) {
   EXPECT_DOUBLE_EQ(off, 9.0);
 }
 
+// The texture quadric of a triangle is the squared distance between a point's coordinates and
+// the triangle's linear coordinate function there (its value in the triangle's plane; moving
+// along the normal changes nothing), weighted; sums add.
+TEST(UvQuadric, MeasuresCoordinatesAgainstTheTrianglesLinearFunction) {
+  Random random(11);
+  for (int round = 0; round < 50; ++round) {
+    std::array<Vec3d, 3> p;
+    std::array<Vec2f, 3> uv;
+    for (std::size_t k = 0; k < 3; ++k) {
+      p[k] = {random.uniform(-3, 3), random.uniform(-3, 3), random.uniform(-3, 3)};
+      uv[k] = {float(random.uniform(0, 1)), float(random.uniform(0, 1))};
+    }
+    const double weight = random.uniform(0.1, 4);
+    const UvQuadric q = UvQuadric::fromTriangle(p[0], p[1], p[2], uv[0], uv[1], uv[2], weight);
+    // At a point of the triangle (barycentric s, r) lifted off its plane by h.
+    const double s = random.uniform(-0.5, 1), r = random.uniform(-0.5, 1);
+    const Vec3d n = normalizeOr(cross(p[1] - p[0], p[2] - p[0]), Vec3d{});
+    const Vec3d at = p[0] + (p[1] - p[0]) * s + (p[2] - p[0]) * r + n * random.uniform(-1, 1);
+    const Vec2f exact{float(uv[0].x + s * (uv[1].x - uv[0].x) + r * (uv[2].x - uv[0].x)),
+                      float(uv[0].y + s * (uv[1].y - uv[0].y) + r * (uv[2].y - uv[0].y))};
+    EXPECT_NEAR(q.evaluate(at, exact), 0.0, 1e-6 * weight);
+    const Vec2f off{exact.x + 0.25f, exact.y - 0.5f};
+    const double expected = weight * (double(off.x - exact.x) * (off.x - exact.x) +
+                                      double(off.y - exact.y) * (off.y - exact.y));
+    EXPECT_NEAR(q.evaluate(at, off), expected, 1e-6 * weight);
+    UvQuadric twice = q;
+    twice += q;
+    EXPECT_NEAR(twice.evaluate(at, off), 2 * expected, 2e-6 * weight);
+  }
+  // No area, no term.
+  const UvQuadric flat =
+      UvQuadric::fromTriangle({0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {}, {1, 0}, {0, 1}, 1);
+  EXPECT_EQ(flat.evaluate({1, 2, 3}, {5, 5}), 0.0);
+}
+
 TEST(Box3, EmptyAbsorbsPoints) {
   Aabb box;
   EXPECT_TRUE(box.empty());

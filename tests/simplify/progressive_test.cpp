@@ -413,5 +413,154 @@ TEST(Progressive, AttributesFollowTheirVertices) {
   }
 }
 
+// A flat square of n x n cells, textured: each vertex has one wedge per chart its cells belong
+// to, charts given per cell, coordinates by a function of the chart and the point.
+struct TexturedGrid {
+  std::vector<Vec3f> positions;
+  std::vector<std::uint32_t> indices, wedges;
+  std::vector<Vec2f> uvs;
+  std::vector<std::uint32_t> wedgeVertex, wedgeChart;
+};
+
+template <class Chart, class Uv>
+TexturedGrid texturedGrid(int n, Chart chartOf, Uv uvOf) {
+  TexturedGrid grid;
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> wedgeOf;  // (vertex, chart)
+  const auto vertex = [&](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      grid.positions.push_back({float(i) / float(n), float(j) / float(n), 0});
+  const auto corner = [&](std::uint32_t v, std::uint32_t chart) {
+    const auto [at, fresh] = wedgeOf.emplace(std::pair{v, chart}, grid.uvs.size());
+    if (fresh) {
+      grid.uvs.push_back(uvOf(chart, grid.positions[v]));
+      grid.wedgeVertex.push_back(v);
+      grid.wedgeChart.push_back(chart);
+    }
+    grid.indices.push_back(v);
+    grid.wedges.push_back(at->second);
+  };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const std::uint32_t chart = chartOf((i + 0.5) / n, (j + 0.5) / n);
+      for (std::uint32_t v : {vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j),
+                              vertex(i + 1, j + 1), vertex(i, j + 1)})
+        corner(v, chart);
+    }
+  }
+  return grid;
+}
+
+double uvArea(Vec2f a, Vec2f b, Vec2f c) {
+  return (double(b.x) - a.x) * (double(c.y) - a.y) - (double(c.x) - a.x) * (double(b.y) - a.y);
+}
+
+TEST(SimplifyMesh, TexturedSeamsSlideAlongThemselvesAndEveryTriangleKeepsOneChart) {
+  // Three charts: the left half, and the right half cut in two (a T where the seams meet).
+  const auto chartOf = [](double x, double y) { return x < 0.5 ? 0u : y < 0.5 ? 1u : 2u; };
+  const auto uvOf = [](std::uint32_t chart, Vec3f p) {
+    return Vec2f{0.3f * p.x + 0.3f * float(chart), 0.5f * p.y};
+  };
+  const TexturedGrid grid = texturedGrid(24, chartOf, uvOf);
+  ProgressiveOptions options;
+  options.wedges = grid.wedges;
+  options.wedgeUvs = grid.uvs;
+  options.stopAtTriangles = 1;
+  const SimplifiedMesh out = simplifyMesh(grid.positions, grid.indices, options);
+  ASSERT_EQ(out.wedges.size(), out.indices.size());
+  ASSERT_GT(out.indices.size(), 0u);
+  double area = 0;
+  std::set<std::uint32_t> seamVertices;
+  for (std::size_t t = 0; t < out.indices.size(); t += 3) {
+    std::array<Vec3f, 3> p;
+    std::array<Vec2f, 3> uv;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t v = out.vertices[out.indices[t + k]], w = out.wedges[t + k];
+      // Each corner's wedge belongs to its vertex, and the triangle's wedges to one chart.
+      ASSERT_EQ(grid.wedgeVertex[w], v) << "triangle " << t / 3;
+      ASSERT_EQ(grid.wedgeChart[w], grid.wedgeChart[out.wedges[t]]) << "triangle " << t / 3;
+      p[k] = grid.positions[v];
+      uv[k] = grid.uvs[w];
+    }
+    // Never turned over in texture space (every chart is mapped the right way round).
+    EXPECT_GT(uvArea(uv[0], uv[1], uv[2]), 0) << "triangle " << t / 3;
+    area += 0.5 * length(cross(toDouble(p[1] - p[0]), toDouble(p[2] - p[0])));
+  }
+  // Still the whole square (the rim stays, nothing folds), in far fewer triangles.
+  EXPECT_NEAR(area, 1.0, 1e-5);
+  EXPECT_LT(out.indices.size() / 3, grid.indices.size() / 3 / 10);
+  // The seams simplified along themselves: the vertices with two charts' wedges are on a seam,
+  // and far fewer of them are left than the 25 + 12 the seams had.
+  std::map<std::uint32_t, std::set<std::uint32_t>> chartsAt;
+  for (std::size_t i = 0; i < out.wedges.size(); ++i)
+    chartsAt[out.vertices[out.indices[i]]].insert(grid.wedgeChart[out.wedges[i]]);
+  std::size_t onSeams = 0;
+  for (const auto& [v, charts] : chartsAt) {
+    if (charts.size() < 2) continue;
+    const Vec3f p = grid.positions[v];
+    EXPECT_TRUE(p.x == 0.5f || (p.y == 0.5f && p.x >= 0.5f)) << p.x << " " << p.y;
+    ++onSeams;
+  }
+  EXPECT_GE(onSeams, 3u);  // both ends of the long seam and the T
+  EXPECT_LT(onSeams, 12u);
+}
+
+// The largest texture-coordinate error over the square of the simplified mesh, each of its
+// triangles interpolating its corners' coordinates, against the exact coordinates `uvOf`.
+template <class Uv>
+double largestUvError(const TexturedGrid& grid, const SimplifiedMesh& out, Uv uvOf) {
+  double worst = 0;
+  for (int j = 0; j <= 60; ++j) {
+    for (int i = 0; i <= 60; ++i) {
+      const double x = i / 60.0, y = j / 60.0;
+      for (std::size_t t = 0; t < out.indices.size(); t += 3) {
+        const auto at = [&](std::size_t k) {
+          return grid.positions[out.vertices[out.indices[t + k]]];
+        };
+        const Vec3f a = at(0), b = at(1), c = at(2);
+        const double d =
+            (double(b.x) - a.x) * (double(c.y) - a.y) - (double(c.x) - a.x) * (double(b.y) - a.y);
+        const double s = ((x - a.x) * (double(c.y) - a.y) - (double(c.x) - a.x) * (y - a.y)) / d;
+        const double r = ((double(b.x) - a.x) * (y - a.y) - (x - a.x) * (double(b.y) - a.y)) / d;
+        if (s < -1e-9 || r < -1e-9 || s + r > 1 + 1e-9) continue;
+        const Vec2f ta = uvOf(at(0)), tb = uvOf(at(1)), tc = uvOf(at(2));
+        const Vec2f exact = uvOf(Vec3f{float(x), float(y), 0});
+        const double u = ta.x + s * (tb.x - ta.x) + r * (tc.x - ta.x);
+        const double v = ta.y + s * (tb.y - ta.y) + r * (tc.y - ta.y);
+        worst = std::max(worst, std::hypot(u - exact.x, v - exact.y));
+        break;
+      }
+    }
+  }
+  return worst;
+}
+
+TEST(SimplifyMesh, TextureErrorIsPartOfTheCost) {
+  // A flat square whose texture is stretched in one place: geometry alone sees nothing to keep
+  // there; with the texture in the cost, the simplified mesh follows the stretch.
+  const auto stretched = [](Vec3f p) {
+    const double bump = 0.06 * std::exp(-(std::pow(p.x - 0.3, 2) + std::pow(p.y - 0.6, 2)) / 0.01);
+    return Vec2f{float(p.x + bump), p.y};
+  };
+  const auto one = [](double, double) { return 0u; };
+  const TexturedGrid grid =
+      texturedGrid(30, one, [&](std::uint32_t, Vec3f p) { return stretched(p); });
+  // The same collapses blind to the texture: coordinates that are affine everywhere.
+  const TexturedGrid blind = texturedGrid(30, one, [](std::uint32_t, Vec3f p) {
+    return Vec2f{p.x, p.y};
+  });
+  ProgressiveOptions options;
+  options.stopAtTriangles = static_cast<std::uint32_t>(grid.indices.size() / 3 / 12);
+  options.wedges = grid.wedges;
+  options.wedgeUvs = grid.uvs;
+  const SimplifiedMesh aware = simplifyMesh(grid.positions, grid.indices, options);
+  options.wedgeUvs = blind.uvs;
+  const SimplifiedMesh unaware = simplifyMesh(grid.positions, grid.indices, options);
+  EXPECT_LE(aware.indices.size(), 3 * std::size_t{options.stopAtTriangles});
+  const double withTexture = largestUvError(grid, aware, stretched);
+  const double without = largestUvError(grid, unaware, stretched);
+  EXPECT_LT(withTexture, 0.5 * without) << withTexture << " against " << without;
+}
+
 }  // namespace
 }  // namespace lodforge

@@ -137,6 +137,61 @@ TEST(SimplifyNode, KeepsItsOuterFacesBitIdenticalAndReachesItsTarget) {
   EXPECT_EQ(out.droppedError, 0);
 }
 
+// Each child its own texture chart (a quadrant of the texture): the children's shared borders are
+// UV seams, two vertices at each point. The parent slides them with both sides together: fewer
+// seam points remain, none moved off the surface or its coordinates, no crack opens along a seam
+// (every edge used once is on the rim), and every triangle's corners come from one chart.
+TEST(SimplifyNode, TexturedSeamsSlideWithBothSidesAndEveryTriangleKeepsOneChart) {
+  Node n = surfaceNode();
+  const auto uvOf = [](int chart, Vec3d p) {
+    const int cx = chart % 2, cy = chart / 2;
+    return Vec2f{float((p.x - 8 * cx) / 8 * 0.45 + 0.5 * cx),
+                 float((p.y - 8 * cy) / 8 * 0.45 + 0.5 * cy)};
+  };
+  const auto chartOf = [](Vec2f uv) { return int(uv.x * 2) + 2 * int(uv.y * 2); };
+  std::set<Key> seam;
+  for (int c = 0; c < 4; ++c) {
+    MeshPart& child = n.children[static_cast<std::size_t>(c)];
+    for (const Vec3d& p : child.positions) {
+      child.uvs.push_back(uvOf(c, p));
+      child.materials.push_back(0);
+      if (!onOuterFace(p) && (p.x == 8 || p.y == 8)) seam.insert(keyOf(p));
+    }
+  }
+  const std::uint64_t target = static_cast<std::uint64_t>(0.2 * trianglesOf(n.children));
+  const SimplifiedNode out = simplifyNode(std::move(n.children), kGrid, n.node, {});
+  const MeshPart& mesh = out.mesh;
+  EXPECT_LE(mesh.triangleCount(), target);
+  ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());
+  std::map<Key, std::uint32_t> point;  // one number per position
+  std::set<Key> seamKept;
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const Vec3d& p = mesh.positions[v];
+    EXPECT_EQ(p.z, heightAt(p.x, p.y)) << "moved: " << p.x << ' ' << p.y;
+    EXPECT_EQ(mesh.uvs[v], uvOf(chartOf(mesh.uvs[v]), p)) << p.x << ' ' << p.y;
+    point.emplace(keyOf(p), static_cast<std::uint32_t>(point.size()));
+    if (seam.count(keyOf(p)) != 0) seamKept.insert(keyOf(p));
+  }
+  EXPECT_LT(seamKept.size(), seam.size() / 2);
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+    const int chart = chartOf(mesh.uvs[mesh.indices[t]]);
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_EQ(chartOf(mesh.uvs[mesh.indices[t + k]]), chart) << "triangle " << t / 3;
+      const std::uint32_t a = point[keyOf(mesh.positions[mesh.indices[t + k]])];
+      const std::uint32_t b = point[keyOf(mesh.positions[mesh.indices[t + (k + 1) % 3]])];
+      ++uses[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  std::vector<Vec3d> at(point.size());
+  for (const auto& [key, i] : point) at[i] = {std::get<0>(key), std::get<1>(key), std::get<2>(key)};
+  const auto onRim = [](Vec3d p) { return p.x == 0 || p.y == 0 || p.x == 16 || p.y == 16; };
+  for (const auto& [edge, count] : uses) {
+    EXPECT_TRUE(count == 2 || (count == 1 && onRim(at[edge.first]) && onRim(at[edge.second])))
+        << at[edge.first].x << ' ' << at[edge.first].y << " used " << count;
+  }
+}
+
 // The simplification error bounds how far every vertex of the children is from the parent's
 // surface, however few area samples measure it (removed vertices are bounded on their own: the
 // samples could miss them); and it is reproducible.

@@ -41,6 +41,11 @@ std::uint64_t progressiveBuildBytes(std::uint64_t vertices, std::uint64_t triang
 namespace {
 
 constexpr std::uint32_t kNone = ~0u;
+
+// Twice the signed area of a triangle in texture space (positive counter-clockwise).
+double signedUvArea(Vec2f a, Vec2f b, Vec2f c) {
+  return (double(b.x) - a.x) * (double(c.y) - a.y) - (double(c.x) - a.x) * (double(b.y) - a.y);
+}
 // Each pass collapses at most this share of the ranked candidates (the cheapest ones): small
 // enough that costs stay close to a global order, large enough that passes stay few. 0.2 keeps
 // the distance to the original within ~1.2x of meshoptimizer's at 10 % and 1 % (bench_simplify)
@@ -113,11 +118,14 @@ class Simplifier {
         triangleCount_(static_cast<std::uint32_t>(indices.size() / 3)),
         minNormalCos2_(options.minNormalCos * options.minNormalCos) {
     assert(options.locked.empty() || options.locked.size() == positions.size());
+    assert(options.wedges.empty() || options.wedges.size() == indices.size());
   }
 
   void classifyBoundary();
   void computeQuadrics();
   void addBoundaryPlanes();
+  void addSeamPlanes();
+  void computeUvQuadrics();
   void collapseAll();
   ProgressiveMesh rearrange(std::span<const Vec3f> normals, std::span<const Rgba8> colors) const;
   SimplifiedMesh current() const;
@@ -157,6 +165,30 @@ class Simplifier {
     return std::span(incident_).subspan(vertex_[v].incidentStart, vertex_[v].incidentCount);
   }
   bool allowed(std::uint32_t from, std::uint32_t to) const;
+  bool textured() const { return !wedgeCorners_.empty(); }
+  std::uint32_t wedgeAt(std::uint32_t t, std::uint32_t v) const {
+    const auto& c = corners_[t];
+    return wedgeCorners_[t][(c[1] == v) + 2u * (c[2] == v)];
+  }
+  bool isSeam(std::uint32_t t, std::uint32_t a, std::uint32_t b) const;
+  // Where each wedge of a collapse's `from` goes (from's wedge, to's wedge); a vertex has a few.
+  struct WedgeMap {
+    std::array<std::pair<std::uint32_t, std::uint32_t>, 16> items;
+    std::size_t count = 0;
+    std::span<const std::pair<std::uint32_t, std::uint32_t>> pairs() const {
+      return std::span(items).first(count);
+    }
+    std::uint32_t find(std::uint32_t wedge) const {
+      for (const auto& [wf, wt] : pairs())
+        if (wf == wedge) return wt;
+      return kNone;
+    }
+  };
+  bool mapWedges(std::uint32_t from, std::uint32_t to, WedgeMap& map) const;
+  double uvCost(std::uint32_t from, std::uint32_t to) const;
+  std::uint32_t onlyWedge(std::uint32_t v) const;
+  bool keepsTextureOrientation(std::uint32_t from, std::uint32_t to) const;
+  void moveWedges(std::uint32_t from, std::uint32_t to);
   void buildIncidence();
   void mergeFans(std::uint32_t from, std::uint32_t to);
   void updateFaceNormals();
@@ -206,6 +238,13 @@ class Simplifier {
   std::vector<float> errorAfter_;                // monotone error after collapse k
   double maxError_ = 0;
   std::vector<std::uint8_t> border_;  // per vertex: on a boundary or non-manifold edge
+
+  // Textured meshes: the wedge of each corner (kept with corners_), each wedge's texture error
+  // quadric and its value at the wedge itself, and the wedge map of the last valid() collapse.
+  std::vector<std::array<std::uint32_t, 3>> wedgeCorners_;
+  std::vector<UvQuadric> uvQuadrics_;
+  std::vector<double> uvSelfCost_;
+  WedgeMap wedgeMap_;
 };
 
 void Simplifier::classifyBoundary() {
@@ -217,6 +256,11 @@ void Simplifier::classifyBoundary() {
   }
   corners_.resize(triangleCount_);
   target_.assign(vertexCount_, kNone);
+  if (!options_.wedges.empty()) {
+    wedgeCorners_.resize(triangleCount_);
+    for (std::uint32_t t = 0; t < triangleCount_; ++t)
+      for (std::size_t k = 0; k < 3; ++k) wedgeCorners_[t][k] = options_.wedges[3 * t + k];
+  }
   for (std::uint32_t t = 0; t < triangleCount_; ++t) {
     for (std::size_t k = 0; k < 3; ++k) {
       corners_[t][k] = indices_[3 * t + k];
@@ -271,8 +315,152 @@ void Simplifier::computeQuadrics() {
     for (std::uint32_t v : c) quadrics_[v] += plane;
   }
   if (options_.collapseBorders) addBoundaryPlanes();
+  if (textured()) {
+    addSeamPlanes();
+    computeUvQuadrics();
+  }
   for (std::uint32_t v = 0; v < vertexCount_; ++v)
     vertex_[v].selfCost = quadrics_[v].evaluate(position(v));
+}
+
+bool Simplifier::isSeam(std::uint32_t t, std::uint32_t a, std::uint32_t b) const {
+  // Edge a-b of t is a seam where the triangle across it has other wedges at either end.
+  for (std::uint32_t s : around(a)) {
+    if (s == t || !alive(s) || !contains(s, b)) continue;
+    if (wedgeAt(s, a) != wedgeAt(t, a) || wedgeAt(s, b) != wedgeAt(t, b)) return true;
+  }
+  return false;
+}
+
+void Simplifier::addSeamPlanes() {
+  // As for a rim (addBoundaryPlanes): a plane through each seam edge, perpendicular to each face
+  // on it, weighted by the edge's squared length, so a seam that slides keeps its course.
+  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
+    const auto& c = corners_[t];
+    const Vec3d n = cross(position(c[1]) - position(c[0]), position(c[2]) - position(c[0]));
+    const double twiceArea = length(n);
+    if (twiceArea <= 0) continue;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = c[k], b = c[(k + 1) % 3];
+      if (!isSeam(t, a, b)) continue;
+      const Vec3d edge = position(b) - position(a);
+      const Vec3d across = cross(edge, n / twiceArea);
+      const double span = length(across);
+      if (span <= 0) continue;
+      const Quadric plane = Quadric::fromPlane(across / span, position(a), dot(edge, edge));
+      quadrics_[a] += plane;
+      quadrics_[b] += plane;
+    }
+  }
+}
+
+void Simplifier::computeUvQuadrics() {
+  // Texture coordinates count in model units: scaled by the mesh's model-to-texture ratio (the
+  // square root of its area over its texture area), so a texture error weighs like a distance.
+  const std::span<const Vec2f> uv = options_.wedgeUvs;
+  std::uint32_t wedgeCount = 0;
+  for (std::uint32_t w : options_.wedges) wedgeCount = std::max(wedgeCount, w + 1);
+  assert(uv.size() >= wedgeCount);
+  double area = 0, uvArea = 0;
+  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
+    const auto& c = corners_[t];
+    const auto& w = wedgeCorners_[t];
+    area += 0.5 * length(cross(position(c[1]) - position(c[0]), position(c[2]) - position(c[0])));
+    uvArea += 0.5 * std::abs(signedUvArea(uv[w[0]], uv[w[1]], uv[w[2]]));
+  }
+  const double scale2 = uvArea > 0 ? area / uvArea : 0.0;
+  uvQuadrics_.assign(wedgeCount, UvQuadric{});
+  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
+    const auto& c = corners_[t];
+    const auto& w = wedgeCorners_[t];
+    const Vec3d a = position(c[0]), b = position(c[1]), d = position(c[2]);
+    const double weight = 0.5 * length(cross(b - a, d - a)) * scale2;
+    const UvQuadric q = UvQuadric::fromTriangle(a, b, d, uv[w[0]], uv[w[1]], uv[w[2]], weight);
+    for (std::uint32_t wedge : w) uvQuadrics_[wedge] += q;
+  }
+  uvSelfCost_.assign(wedgeCount, 0.0);
+  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t wedge = wedgeCorners_[t][k];
+      uvSelfCost_[wedge] = uvQuadrics_[wedge].evaluate(position(corners_[t][k]), uv[wedge]);
+    }
+  }
+}
+
+bool Simplifier::mapWedges(std::uint32_t from, std::uint32_t to, WedgeMap& map) const {
+  // Each wedge of `from` goes to the wedge `to` has on the triangles of their edge (the ones that
+  // die): one target per wedge, and every wedge of `from` still in use must have one, or a
+  // triangle would take coordinates from another chart.
+  map.count = 0;
+  for (std::uint32_t t : around(from)) {
+    if (!alive(t) || !contains(t, to)) continue;
+    const std::uint32_t wf = wedgeAt(t, from), wt = wedgeAt(t, to);
+    const std::uint32_t known = map.find(wf);
+    if (known == kNone) {
+      if (map.count == map.items.size()) return false;
+      map.items[map.count++] = {wf, wt};
+    } else if (known != wt) {
+      return false;
+    }
+  }
+  for (std::uint32_t t : around(from)) {
+    if (alive(t) && !contains(t, to) && map.find(wedgeAt(t, from)) == kNone) return false;
+  }
+  return map.count > 0;
+}
+
+std::uint32_t Simplifier::onlyWedge(std::uint32_t v) const {
+  // The wedge of v if its live triangles all share one, kNone if they have several.
+  std::uint32_t wedge = kNone;
+  for (std::uint32_t t : around(v)) {
+    if (!alive(t)) continue;
+    const std::uint32_t w = wedgeAt(t, v);
+    if (wedge != kNone && w != wedge) return kNone;
+    wedge = w;
+  }
+  return wedge;
+}
+
+double Simplifier::uvCost(std::uint32_t from, std::uint32_t to) const {
+  // Each wedge's texture error at its target's coordinates, (Q_w + Q_w')(p_to, uv_w').
+  WedgeMap map;
+  if (!mapWedges(from, to, map)) return 0;  // valid() refuses it
+  const Vec3d p = position(to);
+  double sum = 0;
+  for (const auto& [wf, wt] : map.pairs())
+    sum += uvQuadrics_[wf].evaluate(p, options_.wedgeUvs[wt]) + uvSelfCost_[wt];
+  return std::max(0.0, sum);
+}
+
+bool Simplifier::keepsTextureOrientation(std::uint32_t from, std::uint32_t to) const {
+  // No triangle that stays may turn over (or collapse) in texture space: it would fold its chart.
+  const std::span<const Vec2f> uv = options_.wedgeUvs;
+  for (std::uint32_t t : around(from)) {
+    if (!alive(t) || contains(t, to)) continue;
+    const auto& w = wedgeCorners_[t];
+    const std::uint32_t k = (corners_[t][1] == from) + 2u * (corners_[t][2] == from);
+    std::array<std::uint32_t, 3> after = w;
+    after[k] = wedgeMap_.find(w[k]);
+    const double before = signedUvArea(uv[w[0]], uv[w[1]], uv[w[2]]);
+    const double now = signedUvArea(uv[after[0]], uv[after[1]], uv[after[2]]);
+    if (before * now < 0 || (before != 0 && now == 0)) return false;
+  }
+  return true;
+}
+
+void Simplifier::moveWedges(std::uint32_t from, std::uint32_t to) {
+  // After valid(from, to): the corners `from` hands over take their mapped wedges, and each
+  // target wedge takes on its source's texture error.
+  for (std::uint32_t t : around(from)) {
+    if (!alive(t) || contains(t, to)) continue;
+    const std::uint32_t k = (corners_[t][1] == from) + 2u * (corners_[t][2] == from);
+    wedgeCorners_[t][k] = wedgeMap_.find(wedgeCorners_[t][k]);
+  }
+  const Vec3d p = position(to);
+  for (const auto& [wf, wt] : wedgeMap_.pairs()) {
+    uvQuadrics_[wt] += uvQuadrics_[wf];
+    uvSelfCost_[wt] = uvQuadrics_[wt].evaluate(p, options_.wedgeUvs[wt]);
+  }
 }
 
 void Simplifier::addBoundaryPlanes() {
@@ -376,7 +564,8 @@ void Simplifier::updateFaceNormals() {
 float Simplifier::cost(std::uint32_t from, std::uint32_t to) const {
   if (options_.cost == CollapseCost::kQuadric) {
     const Quadric q = quadrics_[from] + quadrics_[to];
-    return static_cast<float>(std::max(0.0, q.evaluate(position(to))));
+    const double uv = textured() ? uvCost(from, to) : 0.0;
+    return static_cast<float>(std::max(0.0, q.evaluate(position(to))) + uv);
   }
   // Melax (1998): edge length times the largest angle between a face around `from` and the
   // closest-facing face on the edge.
@@ -432,13 +621,21 @@ void Simplifier::rankVertex(std::uint32_t u) {
   const auto quadricCost = [&](double atV, std::uint32_t v) {
     return static_cast<float>(std::max(0.0, atV + vertex_[v].selfCost));
   };
+  // Textured: most vertices are inside one chart, with one wedge, whose texture cost to v needs
+  // only v's wedge on this triangle (uvCost's walk of the fan, for the others).
+  const std::uint32_t soleWedge = textured() ? onlyWedge(u) : kNone;
   std::uint32_t pending = kNone;
   for (std::uint32_t t : around(u)) {
     const auto& c = corners_[t];
     if (c[0] == kNone) continue;  // died since the fan was listed
     const std::uint32_t v = otherCorners(t, u)[0];
     if (paper && !allowed(u, v)) continue;
-    if (!quadric) {
+    if (quadric && soleWedge != kNone) {
+      const std::uint32_t wv = wedgeAt(t, v);
+      const double uv =
+          uvQuadrics_[soleWedge].evaluate(position(v), options_.wedgeUvs[wv]) + uvSelfCost_[wv];
+      consider(v, quadricCost(q.evaluate(position(v)), v) + static_cast<float>(std::max(0.0, uv)));
+    } else if (!quadric || textured()) {
       consider(v, this->cost(u, v));
     } else if (pending == kNone) {
       pending = v;
@@ -531,6 +728,8 @@ std::optional<Simplifier::Rings> Simplifier::valid(std::uint32_t from, std::uint
     if (d <= 0 || l1 <= 0 || d * d <= minNormalCos2_ * l0 * l1)
       return std::nullopt;  // without roots
   }
+  if (textured() && !(mapWedges(from, to, wedgeMap_) && keepsTextureOrientation(from, to)))
+    return std::nullopt;
   return Rings{std::span(ringFrom_).first(ringFrom), std::span(ringTo_).first(ringTo)};
 }
 
@@ -600,7 +799,8 @@ void Simplifier::rankNewNeighbours() {
   for (const auto& [w, to] : std::span(newNeighbour_).first(newNeighbourCount_)) {
     if (vertex_[w].dirty || vertex_[w].removed || !allowed(w, to)) continue;
     const float cost = static_cast<float>(
-        std::max(0.0, quadrics_[w].evaluate(position(to)) + vertex_[to].selfCost));
+        std::max(0.0, quadrics_[w].evaluate(position(to)) + vertex_[to].selfCost) +
+        (textured() ? uvCost(w, to) : 0.0));
     if (cost < vertex_[w].bestCost || (cost == vertex_[w].bestCost && to < vertex_[w].bestTarget)) {
       vertex_[w].bestCost = cost;
       vertex_[w].bestTarget = to;
@@ -620,6 +820,7 @@ void Simplifier::collapse(std::uint32_t from, const Target& target) {
   // is re-ranked next pass.
   vertex_[from].touched = vertex_[to].touched = pass_;
   markChanged(from, target);
+  if (textured()) moveWedges(from, to);
   for (std::uint32_t t : around(from)) {
     if (!alive(t)) continue;
     if (contains(t, to)) {
@@ -717,6 +918,7 @@ void Simplifier::collapseAll() {
 
 ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
                                       std::span<const Rgba8> colors) const {
+  assert(!textured());  // progressive meshes carry one attribute set per vertex
   ProgressiveMesh mesh;
   const auto collapses = static_cast<std::uint32_t>(collapsed_.size());
   mesh.q = vertexCount_ - collapses;
@@ -785,6 +987,8 @@ SimplifiedMesh Simplifier::current() const {
       }
       out.indices.push_back(remap[v]);
     }
+    if (textured())
+      out.wedges.insert(out.wedges.end(), wedgeCorners_[t].begin(), wedgeCorners_[t].end());
   }
   out.error = errorAfter_.empty() ? 0.0f : errorAfter_.back();
   // Where each removed vertex went: a collapse's target was live then, so it went later or not

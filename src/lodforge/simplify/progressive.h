@@ -41,6 +41,14 @@ struct ProgressiveOptions {
   // has it: boundary vertices never move. Vertices where a boundary meets itself or a
   // non-manifold edge, and `locked` ones, stay put either way.
   bool collapseBorders = false;
+  // Textured meshes (simplifyMesh only): positions are then one vertex per point of the surface,
+  // and `wedges` gives each index's wedge (the vertex of the textured mesh it came from: its
+  // texture coordinates `wedgeUvs`, material and the rest). A collapse maps each wedge of the
+  // vertex that goes to the wedge of its target on the same triangles, so every triangle keeps
+  // one chart and a seam moves only along itself; one that cannot (a chart corner) is refused,
+  // as is one that flips a triangle in texture space. The texture error joins the cost.
+  std::span<const std::uint32_t> wedges{};
+  std::span<const Vec2f> wedgeUvs{};
 };
 
 // One object after preprocessing. p = vertexCount(), q = the vertices that never collapse (the
@@ -94,6 +102,8 @@ struct SimplifiedMesh {
   // Per input vertex: the kept vertex (index into `vertices`) it was collapsed into, through
   // however many collapses; ~0u if that vertex is left in no triangle.
   std::vector<std::uint32_t> representative;
+  // With ProgressiveOptions::wedges: the input wedge of each corner of `indices`.
+  std::vector<std::uint32_t> wedges;
 };
 
 // Collapses until at most `options.stopAtTriangles` triangles remain or nothing more may

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 
 #include <nanoflann.hpp>
 
@@ -15,6 +16,8 @@
 
 namespace lodforge {
 namespace {
+
+constexpr std::uint32_t kNoVertex = ~0u;
 
 // Float positions relative to `center`: what the simplifier and the distance kernel take.
 std::vector<Vec3f> relativeTo(const MeshPart& mesh, Vec3d center) {
@@ -135,18 +138,6 @@ std::vector<std::uint32_t> positionRepresentatives(const MeshPart& mesh) {
   return first;
 }
 
-// The vertices on a UV seam (a position other vertices share). They are locked, so a seam never
-// moves off itself and two charts never mix; the charts' insides simplify.
-std::vector<std::uint8_t> onUvSeams(std::span<const std::uint32_t> representative,
-                                    std::size_t vertexCount) {
-  std::vector<std::uint8_t> flags(vertexCount, 0);
-  std::vector<std::uint32_t> members(representative.size(), 0);
-  for (std::uint32_t r : representative) ++members[r];
-  for (std::size_t v = 0; v < representative.size(); ++v)
-    flags[v] = members[representative[v]] > 1 ? 1 : 0;
-  return flags;
-}
-
 struct Dropped {
   std::uint64_t segments = 0;
   double error = 0;  // bound on the distance from any dropped point to what remains
@@ -239,6 +230,81 @@ Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border,
   return dropped;
 }
 
+// One level's mesh as the simplifier left it: each vertex's source in the merged mesh, whether
+// it sits on a boundary, the recorded error and the removed vertices' bound.
+struct Collapsed {
+  MeshPart mesh;
+  std::vector<std::uint32_t> source;
+  std::vector<std::uint8_t> border;
+  double recorded = 0, vertexError = 0;
+};
+
+Collapsed simplifyPlain(const MeshPart& merged, std::span<const Vec3f> positions,
+                        const ProgressiveOptions& simplify, Vec3d center) {
+  SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
+  Collapsed out;
+  for (std::uint32_t v : simplified.vertices) appendVertex(merged, v, out.mesh);
+  out.mesh.indices = simplified.indices;
+  out.source = simplified.vertices;
+  out.border = std::move(simplified.border);
+  out.recorded = simplified.error;
+  out.vertexError =
+      removedVertexBound(positions, relativeTo(out.mesh, center), out.mesh.indices, simplified);
+  return out;
+}
+
+// A textured mesh goes to the simplifier as its surface: one vertex per point (the two sides of a
+// UV seam, which welding keeps apart, are one), each corner naming its wedge (the merged vertex
+// it came from), so seams slide along themselves with both sides together (ProgressiveOptions::
+// wedges) instead of being locked. Triangles with two corners at one point have no area; they go.
+Collapsed simplifyTextured(const MeshPart& merged, std::span<const Vec3f> positions,
+                           std::span<const std::uint32_t> samePosition,
+                           std::span<const std::uint8_t> outer, ProgressiveOptions simplify) {
+  std::vector<std::uint32_t> surfaceOf(merged.vertexCount(), kNoVertex), first;
+  for (std::uint32_t v = 0; v < merged.vertexCount(); ++v) {
+    if (samePosition[v] != v) continue;
+    surfaceOf[v] = static_cast<std::uint32_t>(first.size());
+    first.push_back(v);
+  }
+  std::vector<Vec3f> surfacePositions(first.size());
+  std::vector<std::uint8_t> locked(first.size());
+  for (std::size_t s = 0; s < first.size(); ++s) {
+    surfacePositions[s] = positions[first[s]];
+    locked[s] = outer[first[s]];
+  }
+  std::vector<std::uint32_t> indices, wedges;
+  for (std::size_t t = 0; t < merged.indices.size(); t += 3) {
+    std::array<std::uint32_t, 3> c{};
+    for (std::size_t k = 0; k < 3; ++k) c[k] = surfaceOf[samePosition[merged.indices[t + k]]];
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    indices.insert(indices.end(), c.begin(), c.end());
+    wedges.insert(wedges.end(), merged.indices.begin() + static_cast<std::ptrdiff_t>(t),
+                  merged.indices.begin() + static_cast<std::ptrdiff_t>(t + 3));
+  }
+  simplify.locked = locked;
+  simplify.wedges = wedges;
+  simplify.wedgeUvs = merged.uvs;
+  const SimplifiedMesh simplified = simplifyMesh(surfacePositions, indices, simplify);
+  // The mesh again: one vertex per wedge still in use, in order of first use.
+  Collapsed out;
+  std::vector<std::uint32_t> remap(merged.vertexCount(), kNoVertex);
+  for (std::size_t i = 0; i < simplified.wedges.size(); ++i) {
+    const std::uint32_t w = simplified.wedges[i];
+    if (remap[w] == kNoVertex) {
+      remap[w] = out.mesh.vertexCount();
+      appendVertex(merged, w, out.mesh);
+      out.source.push_back(w);
+      out.border.push_back(simplified.border[simplified.indices[i]]);
+    }
+    out.mesh.indices.push_back(remap[w]);
+  }
+  out.recorded = simplified.error;
+  std::vector<Vec3f> kept(simplified.vertices.size());
+  for (std::size_t i = 0; i < kept.size(); ++i) kept[i] = surfacePositions[simplified.vertices[i]];
+  out.vertexError = removedVertexBound(surfacePositions, kept, simplified.indices, simplified);
+  return out;
+}
+
 }  // namespace
 
 Aabbd boundsOf(const MeshPart& mesh) {
@@ -262,15 +328,16 @@ SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& gri
   // Only the node's outer faces are shared with other tiles: vertices there never move. The
   // input's own rims (and seams inside the node) may simplify, along themselves.
   const std::vector<std::uint8_t> outer = onOuterFaces(merged, grid, node);
-  std::vector<std::uint8_t> locked =
-      onUvSeams(positionRepresentatives(merged), merged.vertexCount());
-  for (std::size_t v = 0; v < locked.size(); ++v) locked[v] |= outer[v];
-  simplify.locked = locked;
   simplify.collapseBorders = true;
-  SimplifiedMesh simplified = simplifyMesh(positions, merged.indices, simplify);
-  MeshPart mesh;
-  for (std::uint32_t v : simplified.vertices) appendVertex(merged, v, mesh);
-  mesh.indices = simplified.indices;
+  const std::vector<std::uint32_t> samePosition = positionRepresentatives(merged);
+  Collapsed collapsed;
+  if (samePosition.empty()) {
+    simplify.locked = outer;
+    collapsed = simplifyPlain(merged, positions, simplify, center);
+  } else {
+    collapsed = simplifyTextured(merged, positions, samePosition, outer, simplify);
+  }
+  MeshPart& mesh = collapsed.mesh;
   // Geometric error: measured against the children's geometry, plus what they already
   // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
   // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
@@ -282,18 +349,16 @@ SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& gri
   const double sampled =
       sampledHausdorff(simplifiedPositions, mesh.indices, positions, merged.indices,
                        options.errorSamples, seedOf(node), /*corners=*/false);
-  const double vertexError =
-      removedVertexBound(positions, simplifiedPositions, mesh.indices, simplified);
   std::vector<std::uint8_t> shared(mesh.vertexCount());
-  for (std::size_t i = 0; i < shared.size(); ++i) shared[i] = outer[simplified.vertices[i]];
+  for (std::size_t i = 0; i < shared.size(); ++i) shared[i] = outer[collapsed.source[i]];
   const Dropped dropped =
-      dropSmallSegments(mesh, simplified.border, shared, simplify.stopAtTriangles, center);
+      dropSmallSegments(mesh, collapsed.border, shared, simplify.stopAtTriangles, center);
   SimplifiedNode out;
   out.droppedSegments = dropped.segments;
   // The price of locking: border vertices the tile had to keep.
   out.lockedVertices =
-      static_cast<std::uint64_t>(std::count(simplified.border.begin(), simplified.border.end(), 1));
-  out.simplificationError = std::max({sampled, static_cast<double>(simplified.error), vertexError});
+      static_cast<std::uint64_t>(std::count(collapsed.border.begin(), collapsed.border.end(), 1));
+  out.simplificationError = std::max({sampled, collapsed.recorded, collapsed.vertexError});
   out.droppedError = dropped.error;
   out.mesh = std::move(mesh);
   return out;

@@ -1,6 +1,8 @@
 // `lodforge compare A.png B.png` or `lodforge compare A/ B/`: the large-meshes paper's image
 // difference — CIE76 ΔE per pixel — as the share of pixels above the just-noticeable 2.3, the
 // mean ΔE and PSNR; `--diff` writes a heat map (for folders, one per frame pair into a folder).
+// Images are PNG, JPEG or WebP (by their bytes), so an encoded texture compares with its source;
+// frames of two folders pair by name without the extension.
 // Two meshes go to compare_meshes (surface distance).
 #include <algorithm>
 #include <cmath>
@@ -12,6 +14,7 @@
 #include "cli.h"
 #include "compare_meshes.h"
 #include "lodforge/core/file.h"
+#include "lodforge/io/image/image_codec.h"
 #include "lodforge/render/image.h"
 #include "outputs.h"
 
@@ -30,6 +33,27 @@ struct Pair {
   std::string name, a, b;
 };
 
+bool isImageFile(const std::filesystem::path& path) {
+  const std::string e = path.extension().string();
+  return e == ".png" || e == ".jpg" || e == ".jpeg" || e == ".webp";
+}
+
+// The image of `folder` whose name without its extension is `stem`; empty if none.
+std::filesystem::path imageNamed(const std::string& folder, const std::string& stem) {
+  std::error_code error;
+  for (const char* extension : {".png", ".jpg", ".jpeg", ".webp"}) {
+    const std::filesystem::path path = std::filesystem::path(folder) / (stem + extension);
+    if (std::filesystem::exists(path, error)) return path;
+  }
+  return {};
+}
+
+Result<Image> readImageFile(const std::string& path) {
+  auto file = MappedFile::open(path);
+  if (!file) return file.status();
+  return decodeImage(file->bytes(), path);
+}
+
 Result<std::vector<Pair>> pairsOf(const CompareOptions& o) {
   namespace fs = std::filesystem;
   std::error_code error;
@@ -42,16 +66,17 @@ Result<std::vector<Pair>> pairsOf(const CompareOptions& o) {
   // Frames pair up by file name; a frame missing on either side is an error, not a skip.
   std::vector<Pair> pairs;
   for (const auto& entry : fs::directory_iterator(o.a, error)) {
-    if (entry.path().extension() != ".png") continue;
-    const std::string name = entry.path().filename().string();
-    const fs::path other = fs::path(o.b) / name;
-    if (!fs::exists(other, error))
+    if (!isImageFile(entry.path())) continue;
+    const std::string name = entry.path().stem().string();
+    const fs::path other = imageNamed(o.b, name);
+    if (other.empty())
       return Error{ErrorKind::kBadInput, fmt::format("{}: no frame '{}' to compare with {}", o.b,
                                                      name, entry.path().string())};
     pairs.push_back({name, entry.path().string(), other.string()});
   }
   if (error) return Error{ErrorKind::kIo, fmt::format("{}: {}", o.a, error.message())};
-  if (pairs.empty()) return Error{ErrorKind::kBadInput, fmt::format("{}: no .png frames", o.a)};
+  if (pairs.empty())
+    return Error{ErrorKind::kBadInput, fmt::format("{}: no .png, .jpg or .webp frames", o.a)};
   std::sort(pairs.begin(), pairs.end(),
             [](const Pair& x, const Pair& y) { return x.name < y.name; });
   return pairs;
@@ -82,9 +107,9 @@ Status runCompare(const Global& global, const CompareOptions& o) {
   say(global, "|--------------------------|-----------|----------|----------|-----------|");
   double shareSum = 0, meanSum = 0;
   for (const Pair& pair : *pairs) {
-    auto a = readPng(pair.a);
+    auto a = readImageFile(pair.a);
     if (!a) return a.status();
-    auto b = readPng(pair.b);
+    auto b = readImageFile(pair.b);
     if (!b) return b.status();
     if (a->width != b->width || a->height != b->height)
       return Error{ErrorKind::kBadInput,
@@ -94,7 +119,7 @@ Status runCompare(const Global& global, const CompareOptions& o) {
     const ImageDifference d = compareImages(*a, *b, o.threshold, &deltaE);
     if (!o.diff.empty()) {
       const std::string out =
-          folders ? (std::filesystem::path(o.diff) / pair.name).string() : o.diff;
+          folders ? (std::filesystem::path(o.diff) / (pair.name + ".png")).string() : o.diff;
       LODFORGE_TRY(writePng(out, deltaEHeatMap(deltaE, a->width, a->height)));
     }
     say(global,
@@ -135,10 +160,10 @@ void addCompare(CLI::App& app, const Global& global, Run& run) {
   auto options = std::make_shared<CompareOptions>();
   auto* command = app.add_subcommand(
       "compare",
-      "Image difference (CIE76 ΔE, PSNR) of two PNG files or two folders of frames; surface "
-      "distance (Hausdorff, RMS) of two meshes");
-  command->add_option("a", options->a, "First PNG (or folder, or mesh)")->required();
-  command->add_option("b", options->b, "Second PNG (or folder, or mesh)")->required();
+      "Image difference (CIE76 ΔE, PSNR) of two images (PNG, JPEG, WebP) or two folders of "
+      "frames; surface distance (Hausdorff, RMS) of two meshes");
+  command->add_option("a", options->a, "First image (or folder, or mesh)")->required();
+  command->add_option("b", options->b, "Second image (or folder, or mesh)")->required();
   command
       ->add_option("--samples", options->samples,
                    "Meshes: points sampled on each surface (default 200K)")

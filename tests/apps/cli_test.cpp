@@ -24,6 +24,7 @@
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
 
+#include "lodforge/io/image/image_codec.h"
 #include "lodforge/render/image.h"
 #include "run_lodforge.h"
 #include "test_support.h"
@@ -1433,7 +1434,8 @@ void expectResumesToTheSameTileset(const test::TempDir& dir, const std::string& 
     ASSERT_EQ(test::readFile(dir.file("a/tiles/" + f)), test::readFile(dir.file("b/tiles/" + f)))
         << f;
   EXPECT_EQ(test::readFile(dir.file("a/tileset.json")), test::readFile(dir.file("b/tileset.json")));
-  const std::string name = std::filesystem::path(input).filename().string();
+  // (The input's own entry: the file, or the folder it and its images are in.)
+  const std::string name = std::filesystem::relative(input, dir.path()).begin()->string();
   EXPECT_EQ(test::listFolder(dir.path()), (std::vector<std::string>{"a", "b", name}));
 }
 
@@ -1441,6 +1443,36 @@ TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
   test::TempDir dir;
   ASSERT_EQ(lodforge("-q generate scan --triangles 200K -o " + dir.file("scan.ply"), dir).code, 0);
   expectResumesToTheSameTileset(dir, dir.file("scan.ply"), {});
+}
+
+// A textured input resumes too: its materials and images are in the chunk state (an embedded
+// image's bytes in the work directory) and its texture pyramids are taken as they are.
+TEST(CliTiles, AnInterruptedTexturedRunResumesToTheSameTileset) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("in"));
+  ASSERT_EQ(lodforge("-q generate scan --triangles 60K --texture 512 --atlases 2 -o " +
+                         dir.file("in/scan.ply"),
+                     dir)
+                .code,
+            0);
+  expectResumesToTheSameTileset(dir, dir.file("in/scan.ply"), {});
+}
+
+TEST(CliTiles, AnInterruptedRunOfEmbeddedTexturesResumesToTheSameTileset) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("in"));
+  ASSERT_EQ(lodforge("-q generate scan --triangles 60K --texture 512 --atlases 2 -o " +
+                         dir.file("in/scan.ply"),
+                     dir)
+                .code,
+            0);
+  ASSERT_EQ(
+      lodforge("-q convert " + dir.file("in/scan.ply") + " -o " + dir.file("in/scan.glb"), dir)
+          .code,
+      0);
+  for (const char* name : {"scan.ply", "scan_atlas_00.jpg", "scan_atlas_01.jpg"})
+    std::filesystem::remove(dir.file(std::string("in/") + name));
+  expectResumesToTheSameTileset(dir, dir.file("in/scan.glb"), {});
 }
 
 // tiles --surface resumes like any tileset: the reconstructed chunks are kept.
@@ -1590,6 +1622,27 @@ TEST(CliCompare, FilesAndFoldersWithHeatMapsAndJson) {
   // The library's own figures agree with the command's.
   const ImageDifference d = compareImages(gradient(64, 32, 0), gradient(64, 32, 40));
   EXPECT_NEAR(j["frames"][1]["mean_delta_e"].get<double>(), d.meanDeltaE, 1e-9);
+  // A JPEG against its PNG source, paired by name without the extension: a finite PSNR that
+  // agrees with the library's for the decoded JPEG.
+  std::filesystem::create_directories(dir.file("jpeg"));
+  auto jpeg = encodeImage(gradient(64, 32, 0), {.format = ImageFormat::kJpeg, .quality = 80});
+  ASSERT_TRUE(jpeg.ok());
+  test::writeFile(dir.file("jpeg/f0.jpg"),
+                  std::string(reinterpret_cast<const char*>(jpeg->data()), jpeg->size()));
+  std::filesystem::remove(dir.file("b/f1.png"));
+  std::filesystem::remove(dir.file("a/f1.png"));
+  o = lodforge(
+      "compare " + dir.file("a") + " " + dir.file("jpeg") + " --json " + dir.file("three.json"),
+      dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  j = nlohmann::json::parse(test::readFile(dir.file("three.json")));
+  ASSERT_EQ(j["frames"].size(), 1u);
+  auto decoded = decodeImage(*jpeg, "f0.jpg");
+  ASSERT_TRUE(decoded.ok());
+  const ImageDifference lossy = compareImages(gradient(64, 32, 0), *decoded);
+  ASSERT_TRUE(std::isfinite(lossy.psnr));
+  EXPECT_GT(lossy.psnr, 15);
+  EXPECT_NEAR(j["frames"][0]["psnr_db"].get<double>(), lossy.psnr, 1e-9);
 }
 
 // Two meshes: their surface distance — none from a mesh to itself, the offset between a mesh

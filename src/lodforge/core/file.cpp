@@ -425,6 +425,12 @@ Result<std::uint64_t> fileSize(const std::string& path) {
   return static_cast<std::uint64_t>(info.st_size);
 }
 
+std::int64_t modifiedTicks(const std::string& path) {
+  std::error_code error;
+  const auto time = std::filesystem::last_write_time(path, error);
+  return error ? 0 : static_cast<std::int64_t>(time.time_since_epoch().count());
+}
+
 Result<std::string> readFileToString(const std::string& path, std::uint64_t maxBytes) {
   Result<ByteSource> source = ByteSource::openFile(path);
   if (!source) return source.status();

@@ -149,6 +149,9 @@ Result<std::string> readFileToString(const std::string& path, std::uint64_t maxB
 // The file's bytes, read at once (work files read back whole: node meshes, chunks).
 Result<std::vector<std::byte>> readFileBytes(const std::string& path);
 Result<std::uint64_t> fileSize(const std::string& path);
+// The file's modification time in the file system's ticks; 0 when it cannot be read. With the
+// size, what tells a resumed run that an input file is the one it started from.
+std::int64_t modifiedTicks(const std::string& path);
 // Lower-cased extension without the dot ("glb", "ply"); empty when there is none.
 std::string fileExtension(const std::string& path);
 // The file name without folder and extension ("scan" for "data/scan.ply").

@@ -187,6 +187,20 @@ Result<Pyramid> buildOne(const ImageSource& source, const std::string& path) {
   return pyramid;
 }
 
+// The pyramid an earlier run left at `path`, when its file has the full size; nothing otherwise.
+std::optional<Pyramid> keptPyramid(const ImageSource& source, const std::string& path) {
+  Pyramid pyramid;
+  pyramid.path = path;
+  pyramid.levels = levelsOf(source.width, source.height);
+  const Level& last = pyramid.levels.back();
+  const Result<std::uint64_t> size = fileSize(path);
+  if (!size || *size != last.offset + std::uint64_t{last.blocksX} * last.blocksY * kBlockBytes)
+    return std::nullopt;
+  pyramid.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (pyramid.fd < 0) return std::nullopt;
+  return pyramid;
+}
+
 }  // namespace
 
 std::int64_t wrapTexel(std::int64_t x, std::int64_t size, TextureWrap wrap) {
@@ -277,12 +291,17 @@ TexturePyramid& TexturePyramid::operator=(TexturePyramid&&) noexcept = default;
 TexturePyramid::~TexturePyramid() = default;
 
 Result<TexturePyramid> TexturePyramid::build(std::span<const ImageSource> images,
-                                             const std::string& directory,
-                                             std::uint64_t cacheBytes) {
+                                             const std::string& directory, std::uint64_t cacheBytes,
+                                             bool reuse) {
   auto state = std::make_unique<State>();
   state->cacheBytes = std::max<std::uint64_t>(cacheBytes, 4 * kBlockBytes);
   for (std::size_t i = 0; i < images.size(); ++i) {
-    Result<Pyramid> pyramid = buildOne(images[i], fmt::format("{}/{}.pyr", directory, i));
+    const std::string path = fmt::format("{}/{}.pyr", directory, i);
+    if (std::optional<Pyramid> kept = reuse ? keptPyramid(images[i], path) : std::nullopt) {
+      state->images.push_back(std::move(*kept));
+      continue;
+    }
+    Result<Pyramid> pyramid = buildOne(images[i], path);
     if (!pyramid) return pyramid.status();
     state->images.push_back(std::move(*pyramid));
   }

@@ -22,9 +22,12 @@ inline constexpr std::uint32_t kPyramidBlock = 64;
 class TexturePyramid {
  public:
   // Decodes each image (one at a time) into `directory`/<index>.pyr. An image that cannot be
-  // decoded is bad input naming it. `cacheBytes` bounds the blocks held for reading.
+  // decoded is bad input naming it. `cacheBytes` bounds the blocks held for reading. With
+  // `reuse` (a resumed run, whose images are the ones it started from), a pyramid file already
+  // there of its full size is taken as it is: it was renamed into place only when complete.
   static Result<TexturePyramid> build(std::span<const ImageSource> images,
-                                      const std::string& directory, std::uint64_t cacheBytes);
+                                      const std::string& directory, std::uint64_t cacheBytes,
+                                      bool reuse = false);
   TexturePyramid(TexturePyramid&&) noexcept;
   TexturePyramid& operator=(TexturePyramid&&) noexcept;
   ~TexturePyramid();

@@ -29,11 +29,6 @@ std::uint64_t fileBytes(const std::string& path) {
   Result<std::uint64_t> size = fileSize(path);
   return size ? *size : 0;
 }
-std::int64_t modifiedTicks(const std::string& path) {
-  std::error_code error;
-  const auto time = fs::last_write_time(path, error);
-  return error ? 0 : static_cast<std::int64_t>(time.time_since_epoch().count());
-}
 
 // The work directory (stable name, marked as ours) and the tileset staged inside it. On failure
 // or Ctrl-C after the chunks are complete, it stays for --resume; otherwise (bad input, or
@@ -105,7 +100,8 @@ nlohmann::json surfaceIdentity(const std::optional<ReconstructOptions>& surface)
 nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
                            const ChunkInputOptions& input, const OctreeOptions& octree) {
   std::error_code error;
-  return {{"workFormat", 2},  // 2: indexed chunk blocks; work files of another format start over
+  // 3: textures in the state; work files of another format start over.
+  return {{"workFormat", 3},
           {"input", fs::absolute(path, error).string()},
           {"bytes", fileBytes(path)},
           {"modified", modifiedTicks(path)},
@@ -161,9 +157,7 @@ Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& op
   if (!fresh) return crs.error.ok() ? fresh.status() : crs.error;
   if (options.origin) fresh->frame = eastNorthUpToEcef(*options.origin);
   if (crs.transform) fresh->frame = crs.transform->localToEcef();
-  // (A textured input's images are not in the state: its build cannot be resumed yet.)
-  if (!input.keepInMemory && fresh->textures.empty())
-    LODFORGE_TRY(saveChunkState(statePath, identity, *fresh));
+  if (!input.keepInMemory) LODFORGE_TRY(saveChunkState(statePath, identity, *fresh));
   return fresh;
 }
 
@@ -187,7 +181,7 @@ Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& o
 // A textured input's images as pyramids in the work directory, for every tile to bake from.
 Result<std::optional<TexturePyramid>> buildPyramids(const ChunkInput& chunked,
                                                     const std::string& workDirectory,
-                                                    const TexturePlan& plan) {
+                                                    const TexturePlan& plan, bool resumed) {
   if (chunked.textures.empty()) return std::optional<TexturePyramid>();
   for (const ImageSource& image : chunked.textures.images) {
     if (image.format == ImageFormat::kJpeg || plan.wholeImageBytes == 0 ||
@@ -205,7 +199,7 @@ Result<std::optional<TexturePyramid>> buildPyramids(const ChunkInput& chunked,
   fs::create_directories(directory, error);
   if (error) return ioError(directory, fmt::format("cannot create: {}", error.message()));
   Result<TexturePyramid> pyramid =
-      TexturePyramid::build(chunked.textures.images, directory, plan.cacheBytes);
+      TexturePyramid::build(chunked.textures.images, directory, plan.cacheBytes, resumed);
   if (!pyramid) return pyramid.status();
   return std::optional(std::move(*pyramid));
 }
@@ -285,7 +279,8 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   octree.resume = stats.resumed;
   const TexturePlan plan = planTextureMemory(options.memoryLimit, octree.threads,
                                              options.atlas.maxSize, options.textureCacheBytes);
-  Result<std::optional<TexturePyramid>> pyramid = buildPyramids(*chunked, workDirectory, plan);
+  Result<std::optional<TexturePyramid>> pyramid =
+      buildPyramids(*chunked, workDirectory, plan, stats.resumed);
   if (!pyramid) return pyramid.status();
   AtlasOptions atlas = options.atlas;
   atlas.maxSize = plan.pageSide;

@@ -1,5 +1,6 @@
 #include "lodforge/tiling/resume.h"
 
+#include <filesystem>
 #include <fstream>
 #include <map>
 
@@ -7,6 +8,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/tiling/texture_state.h"
 
 namespace lodforge {
 
@@ -32,27 +34,6 @@ nlohmann::json boundsList(const std::vector<Aabbd>& boxes) {
   return list;
 }
 
-nlohmann::json materialsToJson(const std::vector<Material>& materials) {
-  nlohmann::json list = nlohmann::json::array();
-  for (const Material& m : materials)
-    list.push_back({m.name, m.baseColor, m.metallic, m.roughness, static_cast<int>(m.alphaMode),
-                    m.alphaCutoff, m.doubleSided, m.emissive});
-  return list;
-}
-
-// Nothing for an unknown alpha mode; throws nlohmann::json::exception when malformed.
-std::optional<std::vector<Material>> materialsFromJson(const nlohmann::json& list) {
-  std::vector<Material> materials;
-  for (const auto& m : list) {
-    const int alpha = m.at(4).get<int>();
-    if (alpha < 0 || alpha > 2) return std::nullopt;
-    materials.push_back({m.at(0).get<std::string>(), m.at(1).get<std::array<float, 4>>(),
-                         m.at(2).get<float>(), m.at(3).get<float>(), static_cast<AlphaMode>(alpha),
-                         m.at(5).get<float>(), m.at(6).get<bool>(),
-                         m.at(7).get<std::array<float, 3>>()});
-  }
-  return materials;
-}
 }  // namespace
 
 Status saveChunkState(const std::string& path, const nlohmann::json& identity,
@@ -61,8 +42,12 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
   nlohmann::json counts = nlohmann::json::array();
   for (const auto& [index, count] : input.chunks->triangleCounts())
     counts.push_back({index, count});
+  Result<nlohmann::json> textures =
+      saveTextureTable(input.textures, std::filesystem::path(path).parent_path().string());
+  if (!textures) return textures.status();
   const nlohmann::json state = {
       {"identity", identity},
+      {"textures", *textures},
       {"grid",
        {{"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
         {"size", grid.size},
@@ -130,6 +115,10 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
       if (m != kNoMaterial && m >= input.parts.materialTable.size()) return std::nullopt;
     for (std::uint32_t l : input.parts.layers)
       if (l != kNoLayer && l >= input.parts.layerTable.size()) return std::nullopt;
+    std::optional<TextureTable> textures =
+        loadTextureTable(state.at("textures"), std::filesystem::path(path).parent_path().string());
+    if (!textures) return std::nullopt;
+    input.textures = std::move(*textures);
     input.chunks =
         std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
     return input;

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad, instances, textures or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad, instances, textures, texture-formats or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -530,7 +530,50 @@ textures_section() {
   done
   rm -rf "$work/tex"
 }
-if [[ ${BENCH_ONLY:-} == textures ]]; then textures_section; exit 0; fi
+# Texture pages by format: the same textured scan tiled with PNG pages (lossless: the pages as
+# baked, the source resampled) and with each lossy format; each page's PSNR against its PNG twin
+# (`lodforge compare`), and the texture bytes per texel.
+texture_formats_section() {
+  echo
+  echo "== tiles: texture pages by format (200 K-triangle scan, 4 atlases of 2K), PSNR against the lossless pages"
+  printf '| %-12s | %7s | %12s | %13s | %13s | %9s |\n' format pages "image bytes" "bits / texel" "mean PSNR dB" "min PSNR"
+  printf '|%s|%s|%s|%s|%s|%s|\n' -------------- --------- -------------- --------------- --------------- -----------
+  rm -rf "$work/texfmt" && mkdir -p "$work/texfmt"
+  "$lodforge" -q generate scan --triangles 200K --texture 2K --atlases 4 -o "$work/texfmt/scan.ply"
+  local format quality texels=0
+  for format in png jpeg:75 jpeg:85 jpeg:95 webp:85; do
+    quality=${format#*:}
+    [[ $quality == "$format" ]] && quality=85
+    "$lodforge" -q tiles "$work/texfmt/scan.ply" -o "$work/texfmt/${format/:/-}" \
+      --texture-format "${format%%:*}" --texture-quality "$quality"
+    python3 scripts/glb-images.py "$work/texfmt/pages-${format/:/-}" "$work"/texfmt/"${format/:/-}"/tiles/*.glb > /dev/null
+    if [[ $format == png ]]; then
+      texels=$(python3 -c 'import struct,sys
+total = 0
+for path in sys.argv[1:]:
+    with open(path, "rb") as f: f.read(16); w, h = struct.unpack(">II", f.read(8))
+    total += w * h
+print(total)' "$work"/texfmt/pages-png/*.png)
+    fi
+    local bytes report
+    bytes=$(du -cb "$work"/texfmt/pages-"${format/:/-}"/* | tail -1 | cut -f1)
+    report=-
+    if [[ $format != png ]]; then
+      "$lodforge" -q compare "$work/texfmt/pages-png" "$work/texfmt/pages-${format/:/-}" --json "$work/texfmt/psnr.json" > /dev/null
+      report=$(python3 -c 'import json,sys
+frames = json.load(open(sys.argv[1]))["frames"]
+values = [f["psnr_db"] for f in frames if f["psnr_db"] is not None]
+print(f"{sum(values) / len(values):.2f} {min(values):.2f}")' "$work/texfmt/psnr.json")
+    fi
+    printf '| %-12s | %7d | %12s | %13.2f | %13s | %9s |\n' "$format" \
+      "$(ls "$work/texfmt/pages-${format/:/-}" | wc -l)" "$(numfmt --to=iec "$bytes")" \
+      "$(awk -v b="$bytes" -v t="$texels" 'BEGIN { print 8 * b / t }')" \
+      "$( [[ $report == - ]] && echo "lossless" || echo "${report% *}")" "$( [[ $report == - ]] && echo "-" || echo "${report#* }")"
+  done
+  rm -rf "$work/texfmt"
+}
+if [[ ${BENCH_ONLY:-} == textures ]]; then textures_section; texture_formats_section; exit 0; fi
+if [[ ${BENCH_ONLY:-} == texture-formats ]]; then texture_formats_section; exit 0; fi
 
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
@@ -560,5 +603,6 @@ surface_tiles_section
 cad_section
 instances_section
 textures_section
+texture_formats_section
 render_section
 runtime_section

@@ -1,11 +1,15 @@
 // The OBJ reader on any bytes; inputs whose first byte is a multiple of 4 are a material
 // library instead (its map_Kd names, options and paths), read beside a fixed textured OBJ and
 // a real PNG: either a consistent model (a texture that cannot be used is a warning) or a
-// bad-input error naming the file.
+// bad-input error naming the file. Inputs whose first byte is 1 modulo 4 go through the
+// streamed chunking of `tiles` (tiling/chunk_obj) instead: chunks whose triangles are all
+// there, or a bad-input error naming the file.
 #include <unistd.h>
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,6 +17,7 @@
 #include "fuzz_check.h"
 #include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/mesh/obj_reader.h"
+#include "lodforge/tiling/chunk_input.h"
 
 namespace {
 
@@ -36,11 +41,36 @@ const std::string& folder() {
   return path;
 }
 
+void checkStreamed(const std::uint8_t* data, std::size_t size) {
+  using namespace lodforge;
+  const std::string path = folder() + "/stream.obj";
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
+  ChunkInputOptions options;
+  options.workDirectory = folder() + "/work";
+  options.keepInMemory = true;
+  options.vertexCacheBytes = 1;
+  const Result<ChunkInput> input = chunkInput(path, options);
+  if (!input) {
+    if (input.error().kind != ErrorKind::kBadInput ||
+        input.error().message.find(path) == std::string::npos) {
+      std::fprintf(stderr, "unexpected error: %s\n", input.error().message.c_str());
+      std::abort();
+    }
+    return;
+  }
+  if (input->inputTriangles == 0 || input->bounds.empty()) std::abort();
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace lodforge;
   const std::span<const std::byte> bytes(reinterpret_cast<const std::byte*>(data), size);
+  if (size > 0 && data[0] % 4 == 1) {
+    checkStreamed(data, size);
+    return 0;
+  }
   if (size == 0 || data[0] % 4 != 0) {
     fuzz::check(readObjFromMemory(bytes, "fuzz.obj"), "fuzz.obj");
     return 0;

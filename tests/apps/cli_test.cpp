@@ -1349,6 +1349,29 @@ TEST(CliTiles, StaysUnderItsMemoryLimitOnAnInputLargerThanIt) {
   EXPECT_NE(small.err.find("too small"), std::string::npos) << small.err;
 }
 
+// An OBJ streams too (tiling/chunk_obj): a textured one larger than the limit, images included.
+TEST(CliTiles, AStreamedObjStaysUnderItsMemoryLimit) {
+#ifdef LODFORGE_SANITIZED
+  GTEST_SKIP() << "peak RSS means nothing under ASan; the release build checks it";
+#endif
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate scan --triangles 1M --texture 1K --atlases 2 -o " +
+                         dir.file("scan.ply"),
+                     dir)
+                .code,
+            0);
+  ASSERT_EQ(
+      lodforge("-q convert " + dir.file("scan.ply") + " -o " + dir.file("scan.obj"), dir).code, 0);
+  constexpr std::uint64_t kLimit = 96ull << 20;
+  ASSERT_GT(std::filesystem::file_size(dir.file("scan.obj")), kLimit);
+  const Finished run = waitFor(spawnLodforge(
+      {"-q", "--memory-limit", "96M", "tiles", dir.file("scan.obj"), "-o", dir.file("tiles")}));
+  ASSERT_EQ(run.code, 0);
+  EXPECT_LT(run.peak, kLimit) << "peak RSS " << run.peak / (1 << 20) << " MiB";
+  const nlohmann::json root = info(dir.file("tiles/tiles/0-0-0-0.glb"), dir);
+  EXPECT_TRUE(root.contains("textures")) << root.dump();
+}
+
 TEST(CliTiles, TexturedStaysUnderItsMemoryLimitWithImagesLargerThanIt) {
 #ifdef LODFORGE_SANITIZED
   GTEST_SKIP() << "peak RSS means nothing under ASan; the release build checks it";

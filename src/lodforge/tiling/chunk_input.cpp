@@ -16,6 +16,7 @@
 #include "lodforge/simplify/extract.h"
 #include "lodforge/simplify/package.h"
 #include "lodforge/tiling/chunk_grid.h"
+#include "lodforge/tiling/chunk_obj.h"
 #include "lodforge/tiling/chunk_ply.h"
 #include "lodforge/tiling/chunk_sizing.h"
 
@@ -257,6 +258,9 @@ Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& 
   if (error)
     return ioError(options.workDirectory, fmt::format("cannot create: {}", error.message()));
   if (fileExtension(path) == "ply") return chunkPly(path, options);
+  // An OBJ streams unless its objects are asked to be parts (read whole, by object).
+  if (fileExtension(path) == "obj" && options.parts != PartsMode::kOn)
+    return chunkObj(path, options);
   return chunkModel(path, options);
 }
 

@@ -1,8 +1,9 @@
 // The input streamed into the chunk grid (large-meshes paper §3.3–3.4). A PLY is never held in
 // memory: a first pass copies its vertices to a work file (exact doubles) and finds the bounds,
 // a second pass reads the faces, fetches their corners through a fixed block cache over that
-// file, cuts them and hands the pieces to the chunk files. Other formats, and progressive
-// packages (at full detail), are read whole first (their readers do not stream). Segments
+// file, cuts them and hands the pieces to the chunk files; an OBJ streams likewise (chunk_obj.h)
+// unless its objects are to be parts. Other formats, and progressive packages (at full
+// detail), are read whole first (their readers do not stream). Segments
 // smaller than a chunk go in whole (ChunkWriter::addSegmentTriangle): connected components of
 // each object for a model read whole, objects for a PLY with object ids.
 #pragma once

@@ -21,105 +21,10 @@
 #include "lodforge/io/mesh/ply_textures.h"
 #include "lodforge/tiling/chunk_grid.h"
 #include "lodforge/tiling/chunk_sizing.h"
+#include "lodforge/tiling/vertex_cache.h"
 
 namespace lodforge {
 namespace {
-
-// A vertex in the work file: position (3 doubles), colour, normal (3 floats; a sum of face
-// normals while a normals pass accumulates it); for a textured file then its texture
-// coordinate (2 floats).
-constexpr std::size_t kVertexBytes = 3 * sizeof(double) + sizeof(Rgba8) + 3 * sizeof(float);
-constexpr std::size_t kNormalOffset = 3 * sizeof(double) + sizeof(Rgba8);
-constexpr std::size_t kUvBytes = sizeof(Vec2f);
-constexpr std::uint64_t kBlockVertices = 1 << 14;
-
-// Corners of the faces, fetched from the vertex work file through a direct-mapped cache of
-// fixed-size blocks: meshes written in scan or grid order touch a few blocks at a time. Blocks
-// changed by addNormal are written back when evicted and by flush().
-class VertexCache {
- public:
-  VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes, std::size_t recordBytes)
-      : fd_(fd), vertices_(vertices), recordBytes_(recordBytes) {
-    const std::uint64_t blockBytes = kBlockVertices * recordBytes_;
-    slots_ = std::max<std::uint64_t>(4, bytes / blockBytes);
-    data_.resize(slots_ * blockBytes);
-    tags_.assign(slots_, ~std::uint64_t{0});
-    dirty_.assign(slots_, 0);
-  }
-
-  bool fetch(std::uint64_t vertex, CutCorner& out) {
-    const std::byte* at = record(vertex);
-    if (at == nullptr) return false;
-    double xyz[3];
-    float normal[3];
-    std::memcpy(xyz, at, sizeof xyz);
-    std::memcpy(&out.color, at + sizeof xyz, sizeof(Rgba8));
-    std::memcpy(normal, at + kNormalOffset, sizeof normal);
-    out.position = {xyz[0], xyz[1], xyz[2]};
-    out.normal = normalizeOr(Vec3f{normal[0], normal[1], normal[2]}, Vec3f{0, 0, 1});
-    if (recordBytes_ > kVertexBytes) std::memcpy(&out.uv, at + kVertexBytes, kUvBytes);
-    out.source = vertex;
-    return true;
-  }
-
-  bool addNormal(std::uint64_t vertex, Vec3f add) {
-    std::byte* at = record(vertex);
-    if (at == nullptr) return false;
-    float normal[3];
-    std::memcpy(normal, at + kNormalOffset, sizeof normal);
-    normal[0] += add.x, normal[1] += add.y, normal[2] += add.z;
-    std::memcpy(at + kNormalOffset, normal, sizeof normal);
-    dirty_[vertex / kBlockVertices % slots_] = 1;
-    return true;
-  }
-
-  bool flush() {
-    for (std::uint64_t slot = 0; slot < slots_; ++slot)
-      if (dirty_[slot] != 0 && !writeBack(slot)) return false;
-    return true;
-  }
-
- private:
-  std::byte* record(std::uint64_t vertex) {
-    if (vertex >= vertices_) return nullptr;
-    const std::uint64_t block = vertex / kBlockVertices;
-    const std::uint64_t slot = block % slots_;
-    std::byte* base = data_.data() + slot * kBlockVertices * recordBytes_;
-    if (tags_[slot] != block) {
-      if (dirty_[slot] != 0 && !writeBack(slot)) return nullptr;
-      const std::uint64_t first = block * kBlockVertices;
-      const auto wanted = static_cast<std::size_t>(blockVertices(block) * recordBytes_);
-      if (::pread(fd_, base, wanted, static_cast<off_t>(first * recordBytes_)) !=
-          static_cast<ssize_t>(wanted))
-        return nullptr;
-      tags_[slot] = block;
-    }
-    return base + (vertex % kBlockVertices) * recordBytes_;
-  }
-
-  std::uint64_t blockVertices(std::uint64_t block) const {
-    return std::min(kBlockVertices, vertices_ - block * kBlockVertices);
-  }
-
-  bool writeBack(std::uint64_t slot) {
-    const std::uint64_t block = tags_[slot];
-    const auto bytes = static_cast<std::size_t>(blockVertices(block) * recordBytes_);
-    const std::byte* base = data_.data() + slot * kBlockVertices * recordBytes_;
-    if (::pwrite(fd_, base, bytes, static_cast<off_t>(block * kBlockVertices * recordBytes_)) !=
-        static_cast<ssize_t>(bytes))
-      return false;
-    dirty_[slot] = 0;
-    return true;
-  }
-
-  int fd_;
-  std::uint64_t vertices_;
-  std::size_t recordBytes_;
-  std::uint64_t slots_ = 0;
-  std::vector<std::byte> data_;
-  std::vector<std::uint64_t> tags_;
-  std::vector<std::uint8_t> dirty_;
-};
 
 // The failure of a pipeline over batches, from any of its stages: the one nearest the start of
 // the file is kept (the same message whatever the timing), and every stage stops once one is.
@@ -289,17 +194,13 @@ void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>
       return;
     }
     input_.bounds.add(p);
-    const double xyz[3] = {p.x, p.y, p.z};
     const Rgba8 color = batch.colors.empty() ? Rgba8{255, 255, 255, 255} : batch.colors[i];
     // The file's normals (turned with the positions), or zero for the normals pass to fill.
     const Vec3f n = batch.normals.empty()
                         ? Vec3f{}
                         : transformNormal(options_, batch.positions[i], p, batch.normals[i]);
-    const float normal[3] = {n.x, n.y, n.z};
     std::byte* record = buffer.data() + i * recordBytes_;
-    std::memcpy(record, xyz, sizeof xyz);
-    std::memcpy(record + sizeof xyz, &color, sizeof color);
-    std::memcpy(record + kNormalOffset, normal, sizeof normal);
+    writeVertexRecord(record, p, color, n);
     if (recordBytes_ > kVertexBytes) {
       const Vec2f uv = batch.uvs.empty() ? Vec2f{} : batch.uvs[i];
       std::memcpy(record + kVertexBytes, &uv, kUvBytes);

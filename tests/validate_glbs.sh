@@ -31,8 +31,10 @@ done
 # Textured models: an OBJ whose MTL names five JPEGs, a GLB with an embedded PNG.
 "$lodforge" -q convert "$data/textured/spider/spider.obj" -o "$out/spider-textured.glb"
 "$lodforge" -q convert "$data/textured/BoxTextured.glb" -o "$out/box-textured.glb"
+# A TGA texture (assimp's Collada duck): embedded as a PNG, glTF having no TGA.
+"$lodforge" -q convert /usr/share/assimp/models/Collada/duck.dae -o "$out/duck-tga.glb"
 count=$(ls "$out"/*.glb | wc -l)
-want=$(( $(ls "$data"/meshes | wc -l) + 11 ))
+want=$(( $(ls "$data"/meshes | wc -l) + 12 ))
 [[ $count -eq $want ]] || { echo "expected $want GLBs, found $count" >&2; exit 1; }
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse-tiles" --chunk-size 0.05 --no-quantization
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan-tiles" --chunk-size 60 --compress meshopt

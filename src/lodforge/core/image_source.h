@@ -12,7 +12,9 @@
 
 namespace lodforge {
 
-enum class ImageFormat : std::uint8_t { kUnknown, kJpeg, kPng, kWebp };
+// BMP and TGA come in through OBJ and assimp's formats; glTF holds only JPEG, PNG and WebP, so
+// a GLB writer re-encodes them (gltfImageFormat).
+enum class ImageFormat : std::uint8_t { kUnknown, kJpeg, kPng, kWebp, kBmp, kTga };
 
 struct ImageSource {
   std::string name{};              // as the input names it: a file name, or "image 3"
@@ -28,13 +30,18 @@ struct ImageSource {
   std::uint64_t decodedBytes() const { return std::uint64_t{width} * height * 4; }
 };
 
-// The format an image's first bytes announce (JPEG, PNG and WebP signatures).
+// The format an image's first bytes announce (JPEG, PNG, WebP and BMP signatures; a TGA has
+// none, see imageFormatOfName).
 ImageFormat imageFormatOf(std::span<const std::byte> header);
-// "image/jpeg", "image/png", "image/webp"; empty for kUnknown.
+// kTga for a name ending in ".tga" (any case), kUnknown otherwise: a TGA is known by its name.
+ImageFormat imageFormatOfName(std::string_view name);
+// What glTF may hold: JPEG, PNG, or WebP (EXT_texture_webp).
+bool gltfImageFormat(ImageFormat format);
+// "image/jpeg", "image/png", "image/webp", "image/bmp", "image/x-tga"; empty for kUnknown.
 std::string_view mimeTypeOf(ImageFormat format);
 // The format of a glTF mimeType ("image/png"), kUnknown for any other.
 ImageFormat imageFormatOfMimeType(std::string_view mimeType);
-// "JPEG", "PNG", "WebP", "unknown".
+// "JPEG", "PNG", "WebP", "BMP", "TGA", "unknown".
 std::string_view imageFormatName(ImageFormat format);
 
 }  // namespace lodforge

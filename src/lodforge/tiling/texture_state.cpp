@@ -29,7 +29,7 @@ std::optional<ImageSource> imageFromJson(const nlohmann::json& j, std::size_t in
   image.name = j.at("name").get<std::string>();
   image.path = j.at("path").get<std::string>();
   const int format = j.at("format").get<int>();
-  if (format < 0 || format > static_cast<int>(ImageFormat::kWebp)) return std::nullopt;
+  if (format < 0 || format > static_cast<int>(ImageFormat::kTga)) return std::nullopt;
   image.format = static_cast<ImageFormat>(format);
   image.width = j.at("width").get<std::uint32_t>();
   image.height = j.at("height").get<std::uint32_t>();

@@ -1,9 +1,11 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <tuple>
 
 #include "lodforge/io/image/image_codec.h"
 #include "test_support.h"
+#include "texture_support.h"
 
 namespace lodforge {
 namespace {
@@ -92,6 +94,51 @@ TEST(ImageCodec, ProbeReadsTheHeaderOfFilesAndEmbeddedBytes) {
   EXPECT_EQ(decoded->height, 9u);
 }
 
+TEST(ImageCodec, TgaAndBmpDecodeExactly) {
+  test::TempDir dir;
+  const Image opaque = pattern(13, 7), clear = pattern(9, 5, true);
+  test::writeFile(dir.file("a.TGA"), test::tgaOf(opaque, false));
+  test::writeFile(dir.file("b.tga"), test::tgaOf(clear, true));
+  test::writeFile(dir.file("c.bmp"), test::bmpOf(opaque));
+  const std::vector<std::tuple<std::string, ImageFormat, const Image*, std::uint32_t>> cases = {
+      {"a.TGA", ImageFormat::kTga, &opaque, 3},
+      {"b.tga", ImageFormat::kTga, &clear, 4},
+      {"c.bmp", ImageFormat::kBmp, &opaque, 3}};
+  for (const auto& [name, format, expected, channels] : cases) {
+    ImageSource file{.name = name, .path = dir.file(name)};
+    ASSERT_TRUE(probeImage(file).ok()) << name;
+    EXPECT_EQ(file.format, format) << name;
+    EXPECT_EQ(file.width, expected->width) << name;
+    EXPECT_EQ(file.height, expected->height) << name;
+    EXPECT_EQ(file.channels, channels) << name;
+    Result<Image> decoded = decodeImage(file);
+    ASSERT_TRUE(decoded.ok()) << name << ": " << decoded.error().message;
+    EXPECT_EQ(decoded->rgba, expected->rgba) << name;
+  }
+  // A TGA has no signature: bytes named otherwise are not taken for one, and a .tga that
+  // is not one (an unknown image type) is refused naming it.
+  const std::string bytes = test::tgaOf(opaque, false);
+  ImageSource unnamed{.name = "image 3",
+                      .bytes = std::vector<std::byte>(
+                          reinterpret_cast<const std::byte*>(bytes.data()),
+                          reinterpret_cast<const std::byte*>(bytes.data()) + bytes.size())};
+  EXPECT_FALSE(probeImage(unnamed).ok());
+  // A BMP of no rows (stb decodes it as an empty image) is refused.
+  std::string empty = test::bmpOf(opaque);
+  std::fill(empty.begin() + 22, empty.begin() + 26, '\0');
+  const Result<Image> none = decodeImage(
+      std::span(reinterpret_cast<const std::byte*>(empty.data()), empty.size()), "empty.bmp");
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().message.find("no texels"), std::string::npos) << none.error().message;
+  std::string broken = bytes;
+  broken[2] = 7;
+  test::writeFile(dir.file("broken.tga"), broken);
+  ImageSource bad{.name = "broken.tga", .path = dir.file("broken.tga")};
+  const Status refused = probeImage(bad);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("broken.tga"), std::string::npos);
+}
+
 TEST(ImageCodec, MissingGarbageAndCutShortImagesAreRefusedByName) {
   test::TempDir dir;
   ImageSource missing{.name = "gone.jpg", .path = dir.file("gone.jpg")};
@@ -103,7 +150,7 @@ TEST(ImageCodec, MissingGarbageAndCutShortImagesAreRefusedByName) {
   ImageSource garbage{.name = "notes.png", .bytes = {std::byte{'h'}, std::byte{'i'}}};
   status = probeImage(garbage);
   ASSERT_FALSE(status.ok());
-  EXPECT_NE(status.error().message.find("not a JPEG, PNG or WebP"), std::string::npos);
+  EXPECT_NE(status.error().message.find("not a JPEG, PNG, WebP, BMP or TGA"), std::string::npos);
 
   // A JPEG cut in half decodes to grey rows in libjpeg: refused here instead.
   Result<std::vector<std::byte>> jpeg =

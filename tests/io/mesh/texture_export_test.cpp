@@ -9,6 +9,7 @@
 #include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/model_io.h"
 #include "test_support.h"
+#include "texture_support.h"
 
 namespace lodforge {
 namespace {
@@ -78,6 +79,41 @@ TEST(TextureExport, AFileInAnImagesPlaceIsNeverReplacedAndNothingIsWritten) {
   test::writeFile(dir.file("mine.mtl"), "newmtl theirs\n");
   ASSERT_FALSE(writeModel(*spider, dir.file("mine.obj")).ok());
   EXPECT_EQ(test::listFolder(dir.path()), std::vector<std::string>{"mine.mtl"});
+}
+
+// A TGA texture (common beside OBJ and 3DS files) is read, written beside an OBJ as a TGA, and
+// embedded in a GLB as a PNG (glTF holds no TGA) with the same texels.
+TEST(TextureExport, ATgaTextureGoesBesideAnObjAndIntoAGlbAsPng) {
+  test::TempDir dir;
+  Image texels(6, 4);
+  for (std::size_t i = 0; i < texels.rgba.size(); ++i)
+    texels.rgba[i] = static_cast<std::uint8_t>(i % 4 == 3 ? 255 : i * 11);
+  std::filesystem::create_directories(dir.file("in"));
+  std::filesystem::create_directories(dir.file("out"));
+  test::writeFile(dir.file("in/wood.tga"), test::tgaOf(texels, false));
+  test::writeFile(dir.file("in/box.mtl"), "newmtl wood\nKd 1 1 1\nmap_Kd wood.tga\n");
+  test::writeFile(dir.file("in/box.obj"),
+                  "mtllib box.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                  "usemtl wood\nf 1/1 2/2 3/3\n");
+  std::vector<std::string> warnings;
+  ReadOptions read;
+  read.warnings = &warnings;
+  Result<Model> box = readModel(dir.file("in/box.obj"), read);
+  ASSERT_TRUE(box.ok()) << box.error().message;
+  EXPECT_TRUE(warnings.empty()) << warnings.front();
+  ASSERT_EQ(box->images.size(), 1u);
+  EXPECT_EQ(box->images[0].format, ImageFormat::kTga);
+  ASSERT_TRUE(writeModel(*box, dir.file("out/box.obj")).ok());
+  EXPECT_EQ(test::readFile(dir.file("out/box_texture0.tga")),
+            test::readFile(dir.file("in/wood.tga")));
+  ASSERT_TRUE(writeModel(*box, dir.file("out/box.glb")).ok());
+  Result<Model> glb = readModel(dir.file("out/box.glb"));
+  ASSERT_TRUE(glb.ok()) << glb.error().message;
+  ASSERT_EQ(glb->images.size(), 1u);
+  EXPECT_EQ(glb->images[0].format, ImageFormat::kPng);
+  Result<Image> embedded = decodeImage(glb->images[0]);
+  ASSERT_TRUE(embedded.ok());
+  EXPECT_EQ(embedded->rgba, texels.rgba);
 }
 
 }  // namespace

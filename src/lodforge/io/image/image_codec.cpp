@@ -181,16 +181,19 @@ Status pngChunksFit(std::span<const std::byte> bytes, const std::string& name) {
 
 Result<Image> decodeStb(std::span<const std::byte> bytes, const std::string& name,
                         std::uint64_t maxPixels) {
-  LODFORGE_TRY(pngChunksFit(bytes, name));
+  if (imageFormatOf(bytes) == ImageFormat::kPng) LODFORGE_TRY(pngChunksFit(bytes, name));
   int width = 0, height = 0, channels = 0;
   std::string why;
   if (!stb::imageInfo(bytes, width, height, channels, why))
-    return badInput(name, fmt::format("cannot read the PNG header ({})", why));
+    return badInput(name, fmt::format("cannot read the image header ({})", why));
+  // (stb reads a BMP of no rows as an empty image: none is a texture.)
+  if (width <= 0 || height <= 0)
+    return badInput(name, fmt::format("image of {}x{} pixels has no texels", width, height));
   if (static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) > maxPixels)
-    return badInput(name, fmt::format("PNG image of {}x{} pixels is too large", width, height));
+    return badInput(name, fmt::format("image of {}x{} pixels is too large", width, height));
   Image image;
   if (!stb::decodeImage(bytes, width, height, image.rgba, why))
-    return badInput(name, fmt::format("cannot decode the PNG image ({})", why));
+    return badInput(name, fmt::format("cannot decode the image ({})", why));
   image.width = static_cast<std::uint32_t>(width);
   image.height = static_cast<std::uint32_t>(height);
   return image;
@@ -237,8 +240,10 @@ std::vector<std::byte> copyOf(const void* data, std::size_t size) {
 // whose frame header follows a large EXIF block: then the whole file is read).
 Status probeBytes(ImageSource& image, std::span<const std::byte> bytes) {
   image.format = imageFormatOf(bytes);
+  if (image.format == ImageFormat::kUnknown)
+    image.format = imageFormatOfName(image.embedded() ? image.name : image.path);
   int width = 0, height = 0, channels = 0;
-  std::string why = "not a JPEG, PNG or WebP image";
+  std::string why = "not a JPEG, PNG, WebP, BMP or TGA image";
   bool ok = false;
   if (image.format == ImageFormat::kWebp) {
     WebPBitstreamFeatures features;
@@ -252,8 +257,9 @@ Status probeBytes(ImageSource& image, std::span<const std::byte> bytes) {
     JpegError error{};
     ok = readJpegHeader(bytes, width, height, channels, error);
     why = fmt::format("cannot read the JPEG header ({})", error.message);
-  } else if (image.format == ImageFormat::kPng) {
-    ok = stb::imageInfo(bytes, width, height, channels, why);
+  } else if (image.format != ImageFormat::kUnknown) {  // PNG, BMP, TGA: stb
+    ok = bytes.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()) &&
+         stb::imageInfo(bytes, width, height, channels, why);
   }
   if (!ok || width <= 0 || height <= 0)
     return badInput(describe(image), fmt::format("texture image: {}", why));
@@ -289,9 +295,12 @@ Status probeImage(ImageSource& image) {
   return probeBytes(image, *whole);
 }
 
-Result<Image> decodeImage(std::span<const std::byte> bytes, const std::string& name,
-                          std::uint64_t maxPixels) {
-  switch (imageFormatOf(bytes)) {
+namespace {
+
+// The texels of an image of a known format.
+Result<Image> decodeAs(std::span<const std::byte> bytes, ImageFormat format,
+                       const std::string& name, std::uint64_t maxPixels) {
+  switch (format) {
     case ImageFormat::kJpeg:
       return decodeJpeg(bytes, name, maxPixels);
     case ImageFormat::kPng:
@@ -300,16 +309,32 @@ Result<Image> decodeImage(std::span<const std::byte> bytes, const std::string& n
       return decodeStb(bytes, name, maxPixels);
     case ImageFormat::kWebp:
       return decodeWebp(bytes, name, maxPixels);
+    case ImageFormat::kBmp:
+    case ImageFormat::kTga:
+      if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+        return badInput(name, "texture image larger than 2 GiB");
+      return decodeStb(bytes, name, maxPixels);
     case ImageFormat::kUnknown:
       break;
   }
-  return badInput(name, "texture image: not a JPEG, PNG or WebP image");
+  return badInput(name, "texture image: not a JPEG, PNG, WebP, BMP or TGA image");
+}
+
+}  // namespace
+
+Result<Image> decodeImage(std::span<const std::byte> bytes, const std::string& name,
+                          std::uint64_t maxPixels) {
+  ImageFormat format = imageFormatOf(bytes);
+  if (format == ImageFormat::kUnknown) format = imageFormatOfName(name);
+  return decodeAs(bytes, format, name, maxPixels);
 }
 
 Result<Image> decodeImage(const ImageSource& image, std::uint64_t maxPixels) {
   Result<std::vector<std::byte>> bytes = imageBytes(image);
   if (!bytes) return bytes.status();
-  return decodeImage(*bytes, describe(image), maxPixels);
+  ImageFormat format = imageFormatOf(*bytes);
+  if (format == ImageFormat::kUnknown) format = image.format;  // a TGA, probed by its name
+  return decodeAs(*bytes, format, describe(image), maxPixels);
 }
 
 Status decodeImageRows(const ImageSource& image, std::uint64_t maxPixels,

@@ -1,4 +1,5 @@
-// stb's PNG decoder and encoder (Debian's libstb-dev header), compiled in stb_image.cpp: the
+// stb's PNG, BMP and TGA decoders and PNG encoder (Debian's libstb-dev header), compiled in
+// stb_image.cpp (callers pick the format by its signature, a TGA by its name): the
 // fuzzers' sanitizers then see inside the decoder, and nothing clashes with libstb's own copy.
 // (Its JPEG decoder is left out: the fuzzer found it reading past a Huffman table; JPEG goes
 // through libjpeg-turbo, image_codec.h.)

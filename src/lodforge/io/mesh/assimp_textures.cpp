@@ -25,7 +25,12 @@ Result<std::vector<std::byte>> embeddedBytes(const aiTexture& texture, const std
   if (texture.pcData == nullptr) return badInput(name, "embedded texture without data");
   if (texture.mHeight == 0) {
     const auto* begin = reinterpret_cast<const std::byte*>(texture.pcData);
-    return std::vector<std::byte>(begin, begin + texture.mWidth);
+    std::vector<std::byte> bytes(begin, begin + texture.mWidth);
+    if (std::string_view(texture.achFormatHint) != "tga") return bytes;
+    // A TGA has no signature to know it by later: its texels go in as a PNG.
+    Result<Image> texels = decodeImage(bytes, name + ".tga");
+    if (!texels) return texels.status();
+    return encodeImage(*texels, {.format = ImageFormat::kPng});
   }
   if (std::uint64_t{texture.mWidth} * texture.mHeight > kMaxTexturePixels)
     return badInput(name, "embedded texture too large");

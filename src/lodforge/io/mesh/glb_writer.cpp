@@ -662,10 +662,20 @@ class ModelTextures {
     const ImageSource& image = model_.images[material.baseColorImage];
     Result<std::vector<std::byte>> bytes = imageBytes(image);
     if (!bytes) return bytes.status();
-    const ImageFormat format = imageFormatOf(*bytes);
+    ImageFormat format = imageFormatOf(*bytes);
+    if (format == ImageFormat::kUnknown) format = image.format;  // a TGA, known by its name
     if (format == ImageFormat::kUnknown)
       return badInput(image.embedded() ? image.name : image.path,
-                      "texture image: not a JPEG, PNG or WebP image");
+                      "texture image: not a JPEG, PNG, WebP, BMP or TGA image");
+    if (!gltfImageFormat(format)) {
+      // glTF holds JPEG, PNG and WebP: a BMP or TGA goes in as a PNG (lossless, alpha kept).
+      Result<Image> texels = decodeImage(image);
+      if (!texels) return texels.status();
+      Result<std::vector<std::byte>> png = encodeImage(*texels, {.format = ImageFormat::kPng});
+      if (!png) return png.status();
+      bytes = std::move(*png);
+      format = ImageFormat::kPng;
+    }
     Result<std::uint32_t> texture =
         writer_.addTexture(*bytes, format, material.wrapS, material.wrapT);
     if (!texture) return texture.status();

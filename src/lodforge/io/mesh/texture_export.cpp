@@ -17,6 +17,10 @@ std::string_view extensionOf(ImageFormat format) {
       return "jpg";
     case ImageFormat::kWebp:
       return "webp";
+    case ImageFormat::kBmp:
+      return "bmp";
+    case ImageFormat::kTga:
+      return "tga";
     default:
       break;
   }
@@ -67,7 +71,7 @@ Result<std::vector<std::string>> addImagesBeside(const Model& model, const std::
   for (std::size_t i = 0; i < model.images.size(); ++i) {
     Result<std::vector<std::byte>> bytes = imageBytes(model.images[i]);
     if (!bytes) return bytes.status();
-    names.push_back(fmt::format("{}_texture{}.{}", stem, i, extensionOf(imageFormatOf(*bytes))));
+    names.push_back(fmt::format("{}_texture{}.{}", stem, i, extensionOf(model.images[i].format)));
     files.add((target.parent_path() / names.back()).string(),
               std::string(reinterpret_cast<const char*>(bytes->data()), bytes->size()));
   }

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad, instances, textures, texture-formats or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad, instances, textures, texture-formats, gltfpack or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -575,6 +575,43 @@ print(f"{sum(values) / len(values):.2f} {min(values):.2f}")' "$work/texfmt/psnr.
 if [[ ${BENCH_ONLY:-} == textures ]]; then textures_section; texture_formats_section; exit 0; fi
 if [[ ${BENCH_ONLY:-} == texture-formats ]]; then texture_formats_section; exit 0; fi
 
+# Textured simplification beside gltfpack (issue 36): the same textured GLB (a generated scan, 16
+# atlases of 4K) simplified to a tenth of its triangles by `lodforge convert --simplify 0.1` and
+# by `gltfpack -si 0.1 -noq` (no quantization, so both keep full-precision positions and
+# coordinates); wall and peak RSS of each, then `lodforge compare` of each result against the
+# input: surface distance and the texture-space error in texels. GLTFPACK names the peer's
+# binary (npm's gltfpack, installed outside the project).
+gltfpack_section() {
+  echo
+  echo "== textured simplification beside gltfpack (2 M-triangle scan, 16 x 4K atlases, to a tenth)"
+  if [[ -z ${GLTFPACK:-} || ! -x ${GLTFPACK:-} ]]; then
+    echo "GLTFPACK is not set to a gltfpack binary: nothing to compare against (skipped)"
+    return
+  fi
+  printf '| %-26s | %7s | %9s | %9s | %9s | %8s | %13s | %11s |\n' tool wall "peak RSS" triangles hausdorff rms "texels mean" "texels p95"
+  printf '|%s|%s|%s|%s|%s|%s|%s|%s|\n' ---------------------------- --------- ----------- ----------- ----------- ---------- --------------- -------------
+  rm -rf "$work/gp" && mkdir -p "$work/gp"
+  "$lodforge" -q generate scan --triangles "${GLTFPACK_TRIANGLES:-2M}" --texture 4K --atlases 16 -o "$work/gp/scan.ply"
+  "$lodforge" -q convert "$work/gp/scan.ply" -o "$work/gp/scan.glb"
+  local tool result report
+  for tool in "lodforge (1 thread)" "lodforge" "gltfpack"; do
+    case $tool in
+      "lodforge (1 thread)") result=$(timed "$lodforge" -q --threads 1 convert "$work/gp/scan.glb" -o "$work/gp/out.glb" --simplify 0.1) ;;
+      lodforge) result=$(timed "$lodforge" -q convert "$work/gp/scan.glb" -o "$work/gp/out.glb" --simplify 0.1) ;;
+      gltfpack) result=$(timed "$GLTFPACK" -i "$work/gp/scan.glb" -o "$work/gp/out.glb" -si 0.1 -noq) ;;
+    esac
+    "$lodforge" -q compare "$work/gp/scan.glb" "$work/gp/out.glb" --json "$work/gp/compare.json"
+    report=$(python3 -c 'import json,sys
+j = json.load(open(sys.argv[1])); t = j["texture_texels"]
+print("%.4g %.4g %.3g %.3g" % (j["hausdorff"], j["rms"], t["mean"], t["p95"]))' "$work/gp/compare.json")
+    read -r h r tm tp <<< "$report"
+    printf '| %-26s | %6ss | %5d MiB | %9s | %9s | %8s | %13s | %11s |\n' "$tool" "${result% *}" $((${result#* } / 1024)) \
+      "$("$lodforge" info "$work/gp/out.glb" | sed -n 's/^triangles *//p')" "$h" "$r" "$tm" "$tp"
+  done
+  rm -rf "$work/gp"
+}
+if [[ ${BENCH_ONLY:-} == gltfpack ]]; then gltfpack_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -604,5 +641,6 @@ cad_section
 instances_section
 textures_section
 texture_formats_section
+gltfpack_section
 render_section
 runtime_section

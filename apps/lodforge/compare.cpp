@@ -34,17 +34,15 @@ struct Pair {
 };
 
 bool isImageFile(const std::filesystem::path& path) {
-  const std::string e = path.extension().string();
-  return e == ".png" || e == ".jpg" || e == ".jpeg" || e == ".webp";
+  const std::string e = fileExtension(path.string());  // lower case
+  return e == "png" || e == "jpg" || e == "jpeg" || e == "webp";
 }
 
 // The image of `folder` whose name without its extension is `stem`; empty if none.
 std::filesystem::path imageNamed(const std::string& folder, const std::string& stem) {
   std::error_code error;
-  for (const char* extension : {".png", ".jpg", ".jpeg", ".webp"}) {
-    const std::filesystem::path path = std::filesystem::path(folder) / (stem + extension);
-    if (std::filesystem::exists(path, error)) return path;
-  }
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error))
+    if (isImageFile(entry.path()) && entry.path().stem().string() == stem) return entry.path();
   return {};
 }
 
@@ -61,13 +59,18 @@ Result<std::vector<Pair>> pairsOf(const CompareOptions& o) {
   if (folderA != folderB)
     return Error{
         ErrorKind::kUsage,
-        fmt::format("compare two PNG files or two folders of them, not '{}' and '{}'", o.a, o.b)};
+        fmt::format("compare two images or two folders of them, not '{}' and '{}'", o.a, o.b)};
   if (!folderA) return std::vector<Pair>{{fs::path(o.a).filename().string(), o.a, o.b}};
   // Frames pair up by file name; a frame missing on either side is an error, not a skip.
   std::vector<Pair> pairs;
   for (const auto& entry : fs::directory_iterator(o.a, error)) {
     if (!isImageFile(entry.path())) continue;
     const std::string name = entry.path().stem().string();
+    if (std::any_of(pairs.begin(), pairs.end(), [&](const Pair& p) { return p.name == name; }))
+      return Error{ErrorKind::kBadInput,
+                   fmt::format("{}: two frames named '{}' (by name without the extension): "
+                               "which to compare is ambiguous",
+                               o.a, name)};
     const fs::path other = imageNamed(o.b, name);
     if (other.empty())
       return Error{ErrorKind::kBadInput, fmt::format("{}: no frame '{}' to compare with {}", o.b,

@@ -1,13 +1,22 @@
 // `lodforge compare A.ply B.ply`: how far two surfaces lie from each other — the symmetric
 // Hausdorff and RMS distance of the project's sampler (core/distance), and the mean each way —
-// e.g. a reconstruction against the surface its points were sampled from.
+// e.g. a reconstruction against the surface its points were sampled from. When both are
+// textured with the same images (matched by their bytes), also how far B's texture mapping is
+// from A's in texels (textureDistance): the texture-space error of a simplification.
 #include "compare_meshes.h"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/core/checksum.h"
 #include "lodforge/core/distance.h"
 #include "lodforge/core/file.h"
+#include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/points/point_reader.h"
 #include "outputs.h"
@@ -32,6 +41,54 @@ Flat flatten(const Model& model, Vec3d origin) {
     for (std::uint32_t i : model.objectIndices(o)) flat.indices.push_back(base + i);
   }
   return flat;
+}
+
+// Each triangle's texture as the index of A's image with the same bytes (~0u: none, or an image
+// A lacks), and A's images' sizes.
+struct Textures {
+  std::vector<std::uint32_t> texture;
+  std::vector<std::array<std::uint32_t, 2>> texels;
+};
+
+Result<Textures> texturesOf(const Model& model, const Model& reference) {
+  std::map<std::uint64_t, std::uint32_t> byBytes;
+  Textures out;
+  for (std::size_t i = 0; i < reference.images.size(); ++i) {
+    Result<std::vector<std::byte>> bytes = imageBytes(reference.images[i]);
+    if (!bytes) return bytes.status();
+    byBytes.emplace(checksum64(*bytes), static_cast<std::uint32_t>(i));
+    out.texels.push_back({reference.images[i].width, reference.images[i].height});
+  }
+  std::vector<std::uint32_t> imageToReference(model.images.size(), ~0u);
+  for (std::size_t i = 0; i < model.images.size(); ++i) {
+    Result<std::vector<std::byte>> bytes = imageBytes(model.images[i]);
+    if (!bytes) return bytes.status();
+    if (const auto found = byBytes.find(checksum64(*bytes)); found != byBytes.end())
+      imageToReference[i] = found->second;
+  }
+  for (const ObjectRecord& o : model.objects) {
+    std::uint32_t texture = ~0u;
+    if (model.hasUvs() && o.material < model.materials.size() &&
+        model.materials[o.material].baseColorImage != kNoImage)
+      texture = imageToReference[model.materials[o.material].baseColorImage];
+    out.texture.insert(out.texture.end(), o.triangleCount, texture);
+  }
+  return out;
+}
+
+// The texture-space error of B against A, when both are textured with images they share.
+Result<std::optional<TextureDistance>> compareTextures(const Model& a, const Flat& fa,
+                                                       const Model& b, const Flat& fb,
+                                                       std::uint32_t samples) {
+  if (!a.hasUvs() || !b.hasUvs() || a.images.empty()) return std::optional<TextureDistance>();
+  Result<Textures> ta = texturesOf(a, a), tb = texturesOf(b, a);
+  if (!ta) return ta.status();
+  if (!tb) return tb.status();
+  if (std::all_of(tb->texture.begin(), tb->texture.end(), [](std::uint32_t t) { return t == ~0u; }))
+    return std::optional<TextureDistance>();
+  const TexturedSurface sa{fa.positions, fa.indices, a.uvs, ta->texture, ta->texels};
+  const TexturedSurface sb{fb.positions, fb.indices, b.uvs, tb->texture, ta->texels};
+  return std::optional(textureDistance(sa, sb, samples));
 }
 
 bool isGeometryPath(const std::string& path) {
@@ -76,14 +133,28 @@ Status runCompareMeshes(const Global& global, const std::string& a, const std::s
   say(global, fmt::format("hausdorff {:.6g}  rms {:.6g}  mean {} → {}: {:.6g}  mean {} → {}: "
                           "{:.6g}  ({} samples on each)",
                           d.hausdorff, d.rms, a, b, d.meanAB, b, a, d.meanBA, samples));
+  Result<std::optional<TextureDistance>> texture =
+      compareTextures(*first, fa, *second, fb, samples);
+  if (!texture) return texture.status();
+  if (*texture)
+    say(global, fmt::format("texture error {} → {} in texels: mean {:.3g}  median {:.3g}  "
+                            "95th percentile {:.3g}  max {:.3g}  ({} samples; {} where {} has "
+                            "another texture)",
+                            a, b, (*texture)->mean, (*texture)->median, (*texture)->p95,
+                            (*texture)->max, (*texture)->samples, (*texture)->otherTexture, b));
   if (json.empty()) return {};
-  const nlohmann::json report = {{"a", a},
-                                 {"b", b},
-                                 {"samples", samples},
-                                 {"hausdorff", d.hausdorff},
-                                 {"rms", d.rms},
-                                 {"mean_ab", d.meanAB},
-                                 {"mean_ba", d.meanBA}};
+  nlohmann::json report = {{"a", a},
+                           {"b", b},
+                           {"samples", samples},
+                           {"hausdorff", d.hausdorff},
+                           {"rms", d.rms},
+                           {"mean_ab", d.meanAB},
+                           {"mean_ba", d.meanBA}};
+  if (*texture)
+    report["texture_texels"] = {
+        {"mean", (*texture)->mean},       {"median", (*texture)->median},
+        {"p95", (*texture)->p95},         {"max", (*texture)->max},
+        {"samples", (*texture)->samples}, {"other_texture", (*texture)->otherTexture}};
   Result<OutputFile> file = OutputFile::create(json);
   if (!file) return file.status();
   const std::string text = report.dump(2) + "\n";

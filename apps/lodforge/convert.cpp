@@ -1,6 +1,6 @@
 // `lodforge convert IN -o OUT`: between the formats lodforge reads (.ply .obj .stl .gltf .glb)
-// and writes (.ply .glb .obj .stl), optionally welding vertices on the way; and LAZ (or LAS) to
-// plain LAS, the point records as decoded.
+// and writes (.ply .glb .obj .stl), optionally welding vertices or simplifying (textures kept,
+// simplify_model.h) on the way; and LAZ (or LAS) to plain LAS, the point records as decoded.
 #include <chrono>
 
 #include <fmt/format.h>
@@ -15,6 +15,7 @@
 #include "lodforge/io/mesh/stl_writer.h"
 #include "lodforge/io/model_io.h"
 #include "lodforge/io/points/las_copy.h"
+#include "lodforge/simplify/simplify_model.h"
 #include "outputs.h"
 
 namespace lodforge::cli {
@@ -80,6 +81,7 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
     float weldEpsilon = 0;
     bool stlAscii = false;
     bool salvage = false;
+    double simplify = 1;
     CadCommand cad;
   };
   auto options = std::make_shared<Options>();
@@ -98,6 +100,10 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
   sub->add_flag("--stl-ascii", options->stlAscii, "Write ascii STL instead of binary");
   sub->add_flag("--salvage", options->salvage,
                 "Keep what a truncated PLY, STEP or IFC holds up to the cut (with a warning)");
+  sub->add_option("--simplify", options->simplify,
+                  "Keep this share of each object's triangles (0.1: a tenth), texture seams and "
+                  "attribute splits kept")
+      ->check(CLI::Range(0.0, 1.0));
   addCadOptions(*sub, options->cad);
   sub->callback([&global, &run, options] {
     run = [&global, options]() -> Status {
@@ -133,6 +139,12 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
         weld.keepNormalSplits = model->hasNormals();
         weld.keepColorSplits = model->hasColors();
         weldModel(*model, weld);
+      }
+      if (options->simplify < 1) {
+        const ModelSimplifyStats stats = simplifyModel(*model, options->simplify);
+        say(global, fmt::format("simplified {} triangles to {} (error {:.4g} model units)",
+                                formatCount(stats.trianglesBefore),
+                                formatCount(stats.trianglesAfter), stats.error));
       }
       if (formatFromPath(options->output) == FileFormat::kStl && !model->images.empty())
         fmt::print(stderr,

@@ -1468,27 +1468,27 @@ TEST(CliTiles, AnInterruptedRunResumesToTheSameTileset) {
   expectResumesToTheSameTileset(dir, dir.file("scan.ply"), {});
 }
 
-// A textured input resumes too: its materials and images are in the chunk state (an embedded
-// image's bytes in the work directory) and its texture pyramids are taken as they are.
-TEST(CliTiles, AnInterruptedTexturedRunResumesToTheSameTileset) {
-  test::TempDir dir;
+// A small textured scan, in/scan.ply with its two atlases beside it.
+void generateTexturedScan(const test::TempDir& dir) {
   std::filesystem::create_directories(dir.file("in"));
   ASSERT_EQ(lodforge("-q generate scan --triangles 60K --texture 512 --atlases 2 -o " +
                          dir.file("in/scan.ply"),
                      dir)
                 .code,
             0);
+}
+
+// A textured input resumes too: its materials and images are in the chunk state (an embedded
+// image's bytes in the work directory) and its texture pyramids are taken as they are.
+TEST(CliTiles, AnInterruptedTexturedRunResumesToTheSameTileset) {
+  test::TempDir dir;
+  generateTexturedScan(dir);
   expectResumesToTheSameTileset(dir, dir.file("in/scan.ply"), {});
 }
 
 TEST(CliTiles, AnInterruptedRunOfEmbeddedTexturesResumesToTheSameTileset) {
   test::TempDir dir;
-  std::filesystem::create_directories(dir.file("in"));
-  ASSERT_EQ(lodforge("-q generate scan --triangles 60K --texture 512 --atlases 2 -o " +
-                         dir.file("in/scan.ply"),
-                     dir)
-                .code,
-            0);
+  generateTexturedScan(dir);
   ASSERT_EQ(
       lodforge("-q convert " + dir.file("in/scan.ply") + " -o " + dir.file("in/scan.glb"), dir)
           .code,
@@ -1496,6 +1496,41 @@ TEST(CliTiles, AnInterruptedRunOfEmbeddedTexturesResumesToTheSameTileset) {
   for (const char* name : {"scan.ply", "scan_atlas_00.jpg", "scan_atlas_01.jpg"})
     std::filesystem::remove(dir.file(std::string("in/") + name));
   expectResumesToTheSameTileset(dir, dir.file("in/scan.glb"), {});
+}
+
+// An OBJ's material library is part of what its chunks were made from: edited between the
+// interrupted run and --resume, the run chunks again (the edit is in the tiles).
+TEST(CliTiles, AnEditedMaterialLibraryMeansChunkingAgainOnResume) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("in"));
+  ASSERT_EQ(lodforge("-q generate scan --triangles 60K -o " + dir.file("in/scan.ply"), dir).code,
+            0);
+  ASSERT_EQ(
+      lodforge("-q convert " + dir.file("in/scan.ply") + " -o " + dir.file("in/scan.obj"), dir)
+          .code,
+      0);
+  const std::string obj = test::readFile(dir.file("in/scan.obj"));
+  test::writeFile(dir.file("in/scan.obj"), "mtllib paint.mtl\nusemtl paint\n" + obj);
+  test::writeFile(dir.file("in/paint.mtl"), "newmtl paint\nKd 1 0 0\n");
+  interruptAfter(dir,
+                 {"-q", "--threads", "1", "tiles", dir.file("in/scan.obj"), "-o", dir.file("b")},
+                 "node:6");
+  test::writeFile(dir.file("in/paint.mtl"), "newmtl paint\nKd 0 0 1\n# now blue\n");
+  const Outcome o = lodforge(
+      "-v --threads 1 tiles " + dir.file("in/scan.obj") + " -o " + dir.file("b") + " --resume",
+      dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ((o.out + o.err).find("chunks resumed"), std::string::npos) << o.out << o.err;
+  // The same tileset as a run that only ever saw the blue library.
+  ASSERT_EQ(
+      lodforge("-q --threads 1 tiles " + dir.file("in/scan.obj") + " -o " + dir.file("c"), dir)
+          .code,
+      0);
+  const std::vector<std::string> files = test::listFolder(dir.file("c/tiles"));
+  ASSERT_EQ(test::listFolder(dir.file("b/tiles")), files);
+  for (const std::string& f : files)
+    ASSERT_EQ(test::readFile(dir.file("c/tiles/" + f)), test::readFile(dir.file("b/tiles/" + f)))
+        << f;
 }
 
 // tiles --surface resumes like any tileset: the reconstructed chunks are kept.
@@ -1666,6 +1701,43 @@ TEST(CliCompare, FilesAndFoldersWithHeatMapsAndJson) {
   ASSERT_TRUE(std::isfinite(lossy.psnr));
   EXPECT_GT(lossy.psnr, 15);
   EXPECT_NEAR(j["frames"][0]["psnr_db"].get<double>(), lossy.psnr, 1e-9);
+}
+
+// Two textured meshes with the same image: their texture-space error in texels — none from a
+// mesh to itself, 2 texels everywhere against a copy whose coordinates are shifted by 0.02 on a
+// texture 100 texels wide (the JSON too).
+TEST(CliCompare, TexturedMeshesGiveTheirTextureErrorInTexels) {
+  test::TempDir dir;
+  Image texels(100, 50);
+  auto png = encodeImage(texels, {.format = ImageFormat::kPng});
+  ASSERT_TRUE(png.ok());
+  test::writeFile(dir.file("t.png"),
+                  std::string(reinterpret_cast<const char*>(png->data()), png->size()));
+  test::writeFile(dir.file("t.mtl"), "newmtl t\nmap_Kd t.png\n");
+  const auto quad = [&](const std::string& name, double shift) {
+    test::writeFile(dir.file(name), fmt::format("mtllib t.mtl\nv 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\n"
+                                                "vt {0} 0.1\nvt {1} 0.1\nvt {1} 0.9\nvt {0} 0.9\n"
+                                                "usemtl t\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n",
+                                                0.1 + shift, 0.9 + shift));
+  };
+  quad("a.obj", 0);
+  quad("b.obj", 0.02);
+  Outcome o = lodforge("compare " + dir.file("a.obj") + " " + dir.file("a.obj") +
+                           " --samples 2000 --json " + dir.file("same.json"),
+                       dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  auto j = nlohmann::json::parse(test::readFile(dir.file("same.json")));
+  ASSERT_TRUE(j.contains("texture_texels")) << j.dump();
+  EXPECT_NEAR(j["texture_texels"]["max"].get<double>(), 0.0, 1e-4);
+  o = lodforge("compare " + dir.file("a.obj") + " " + dir.file("b.obj") +
+                   " --samples 2000 --json " + dir.file("shifted.json"),
+               dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("texture error"), std::string::npos) << o.out;
+  j = nlohmann::json::parse(test::readFile(dir.file("shifted.json")));
+  EXPECT_NEAR(j["texture_texels"]["mean"].get<double>(), 2.0, 1e-3);
+  EXPECT_NEAR(j["texture_texels"]["max"].get<double>(), 2.0, 1e-3);
+  EXPECT_EQ(j["texture_texels"]["other_texture"].get<int>(), 0);
 }
 
 // Two meshes: their surface distance — none from a mesh to itself, the offset between a mesh

@@ -150,6 +150,57 @@ TEST(ChunkObj, PolygonsNegativeIndicesColoursAndNormals) {
   EXPECT_EQ(red, 5u);
 }
 
+// Triangles of one chunk's mesh as sorted position triples (positions rounded to floats).
+std::vector<std::array<float, 9>> trianglesOf(const ChunkInput& input) {
+  std::vector<std::array<float, 9>> out;
+  for (const Drawn& d : drawnTriangles(input)) out.push_back(std::get<0>(d));
+  return out;
+}
+
+double areaOf(const ChunkInput& input) {
+  double area = 0;
+  for (const auto& t : trianglesOf(input)) {
+    const Vec3d a{t[0], t[1], t[2]}, b{t[3], t[4], t[5]}, c{t[6], t[7], t[8]};
+    area += 0.5 * length(cross(b - a, c - a));
+  }
+  return area;
+}
+
+// A concave polygon (an L of area 3, 6 corners) is ear-clipped, not fanned: a fan from its
+// first corner would cover the missing square (area 4) and fold. A face of 100 corners (a disc)
+// keeps every corner; a library line of two names reads both.
+TEST(ChunkObj, ConcaveAndLargePolygonsAndSeveralLibraries) {
+  test::TempDir dir;
+  test::writeFile(dir.file("a.mtl"), "newmtl red\nKd 1 0 0\n");
+  test::writeFile(dir.file("b.mtl"), "newmtl blue\nKd 0 0 1\n");
+  std::string text = "mtllib a.mtl b.mtl\n";
+  // The L: (0,0) (2,0) (2,1) (1,1) (1,2) (0,2), starting at the reflex corner (1,1).
+  text += "v 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\nv 2 1 0\nusemtl red\nf 1 2 3 4 5 6\n";
+  std::string disc = "usemtl blue\nf";
+  for (int k = 0; k < 100; ++k) {
+    const double angle = 2 * 3.141592653589793 * k / 100;
+    text += fmt::format("v {} {} 0\n", 10 + std::cos(angle), std::sin(angle));
+    disc += fmt::format(" {}", 7 + k);
+  }
+  test::writeFile(dir.file("shapes.obj"), text + disc + "\n");
+  ChunkInputOptions options;
+  options.chunkSize = 1000;
+  options.workDirectory = dir.file("work");
+  Result<ChunkInput> input = chunkInput(dir.file("shapes.obj"), options);
+  ASSERT_TRUE(input.ok()) << input.error().message;
+  EXPECT_EQ(input->inputTriangles, 4u + 98u);
+  const double disc100 = 50 * std::sin(2 * 3.141592653589793 / 100);
+  EXPECT_NEAR(areaOf(*input), 3.0 + disc100, 1e-4);
+  EXPECT_EQ(input->sideFiles.size(), 2u);
+  std::size_t red = 0, blue = 0;
+  for (const Drawn& d : drawnTriangles(*input)) {
+    red += std::get<2>(d)[0] == 255 && std::get<2>(d)[2] == 0;
+    blue += std::get<2>(d)[0] == 0 && std::get<2>(d)[2] == 255;
+  }
+  EXPECT_EQ(red, 4u);
+  EXPECT_EQ(blue, 98u);
+}
+
 TEST(ChunkObj, BadLinesAreRefusedNamingTheLine) {
   test::TempDir dir;
   const std::vector<std::pair<std::string, std::string>> cases = {

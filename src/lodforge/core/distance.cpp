@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include "lodforge/core/random.h"
@@ -37,6 +38,38 @@ double pointTriangleDistanceSquared(Vec3d p, Vec3d a, Vec3d b, Vec3d c) {
   }
   const double v = vb / denominator, w = vc / denominator;
   return squared(a + ab * v + ac * w);
+}
+
+Vec3d closestPointWeights(Vec3d p, Vec3d a, Vec3d b, Vec3d c) {
+  // pointTriangleDistanceSquared's Voronoi regions, answering with the point's weights.
+  const Vec3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
+  const Vec3d bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return {1 - v, v, 0};
+  }
+  const Vec3d cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double w = d2 / (d2 - d6);
+    return {1 - w, 0, w};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0, 1 - w, w};
+  }
+  const double denominator = va + vb + vc;
+  if (denominator <= 0) return {1, 0, 0};
+  const double v = vb / denominator, w = vc / denominator;
+  return {1 - v - w, v, w};
 }
 
 namespace {
@@ -114,8 +147,9 @@ class TriangleGrid {
   }
 
   // The squared distance from p to the nearest triangle, or any value not above `enough` as soon
-  // as one is found (a maximum over many queries needs nothing more from a query below it).
-  double nearestSquared(Vec3d p, double enough = -1) const {
+  // as one is found (a maximum over many queries needs nothing more from a query below it);
+  // that triangle in `nearest` when given.
+  double nearestSquared(Vec3d p, double enough = -1, std::uint32_t* nearest = nullptr) const {
     const int cx = clampCell(0, p.x), cy = clampCell(1, p.y), cz = clampCell(2, p.z);
     double best = std::numeric_limits<double>::max();
     const int maxRing = std::max({dims_[0], dims_[1], dims_[2]});
@@ -130,8 +164,10 @@ class TriangleGrid {
         const std::size_t cell = index(x, y, z);
         for (std::uint32_t i = start_[cell]; i < start_[cell + 1]; ++i) {
           const std::uint32_t t = items_[i];
-          best = std::min(
-              best, pointTriangleDistanceSquared(p, corner(t, 0), corner(t, 1), corner(t, 2)));
+          const double d =
+              pointTriangleDistanceSquared(p, corner(t, 0), corner(t, 1), corner(t, 2));
+          if (nearest != nullptr && d < best) *nearest = t;
+          best = std::min(best, d);
           if (best <= enough) return true;
         }
         return false;
@@ -339,6 +375,92 @@ double farthestDistance(std::span<const Vec3f> points, std::span<const Vec3f> po
   std::vector<Vec3d> wide(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) wide[i] = toDouble(points[i]);
   return measure(wide, grid).max;
+}
+
+namespace {
+
+// A sample on A's textured triangles: where it is, its texture and texture coordinate there.
+struct TexturedSample {
+  Vec3d point;
+  std::uint32_t texture;
+  Vec2f uv;
+};
+
+std::vector<TexturedSample> textureSamples(const TexturedSurface& s, std::uint32_t count,
+                                           std::uint64_t seed) {
+  const std::size_t triangles = s.indices.size() / 3;
+  const auto corner = [&](std::size_t t, std::size_t k) {
+    return toDouble(s.positions[s.indices[3 * t + k]]);
+  };
+  std::vector<double> cumulative(triangles);
+  double total = 0;
+  for (std::size_t t = 0; t < triangles; ++t) {
+    if (s.texture[t] != ~0u)
+      total += 0.5 * length(cross(corner(t, 1) - corner(t, 0), corner(t, 2) - corner(t, 0)));
+    cumulative[t] = total;
+  }
+  std::vector<TexturedSample> out;
+  if (total <= 0) return out;
+  Random random(seed);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const double pick = random.uniform() * total;
+    const std::size_t t = std::min<std::size_t>(
+        triangles - 1,
+        static_cast<std::size_t>(std::lower_bound(cumulative.begin(), cumulative.end(), pick) -
+                                 cumulative.begin()));
+    double r1 = random.uniform(), r2 = random.uniform();
+    if (r1 + r2 > 1) r1 = 1 - r1, r2 = 1 - r2;
+    const Vec2f a = s.uvs[s.indices[3 * t]], b = s.uvs[s.indices[3 * t + 1]],
+                c = s.uvs[s.indices[3 * t + 2]];
+    out.push_back(
+        {corner(t, 0) + (corner(t, 1) - corner(t, 0)) * r1 + (corner(t, 2) - corner(t, 0)) * r2,
+         s.texture[t],
+         {static_cast<float>(a.x + (b.x - a.x) * r1 + (c.x - a.x) * r2),
+          static_cast<float>(a.y + (b.y - a.y) * r1 + (c.y - a.y) * r2)}});
+  }
+  return out;
+}
+
+}  // namespace
+
+TextureDistance textureDistance(const TexturedSurface& a, const TexturedSurface& b,
+                                std::uint32_t samples, std::uint64_t seed) {
+  assert(a.texture.size() == a.indices.size() / 3 && b.texture.size() == b.indices.size() / 3);
+  TextureDistance result;
+  const std::vector<TexturedSample> points = textureSamples(a, samples, seed);
+  if (points.empty() || b.indices.empty()) return result;
+  const TriangleGrid grid(b.positions, b.indices);
+  // Per sample: its distance in texels, or -1 where B has another texture there.
+  std::vector<double> texels(points.size());
+  tbb::parallel_for(std::size_t{0}, points.size(), [&](std::size_t i) {
+    const TexturedSample& p = points[i];
+    std::uint32_t t = 0;
+    grid.nearestSquared(p.point, -1, &t);
+    if (b.texture[t] != p.texture) {
+      texels[i] = -1;
+      return;
+    }
+    const auto at = [&](std::size_t k) { return b.indices[3 * std::size_t{t} + k]; };
+    const Vec3d w = closestPointWeights(p.point, toDouble(b.positions[at(0)]),
+                                        toDouble(b.positions[at(1)]), toDouble(b.positions[at(2)]));
+    const Vec2f u0 = b.uvs[at(0)], u1 = b.uvs[at(1)], u2 = b.uvs[at(2)];
+    const double du = (w.x * u0.x + w.y * u1.x + w.z * u2.x - p.uv.x) * a.texels[p.texture][0];
+    const double dv = (w.x * u0.y + w.y * u1.y + w.z * u2.y - p.uv.y) * a.texels[p.texture][1];
+    texels[i] = std::hypot(du, dv);
+  });
+  std::vector<double> same;
+  for (double d : texels) (d < 0 ? result.otherTexture : result.samples) += 1;
+  for (double d : texels)
+    if (d >= 0) same.push_back(d);
+  if (same.empty()) return result;
+  std::sort(same.begin(), same.end());
+  double sum = 0;
+  for (double d : same) sum += d;
+  result.mean = sum / static_cast<double>(same.size());
+  result.median = same[same.size() / 2];
+  result.p95 = same[std::min(same.size() - 1, same.size() * 95 / 100)];
+  result.max = same.back();
+  return result;
 }
 
 }  // namespace lodforge

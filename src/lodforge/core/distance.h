@@ -2,6 +2,7 @@
 // the quality measure for simplification and tiling (symmetric Hausdorff and RMS distance).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 
@@ -11,6 +12,8 @@ namespace lodforge {
 
 // Squared distance from p to triangle abc (closest point by Voronoi regions, Ericson §5.1.5).
 double pointTriangleDistanceSquared(Vec3d p, Vec3d a, Vec3d b, Vec3d c);
+// The closest point of triangle abc to p as weights of a, b and c (summing to 1).
+Vec3d closestPointWeights(Vec3d p, Vec3d a, Vec3d b, Vec3d c);
 
 struct SurfaceDistance {
   double hausdorff = 0;  // max over both directions of the max sample distance
@@ -40,5 +43,28 @@ double sampledHausdorff(std::span<const Vec3f> positionsA, std::span<const std::
 // surface has no triangles).
 double farthestDistance(std::span<const Vec3f> points, std::span<const Vec3f> positions,
                         std::span<const std::uint32_t> indices);
+
+// A textured mesh for textureDistance: per-vertex texture coordinates, each triangle's texture
+// (~0u: none) and each texture's size in texels (width, height).
+struct TexturedSurface {
+  std::span<const Vec3f> positions;
+  std::span<const std::uint32_t> indices;
+  std::span<const Vec2f> uvs;
+  std::span<const std::uint32_t> texture;
+  std::span<const std::array<std::uint32_t, 2>> texels;
+};
+
+struct TextureDistance {
+  double mean = 0, median = 0, p95 = 0, max = 0;  // texels of A's textures
+  std::uint64_t samples = 0;       // measured: B's nearest point has the same texture
+  std::uint64_t otherTexture = 0;  // not measured: B has another texture (or none) there
+};
+
+// How far B's texture mapping is from A's, in texels: `samples` points spread over A's textured
+// triangles by area, each with A's texture coordinate there, against B's coordinate at the
+// closest point of B (the texture-space error of a simplification B of A). Textures are numbered
+// alike in both.
+TextureDistance textureDistance(const TexturedSurface& a, const TexturedSurface& b,
+                                std::uint32_t samples = 100'000, std::uint64_t seed = 1);
 
 }  // namespace lodforge

@@ -41,6 +41,9 @@ std::uint64_t progressiveBuildBytes(std::uint64_t vertices, std::uint64_t triang
 namespace {
 
 constexpr std::uint32_t kNone = ~0u;
+// The texture cost of a collapse whose wedges cannot be mapped (valid() refuses it): it ranks
+// after every other.
+constexpr double kRefused = 1e30;
 
 // Twice the signed area of a triangle in texture space (positive counter-clockwise).
 double signedUvArea(Vec2f a, Vec2f b, Vec2f c) {
@@ -125,6 +128,7 @@ class Simplifier {
   void computeQuadrics();
   void addBoundaryPlanes();
   void addSeamPlanes();
+  void addEdgePlane(std::uint32_t a, std::uint32_t b, Vec3d faceNormal);
   void computeUvQuadrics();
   void collapseAll();
   ProgressiveMesh rearrange(std::span<const Vec3f> normals, std::span<const Rgba8> colors) const;
@@ -323,6 +327,17 @@ void Simplifier::computeQuadrics() {
     vertex_[v].selfCost = quadrics_[v].evaluate(position(v));
 }
 
+void Simplifier::addEdgePlane(std::uint32_t a, std::uint32_t b, Vec3d faceNormal) {
+  // The plane through edge a-b perpendicular to its face, weighted by the edge's squared length.
+  const Vec3d edge = position(b) - position(a);
+  const Vec3d across = cross(edge, faceNormal);
+  const double span = length(across);
+  if (span <= 0) return;
+  const Quadric plane = Quadric::fromPlane(across / span, position(a), dot(edge, edge));
+  quadrics_[a] += plane;
+  quadrics_[b] += plane;
+}
+
 bool Simplifier::isSeam(std::uint32_t t, std::uint32_t a, std::uint32_t b) const {
   // Edge a-b of t is a seam where the triangle across it has other wedges at either end.
   for (std::uint32_t s : around(a)) {
@@ -342,14 +357,7 @@ void Simplifier::addSeamPlanes() {
     if (twiceArea <= 0) continue;
     for (std::size_t k = 0; k < 3; ++k) {
       const std::uint32_t a = c[k], b = c[(k + 1) % 3];
-      if (!isSeam(t, a, b)) continue;
-      const Vec3d edge = position(b) - position(a);
-      const Vec3d across = cross(edge, n / twiceArea);
-      const double span = length(across);
-      if (span <= 0) continue;
-      const Quadric plane = Quadric::fromPlane(across / span, position(a), dot(edge, edge));
-      quadrics_[a] += plane;
-      quadrics_[b] += plane;
+      if (isSeam(t, a, b)) addEdgePlane(a, b, n / twiceArea);
     }
   }
 }
@@ -424,7 +432,7 @@ std::uint32_t Simplifier::onlyWedge(std::uint32_t v) const {
 double Simplifier::uvCost(std::uint32_t from, std::uint32_t to) const {
   // Each wedge's texture error at its target's coordinates, (Q_w + Q_w')(p_to, uv_w').
   WedgeMap map;
-  if (!mapWedges(from, to, map)) return 0;  // valid() refuses it
+  if (!mapWedges(from, to, map)) return kRefused;  // valid() refuses it: never the cheapest
   const Vec3d p = position(to);
   double sum = 0;
   for (const auto& [wf, wt] : map.pairs())
@@ -478,14 +486,7 @@ void Simplifier::addBoundaryPlanes() {
       if (border_[a] == 0 || border_[b] == 0) continue;
       std::uint32_t onEdge = 0;
       for (std::uint32_t s : around(a)) onEdge += contains(s, b) ? 1u : 0u;
-      if (onEdge != 1) continue;
-      const Vec3d edge = position(b) - position(a);
-      const Vec3d across = cross(edge, n / twiceArea);
-      const double span = length(across);
-      if (span <= 0) continue;
-      const Quadric plane = Quadric::fromPlane(across / span, position(a), dot(edge, edge));
-      quadrics_[a] += plane;
-      quadrics_[b] += plane;
+      if (onEdge == 1) addEdgePlane(a, b, n / twiceArea);
     }
   }
 }
@@ -634,7 +635,8 @@ void Simplifier::rankVertex(std::uint32_t u) {
       const std::uint32_t wv = wedgeAt(t, v);
       const double uv =
           uvQuadrics_[soleWedge].evaluate(position(v), options_.wedgeUvs[wv]) + uvSelfCost_[wv];
-      consider(v, quadricCost(q.evaluate(position(v)), v) + static_cast<float>(std::max(0.0, uv)));
+      consider(v, static_cast<float>(std::max(0.0, q.evaluate(position(v)) + vertex_[v].selfCost) +
+                                     std::max(0.0, uv)));
     } else if (!quadric || textured()) {
       consider(v, this->cost(u, v));
     } else if (pending == kNone) {

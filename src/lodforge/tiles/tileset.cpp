@@ -50,6 +50,10 @@ Status prepareWorkPlace(const WorkPlace& place, bool keepEarlierWork) {
     fs::remove_all(place.staging.path, error);
     fs::remove_all(place.work.path + "/nodes", error);
     fs::remove_all(place.work.path + "/chunks", error);  // chunk files are appended to
+    // Texture pyramids and embedded images belong to the state they were made with: a
+    // resumed run takes a pyramid by its size alone.
+    fs::remove_all(place.work.path + "/textures", error);
+    fs::remove_all(place.work.path + "/images", error);
     fs::remove(workStatePath(place.work.path), error);
   }
   fs::create_directories(fs::path(place.staging.path) / "tiles", error);

@@ -86,6 +86,9 @@ struct ChunkInput {
   std::vector<std::string> warnings;      // the reader's (a CAD part that did not mesh)
   PartTable parts;
   TextureTable textures;
+  // Files beside the input that the chunks depend on (an OBJ's material libraries): a resumed
+  // run checks them as it checks the input.
+  std::vector<std::string> sideFiles;
 };
 
 Result<ChunkInput> chunkInput(const std::string& path, const ChunkInputOptions& options);

@@ -29,17 +29,75 @@ namespace {
 constexpr std::size_t kReadBlock = std::size_t{4} << 20;
 constexpr std::uint32_t kNoIndex = ~0u;
 
-// The words of a line, split at spaces and tabs (a '#' starts a comment).
-std::size_t splitWords(std::string_view line, std::array<std::string_view, 64>& words) {
-  std::size_t count = 0, i = 0;
-  while (i < line.size() && count < words.size()) {
+// The words of a line, split at spaces and tabs (a '#' starts a comment), into `words`.
+std::size_t splitWords(std::string_view line, std::vector<std::string_view>& words) {
+  words.clear();
+  std::size_t i = 0;
+  while (i < line.size()) {
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
     if (i == line.size() || line[i] == '#') break;
     const std::size_t start = i;
     while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
-    words[count++] = line.substr(start, i - start);
+    words.push_back(line.substr(start, i - start));
   }
-  return count;
+  return words.size();
+}
+
+// Twice the signed area of 2D triangle abc.
+double cross2(const std::array<double, 2>& a, const std::array<double, 2>& b,
+              const std::array<double, 2>& c) {
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+bool insideTriangle(const std::array<double, 2>& p, const std::array<double, 2>& a,
+                    const std::array<double, 2>& b, const std::array<double, 2>& c) {
+  return cross2(a, b, p) > 0 && cross2(b, c, p) > 0 && cross2(c, a, p) > 0;
+}
+
+// A polygon's triangles as triples of its corner numbers: a fan where it is convex, ear clipping
+// in its plane where it is not (a fan would cover what the polygon leaves out).
+void triangulatePolygon(std::span<const Vec3d> points, std::vector<std::uint32_t>& out) {
+  out.clear();
+  const std::size_t n = points.size();
+  // Newell's normal; the polygon projected on the plane of its two other axes, counter-clockwise.
+  Vec3d normal{};
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3d& a = points[k];
+    const Vec3d& b = points[(k + 1) % n];
+    normal = normal +
+             Vec3d{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+  }
+  const int drop =
+      std::abs(normal.x) >= std::abs(normal.y) && std::abs(normal.x) >= std::abs(normal.z) ? 0
+      : std::abs(normal.y) >= std::abs(normal.z)                                           ? 1
+                                                                                           : 2;
+  const double sign = normal[drop] >= 0 ? 1 : -1;
+  std::vector<std::array<double, 2>> p(n);
+  for (std::size_t k = 0; k < n; ++k)
+    p[k] = {points[k][(drop + 1) % 3], sign * points[k][(drop + 2) % 3]};
+  bool convex = true;
+  for (std::size_t k = 0; k < n && convex; ++k)
+    convex = cross2(p[k], p[(k + 1) % n], p[(k + 2) % n]) >= 0;
+  std::vector<std::uint32_t> left(n);
+  for (std::size_t k = 0; k < n; ++k) left[k] = static_cast<std::uint32_t>(k);
+  while (!convex && left.size() > 3) {
+    bool clipped = false;
+    for (std::size_t i = 0; i < left.size() && !clipped; ++i) {
+      const std::uint32_t a = left[(i + left.size() - 1) % left.size()], b = left[i],
+                          c = left[(i + 1) % left.size()];
+      if (cross2(p[a], p[b], p[c]) <= 0) continue;  // a reflex corner is no ear
+      bool empty = true;
+      for (std::uint32_t q : left)
+        if (q != a && q != b && q != c && insideTriangle(p[q], p[a], p[b], p[c])) empty = false;
+      if (!empty) continue;
+      out.insert(out.end(), {a, b, c});
+      left.erase(left.begin() + static_cast<std::ptrdiff_t>(i));
+      clipped = true;
+    }
+    if (!clipped) break;  // degenerate (self-touching, collinear): the rest as a fan
+  }
+  for (std::size_t k = 1; k + 1 < left.size(); ++k)
+    out.insert(out.end(), {left[0], left[k], left[k + 1]});
 }
 
 // Calls fn(line number, line) for every line of the file, reading it in blocks (a line is never
@@ -155,12 +213,15 @@ class ObjChunking {
   ~ObjChunking() {
     for (int fd : {vertexFd_, uvFd_, normalFd_})
       if (fd >= 0) ::close(fd);
+    std::error_code ignored;  // the work files go however the chunking ended
+    std::filesystem::remove_all(work_, ignored);
   }
   ObjChunking(const ObjChunking&) = delete;
   ObjChunking& operator=(const ObjChunking&) = delete;
 
   Status copyRecords();
   Status loadMaterials();
+  std::vector<std::string> libraryNames() const;
   Status sumNormals();
   Status cutFaces();
   ChunkInput finish();
@@ -178,9 +239,13 @@ class ObjChunking {
   Status appendRecord(int fd, std::vector<std::byte>& pending, const void* bytes, std::size_t size,
                       const char* what);
   Result<std::size_t> faceCorners(std::uint64_t line, std::span<const std::string_view> words);
+  template <class OnFace>
+  Status forEachFace(const char* label, OnFace&& onFace);
   Status trackLine(std::string_view keyword, std::span<const std::string_view> words);
   Status fetch(const ObjCorner& corner, CutCorner& out);
   Status cutFace(std::size_t corners);
+  Status triangulate(std::size_t corners);
+  Status facePositions(std::size_t corners);
   Status flushRecords(int fd, std::vector<std::byte>& pending, const char* what);
 
   const std::string& path_;
@@ -201,7 +266,10 @@ class ObjChunking {
   ObjTextures textures_;
   int material_ = -1;  // the current usemtl, into mtl_
   std::uint64_t cornersWithoutUv_ = 0;
-  std::array<ObjCorner, 64> face_{};
+  std::vector<ObjCorner> face_;               // the face being read
+  std::vector<std::string_view> words_;       // the line being read
+  std::vector<Vec3d> polygon_;                // the face's positions, for its triangulation
+  std::vector<std::uint32_t> faceTriangles_;  // its triangles (corner numbers)
   std::optional<ChunkGrid> grid_;
   ChunkInput input_;
   std::vector<ChunkCell> cells_;
@@ -259,7 +327,7 @@ Status ObjChunking::copyRecords() {
 }
 
 Status ObjChunking::scanLine(std::uint64_t line, std::string_view text) {
-  std::array<std::string_view, 64> words;
+  std::vector<std::string_view>& words = words_;
   const std::size_t count = splitWords(text, words);
   if (count == 0) return {};
   const std::span<const std::string_view> args(words.data() + 1, count - 1);
@@ -327,9 +395,7 @@ Status ObjChunking::addCoordinates(std::uint64_t line, std::span<const std::stri
 
 Result<std::size_t> ObjChunking::faceCorners(std::uint64_t line,
                                              std::span<const std::string_view> words) {
-  if (words.size() > face_.size())
-    return badInput(path_,
-                    fmt::format("line {}: a face of more than {} corners", line, face_.size()));
+  face_.resize(words.size());
   for (std::size_t k = 0; k < words.size(); ++k) {
     if (!parseCorner(words[k], counts_, face_[k]))
       return badInput(path_, fmt::format("line {}: corner '{}' is malformed or refers to a "
@@ -350,11 +416,29 @@ Status ObjChunking::countFace(std::uint64_t line, std::span<const std::string_vi
   return {};
 }
 
+// The libraries `mtllib` lines name: the rest of the line when a file of that name is there (a
+// name with spaces), its words otherwise (several libraries, as tinyobjloader reads them).
+std::vector<std::string> ObjChunking::libraryNames() const {
+  std::vector<std::string> names;
+  for (const std::string& rest : libraries_) {
+    std::error_code error;
+    if (std::filesystem::exists(baseDir_ + rest, error)) {
+      names.push_back(rest);
+      continue;
+    }
+    std::vector<std::string_view> words;
+    splitWords(rest, words);
+    names.insert(names.end(), words.begin(), words.end());
+  }
+  return names;
+}
+
 // The material libraries, read once the first pass has named them: a textured material's map_Kd
 // becomes a texture (found as the whole-file reader finds it), the others give their Kd.
 Status ObjChunking::loadMaterials() {
   std::vector<std::string> directories{baseDir_};
-  for (const std::string& library : libraries_) {
+  for (const std::string& library : libraryNames()) {
+    input_.sideFiles.push_back(baseDir_ + library);
     tinyobj::MaterialFileReader reader(baseDir_);
     std::string warning, error;
     if (!reader(library, &mtl_, &mtlIndex_, &warning, &error))
@@ -377,6 +461,23 @@ Status ObjChunking::loadMaterials() {
   return {};
 }
 
+// A later pass: every face read into face_ (the material and record counts kept as it goes),
+// handed to `onFace` with its corner count.
+template <class OnFace>
+Status ObjChunking::forEachFace(const char* label, OnFace&& onFace) {
+  counts_ = {};
+  material_ = -1;
+  return forEachObjLine(path_, label, [&](std::uint64_t line, std::string_view text) -> Status {
+    const std::size_t count = splitWords(text, words_);
+    if (count == 0) return {};
+    const std::span<const std::string_view> args(words_.data() + 1, count - 1);
+    if (words_[0] != "f") return trackLine(words_[0], args);
+    Result<std::size_t> corners = faceCorners(line, args);
+    if (!corners) return corners.status();
+    return onFace(*corners);
+  });
+}
+
 // Keeps the current material and the record counts while a later pass reads.
 Status ObjChunking::trackLine(std::string_view keyword, std::span<const std::string_view> words) {
   if (keyword == "v") {
@@ -397,30 +498,20 @@ Status ObjChunking::trackLine(std::string_view keyword, std::span<const std::str
 // borders.
 Status ObjChunking::sumNormals() {
   if (!cornersWithoutNormal_ && !options_.transform) return {};
-  counts_ = {};
-  LODFORGE_TRY(forEachObjLine(
-      path_, "tiles: normals", [&](std::uint64_t line, std::string_view text) -> Status {
-        std::array<std::string_view, 64> words;
-        const std::size_t count = splitWords(text, words);
-        if (count == 0) return {};
-        const std::span<const std::string_view> args(words.data() + 1, count - 1);
-        if (words[0] != "f") return trackLine(words[0], args);
-        Result<std::size_t> corners = faceCorners(line, args);
-        if (!corners) return corners.status();
-        for (std::size_t k = 1; k + 1 < *corners; ++k) {
-          const std::array<std::size_t, 3> fan = {0, k, k + 1};
-          std::array<CutCorner, 3> t;
-          for (std::size_t c = 0; c < 3; ++c)
-            if (!vertices_->fetch(face_[fan[c]].v, t[c]))
-              return ioErrorFromErrno(work_ + "/vertices.bin", "read");
-          const Vec3f face =
-              toFloat(cross(t[1].position - t[0].position, t[2].position - t[0].position));
-          for (std::size_t c : fan)
-            if (!vertices_->addNormal(face_[c].v, face))
-              return ioErrorFromErrno(work_ + "/vertices.bin", "update");
-        }
-        return {};
-      }));
+  LODFORGE_TRY(forEachFace("tiles: normals", [&](std::size_t corners) -> Status {
+    LODFORGE_TRY(triangulate(corners));
+    LODFORGE_TRY(facePositions(corners));
+    for (std::size_t i = 0; i < faceTriangles_.size(); i += 3) {
+      const std::array<std::uint32_t, 3> fan = {faceTriangles_[i], faceTriangles_[i + 1],
+                                                faceTriangles_[i + 2]};
+      const Vec3d a = polygon_[fan[0]], b = polygon_[fan[1]], c = polygon_[fan[2]];
+      const Vec3f face = toFloat(cross(b - a, c - a));
+      for (std::uint32_t k : fan)
+        if (!vertices_->addNormal(face_[k].v, face))
+          return ioErrorFromErrno(work_ + "/vertices.bin", "update");
+    }
+    return {};
+  }));
   if (!vertices_->flush()) return ioErrorFromErrno(work_ + "/vertices.bin", "write");
   return {};
 }
@@ -429,6 +520,7 @@ Status ObjChunking::sumNormals() {
 // Kd: grey for a texture that could not be read) and normal (the file's, or the summed one), the
 // texture coordinate of a textured material.
 Status ObjChunking::fetch(const ObjCorner& corner, CutCorner& out) {
+  out = CutCorner{};  // nothing of the corner before (a coordinate, a material) stays
   if (!vertices_->fetch(corner.v, out)) return ioErrorFromErrno(work_ + "/vertices.bin", "read");
   const bool textured = textures_.textured(material_);
   const bool kd = !vertexColors_ && !textured && material_ >= 0;
@@ -462,12 +554,34 @@ Status ObjChunking::fetch(const ObjCorner& corner, CutCorner& out) {
   return {};
 }
 
+// The triangles of the face read (its first `corners` corners) into faceTriangles_.
+Status ObjChunking::triangulate(std::size_t corners) {
+  if (corners == 3) {
+    faceTriangles_ = {0, 1, 2};
+    return {};
+  }
+  LODFORGE_TRY(facePositions(corners));
+  triangulatePolygon(polygon_, faceTriangles_);
+  return {};
+}
+
+// The positions of the face read into polygon_.
+Status ObjChunking::facePositions(std::size_t corners) {
+  polygon_.resize(corners);
+  CutCorner c;
+  for (std::size_t k = 0; k < corners; ++k) {
+    if (!vertices_->fetch(face_[k].v, c)) return ioErrorFromErrno(work_ + "/vertices.bin", "read");
+    polygon_[k] = c.position;
+  }
+  return {};
+}
+
 Status ObjChunking::cutFace(std::size_t corners) {
+  LODFORGE_TRY(triangulate(corners));
   std::array<CutCorner, 3> triangle;
-  for (std::size_t k = 1; k + 1 < corners; ++k) {
-    LODFORGE_TRY(fetch(face_[0], triangle[0]));
-    LODFORGE_TRY(fetch(face_[k], triangle[1]));
-    LODFORGE_TRY(fetch(face_[k + 1], triangle[2]));
+  for (std::size_t i = 0; i < faceTriangles_.size(); i += 3) {
+    for (std::size_t k = 0; k < 3; ++k)
+      LODFORGE_TRY(fetch(face_[faceTriangles_[i + k]], triangle[k]));
     cutSegmentTriangle(*grid_, nullptr, triangle, cells_, pieces_);
     ++input_.inputTriangles;
   }
@@ -486,19 +600,7 @@ Status ObjChunking::cutFaces() {
   input_.chunks = std::make_unique<ChunkWriter>(*grid_, options_.workDirectory + "/chunks",
                                                 options_.chunkBufferBytes, options_.keepInMemory);
   input_.chunks->setTextured(!input_.textures.empty());
-  counts_ = {};
-  material_ = -1;
-  LODFORGE_TRY(forEachObjLine(
-      path_, "tiles: chunks", [&](std::uint64_t line, std::string_view text) -> Status {
-        std::array<std::string_view, 64> words;
-        const std::size_t count = splitWords(text, words);
-        if (count == 0) return {};
-        const std::span<const std::string_view> args(words.data() + 1, count - 1);
-        if (words[0] != "f") return trackLine(words[0], args);
-        Result<std::size_t> corners = faceCorners(line, args);
-        if (!corners) return corners.status();
-        return cutFace(*corners);
-      }));
+  LODFORGE_TRY(forEachFace("tiles: chunks", [&](std::size_t corners) { return cutFace(corners); }));
   LODFORGE_TRY(input_.chunks->addPieces(cells_, pieces_));
   LODFORGE_TRY(input_.chunks->flush());
   if (cornersWithoutUv_ > 0)

@@ -11,9 +11,11 @@
 namespace lodforge {
 namespace {
 
-// Bytes one node takes while it is built: its mesh, the simplifier, the distance grids.
-std::uint64_t estimateBytes(std::uint64_t triangles) {
-  return triangles * 320 + (1 << 20);
+// Bytes one node takes while it is built: its mesh, the simplifier, the distance grids; a
+// textured one also its coordinates and materials, its surface mesh and wedge lists, and a
+// texture quadric per wedge (152 B, about half a wedge a triangle).
+std::uint64_t estimateBytes(std::uint64_t triangles, bool textured) {
+  return triangles * (textured ? 480 : 320) + (1 << 20);
 }
 
 }  // namespace
@@ -78,7 +80,7 @@ Status buildWhenReady(const std::vector<OctreeNode>& nodes, std::span<const std:
   admit = [&] {
     while (failure.ok() && !ready.empty() && inFlight < static_cast<std::uint32_t>(threads)) {
       const std::uint32_t next = ready.top();
-      const std::uint64_t bytes = estimateBytes(inputTriangles[next]);
+      const std::uint64_t bytes = estimateBytes(inputTriangles[next], schedule.textured);
       if (schedule.memoryBudget > 0 && inFlight > 0 &&
           inFlightBytes + bytes > schedule.memoryBudget)
         return;  // waits for a node in progress to finish

@@ -18,6 +18,8 @@ inline constexpr std::uint32_t kNoParent = ~0u;
 struct NodeSchedule {
   int threads = 0;                 // workers (0: as many as the process allows)
   std::uint64_t memoryBudget = 0;  // bytes the nodes in progress may take (0: no limit)
+  // A textured node also holds its texture coordinates, wedges and their texture quadrics.
+  bool textured = false;
 };
 
 // Calls build(i) for every node i of `nodes` (children listed in each node), each once all its

@@ -96,7 +96,9 @@ class OctreeBuild {
 
   Status run() {
     return buildWhenReady(plan_.result.nodes, plan_.parentOf, plan_.inputTriangles,
-                          {.threads = options_.threads, .memoryBudget = options_.memoryBudget},
+                          {.threads = options_.threads,
+                           .memoryBudget = options_.memoryBudget,
+                           .textured = chunks_.textured()},
                           [this](std::uint32_t index) {
                             OctreeNode& node = plan_.result.nodes[index];
                             return node.level == 0 ? buildLeaf(index) : buildParent(index);

@@ -34,6 +34,30 @@ nlohmann::json boundsList(const std::vector<Aabbd>& boxes) {
   return list;
 }
 
+// Each side file with its size and modification time.
+nlohmann::json sideFilesToJson(const std::vector<std::string>& files) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const std::string& file : files) {
+    const Result<std::uint64_t> size = fileSize(file);
+    list.push_back({file, size ? *size : 0, modifiedTicks(file)});
+  }
+  return list;
+}
+
+// The side files, when every one is still the file it was; nothing otherwise.
+std::optional<std::vector<std::string>> unchangedSideFiles(const nlohmann::json& list) {
+  std::vector<std::string> files;
+  for (const auto& entry : list) {
+    const std::string file = entry.at(0).get<std::string>();
+    const Result<std::uint64_t> size = fileSize(file);
+    if ((size ? *size : 0) != entry.at(1).get<std::uint64_t>() ||
+        modifiedTicks(file) != entry.at(2).get<std::int64_t>())
+      return std::nullopt;
+    files.push_back(file);
+  }
+  return files;
+}
+
 }  // namespace
 
 Status saveChunkState(const std::string& path, const nlohmann::json& identity,
@@ -48,6 +72,7 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
   const nlohmann::json state = {
       {"identity", identity},
       {"textures", *textures},
+      {"sideFiles", sideFilesToJson(input.sideFiles)},
       {"grid",
        {{"origin", {grid.origin.x, grid.origin.y, grid.origin.z}},
         {"size", grid.size},
@@ -119,6 +144,9 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
         loadTextureTable(state.at("textures"), std::filesystem::path(path).parent_path().string());
     if (!textures) return std::nullopt;
     input.textures = std::move(*textures);
+    std::optional<std::vector<std::string>> sideFiles = unchangedSideFiles(state.at("sideFiles"));
+    if (!sideFiles) return std::nullopt;  // a material library changed: chunk again
+    input.sideFiles = std::move(*sideFiles);
     input.chunks =
         std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
     return input;

@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include <span>
+#include <utility>
 
 #include <nanoflann.hpp>
 
@@ -288,13 +289,16 @@ Collapsed simplifyTextured(const MeshPart& merged, std::span<const Vec3f> positi
   // The mesh again: one vertex per wedge still in use, in order of first use.
   Collapsed out;
   std::vector<std::uint32_t> remap(merged.vertexCount(), kNoVertex);
+  std::vector<std::uint8_t> flagged = simplified.border;
   for (std::size_t i = 0; i < simplified.wedges.size(); ++i) {
     const std::uint32_t w = simplified.wedges[i];
     if (remap[w] == kNoVertex) {
       remap[w] = out.mesh.vertexCount();
       appendVertex(merged, w, out.mesh);
       out.source.push_back(w);
-      out.border.push_back(simplified.border[simplified.indices[i]]);
+      // A point's border flag once, on its first wedge: the count is of points.
+      const std::uint32_t point = simplified.indices[i];
+      out.border.push_back(std::exchange(flagged[point], 0));
     }
     out.mesh.indices.push_back(remap[w]);
   }

@@ -72,19 +72,91 @@ Status convertToLas(const Global& global, const std::string& input, const std::s
   return {};
 }
 
+struct ConvertOptions {
+  std::string input, output;
+  bool weld = false;
+  float weldEpsilon = 0;
+  bool stlAscii = false;
+  bool salvage = false;
+  double simplify = 1;
+  CadCommand cad;
+};
+
+// What the output's extension asks for, before anything is read: a format convert writes, and
+// an output it may claim.
+Status checkModelOutput(const ConvertOptions& o) {
+  if (!canWrite(formatFromPath(o.output)))
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: convert does not write {} (it writes .ply .glb .obj .stl "
+                             "models, and .las from .las or .laz point clouds)",
+                             o.output,
+                             fileExtension(o.output) == "laz" ? std::string("LAZ (compressed LAS)")
+                                                              : std::string("this format"))};
+  LODFORGE_TRY(refusePointCloud(o.input, "convert"));
+  return claimOutput(o.output, modelFileOutput(o.output), std::vector<std::string>{o.input});
+}
+
+// The input read (its warnings said), refused when it holds no triangle.
+Result<Model> readConvertInput(const Global& global, const ConvertOptions& o) {
+  LODFORGE_TRY(checkMemory(o.input, global.memoryLimit));
+  Result<CadReadOptions> cad = cadOptions(o.cad, global);
+  if (!cad) return cad.status();
+  std::vector<std::string> warnings;
+  Result<Model> model =
+      readModel(o.input, {.salvageTruncated = o.salvage, .warnings = &warnings, .cad = *cad});
+  for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
+  if (!model) return model.status();
+  // As tiles and build: a model without triangles is nothing to convert (an empty file).
+  if (model->triangleCount() == 0)
+    return badInput(o.input, "the model has no triangles: nothing to convert");
+  return model;
+}
+
+// --weld and --simplify, in that order.
+void reshapeModel(const Global& global, const ConvertOptions& o, Model& model) {
+  if (o.weld) {
+    WeldOptions weld;
+    weld.epsilon = o.weldEpsilon;
+    weld.keepNormalSplits = model.hasNormals();
+    weld.keepColorSplits = model.hasColors();
+    weldModel(model, weld);
+  }
+  if (o.simplify < 1) {
+    const ModelSimplifyStats stats = simplifyModel(model, o.simplify);
+    say(global, fmt::format("simplified {} triangles to {} (error {:.4g} model units)",
+                            formatCount(stats.trianglesBefore), formatCount(stats.trianglesAfter),
+                            stats.error));
+  }
+}
+
+Status writeConverted(const ConvertOptions& o, const Model& model) {
+  if (formatFromPath(o.output) != FileFormat::kStl) return writeModel(model, o.output);
+  if (!model.images.empty())
+    fmt::print(stderr,
+               "lodforge: warning: STL holds no textures: the {} image(s) of {} are left "
+               "out (GLB, OBJ and PLY keep them)\n",
+               model.images.size(), o.input);
+  return writeStl(model, o.output, {o.stlAscii});
+}
+
+Status runConvert(const Global& global, const ConvertOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  if (fileExtension(o.output) == "las") return convertToLas(global, o.input, o.output);
+  LODFORGE_TRY(checkModelOutput(o));
+  Result<Model> model = readConvertInput(global, o);
+  if (!model) return model.status();
+  reshapeModel(global, o, *model);
+  LODFORGE_TRY(writeConverted(o, *model));
+  say(global, fmt::format("wrote {}: {} objects, {} vertices, {} triangles in {:.2f} s", o.output,
+                          formatCount(model->objectCount()), formatCount(model->vertexCount()),
+                          formatCount(model->triangleCount()), secondsSince(start)));
+  return {};
+}
+
 }  // namespace
 
 void addConvert(CLI::App& app, const Global& global, Run& run) {
-  struct Options {
-    std::string input, output;
-    bool weld = false;
-    float weldEpsilon = 0;
-    bool stlAscii = false;
-    bool salvage = false;
-    double simplify = 1;
-    CadCommand cad;
-  };
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<ConvertOptions>();
   CLI::App* sub = app.add_subcommand("convert", "Convert a model between formats (by extension)");
   sub->add_option("INPUT", options->input,
                   "A .ply .obj .stl .gltf .glb model, a .step .iges .brep CAD file (or .laz/.las)")
@@ -106,63 +178,7 @@ void addConvert(CLI::App& app, const Global& global, Run& run) {
       ->check(CLI::Range(0.0, 1.0));
   addCadOptions(*sub, options->cad);
   sub->callback([&global, &run, options] {
-    run = [&global, options]() -> Status {
-      const auto start = std::chrono::steady_clock::now();
-      if (fileExtension(options->output) == "las")
-        return convertToLas(global, options->input, options->output);
-      if (!canWrite(formatFromPath(options->output)))
-        return Error{ErrorKind::kUsage,
-                     fmt::format("{}: convert does not write {} (it writes .ply .glb .obj .stl "
-                                 "models, and .las from .las or .laz point clouds)",
-                                 options->output,
-                                 fileExtension(options->output) == "laz"
-                                     ? std::string("LAZ (compressed LAS)")
-                                     : std::string("this format"))};
-      LODFORGE_TRY(refusePointCloud(options->input, "convert"));
-      LODFORGE_TRY(claimOutput(options->output, modelFileOutput(options->output),
-                               std::vector<std::string>{options->input}));
-      LODFORGE_TRY(checkMemory(options->input, global.memoryLimit));
-      Result<CadReadOptions> cad = cadOptions(options->cad, global);
-      if (!cad) return cad.status();
-      std::vector<std::string> warnings;
-      Result<Model> model =
-          readModel(options->input,
-                    {.salvageTruncated = options->salvage, .warnings = &warnings, .cad = *cad});
-      for (const std::string& w : warnings) fmt::print(stderr, "lodforge: warning: {}\n", w);
-      if (!model) return model.status();
-      // As tiles and build: a model without triangles is nothing to convert (an empty file).
-      if (model->triangleCount() == 0)
-        return badInput(options->input, "the model has no triangles: nothing to convert");
-      if (options->weld) {
-        WeldOptions weld;
-        weld.epsilon = options->weldEpsilon;
-        weld.keepNormalSplits = model->hasNormals();
-        weld.keepColorSplits = model->hasColors();
-        weldModel(*model, weld);
-      }
-      if (options->simplify < 1) {
-        const ModelSimplifyStats stats = simplifyModel(*model, options->simplify);
-        say(global, fmt::format("simplified {} triangles to {} (error {:.4g} model units)",
-                                formatCount(stats.trianglesBefore),
-                                formatCount(stats.trianglesAfter), stats.error));
-      }
-      if (formatFromPath(options->output) == FileFormat::kStl && !model->images.empty())
-        fmt::print(stderr,
-                   "lodforge: warning: STL holds no textures: the {} image(s) of {} are left "
-                   "out (GLB, OBJ and PLY keep them)\n",
-                   model->images.size(), options->input);
-      const Status written = formatFromPath(options->output) == FileFormat::kStl
-                                 ? writeStl(*model, options->output, {options->stlAscii})
-                                 : writeModel(*model, options->output);
-      LODFORGE_TRY(written);
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      say(global, fmt::format("wrote {}: {} objects, {} vertices, {} triangles in {:.2f} s",
-                              options->output, formatCount(model->objectCount()),
-                              formatCount(model->vertexCount()),
-                              formatCount(model->triangleCount()), seconds));
-      return {};
-    };
+    run = [&global, options] { return runConvert(global, *options); };
   });
 }
 

@@ -12,11 +12,10 @@
 namespace lodforge {
 namespace {
 
-// One object's surface: a vertex per position, each corner naming its wedge (the object's vertex
-// it came from). Triangles with two corners at one point have no area; they go.
+// One object's surface: a vertex per position, with its triangles' wedges.
 struct Surface {
   std::vector<Vec3f> positions;
-  std::vector<std::uint32_t> indices, wedges;
+  WedgeSurface triangles;
 };
 
 Surface surfaceOf(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices) {
@@ -25,14 +24,7 @@ Surface surfaceOf(std::span<const Vec3f> positions, std::span<const std::uint32_
   Surface s;
   s.positions.resize(count);
   remapVertexAttribute(positions, remap, std::span(s.positions));
-  for (std::size_t t = 0; t < indices.size(); t += 3) {
-    const std::array<std::uint32_t, 3> c = {remap[indices[t]], remap[indices[t + 1]],
-                                            remap[indices[t + 2]]};
-    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
-    s.indices.insert(s.indices.end(), c.begin(), c.end());
-    s.wedges.insert(s.wedges.end(), indices.begin() + static_cast<std::ptrdiff_t>(t),
-                    indices.begin() + static_cast<std::ptrdiff_t>(t + 3));
-  }
+  s.triangles = wedgeSurface(remap, indices);
   return s;
 }
 
@@ -64,6 +56,20 @@ void appendSimplified(const Model& in, std::size_t o, const SimplifiedMesh& simp
 
 }  // namespace
 
+WedgeSurface wedgeSurface(std::span<const std::uint32_t> pointOf,
+                          std::span<const std::uint32_t> indices) {
+  WedgeSurface out;
+  for (std::size_t t = 0; t < indices.size(); t += 3) {
+    const std::array<std::uint32_t, 3> c = {pointOf[indices[t]], pointOf[indices[t + 1]],
+                                            pointOf[indices[t + 2]]};
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    out.indices.insert(out.indices.end(), c.begin(), c.end());
+    out.wedges.insert(out.wedges.end(), indices.begin() + static_cast<std::ptrdiff_t>(t),
+                      indices.begin() + static_cast<std::ptrdiff_t>(t + 3));
+  }
+  return out;
+}
+
 ModelSimplifyStats simplifyModel(Model& model, double ratio) {
   assert(ratio >= 0 && ratio <= 1);
   ModelSimplifyStats stats;
@@ -86,11 +92,12 @@ ModelSimplifyStats simplifyModel(Model& model, double ratio) {
     options.collapseBorders = true;
     options.stopAtTriangles = static_cast<std::uint32_t>(
         std::max(1.0, std::floor(ratio * static_cast<double>(model.objects[o].triangleCount))));
-    options.wedges = surface.wedges;
+    options.wedges = surface.triangles.wedges;
     options.wedgeUvs = uvs;
     const SimplifiedMesh simplified =
-        surface.indices.empty() ? SimplifiedMesh{}
-                                : simplifyMesh(surface.positions, surface.indices, options);
+        surface.triangles.indices.empty()
+            ? SimplifiedMesh{}
+            : simplifyMesh(surface.positions, surface.triangles.indices, options);
     stats.error = std::max(stats.error, static_cast<double>(simplified.error));
     appendSimplified(model, o, simplified, builder, out);
   }

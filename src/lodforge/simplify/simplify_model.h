@@ -6,10 +6,21 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "lodforge/core/model.h"
 
 namespace lodforge {
+
+// A mesh's triangles over its surface points, each corner naming its wedge (the mesh vertex it
+// came from): what simplifyMesh takes with ProgressiveOptions::wedges. `pointOf` gives each
+// mesh vertex's surface point; triangles with two corners at one point have no area and go.
+struct WedgeSurface {
+  std::vector<std::uint32_t> indices, wedges;
+};
+WedgeSurface wedgeSurface(std::span<const std::uint32_t> pointOf,
+                          std::span<const std::uint32_t> indices);
 
 struct ModelSimplifyStats {
   std::uint64_t trianglesBefore = 0, trianglesAfter = 0;

@@ -13,6 +13,7 @@
 #include "lodforge/core/distance.h"
 #include "lodforge/core/mesh.h"
 #include "lodforge/simplify/progressive.h"
+#include "lodforge/simplify/simplify_model.h"
 #include "lodforge/tiling/weld.h"
 
 namespace lodforge {
@@ -273,17 +274,12 @@ Collapsed simplifyTextured(const MeshPart& merged, std::span<const Vec3f> positi
     surfacePositions[s] = positions[first[s]];
     locked[s] = outer[first[s]];
   }
-  std::vector<std::uint32_t> indices, wedges;
-  for (std::size_t t = 0; t < merged.indices.size(); t += 3) {
-    std::array<std::uint32_t, 3> c{};
-    for (std::size_t k = 0; k < 3; ++k) c[k] = surfaceOf[samePosition[merged.indices[t + k]]];
-    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
-    indices.insert(indices.end(), c.begin(), c.end());
-    wedges.insert(wedges.end(), merged.indices.begin() + static_cast<std::ptrdiff_t>(t),
-                  merged.indices.begin() + static_cast<std::ptrdiff_t>(t + 3));
-  }
+  std::vector<std::uint32_t> pointOf(merged.vertexCount());
+  for (std::uint32_t v = 0; v < merged.vertexCount(); ++v) pointOf[v] = surfaceOf[samePosition[v]];
+  const WedgeSurface surface = wedgeSurface(pointOf, merged.indices);
+  const std::vector<std::uint32_t>& indices = surface.indices;
   simplify.locked = locked;
-  simplify.wedges = wedges;
+  simplify.wedges = surface.wedges;
   simplify.wedgeUvs = merged.uvs;
   const SimplifiedMesh simplified = simplifyMesh(surfacePositions, indices, simplify);
   // The mesh again: one vertex per wedge still in use, in order of first use.

@@ -85,7 +85,8 @@ TEST(ObjMaterials, AMissingOrBrokenTextureIsAWarningAndAGreyMaterial) {
     ASSERT_EQ(warnings.size(), 1u);
     EXPECT_TRUE(test::anyContains(warnings, "photo.png")) << warnings[0];
     EXPECT_TRUE(test::anyContains(warnings, "grey")) << warnings[0];
-    EXPECT_TRUE(test::anyContains(warnings, broken ? "not a JPEG, PNG, WebP, BMP or TGA" : "not found"))
+    EXPECT_TRUE(
+        test::anyContains(warnings, broken ? "not a JPEG, PNG, WebP, BMP or TGA" : "not found"))
         << warnings[0];
     EXPECT_TRUE(model->images.empty());
     EXPECT_FALSE(model->hasUvs());

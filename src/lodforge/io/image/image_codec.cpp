@@ -42,6 +42,15 @@ void jpegWarning(j_common_ptr info, int level) {
   if (error->manager.num_warnings++ == 0) (*info->err->format_message)(info, error->message);
 }
 
+// libjpeg's error manager routed to `error`: errors jump to its setjmp, warnings are kept. (The
+// setjmp itself stays in each caller: the frame it marks must still be live when libjpeg jumps.)
+jpeg_error_mgr* jpegErrors(JpegError& error) {
+  jpeg_error_mgr* manager = jpeg_std_error(&error.manager);
+  error.manager.error_exit = jpegErrorExit;
+  error.manager.emit_message = jpegWarning;
+  return manager;
+}
+
 // Streams a JPEG's rows (from memory or a file) to `row`; libjpeg's errors jump back here, past
 // libjpeg's frames only. The callbacks' status is kept in `failed`.
 bool decodeJpegRows(std::span<const std::byte> bytes, std::FILE* file, std::uint64_t maxPixels,
@@ -51,9 +60,7 @@ bool decodeJpegRows(std::span<const std::byte> bytes, std::FILE* file, std::uint
   // (Everything this function changes after setjmp lives in the caller: a local changed there
   // would hold no defined value after the jump.)
   jpeg_decompress_struct info;
-  info.err = jpeg_std_error(&error.manager);
-  error.manager.error_exit = jpegErrorExit;
-  error.manager.emit_message = jpegWarning;
+  info.err = jpegErrors(error);
   if (setjmp(error.jump)) {
     jpeg_destroy_decompress(&info);
     return false;
@@ -93,9 +100,7 @@ bool decodeJpegRows(std::span<const std::byte> bytes, std::FILE* file, std::uint
 bool readJpegHeader(std::span<const std::byte> bytes, int& width, int& height, int& channels,
                     JpegError& error) {
   jpeg_decompress_struct info;
-  info.err = jpeg_std_error(&error.manager);
-  error.manager.error_exit = jpegErrorExit;
-  error.manager.emit_message = jpegWarning;
+  info.err = jpegErrors(error);
   if (setjmp(error.jump)) {
     jpeg_destroy_decompress(&info);
     return false;

@@ -55,6 +55,11 @@ want=$(( $(ls "$data"/meshes | wc -l) + 12 ))
 # A generated textured scan (MeshLab's textured PLY: four JPEG atlases), streamed.
 "$lodforge" -q generate scan --triangles 20K --texture 256 --atlases 4 -o "$out/scan-textured.ply"
 "$lodforge" -q tiles "$out/scan-textured.ply" -o "$out/scan-textured-tiles" --chunk-size 150
+# Textured levels out of a progressive package (its images embedded in the package).
+"$lodforge" -q build "$out/scan-textured.ply" -o "$out/scan-textured.lfp"
+"$lodforge" -q extract "$out/scan-textured.lfp" --ratio 0.2 -o "$out/scan-textured-lod20.glb"
+"$lodforge" -q build "$data/textured/spider/spider.obj" -o "$out/spider.lfp"
+"$lodforge" -q extract "$out/spider.lfp" --ratio 0 -o "$out/spider-lod0.glb"
 tiles=$(ls "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb | wc -l)
 [[ $tiles -ge 20 ]] || { echo "expected at least 20 tile GLBs, found $tiles" >&2; exit 1; }
 node "$here/js/validate-gltf.mjs" "$out"/*.glb "$out"/horse-tiles/tiles/*.glb "$out"/scan-tiles/tiles/*.glb \

@@ -215,6 +215,16 @@ void print(const std::string& path, const Summary& s) {
 }
 
 // A progressive package: counts, levels, and what the LOD bookkeeping costs.
+// A textured package's materials and images, as info_textures says them of a model.
+nlohmann::json packageTextures(const Package& package) {
+  if (!package.header().hasUvs()) return {};
+  Model model;
+  for (std::size_t m = 0; m < package.materialCount(); ++m)
+    model.materials.push_back(package.material(m));
+  for (std::size_t k = 0; k < package.imageCount(); ++k) model.images.push_back(package.image(k));
+  return textureSummary(model);
+}
+
 Status describePackage(const std::string& path, bool json) {
   Result<Package> package = Package::open(path);
   if (!package) return package.status();
@@ -261,6 +271,8 @@ Status describePackage(const std::string& path, bool json) {
                         {"materials", package->materialCount()},
                         {"layers", package->layerCount()},
                         {"origin", {h.origin[0], h.origin[1], h.origin[2]}}};
+    if (const nlohmann::json textures = packageTextures(*package); !textures.empty())
+      j["textures"] = textures;
     for (std::uint32_t s = 0; s < kPackageSections; ++s)
       j["sections"][std::string(packageSectionName(static_cast<PackageSection>(s)))] =
           h.sections[s].bytes;
@@ -271,8 +283,9 @@ Status describePackage(const std::string& path, bool json) {
   fmt::print("format     lodforge package v{} ({})\n", h.version,
              formatBytes(package->fileBytes()));
   fmt::print("objects    {}\n", formatCount(h.objectCount));
-  fmt::print("vertices   {} full, {} at the simplest level{}\n", formatCount(h.vertexCount),
-             formatCount(minVertices), h.hasColors() ? " (normals, colors)" : " (normals)");
+  fmt::print("vertices   {} full, {} at the simplest level (normals{}{})\n",
+             formatCount(h.vertexCount), formatCount(minVertices), h.hasColors() ? ", colors" : "",
+             h.hasUvs() ? ", texture coordinates" : "");
   fmt::print("triangles  {} full, {} at the simplest level\n", formatCount(h.triangleCount),
              formatCount(minTriangles));
   fmt::print("assembly   {} of the objects in a tree {} deep, {} materials, {} layers\n",
@@ -289,6 +302,7 @@ Status describePackage(const std::string& path, bool json) {
   for (std::uint32_t s = 0; s < kPackageSections; ++s)
     fmt::print(" {} {}{}", packageSectionName(static_cast<PackageSection>(s)),
                formatBytes(h.sections[s].bytes), s + 1 < kPackageSections ? "," : "\n");
+  printTextures(packageTextures(*package));
   return {};
 }
 

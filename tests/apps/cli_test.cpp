@@ -461,6 +461,40 @@ TEST(CliPackage, BuildInfoAndExtract) {
       2);
 }
 
+// A textured OBJ through build, info, extract and render: the package carries the coordinates
+// and the four JPEGs, every level comes out textured (GLB with them embedded, OBJ with them
+// beside), and the frames are drawn from it.
+TEST(CliPackage, ATexturedModelKeepsItsTexturesThroughBuildExtractAndRender) {
+  test::TempDir dir;
+  const std::string package = dir.file("spider.lfp");
+  Outcome o =
+      lodforge("build " + test::dataPath("textured/spider/spider.obj") + " -o " + package, dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(o.err.find("warning"), std::string::npos) << o.err;
+  const nlohmann::json j = info(package, dir);
+  ASSERT_TRUE(j.contains("textures")) << j.dump();
+  EXPECT_EQ(j["textures"]["images"].size(), 4u);
+  EXPECT_EQ(j["textures"]["images"][0]["format"], "JPEG");
+  for (const char* ratio : {"1", "0.3", "0"}) {
+    const std::string glb = dir.file(std::string("lod") + ratio + ".glb");
+    o = lodforge("extract " + package + " --ratio " + ratio + " -o " + glb, dir);
+    ASSERT_EQ(o.code, 0) << o.err;
+    const nlohmann::json level = info(glb, dir);
+    ASSERT_TRUE(level.contains("textures")) << ratio << ": " << level.dump();
+    EXPECT_EQ(level["textures"]["images"].size(), 4u) << ratio;
+    EXPECT_TRUE(level["uvs"].get<bool>()) << ratio;
+  }
+  o = lodforge("extract " + package + " --ratio 0.5 -o " + dir.file("half/spider.obj"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("half/spider.mtl")));
+  EXPECT_EQ(info(dir.file("half/spider.obj"), dir)["textures"]["images"].size(), 4u);
+  o = lodforge(
+      "render " + package + " --frames 1 --size 160x120 --budget 50% -o " + dir.file("frames"),
+      dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("frames/frame_0000.png")));
+}
+
 nlohmann::json glbJson(const std::string& path);
 
 // 2CylinderEngine repeats 29 shapes in 67 objects: `build` places the repeats and `extract` writes

@@ -28,7 +28,7 @@ std::vector<std::uint32_t> words(std::span<const T> values) {
 TEST(GpuStream, EveryFrameEqualsTheCpuStreamAndReadsOnlyTheDelta) {
   test::headlessContext();
   Random random(77);
-  for (const char* key : {"engine", "motor", "cad", "crowd"}) {
+  for (const char* key : {"engine", "motor", "cad", "crowd", "spider"}) {
     const Package& package = test::RuntimePackages::get(key);
     const LodScene scene = LodScene::fromPackage(package);
     const std::uint64_t full = scene.totalMaxVertices();
@@ -70,6 +70,10 @@ TEST(GpuStream, EveryFrameEqualsTheCpuStreamAndReadsOnlyTheDelta) {
       if (package.header().hasNormals()) {
         EXPECT_EQ(readBufferWords(gpu->normalBuffer(), 3 * gpu->vertexCount()),
                   words(cpu.normals()));
+      }
+      if (package.header().hasUvs()) {
+        EXPECT_EQ(readBufferWords(gpu->uvBuffer(), 2 * gpu->vertexCount()), words(cpu.uvs()))
+            << key << " frame " << f;
       }
       EXPECT_EQ(readBufferWords(gpu->sourceBuffer(), 3 * gpu->triangleCount()),
                 words(cpu.sourceTriangles()))

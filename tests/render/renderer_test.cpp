@@ -2,8 +2,13 @@
 // tolerant measures, not golden pixels.
 #include "lodforge/render/renderer.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
 #include <gtest/gtest.h>
 
+#include "lodforge/generate/scan.h"
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
 #include "render/headless.h"
@@ -171,6 +176,69 @@ TEST(Renderer, ColourModesDiffer) {
   }
   EXPECT_EQ(parseColorMode("lod").value(), ColorMode::kLodRatio);
   EXPECT_FALSE(parseColorMode("rainbow").ok());
+}
+
+// Mean chroma (largest minus smallest channel) of the covered pixels: 0 for a grey model under
+// the headlight, large for the generated scan's photo-like greens and browns.
+double meanChroma(const Image& image) {
+  const auto background = DrawOptions{}.background;
+  double sum = 0, n = 0;
+  for (std::size_t i = 0; i < image.pixelCount(); ++i) {
+    const std::uint8_t* p = &image.rgba[4 * i];
+    if (p[0] == background[0] && p[1] == background[1] && p[2] == background[2]) continue;
+    sum += std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]});
+    n += 1;
+  }
+  return n > 0 ? sum / n : 0.0;
+}
+
+TEST(Renderer, TexturedLevelsStayCloseToTheFullResolutionTexturedRender) {
+  test::headlessContext();
+  test::TempDir folder;
+  ASSERT_TRUE(generateScan({.triangles = 40'000, .textureSize = 1024, .atlases = 4},
+                           folder.file("scan.ply"))
+                  .ok());
+  ASSERT_TRUE(buildPackage(folder.file("scan.ply"), folder.file("scan.lfp")).ok());
+  auto package = Package::open(folder.file("scan.lfp"));
+  ASSERT_TRUE(package.ok());
+  ASSERT_EQ(package->imageCount(), 4u);
+  const LodScene scene = LodScene::fromPackage(*package);
+  const std::uint64_t full = scene.totalMaxVertices();
+  StreamBuffer reference(*package, StreamCapacity::forVertices(*package, full));
+  StreamBuffer reduced(*package, StreamCapacity::forVertices(*package, full));
+  Selection selection;
+  for (const Camera& camera :
+       orbitPath(test::packageBounds(*package), {.frames = 2, .width = 320, .height = 240})) {
+    selectTwoPass(scene, camera, full, {}, selection);
+    ASSERT_TRUE(reference.update(selection.vertexCounts, selection.triangleCounts).ok());
+    const Image truth = render(*package, reference, camera);
+    // The texture is drawn (the objects' base colour is grey).
+    EXPECT_GT(meanChroma(truth), 15.0);
+    EXPECT_GT(coverage(truth), 0.1);
+    double previous = 0;
+    for (const auto& [share, bound] :
+         {std::pair{0.5, 0.05}, std::pair{0.2, 0.10}, std::pair{0.05, 0.25}}) {
+      const auto budget = static_cast<std::uint64_t>(share * static_cast<double>(full));
+      selectTwoPass(scene, camera, budget, {}, selection);
+      // Whole counts only (no point half collapsed), so at most the budget.
+      EXPECT_LE(selection.totalVertices, budget);
+      EXPECT_GT(selection.totalVertices, budget * 9 / 10);
+      for (std::size_t i = 0; i < package->objectCount(); ++i) {
+        const std::uint32_t v = selection.vertexCounts[i];
+        if (v != 0) {
+          EXPECT_EQ(package->wholeAt(i, v), v);
+        }
+      }
+      ASSERT_TRUE(reduced.update(selection.vertexCounts, selection.triangleCounts).ok());
+      const ImageDifference d = compareImages(render(*package, reduced, camera), truth);
+      std::printf("budget %.2f: %.4f of pixels above dE 2.3, mean dE %.2f\n", share, d.shareAbove,
+                  d.meanDeltaE);
+      EXPECT_LT(d.shareAbove, bound) << "budget " << share;
+      EXPECT_GT(d.shareAbove, 0.0) << "budget " << share << ": a reduced model should differ";
+      EXPECT_GE(d.shareAbove + 0.01, previous) << "fewer vertices should not look better";
+      previous = d.shareAbove;
+    }
+  }
 }
 
 }  // namespace

@@ -19,6 +19,7 @@ namespace lodforge::test {
 class RuntimePackages {
  public:
   // "engine" (2CylinderEngine.glb), "motor" (as1_motor.glb), "horse" (one scanned mesh),
+  // "spider" (19 textured objects over 4 JPEGs, an OBJ),
   // "cad" (a generated assembly of 1,500 parts), "crowd" (20,000 copies of the motor's small
   // parts).
   static const Package& get(const std::string& key) {
@@ -38,6 +39,8 @@ class RuntimePackages {
       input = dataPath("meshes/as1_motor.glb");
     else if (key == "horse")
       input = dataPath("meshes/horse.ply");
+    else if (key == "spider")
+      input = dataPath("textured/spider/spider.obj");
     else if (key == "crowd")
       return crowd();
     else {

@@ -1,6 +1,9 @@
 #include "lodforge/simplify/package.h"
 
+#include <array>
 #include <cstring>
+#include <functional>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -151,14 +154,16 @@ TEST_F(Corrupted, TruncationMagicAndVersionAreRejected) {
   EXPECT_NE(open(version).error().message.find("package version 99"), std::string::npos);
 }
 
+// A forged change to a package and the words its refusal must contain.
+struct Case {
+  const char* what;
+  std::function<void(std::string&)> damage;
+  const char* expected;
+};
+
 TEST_F(Corrupted, ForgedContentIsCaughtEvenWithValidChecksums) {
   // With checksums recomputed (or not verified), the structure checks still stand between a
   // bad file and an out-of-bounds read.
-  struct Case {
-    const char* what;
-    std::function<void(std::string&)> damage;
-    const char* expected;
-  };
   const auto& h = header();
   const std::uint64_t ecolAt = h.sections[static_cast<std::uint32_t>(PackageSection::kEcol)].offset;
   const std::uint64_t trianglesAt =
@@ -246,6 +251,104 @@ TEST_F(Corrupted, ForgedContentIsCaughtEvenWithValidChecksums) {
       EXPECT_NE(p.error().message.find(c.expected), std::string::npos)
           << c.what << ": " << p.error().message;
     }
+  }
+}
+
+TEST(Package, ATexturedModelKeepsItsWedgesMaterialsAndImages) {
+  const std::string input = test::dataPath("textured/spider/spider.obj");
+  Result<Model> spider = readModel(input);
+  ASSERT_TRUE(spider.ok()) << spider.error().message;
+  ASSERT_GT(spider->images.size(), 1u);
+  test::TempDir dir;
+  ASSERT_TRUE(buildPackage(input, dir.file("s.lfp")).ok());
+  Result<Package> package = Package::open(dir.file("s.lfp"));
+  ASSERT_TRUE(package.ok()) << package.error().message;
+  ASSERT_TRUE(package->header().hasUvs());
+  // Materials with their textures and wraps, and every image's bytes as the file holds them.
+  ASSERT_EQ(package->materialCount(), spider->materials.size());
+  for (std::size_t m = 0; m < spider->materials.size(); ++m)
+    EXPECT_EQ(package->material(m), spider->materials[m]) << m;
+  ASSERT_EQ(package->imageCount(), spider->images.size());
+  for (std::size_t k = 0; k < spider->images.size(); ++k) {
+    const ImageSource stored = package->image(k);
+    EXPECT_EQ(stored.name, spider->images[k].name);
+    EXPECT_EQ(stored.format, spider->images[k].format);
+    EXPECT_EQ(stored.width, spider->images[k].width);
+    const std::string file = test::readFile(spider->images[k].path);
+    ASSERT_EQ(stored.bytes.size(), file.size()) << stored.name;
+    EXPECT_EQ(std::memcmp(stored.bytes.data(), file.data(), file.size()), 0) << stored.name;
+  }
+  // Each object's full level holds exactly the input's (position, coordinates) pairs.
+  ASSERT_EQ(package->objectCount(), spider->objectCount());
+  for (std::size_t o = 0; o < spider->objectCount(); ++o) {
+    std::set<std::array<float, 5>> given, stored;
+    const ObjectRecord& r = spider->objects[o];
+    for (std::uint32_t v = 0; v < r.vertexCount; ++v) {
+      const Vec3f p = spider->positions[r.vertexOffset + v];
+      const Vec2f uv = spider->uvs[r.vertexOffset + v];
+      given.insert({p.x, p.y, p.z, uv.x, uv.y});
+    }
+    for (std::uint32_t v = 0; v < package->object(o).vertexCount; ++v) {
+      const Vec3f p = package->positions(o)[v];
+      const Vec2f uv = package->uvs(o)[v];
+      stored.insert({p.x, p.y, p.z, uv.x, uv.y});
+    }
+    EXPECT_EQ(stored, given) << spider->objectName(o);
+    // Whole counts: the full mesh and the coarsest, and never above the count asked for.
+    const PackageObject& object = package->object(o);
+    EXPECT_EQ(package->wholeAt(o, object.vertexCount), object.vertexCount);
+    EXPECT_EQ(package->wholeAt(o, object.minVertexCount), object.minVertexCount);
+  }
+}
+
+TEST_F(Corrupted, ATexturedPackagesWholeCountsImagesAndTexturesAreChecked) {
+  ASSERT_TRUE(buildPackage(test::dataPath("textured/spider/spider.obj"), dir.file("t.lfp")).ok());
+  bytes = test::readFile(dir.file("t.lfp"));
+  ASSERT_TRUE(open(bytes).ok());
+  const auto& h = header();
+  const auto at = [&](PackageSection s) {
+    return h.sections[static_cast<std::uint32_t>(s)].offset;
+  };
+  const Case cases[] = {
+      {"a whole count above its level",
+       [&](std::string& d) {
+         const auto& o =
+             *reinterpret_cast<const PackageObject*>(d.data() + at(PackageSection::kObjects));
+         reinterpret_cast<std::uint32_t*>(d.data() + at(PackageSection::kWhole))[0] =
+             o.minVertexCount + 1;
+       },
+       "object 0: whole count"},
+      {"image bytes outside the section",
+       [&](std::string& d) {
+         reinterpret_cast<PackageImage*>(d.data() + at(PackageSection::kImages))->dataBytes = 1ull
+                                                                                              << 40;
+       },
+       "image 0: bytes outside"},
+      {"unknown image format",
+       [&](std::string& d) {
+         reinterpret_cast<PackageImage*>(d.data() + at(PackageSection::kImages))->format = 77;
+       },
+       "image 0: unknown image format"},
+      {"texture past the images",
+       [&](std::string& d) {
+         reinterpret_cast<PackageMaterial*>(d.data() + at(PackageSection::kMaterials))
+             ->baseColorImage = 99;
+       },
+       "material 0: texture image outside"},
+      {"unknown wrap mode",
+       [&](std::string& d) {
+         reinterpret_cast<PackageMaterial*>(d.data() + at(PackageSection::kMaterials))->wrapT = 9;
+       },
+       "material 0: a wrap mode"},
+  };
+  for (const Case& c : cases) {
+    std::string copy = bytes;
+    c.damage(copy);
+    reseal(copy);
+    Result<Package> p = open(copy);
+    ASSERT_FALSE(p.ok()) << c.what;
+    EXPECT_NE(p.error().message.find(c.expected), std::string::npos)
+        << c.what << ": " << p.error().message;
   }
 }
 

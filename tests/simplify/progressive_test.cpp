@@ -505,6 +505,67 @@ TEST(SimplifyMesh, TexturedSeamsSlideAlongThemselvesAndEveryTriangleKeepsOneChar
   EXPECT_LT(onSeams, 12u);
 }
 
+TEST(ProgressiveMesh, TexturedLevelsKeepOneChartPerTriangleAndNoCrackAtEveryWholeCount) {
+  const auto chartOf = [](double x, double y) { return x < 0.5 ? 0u : y < 0.5 ? 1u : 2u; };
+  const auto uvOf = [](std::uint32_t chart, Vec3f p) {
+    return Vec2f{0.3f * p.x + 0.3f * float(chart), 0.5f * p.y};
+  };
+  const TexturedGrid grid = texturedGrid(16, chartOf, uvOf);
+  ProgressiveOptions options;
+  options.wedges = grid.wedges;
+  options.wedgeUvs = grid.uvs;
+  const ProgressiveMesh mesh = buildProgressive(grid.positions, grid.indices, {}, {}, options);
+  // Over the wedges: one vertex each, with its own coordinates.
+  ASSERT_EQ(mesh.vertexCount(), grid.uvs.size());
+  ASSERT_EQ(mesh.uvs.size(), grid.uvs.size());
+  ASSERT_EQ(mesh.whole.size(), mesh.map.size());
+  std::vector<std::uint32_t> wedgeOf(mesh.vertexCount());
+  for (std::uint32_t w = 0; w < grid.uvs.size(); ++w) {
+    wedgeOf[mesh.permuteV[w]] = w;
+    EXPECT_EQ(mesh.uvs[mesh.permuteV[w]], grid.uvs[w]);
+    EXPECT_EQ(mesh.positions[mesh.permuteV[w]], grid.positions[grid.wedgeVertex[w]]);
+  }
+  std::size_t wholeCounts = 0, partialCounts = 0;
+  for (std::uint32_t n = mesh.q; n <= mesh.vertexCount(); ++n) {
+    if (mesh.wholeAt(n) != n) {
+      ++partialCounts;
+      EXPECT_LT(mesh.wholeAt(n), n);
+      EXPECT_EQ(mesh.wholeAt(mesh.wholeAt(n)), mesh.wholeAt(n));
+      continue;
+    }
+    ++wholeCounts;
+    const std::uint32_t triangles = mesh.trianglesAt(n);
+    std::vector<std::uint32_t> reformed(3 * std::size_t{triangles});
+    reformObject(std::span(mesh.triangles).first(reformed.size()), mesh.ecol, n, 0, reformed);
+    double area = 0;
+    std::map<std::uint32_t, Vec3f> pointAt;  // every wedge of a point at one place: no crack
+    for (std::size_t t = 0; t < reformed.size(); t += 3) {
+      std::array<Vec2f, 3> uv;
+      for (std::size_t k = 0; k < 3; ++k) {
+        ASSERT_LT(reformed[t + k], n);
+        const std::uint32_t w = wedgeOf[reformed[t + k]];
+        ASSERT_EQ(grid.wedgeChart[w], grid.wedgeChart[wedgeOf[reformed[t]]])
+            << "triangle " << t / 3 << " at " << n << " vertices mixes two charts";
+        uv[k] = mesh.uvs[reformed[t + k]];
+        const auto [at, fresh] =
+            pointAt.emplace(grid.wedgeVertex[w], mesh.positions[reformed[t + k]]);
+        ASSERT_EQ(at->second, mesh.positions[reformed[t + k]]);
+      }
+      EXPECT_GT(uvArea(uv[0], uv[1], uv[2]), 0) << "triangle " << t / 3 << " at " << n;
+      const Vec3f a = mesh.positions[reformed[t]], b = mesh.positions[reformed[t + 1]],
+                  c = mesh.positions[reformed[t + 2]];
+      area += 0.5 * length(cross(toDouble(b - a), toDouble(c - a)));
+    }
+    // The whole square at every level: nothing folds, nothing opens.
+    ASSERT_NEAR(area, 1.0, 1e-5) << "at " << n << " vertices";
+  }
+  // Seam points have several wedges, so some counts are not whole; the coarsest level is small
+  // (the rim's 64 points stay: borders do not collapse by default).
+  EXPECT_GT(partialCounts, 0u);
+  EXPECT_GT(wholeCounts, mesh.vertexCount() / 2);
+  EXPECT_LT(mesh.map.front(), grid.indices.size() / 3 / 6);
+}
+
 // The largest texture-coordinate error over the square of the simplified mesh, each of its
 // triangles interpolating its corners' coordinates, against the exact coordinates `uvOf`.
 template <class Uv>

@@ -63,9 +63,9 @@ struct Stream {
 struct GpuStream::State {
   const Package* package = nullptr;
   StreamCapacity capacity;
-  bool normals = false, colors = false;
+  bool normals = false, colors = false, uvs = false;
   Program program;
-  Stream positions, normalStream, colorStream, source;
+  Stream positions, normalStream, colorStream, uvStream, source;
   GLuint vertexTable = 0, triangleTable = 0;
   int current = 0;  // which copy holds the frame
   std::vector<std::uint64_t> vertexStart, triangleStart, oldVertexStart, oldTriangleStart;
@@ -73,7 +73,7 @@ struct GpuStream::State {
   std::vector<std::array<std::uint32_t, 4>> vertexRows, triangleRows;
 
   ~State() {
-    for (Stream* s : {&positions, &normalStream, &colorStream, &source}) s->destroy();
+    for (Stream* s : {&positions, &normalStream, &colorStream, &uvStream, &source}) s->destroy();
     for (GLuint b : {vertexTable, triangleTable}) {
       if (b) glDeleteBuffers(1, &b);
     }
@@ -105,12 +105,14 @@ Result<GpuStream> GpuStream::create(const Package& package, const StreamCapacity
   s->capacity = capacity;
   s->normals = package.header().hasNormals();
   s->colors = package.header().hasColors();
+  s->uvs = package.header().hasUvs();
   auto program = Program::link({{GL_COMPUTE_SHADER, std::string(kElementGlsl) + kAssembleMain}});
   if (!program) return program.status();
   s->program = std::move(*program);
   s->positions.create(capacity.vertices, 3);
   if (s->normals) s->normalStream.create(capacity.vertices, 3);
   if (s->colors) s->colorStream.create(capacity.vertices, 1);
+  if (s->uvs) s->uvStream.create(capacity.vertices, 2);
   s->source.create(capacity.triangles, 3);
   const std::size_t objects = package.objectCount();
   s->vertexTable = makeBuffer(objects * 16);
@@ -152,7 +154,7 @@ Result<FrameStats> GpuStream::update(std::span<const std::uint32_t> vc,
   std::swap(s.oldTriangleStart, s.triangleStart);
   s.vertexStart.assign(objects + 1, 0);
   s.triangleStart.assign(objects + 1, 0);
-  for (Stream* stream : {&s.positions, &s.normalStream, &s.colorStream, &s.source})
+  for (Stream* stream : {&s.positions, &s.normalStream, &s.colorStream, &s.uvStream, &s.source})
     stream->staged.clear();
   s.vertexRows.clear();
   s.triangleRows.clear();
@@ -180,6 +182,7 @@ Result<FrameStats> GpuStream::update(std::span<const std::uint32_t> vc,
         stage(s.normalStream.staged, package.normals(i).data() + kept, fresh * sizeof(Vec3f));
       if (s.colors)
         stage(s.colorStream.staged, package.colors(i).data() + kept, fresh * sizeof(Rgba8));
+      if (s.uvs) stage(s.uvStream.staged, package.uvs(i).data() + kept, fresh * sizeof(Vec2f));
       vertexDelta += fresh;
       keptVertices += kept;
     }
@@ -204,6 +207,7 @@ Result<FrameStats> GpuStream::update(std::span<const std::uint32_t> vc,
   s.assemble(s.positions, vertices, s.vertexTable, s.vertexRows.size());
   if (s.normals) s.assemble(s.normalStream, vertices, s.vertexTable, s.vertexRows.size());
   if (s.colors) s.assemble(s.colorStream, vertices, s.vertexTable, s.vertexRows.size());
+  if (s.uvs) s.assemble(s.uvStream, vertices, s.vertexTable, s.vertexRows.size());
   s.assemble(s.source, triangles, s.triangleTable, s.triangleRows.size());
   // Draws read the vertices; the reformation reads the source triangles.
   glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT |
@@ -249,6 +253,9 @@ unsigned GpuStream::positionBuffer() const {
 unsigned GpuStream::normalBuffer() const {
   return state_->normals ? state_->normalStream.copies[static_cast<std::size_t>(state_->current)]
                          : 0;
+}
+unsigned GpuStream::uvBuffer() const {
+  return state_->uvs ? state_->uvStream.copies[static_cast<std::size_t>(state_->current)] : 0;
 }
 unsigned GpuStream::colorBuffer() const {
   return state_->colors ? state_->colorStream.copies[static_cast<std::size_t>(state_->current)] : 0;

@@ -35,10 +35,11 @@ class GpuStream {
   std::span<const std::uint64_t> vertexStart() const;    // objects + 1
   std::span<const std::uint64_t> triangleStart() const;  // objects + 1
   std::span<const std::uint32_t> vertexCounts() const;
-  // The current copy's GL buffers (0 when the package has no normals / colours).
+  // The current copy's GL buffers (0 when the package has no normals / colours / uvs).
   unsigned positionBuffer() const;
   unsigned normalBuffer() const;
   unsigned colorBuffer() const;
+  unsigned uvBuffer() const;
   unsigned sourceBuffer() const;  // 3 uint32 per triangle, object-local corners
 
  private:

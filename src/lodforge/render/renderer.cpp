@@ -10,6 +10,7 @@
 #include <epoxy/gl.h>
 
 #include "lodforge/render/shader.h"
+#include "lodforge/render/textures.h"
 
 namespace lodforge {
 
@@ -120,12 +121,14 @@ layout(location = 1) in vec3 normal;
 layout(location = 2) in vec4 color;
 layout(location = 3) in vec4 objectColor;  // per object (instanced)
 layout(location = 4) in float lodRatio;    // per object (instanced)
+layout(location = 5) in vec2 uv;
 uniform mat4 viewProjection;
 uniform int mode;
 uniform bool useVertexColor;
 out vec3 worldPosition;
 out vec3 worldNormal;
 out vec4 baseColor;
+out vec2 texcoord;
 
 vec3 ramp(float t) {  // blue, cyan, green, yellow, red
   return clamp(vec3(1.5 - abs(4.0 * t - 3.0), 1.5 - abs(4.0 * t - 2.0), 1.5 - abs(4.0 * t - 1.0)),
@@ -136,6 +139,7 @@ void main() {
   gl_Position = viewProjection * vec4(position, 1.0);
   worldPosition = position;
   worldNormal = normal;
+  texcoord = uv;
   if (mode == 0) baseColor = useVertexColor ? color : objectColor;
   else if (mode == 1) baseColor = objectColor;
   else baseColor = vec4(ramp(lodRatio), 1.0);
@@ -146,9 +150,12 @@ constexpr const char* kFragmentShader = R"(#version 450 core
 in vec3 worldPosition;
 in vec3 worldNormal;
 in vec4 baseColor;
+in vec2 texcoord;
 uniform vec3 eye;
 uniform int mode;
 uniform bool useVertexNormal;
+uniform bool useTexture;
+uniform sampler2D baseTexture;
 out vec4 fragColor;
 
 void main() {
@@ -161,7 +168,8 @@ void main() {
   }
   // A headlight, two-sided: CAD parts are often open shells.
   float diffuse = abs(dot(n, normalize(eye - worldPosition)));
-  fragColor = vec4(baseColor.rgb * (0.3 + 0.7 * diffuse), 1.0);
+  vec3 albedo = useTexture ? texture(baseTexture, texcoord).rgb : baseColor.rgb;
+  fragColor = vec4(albedo * (0.3 + 0.7 * diffuse), 1.0);
 }
 )";
 
@@ -188,10 +196,17 @@ struct DrawCommand {  // GL's DrawElementsIndirectCommand
 struct Renderer::State {
   const Package* package = nullptr;
   StreamCapacity capacity;
-  bool normals = false, colors = false;
+  bool normals = false, colors = false, uvs = false;
   Program program;
   GLuint vertexArray = 0;
-  GLuint positions = 0, normalBuffer = 0, colorBuffer = 0, indices = 0;
+  GLuint positions = 0, normalBuffer = 0, colorBuffer = 0, uvBuffer = 0, indices = 0;
+  PackageTextures textures;
+  // Textured: the commands sorted by image, drawn one image at a time.
+  struct ImageRange {
+    std::uint32_t image;
+    GLsizei first, count;
+  };
+  std::vector<ImageRange> imageRanges;
   GLuint objectColors = 0, lodRatios = 0, commands = 0;
   GLsizei commandCount = 0;
   std::vector<DrawCommand> commandList;
@@ -202,8 +217,8 @@ struct Renderer::State {
   mutable bool idColorsUploaded = false;  // which colours the object colour buffer holds
 
   ~State() {
-    const GLuint buffers[] = {positions,    normalBuffer, colorBuffer, indices,
-                              objectColors, lodRatios,    commands};
+    const GLuint buffers[] = {positions, normalBuffer, colorBuffer, uvBuffer,
+                              indices,   objectColors, lodRatios,   commands};
     for (GLuint b : buffers) {
       if (b) glDeleteBuffers(1, &b);
     }
@@ -218,6 +233,10 @@ Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& 
   s->capacity = capacity;
   s->normals = package.header().hasNormals();
   s->colors = package.header().hasColors();
+  s->uvs = package.header().hasUvs();
+  Result<PackageTextures> textures = PackageTextures::load(package);
+  if (!textures) return textures.status();
+  s->textures = std::move(*textures);
   auto program =
       Program::link({{GL_VERTEX_SHADER, kVertexShader}, {GL_FRAGMENT_SHADER, kFragmentShader}});
   if (!program) return program.status();
@@ -236,6 +255,7 @@ Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& 
     s->positions = makeBuffer(capacity.vertices * sizeof(Vec3f));
     if (s->normals) s->normalBuffer = makeBuffer(capacity.vertices * sizeof(Vec3f));
     if (s->colors) s->colorBuffer = makeBuffer(capacity.vertices * sizeof(Rgba8));
+    if (s->uvs) s->uvBuffer = makeBuffer(capacity.vertices * sizeof(Vec2f));
   }
   s->indices = makeBuffer(capacity.triangles * 3 * sizeof(std::uint32_t));
   s->objectColors = makeBuffer(objects * sizeof(Rgba8), s->baseColors.data());
@@ -257,6 +277,7 @@ Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& 
   if (s->colors) attribute(2, s->colorBuffer, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(Rgba8), 0);
   attribute(3, s->objectColors, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(Rgba8), 1);
   attribute(4, s->lodRatios, 1, GL_FLOAT, GL_FALSE, sizeof(float), 1);
+  if (s->uvs) attribute(5, s->uvBuffer, 2, GL_FLOAT, GL_FALSE, sizeof(Vec2f), 0);
   glVertexArrayElementBuffer(vao, s->indices);
   return Renderer(std::move(s));
 }
@@ -278,6 +299,7 @@ void Renderer::upload(const StreamBuffer& buffer, bool indices) {
   upload(s.positions, buffer.positions());
   if (s.normals) upload(s.normalBuffer, buffer.normals());
   if (s.colors) upload(s.colorBuffer, buffer.colors());
+  if (s.uvs) upload(s.uvBuffer, buffer.uvs());
   if (indices) upload(s.indices, buffer.indices());
 
   setCommands(buffer.vertexCounts(), buffer.triangleStart());
@@ -286,6 +308,7 @@ void Renderer::upload(const StreamBuffer& buffer, bool indices) {
     glVertexArrayVertexBuffer(s.vertexArray, 0, s.positions, 0, sizeof(Vec3f));
     if (s.normals) glVertexArrayVertexBuffer(s.vertexArray, 1, s.normalBuffer, 0, sizeof(Vec3f));
     if (s.colors) glVertexArrayVertexBuffer(s.vertexArray, 2, s.colorBuffer, 0, sizeof(Rgba8));
+    if (s.uvs) glVertexArrayVertexBuffer(s.vertexArray, 5, s.uvBuffer, 0, sizeof(Vec2f));
     s.attached = false;
   }
 }
@@ -297,8 +320,39 @@ void Renderer::attach(const GpuStream& stream) {
   if (s.normals)
     glVertexArrayVertexBuffer(s.vertexArray, 1, stream.normalBuffer(), 0, sizeof(Vec3f));
   if (s.colors) glVertexArrayVertexBuffer(s.vertexArray, 2, stream.colorBuffer(), 0, sizeof(Rgba8));
+  if (s.uvs) glVertexArrayVertexBuffer(s.vertexArray, 5, stream.uvBuffer(), 0, sizeof(Vec2f));
   s.attached = true;
   setCommands(stream.vertexCounts(), stream.triangleStart());
+}
+
+// The commands sorted by their object's image (stable: objects in order within one image),
+// with a range per image; nothing to do for a package without textures.
+void groupByImage(Renderer::State& s) {
+  s.imageRanges.clear();
+  if (s.textures.empty()) return;
+  std::stable_sort(s.commandList.begin(), s.commandList.end(), [&](const auto& a, const auto& b) {
+    return s.textures.objectImage(a.baseInstance) < s.textures.objectImage(b.baseInstance);
+  });
+  for (std::size_t c = 0; c < s.commandList.size(); ++c) {
+    const std::uint32_t image = s.textures.objectImage(s.commandList[c].baseInstance);
+    if (s.imageRanges.empty() || s.imageRanges.back().image != image)
+      s.imageRanges.push_back({image, static_cast<GLsizei>(c), 0});
+    ++s.imageRanges.back().count;
+  }
+}
+
+// One multi-draw per image, its texture bound (objects without one untextured).
+void drawByImage(const Renderer::State& s, GLuint program) {
+  glUniform1i(glGetUniformLocation(program, "baseTexture"), 0);
+  for (const auto& range : s.imageRanges) {
+    const bool has = range.image != kNoImage;
+    glUniform1i(glGetUniformLocation(program, "useTexture"), has ? 1 : 0);
+    if (has) glBindTextureUnit(0, s.textures.texture(range.image));
+    glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT,
+                                reinterpret_cast<const void*>(
+                                    static_cast<std::uintptr_t>(range.first) * sizeof(DrawCommand)),
+                                range.count, 0);
+  }
 }
 
 void Renderer::setCommands(std::span<const std::uint32_t> counts,
@@ -315,6 +369,7 @@ void Renderer::setCommands(std::span<const std::uint32_t> counts,
                              static_cast<GLuint>(3 * triangleStart[i]), 0, static_cast<GLuint>(i)});
   }
   s.commandCount = static_cast<GLsizei>(s.commandList.size());
+  groupByImage(s);
   const auto upload = [&](GLuint target, const auto& span) {
     glNamedBufferSubData(target, 0, static_cast<GLsizeiptr>(span.size_bytes()), span.data());
     s.uploaded += span.size_bytes();
@@ -402,7 +457,13 @@ void Renderer::draw(const Camera& camera, const DrawOptions& options) const {
   glUniform1i(glGetUniformLocation(p, "useVertexNormal"), s.normals ? 1 : 0);
   glBindVertexArray(s.vertexArray);
   glBindBuffer(GL_DRAW_INDIRECT_BUFFER, s.commands);
-  glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, nullptr, s.commandCount, 0);
+  const bool textured = !s.imageRanges.empty() && options.colorMode == ColorMode::kShaded;
+  if (!textured) {
+    glUniform1i(glGetUniformLocation(p, "useTexture"), 0);
+    glMultiDrawElementsIndirect(GL_TRIANGLES, GL_UNSIGNED_INT, nullptr, s.commandCount, 0);
+  } else {
+    drawByImage(s, p);
+  }
   glBindVertexArray(0);
 }
 

@@ -1,7 +1,8 @@
 // Draws the streamed buffer (runtime/stream.h) with OpenGL 4.5: one vertex and one index buffer
 // sized to the stream's capacity, one multi-draw per frame whose commands are the objects'
 // triangle ranges (each command's base instance is the object id, so per-object colour and LOD
-// ratio reach the shaders as instanced attributes), headlight shading. Offscreen rendering goes
+// ratio reach the shaders as instanced attributes), headlight shading. A textured package is
+// drawn one multi-draw per image, with its texture (render/textures.h). Offscreen rendering goes
 // into a Framebuffer and reads back as an Image.
 #pragma once
 
@@ -82,8 +83,9 @@ class Renderer {
   // The GL buffer holding the indices (for the compute-shader reformation).
   unsigned indexBuffer() const;
 
+  struct State;  // (its helpers in renderer.cpp take it)
+
  private:
-  struct State;
   explicit Renderer(std::unique_ptr<State> state);
   std::unique_ptr<State> state_;
   void setCommands(std::span<const std::uint32_t> counts,

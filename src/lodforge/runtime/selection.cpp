@@ -28,6 +28,7 @@ LodScene LodScene::fromPackage(const Package& package, double exponent) {
   scene.maxVertices.resize(n);
   scene.levelOffset.resize(n);
   scene.map = package.allMap().data();
+  if (package.header().hasUvs()) scene.whole = package.allWhole().data();
   tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
     const PackageObject& o = package.object(i);
     scene.cx[i] = 0.5f * (o.boundsMin[0] + o.boundsMax[0]);
@@ -422,6 +423,16 @@ void secondPass(const LodScene& scene, std::uint64_t budget, Selection& out) {
   settle(scene, out.importance, work.order, left, out.vertexCounts);
 }
 
+// A textured object's count rounds down to a whole one (a point's wedges go together): the sum
+// then falls short of N by less than the wedges of one point per textured object.
+void roundDownToWhole(const LodScene& scene, Selection& out) {
+  if (!scene.whole) return;
+  tbb::parallel_for(std::size_t{0}, scene.size(), [&](std::size_t i) {
+    std::uint32_t& v = out.vertexCounts[i];
+    if (v != 0) v = scene.whole[scene.levelOffset[i] + (v - scene.minVertices[i])];
+  });
+}
+
 // tc_i = map(vc_i), looked up only where vc_i changed since the last frame (a few percent of
 // the objects along a smooth path): each lookup is a cache miss in a table of the package's size.
 void lookUpTriangleCounts(const LodScene& scene, Selection& out) {
@@ -477,6 +488,7 @@ void selectTwoPass(const LodScene& scene, const Camera& camera, std::uint64_t bu
   firstPass(scene, budget, options.minT, out);
   out.timings.firstPass = millisecondsSince(clock);
   if (!options.firstPassOnly) secondPass(scene, budget, out);
+  roundDownToWhole(scene, out);
   out.timings.secondPass = millisecondsSince(clock);
   lookUpTriangleCounts(scene, out);
   out.timings.finish = millisecondsSince(clock);

@@ -29,6 +29,8 @@ struct LodScene {
   std::vector<std::uint32_t> minVertices, maxVertices;  // q_i, p_i
   std::vector<std::uint64_t> levelOffset;  // into the package's map: map(n) = map[offset + n - q]
   const std::uint32_t* map = nullptr;      // the package's map section (mmap'd)
+  // A textured package's whole counts (Package::wholeAt), same layout as map; null otherwise.
+  const std::uint32_t* whole = nullptr;
   double exponent = 3.0;
 
   static LodScene fromPackage(const Package& package, double exponent = 3.0);
@@ -65,7 +67,9 @@ struct Selection {
   } workspace;
 };
 
-// The two passes; with options.firstPassOnly, Eq. 2 and Eq. 3 only (the sum is then not N).
+// The two passes; with options.firstPassOnly, Eq. 2 and Eq. 3 only (the sum is then not N). In
+// a textured package each count then rounds down to a whole one (LodScene::whole), so the sum
+// may fall short of N by less than one point's wedges per textured object.
 void selectTwoPass(const LodScene& scene, const Camera& camera, std::uint64_t budget,
                    const SelectionOptions& options, Selection& out);
 

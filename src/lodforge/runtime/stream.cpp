@@ -24,16 +24,18 @@ constexpr std::uint64_t kTriangleBytes = 3 * sizeof(std::uint32_t);
 struct BufferCopy {
   std::unique_ptr<Vec3f[]> positions, normals;
   std::unique_ptr<Rgba8[]> colors;
+  std::unique_ptr<Vec2f[]> uvs;
   std::unique_ptr<std::uint32_t[]> source, indices;
   std::vector<std::uint64_t> vertexStart, triangleStart;  // objects + 1
   std::vector<std::uint32_t> vertexCounts, triangleCounts;
 
   void allocate(std::size_t objects, const StreamCapacity& capacity, bool withNormals,
-                bool withColors) {
+                bool withColors, bool withUvs) {
     // Left uninitialised: only [0, count) is ever read, and it is always written first.
     positions = std::make_unique_for_overwrite<Vec3f[]>(capacity.vertices);
     if (withNormals) normals = std::make_unique_for_overwrite<Vec3f[]>(capacity.vertices);
     if (withColors) colors = std::make_unique_for_overwrite<Rgba8[]>(capacity.vertices);
+    if (withUvs) uvs = std::make_unique_for_overwrite<Vec2f[]>(capacity.vertices);
     source = std::make_unique_for_overwrite<std::uint32_t[]>(3 * capacity.triangles);
     indices = std::make_unique_for_overwrite<std::uint32_t[]>(3 * capacity.triangles);
     vertexStart.assign(objects + 1, 0);
@@ -93,7 +95,8 @@ void reassemble(const std::vector<std::uint64_t>& newStart,
 
 std::uint64_t StreamCapacity::vertexBytes(const Package& package) {
   return sizeof(Vec3f) + (package.header().hasNormals() ? sizeof(Vec3f) : 0) +
-         (package.header().hasColors() ? sizeof(Rgba8) : 0);
+         (package.header().hasColors() ? sizeof(Rgba8) : 0) +
+         (package.header().hasUvs() ? sizeof(Vec2f) : 0);
 }
 
 double StreamCapacity::triangleRatio(const Package& package) {
@@ -155,7 +158,7 @@ StreamBuffer::StreamBuffer(const Package& package, StreamCapacity capacity)
   state_->capacity = capacity;
   for (BufferCopy& copy : state_->copies)
     copy.allocate(package.objectCount(), capacity, package.header().hasNormals(),
-                  package.header().hasColors());
+                  package.header().hasColors(), package.header().hasUvs());
 }
 
 StreamBuffer::StreamBuffer(StreamBuffer&&) noexcept = default;
@@ -257,6 +260,9 @@ void reassembleFrame(const Package& package, const BufferCopy& old, BufferCopy& 
   if (next.colors)
     reassemble(next.vertexStart, old.vertexStart, oldVertexCounts, old.colors.get(),
                package.allColors().data(), vertexOffset, 1, next.colors.get());
+  if (next.uvs)
+    reassemble(next.vertexStart, old.vertexStart, oldVertexCounts, old.uvs.get(),
+               package.allUvs().data(), vertexOffset, 1, next.uvs.get());
   reassemble(next.triangleStart, old.triangleStart,
              std::span<const std::uint32_t>(old.triangleCounts), old.source.get(),
              package.allTriangles().data(), triangleOffset, 3, next.source.get());
@@ -339,6 +345,10 @@ std::span<const Rgba8> StreamBuffer::colors() const {
   const auto& c = state_->current();
   return c.colors ? std::span<const Rgba8>(c.colors.get(), vertexCount())
                   : std::span<const Rgba8>();
+}
+std::span<const Vec2f> StreamBuffer::uvs() const {
+  const auto& c = state_->current();
+  return c.uvs ? std::span<const Vec2f>(c.uvs.get(), vertexCount()) : std::span<const Vec2f>();
 }
 std::span<const std::uint32_t> StreamBuffer::sourceTriangles() const {
   return {state_->current().source.get(), 3 * triangleCount()};

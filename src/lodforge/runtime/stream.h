@@ -4,7 +4,7 @@
 // frame's buffer. The buffer stands for GPU memory; the renderer uploads or maps its arrays.
 //
 // Per object i with vc_i vertices and tc_i = map(vc_i) triangles the buffer holds
-//   vertices      positions (and normals, colors when the package has them) [0, vc_i)
+//   vertices      positions (and normals, colors, uvs when the package has them) [0, vc_i)
 //   source        the first tc_i rearranged triangles, object-local full-detail corners
 //   indices       the same triangles re-formed at vc_i (Algorithm 2), as indices into the
 //                 whole vertex buffer, so one draw call renders the frame
@@ -31,7 +31,7 @@ struct StreamCapacity {
   std::uint64_t vertices = 0;
   std::uint64_t triangles = 0;
 
-  // Bytes per vertex (position, plus normal and color when the package has them).
+  // Bytes per vertex (position, plus normal, color and uv when the package has them).
   static std::uint64_t vertexBytes(const Package& package);
   // max over objects and levels n of map(n) / n.
   static double triangleRatio(const Package& package);
@@ -77,6 +77,7 @@ class StreamBuffer {
   std::span<const Vec3f> positions() const;
   std::span<const Vec3f> normals() const;                  // empty without normals in the package
   std::span<const Rgba8> colors() const;                   // empty without colors
+  std::span<const Vec2f> uvs() const;                      // empty unless textured
   std::span<const std::uint32_t> sourceTriangles() const;  // 3 per triangle, object-local
   std::span<const std::uint32_t> indices() const;          // 3 per triangle, buffer-global
   // Per object: where its vertices and triangles start (object count + 1 entries) and counts.

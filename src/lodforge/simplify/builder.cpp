@@ -52,8 +52,24 @@ Built describe(SourceObject& source) {
   return built;
 }
 
+// A textured object is built over its wedges (prepareTexturedObject): seams slide along
+// themselves and every level's triangles keep one chart each.
+ProgressiveMesh buildTextured(SourceObject& source, ProgressiveOptions options) {
+  PreparedTexturedObject prepared = prepareTexturedObject(
+      source.positions, source.normals, source.colors, source.uvs, source.indices);
+  source = SourceObject{};
+  options.wedges = prepared.wedges;
+  options.wedgeUvs = prepared.uvs;
+  return buildProgressive(prepared.points, prepared.indices, prepared.normals, prepared.colors,
+                          options);
+}
+
 Built buildOne(SourceObject& source, const ProgressiveOptions& options) {
   Built built = describe(source);
+  if (!source.uvs.empty()) {
+    built.mesh = buildTextured(source, options);
+    return built;
+  }
   PreparedObject prepared =
       prepareObject(source.positions, source.normals, source.colors, source.indices);
   source = SourceObject{};  // release the input before the simplifier allocates
@@ -84,7 +100,8 @@ Status readWave(ObjectStream& stream, ShapeCache& shapes, std::uint64_t budget,
       Result<bool> more = stream.next(object.source);
       if (!more) return more.status();
       if (!*more) break;
-      object.shape = shapes.lookup(object.source);
+      // A textured shape placed again would need the same coordinates too: built anew.
+      if (object.source.uvs.empty()) object.shape = shapes.lookup(object.source);
       if (object.shape.placed) {
         object.built = describe(object.source);
         object.source = SourceObject{};
@@ -135,8 +152,8 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
   const std::uint64_t cacheBytes = options.placeRepeatedShapes ? limit / 8 : 0;
   ShapeCache shapes(cacheBytes);
   const std::uint64_t budget = limit - cacheBytes;
-  Result<PackageWriter> writer =
-      PackageWriter::create(output, stream.origin(), true, stream.hasColors());
+  Result<PackageWriter> writer = PackageWriter::create(
+      output, stream.origin(), true, stream.hasColors(), !stream.images().empty());
   if (!writer) return writer.status();
   BuildStats stats;
   stats.streamed = stream.streaming();
@@ -173,7 +190,7 @@ Result<BuildStats> build(const std::string& input, ObjectStream& stream, const s
     return badInput(input,
                     "no triangles: a package is built from a mesh (for a point cloud use "
                     "`lodforge points` or `lodforge tiles`)");
-  LODFORGE_TRY(writer->finish(stream.materials(), stream.layers()));
+  LODFORGE_TRY(writer->finish(stream.materials(), stream.layers(), stream.images()));
   progress.finish();
   Result<std::uint64_t> size = fileSize(output);
   if (!size) return size.status();

@@ -1,6 +1,7 @@
 #include "lodforge/simplify/extract.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include "lodforge/simplify/progressive.h"
@@ -14,7 +15,7 @@ std::vector<std::uint32_t> vertexCountsForRatio(const Package& package, double r
     const PackageObject& o = package.object(i);
     const auto wanted =
         static_cast<std::uint32_t>(std::llround(std::clamp(ratio, 0.0, 1.0) * o.vertexCount));
-    counts[i] = std::clamp(wanted, o.minVertexCount, o.vertexCount);
+    counts[i] = package.wholeAt(i, std::clamp(wanted, o.minVertexCount, o.vertexCount));
   }
   return counts;
 }
@@ -37,6 +38,7 @@ Model extractModel(const Package& package, std::span<const std::uint32_t> vertex
   for (std::size_t i = 0; i < objects; ++i) {
     ids[i] = static_cast<std::uint32_t>(i);
     bases[i] = 0;  // object-local indices: the Model keeps them per object
+    assert(package.wholeAt(i, vertexCounts[i]) == vertexCounts[i]);
     starts[i + 1] = starts[i] + package.trianglesAt(i, vertexCounts[i]);
     vertexTotal += vertexCounts[i];
   }
@@ -46,12 +48,14 @@ Model extractModel(const Package& package, std::span<const std::uint32_t> vertex
     model.materials.push_back(package.material(m));
   for (std::size_t l = 0; l < package.layerCount(); ++l)
     model.layers.emplace_back(package.layer(l));
+  for (std::size_t k = 0; k < package.imageCount(); ++k) model.images.push_back(package.image(k));
   model.indices.resize(3 * starts[objects]);
   reformSelection(ReformSource::of(package), {ids, vertexCounts, starts, bases}, model.indices);
 
   model.positions.reserve(vertexTotal);
   if (package.header().hasNormals()) model.normals.reserve(vertexTotal);
   if (package.header().hasColors()) model.colors.reserve(vertexTotal);
+  if (package.header().hasUvs()) model.uvs.reserve(vertexTotal);
   // The triangles are already in place (object after object); add each object's vertices and
   // its record.
   for (std::size_t i = 0; i < objects; ++i) {
@@ -78,6 +82,10 @@ Model extractModel(const Package& package, std::span<const std::uint32_t> vertex
     if (package.header().hasColors()) {
       const auto colors = package.colors(i).first(n);
       model.colors.insert(model.colors.end(), colors.begin(), colors.end());
+    }
+    if (package.header().hasUvs()) {
+      const auto uvs = package.uvs(i).first(n);
+      model.uvs.insert(model.uvs.end(), uvs.begin(), uvs.end());
     }
     Aabb box;
     for (const Vec3f& p : positions) box.add(p);

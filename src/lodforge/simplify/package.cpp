@@ -18,8 +18,8 @@ namespace lodforge {
 
 std::string_view packageSectionName(PackageSection section) {
   static constexpr std::string_view kNames[] = {
-      "objects", "names", "positions", "normals",   "colors",       "triangles", "ecol",
-      "map",     "error", "assembly",  "materials", "objectLayers", "layers"};
+      "objects", "names",    "positions", "normals",      "colors", "triangles", "ecol",  "map",
+      "error",   "assembly", "materials", "objectLayers", "layers", "uvs",       "whole", "images"};
   return kNames[static_cast<std::uint32_t>(section)];
 }
 
@@ -84,14 +84,15 @@ std::uint64_t PackageWriter::objectCount() const {
 }
 
 Result<PackageWriter> PackageWriter::create(const std::string& path, Vec3d origin, bool normals,
-                                            bool colors) {
+                                            bool colors, bool uvs) {
   auto state = std::make_unique<State>();
   state->path = path;
   state->header.origin[0] = origin.x;
   state->header.origin[1] = origin.y;
   state->header.origin[2] = origin.z;
-  state->header.flags =
-      (normals ? PackageHeader::kHasNormals : 0) | (colors ? PackageHeader::kHasColors : 0);
+  state->header.flags = (normals ? PackageHeader::kHasNormals : 0) |
+                        (colors ? PackageHeader::kHasColors : 0) |
+                        (uvs ? PackageHeader::kHasUvs : 0);
   for (std::uint32_t s = 0; s < kPackageSections; ++s) {
     // Each section is spilled to "<path>.<section>", itself written under a temporary name.
     auto& spill = state->spills[s];
@@ -104,6 +105,59 @@ Result<PackageWriter> PackageWriter::create(const std::string& path, Vec3d origi
   }
   return PackageWriter(std::move(state));
 }
+
+namespace {
+
+// A textured package's per-vertex coordinates and per-level whole counts (zeros and identity
+// for an untextured object).
+Status appendTexture(PackageWriter::State& s, const ProgressiveMesh& mesh, std::size_t levels) {
+  if (!mesh.uvs.empty()) {
+    LODFORGE_TRY(s.append<Vec2f>(PackageSection::kUvs, mesh.uvs));
+  } else {
+    const std::vector<Vec2f> zeros(mesh.vertexCount());
+    LODFORGE_TRY(s.append<Vec2f>(PackageSection::kUvs, zeros));
+  }
+  if (!mesh.whole.empty()) return s.append<std::uint32_t>(PackageSection::kWhole, mesh.whole);
+  std::vector<std::uint32_t> identity(levels);
+  for (std::size_t k = 0; k < levels; ++k) identity[k] = mesh.q + static_cast<std::uint32_t>(k);
+  return s.append<std::uint32_t>(PackageSection::kWhole, identity);
+}
+
+// The images table, then each image's encoded bytes (a file's read now: the package stands
+// alone).
+Status appendImages(PackageWriter::State& s, std::span<const ImageSource> images) {
+  std::vector<std::vector<std::byte>> files(images.size());
+  std::uint64_t at = 0;
+  for (std::size_t k = 0; k < images.size(); ++k) {
+    const ImageSource& image = images[k];
+    if (!image.embedded()) {
+      Result<std::vector<std::byte>> bytes = readFileBytes(image.path);
+      if (!bytes) return bytes.status();
+      files[k] = std::move(*bytes);
+    }
+    const std::size_t size = image.embedded() ? image.bytes.size() : files[k].size();
+    PackageImage record;
+    record.dataOffset = at;
+    record.dataBytes = size;
+    record.nameOffset = s.spills[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
+    record.nameLength = static_cast<std::uint32_t>(image.name.size());
+    record.format = static_cast<std::uint32_t>(image.format);
+    record.width = image.width;
+    record.height = image.height;
+    record.channels = image.channels;
+    LODFORGE_TRY(s.append(PackageSection::kNames, image.name.data(), image.name.size()));
+    LODFORGE_TRY(s.append(PackageSection::kImages, &record, sizeof record));
+    at += size;
+  }
+  for (std::size_t k = 0; k < images.size(); ++k) {
+    const auto& bytes = images[k].embedded() ? images[k].bytes : files[k];
+    LODFORGE_TRY(s.append<std::byte>(PackageSection::kImages, bytes));
+  }
+  s.header.imageCount = static_cast<std::uint32_t>(images.size());
+  return {};
+}
+
+}  // namespace
 
 Status PackageWriter::add(const ProgressiveMesh& mesh, const PackageObjectInfo& info) {
   State& s = *state_;
@@ -149,6 +203,7 @@ Status PackageWriter::add(const ProgressiveMesh& mesh, const PackageObjectInfo& 
   LODFORGE_TRY(s.append<std::uint32_t>(PackageSection::kEcol, mesh.ecol));
   LODFORGE_TRY(s.append<std::uint32_t>(PackageSection::kMap, map));
   LODFORGE_TRY(s.append<float>(PackageSection::kError, error));
+  if (h.hasUvs()) LODFORGE_TRY(appendTexture(s, mesh, map.size()));
   ++h.objectCount;
   h.vertexCount += mesh.vertexCount();
   h.triangleCount += mesh.triangleCount();
@@ -157,7 +212,8 @@ Status PackageWriter::add(const ProgressiveMesh& mesh, const PackageObjectInfo& 
 }
 
 Status PackageWriter::finish(std::span<const Material> materials,
-                             std::span<const std::string> layers) {
+                             std::span<const std::string> layers,
+                             std::span<const ImageSource> images) {
   State& s = *state_;
   PackageHeader& h = s.header;
   for (const Material& m : materials) {
@@ -169,6 +225,9 @@ Status PackageWriter::finish(std::span<const Material> materials,
     record.alphaCutoff = m.alphaCutoff;
     record.alphaMode = static_cast<std::uint32_t>(m.alphaMode);
     record.doubleSided = m.doubleSided ? 1 : 0;
+    record.wrapS = static_cast<std::uint8_t>(m.wrapS);
+    record.wrapT = static_cast<std::uint8_t>(m.wrapT);
+    record.baseColorImage = m.baseColorImage;
     record.nameOffset = s.spills[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
     record.nameLength = static_cast<std::uint32_t>(m.name.size());
     LODFORGE_TRY(s.append(PackageSection::kNames, m.name.data(), m.name.size()));
@@ -180,6 +239,7 @@ Status PackageWriter::finish(std::span<const Material> materials,
     LODFORGE_TRY(s.append(PackageSection::kNames, name.data(), name.size()));
     LODFORGE_TRY(s.append(PackageSection::kLayers, &record, sizeof record));
   }
+  LODFORGE_TRY(appendImages(s, images));
   const Aabb bounds = s.bounds.empty() ? Aabb{Vec3f{}, Vec3f{}} : s.bounds;
   std::memcpy(h.boundsMin, &bounds.min, 12);
   std::memcpy(h.boundsMax, &bounds.max, 12);
@@ -225,6 +285,9 @@ std::span<const Vec3f> Package::allNormals() const {
 std::span<const Rgba8> Package::allColors() const {
   return section<Rgba8>(PackageSection::kColors);
 }
+std::span<const Vec2f> Package::allUvs() const {
+  return section<Vec2f>(PackageSection::kUvs);
+}
 std::span<const std::uint32_t> Package::allTriangles() const {
   return section<std::uint32_t>(PackageSection::kTriangles);
 }
@@ -234,6 +297,9 @@ std::span<const std::uint32_t> Package::allEcol() const {
 
 std::span<const std::uint32_t> Package::allMap() const {
   return section<std::uint32_t>(PackageSection::kMap);
+}
+std::span<const std::uint32_t> Package::allWhole() const {
+  return section<std::uint32_t>(PackageSection::kWhole);
 }
 
 std::string_view Package::objectName(std::size_t i) const {
@@ -278,6 +344,9 @@ Material Package::material(std::size_t m) const {
   material.alphaCutoff = r.alphaCutoff;
   material.alphaMode = static_cast<AlphaMode>(r.alphaMode);
   material.doubleSided = r.doubleSided != 0;
+  material.baseColorImage = r.baseColorImage;
+  material.wrapS = static_cast<TextureWrap>(r.wrapS);
+  material.wrapT = static_cast<TextureWrap>(r.wrapT);
   return material;
 }
 std::span<const Vec3f> Package::positions(std::size_t i) const {
@@ -290,6 +359,31 @@ std::span<const Vec3f> Package::normals(std::size_t i) const {
 std::span<const Rgba8> Package::colors(std::size_t i) const {
   if (!header_->hasColors()) return {};
   return allColors().subspan(object(i).vertexOffset, object(i).vertexCount);
+}
+std::span<const Vec2f> Package::uvs(std::size_t i) const {
+  if (!header_->hasUvs()) return {};
+  return allUvs().subspan(object(i).vertexOffset, object(i).vertexCount);
+}
+std::uint32_t Package::wholeAt(std::size_t i, std::uint32_t n) const {
+  const PackageObject& o = object(i);
+  assert(n >= o.minVertexCount && n <= o.vertexCount);
+  if (!header_->hasUvs()) return n;
+  return section<std::uint32_t>(PackageSection::kWhole)[o.levelOffset + (n - o.minVertexCount)];
+}
+ImageSource Package::image(std::size_t k) const {
+  const auto table = section<PackageImage>(PackageSection::kImages).first(imageCount());
+  const PackageImage& r = table[k];
+  const auto names = section<char>(PackageSection::kNames);
+  const auto data = section<std::byte>(PackageSection::kImages).subspan(table.size_bytes());
+  ImageSource image;
+  image.name.assign(names.data() + r.nameOffset, r.nameLength);
+  const auto bytes = data.subspan(r.dataOffset, r.dataBytes);
+  image.bytes.assign(bytes.begin(), bytes.end());
+  image.format = static_cast<ImageFormat>(r.format);
+  image.width = r.width;
+  image.height = r.height;
+  image.channels = r.channels;
+  return image;
 }
 std::span<const std::uint32_t> Package::triangles(std::size_t i) const {
   return allTriangles().subspan(3 * object(i).triangleOffset,
@@ -343,6 +437,7 @@ Status Package::validate(const OpenOptions& options) {
   LODFORGE_TRY(validateSections(options));
   LODFORGE_TRY(validateMaterials());
   LODFORGE_TRY(validateLayers());
+  LODFORGE_TRY(validateImages());
   return validateObjects();
 }
 
@@ -379,7 +474,8 @@ Status Package::validateSections(const OpenOptions& options) const {
   auto sectionAt = [&](std::uint32_t s) {
     return offsetof(PackageHeader, sections) + s * sizeof(PackageSectionEntry);
   };
-  for (std::uint64_t count : {h.objectCount, h.vertexCount, h.triangleCount, h.levelCount}) {
+  for (std::uint64_t count :
+       {h.objectCount, h.vertexCount, h.triangleCount, h.levelCount, std::uint64_t{h.imageCount}}) {
     if (count > size)
       return badAt(16, "counts larger than the file can hold: the package is corrupted");
   }
@@ -398,7 +494,11 @@ Status Package::validateSections(const OpenOptions& options) const {
           sizeof(PackageMaterial) * sizeof(PackageMaterial),
       h.objectCount * sizeof(std::uint32_t),
       h.sections[static_cast<std::uint32_t>(PackageSection::kLayers)].bytes / sizeof(PackageLayer) *
-          sizeof(PackageLayer)};
+          sizeof(PackageLayer),
+      h.hasUvs() ? h.vertexCount * sizeof(Vec2f) : 0,
+      h.hasUvs() ? h.levelCount * sizeof(std::uint32_t) : 0,
+      std::max<std::uint64_t>(h.sections[static_cast<std::uint32_t>(PackageSection::kImages)].bytes,
+                              std::uint64_t{h.imageCount} * sizeof(PackageImage))};
   for (std::uint32_t s = 0; s < kPackageSections; ++s) {
     const PackageSectionEntry& e = h.sections[s];
     const auto name = packageSectionName(static_cast<PackageSection>(s));
@@ -467,7 +567,7 @@ std::string Package::objectProblem(std::size_t i) const {
     if (!std::isfinite(err[k]) || err[k] < 0 || (k > 0 && err[k] > err[k - 1]))
       return "error table is not finite and non-increasing";
   }
-  return {};
+  return wholeProblem(i);
 }
 
 // Every material's name inside the names section and its fields in their ranges.
@@ -489,11 +589,57 @@ Status Package::validateMaterials() const {
       problem = "alpha mode is not OPAQUE, MASK or BLEND";
     else if (r.doubleSided > 1)
       problem = "doubleSided is neither 0 nor 1";
+    else if (r.wrapS > static_cast<std::uint8_t>(TextureWrap::kClamp) ||
+             r.wrapT > static_cast<std::uint8_t>(TextureWrap::kClamp))
+      problem = "a wrap mode is not REPEAT, MIRRORED_REPEAT or CLAMP_TO_EDGE";
+    else if (r.baseColorImage != kNoImage && r.baseColorImage >= imageCount())
+      problem = "texture image outside the images table";
     else if (!finite)
       problem = "a factor is not finite";
     if (problem)
       return badAt(table.offset + m * sizeof(PackageMaterial),
                    fmt::format("material {}: {}", m, problem));
+  }
+  return {};
+}
+
+// A textured object's whole counts: each in [q, n], itself whole, never decreasing, p whole.
+std::string Package::wholeProblem(std::size_t i) const {
+  if (!header_->hasUvs()) return {};
+  const PackageObject& o = objects()[i];
+  const auto whole = section<std::uint32_t>(PackageSection::kWhole)
+                         .subspan(o.levelOffset, o.vertexCount - o.minVertexCount + 1);
+  for (std::size_t k = 0; k < whole.size(); ++k) {
+    const std::uint32_t n = o.minVertexCount + static_cast<std::uint32_t>(k), w = whole[k];
+    if (w < o.minVertexCount || w > n || whole[w - o.minVertexCount] != w ||
+        (k > 0 && w < whole[k - 1]))
+      return fmt::format("whole count {} at {} vertices", w, n);
+  }
+  if (whole.back() != o.vertexCount) return "the full mesh is not a whole count";
+  return {};
+}
+
+// The images table inside its section, each image's bytes and name inside theirs, a known
+// format.
+Status Package::validateImages() const {
+  const PackageSectionEntry& entry =
+      header_->sections[static_cast<std::uint32_t>(PackageSection::kImages)];
+  const std::uint64_t nameBytes =
+      header_->sections[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
+  const auto table = section<PackageImage>(PackageSection::kImages).first(imageCount());
+  const std::uint64_t dataBytes = entry.bytes - table.size_bytes();
+  for (std::size_t k = 0; k < table.size(); ++k) {
+    const PackageImage& r = table[k];
+    const char* problem = nullptr;
+    if (outside(r.dataOffset, r.dataBytes, dataBytes))
+      problem = "bytes outside the images section";
+    else if (outside(r.nameOffset, r.nameLength, nameBytes))
+      problem = "name outside the names section";
+    else if (r.format == 0 || r.format > static_cast<std::uint32_t>(ImageFormat::kTga))
+      problem = "unknown image format";
+    if (problem)
+      return badAt(entry.offset + k * sizeof(PackageImage),
+                   fmt::format("image {}: {}", k, problem));
   }
   return {};
 }

@@ -17,6 +17,11 @@
 //   materials     PackageMaterial per material the objects use (64 bytes each)
 //   objectLayers  uint32 per object: its CAD layer, into layers, or ~0u
 //   layers        PackageLayer per layer the objects are on (16 bytes each)
+//   uvs           float[2] per vertex (flag bit 2: textured; a textured object's vertices are
+//                 its wedges, ProgressiveMesh::uvs)
+//   whole         uint32 per level (flag bit 2): the largest count <= n that leaves no surface
+//                 point half collapsed (n itself for an untextured object)
+//   images        PackageImage[imageCount], then the images' encoded bytes (JPEG, PNG, ...)
 //
 // Each section carries an XXH3-64 checksum; the header checksums itself. Package::open checks
 // all of it, and every index a kernel will follow, before handing out a single span.
@@ -31,6 +36,7 @@
 #include <string_view>
 
 #include "lodforge/core/file.h"
+#include "lodforge/core/image_source.h"
 #include "lodforge/core/material.h"
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
@@ -52,14 +58,18 @@ enum class PackageSection : std::uint32_t {
   kMaterials,
   kObjectLayers,
   kLayers,
+  kUvs,
+  kWhole,
+  kImages,
   kCount
 };
 inline constexpr std::uint32_t kPackageSections =
     static_cast<std::uint32_t>(PackageSection::kCount);
 std::string_view packageSectionName(PackageSection section);
 
-// Version 2 added the assembly and materials sections, version 3 the layers.
-inline constexpr std::uint32_t kPackageVersion = 3;
+// Version 2 added the assembly and materials sections, version 3 the layers, version 4 textures
+// (uvs, whole counts, images, a material's texture).
+inline constexpr std::uint32_t kPackageVersion = 4;
 inline constexpr std::size_t kPackageAlignment = 64;
 // PNG-style magic: a high byte and CR LF / ^Z / LF catch text-mode transfers that damage files.
 inline constexpr std::array<char, 8> kPackageMagic = {'\x89', 'L',  'F',    'P',
@@ -74,7 +84,7 @@ struct PackageSectionEntry {
 struct PackageHeader {
   std::array<char, 8> magic = kPackageMagic;
   std::uint32_t version = kPackageVersion;
-  std::uint32_t flags = 0;  // bit 0: normals, bit 1: colors
+  std::uint32_t flags = 0;  // bit 0: normals, bit 1: colors, bit 2: uvs (textured)
   std::uint64_t objectCount = 0;
   std::uint64_t vertexCount = 0;
   std::uint64_t triangleCount = 0;
@@ -83,14 +93,15 @@ struct PackageHeader {
   float boundsMin[3] = {0, 0, 0};
   float boundsMax[3] = {0, 0, 0};
   std::uint32_t sectionCount = kPackageSections;
-  std::uint32_t reserved = 0;
+  std::uint32_t imageCount = 0;  // entries of the images section's table
   PackageSectionEntry sections[kPackageSections];
   std::uint8_t padding[512 - 104 - kPackageSections * sizeof(PackageSectionEntry) - 8] = {};
   std::uint64_t headerChecksum = 0;  // XXH3-64 of the 504 bytes before it
 
-  static constexpr std::uint32_t kHasNormals = 1, kHasColors = 2;
+  static constexpr std::uint32_t kHasNormals = 1, kHasColors = 2, kHasUvs = 4;
   bool hasNormals() const { return (flags & kHasNormals) != 0; }
   bool hasColors() const { return (flags & kHasColors) != 0; }
+  bool hasUvs() const { return (flags & kHasUvs) != 0; }
 };
 static_assert(sizeof(PackageHeader) == 512);
 
@@ -127,12 +138,26 @@ struct PackageMaterial {
   float roughness = 0.5f;
   float alphaCutoff = 0.5f;
   std::uint32_t alphaMode = 0;  // AlphaMode
-  std::uint32_t doubleSided = 0;
+  std::uint8_t doubleSided = 0;
+  std::uint8_t wrapS = 0, wrapT = 0;  // TextureWrap
+  std::uint8_t reserved = 0;
   std::uint64_t nameOffset = 0;  // into names
   std::uint32_t nameLength = 0;
-  std::uint32_t reserved = 0;
+  std::uint32_t baseColorImage = kNoImage;  // into the images table
 };
 static_assert(sizeof(PackageMaterial) == 64);
+
+// A texture image as stored: its encoded bytes in the images section after the table.
+struct PackageImage {
+  std::uint64_t dataOffset = 0;  // from the end of the table
+  std::uint64_t dataBytes = 0;
+  std::uint64_t nameOffset = 0;  // into names
+  std::uint32_t nameLength = 0;
+  std::uint32_t format = 0;  // ImageFormat
+  std::uint32_t width = 0, height = 0, channels = 0;
+  std::uint32_t reserved = 0;
+};
+static_assert(sizeof(PackageImage) == 48);
 
 // A CAD layer's name as stored.
 struct PackageLayer {
@@ -155,19 +180,24 @@ struct PackageObjectInfo {
 // joined under a temporary name and renamed. Memory does not grow with the number of objects.
 class PackageWriter {
  public:
+  // `uvs`: a textured package (objects may then carry ProgressiveMesh::uvs and whole).
   static Result<PackageWriter> create(const std::string& path, Vec3d origin, bool normals,
-                                      bool colors);
+                                      bool colors, bool uvs = false);
   PackageWriter(PackageWriter&&) noexcept;
   PackageWriter& operator=(PackageWriter&&) noexcept;
   ~PackageWriter();
 
   Status add(const ProgressiveMesh& mesh, const PackageObjectInfo& info);
-  // `materials` and `layers` are what the objects' material and layer indices refer to.
-  Status finish(std::span<const Material> materials = {}, std::span<const std::string> layers = {});
+  // `materials` and `layers` are what the objects' material and layer indices refer to, `images`
+  // what the materials' textures refer to (a file's bytes are read here and stored).
+  Status finish(std::span<const Material> materials = {}, std::span<const std::string> layers = {},
+                std::span<const ImageSource> images = {});
   std::uint64_t objectCount() const;
 
+ public:
+  struct State;  // (its helpers in package.cpp take it)
+
  private:
-  struct State;
   explicit PackageWriter(std::unique_ptr<State> state);
   std::unique_ptr<State> state_;
 };
@@ -205,8 +235,15 @@ class Package {
   std::string_view layer(std::size_t l) const;
   Material material(std::size_t m) const;
   std::span<const Vec3f> positions(std::size_t i) const;
-  std::span<const Vec3f> normals(std::size_t i) const;            // empty without normals
-  std::span<const Rgba8> colors(std::size_t i) const;             // empty without colors
+  std::span<const Vec3f> normals(std::size_t i) const;  // empty without normals
+  std::span<const Rgba8> colors(std::size_t i) const;   // empty without colors
+  std::span<const Vec2f> uvs(std::size_t i) const;      // empty unless textured
+  // The largest count <= n (q <= n <= p) that leaves no point half collapsed: the count to
+  // re-form at (n itself in an untextured package).
+  std::uint32_t wholeAt(std::size_t i, std::uint32_t n) const;
+  std::size_t imageCount() const { return header_->imageCount; }
+  // Image k with its encoded bytes embedded (name, format, size as stored).
+  ImageSource image(std::size_t k) const;
   std::span<const std::uint32_t> triangles(std::size_t i) const;  // 3 x triangleCount
   std::span<const std::uint32_t> ecol(std::size_t i) const;
   std::span<const std::uint32_t> map(std::size_t i) const;  // p - q + 1
@@ -218,9 +255,11 @@ class Package {
   std::span<const Vec3f> allPositions() const;
   std::span<const Vec3f> allNormals() const;
   std::span<const Rgba8> allColors() const;
+  std::span<const Vec2f> allUvs() const;
   std::span<const std::uint32_t> allTriangles() const;
   std::span<const std::uint32_t> allEcol() const;
-  std::span<const std::uint32_t> allMap() const;  // every object's map, at its levelOffset
+  std::span<const std::uint32_t> allMap() const;    // every object's map, at its levelOffset
+  std::span<const std::uint32_t> allWhole() const;  // likewise; empty unless textured
   std::uint64_t sectionBytes(PackageSection section) const {
     return header_->sections[static_cast<std::uint32_t>(section)].bytes;
   }
@@ -234,8 +273,10 @@ class Package {
   // What breaks object i's invariants (ranges inside the sections, ECol chains, corners, Map and
   // the error table), empty when nothing does.
   std::string objectProblem(std::size_t i) const;
+  std::string wholeProblem(std::size_t i) const;
   Status validateMaterials() const;
   Status validateLayers() const;
+  Status validateImages() const;
   Status badAt(std::uint64_t at, std::string_view what) const;
   template <class T>
   std::span<const T> section(PackageSection s) const;

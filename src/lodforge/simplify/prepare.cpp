@@ -63,4 +63,86 @@ PreparedObject prepareObject(std::span<const Vec3f> positions, std::span<const V
   return out;
 }
 
+namespace {
+
+// The wedges: input vertices welded where position, coordinates, normal and colour all agree.
+struct Wedges {
+  std::vector<std::uint32_t> remap;  // input vertex -> wedge
+  std::uint32_t count = 0;
+};
+
+Wedges weldWedges(std::span<const Vec3f> positions, std::span<const Vec3f> normals,
+                  std::span<const Rgba8> colors, std::span<const Vec2f> uvs) {
+  Wedges w;
+  w.remap.resize(positions.size());
+  w.count = weldVertices(positions, normals, colors,
+                         {.keepNormalSplits = !normals.empty(),
+                          .normalAngleDegrees = 0.5f,
+                          .keepColorSplits = !colors.empty()},
+                         w.remap, uvs);
+  return w;
+}
+
+template <class T>
+std::vector<T> gather(std::span<const T> in, std::span<const std::uint32_t> remap,
+                      std::uint32_t count) {
+  std::vector<T> out(count);
+  for (std::size_t v = 0; v < remap.size(); ++v)
+    if (remap[v] != ~0u) out[remap[v]] = in[v];
+  return out;
+}
+
+}  // namespace
+
+PreparedTexturedObject prepareTexturedObject(std::span<const Vec3f> positions,
+                                             std::span<const Vec3f> normals,
+                                             std::span<const Rgba8> colors,
+                                             std::span<const Vec2f> uvs,
+                                             std::span<const std::uint32_t> indices) {
+  assert(uvs.size() == positions.size());
+  PreparedTexturedObject out;
+  // Points: bit-identical positions welded, whatever their attributes.
+  std::vector<std::uint32_t> pointOf(positions.size());
+  const std::uint32_t pointCount = weldVertices(positions, {}, {}, WeldOptions{}, pointOf);
+  const Wedges wedges = weldWedges(positions, normals, colors, uvs);
+  // Triangles over points, corners naming wedges; those with a repeated point have no area.
+  std::vector<std::uint32_t> wedgeIndices(indices.begin(), indices.end());
+  remapIndices(wedgeIndices, wedges.remap);
+  std::vector<std::uint32_t> wedgePoint(wedges.count);
+  for (std::size_t v = 0; v < positions.size(); ++v) wedgePoint[wedges.remap[v]] = pointOf[v];
+  for (std::size_t t = 0; t < wedgeIndices.size(); t += 3) {
+    const std::uint32_t a = wedgePoint[wedgeIndices[t]], b = wedgePoint[wedgeIndices[t + 1]],
+                        c = wedgePoint[wedgeIndices[t + 2]];
+    if (a == b || b == c || a == c) continue;
+    out.indices.insert(out.indices.end(), {a, b, c});
+    out.wedges.insert(out.wedges.end(), wedgeIndices.begin() + static_cast<std::ptrdiff_t>(t),
+                      wedgeIndices.begin() + static_cast<std::ptrdiff_t>(t + 3));
+  }
+  // Only what the triangles use, points and wedges each in order of first index.
+  std::vector<std::uint32_t> keepPoint(pointCount), keepWedge(wedges.count);
+  const std::uint32_t points = findReferencedVertices(pointCount, out.indices, keepPoint);
+  const std::uint32_t kept = findReferencedVertices(wedges.count, out.wedges, keepWedge);
+  std::vector<Vec3f> pointPositions(pointCount);
+  remapVertexAttribute(positions, pointOf, std::span(pointPositions));
+  out.points.resize(points);
+  compactVertexAttribute<Vec3f>(pointPositions, keepPoint, out.points);
+  remapIndices(out.indices, keepPoint);
+  remapIndices(out.wedges, keepWedge);
+  std::vector<std::uint32_t> inputToWedge(positions.size());
+  for (std::size_t v = 0; v < positions.size(); ++v) inputToWedge[v] = keepWedge[wedges.remap[v]];
+  out.uvs = gather(uvs, inputToWedge, kept);
+  if (!colors.empty()) out.colors = gather(colors, inputToWedge, kept);
+  if (!normals.empty()) {
+    out.normals = gather(normals, inputToWedge, kept);
+    for (Vec3f& n : out.normals) n = normalizeOr(n, Vec3f{0, 0, 1});
+  } else {
+    std::vector<Vec3f> pointNormals(points);
+    computeVertexNormals(out.points, out.indices, pointNormals);
+    out.normals.resize(kept);
+    for (std::size_t c = 0; c < out.wedges.size(); ++c)
+      out.normals[out.wedges[c]] = pointNormals[out.indices[c]];
+  }
+  return out;
+}
+
 }  // namespace lodforge

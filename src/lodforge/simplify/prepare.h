@@ -28,4 +28,24 @@ PreparedObject prepareObject(std::span<const Vec3f> positions, std::span<const V
                              std::span<const Rgba8> colors, std::span<const std::uint32_t> indices,
                              const PrepareOptions& options = {});
 
+// A textured object as buildProgressive takes it with ProgressiveOptions::wedges: its surface
+// (a point per position, triangles without a repeated point) with each corner's wedge, and the
+// wedges (the input's vertices that differ in position, coordinates, normal or colour, unused
+// ones dropped) with their attributes. Normals: the input's, or per point area-weighted and
+// shared by its wedges, so shading stays smooth across a texture seam.
+struct PreparedTexturedObject {
+  std::vector<Vec3f> points;
+  std::vector<std::uint32_t> indices;  // over points
+  std::vector<std::uint32_t> wedges;   // per corner of `indices`
+  std::vector<Vec2f> uvs;              // per wedge
+  std::vector<Vec3f> normals;          // per wedge
+  std::vector<Rgba8> colors;           // per wedge, or empty
+};
+
+PreparedTexturedObject prepareTexturedObject(std::span<const Vec3f> positions,
+                                             std::span<const Vec3f> normals,
+                                             std::span<const Rgba8> colors,
+                                             std::span<const Vec2f> uvs,
+                                             std::span<const std::uint32_t> indices);
+
 }  // namespace lodforge

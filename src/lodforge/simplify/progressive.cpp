@@ -132,7 +132,11 @@ class Simplifier {
   void computeUvQuadrics();
   void collapseAll();
   ProgressiveMesh rearrange(std::span<const Vec3f> normals, std::span<const Rgba8> colors) const;
+  ProgressiveMesh rearrangeWedges(std::span<const Vec3f> normals,
+                                  std::span<const Rgba8> colors) const;
+  void wedgeLevels(std::span<const std::uint32_t> groupStart, ProgressiveMesh& mesh) const;
   SimplifiedMesh current() const;
+  std::vector<std::uint32_t> triangleOrder() const;
 
  private:
   // The neighbours of a collapse's two ends (each once, the ends left out), as valid() found
@@ -249,6 +253,7 @@ class Simplifier {
   std::vector<UvQuadric> uvQuadrics_;
   std::vector<double> uvSelfCost_;
   WedgeMap wedgeMap_;
+  std::vector<std::uint32_t> wedgeTarget_;  // per wedge: the wedge it went to (kNone: none yet)
 };
 
 void Simplifier::classifyBoundary() {
@@ -387,6 +392,7 @@ void Simplifier::computeUvQuadrics() {
     for (std::uint32_t wedge : w) uvQuadrics_[wedge] += q;
   }
   uvSelfCost_.assign(wedgeCount, 0.0);
+  wedgeTarget_.assign(wedgeCount, kNone);
   for (std::uint32_t t = 0; t < triangleCount_; ++t) {
     for (std::size_t k = 0; k < 3; ++k) {
       const std::uint32_t wedge = wedgeCorners_[t][k];
@@ -466,6 +472,7 @@ void Simplifier::moveWedges(std::uint32_t from, std::uint32_t to) {
   }
   const Vec3d p = position(to);
   for (const auto& [wf, wt] : wedgeMap_.pairs()) {
+    wedgeTarget_[wf] = wt;
     uvQuadrics_[wt] += uvQuadrics_[wf];
     uvSelfCost_[wt] = uvQuadrics_[wt].evaluate(p, options_.wedgeUvs[wt]);
   }
@@ -918,9 +925,22 @@ void Simplifier::collapseAll() {
   }
 }
 
+// PermuteT: surviving triangles first, then the removed ones, latest removal first.
+std::vector<std::uint32_t> Simplifier::triangleOrder() const {
+  std::vector<std::uint32_t> order(triangleCount_, kNone);
+  std::uint32_t next = 0;
+  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
+    if (alive(t)) order[t] = next++;
+  }
+  const auto removedCount = static_cast<std::uint32_t>(removedTriangles_.size());
+  for (std::uint32_t r = 0; r < removedCount; ++r)
+    order[removedTriangles_[r]] = triangleCount_ - 1 - r;
+  return order;
+}
+
 ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
                                       std::span<const Rgba8> colors) const {
-  assert(!textured());  // progressive meshes carry one attribute set per vertex
+  assert(!textured());  // rearrangeWedges
   ProgressiveMesh mesh;
   const auto collapses = static_cast<std::uint32_t>(collapsed_.size());
   mesh.q = vertexCount_ - collapses;
@@ -932,15 +952,7 @@ ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
     if (!vertex_[v].removed) mesh.permuteV[v] = next++;
   }
   for (std::uint32_t k = 0; k < collapses; ++k) mesh.permuteV[collapsed_[k]] = vertexCount_ - 1 - k;
-  // PermuteT: surviving triangles first, then the removed ones, latest removal first.
-  mesh.permuteT.assign(triangleCount_, kNone);
-  next = 0;
-  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
-    if (alive(t)) mesh.permuteT[t] = next++;
-  }
-  const auto removedCount = static_cast<std::uint32_t>(removedTriangles_.size());
-  for (std::uint32_t r = 0; r < removedCount; ++r)
-    mesh.permuteT[removedTriangles_[r]] = triangleCount_ - 1 - r;
+  mesh.permuteT = triangleOrder();
 
   // Algorithm 1: ECol'[permuteV(i)] = permuteV(ecol(i)); V'[permuteV(i)] = V[i]; T'[permuteT(i)] =
   // T[i].
@@ -972,6 +984,111 @@ ProgressiveMesh Simplifier::rearrange(std::span<const Vec3f> normals,
     mesh.error[collapses - 1 - k] = errorAfter_[k];
   }
   return mesh;
+}
+
+// The wedges of each point, in wedge order, from the corners (a wedge no corner names has no
+// point and is left out).
+struct PointWedges {
+  std::vector<std::uint32_t> pointOf;  // per wedge, kNone when unused
+  std::vector<std::uint32_t> first;    // per point + 1: where its wedges start in `wedges`
+  std::vector<std::uint32_t> wedges;
+  std::span<const std::uint32_t> of(std::uint32_t v) const {
+    return std::span(wedges).subspan(first[v], first[v + 1] - first[v]);
+  }
+};
+
+PointWedges groupWedges(std::span<const std::uint32_t> indices,
+                        std::span<const std::uint32_t> cornerWedges, std::uint32_t points,
+                        std::uint32_t wedgeCount) {
+  PointWedges g;
+  g.pointOf.assign(wedgeCount, kNone);
+  for (std::size_t c = 0; c < indices.size(); ++c) g.pointOf[cornerWedges[c]] = indices[c];
+  g.first.assign(points + 1, 0);
+  for (std::uint32_t w = 0; w < wedgeCount; ++w)
+    if (g.pointOf[w] != kNone) ++g.first[g.pointOf[w] + 1];
+  for (std::uint32_t v = 0; v < points; ++v) g.first[v + 1] += g.first[v];
+  g.wedges.resize(g.first.back());
+  std::vector<std::uint32_t> next(g.first.begin(), g.first.end() - 1);
+  for (std::uint32_t w = 0; w < wedgeCount; ++w)
+    if (g.pointOf[w] != kNone) g.wedges[next[g.pointOf[w]]++] = w;
+  return g;
+}
+
+// A textured mesh's progressive mesh is over its wedges: each wedge is a vertex with its point's
+// position and its own coordinates, and a surface vertex's wedges leave together, latest
+// collapse first, each into the wedge of its target that it was mapped to. So re-formation
+// (Algorithm 2) works unchanged, and a count that leaves a vertex half collapsed is not whole.
+ProgressiveMesh Simplifier::rearrangeWedges(std::span<const Vec3f> normals,
+                                            std::span<const Rgba8> colors) const {
+  const std::span<const Vec2f> uv = options_.wedgeUvs;
+  const auto wedgeCount = static_cast<std::uint32_t>(uv.size());
+  assert(normals.empty() || normals.size() == wedgeCount);
+  assert(colors.empty() || colors.size() == wedgeCount);
+  const PointWedges g = groupWedges(indices_, options_.wedges, vertexCount_, wedgeCount);
+  ProgressiveMesh mesh;
+  // PermuteV over wedges: those of points that never collapse first, then each collapsed
+  // point's wedges together, the last collapse first.
+  mesh.permuteV.assign(wedgeCount, kNone);
+  std::uint32_t next = 0;
+  for (std::uint32_t v = 0; v < vertexCount_; ++v)
+    if (!vertex_[v].removed)
+      for (std::uint32_t w : g.of(v)) mesh.permuteV[w] = next++;
+  mesh.q = next;
+  std::vector<std::uint32_t> groupStart(collapsed_.size());
+  for (std::size_t k = collapsed_.size(); k-- > 0;) {
+    groupStart[k] = next;
+    for (std::uint32_t w : g.of(collapsed_[k])) mesh.permuteV[w] = next++;
+  }
+  const auto p = static_cast<std::uint32_t>(g.wedges.size());
+  assert(next == p);
+  mesh.permuteT = triangleOrder();
+  mesh.positions.resize(p);
+  mesh.uvs.resize(p);
+  mesh.ecol.resize(p);
+  if (!normals.empty()) mesh.normals.resize(p);
+  if (!colors.empty()) mesh.colors.resize(p);
+  for (std::uint32_t w = 0; w < wedgeCount; ++w) {
+    const std::uint32_t to = mesh.permuteV[w], v = g.pointOf[w];
+    if (to == kNone) continue;  // a wedge no triangle uses
+    mesh.positions[to] = positions_[v];
+    mesh.uvs[to] = uv[w];
+    if (!normals.empty()) mesh.normals[to] = normals[w];
+    if (!colors.empty()) mesh.colors[to] = colors[w];
+    // A wedge no live triangle used when its point went (mapWedges left it out) goes to any
+    // wedge of the target: no triangle that is drawn names it then.
+    const std::uint32_t target = !vertex_[v].removed        ? w
+                                 : wedgeTarget_[w] != kNone ? wedgeTarget_[w]
+                                                            : g.of(target_[v]).front();
+    mesh.ecol[to] = mesh.permuteV[target];
+    assert(!vertex_[v].removed || mesh.ecol[to] < to);
+  }
+  mesh.triangles.resize(3 * std::size_t{triangleCount_});
+  for (std::uint32_t t = 0; t < triangleCount_; ++t) {
+    for (std::size_t k = 0; k < 3; ++k)
+      mesh.triangles[3 * std::size_t{mesh.permuteT[t]} + k] =
+          mesh.permuteV[options_.wedges[3 * t + k]];
+  }
+  wedgeLevels(groupStart, mesh);
+  return mesh;
+}
+
+// Map, error and the whole count at every n in [q, p]: a count inside a point's group of wedges
+// is the mesh after that point's collapse, as far as map and error tell.
+void Simplifier::wedgeLevels(std::span<const std::uint32_t> groupStart,
+                             ProgressiveMesh& mesh) const {
+  const std::uint32_t p = mesh.vertexCount(), levels = p - mesh.q + 1;
+  mesh.map.assign(levels, triangleCount_);
+  mesh.error.assign(levels, 0.0f);
+  mesh.whole.resize(levels);
+  mesh.whole[levels - 1] = p;
+  for (std::size_t k = 0; k < groupStart.size(); ++k) {
+    const std::uint32_t end = k == 0 ? p : groupStart[k - 1];
+    for (std::uint32_t n = groupStart[k]; n < end; ++n) {
+      mesh.map[n - mesh.q] = trianglesAfter_[k];
+      mesh.error[n - mesh.q] = errorAfter_[k];
+      mesh.whole[n - mesh.q] = groupStart[k];
+    }
+  }
 }
 
 // The mesh as the collapses left it: live triangles (corners are kept re-formed), vertices in
@@ -1014,7 +1131,8 @@ ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
   simplifier.classifyBoundary();
   simplifier.computeQuadrics();
   simplifier.collapseAll();
-  return simplifier.rearrange(normals, colors);
+  return options.wedges.empty() ? simplifier.rearrange(normals, colors)
+                                : simplifier.rearrangeWedges(normals, colors);
 }
 
 SimplifiedMesh simplifyMesh(std::span<const Vec3f> positions,

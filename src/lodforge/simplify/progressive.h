@@ -67,8 +67,16 @@ struct ProgressiveMesh {
   // Geometric error of the mesh at n vertices, model units: error[n - q], non-increasing in n,
   // error[p - q] = 0 (the monotone maximum of the per-collapse errors, see docs/simplify.md).
   std::vector<float> error;
-  // The permutations of Algorithm 1: original index -> rearranged index.
+  // The permutations of Algorithm 1: original index -> rearranged index (of a wedge when
+  // textured; ~0u for a wedge no triangle uses).
   std::vector<std::uint32_t> permuteV, permuteT;
+  // Textured meshes (ProgressiveOptions::wedges): the vertices are the wedges, each with its
+  // point's position and its own texture coordinates `uvs` (p), and a point's wedges leave
+  // together. whole[n - q] is the largest count <= n that leaves no point half collapsed
+  // (between, a count re-forms with cracks; map and error there are the whole count's). Both
+  // empty otherwise: every count is whole.
+  std::vector<Vec2f> uvs;
+  std::vector<std::uint32_t> whole;
 
   std::uint32_t vertexCount() const { return static_cast<std::uint32_t>(positions.size()); }
   std::uint32_t triangleCount() const { return static_cast<std::uint32_t>(triangles.size() / 3); }
@@ -76,6 +84,7 @@ struct ProgressiveMesh {
   float errorAt(std::uint32_t n) const { return error[n - q]; }
   // The fewest vertices whose error is at most `error` (q if every level qualifies).
   std::uint32_t vertexCountForError(float error) const;
+  std::uint32_t wholeAt(std::uint32_t n) const { return whole.empty() ? n : whole[n - q]; }
 };
 
 // An error table is non-increasing in the vertex count (entry i belongs to `fewest + i`
@@ -86,7 +95,9 @@ std::uint32_t vertexCountForError(std::span<const float> error, std::uint32_t fe
 
 // Builds the progressive mesh of one object. Expects a welded, indexed mesh without repeated
 // corners in a triangle and without unreferenced vertices (prepareObject in prepare.h does
-// that). `normals` and `colors` may be empty; they are carried along with their vertex.
+// that). `normals` and `colors` may be empty; they are carried along with their vertex. With
+// `options.wedges` (prepareTexturedObject) the result is over the wedges, and `normals` and
+// `colors` are per wedge (as options.wedgeUvs).
 ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
                                  std::span<const std::uint32_t> indices,
                                  std::span<const Vec3f> normals, std::span<const Rgba8> colors,

@@ -26,6 +26,13 @@ class ModelStream final : public ObjectStream {
     out.positions.assign(positions.begin(), positions.end());
     out.normals.clear();
     out.colors.clear();
+    out.uvs.clear();
+    const bool textured =
+        r.material != kNoMaterial && model_.materials[r.material].baseColorImage != kNoImage;
+    if (textured)
+      out.uvs.assign(
+          model_.uvs.begin() + static_cast<std::ptrdiff_t>(r.vertexOffset),
+          model_.uvs.begin() + static_cast<std::ptrdiff_t>(r.vertexOffset + r.vertexCount));
     if (model_.hasNormals())
       out.normals.assign(
           model_.normals.begin() + static_cast<std::ptrdiff_t>(r.vertexOffset),
@@ -45,6 +52,7 @@ class ModelStream final : public ObjectStream {
   std::uint64_t triangleCountHint() const override { return model_.triangleCount(); }
   std::span<const Material> materials() const override { return model_.materials; }
   std::span<const std::string> layers() const override { return model_.layers; }
+  std::span<const ImageSource> images() const override { return model_.images; }
 
  private:
   Model model_;
@@ -110,6 +118,7 @@ class GroupedPlyStream final : public ObjectStream {
                          positions_.begin() + static_cast<std::ptrdiff_t>(to));
     out.normals.clear();
     out.colors.clear();
+    out.uvs.clear();
     if (!normals_.empty())
       out.normals.assign(normals_.begin() + static_cast<std::ptrdiff_t>(from),
                          normals_.begin() + static_cast<std::ptrdiff_t>(to));
@@ -216,12 +225,6 @@ Result<std::unique_ptr<ObjectStream>> openObjectStream(const std::string& path,
   }
   Result<Model> model = readModel(path, options.read);
   if (!model) return model.status();
-  // Progressive packages hold geometry and colours only.
-  if (!model->images.empty() && options.read.warnings)
-    options.read.warnings->push_back(
-        fmt::format("{}: its {} texture image(s) are left out: progressive packages do not carry "
-                    "textures yet (`tiles` and `convert` to GLB, OBJ or PLY keep them)",
-                    path, model->images.size()));
   return std::unique_ptr<ObjectStream>(new ModelStream(std::move(model.value())));
 }
 

@@ -25,11 +25,12 @@ struct SourceObject {
   std::vector<Vec3f> positions;          // relative to the stream's origin
   std::vector<Vec3f> normals;            // empty or one per vertex
   std::vector<Rgba8> colors;             // empty or one per vertex
+  std::vector<Vec2f> uvs;                // empty or one per vertex (a textured material's)
   std::vector<std::uint32_t> indices;    // local
 
   std::uint64_t memoryBytes() const {
-    return positions.size() * 12 + normals.size() * 12 + colors.size() * 4 + indices.size() * 4 +
-           name.size() + path.size();
+    return positions.size() * 12 + normals.size() * 12 + colors.size() * 4 + uvs.size() * 8 +
+           indices.size() * 4 + name.size() + path.size();
   }
 };
 
@@ -48,6 +49,8 @@ class ObjectStream {
   virtual std::span<const Material> materials() const { return {}; }
   // What the objects' layer indices refer to (CAD layers; empty for a grouped PLY).
   virtual std::span<const std::string> layers() const { return {}; }
+  // What the materials' textures refer to (Material::baseColorImage), still encoded.
+  virtual std::span<const ImageSource> images() const { return {}; }
 };
 
 struct ObjectStreamOptions {

@@ -1125,8 +1125,11 @@ ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
                                  std::span<const Vec3f> normals, std::span<const Rgba8> colors,
                                  const ProgressiveOptions& options) {
   assert(indices.size() % 3 == 0);
-  assert(normals.empty() || normals.size() == positions.size());
-  assert(colors.empty() || colors.size() == positions.size());
+  // Attributes are per vertex, or per wedge for a textured mesh.
+  [[maybe_unused]] const std::size_t attributes =
+      options.wedges.empty() ? positions.size() : options.wedgeUvs.size();
+  assert(normals.empty() || normals.size() == attributes);
+  assert(colors.empty() || colors.size() == attributes);
   Simplifier simplifier(positions, indices, options);
   simplifier.classifyBoundary();
   simplifier.computeQuadrics();

@@ -18,6 +18,17 @@ echo
 echo "== kernels (Google Benchmark)"
 [[ -n ${BENCH_ONLY:-} ]] || build/release/bench/bench_kernels --benchmark_min_time=0.5
 
+timed() {  # command...; prints "seconds peak-KiB" from /usr/bin/time -v
+  local log=$work/time.log
+  /usr/bin/time -v "$@" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
+  seconds_and_kib "$log"
+}
+seconds_and_kib() {  # a /usr/bin/time -v log; prints "seconds peak-KiB"
+  local wall
+  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$1")
+  echo "$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")" \
+    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$1")"
+}
 measure() {  # name, then the command; prints a table row and removes the output file (the last argument)
   local name=$1; shift
   local log=$work/time.log
@@ -71,9 +82,16 @@ render_section() {
   done
   "$lodforge" -q build "$data/meshes/horse.ply" -o "$work/horse.lfp"
   packages+=("$work/horse.lfp@orbit")
+  # A textured scan (issue 36): 2 M triangles, 16 atlases of 4K, drawn with its textures.
+  mkdir -p "$work/texscan"
+  "$lodforge" -q generate scan --triangles 2M --texture 4K --atlases 16 -o "$work/texscan/scan.ply"
+  local built
+  built=$(timed "$lodforge" -q build "$work/texscan/scan.ply" -o "$work/texscan.lfp")
+  echo "textured build (2 M triangles, 16 x 4K): ${built% *} s, $((${built#* } / 1024)) MiB peak, package $(du -h "$work/texscan.lfp" | cut -f1)"
+  packages+=("$work/texscan.lfp@orbit")
   build/release/bench/bench_render --pictures "$work/pictures" "${packages[@]}"
   echo "(side-by-side pictures at 5 %: $work/pictures)"
-  rm -f "$work/cad2k.ply"
+  rm -rf "$work/cad2k.ply" "$work/texscan"
 }
 if [[ ${BENCH_ONLY:-} == render ]]; then render_section; exit 0; fi
 
@@ -251,17 +269,6 @@ if [[ ${BENCH_ONLY:-} == laz ]]; then laz_section; exit 0; fi
 # e.g. a LASzip-based compressor). POTREE_SIZES (default "1M 20M") picks the clouds, kept in
 # the bench folder as cloud-N.las/.laz for the next run; POTREE_RUNS (default 3) runs of each
 # tool alternate and the median wall time is shown (this machine is shared and noisy).
-timed() {  # command...; prints "seconds peak-KiB" from /usr/bin/time -v
-  local log=$work/time.log
-  /usr/bin/time -v "$@" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
-  seconds_and_kib "$log"
-}
-seconds_and_kib() {  # a /usr/bin/time -v log; prints "seconds peak-KiB"
-  local wall
-  wall=$(sed -n 's/.*Elapsed (wall clock) time (h:mm:ss or m:ss): //p' "$1")
-  echo "$(awk -F: '{ s = 0; for (i = 1; i <= NF; ++i) s = s * 60 + $i; print s }' <<< "$wall")" \
-    "$(sed -n 's/.*Maximum resident set size (kbytes): //p' "$1")"
-}
 potree_once() {  # tool, input; prints "seconds peak-KiB output-size"
   local tool=$1 input=$2 out=$work/potree-out
   rm -rf "$out"

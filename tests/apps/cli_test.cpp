@@ -488,6 +488,12 @@ TEST(CliPackage, ATexturedModelKeepsItsTexturesThroughBuildExtractAndRender) {
   ASSERT_EQ(o.code, 0) << o.err;
   EXPECT_TRUE(std::filesystem::exists(dir.file("half/spider.mtl")));
   EXPECT_EQ(info(dir.file("half/spider.obj"), dir)["textures"]["images"].size(), 4u);
+  // A textured PLY of several objects (object_id per face) is read whole, textures and all.
+  o = lodforge("extract " + package + " --ratio 0.5 -o " + dir.file("ply/spider.ply"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  o = lodforge("build " + dir.file("ply/spider.ply") + " -o " + dir.file("again.lfp"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(info(dir.file("again.lfp"), dir)["textures"]["images"].size(), 4u);
   o = lodforge(
       "render " + package + " --frames 1 --size 160x120 --budget 50% -o " + dir.file("frames"),
       dir);

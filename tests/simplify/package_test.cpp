@@ -280,6 +280,7 @@ TEST(Package, ATexturedModelKeepsItsWedgesMaterialsAndImages) {
   }
   // Each object's full level holds exactly the input's (position, coordinates) pairs.
   ASSERT_EQ(package->objectCount(), spider->objectCount());
+  std::size_t partial = 0;
   for (std::size_t o = 0; o < spider->objectCount(); ++o) {
     std::set<std::array<float, 5>> given, stored;
     const ObjectRecord& r = spider->objects[o];
@@ -294,11 +295,12 @@ TEST(Package, ATexturedModelKeepsItsWedgesMaterialsAndImages) {
       stored.insert({p.x, p.y, p.z, uv.x, uv.y});
     }
     EXPECT_EQ(stored, given) << spider->objectName(o);
-    // Whole counts: the full mesh and the coarsest, and never above the count asked for.
+    // Some counts are not whole: seam points have several wedges, which leave together.
     const PackageObject& object = package->object(o);
-    EXPECT_EQ(package->wholeAt(o, object.vertexCount), object.vertexCount);
-    EXPECT_EQ(package->wholeAt(o, object.minVertexCount), object.minVertexCount);
+    for (std::uint32_t n = object.minVertexCount; n <= object.vertexCount; ++n)
+      partial += package->wholeAt(o, n) != n ? 1u : 0u;
   }
+  EXPECT_GT(partial, 0u);
 }
 
 TEST_F(Corrupted, ATexturedPackagesWholeCountsImagesAndTexturesAreChecked) {
@@ -309,7 +311,41 @@ TEST_F(Corrupted, ATexturedPackagesWholeCountsImagesAndTexturesAreChecked) {
   const auto at = [&](PackageSection s) {
     return h.sections[static_cast<std::uint32_t>(s)].offset;
   };
+  // The first object's whole table (any package's), and an object with a count that is not
+  // whole (a seam point's wedges), and where that count sits in the table.
+  const auto* objects =
+      reinterpret_cast<const PackageObject*>(bytes.data() + at(PackageSection::kObjects));
+  const auto* whole =
+      reinterpret_cast<const std::uint32_t*>(bytes.data() + at(PackageSection::kWhole));
+  const auto levelsOf = [](const PackageObject& o) { return o.vertexCount - o.minVertexCount + 1; };
+  const std::uint32_t levels = levelsOf(objects[0]), q = objects[0].minVertexCount;
+  ASSERT_GE(levels, 3u);
+  std::size_t seamed = 0, inside = 0;  // the object, and its first count that is not whole
+  for (; seamed < h.objectCount; ++seamed) {
+    const PackageObject& o = objects[seamed];
+    for (inside = 0; inside < levelsOf(o); ++inside)
+      if (whole[o.levelOffset + inside] != o.minVertexCount + inside) break;
+    if (inside < levelsOf(o)) break;
+  }
+  ASSERT_LT(seamed, h.objectCount) << "some object should have a count that is not whole";
+  const std::string seamedObject = fmt::format("object {}: whole count", seamed);
+  const auto wholeAt = [&](std::string& d) {
+    return reinterpret_cast<std::uint32_t*>(d.data() + at(PackageSection::kWhole));
+  };
   const Case cases[] = {
+      // (The full mesh is whole, so `inside + 1` is a level of the same object.)
+      {"a count pointing at one that is not whole",
+       [&](std::string& d) {
+         const PackageObject& o = objects[seamed];
+         wholeAt(d)[o.levelOffset + inside + 1] =
+             o.minVertexCount + static_cast<std::uint32_t>(inside);
+       },
+       seamedObject.c_str()},
+      {"whole counts decreasing", [&](std::string& d) { wholeAt(d)[1] = q + 1, wholeAt(d)[2] = q; },
+       "object 0: whole count"},
+      {"the full mesh not whole",
+       [&](std::string& d) { wholeAt(d)[levels - 1] = wholeAt(d)[levels - 2]; },
+       "object 0: the full mesh is not a whole count"},
       {"a whole count above its level",
        [&](std::string& d) {
          const auto& o =

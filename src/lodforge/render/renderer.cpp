@@ -168,7 +168,8 @@ void main() {
   }
   // A headlight, two-sided: CAD parts are often open shells.
   float diffuse = abs(dot(n, normalize(eye - worldPosition)));
-  vec3 albedo = useTexture ? texture(baseTexture, texcoord).rgb : baseColor.rgb;
+  // As glTF: the texel times the vertex colour (baseColor is the vertex or object colour).
+  vec3 albedo = useTexture ? texture(baseTexture, texcoord).rgb * baseColor.rgb : baseColor.rgb;
   fragColor = vec4(albedo * (0.3 + 0.7 * diffuse), 1.0);
 }
 )";
@@ -353,6 +354,7 @@ void drawByImage(const Renderer::State& s, GLuint program) {
                                     static_cast<std::uintptr_t>(range.first) * sizeof(DrawCommand)),
                                 range.count, 0);
   }
+  glBindTextureUnit(0, 0);
 }
 
 void Renderer::setCommands(std::span<const std::uint32_t> counts,

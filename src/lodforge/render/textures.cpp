@@ -74,6 +74,7 @@ unsigned makeTexture(const Image& image, const Material& material, std::uint64_t
   glTextureSubImage2D(texture, 0, 0, 0, static_cast<GLsizei>(image.width),
                       static_cast<GLsizei>(image.height), GL_RGBA, GL_UNSIGNED_BYTE,
                       image.rgba.data());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);  // GL's default, for whoever uploads next
   glGenerateTextureMipmap(texture);
   glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
   glTextureParameteri(texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);

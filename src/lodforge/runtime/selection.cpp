@@ -517,6 +517,7 @@ void selectByError(const LodScene& scene, const Camera& camera, double pixels, S
   out.firstPassVertices = 0;
   out.visibleObjects = static_cast<std::uint64_t>(
       std::count_if(out.importance.begin(), out.importance.end(), [](float w) { return w > 0; }));
+  roundDownToWhole(scene, out);
   out.timings.firstPass = millisecondsSince(clock);
   out.timings.secondPass = 0;
   lookUpTriangleCounts(scene, out);

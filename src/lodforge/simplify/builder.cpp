@@ -33,10 +33,13 @@ struct Built {
   std::uint64_t inputTriangles = 0;
 };
 
-// Memory one object needs while it is built: the source, the prepared copy, the simplifier.
+// Memory one object needs while it is built: the source, the prepared copy, the simplifier;
+// a textured one also a texture quadric, cost and target per wedge (at most one per vertex)
+// and a wedge per triangle corner.
 std::uint64_t footprint(const SourceObject& object) {
   const std::uint64_t vertices = object.positions.size(), triangles = object.indices.size() / 3;
-  return 2 * object.memoryBytes() + progressiveBuildBytes(vertices, triangles);
+  const std::uint64_t wedges = object.uvs.empty() ? 0 : vertices * 192 + triangles * 24;
+  return 2 * object.memoryBytes() + progressiveBuildBytes(vertices, triangles) + wedges;
 }
 
 // What the package says of an object besides its mesh; the object keeps its arrays.

@@ -23,7 +23,10 @@ std::vector<std::uint32_t> vertexCountsForRatio(const Package& package, double r
 std::vector<std::uint32_t> vertexCountsForError(const Package& package, double error) {
   std::vector<std::uint32_t> counts(package.objectCount());
   for (std::size_t i = 0; i < counts.size(); ++i) {
-    counts[i] = vertexCountForError(package.error(i), package.object(i).minVertexCount, error);
+    // Whole already in a package lodforge wrote (the error is flat between whole counts); a
+    // forged table is rounded down all the same.
+    counts[i] = package.wholeAt(
+        i, vertexCountForError(package.error(i), package.object(i).minVertexCount, error));
   }
   return counts;
 }

@@ -123,22 +123,23 @@ Status appendTexture(PackageWriter::State& s, const ProgressiveMesh& mesh, std::
   return s.append<std::uint32_t>(PackageSection::kWhole, identity);
 }
 
-// The images table, then each image's encoded bytes (a file's read now: the package stands
-// alone).
+// The images table, then each image's encoded bytes (a file's read now, one at a time: the
+// package stands alone, and 16 atlases of 8K never sit in memory together).
 Status appendImages(PackageWriter::State& s, std::span<const ImageSource> images) {
-  std::vector<std::vector<std::byte>> files(images.size());
+  std::vector<std::uint64_t> sizes(images.size());
   std::uint64_t at = 0;
   for (std::size_t k = 0; k < images.size(); ++k) {
     const ImageSource& image = images[k];
-    if (!image.embedded()) {
-      Result<std::vector<std::byte>> bytes = readFileBytes(image.path);
-      if (!bytes) return bytes.status();
-      files[k] = std::move(*bytes);
+    if (image.embedded()) {
+      sizes[k] = image.bytes.size();
+    } else {
+      Result<std::uint64_t> size = fileSize(image.path);
+      if (!size) return size.status();
+      sizes[k] = *size;
     }
-    const std::size_t size = image.embedded() ? image.bytes.size() : files[k].size();
     PackageImage record;
     record.dataOffset = at;
-    record.dataBytes = size;
+    record.dataBytes = sizes[k];
     record.nameOffset = s.spills[static_cast<std::uint32_t>(PackageSection::kNames)].bytes;
     record.nameLength = static_cast<std::uint32_t>(image.name.size());
     record.format = static_cast<std::uint32_t>(image.format);
@@ -147,11 +148,18 @@ Status appendImages(PackageWriter::State& s, std::span<const ImageSource> images
     record.channels = image.channels;
     LODFORGE_TRY(s.append(PackageSection::kNames, image.name.data(), image.name.size()));
     LODFORGE_TRY(s.append(PackageSection::kImages, &record, sizeof record));
-    at += size;
+    at += sizes[k];
   }
   for (std::size_t k = 0; k < images.size(); ++k) {
-    const auto& bytes = images[k].embedded() ? images[k].bytes : files[k];
-    LODFORGE_TRY(s.append<std::byte>(PackageSection::kImages, bytes));
+    if (images[k].embedded()) {
+      LODFORGE_TRY(s.append<std::byte>(PackageSection::kImages, images[k].bytes));
+      continue;
+    }
+    Result<std::vector<std::byte>> bytes = readFileBytes(images[k].path);
+    if (!bytes) return bytes.status();
+    if (bytes->size() != sizes[k])
+      return ioError(images[k].path, "changed size while the package was written");
+    LODFORGE_TRY(s.append<std::byte>(PackageSection::kImages, *bytes));
   }
   s.header.imageCount = static_cast<std::uint32_t>(images.size());
   return {};
@@ -164,6 +172,8 @@ Status PackageWriter::add(const ProgressiveMesh& mesh, const PackageObjectInfo& 
   PackageHeader& h = s.header;
   assert(mesh.normals.empty() != h.hasNormals() || mesh.vertexCount() == 0);
   assert(mesh.colors.empty() != h.hasColors() || mesh.vertexCount() == 0);
+  // A textured mesh's partial counts must stay undrawable: its whole counts need the section.
+  assert((mesh.uvs.empty() && mesh.whole.empty()) || h.hasUvs());
   PackageObject record;
   record.vertexOffset = h.vertexCount;
   record.triangleOffset = h.triangleCount;
@@ -395,12 +405,12 @@ std::span<const std::uint32_t> Package::ecol(std::size_t i) const {
 std::span<const std::uint32_t> Package::map(std::size_t i) const {
   const PackageObject& o = object(i);
   return section<std::uint32_t>(PackageSection::kMap)
-      .subspan(o.levelOffset, o.vertexCount - o.minVertexCount + 1);
+      .subspan(o.levelOffset, std::uint64_t{o.vertexCount} - o.minVertexCount + 1);
 }
 std::span<const float> Package::error(std::size_t i) const {
   const PackageObject& o = object(i);
   return section<float>(PackageSection::kError)
-      .subspan(o.levelOffset, o.vertexCount - o.minVertexCount + 1);
+      .subspan(o.levelOffset, std::uint64_t{o.vertexCount} - o.minVertexCount + 1);
 }
 std::uint32_t Package::trianglesAt(std::size_t i, std::uint32_t n) const {
   const PackageObject& o = object(i);
@@ -607,8 +617,8 @@ Status Package::validateMaterials() const {
 std::string Package::wholeProblem(std::size_t i) const {
   if (!header_->hasUvs()) return {};
   const PackageObject& o = objects()[i];
-  const auto whole = section<std::uint32_t>(PackageSection::kWhole)
-                         .subspan(o.levelOffset, o.vertexCount - o.minVertexCount + 1);
+  const std::uint64_t levels = std::uint64_t{o.vertexCount} - o.minVertexCount + 1;
+  const auto whole = section<std::uint32_t>(PackageSection::kWhole).subspan(o.levelOffset, levels);
   for (std::size_t k = 0; k < whole.size(); ++k) {
     const std::uint32_t n = o.minVertexCount + static_cast<std::uint32_t>(k), w = whole[k];
     if (w < o.minVertexCount || w > n || whole[w - o.minVertexCount] != w ||

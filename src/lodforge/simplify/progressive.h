@@ -41,7 +41,7 @@ struct ProgressiveOptions {
   // has it: boundary vertices never move. Vertices where a boundary meets itself or a
   // non-manifold edge, and `locked` ones, stay put either way.
   bool collapseBorders = false;
-  // Textured meshes (simplifyMesh only): positions are then one vertex per point of the surface,
+  // Textured meshes: positions are then one vertex per point of the surface,
   // and `wedges` gives each index's wedge (the vertex of the textured mesh it came from: its
   // texture coordinates `wedgeUvs`, material and the rest). A collapse maps each wedge of the
   // vertex that goes to the wedge of its target on the same triangles, so every triangle keeps

@@ -18,6 +18,8 @@ ProgressiveMesh levelsOf(const ProgressiveMesh& mesh) {
   ProgressiveMesh levels;
   levels.q = mesh.q;
   levels.colors = mesh.colors;
+  levels.uvs = mesh.uvs;
+  levels.whole = mesh.whole;
   levels.triangles = mesh.triangles;
   levels.ecol = mesh.ecol;
   levels.map = mesh.map;

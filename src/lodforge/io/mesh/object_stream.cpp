@@ -27,8 +27,8 @@ class ModelStream final : public ObjectStream {
     out.normals.clear();
     out.colors.clear();
     out.uvs.clear();
-    const bool textured =
-        r.material != kNoMaterial && model_.materials[r.material].baseColorImage != kNoImage;
+    const bool textured = model_.hasUvs() && r.material != kNoMaterial &&
+                          model_.materials[r.material].baseColorImage != kNoImage;
     if (textured)
       out.uvs.assign(
           model_.uvs.begin() + static_cast<std::ptrdiff_t>(r.vertexOffset),
@@ -221,7 +221,10 @@ Result<std::unique_ptr<ObjectStream>> openObjectStream(const std::string& path,
   if (!options.load && formatFromPath(path) == FileFormat::kPly) {
     Result<PlyReader> probe = PlyReader::open(path);
     if (!probe) return probe.status();
-    if (probe->header().hasObjectIds) return GroupedPlyStream::open(path, options.read);
+    // A textured PLY is read whole (its images and per-corner coordinates come with the model).
+    const PlyHeader& header = probe->header();
+    const bool textured = header.hasUvs || header.hasFaceUvs || !header.textureFiles.empty();
+    if (header.hasObjectIds && !textured) return GroupedPlyStream::open(path, options.read);
   }
   Result<Model> model = readModel(path, options.read);
   if (!model) return model.status();

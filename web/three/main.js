@@ -311,6 +311,21 @@ function main() {
     }
     return corners;
   };
+  // For pictures: the camera `distance` above the surface point under the middle of the model
+  // (found by a ray straight down), looking down on it; false when the ray meets nothing.
+  report.lookDownOnMiddle = (distance) => {
+    const sphere = new THREE.Sphere();
+    if (!tiles.getBoundingSphere(sphere)) return false;
+    sphere.applyMatrix4(tiles.group.matrixWorld);
+    const top = sphere.center.clone().add(new THREE.Vector3(0, sphere.radius * 2, 0));
+    const hit = new THREE.Raycaster(top, new THREE.Vector3(0, -1, 0)).intersectObject(tiles.group, true)[0];
+    if (!hit) return false;
+    controls.target.copy(hit.point);
+    // A hair off vertical: the orbit controls need a view direction apart from their up.
+    camera.position.copy(hit.point).add(new THREE.Vector3(0, distance, distance * 1e-3));
+    controls.update();
+    return true;
+  };
   tiles.addEventListener('load-model', (e) => {
     report.tilesLoaded += 1;
     e.scene.traverse((o) => { if (o.isPoints) preparePoints(o); });

@@ -455,13 +455,18 @@ double uvArea(Vec2f a, Vec2f b, Vec2f c) {
   return (double(b.x) - a.x) * (double(c.y) - a.y) - (double(c.x) - a.x) * (double(b.y) - a.y);
 }
 
-TEST(SimplifyMesh, TexturedSeamsSlideAlongThemselvesAndEveryTriangleKeepsOneChart) {
-  // Three charts: the left half, and the right half cut in two (a T where the seams meet).
+// Three charts on an n x n grid of the unit square: the left half, and the right half cut in
+// two (a T where the seams meet), each mapped the right way round.
+TexturedGrid threeChartGrid(int n) {
   const auto chartOf = [](double x, double y) { return x < 0.5 ? 0u : y < 0.5 ? 1u : 2u; };
   const auto uvOf = [](std::uint32_t chart, Vec3f p) {
     return Vec2f{0.3f * p.x + 0.3f * float(chart), 0.5f * p.y};
   };
-  const TexturedGrid grid = texturedGrid(24, chartOf, uvOf);
+  return texturedGrid(n, chartOf, uvOf);
+}
+
+TEST(SimplifyMesh, TexturedSeamsSlideAlongThemselvesAndEveryTriangleKeepsOneChart) {
+  const TexturedGrid grid = threeChartGrid(24);
   ProgressiveOptions options;
   options.wedges = grid.wedges;
   options.wedgeUvs = grid.uvs;
@@ -506,11 +511,7 @@ TEST(SimplifyMesh, TexturedSeamsSlideAlongThemselvesAndEveryTriangleKeepsOneChar
 }
 
 TEST(ProgressiveMesh, TexturedLevelsKeepOneChartPerTriangleAndNoCrackAtEveryWholeCount) {
-  const auto chartOf = [](double x, double y) { return x < 0.5 ? 0u : y < 0.5 ? 1u : 2u; };
-  const auto uvOf = [](std::uint32_t chart, Vec3f p) {
-    return Vec2f{0.3f * p.x + 0.3f * float(chart), 0.5f * p.y};
-  };
-  const TexturedGrid grid = texturedGrid(16, chartOf, uvOf);
+  const TexturedGrid grid = threeChartGrid(16);
   ProgressiveOptions options;
   options.wedges = grid.wedges;
   options.wedgeUvs = grid.uvs;

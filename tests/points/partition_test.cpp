@@ -35,13 +35,10 @@ std::vector<Vec3d> writeCloud(const std::string& path, std::size_t n, std::uint6
 }
 
 std::vector<CloudPoint> readBlock(const PointBlock& block) {
-  std::vector<CloudPoint> points(block.count);
-  std::ifstream in(block.path, std::ios::binary);
-  in.seekg(static_cast<std::streamoff>(block.first * sizeof(CloudPoint)));
-  in.read(reinterpret_cast<char*>(points.data()),
-          static_cast<std::streamsize>(points.size() * sizeof(CloudPoint)));
-  EXPECT_TRUE(in.good());
-  return points;
+  Result<std::vector<CloudPoint>> points =
+      readPointRecords(block.path, block.layout, block.first, block.count);
+  EXPECT_TRUE(points.ok()) << points.error().message;
+  return points.ok() ? std::move(*points) : std::vector<CloudPoint>{};
 }
 
 using Multiset = std::map<std::tuple<double, double, double>, int>;
@@ -395,7 +392,8 @@ TEST(Partition, KeepsTheLidarAttributesOfLasAndLaz) {
     EXPECT_EQ(partition->info.attributes & kAttrNir, 0u);
     std::uint64_t ground = 0, withTime = 0;
     for (const PointBlock& block : partition->blocks) {
-      Result<std::vector<CloudPoint>> points = readPointRecords(block.path, 0, block.count);
+      Result<std::vector<CloudPoint>> points =
+          readPointRecords(block.path, block.layout, block.first, block.count);
       ASSERT_TRUE(points.ok());
       for (const CloudPoint& p : *points) {
         ground += p.attributes.classification == 2;

@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 namespace {
 
 Result<std::vector<CloudPoint>> loadBlock(const PointBlock& block) {
-  return readPointRecords(block.path, block.first, block.count);
+  return readPointRecords(block.path, block.layout, block.first, block.count);
 }
 
 // The automatic tolerance: the median over sample blocks of the one that keeps `share` of a

@@ -47,15 +47,37 @@ Vec3d centroidOf(const Vec3d& sum, std::uint64_t count) {
   return sum * (1.0 / static_cast<double>(std::max<std::uint64_t>(1, count)));
 }
 
-constexpr std::uint64_t at(std::uint64_t record) {
-  return record * sizeof(CloudPoint);
-}
-
-// The work files: the points and, when the input has extra fields, their bytes in step.
+// The work files: the points (records of `layout`) and, when the input has extra fields, their
+// bytes in step.
 struct WorkFiles {
   const WorkFile& points;
+  const PointRecordLayout& layout;
   const WorkFile* extras = nullptr;
   std::size_t stride = 0;  // extra bytes a point
+
+  std::uint64_t at(std::uint64_t record) const { return record * layout.bytes(); }
+  // Records [first, first + out.size()) into `out`, a slice at a time through `scratch`.
+  Status readPoints(std::uint64_t first, std::span<CloudPoint> out,
+                    std::vector<std::byte>& scratch) const {
+    for (std::size_t done = 0; done < out.size(); done += kSlice) {
+      const std::size_t n = std::min(kSlice, out.size() - done);
+      scratch.resize(n * layout.bytes());
+      LODFORGE_TRY(points.readAt(at(first + done), scratch.data(), scratch.size()));
+      layout.decode(scratch.data(), out.subspan(done, n));
+    }
+    return {};
+  }
+  Status writePoints(std::uint64_t first, std::span<const CloudPoint> in,
+                     std::vector<std::byte>& scratch) const {
+    for (std::size_t done = 0; done < in.size(); done += kSlice) {
+      const std::size_t n = std::min(kSlice, in.size() - done);
+      scratch.resize(n * layout.bytes());
+      LODFORGE_TRY(layout.encode(in.subspan(done, n), scratch.data()));
+      LODFORGE_TRY(points.writeAt(at(first + done), scratch.data(), scratch.size()));
+    }
+    return {};
+  }
+  static constexpr std::size_t kSlice = std::size_t{1} << 14;
 };
 
 // Consecutive records in memory: the points and, in step, their extra bytes.
@@ -63,6 +85,7 @@ struct Records {
   std::size_t stride = 0;
   std::vector<CloudPoint> points;
   std::vector<std::byte> extras;
+  std::vector<std::byte> scratch;  // encoded records on their way to or from the file
 
   std::size_t size() const { return points.size(); }
   void resize(std::size_t n) {
@@ -78,13 +101,13 @@ struct Records {
   // n records from record `first` of the files.
   Status read(const WorkFiles& files, std::uint64_t first, std::size_t n) {
     resize(n);
-    LODFORGE_TRY(files.points.readAt(at(first), points.data(), n * sizeof(CloudPoint)));
+    LODFORGE_TRY(files.readPoints(first, points, scratch));
     if (stride == 0) return {};
     return files.extras->readAt(first * stride, extras.data(), n * stride);
   }
   // Records [from, from + n) to record `first` of the files.
-  Status write(const WorkFiles& files, std::uint64_t first, std::size_t from, std::size_t n) const {
-    LODFORGE_TRY(files.points.writeAt(at(first), points.data() + from, n * sizeof(CloudPoint)));
+  Status write(const WorkFiles& files, std::uint64_t first, std::size_t from, std::size_t n) {
+    LODFORGE_TRY(files.writePoints(first, std::span(points).subspan(from, n), scratch));
     if (stride == 0) return {};
     return files.extras->writeAt(first * stride, extras.data() + from * stride, n * stride);
   }
@@ -119,12 +142,13 @@ Status convertBatch(const std::string& input, const PartitionOptions& options, P
 // Pass 0: the input into the work files, with its bounds and centroid.
 Result<PartNode> readInput(const std::string& input, const std::string& path,
                            const std::string& extrasPath, const PartitionOptions& options,
-                           Partition& partition) {
+                           Partition& partition, PointRecordLayout& layout) {
   PointCloudInfo& info = partition.info;
   Result<PointReader> reader = PointReader::open(
       input, {.salvageTruncated = options.salvageTruncated, .readExtras = options.carryExtras});
   if (!reader) return reader.status();
   info = reader->info();
+  layout = PointRecordLayout::of(info, static_cast<bool>(options.transform), options.keepNormals);
   const std::size_t stride = info.extras.stride;
   Result<OutputFile> out = OutputFile::create(path, std::size_t{1} << 20);
   if (!out) return out.status();
@@ -138,7 +162,7 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
   PointBatch batch;
   // Each batch is written (a kernel copy into new pages, as costly as the parsing) while the
   // next is converted: two buffers, one write in flight, awaited on every way out.
-  std::array<Records, 2> records{Records{stride, {}, {}}, Records{stride, {}, {}}};
+  std::array<Records, 2> records{Records{stride, {}, {}, {}}, Records{stride, {}, {}, {}}};
   Status written;
   tbb::task_group writing;
   struct Await {
@@ -154,9 +178,11 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
     LODFORGE_TRY(convertBatch(input, options, batch, stride, mine, stats));
     writing.wait();
     LODFORGE_TRY(written);
-    writing.run([&out, &extrasOut, &written, &mine] {
+    writing.run([&out, &extrasOut, &written, &mine, &layout] {
       try {  // nothing may escape into the waiting destructor
-        written = out->writeSpan(std::span<const CloudPoint>(mine.points));
+        mine.scratch.resize(mine.points.size() * layout.bytes());
+        written = layout.encode(mine.points, mine.scratch.data());
+        if (written.ok()) written = out->writeSpan(std::span<const std::byte>(mine.scratch));
         if (written.ok() && extrasOut)
           written = extrasOut->writeSpan(std::span<const std::byte>(mine.extras));
       } catch (const std::exception& e) {
@@ -188,7 +214,7 @@ Result<std::array<PartNode, 2>> splitInPlace(const PartNode& node, const WorkFil
   const std::uint64_t begin = node.first, end = node.first + node.count;
   std::uint64_t front = begin, back = end;  // not read yet: [front, back)
   std::uint64_t low = begin, high = end;    // written: below in [begin, low), above in [high, end)
-  Records chunk{files.stride, {}, {}};
+  Records chunk{files.stride, {}, {}, {}};
   std::array<Records, 2> waiting{chunk, chunk};  // below, above
   std::array<Stats, 2> stats;
   // Writes what fits into space already read: below after `low`, above before `high`.
@@ -262,7 +288,8 @@ Status finishBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids, P
                    const InMemory& shared) {
   if (shared.options.blockSink && !cancelRequested())
     LODFORGE_TRY(shared.options.blockSink(points, ids, block));
-  LODFORGE_TRY(shared.files.points.writeAt(at(block.first), points.data(), points.size_bytes()));
+  std::vector<std::byte> scratch;
+  LODFORGE_TRY(shared.files.writePoints(block.first, points, scratch));
   const std::size_t stride = shared.files.stride;
   if (stride == 0) return {};
   std::vector<std::byte> extras(points.size() * stride);
@@ -281,6 +308,7 @@ void splitInMemory(std::span<CloudPoint> points, std::span<std::uint32_t> ids, s
     PointBlock block;
     block.name = name;
     block.path = shared.files.points.path();
+    block.layout = shared.files.layout;
     block.first = first;
     block.count = points.size();
     block.bounds = stats.bounds;
@@ -399,14 +427,16 @@ std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
   return count;
 }
 
-Result<std::vector<CloudPoint>> readPointRecords(const std::string& path, std::uint64_t first,
-                                                 std::uint64_t count) {
+Result<std::vector<CloudPoint>> readPointRecords(const std::string& path,
+                                                 const PointRecordLayout& layout,
+                                                 std::uint64_t first, std::uint64_t count) {
   Result<ByteSource> in = ByteSource::openFile(path);
   if (!in) return in.status();
   std::vector<CloudPoint> points(count);
-  if (!in->skip(first * sizeof(CloudPoint)) ||
-      !in->read(points.data(), points.size() * sizeof(CloudPoint)))
+  std::vector<std::byte> bytes(count * layout.bytes());
+  if (!in->skip(first * layout.bytes()) || !in->read(bytes.data(), bytes.size()))
     return ioError(path, "work file is shorter than expected");
+  layout.decode(bytes.data(), points);
   return points;
 }
 
@@ -425,7 +455,8 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
   Partition partition;
   const std::string path = options.workDirectory + "/b.points";
   const std::string extrasPath = options.workDirectory + "/b.extras";
-  Result<PartNode> root = readInput(input, path, extrasPath, options, partition);
+  PointRecordLayout layout;
+  Result<PartNode> root = readInput(input, path, extrasPath, options, partition, layout);
   if (!root) return root.status();
   partition.pointCount = root->count;
   partition.bounds = root->bounds;
@@ -439,7 +470,7 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
     if (!opened) return opened.status();
     extrasFile.emplace(std::move(*opened));
   }
-  const WorkFiles files{*file, extrasFile ? &*extrasFile : nullptr, stride};
+  const WorkFiles files{*file, layout, extrasFile ? &*extrasFile : nullptr, stride};
   // A point in memory: its record, and with extras their bytes twice (read, gathered) and an id.
   const std::uint64_t pointBytes = sizeof(CloudPoint) + (stride == 0 ? 0 : 2 * stride + 4);
   // Ids are 32-bit: no node is split in memory with more points than they count.
@@ -453,7 +484,7 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
   Blocks blocks;
   Progress progress("points: partition", partition.pointCount);
   // One buffer for the biggest node (growing it node by node would hold two at once).
-  Records records{stride, {}, {}};
+  Records records{stride, {}, {}, {}};
   std::vector<std::uint32_t> ids;
   std::uint64_t biggest = 0;
   for (const PartNode& node : *nodes) biggest = std::max(biggest, node.count);

@@ -15,23 +15,14 @@
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
 #include "lodforge/io/points/point_reader.h"
+#include "lodforge/points/point_record.h"
 
 namespace lodforge {
-
-// One point in the work files (64 bytes): double position, normal (zero when the input has
-// none), colour (white when it has none), lidar attributes (zero when it has none). Extra fields
-// travel in a second work file, moved in step.
-struct CloudPoint {
-  Vec3d position;
-  Vec3f normal;
-  Rgba8 color;
-  PointAttributes attributes;
-};
-static_assert(sizeof(CloudPoint) == 64);
 
 struct PointBlock {
   std::string name;  // its path in the split tree: "b", then "0" (lower side) or "1" per split
   std::string path;  // the work file that holds its CloudPoint records, from `first` on
+  PointRecordLayout layout;  // of those records
   std::uint64_t first = 0;
   std::uint64_t count = 0;
   Aabbd bounds;
@@ -48,6 +39,9 @@ struct PartitionOptions {
   // Carry the input's extra fields (LAS extra bytes, other PLY properties) in a second work file;
   // without, they are not read.
   bool carryExtras = false;
+  // The block sink sets normals (a cloud without any gets them by PCA): keep them in the work
+  // file even when the input has none.
+  bool keepNormals = false;
   // Applied to every point as it is read (one thread): e.g. a CRS to a local frame. False
   // refuses the point.
   std::function<bool(Vec3d, Vec3d&)> transform;
@@ -85,8 +79,9 @@ std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
                         std::span<std::uint32_t> ids = {});
 
 // Records [first, first + count) of a work file of CloudPoints (a block's, say).
-Result<std::vector<CloudPoint>> readPointRecords(const std::string& path, std::uint64_t first,
-                                                 std::uint64_t count);
+Result<std::vector<CloudPoint>> readPointRecords(const std::string& path,
+                                                 const PointRecordLayout& layout,
+                                                 std::uint64_t first, std::uint64_t count);
 // The same records' extra bytes from the extras work file.
 Result<std::vector<std::byte>> readExtraRecords(const std::string& path, std::uint32_t stride,
                                                 std::uint64_t first, std::uint64_t count);

@@ -60,6 +60,7 @@ std::vector<ClusterNode> tileErrorTree(std::vector<ClusterNode> tree) {
 // prefix of the sorted block whatever the τ turn out to be.
 struct BlockTiles {
   std::string path, keysPath;  // the partition's work file (from `first` on), the keys
+  PointRecordLayout layout;    // of the work file's records
   std::uint64_t first = 0;
   std::vector<std::uint64_t> counts;  // per depth 0..depthOf(block), once the τ are known
   Aabbd bounds;
@@ -96,6 +97,7 @@ Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
     sortedKeys[i] = key[from];
   }
   out.path = block.path;
+  out.layout = block.layout;
   out.first = block.first;
   out.keysPath = workDirectory + "/" + block.name + ".keys";
   out.bounds = block.bounds;
@@ -216,7 +218,8 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
     const auto d = static_cast<std::size_t>(node.depth);
     std::uint64_t first = block.first;
     for (std::size_t k = 0; k < d; ++k) first += block.counts[k];
-    Result<std::vector<CloudPoint>> section = readPointRecords(block.path, first, block.counts[d]);
+    Result<std::vector<CloudPoint>> section =
+        readPointRecords(block.path, block.layout, first, block.counts[d]);
     if (!section) return section.status();
     points.insert(points.end(), section->begin(), section->end());
     if (!extras) continue;
@@ -419,6 +422,7 @@ Result<RankedPartition> partitionAndRank(const std::string& input, const PointTi
   partitionOptions.workDirectory = workDirectory;
   partitionOptions.salvageTruncated = options.salvageTruncated;
   partitionOptions.carryExtras = (options.attributes & kAttrExtras) != 0;
+  partitionOptions.keepNormals = true;  // rankBlock's clustering gives every point a normal
   partitionOptions.memoryBytes = plan.partitionBytes;
   if (frame)
     partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) { return frame->apply(in, out); };

@@ -52,6 +52,8 @@ Result<PointReader> PointReader::open(const std::string& path, const PointReadOp
     info.count = h.pointCount;
     info.bounds = h.bounds;
     info.crs = h.crs;
+    info.grid = PointCloudInfo::Grid{{h.scale[0], h.scale[1], h.scale[2]},
+                                     {h.offset[0], h.offset[1], h.offset[2]}};
     info.hasColors = h.hasColors;
     info.attributes = h.attributes;
     info.extras = h.extras;

@@ -24,6 +24,12 @@ struct PointCloudInfo {
   std::uint32_t attributes = 0;       // PointAttributeBit: the lidar fields a LAS or LAZ has
   PointExtras extras;                 // documented extra bytes, other PLY vertex properties
   std::vector<std::string> warnings;  // what is read past (a damaged Extra Bytes record, …)
+  // LAS and LAZ: every position is offset + scale × a 32-bit integer, computed in that order in
+  // double precision, so the integers hold the positions exactly (the work files keep them so).
+  struct Grid {
+    Vec3d scale, offset;
+  };
+  std::optional<Grid> grid;
 };
 
 // Whether `path` names a point file by its extension (las laz xyz txt csv pts); a PLY may hold

@@ -1,0 +1,91 @@
+#include "lodforge/points/point_record.h"
+
+#include <cassert>
+#include <cmath>
+#include <cstring>
+
+namespace lodforge {
+
+namespace {
+
+template <class T>
+void put(std::byte*& at, const T& value) {
+  std::memcpy(at, &value, sizeof value);
+  at += sizeof value;
+}
+
+template <class T>
+void take(const std::byte*& at, T& value) {
+  std::memcpy(&value, at, sizeof value);
+  at += sizeof value;
+}
+
+}  // namespace
+
+PointRecordLayout PointRecordLayout::of(const PointCloudInfo& info, bool placed, bool normals) {
+  PointRecordLayout layout;
+  layout.gridded_ = info.grid.has_value() && !placed;
+  if (layout.gridded_) {
+    layout.grid_ = *info.grid;
+    for (int k = 0; k < 3; ++k) layout.inverseScale_[k] = 1.0 / layout.grid_.scale[k];
+  }
+  layout.normals_ = info.hasNormals || normals;
+  layout.colors_ = info.hasColors;
+  // The extra fields have a file of their own.
+  layout.attributes_ = (info.attributes & ~std::uint32_t{kAttrExtras}) != 0;
+  layout.bytes_ = (layout.gridded_ ? 3 * sizeof(std::int32_t) : sizeof(Vec3d)) +
+                  (layout.normals_ ? sizeof(Vec3f) : 0) + (layout.colors_ ? sizeof(Rgba8) : 0) +
+                  (layout.attributes_ ? sizeof(PointAttributes) : 0);
+  return layout;
+}
+
+Status PointRecordLayout::encode(std::span<const CloudPoint> points, std::byte* out) const {
+  for (const CloudPoint& p : points) {
+    if (gridded_) {
+      for (int k = 0; k < 3; ++k) {
+        // Rounded by adding a half and truncating (one instruction, where nearbyint is a libm
+        // call without SSE4.1); the check below catches any rounding that missed.
+        const double t = (p.position[k] - grid_.offset[k]) * inverseScale_[k];
+        const double n = t + (t < 0 ? -0.5 : 0.5);
+        const bool inRange = n > -2147483649.0 && n < 2147483648.0;
+        const auto integer = inRange ? static_cast<std::int32_t>(n) : 0;
+        // As the LAS reader computes it: the same integer must give back the same double.
+        if (!inRange ||
+            static_cast<double>(integer) * grid_.scale[k] + grid_.offset[k] != p.position[k])
+          return Error{ErrorKind::kInternal,
+                       fmt::format("position {:.17g} is not on the input's grid (scale {}, "
+                                   "offset {})",
+                                   p.position[k], grid_.scale[k], grid_.offset[k])};
+        put(out, integer);
+      }
+    } else {
+      put(out, p.position);
+    }
+    if (normals_) put(out, p.normal);
+    if (colors_) put(out, p.color);
+    if (attributes_) put(out, p.attributes);
+  }
+  return {};
+}
+
+void PointRecordLayout::decode(const std::byte* in, std::span<CloudPoint> points) const {
+  for (CloudPoint& p : points) {
+    if (gridded_) {
+      for (int k = 0; k < 3; ++k) {
+        std::int32_t integer;
+        take(in, integer);
+        p.position[k] = static_cast<double>(integer) * grid_.scale[k] + grid_.offset[k];
+      }
+    } else {
+      take(in, p.position);
+    }
+    p.normal = Vec3f{};
+    p.color = Rgba8{};
+    p.attributes = PointAttributes{};
+    if (normals_) take(in, p.normal);
+    if (colors_) take(in, p.color);
+    if (attributes_) take(in, p.attributes);
+  }
+}
+
+}  // namespace lodforge

@@ -33,7 +33,7 @@ struct PartitionOptions {
   std::uint64_t blockSize = 50'000;  // at most this many points per block
   // Points held in memory at once while splitting (bytes); nodes above it are split by streamed
   // passes over their files.
-  std::uint64_t memoryBytes = std::uint64_t{256} << 20;
+  std::uint64_t memoryBytes = std::uint64_t{512} << 20;
   std::string workDirectory;      // must exist
   bool salvageTruncated = false;  // read a PLY cut short up to its last whole point
   // Carry the input's extra fields (LAS extra bytes, other PLY properties) in a second work file;

@@ -72,6 +72,15 @@ struct GpuStream::State {
   std::vector<std::uint32_t> vertexCounts, triangleCounts;
   std::vector<std::array<std::uint32_t, 4>> vertexRows, triangleRows;
 
+  // Object i's rows: the prefix both selections share stays on the GPU, the rest is staged from
+  // the package.
+  void stageVertices(std::size_t i, std::uint32_t count, std::uint64_t& delta,
+                     std::uint64_t& keptTotal);
+  void stageTriangles(std::size_t i, std::uint32_t count, std::uint64_t& delta,
+                      std::uint64_t& keptTotal);
+  // The staged data and the kept prefixes into the next copy, on the GPU.
+  void assembleFrame(std::uint64_t vertices, std::uint64_t triangles);
+
   ~State() {
     for (Stream* s : {&positions, &normalStream, &colorStream, &uvStream, &source}) s->destroy();
     for (GLuint b : {vertexTable, triangleTable}) {
@@ -93,6 +102,61 @@ struct GpuStream::State {
     dispatchElements(count);
   }
 };
+
+namespace {
+
+void stage(std::vector<std::uint32_t>& to, const void* from, std::size_t bytes) {
+  const std::size_t at = to.size();
+  to.resize(at + bytes / 4);
+  std::memcpy(to.data() + at, from, bytes);
+}
+
+}  // namespace
+
+void GpuStream::State::stageVertices(std::size_t i, std::uint32_t count, std::uint64_t& delta,
+                                     std::uint64_t& keptTotal) {
+  const std::uint32_t kept = std::min(count, vertexCounts[i]);
+  vertexRows.push_back({static_cast<std::uint32_t>(vertexStart[i]),
+                        static_cast<std::uint32_t>(oldVertexStart.empty() ? 0 : oldVertexStart[i]),
+                        kept, static_cast<std::uint32_t>(delta)});
+  const std::size_t fresh = count - kept;
+  stage(positions.staged, package->positions(i).data() + kept, fresh * sizeof(Vec3f));
+  if (normals) stage(normalStream.staged, package->normals(i).data() + kept, fresh * sizeof(Vec3f));
+  if (colors) stage(colorStream.staged, package->colors(i).data() + kept, fresh * sizeof(Rgba8));
+  if (uvs) stage(uvStream.staged, package->uvs(i).data() + kept, fresh * sizeof(Vec2f));
+  delta += fresh;
+  keptTotal += kept;
+}
+
+void GpuStream::State::stageTriangles(std::size_t i, std::uint32_t count, std::uint64_t& delta,
+                                      std::uint64_t& keptTotal) {
+  const std::uint32_t kept = std::min(count, triangleCounts[i]);
+  triangleRows.push_back(
+      {static_cast<std::uint32_t>(triangleStart[i]),
+       static_cast<std::uint32_t>(oldTriangleStart.empty() ? 0 : oldTriangleStart[i]), kept,
+       static_cast<std::uint32_t>(delta)});
+  const std::size_t fresh = count - kept;
+  stage(source.staged, package->triangles(i).data() + 3 * std::size_t{kept},
+        fresh * 3 * sizeof(std::uint32_t));
+  delta += fresh;
+  keptTotal += kept;
+}
+
+void GpuStream::State::assembleFrame(std::uint64_t vertices, std::uint64_t triangles) {
+  glNamedBufferSubData(vertexTable, 0, static_cast<GLsizeiptr>(vertexRows.size() * 16),
+                       vertexRows.data());
+  glNamedBufferSubData(triangleTable, 0, static_cast<GLsizeiptr>(triangleRows.size() * 16),
+                       triangleRows.data());
+  glUseProgram(program.id());
+  assemble(positions, vertices, vertexTable, vertexRows.size());
+  if (normals) assemble(normalStream, vertices, vertexTable, vertexRows.size());
+  if (colors) assemble(colorStream, vertices, vertexTable, vertexRows.size());
+  if (uvs) assemble(uvStream, vertices, vertexTable, vertexRows.size());
+  assemble(source, triangles, triangleTable, triangleRows.size());
+  // Draws read the vertices; the reformation reads the source triangles.
+  glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT |
+                  GL_BUFFER_UPDATE_BARRIER_BIT);
+}
 
 Result<GpuStream> GpuStream::create(const Package& package, const StreamCapacity& capacity) {
   if (capacity.vertices >= (std::uint64_t{1} << 30) ||
@@ -160,58 +224,14 @@ Result<FrameStats> GpuStream::update(std::span<const std::uint32_t> vc,
   s.triangleRows.clear();
   FrameStats stats;
   std::uint64_t vertexDelta = 0, triangleDelta = 0, keptVertices = 0, keptTriangles = 0;
-  const auto stage = [](std::vector<std::uint32_t>& to, const void* from, std::size_t bytes) {
-    const std::size_t at = to.size();
-    to.resize(at + bytes / 4);
-    std::memcpy(to.data() + at, from, bytes);
-  };
   for (std::size_t i = 0; i < objects; ++i) {
     s.vertexStart[i + 1] = s.vertexStart[i] + vc[i];
     s.triangleStart[i + 1] = s.triangleStart[i] + tc[i];
     if (vc[i] != s.vertexCounts[i]) ++stats.objectsChanged;
-    if (vc[i] > 0) {
-      // The prefix both selections share stays on the GPU; the rest comes from the package.
-      const std::uint32_t kept = std::min(vc[i], s.vertexCounts[i]);
-      s.vertexRows.push_back(
-          {static_cast<std::uint32_t>(s.vertexStart[i]),
-           static_cast<std::uint32_t>(s.oldVertexStart.empty() ? 0 : s.oldVertexStart[i]), kept,
-           static_cast<std::uint32_t>(vertexDelta)});
-      const std::size_t fresh = vc[i] - kept;
-      stage(s.positions.staged, package.positions(i).data() + kept, fresh * sizeof(Vec3f));
-      if (s.normals)
-        stage(s.normalStream.staged, package.normals(i).data() + kept, fresh * sizeof(Vec3f));
-      if (s.colors)
-        stage(s.colorStream.staged, package.colors(i).data() + kept, fresh * sizeof(Rgba8));
-      if (s.uvs) stage(s.uvStream.staged, package.uvs(i).data() + kept, fresh * sizeof(Vec2f));
-      vertexDelta += fresh;
-      keptVertices += kept;
-    }
-    if (tc[i] > 0) {
-      const std::uint32_t kept = std::min(tc[i], s.triangleCounts[i]);
-      s.triangleRows.push_back(
-          {static_cast<std::uint32_t>(s.triangleStart[i]),
-           static_cast<std::uint32_t>(s.oldTriangleStart.empty() ? 0 : s.oldTriangleStart[i]), kept,
-           static_cast<std::uint32_t>(triangleDelta)});
-      const std::size_t fresh = tc[i] - kept;
-      stage(s.source.staged, package.triangles(i).data() + 3 * std::size_t{kept},
-            fresh * 3 * sizeof(std::uint32_t));
-      triangleDelta += fresh;
-      keptTriangles += kept;
-    }
+    if (vc[i] > 0) s.stageVertices(i, vc[i], vertexDelta, keptVertices);
+    if (tc[i] > 0) s.stageTriangles(i, tc[i], triangleDelta, keptTriangles);
   }
-  glNamedBufferSubData(s.vertexTable, 0, static_cast<GLsizeiptr>(s.vertexRows.size() * 16),
-                       s.vertexRows.data());
-  glNamedBufferSubData(s.triangleTable, 0, static_cast<GLsizeiptr>(s.triangleRows.size() * 16),
-                       s.triangleRows.data());
-  glUseProgram(s.program.id());
-  s.assemble(s.positions, vertices, s.vertexTable, s.vertexRows.size());
-  if (s.normals) s.assemble(s.normalStream, vertices, s.vertexTable, s.vertexRows.size());
-  if (s.colors) s.assemble(s.colorStream, vertices, s.vertexTable, s.vertexRows.size());
-  if (s.uvs) s.assemble(s.uvStream, vertices, s.vertexTable, s.vertexRows.size());
-  s.assemble(s.source, triangles, s.triangleTable, s.triangleRows.size());
-  // Draws read the vertices; the reformation reads the source triangles.
-  glMemoryBarrier(GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT |
-                  GL_BUFFER_UPDATE_BARRIER_BIT);
+  s.assembleFrame(vertices, triangles);
   s.current = 1 - s.current;
   s.vertexCounts.assign(vc.begin(), vc.end());
   s.triangleCounts.assign(tc.begin(), tc.end());

@@ -18,6 +18,11 @@ echo
 echo "== kernels (Google Benchmark)"
 [[ -n ${BENCH_ONLY:-} ]] || build/release/bench/bench_kernels --benchmark_min_time=0.5
 
+missing_peer() {  # VARIABLE name; true (after saying so) when $VARIABLE is no executable
+  local variable=$1 name=$2
+  [[ -n ${!variable:-} && -x ${!variable:-} ]] && return 1
+  echo "$variable is not set to a $name binary: nothing to compare against (skipped)"
+}
 timed() {  # command...; prints "seconds peak-KiB" from /usr/bin/time -v
   local log=$work/time.log
   /usr/bin/time -v "$@" > /dev/null 2> "$log" || { tail -20 "$log" >&2; exit 1; }
@@ -269,24 +274,27 @@ if [[ ${BENCH_ONLY:-} == laz ]]; then laz_section; exit 0; fi
 # e.g. a LASzip-based compressor). POTREE_SIZES (default "1M 20M") picks the clouds, kept in
 # the bench folder as cloud-N.las/.laz for the next run; POTREE_RUNS (default 3) runs of each
 # tool alternate and the median wall time is shown (this machine is shared and noisy).
+# OLD_LODFORGE names another lodforge binary (an earlier build) run alternately beside them, so a
+# change is measured against both in one run.
 potree_once() {  # tool, input; prints "seconds peak-KiB output-size"
   local tool=$1 input=$2 out=$work/potree-out
   rm -rf "$out"
   local cmd
-  if [[ $tool == lodforge ]]; then cmd=("$lodforge" -q tiles "$input" -o "$out"); else cmd=("$POTREE" "$input" -o "$out"); fi
+  case $tool in
+    lodforge) cmd=("$lodforge" -q tiles "$input" -o "$out") ;;
+    lodforge-old) cmd=("$OLD_LODFORGE" -q tiles "$input" -o "$out") ;;
+    *) cmd=("$POTREE" "$input" -o "$out") ;;
+  esac
   echo "$(timed "${cmd[@]}")" "$(du -sh "$out" | cut -f1)"
   rm -rf "$out"
 }
 potree_section() {
   echo
   echo "== point tiles beside PotreeConverter 2 (same input, one run; $(nproc) threads each; median of ${POTREE_RUNS:-3} alternating runs)"
-  if [[ -z ${POTREE:-} || ! -x ${POTREE:-} ]]; then
-    echo "POTREE is not set to a PotreeConverter binary: nothing to compare against (skipped)"
-    return
-  fi
+  missing_peer POTREE PotreeConverter && return
   [[ -n ${LAZ_COMPRESS:-} ]] || echo "LAZ_COMPRESS is not set: LAS rows only"
-  printf '| %-5s | %-4s | %-9s | %9s | %11s | %10s | %7s | %s\n' cloud file tool wall points/s "peak RSS" output "runs (s)"
-  printf '|%s|%s|%s|%s|%s|%s|%s|%s\n' ------- ------ ----------- ----------- ------------- ------------ --------- ---------
+  printf '| %-5s | %-4s | %-12s | %9s | %11s | %10s | %7s | %s\n' cloud file tool wall points/s "peak RSS" output "runs (s)"
+  printf '|%s|%s|%s|%s|%s|%s|%s|%s\n' ------- ------ -------------- ----------- ------------- ------------ --------- ---------
   for n in ${POTREE_SIZES:-1M 20M}; do
     local las=$work/cloud-$n.las laz=$work/cloud-$n.laz
     [[ -f $las ]] || "$lodforge" -q generate points --points "$n" -o "$las"
@@ -299,18 +307,20 @@ potree_section() {
     points=$("$lodforge" info --header-only "$las" | awk '/^points / {print $2}' | tr -d ,)
     for input in "${files[@]}"; do
       declare -A runs=() rss=() size=()
+      local tools=(lodforge potree)
+      [[ -n ${OLD_LODFORGE:-} ]] && tools=(lodforge-old lodforge potree)
       for ((r = 0; r < ${POTREE_RUNS:-3}; ++r)); do
-        for tool in lodforge potree; do
+        for tool in "${tools[@]}"; do
           read -r seconds kib out < <(potree_once "$tool" "$input")
           runs[$tool]+="$seconds "
           rss[$tool]=$(( ${rss[$tool]:-0} > kib ? ${rss[$tool]:-0} : kib ))
           size[$tool]=$out
         done
       done
-      for tool in lodforge potree; do
+      for tool in "${tools[@]}"; do
         local median
         median=$(tr ' ' '\n' <<< "${runs[$tool]}" | grep . | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')
-        printf '| %-5s | %-4s | %-9s | %8ss | %7.2f M/s | %6d MiB | %7s | %s\n' "$n" "${input##*.}" "$tool" "$median" \
+        printf '| %-5s | %-4s | %-12s | %8ss | %7.2f M/s | %6d MiB | %7s | %s\n' "$n" "${input##*.}" "$tool" "$median" \
           "$(awk -v n="$points" -v s="$median" 'BEGIN { print n / s / 1e6 }')" $((rss[$tool] / 1024)) "${size[$tool]}" "${runs[$tool]}"
       done
       unset runs rss size
@@ -328,10 +338,7 @@ if [[ ${BENCH_ONLY:-} == potree ]]; then potree_section; exit 0; fi
 surface_section() {
   echo
   echo "== surfaces beside PoissonRecon (same cloud, one run each; $(nproc) threads)"
-  if [[ -z ${POISSON:-} || ! -x ${POISSON:-} ]]; then
-    echo "POISSON is not set to a PoissonRecon binary: nothing to compare against (skipped)"
-    return
-  fi
+  missing_peer POISSON PoissonRecon && return
   printf '| %-5s | %-12s | %8s | %10s | %10s | %9s | %9s |\n' cloud tool wall "peak RSS" triangles hausdorff rms
   printf '|%s|%s|%s|%s|%s|%s|%s|\n' ------- -------------- ---------- ------------ ------------ ----------- -----------
   for n in ${SURFACE_SIZES:-1M}; do
@@ -612,10 +619,7 @@ if [[ ${BENCH_ONLY:-} == texture-formats ]]; then texture_formats_section; exit 
 gltfpack_section() {
   echo
   echo "== textured simplification beside gltfpack (2 M-triangle scan, 16 x 4K atlases, to a tenth)"
-  if [[ -z ${GLTFPACK:-} || ! -x ${GLTFPACK:-} ]]; then
-    echo "GLTFPACK is not set to a gltfpack binary: nothing to compare against (skipped)"
-    return
-  fi
+  missing_peer GLTFPACK gltfpack && return
   printf '| %-26s | %7s | %9s | %9s | %9s | %8s | %13s | %11s |\n' tool wall "peak RSS" triangles hausdorff rms "texels mean" "texels p95"
   printf '|%s|%s|%s|%s|%s|%s|%s|%s|\n' ---------------------------- --------- ----------- ----------- ----------- ---------- --------------- -------------
   rm -rf "$work/gp" && mkdir -p "$work/gp"

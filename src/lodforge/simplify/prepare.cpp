@@ -3,6 +3,7 @@
 #include <cassert>
 
 #include "lodforge/core/mesh.h"
+#include "lodforge/simplify/simplify_model.h"
 
 namespace lodforge {
 
@@ -87,8 +88,7 @@ template <class T>
 std::vector<T> gather(std::span<const T> in, std::span<const std::uint32_t> remap,
                       std::uint32_t count) {
   std::vector<T> out(count);
-  for (std::size_t v = 0; v < remap.size(); ++v)
-    if (remap[v] != ~0u) out[remap[v]] = in[v];
+  compactVertexAttribute<T>(in, remap, out);
   return out;
 }
 
@@ -110,14 +110,9 @@ PreparedTexturedObject prepareTexturedObject(std::span<const Vec3f> positions,
   remapIndices(wedgeIndices, wedges.remap);
   std::vector<std::uint32_t> wedgePoint(wedges.count);
   for (std::size_t v = 0; v < positions.size(); ++v) wedgePoint[wedges.remap[v]] = pointOf[v];
-  for (std::size_t t = 0; t < wedgeIndices.size(); t += 3) {
-    const std::uint32_t a = wedgePoint[wedgeIndices[t]], b = wedgePoint[wedgeIndices[t + 1]],
-                        c = wedgePoint[wedgeIndices[t + 2]];
-    if (a == b || b == c || a == c) continue;
-    out.indices.insert(out.indices.end(), {a, b, c});
-    out.wedges.insert(out.wedges.end(), wedgeIndices.begin() + static_cast<std::ptrdiff_t>(t),
-                      wedgeIndices.begin() + static_cast<std::ptrdiff_t>(t + 3));
-  }
+  WedgeSurface surface = wedgeSurface(wedgePoint, wedgeIndices);
+  out.indices = std::move(surface.indices);
+  out.wedges = std::move(surface.wedges);
   // Only what the triangles use, points and wedges each in order of first index.
   std::vector<std::uint32_t> keepPoint(pointCount), keepWedge(wedges.count);
   const std::uint32_t points = findReferencedVertices(pointCount, out.indices, keepPoint);

@@ -86,6 +86,14 @@ struct Rgba8 {
 };
 static_assert(sizeof(Rgba8) == 4);
 
+// An opaque colour from channels in [0, 1] (clamped, rounded): OBJ's `v x y z r g b` and `Kd`.
+inline Rgba8 toRgba8(double r, double g, double b) {
+  const auto c = [](double v) {
+    return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
+  };
+  return {c(r), c(g), c(b), 255};
+}
+
 // Axis-aligned box; a default-constructed box is empty (min > max) and absorbs any point.
 template <class T>
 struct Box3 {

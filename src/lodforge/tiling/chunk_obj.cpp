@@ -153,13 +153,6 @@ bool parseNumber(std::string_view word, double& out) {
   return error == std::errc() && end == word.data() + word.size() && std::isfinite(out);
 }
 
-Rgba8 toRgba(double r, double g, double b) {
-  const auto c = [](double v) {
-    return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
-  };
-  return {c(r), c(g), c(b), 255};
-}
-
 // One corner of a face: its position, texture coordinate and normal (kNoIndex: none), 0-based.
 struct ObjCorner {
   std::uint32_t v = kNoIndex, vt = kNoIndex, vn = kNoIndex;
@@ -365,7 +358,7 @@ Status ObjChunking::addVertex(std::uint64_t line, std::span<const std::string_vi
                                        line));
   input_.bounds.add(p);
   std::array<std::byte, kVertexBytes> record{};
-  writeVertexRecord(record.data(), p, toRgba(rgb[0], rgb[1], rgb[2]), Vec3f{});
+  writeVertexRecord(record.data(), p, toRgba8(rgb[0], rgb[1], rgb[2]), Vec3f{});
   ++counts_.v;
   return appendRecord(vertexFd_, pendingVertices_, record.data(), record.size(), "vertices.bin");
 }
@@ -527,7 +520,7 @@ Status ObjChunking::fetch(const ObjCorner& corner, CutCorner& out) {
   bool shared = !kd;  // a vertex of one colour and normal everywhere: one record per vertex
   if (kd) {
     const auto& d = mtl_[static_cast<std::size_t>(material_)].diffuse;
-    out.color = toRgba(d[0], d[1], d[2]);
+    out.color = toRgba8(d[0], d[1], d[2]);
   }
   if (corner.vn != kNoIndex && !options_.transform) {
     const std::byte* n = normals_->at(corner.vn);

@@ -101,13 +101,6 @@ struct CornerHash {
   }
 };
 
-Rgba8 toRgba(double r, double g, double b) {
-  auto c = [](double v) {
-    return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0));
-  };
-  return {c(r), c(g), c(b), 255};
-}
-
 // A file of vertices and no faces (a point cloud, or a mesh cut short before its faces) reads as
 // one object of all its vertices and no triangles, as a PLY without faces does.
 void addVerticesOnly(Model& model, const tinyobj::attrib_t& attrib, const std::string& name) {
@@ -123,7 +116,7 @@ void addVerticesOnly(Model& model, const tinyobj::attrib_t& attrib, const std::s
     model.positions.push_back(toFloat(p - model.origin));
     if (colors)
       model.colors.push_back(
-          toRgba(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]));
+          toRgba8(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]));
   }
   builder.endObject();
 }
@@ -269,10 +262,10 @@ void addCorner(Model& model, const ObjContext& context, const tinyobj::index_t& 
   if (context.summary.anyColor) {
     Rgba8 color;  // white: a texture's own colour, or no colour at all
     if (vertexColors) {
-      color = toRgba(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]);
+      color = toRgba8(attrib.colors[3 * v], attrib.colors[3 * v + 1], attrib.colors[3 * v + 2]);
     } else if (materialColor) {
       const auto& kd = context.obj.materials[static_cast<std::size_t>(material)].diffuse;
-      color = toRgba(kd[0], kd[1], kd[2]);
+      color = toRgba8(kd[0], kd[1], kd[2]);
     }
     model.colors.push_back(color);
   }

@@ -43,37 +43,52 @@ Flat flatten(const Model& model, Vec3d origin) {
   return flat;
 }
 
-// Each triangle's texture as the index of A's image with the same bytes (~0u: none, or an image
-// A lacks), and A's images' sizes.
-struct Textures {
-  std::vector<std::uint32_t> texture;
+// A's images: by the checksum of their bytes (to find B's images among them), their sizes, and
+// each one's index among them (the first with the same bytes).
+struct ReferenceImages {
+  std::map<std::uint64_t, std::uint32_t> byBytes;
   std::vector<std::array<std::uint32_t, 2>> texels;
+  std::vector<std::uint32_t> own;
 };
 
-Result<Textures> texturesOf(const Model& model, const Model& reference) {
-  std::map<std::uint64_t, std::uint32_t> byBytes;
-  Textures out;
+Result<ReferenceImages> referenceImagesOf(const Model& reference) {
+  ReferenceImages out;
   for (std::size_t i = 0; i < reference.images.size(); ++i) {
     Result<std::vector<std::byte>> bytes = imageBytes(reference.images[i]);
     if (!bytes) return bytes.status();
-    byBytes.emplace(checksum64(*bytes), static_cast<std::uint32_t>(i));
+    const auto [at, fresh] = out.byBytes.emplace(checksum64(*bytes), static_cast<std::uint32_t>(i));
+    out.own.push_back(at->second);
     out.texels.push_back({reference.images[i].width, reference.images[i].height});
   }
+  return out;
+}
+
+// Each of B's images as the index of A's image with the same bytes (~0u: one A lacks).
+Result<std::vector<std::uint32_t>> matchImages(const Model& model,
+                                               const ReferenceImages& reference) {
   std::vector<std::uint32_t> imageToReference(model.images.size(), ~0u);
   for (std::size_t i = 0; i < model.images.size(); ++i) {
     Result<std::vector<std::byte>> bytes = imageBytes(model.images[i]);
     if (!bytes) return bytes.status();
-    if (const auto found = byBytes.find(checksum64(*bytes)); found != byBytes.end())
+    if (const auto found = reference.byBytes.find(checksum64(*bytes));
+        found != reference.byBytes.end())
       imageToReference[i] = found->second;
   }
+  return imageToReference;
+}
+
+// Each triangle's texture, through its material's image (~0u: none, or an image A lacks).
+std::vector<std::uint32_t> texturesOf(const Model& model,
+                                      std::span<const std::uint32_t> imageToReference) {
+  std::vector<std::uint32_t> texture;
   for (const ObjectRecord& o : model.objects) {
-    std::uint32_t texture = ~0u;
+    std::uint32_t t = ~0u;
     if (model.hasUvs() && o.material < model.materials.size() &&
         model.materials[o.material].baseColorImage != kNoImage)
-      texture = imageToReference[model.materials[o.material].baseColorImage];
-    out.texture.insert(out.texture.end(), o.triangleCount, texture);
+      t = imageToReference[model.materials[o.material].baseColorImage];
+    texture.insert(texture.end(), o.triangleCount, t);
   }
-  return out;
+  return texture;
 }
 
 // The texture-space error of B against A, when both are textured with images they share.
@@ -81,13 +96,15 @@ Result<std::optional<TextureDistance>> compareTextures(const Model& a, const Fla
                                                        const Model& b, const Flat& fb,
                                                        std::uint32_t samples) {
   if (!a.hasUvs() || !b.hasUvs() || a.images.empty()) return std::optional<TextureDistance>();
-  Result<Textures> ta = texturesOf(a, a), tb = texturesOf(b, a);
-  if (!ta) return ta.status();
-  if (!tb) return tb.status();
-  if (std::all_of(tb->texture.begin(), tb->texture.end(), [](std::uint32_t t) { return t == ~0u; }))
+  Result<ReferenceImages> reference = referenceImagesOf(a);
+  if (!reference) return reference.status();
+  Result<std::vector<std::uint32_t>> matched = matchImages(b, *reference);
+  if (!matched) return matched.status();
+  const std::vector<std::uint32_t> ta = texturesOf(a, reference->own), tb = texturesOf(b, *matched);
+  if (std::all_of(tb.begin(), tb.end(), [](std::uint32_t t) { return t == ~0u; }))
     return std::optional<TextureDistance>();
-  const TexturedSurface sa{fa.positions, fa.indices, a.uvs, ta->texture, ta->texels};
-  const TexturedSurface sb{fb.positions, fb.indices, b.uvs, tb->texture, ta->texels};
+  const TexturedSurface sa{fa.positions, fa.indices, a.uvs, ta, reference->texels};
+  const TexturedSurface sb{fb.positions, fb.indices, b.uvs, tb, reference->texels};
   return std::optional(textureDistance(sa, sb, samples));
 }
 

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <numeric>
 
 #include <tbb/task_arena.h>
 
@@ -126,14 +127,23 @@ void BM_ClusterBlock(benchmark::State& state) {
     const double x = random.uniform(0, 100), y = random.uniform(0, 100);
     p.position = {x, y, 3 * std::sin(x / 9) * std::cos(y / 7) + random.uniform(-0.02, 0.02)};
   }
+  // Arg 1: as tiles call it (no node colours, ids moved with the points, first points kept).
+  const bool tiles = state.range(0) == 1;
+  ClusterOptions options;
+  options.colors = !tiles;
   tbb::task_arena one(1);
   for (auto _ : state) {
     std::vector<CloudPoint> points = block;
-    one.execute([&] { benchmark::DoNotOptimize(clusterBlock(points, {50, 50, 0}, false)); });
+    std::vector<std::uint32_t> ids(tiles ? block.size() : 0), firstPoint;
+    std::iota(ids.begin(), ids.end(), 0u);
+    one.execute([&] {
+      benchmark::DoNotOptimize(
+          clusterBlock(points, {50, 50, 0}, false, options, tiles ? &firstPoint : nullptr, ids));
+    });
   }
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(block.size()));
 }
-BENCHMARK(BM_ClusterBlock)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ClusterBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace lodforge

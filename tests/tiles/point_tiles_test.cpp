@@ -5,7 +5,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
 
@@ -261,6 +263,27 @@ TEST(PointTiles, KeysHoldExactlyTheCutsRepresentatives) {
   std::sort(sorted.begin(), sorted.end(), std::greater<>());
   for (std::size_t budget : {1, 2, 10, 100, 777, 1'999})
     EXPECT_EQ(sorted[budget], toleranceForResident(tree, budget)) << budget;
+}
+
+// Blocks are written in this order; the cut at τ is a prefix of it only if it is exactly a
+// stable sort by descending key (keys spanning many exponents, ties, zeros and +∞ included).
+TEST(PointTiles, KeyOrderIsAStableDescendingSort) {
+  Random random(21);
+  for (const std::size_t n : {0, 1, 2, 1'000, 70'000}) {
+    std::vector<float> keys(n);
+    for (float& k : keys) {
+      const double pick = random.uniform(0, 1);
+      k = pick < 0.1   ? 0.0f
+          : pick < 0.2 ? std::numeric_limits<float>::infinity()
+          : pick < 0.4 ? static_cast<float>(std::floor(random.uniform(0, 8)))  // ties
+                       : static_cast<float>(std::exp(random.uniform(-60, 60)));
+    }
+    std::vector<std::uint32_t> expected(n);
+    std::iota(expected.begin(), expected.end(), 0u);
+    std::stable_sort(expected.begin(), expected.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return keys[a] > keys[b]; });
+    EXPECT_EQ(descendingKeyOrder(keys), expected) << n;
+  }
 }
 
 TEST(PointTiles, PlacesALasOnEarthFromItsCoordinateSystem) {

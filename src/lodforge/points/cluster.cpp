@@ -25,39 +25,64 @@ struct Separator {
   double value = 0;
 };
 
+// What splitting reads of a point, half a CloudPoint's bytes: the splits move these, and the
+// points and ids follow once at the end (each level of splits moves every point).
+struct SplitItem {
+  Vec3d position;
+  Rgba8 color;
+  std::uint32_t index;  // the point's place before splitting
+};
+static_assert(sizeof(SplitItem) == 32);
+
+// `points` (and `ids`, if any) in the items' order.
+void followItems(std::span<const SplitItem> items, std::span<CloudPoint> points,
+                 std::span<std::uint32_t> ids) {
+  const std::vector<CloudPoint> was(points.begin(), points.end());
+  for (std::size_t k = 0; k < items.size(); ++k) points[k] = was[items[k].index];
+  if (ids.empty()) return;
+  const std::vector<std::uint32_t> wasIds(ids.begin(), ids.end());
+  for (std::size_t k = 0; k < items.size(); ++k) ids[k] = wasIds[items[k].index];
+}
+
 // Top-down splitting (§4.1, "Hierarchical clustering"), breadth-first: each node's centroid,
 // mean colour and count; splitting node i reorders only inside ranges[i].
 void splitTree(std::span<CloudPoint> points, std::span<std::uint32_t> ids, Vec3d origin,
-               std::vector<ClusterNode>& nodes, std::vector<Range>& ranges,
+               bool colors, std::vector<ClusterNode>& nodes, std::vector<Range>& ranges,
                std::vector<Separator>& separators) {
   nodes.reserve(2 * points.size() - 1);
   ranges.reserve(2 * points.size() - 1);
   separators.resize(2 * points.size() - 1);
+  std::vector<SplitItem> items(points.size());
+  for (std::uint32_t k = 0; k < items.size(); ++k)
+    items[k] = {points[k].position, points[k].color, k};
   nodes.emplace_back();
   ranges.push_back({0, static_cast<std::uint32_t>(points.size())});
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const Range r = ranges[i];
-    const std::span<CloudPoint> mine = points.subspan(r.begin, r.size());
+    const std::span<SplitItem> mine = std::span(items).subspan(r.begin, r.size());
     Aabbd bounds;
     Vec3d sum, color;
-    for (const CloudPoint& p : mine) {
+    for (const SplitItem& p : mine) {
       bounds.add(p.position);
       sum = sum + p.position;
-      color = color + Vec3d{double(p.color.r), double(p.color.g), double(p.color.b)};
     }
     const double n = static_cast<double>(mine.size());
     const Vec3d centroid = sum * (1 / n);
     ClusterNode& node = nodes[i];
     node.position = toFloat(centroid - origin);
-    color = color * (1 / n);
-    node.color = {static_cast<std::uint8_t>(std::lround(color.x)),
-                  static_cast<std::uint8_t>(std::lround(color.y)),
-                  static_cast<std::uint8_t>(std::lround(color.z)), 255};
+    if (colors) {
+      for (const SplitItem& p : mine)
+        color = color + Vec3d{double(p.color.r), double(p.color.g), double(p.color.b)};
+      color = color * (1 / n);
+      node.color = {static_cast<std::uint8_t>(std::lround(color.x)),
+                    static_cast<std::uint8_t>(std::lround(color.y)),
+                    static_cast<std::uint8_t>(std::lround(color.z)), 255};
+    }
     node.pointCount = static_cast<std::uint32_t>(mine.size());
     if (mine.size() == 1) continue;
     const SplitPlane plane = centroidSplit(bounds, centroid);
-    const auto below = static_cast<std::uint32_t>(
-        splitPoints(mine, plane, ids.empty() ? ids : ids.subspan(r.begin, r.size())));
+    // With ids the split keeps a flat node's order, as splitPoints does (the same tree either way).
+    const auto below = static_cast<std::uint32_t>(splitRecords(mine, plane, {}, !ids.empty()));
     // When the centroid leaves every point on one side, splitPoints splits at the median.
     const bool median =
         bounds.min[plane.axis] >= plane.value || bounds.max[plane.axis] < plane.value;
@@ -68,6 +93,7 @@ void splitTree(std::span<CloudPoint> points, std::span<std::uint32_t> ids, Vec3d
     ranges.push_back({r.begin, r.begin + below});
     ranges.push_back({r.begin + below, r.end});
   }
+  followItems(items, points, ids);
 }
 
 // The direction of least spread of `points` (PCA), facing +z; +z for fewer than three points.
@@ -109,6 +135,19 @@ void cellNormals(std::span<CloudPoint> points, std::span<const ClusterNode> node
     for (std::uint32_t c : {a, b})
       if (ranges[c].size() < k) settle(ranges[i], ranges[c]);
   });
+}
+
+// The least of `best` and the squared distances from `p` to positions[from, to). Not inlined:
+// inside the search, whose loop makes calls, GCC kept `best` in memory (no vector register
+// survives a call), a store and a load on every point of a bucket.
+[[gnu::noinline]] double nearestSquared(std::span<const Vec3d> positions, std::uint32_t from,
+                                        std::uint32_t to, Vec3d p, double best) {
+  for (std::uint32_t q = from; q < to; ++q) {
+    const Vec3d d = positions[q] - p;
+    const double squared = dot(d, d);
+    best = squared < best ? squared : best;
+  }
+  return best;
 }
 
 // Half the distance from every point to its nearest other point (0 for a lone point or a
@@ -157,14 +196,13 @@ std::vector<float> halfSpacing(std::span<const CloudPoint> points,
         std::vector<std::pair<std::uint32_t, double>> stack;  // node, least distance² to it
         for (std::uint32_t j = range.begin(); j < range.end(); ++j) {
           const Vec3d p = positions[j];
-          double best = std::numeric_limits<double>::infinity();
-          const auto bucket = [&](const KdNode& n) {
-            for (std::uint32_t q = n.next; q < n.next + n.count; ++q) {
-              const Vec3d d = positions[q] - p;
-              if (q != j) best = std::min(best, dot(d, d));
-            }
+          const auto bucket = [&](const KdNode& n, double best) {
+            const std::uint32_t end = n.next + n.count;
+            if (j < n.next || j >= end) return nearestSquared(positions, n.next, end, p, best);
+            best = nearestSquared(positions, n.next, j, p, best);
+            return nearestSquared(positions, j + 1, end, p, best);
           };
-          bucket(kd[bucketOf[j]]);
+          double best = bucket(kd[bucketOf[j]], std::numeric_limits<double>::infinity());
           for (std::uint32_t node = bucketOf[j]; node != 0; node = parent[node]) {
             const KdNode& up = kd[parent[node]];
             const double gap = p[up.axis] - up.value;
@@ -176,7 +214,7 @@ std::vector<float> halfSpacing(std::span<const CloudPoint> points,
               if (least >= best) continue;
               const KdNode& n = kd[t];
               if (n.count > 0) {
-                bucket(n);
+                best = bucket(n, best);
                 continue;
               }
               const double side = p[n.axis] - n.value;
@@ -258,7 +296,7 @@ std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin
   if (points.empty()) return nodes;
   std::vector<Range> ranges;
   std::vector<Separator> separators;
-  splitTree(points, ids, origin, nodes, ranges, separators);
+  splitTree(points, ids, origin, options.colors, nodes, ranges, separators);
   if (!hasNormals)
     cellNormals(points, nodes, ranges, static_cast<std::uint32_t>(std::max(3, options.neighbours)));
   const std::vector<float> spacing = halfSpacing(points, nodes, ranges, separators);

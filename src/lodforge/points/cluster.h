@@ -32,6 +32,7 @@ static_assert(sizeof(ClusterNode) == 44);
 struct ClusterOptions {
   double alpha1 = 0.5, alpha2 = 0.5;  // weights of distance and normal difference (the paper's)
   int neighbours = 12;                // k: the fewest points in a normal's neighbourhood
+  bool colors = true;  // nodes' mean colours (point packages draw them; tiles leave them 0)
 };
 
 // The clustering tree of one block, breadth-first with the root first; `points` is reordered.

@@ -382,49 +382,7 @@ SplitPlane centroidSplit(const Aabbd& bounds, Vec3d centroid) {
 
 std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
                         std::span<std::uint32_t> ids) {
-  assert(ids.empty() || ids.size() == points.size());
-  const auto below = [&](std::size_t i) { return points[i].position[plane.axis] < plane.value; };
-  const auto swap = [&](std::size_t i, std::size_t j) {
-    std::swap(points[i], points[j]);
-    if (!ids.empty()) std::swap(ids[i], ids[j]);
-  };
-  // Hoare's partition, as std::partition does it (the same order), moving the ids too.
-  std::size_t i = 0, j = points.size();
-  while (true) {
-    while (i < j && below(i)) ++i;
-    while (i < j && !below(j - 1)) --j;
-    if (i >= j) break;
-    swap(i++, --j);
-  }
-  std::size_t count = i;
-  if ((count == 0 || count == points.size()) && points.size() >= 2) {
-    count = points.size() / 2;
-    const auto byAxis = [&](const CloudPoint& a, const CloudPoint& b) {
-      return a.position[plane.axis] < b.position[plane.axis];
-    };
-    if (ids.empty()) {
-      std::nth_element(points.begin(), points.begin() + static_cast<std::ptrdiff_t>(count),
-                       points.end(), byAxis);
-      return count;
-    }
-    const auto [least, most] = std::minmax_element(points.begin(), points.end(), byAxis);
-    if (least->position[plane.axis] == most->position[plane.axis])
-      return count;  // all on one coordinate (the usual case here): any half will do
-    // Otherwise select through an index (rare: rounding put the centroid outside), then move
-    // the points and their ids together.
-    std::vector<std::uint32_t> order(points.size());
-    std::iota(order.begin(), order.end(), 0u);
-    std::nth_element(
-        order.begin(), order.begin() + static_cast<std::ptrdiff_t>(count), order.end(),
-        [&](std::uint32_t a, std::uint32_t b) { return byAxis(points[a], points[b]); });
-    const std::vector<CloudPoint> was(points.begin(), points.end());
-    const std::vector<std::uint32_t> wasIds(ids.begin(), ids.end());
-    for (std::size_t k = 0; k < order.size(); ++k) {
-      points[k] = was[order[k]];
-      ids[k] = wasIds[order[k]];
-    }
-  }
-  return count;
+  return splitRecords(points, plane, ids, !ids.empty());
 }
 
 Result<std::vector<CloudPoint>> readPointRecords(const std::string& path,

@@ -5,8 +5,11 @@
 // block ends as a contiguous range of CloudPoint records in that file.
 #pragma once
 
+#include <algorithm>
+#include <cassert>
 #include <cstdint>
 #include <functional>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <string>
@@ -77,6 +80,56 @@ SplitPlane centroidSplit(const Aabbd& bounds, Vec3d centroid);
 // (one per point), is reordered with them.
 std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
                         std::span<std::uint32_t> ids = {});
+
+// The same for any record with a `position` (the clustering splits a compact copy). `flatStays`:
+// when every point has the axis' coordinate, any half will do and nothing moves (splitPoints
+// sets it when it has ids). Its swaps depend only on the positions, so the order it leaves is
+// the same for every record type.
+template <class Point>
+std::size_t splitRecords(std::span<Point> points, SplitPlane plane, std::span<std::uint32_t> ids,
+                         bool flatStays) {
+  assert(ids.empty() || ids.size() == points.size());
+  const auto below = [&](std::size_t i) { return points[i].position[plane.axis] < plane.value; };
+  const auto swap = [&](std::size_t i, std::size_t j) {
+    std::swap(points[i], points[j]);
+    if (!ids.empty()) std::swap(ids[i], ids[j]);
+  };
+  // Hoare's partition, as std::partition does it (the same order), moving the ids too.
+  std::size_t i = 0, j = points.size();
+  while (true) {
+    while (i < j && below(i)) ++i;
+    while (i < j && !below(j - 1)) --j;
+    if (i >= j) break;
+    swap(i++, --j);
+  }
+  if ((i != 0 && i != points.size()) || points.size() < 2) return i;
+  const std::size_t count = points.size() / 2;
+  const auto half = static_cast<std::ptrdiff_t>(count);
+  const auto byAxis = [&](const Point& a, const Point& b) {
+    return a.position[plane.axis] < b.position[plane.axis];
+  };
+  if (flatStays) {
+    const auto [least, most] = std::minmax_element(points.begin(), points.end(), byAxis);
+    if (least->position[plane.axis] == most->position[plane.axis]) return count;
+  }
+  if (ids.empty()) {
+    std::nth_element(points.begin(), points.begin() + half, points.end(), byAxis);
+    return count;
+  }
+  // Through an index (rare: rounding put the centroid outside), then the points and their ids
+  // moved together: the same order as selecting on the points themselves.
+  std::vector<std::uint32_t> order(points.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::nth_element(order.begin(), order.begin() + half, order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return byAxis(points[a], points[b]); });
+  const std::vector<Point> was(points.begin(), points.end());
+  const std::vector<std::uint32_t> wasIds(ids.begin(), ids.end());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    points[k] = was[order[k]];
+    ids[k] = wasIds[order[k]];
+  }
+  return count;
+}
 
 // Records [first, first + count) of a work file of CloudPoints (a block's, say).
 Result<std::vector<CloudPoint>> readPointRecords(const std::string& path,

@@ -1,6 +1,7 @@
 #include "lodforge/tiles/point_tiles.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cassert>
@@ -74,24 +75,21 @@ Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
                  const PointBlock& block, bool hasNormals, const PointTilesOptions& options,
                  const std::string& workDirectory, BlockTiles& out) {
   std::vector<std::uint32_t> firstPoint;
-  const std::vector<ClusterNode> tree = tileErrorTree(
-      clusterBlock(points, block.centroid, hasNormals, options.cluster, &firstPoint, ids));
+  ClusterOptions cluster = options.cluster;
+  cluster.colors = false;  // tiles draw the points' own colours
+  const std::vector<ClusterNode> tree =
+      tileErrorTree(clusterBlock(points, block.centroid, hasNormals, cluster, &firstPoint, ids));
   const std::vector<std::uint32_t> reps =
       clusterRepresentatives(tree, points, firstPoint, block.centroid);
   const std::vector<float> key = pointKeys(tree, reps);
   out.leastError = tree.front().error;
   for (const ClusterNode& node : tree) out.leastError = std::min(out.leastError, node.error);
-  // Highest key first, ties in tree order: one 64-bit sort key per point (a non-negative
-  // float's bits order like the float; inverted for descending), far cheaper than a stable sort.
-  std::vector<std::uint64_t> order(points.size());
-  for (std::uint32_t i = 0; i < order.size(); ++i)
-    order[i] = std::uint64_t{~std::bit_cast<std::uint32_t>(key[i])} << 32 | i;
-  std::sort(order.begin(), order.end());
+  const std::vector<std::uint32_t> order = descendingKeyOrder(key);
   const std::vector<CloudPoint> unsorted(points.begin(), points.end());
   const std::vector<std::uint32_t> unsortedIds(ids.begin(), ids.end());
   std::vector<float> sortedKeys(points.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
-    const auto from = static_cast<std::uint32_t>(order[i]);
+    const std::uint32_t from = order[i];
     points[i] = unsorted[from];
     if (!ids.empty()) ids[i] = unsortedIds[from];
     sortedKeys[i] = key[from];
@@ -284,6 +282,27 @@ std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> t
     reps[i] = length(points[a].position - c) <= length(points[b].position - c) ? a : b;
   }
   return reps;
+}
+
+// A stable LSD radix sort of the inverted bits (a non-negative float's bits order like the float),
+// three passes of 11 bits: what sorting (inverted bits << 32 | index) gave, at a third of the time.
+std::vector<std::uint32_t> descendingKeyOrder(std::span<const float> key) {
+  constexpr int kBits = 11;
+  constexpr std::uint32_t kBuckets = 1u << kBits;
+  std::vector<std::uint32_t> order(key.size()), next(key.size()), inverted(key.size());
+  for (std::uint32_t i = 0; i < key.size(); ++i) {
+    assert(!(key[i] < 0));  // −0 was made +0 (pointKeys)
+    inverted[i] = ~std::bit_cast<std::uint32_t>(key[i]);
+    order[i] = i;
+  }
+  for (int shift = 0; shift < 32; shift += kBits) {
+    std::array<std::uint32_t, kBuckets + 1> start{};
+    for (const std::uint32_t v : inverted) ++start[((v >> shift) & (kBuckets - 1)) + 1];
+    for (std::uint32_t b = 0; b < kBuckets; ++b) start[b + 1] += start[b];
+    for (const std::uint32_t i : order) next[start[(inverted[i] >> shift) & (kBuckets - 1)]++] = i;
+    order.swap(next);
+  }
+  return order;
 }
 
 std::vector<float> pointKeys(std::span<const ClusterNode> tree,

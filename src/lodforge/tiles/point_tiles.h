@@ -63,6 +63,10 @@ std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> t
 std::vector<float> pointKeys(std::span<const ClusterNode> tree,
                              std::span<const std::uint32_t> reps);
 
+// The order a block's points are written in: by key (non-negative, +∞ allowed), highest first,
+// ties in index order (what a stable sort by descending key gives).
+std::vector<std::uint32_t> descendingKeyOrder(std::span<const float> key);
+
 // `lodforge tiles cloud.las`: the whole pipeline into `outputDirectory` (written under a
 // temporary name and renamed when complete).
 Result<PointTilesStats> writePointTiles(const std::string& input,

@@ -67,6 +67,18 @@ struct WorkFiles {
     }
     return {};
   }
+  // The same with the slices in parallel, for a node loaded for the in-memory splits (one
+  // thread copied it out of the page cache and decoded it while the other waited).
+  Status readPointsInParallel(std::uint64_t first, std::span<CloudPoint> out) const {
+    std::vector<Status> read((out.size() + kSlice - 1) / kSlice);
+    tbb::parallel_for(std::size_t{0}, read.size(), [&](std::size_t slice) {
+      const std::size_t done = slice * kSlice, n = std::min(kSlice, out.size() - done);
+      std::vector<std::byte> scratch;
+      read[slice] = readPoints(first + done, out.subspan(done, n), scratch);
+    });
+    for (const Status& status : read) LODFORGE_TRY(status);
+    return {};
+  }
   Status writePoints(std::uint64_t first, std::span<const CloudPoint> in,
                      std::vector<std::byte>& scratch) const {
     for (std::size_t done = 0; done < in.size(); done += kSlice) {
@@ -98,10 +110,11 @@ struct Records {
     const auto e = from.extras.begin() + static_cast<std::ptrdiff_t>(i * stride);
     extras.insert(extras.end(), e, e + static_cast<std::ptrdiff_t>(stride));
   }
-  // n records from record `first` of the files.
-  Status read(const WorkFiles& files, std::uint64_t first, std::size_t n) {
+  // n records from record `first` of the files (the points' slices in parallel, or not).
+  Status read(const WorkFiles& files, std::uint64_t first, std::size_t n, bool parallel = false) {
     resize(n);
-    LODFORGE_TRY(files.readPoints(first, points, scratch));
+    LODFORGE_TRY(parallel ? files.readPointsInParallel(first, points)
+                          : files.readPoints(first, points, scratch));
     if (stride == 0) return {};
     return files.extras->readAt(first * stride, extras.data(), n * stride);
   }
@@ -454,7 +467,7 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
                    fmt::format("{}: {} points share one position, more than the 2^32 that can "
                                "carry extra fields; leave them out with --attributes",
                                input, node.count)};
-    LODFORGE_TRY(records.read(files, node.first, static_cast<std::size_t>(node.count)));
+    LODFORGE_TRY(records.read(files, node.first, static_cast<std::size_t>(node.count), true));
     ids.resize(stride == 0 ? 0 : records.size());
     std::iota(ids.begin(), ids.end(), 0u);
     splitInMemory(records.points, ids, node.first, node.name,

@@ -161,12 +161,13 @@ nlohmann::json extraProperty(const ExtraField& field, const ExtraColumn& column)
 }
 
 nlohmann::json classificationEnum(std::span<const CloudPoint> points) {
-  std::set<int> values;
-  for (int c = 0; c <= 22; ++c) values.insert(c);
-  for (const CloudPoint& p : points) values.insert(p.attributes.classification);
+  std::array<bool, 256> used{};  // a table, not a set: this runs over every point of every tile
+  for (int c = 0; c <= 22; ++c) used[static_cast<std::size_t>(c)] = true;
+  for (const CloudPoint& p : points) used[p.attributes.classification] = true;
   nlohmann::json list = nlohmann::json::array();
-  for (int c : values)
-    list.push_back({{"name", asprsClassName(static_cast<std::uint8_t>(c))}, {"value", c}});
+  for (int c = 0; c < 256; ++c)
+    if (used[static_cast<std::size_t>(c)])
+      list.push_back({{"name", asprsClassName(static_cast<std::uint8_t>(c))}, {"value", c}});
   return {{"valueType", "UINT8"}, {"values", list}};
 }
 

@@ -12,13 +12,15 @@
 namespace lodforge {
 namespace {
 
-// A package of generated CAD parts, built once for all tests here.
+// A package of generated CAD parts, built once for all tests here. Its folder goes when the
+// package is open (the mapping keeps the file; a folder that outlived the tests was left in
+// /tmp by every run).
 const Package& parts() {
-  static test::TempDir* dir = new test::TempDir;
   static const Package package = [] {
-    EXPECT_TRUE(generateCad({.objects = 300, .seed = 21}, dir->file("parts.glb")).ok());
-    EXPECT_TRUE(buildPackage(dir->file("parts.glb"), dir->file("parts.lfp")).ok());
-    Result<Package> p = Package::open(dir->file("parts.lfp"));
+    const test::TempDir dir;
+    EXPECT_TRUE(generateCad({.objects = 300, .seed = 21}, dir.file("parts.glb")).ok());
+    EXPECT_TRUE(buildPackage(dir.file("parts.glb"), dir.file("parts.lfp")).ok());
+    Result<Package> p = Package::open(dir.file("parts.lfp"));
     EXPECT_TRUE(p.ok()) << p.error().message;
     return std::move(p.value());
   }();

@@ -18,6 +18,11 @@ seconds=${1:-20}
 forked=" cad assimp "
 readers=(${READERS:-ply obj stl gltf lfp png tiles las laz xyz lfc cad})
 mkdir -p build/fuzz/artifacts
+# The fuzzers' temporary files (an OBJ's folder, a CAD file per input) in a folder of this run,
+# removed at the end: a job stopped at the time limit cannot remove its own.
+export TMPDIR=$PWD/build/fuzz/tmp
+rm -rf "$TMPDIR" && mkdir -p "$TMPDIR"
+trap 'rm -rf "$TMPDIR"' EXIT
 run() {
   local reader=$1 work=build/fuzz/work/$1 mode=() ignored="^$" passing="0" rc=0 replay=0
   mkdir -p "$work"

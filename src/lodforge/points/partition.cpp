@@ -398,26 +398,26 @@ std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
   return splitRecords(points, plane, ids, !ids.empty());
 }
 
+// Exactly the range, by pread: a buffered reader filled a whole megabyte for every tile's
+// section, and the 100 M-point contents read 38.5 GB for 5.4 GB of tiles.
 Result<std::vector<CloudPoint>> readPointRecords(const std::string& path,
                                                  const PointRecordLayout& layout,
                                                  std::uint64_t first, std::uint64_t count) {
-  Result<ByteSource> in = ByteSource::openFile(path);
+  Result<WorkFile> in = WorkFile::open(path);
   if (!in) return in.status();
   std::vector<CloudPoint> points(count);
   std::vector<std::byte> bytes(count * layout.bytes());
-  if (!in->skip(first * layout.bytes()) || !in->read(bytes.data(), bytes.size()))
-    return ioError(path, "work file is shorter than expected");
+  LODFORGE_TRY(in->readAt(first * layout.bytes(), bytes.data(), bytes.size()));
   layout.decode(bytes.data(), points);
   return points;
 }
 
 Result<std::vector<std::byte>> readExtraRecords(const std::string& path, std::uint32_t stride,
                                                 std::uint64_t first, std::uint64_t count) {
-  Result<ByteSource> in = ByteSource::openFile(path);
+  Result<WorkFile> in = WorkFile::open(path);
   if (!in) return in.status();
   std::vector<std::byte> extras(count * stride);
-  if (!in->skip(first * stride) || !in->read(extras.data(), extras.size()))
-    return ioError(path, "work file is shorter than expected");
+  LODFORGE_TRY(in->readAt(first * stride, extras.data(), extras.size()));
   return extras;
 }
 

@@ -37,11 +37,10 @@ static_assert(sizeof(SplitItem) == 32);
 // `points` (and `ids`, if any) in the items' order.
 void followItems(std::span<const SplitItem> items, std::span<CloudPoint> points,
                  std::span<std::uint32_t> ids) {
-  const std::vector<CloudPoint> was(points.begin(), points.end());
-  for (std::size_t k = 0; k < items.size(); ++k) points[k] = was[items[k].index];
-  if (ids.empty()) return;
-  const std::vector<std::uint32_t> wasIds(ids.begin(), ids.end());
-  for (std::size_t k = 0; k < items.size(); ++k) ids[k] = wasIds[items[k].index];
+  std::vector<std::uint32_t> order(items.size());
+  for (std::size_t k = 0; k < items.size(); ++k) order[k] = items[k].index;
+  applyOrder(order, points);
+  applyOrder(order, ids);
 }
 
 // Top-down splitting (§4.1, "Hierarchical clustering"), breadth-first: each node's centroid,

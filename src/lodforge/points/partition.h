@@ -81,6 +81,16 @@ SplitPlane centroidSplit(const Aabbd& bounds, Vec3d centroid);
 std::size_t splitPoints(std::span<CloudPoint> points, SplitPlane plane,
                         std::span<std::uint32_t> ids = {});
 
+// `values` rearranged so that value k is the one that was at order[k] (a permutation); nothing
+// for empty values. Points and their ids follow a sort or a selection this way.
+template <class T>
+void applyOrder(std::span<const std::uint32_t> order, std::span<T> values) {
+  if (values.empty()) return;
+  assert(order.size() == values.size());
+  const std::vector<T> was(values.begin(), values.end());
+  for (std::size_t k = 0; k < order.size(); ++k) values[k] = was[order[k]];
+}
+
 // The same for any record with a `position` (the clustering splits a compact copy). `flatStays`:
 // when every point has the axis' coordinate, any half will do and nothing moves (splitPoints
 // sets it when it has ids). Its swaps depend only on the positions, so the order it leaves is
@@ -122,12 +132,8 @@ std::size_t splitRecords(std::span<Point> points, SplitPlane plane, std::span<st
   std::iota(order.begin(), order.end(), 0u);
   std::nth_element(order.begin(), order.begin() + half, order.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return byAxis(points[a], points[b]); });
-  const std::vector<Point> was(points.begin(), points.end());
-  const std::vector<std::uint32_t> wasIds(ids.begin(), ids.end());
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    points[k] = was[order[k]];
-    ids[k] = wasIds[order[k]];
-  }
+  applyOrder(order, points);
+  applyOrder(order, ids);
   return count;
 }
 

@@ -81,19 +81,13 @@ Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
       tileErrorTree(clusterBlock(points, block.centroid, hasNormals, cluster, &firstPoint, ids));
   const std::vector<std::uint32_t> reps =
       clusterRepresentatives(tree, points, firstPoint, block.centroid);
-  const std::vector<float> key = pointKeys(tree, reps);
+  std::vector<float> key = pointKeys(tree, reps);
   out.leastError = tree.front().error;
   for (const ClusterNode& node : tree) out.leastError = std::min(out.leastError, node.error);
   const std::vector<std::uint32_t> order = descendingKeyOrder(key);
-  const std::vector<CloudPoint> unsorted(points.begin(), points.end());
-  const std::vector<std::uint32_t> unsortedIds(ids.begin(), ids.end());
-  std::vector<float> sortedKeys(points.size());
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    const std::uint32_t from = order[i];
-    points[i] = unsorted[from];
-    if (!ids.empty()) ids[i] = unsortedIds[from];
-    sortedKeys[i] = key[from];
-  }
+  applyOrder(order, points);
+  applyOrder(order, ids);
+  applyOrder(order, std::span(key));  // written beside, sorted like the points
   out.path = block.path;
   out.layout = block.layout;
   out.first = block.first;
@@ -102,7 +96,7 @@ Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
   out.rootError = tree.front().error;
   Result<OutputFile> keys = OutputFile::create(out.keysPath, std::size_t{1} << 20);
   if (!keys) return keys.status();
-  LODFORGE_TRY(keys->writeSpan(std::span<const float>(sortedKeys)));
+  LODFORGE_TRY(keys->writeSpan(std::span<const float>(key)));
   return keys->commit();
 }
 

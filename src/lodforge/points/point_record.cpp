@@ -70,15 +70,8 @@ Status PointRecordLayout::encode(std::span<const CloudPoint> points, std::byte* 
 
 void PointRecordLayout::decode(const std::byte* in, std::span<CloudPoint> points) const {
   for (CloudPoint& p : points) {
-    if (gridded_) {
-      for (int k = 0; k < 3; ++k) {
-        std::int32_t integer;
-        take(in, integer);
-        p.position[k] = static_cast<double>(integer) * grid_.scale[k] + grid_.offset[k];
-      }
-    } else {
-      take(in, p.position);
-    }
+    p.position = position(in);
+    in += gridded_ ? 3 * sizeof(std::int32_t) : sizeof(Vec3d);
     p.normal = Vec3f{};
     p.color = Rgba8{};
     p.attributes = PointAttributes{};

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
 
 #include "lodforge/core/math.h"
@@ -43,6 +44,21 @@ class PointRecordLayout {
   // Reads points.size() records from `in`; what the layout leaves out comes back as the pipeline's
   // defaults (no normal, white, no lidar fields).
   void decode(const std::byte* in, std::span<CloudPoint> points) const;
+  // The position of the record at `record` (bytes() long), exactly as decode gives it.
+  Vec3d position(const std::byte* record) const {
+    Vec3d p;
+    if (gridded_) {
+      for (int k = 0; k < 3; ++k) {
+        std::int32_t integer;
+        std::memcpy(&integer, record + static_cast<std::size_t>(k) * sizeof integer,
+                    sizeof integer);
+        p[k] = static_cast<double>(integer) * grid_.scale[k] + grid_.offset[k];
+      }
+    } else {
+      std::memcpy(&p, record, sizeof p);
+    }
+    return p;
+  }
 
  private:
   bool gridded_ = false, normals_ = true, colors_ = true, attributes_ = true;

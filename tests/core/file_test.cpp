@@ -137,6 +137,23 @@ TEST(OutputFile, PositionalWritesAndAppendedFiles) {
   EXPECT_EQ(test::readFile(dir.file("joined.bin")), "head:012345:end");
 }
 
+TEST(OutputFile, WritesLargerThanTheBufferGoStraightToTheFileInOrder) {
+  test::TempDir dir;
+  Result<OutputFile> out = OutputFile::create(dir.file("out.bin"), 4096);
+  ASSERT_TRUE(out.ok());
+  std::string big(10'000, 'b'), expected = "head";
+  for (std::size_t i = 0; i < big.size(); ++i) big[i] = static_cast<char>('a' + i % 26);
+  ASSERT_TRUE(out->write("head", 4).ok());               // buffered
+  ASSERT_TRUE(out->write(big.data(), big.size()).ok());  // past the buffer, after "head"
+  ASSERT_TRUE(out->write("mid", 3).ok());
+  ASSERT_TRUE(out->write(big.data(), 4096).ok());  // exactly the buffer's size
+  ASSERT_TRUE(out->write("end", 3).ok());
+  expected += big + "mid" + big.substr(0, 4096) + "end";
+  EXPECT_EQ(out->bytesWritten(), expected.size());
+  ASSERT_TRUE(out->commit().ok());
+  EXPECT_EQ(test::readFile(dir.file("out.bin")), expected);
+}
+
 TEST(OutputFile, FailsCleanlyWhereItCannotWrite) {
   Result<OutputFile> out = OutputFile::create("/nonexistent-dir/out.glb");
   ASSERT_FALSE(out.ok());

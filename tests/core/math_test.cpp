@@ -164,6 +164,23 @@ TEST(RoundToLong, EqualsLroundOnEveryFloatNearHalvesAndOnRandomFloats) {
     EXPECT_EQ(roundToLong(x), std::lround(x)) << x;
 }
 
+TEST(RoundHalfAway, EqualsLroundNextToEveryHalfAndOnRandomDoubles) {
+  // Next to n + 0.5 (and 0.5 − 2^-54, where adding 0.5 would round up to 1).
+  for (int n = -70000; n <= 70000; ++n) {
+    double x = static_cast<double>(n) + 0.5;
+    for (int step = 0; step < 3; ++step) x = std::nextafter(x, -1e9);
+    for (int step = 0; step < 7; ++step, x = std::nextafter(x, 1e9))
+      ASSERT_EQ(roundHalfAway(x), std::lround(x)) << x;
+  }
+  Random random(11);
+  for (int i = 0; i < 1'000'000; ++i) {
+    const double x = random.uniform(-1, 1) * 70000;
+    ASSERT_EQ(roundHalfAway(x), std::lround(x)) << x;
+  }
+  for (double x : {0.0, -0.0, 0.49999999999999994, -0.49999999999999994, 1e-300, 65535.0})
+    EXPECT_EQ(roundHalfAway(x), std::lround(x)) << x;
+}
+
 TEST(Random, IsDeterministicAndIndependentPerItem) {
   Random a(42), b(42);
   for (int i = 0; i < 10; ++i) EXPECT_EQ(a.next(), b.next());

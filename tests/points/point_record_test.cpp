@@ -1,6 +1,9 @@
 #include "lodforge/points/point_record.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -53,13 +56,15 @@ TEST(PointRecord, ALasFilesPointsComeBackBitForBitFromTheirGridIn40Bytes) {
     const std::vector<CloudPoint> points = cloudPointsOf(test::dataPath(file), info);
     ASSERT_GT(points.size(), 1000u);
     ASSERT_TRUE(info.grid.has_value());
-    const PointRecordLayout layout = PointRecordLayout::of(info, false, false);
+    const PointRecordLayout layout = PointRecordLayout::of(info, false);
     EXPECT_TRUE(layout.gridded());
     // Integers on the grid, a colour, the lidar fields: no normal.
     EXPECT_EQ(layout.bytes(), 12u + 4u + 24u) << file;
     EXPECT_TRUE(sameBits(roundTrip(layout, points), points)) << file;
-    // Normals kept when the pipeline computes them (tiles): 12 bytes more.
-    EXPECT_EQ(PointRecordLayout::of(info, false, true).bytes(), 52u);
+    // Normals kept when the pipeline computes them: 12 bytes more as floats, 4 as bytes
+    // (quantised tiles).
+    EXPECT_EQ(PointRecordLayout::of(info, false, RecordNormals::kFloat).bytes(), 52u);
+    EXPECT_EQ(PointRecordLayout::of(info, false, RecordNormals::kBytes).bytes(), 44u);
   }
 }
 
@@ -68,7 +73,7 @@ TEST(PointRecord, PlacedOrGridlessPositionsStayDoubles) {
   std::vector<CloudPoint> points = cloudPointsOf(test::dataPath("points/autzen_trim.las"), info);
   points.resize(500);
   // A CRS moves the points off the file's grid: doubles, and any double comes back.
-  const PointRecordLayout placed = PointRecordLayout::of(info, true, false);
+  const PointRecordLayout placed = PointRecordLayout::of(info, true);
   EXPECT_FALSE(placed.gridded());
   EXPECT_EQ(placed.bytes(), 24u + 4u + 24u);
   for (CloudPoint& p : points) p.position = p.position * 1.0000001 + Vec3d{0.1234567, 0, 0};
@@ -78,10 +83,45 @@ TEST(PointRecord, PlacedOrGridlessPositionsStayDoubles) {
   EXPECT_TRUE(sameBits(roundTrip(PointRecordLayout{}, points), points));
 }
 
+TEST(PointRecord, NormalBytesKeepEveryByteNormalExactlyAndOthersToHalfAStep) {
+  PointCloudInfo info;
+  info.grid = PointCloudInfo::Grid{{0.01, 0.01, 0.01}, {0, 0, 0}};
+  const PointRecordLayout layout = PointRecordLayout::of(info, false, RecordNormals::kBytes);
+  ASSERT_TRUE(layout.normalBytes());
+  EXPECT_EQ(layout.bytes(), 12u + 4u);
+  // An input's own normals stay floats (the clustering reads them).
+  PointCloudInfo withNormals = info;
+  withNormals.hasNormals = true;
+  EXPECT_FALSE(PointRecordLayout::of(withNormals, false, RecordNormals::kBytes).normalBytes());
+  EXPECT_EQ(PointRecordLayout::of(withNormals, false, RecordNormals::kBytes).bytes(), 24u);
+  // Every normal of whole bytes over 127 (what tiles keep) comes back bit for bit.
+  std::vector<CloudPoint> bytesOnly;
+  for (int x = -127; x <= 127; x += 3)
+    for (int y = -127; y <= 127; y += 5)
+      for (int z = -127; z <= 127; z += 7) {
+        CloudPoint p;
+        p.normal =
+            Vec3f{static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)} / 127.0f;
+        bytesOnly.push_back(p);
+      }
+  EXPECT_TRUE(sameBits(roundTrip(layout, bytesOnly), bytesOnly));
+  // Any unit normal comes back within half a step (1/254) on each axis.
+  std::mt19937 random(7);
+  std::normal_distribution<float> gauss;
+  std::vector<CloudPoint> units(2000);
+  for (CloudPoint& p : units)
+    p.normal = normalizeOr(Vec3f{gauss(random), gauss(random), gauss(random)}, Vec3f{0, 0, 1});
+  const std::vector<CloudPoint> back = roundTrip(layout, units);
+  for (std::size_t i = 0; i < units.size(); ++i) {
+    const Vec3f d = back[i].normal - units[i].normal;
+    EXPECT_LE(std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}), 0.5f / 127.0f + 1e-6f);
+  }
+}
+
 TEST(PointRecord, APositionOffTheGridIsRefusedNotRounded) {
   PointCloudInfo info;
   info.grid = PointCloudInfo::Grid{{0.01, 0.01, 0.01}, {1000, 2000, 0}};
-  const PointRecordLayout layout = PointRecordLayout::of(info, false, false);
+  const PointRecordLayout layout = PointRecordLayout::of(info, false);
   ASSERT_TRUE(layout.gridded());
   EXPECT_EQ(layout.bytes(), 12u);
   CloudPoint on;

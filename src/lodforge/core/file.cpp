@@ -240,16 +240,21 @@ void OutputFile::discard() {
 }
 
 Status OutputFile::flush() {
+  LODFORGE_TRY(writeOut(buffer_.data(), buffered_));
+  buffered_ = 0;
+  return {};
+}
+
+Status OutputFile::writeOut(const std::byte* data, std::size_t size) {
   std::size_t done = 0;
-  while (done < buffered_) {
-    const ssize_t put = ::write(fd_, buffer_.data() + done, buffered_ - done);
+  while (done < size) {
+    const ssize_t put = ::write(fd_, data + done, size - done);
     if (put < 0) {
       if (errno == EINTR) continue;
       return ioErrorFromErrno(path_, "write");
     }
     done += static_cast<std::size_t>(put);
   }
-  buffered_ = 0;
   return {};
 }
 
@@ -257,6 +262,11 @@ Status OutputFile::write(const void* data, std::size_t size) {
   assert(fd_ >= 0);
   const auto* bytes = static_cast<const std::byte*>(data);
   written_ += size;
+  if (size >= buffer_.size()) {
+    // Straight from the caller's memory (a GLB's binary chunk): no copy through the buffer.
+    LODFORGE_TRY(flush());
+    return writeOut(bytes, size);
+  }
   while (size > 0) {
     if (buffered_ == buffer_.size()) LODFORGE_TRY(flush());
     const std::size_t take = std::min(size, buffer_.size() - buffered_);

@@ -94,6 +94,7 @@ class OutputFile {
  private:
   OutputFile() = default;
   void discard();
+  Status writeOut(const std::byte* data, std::size_t size);  // at the file's position
 
   std::string path_;
   std::string tempPath_;

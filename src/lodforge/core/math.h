@@ -69,6 +69,14 @@ inline Vec3f toFloat(Vec3d a) {
 }
 // std::lround of a float (halves away from zero) without its library call, for per-vertex
 // loops: exact, because a float plus or minus 0.5 is exact in double.
+// std::lround (halves away from zero) without its libm call; exact for |x| < 2^52, where
+// x − trunc(x) is exact.
+inline long roundHalfAway(double x) {
+  const auto t = static_cast<long>(x);
+  const double rest = x - static_cast<double>(t);
+  return t + (rest >= 0.5 ? 1 : 0) - (rest <= -0.5 ? 1 : 0);
+}
+
 inline long roundToLong(float x) {
   const double d = x;
   return static_cast<long>(d + (d >= 0 ? 0.5 : -0.5));

@@ -194,7 +194,7 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
       input, {.salvageTruncated = options.salvageTruncated, .readExtras = options.carryExtras});
   if (!reader) return reader.status();
   info = reader->info();
-  layout = PointRecordLayout::of(info, static_cast<bool>(options.transform), options.keepNormals);
+  layout = PointRecordLayout::of(info, static_cast<bool>(options.transform), options.normals);
   const std::size_t stride = info.extras.stride;
   Result<OutputFile> out = OutputFile::create(path, std::size_t{1} << 20);
   if (!out) return out.status();

@@ -42,9 +42,9 @@ struct PartitionOptions {
   // Carry the input's extra fields (LAS extra bytes, other PLY properties) in a second work file;
   // without, they are not read.
   bool carryExtras = false;
-  // The block sink sets normals (a cloud without any gets them by PCA): keep them in the work
-  // file even when the input has none.
-  bool keepNormals = false;
+  // The block sink sets normals (a cloud without any gets them by PCA): kFloat or kBytes keep
+  // them in the work file even when the input has none.
+  RecordNormals normals = RecordNormals::kInput;
   // Applied to every point as it is read (one thread): e.g. a CRS to a local frame. False
   // refuses the point.
   std::function<bool(Vec3d, Vec3d&)> transform;

@@ -28,16 +28,25 @@ struct CloudPoint {
 };
 static_assert(sizeof(CloudPoint) == 64);
 
+// What a record keeps of the normal: the input's (nothing when it has none); always three
+// floats (the pipeline computes them); or, for an input without normals whose computed ones are
+// only drawn, three signed bytes (127 × each axis, rounded: 4 bytes instead of 12), as
+// quantised tiles write them.
+enum class RecordNormals { kInput, kFloat, kBytes };
+
 class PointRecordLayout {
  public:
   PointRecordLayout() = default;  // every field, positions as doubles (64 bytes)
   // What an input's points need. `placed`: positions are transformed on reading (a CRS), so
-  // they leave the file's grid; `normals`: keep normals even when the input has none (the
-  // pipeline computes them).
-  static PointRecordLayout of(const PointCloudInfo& info, bool placed, bool normals);
+  // they leave the file's grid.
+  static PointRecordLayout of(const PointCloudInfo& info, bool placed,
+                              RecordNormals normals = RecordNormals::kInput);
 
   std::size_t bytes() const { return bytes_; }
   bool gridded() const { return gridded_; }
+  // Normals kept as bytes: decode gives each axis as byte / 127, and 127 × that rounds back to
+  // the byte exactly.
+  bool normalBytes() const { return normalBytes_; }
   // Writes points.size() records to `out` (bytes() each). Fails (kInternal) on a position the
   // grid does not hold exactly, which a reader's own grid never gives.
   Status encode(std::span<const CloudPoint> points, std::byte* out) const;
@@ -61,7 +70,7 @@ class PointRecordLayout {
   }
 
  private:
-  bool gridded_ = false, normals_ = true, colors_ = true, attributes_ = true;
+  bool gridded_ = false, normals_ = true, normalBytes_ = false, colors_ = true, attributes_ = true;
   PointCloudInfo::Grid grid_{};
   Vec3d inverseScale_{1, 1, 1};
   std::size_t bytes_ = sizeof(CloudPoint);

@@ -69,6 +69,32 @@ struct BlockTiles {
   float leastError = 0;  // the least tile error in the block's tree
 };
 
+// Each point's normal made what its tile will write, exactly: the GLB writer's bytes for the
+// y-up normal, turned back to z-up and over 127, which the work record's bytes keep exactly
+// (the clustering is done with the float normals by then).
+void keepTileNormals(std::span<CloudPoint> points) {
+  for (CloudPoint& p : points) {
+    const std::array<std::int8_t, 4> q =
+        glbPackNormal(toYUp(normalizeOr(p.normal, Vec3f{0, 0, 1})));
+    // toYUp maps (x, y, z) to (x, z, −y); its inverse maps (a, b, c) to (a, −c, b).
+    p.normal =
+        Vec3f{static_cast<float>(q[0]), -static_cast<float>(q[2]), static_cast<float>(q[1])} /
+        127.0f;
+  }
+}
+
+// The y-up bytes tiles write for normals that keepTileNormals made (127 × each axis is a whole
+// number there).
+std::vector<std::array<std::int8_t, 4>> tileNormalBytes(std::span<const CloudPoint> points) {
+  std::vector<std::array<std::int8_t, 4>> packed(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Vec3f n = points[i].normal * 127.0f;
+    const auto byte = [](float v) { return static_cast<std::int8_t>(roundToLong(v)); };
+    packed[i] = {byte(n.x), byte(n.z), byte(-n.y), 0};
+  }
+  return packed;
+}
+
 // Sorts the block's points by key (the partition writes them back in that order) and writes
 // the keys beside.
 Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
@@ -84,6 +110,7 @@ Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
   std::vector<float> key = pointKeys(tree, reps);
   out.leastError = tree.front().error;
   for (const ClusterNode& node : tree) out.leastError = std::min(out.leastError, node.error);
+  if (block.layout.normalBytes()) keepTileNormals(points);
   const std::vector<std::uint32_t> order = descendingKeyOrder(key);
   applyOrder(order, points);
   applyOrder(order, ids);
@@ -223,13 +250,17 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
   Aabbd content;
   for (const CloudPoint& p : points) content.add(p.position);
   const Vec3d center = content.center();
-  std::vector<Vec3f> positions(points.size()), normals(points.size());
+  // Normals as bytes already (the work records kept them so) or as floats.
+  const bool normalBytes = !node.blocks.empty() && blocks[node.blocks.front()].layout.normalBytes();
+  std::vector<Vec3f> positions(points.size()), normals(normalBytes ? 0 : points.size());
   std::vector<Rgba8> rgba(colors ? points.size() : 0);
   for (std::size_t i = 0; i < points.size(); ++i) {
     positions[i] = toYUp(toFloat(points[i].position - center));
-    normals[i] = toYUp(normalizeOr(points[i].normal, Vec3f{0, 0, 1}));
+    if (!normalBytes) normals[i] = toYUp(normalizeOr(points[i].normal, Vec3f{0, 0, 1}));
     if (colors) rgba[i] = points[i].color;
   }
+  const std::vector<std::array<std::int8_t, 4>> packedNormals =
+      normalBytes ? tileNormalBytes(points) : std::vector<std::array<std::int8_t, 4>>{};
   const PointTileAttributes lidar =
       pointTileAttributes(points, fields.attributes, {fields.extras, extraBytes});
   Result<GlbWriter> writer = GlbWriter::create(
@@ -237,17 +268,17 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
       {.doubleSided = false, .meshoptCompression = options.meshoptCompression, .flatScene = true});
   if (!writer) return writer.status();
   if (!lidar.metadata.empty()) writer->setStructuralMetadata(lidar.metadata);
-  Result<std::uint32_t> mesh =
-      writer->addMesh({.positions = positions,
-                       .normals = normals,
-                       .colors = rgba,
-                       .indices = {},
-                       .quantized = options.quantize,
-                       .points = true,
-                       .extraAttributes = lidar.attributes,
-                       .propertyAttribute =
-                           lidar.metadata.empty() ? std::nullopt : std::optional<std::uint32_t>(0)},
-                      "points");
+  Result<std::uint32_t> mesh = writer->addMesh(
+      {.positions = positions,
+       .normals = normals,
+       .colors = rgba,
+       .indices = {},
+       .quantized = options.quantize,
+       .points = true,
+       .extraAttributes = lidar.attributes,
+       .propertyAttribute = lidar.metadata.empty() ? std::nullopt : std::optional<std::uint32_t>(0),
+       .packedNormals = packedNormals},
+      "points");
   if (!mesh) return mesh.status();
   const Mat4d placed = Mat4d::translation(toYUp(center));
   writer->addNode("points", *mesh, &placed);
@@ -435,7 +466,8 @@ Result<RankedPartition> partitionAndRank(const std::string& input, const PointTi
   partitionOptions.workDirectory = workDirectory;
   partitionOptions.salvageTruncated = options.salvageTruncated;
   partitionOptions.carryExtras = (options.attributes & kAttrExtras) != 0;
-  partitionOptions.keepNormals = true;  // rankBlock's clustering gives every point a normal
+  // rankBlock's clustering gives every point a normal; quantised tiles only draw it, as bytes.
+  partitionOptions.normals = options.quantize ? RecordNormals::kBytes : RecordNormals::kFloat;
   partitionOptions.memoryBytes = plan.partitionBytes;
   if (frame)
     partitionOptions.transform = [&frame](Vec3d in, Vec3d& out) { return frame->apply(in, out); };

@@ -85,6 +85,18 @@ struct GlbWriter::State {
   std::uint64_t fallbackBytes = 0;  // meshopt: the uncompressed layout the views describe
   std::vector<std::byte> scratch, encoded;
 
+  // Room for a mesh's views at once (growing the binary copied each tile's bytes about twice);
+  // at most what stays in memory before spilling.
+  void reserveFor(const GlbMeshData& mesh) {
+    const std::size_t n = mesh.positions.size();
+    const std::size_t position = mesh.quantized ? 8 : 12, normal = mesh.quantized ? 4 : 12;
+    const bool normals = !mesh.normals.empty() || !mesh.packedNormals.empty();
+    const std::size_t bytes = n * position + (normals ? n * normal : 0) +
+                              n * (mesh.colors.empty() ? 0 : 4) + n * (mesh.uvs.empty() ? 0 : 8) +
+                              n * 4 * mesh.extraAttributes.size() + mesh.indices.size() * 4;
+    binary.reserve(std::min(binary.size() + bytes, options.spillBytes + 4));
+  }
+
   Status appendBinary(const void* data, std::size_t size) {
     const auto* bytes = static_cast<const std::byte*>(data);
     binary.insert(binary.end(), bytes, bytes + size);
@@ -208,6 +220,15 @@ std::uint32_t GlbWriter::addMaterial(const Material& m, std::optional<std::uint3
   return static_cast<std::uint32_t>(state_->materials.size() - 1);
 }
 
+std::array<std::int8_t, 4> glbPackNormal(Vec3f normal) {
+  const Vec3f n = normalizeOr(normal, Vec3f{0, 0, 1});
+  const float axes[3] = {n.x, n.y, n.z};
+  std::array<std::int8_t, 4> packed{};
+  for (std::size_t a = 0; a < 3; ++a)
+    packed[a] = static_cast<std::int8_t>(roundToLong(axes[a] * 127.0f));
+  return packed;
+}
+
 Status GlbWriter::State::addQuantizedAttributes(const GlbMeshData& mesh, const Aabb& bounds,
                                                 nlohmann::json& attributes) {
   const std::size_t vertexCount = mesh.positions.size();
@@ -221,7 +242,7 @@ Status GlbWriter::State::addQuantizedAttributes(const GlbMeshData& mesh, const A
     const Vec3d p = (toDouble(mesh.positions[v]) - box.min) * (1.0 / step);
     const double axes[3] = {p.x, p.y, p.z};
     for (std::size_t a = 0; a < 3; ++a) {
-      const auto q = static_cast<std::uint16_t>(std::clamp(std::lround(axes[a]), 0L, 65535L));
+      const auto q = static_cast<std::uint16_t>(std::clamp(roundHalfAway(axes[a]), 0L, 65535L));
       grid[4 * v + a] = q;
       lo[a] = std::min(lo[a], q);
       hi[a] = std::max(hi[a], q);
@@ -234,16 +255,17 @@ Status GlbWriter::State::addQuantizedAttributes(const GlbMeshData& mesh, const A
   if (!position) return position.status();
   attributes["POSITION"] = *position;
   dequantize.emplace_back(std::pair{box.min, step});
-  if (!mesh.normals.empty()) {
-    std::vector<std::int8_t> packed(vertexCount * 4, 0);
-    for (std::size_t v = 0; v < vertexCount; ++v) {
-      const Vec3f n = normalizeOr(mesh.normals[v], Vec3f{0, 0, 1});
-      const float axes[3] = {n.x, n.y, n.z};
-      for (std::size_t a = 0; a < 3; ++a)
-        packed[4 * v + a] = static_cast<std::int8_t>(roundToLong(axes[a] * 127.0f));
+  if (!mesh.normals.empty() || !mesh.packedNormals.empty()) {
+    std::vector<std::array<std::int8_t, 4>> packing;
+    if (mesh.packedNormals.empty()) {
+      packing.resize(vertexCount);
+      for (std::size_t v = 0; v < vertexCount; ++v) packing[v] = glbPackNormal(mesh.normals[v]);
     }
-    Result<std::uint32_t> normal = addAccessor(packed.data(), packed.size(), vertexCount, kByte,
-                                               "VEC3", kArrayBuffer, true, nullptr, nullptr, 4);
+    const std::span<const std::array<std::int8_t, 4>> packed =
+        mesh.packedNormals.empty() ? packing : mesh.packedNormals;
+    Result<std::uint32_t> normal =
+        addAccessor(packed.data(), packed.size_bytes(), vertexCount, kByte, "VEC3", kArrayBuffer,
+                    true, nullptr, nullptr, 4);
     if (!normal) return normal.status();
     attributes["NORMAL"] = *normal;
   }
@@ -379,10 +401,13 @@ Result<std::uint32_t> GlbWriter::addMesh(const GlbMeshData& mesh, std::string_vi
   assert(mesh.points ? mesh.indices.empty()
                      : (!mesh.indices.empty() && mesh.indices.size() % 3 == 0));
   assert(mesh.normals.empty() || mesh.normals.size() == mesh.positions.size());
+  assert(mesh.packedNormals.empty() || (mesh.quantized && mesh.normals.empty() &&
+                                        mesh.packedNormals.size() == mesh.positions.size()));
   assert(mesh.colors.empty() || mesh.colors.size() == mesh.positions.size());
   assert(mesh.uvs.empty() || mesh.uvs.size() == mesh.positions.size());
   Aabb bounds;
   for (const Vec3f& p : mesh.positions) bounds.add(p);
+  s.reserveFor(mesh);
   nlohmann::json attributes;
   if (mesh.quantized) {
     LODFORGE_TRY(s.addQuantizedAttributes(mesh, bounds, attributes));
@@ -568,7 +593,9 @@ Status GlbWriter::State::writeFile(const std::string& json) {
         ErrorKind::kLimit,
         fmt::format("{}: GLB would be {} bytes; the format's limit is 4 GiB", path, total)};
   }
-  Result<OutputFile> out = OutputFile::create(path);
+  // A small buffer for the header and the JSON: the binary chunk is written from memory as it
+  // is (a 4 MB buffer zeroed for every tile was 4 % of the point tiles' contents).
+  Result<OutputFile> out = OutputFile::create(path, std::size_t{64} << 10);
   if (!out) return out.status();
   const std::uint32_t header[3] = {kGlbMagic, 2, static_cast<std::uint32_t>(total)};
   const std::uint32_t jsonChunk[2] = {static_cast<std::uint32_t>(json.size()), kChunkJson};

@@ -61,7 +61,12 @@ struct GlbMeshData {
   // each, all over the same vertex attributes (a tile's parts grouped by material).
   std::span<const GlbPrimitive> primitives = {};
   std::span<const Vec2f> uvs = {};  // empty or one per vertex: TEXCOORD_0
+  // Instead of `normals`, for a quantised mesh: normals packed already (glbPackNormal).
+  std::span<const std::array<std::int8_t, 4>> packedNormals = {};
 };
+
+// A normal as a quantised mesh holds it: normalised, each axis × 127 rounded, then a zero byte.
+std::array<std::int8_t, 4> glbPackNormal(Vec3f normal);
 
 // The grid step of a quantised mesh inside `bounds`: its longest side over 65535.
 double glbQuantizationStep(const Aabbd& bounds);

@@ -263,7 +263,8 @@ Status OutputFile::write(const void* data, std::size_t size) {
   const auto* bytes = static_cast<const std::byte*>(data);
   written_ += size;
   if (size >= buffer_.size()) {
-    // Straight from the caller's memory (a GLB's binary chunk): no copy through the buffer.
+    // Straight from the caller's memory (a GLB's binary chunk, a batch of work records): no
+    // copy through the buffer.
     LODFORGE_TRY(flush());
     return writeOut(bytes, size);
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -67,16 +68,17 @@ inline Vec3d toDouble(Vec3f a) {
 inline Vec3f toFloat(Vec3d a) {
   return {static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(a.z)};
 }
-// std::lround of a float (halves away from zero) without its library call, for per-vertex
-// loops: exact, because a float plus or minus 0.5 is exact in double.
-// std::lround (halves away from zero) without its libm call; exact for |x| < 2^52, where
-// x − trunc(x) is exact.
+// std::lround of a double (halves away from zero) without its libm call, for per-vertex loops:
+// x − trunc(x) is exact, so it equals lround for any finite |x| < 2^62 (the contract).
 inline long roundHalfAway(double x) {
+  assert(std::abs(x) < 0x1p62);  // false for NaN too
   const auto t = static_cast<long>(x);
   const double rest = x - static_cast<double>(t);
   return t + (rest >= 0.5 ? 1 : 0) - (rest <= -0.5 ? 1 : 0);
 }
 
+// std::lround of a float the same way: exact, because a float plus or minus 0.5 is exact in
+// double.
 inline long roundToLong(float x) {
   const double d = x;
   return static_cast<long>(d + (d >= 0 ? 0.5 : -0.5));

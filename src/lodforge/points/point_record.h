@@ -30,8 +30,8 @@ static_assert(sizeof(CloudPoint) == 64);
 
 // What a record keeps of the normal: the input's (nothing when it has none); always three
 // floats (the pipeline computes them); or, for an input without normals whose computed ones are
-// only drawn, three signed bytes (127 × each axis, rounded: 4 bytes instead of 12), as
-// quantised tiles write them.
+// only drawn, three signed bytes (127 × each axis, rounded: 4 bytes instead of 12; point tiles
+// store normals that are whole bytes over 127 already, so nothing is lost).
 enum class RecordNormals { kInput, kFloat, kBytes };
 
 class PointRecordLayout {

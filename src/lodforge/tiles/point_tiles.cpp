@@ -78,7 +78,7 @@ void keepTileNormals(std::span<CloudPoint> points) {
         glbPackNormal(toYUp(normalizeOr(p.normal, Vec3f{0, 0, 1})));
     // toYUp maps (x, y, z) to (x, z, −y); its inverse maps (a, b, c) to (a, −c, b).
     p.normal =
-        Vec3f{static_cast<float>(q[0]), -static_cast<float>(q[2]), static_cast<float>(q[1])} /
+        Vec3f{static_cast<float>(q[0]), static_cast<float>(-q[2]), static_cast<float>(q[1])} /
         127.0f;
   }
 }

@@ -239,6 +239,39 @@ TEST(GlbWrite, QuantizedMeshesReadBackWithinHalfAGridStep) {
   }
 }
 
+TEST(GlbWrite, PackedNormalsGiveTheBytesTheWriterPacksItself) {
+  // Callers that kept glbPackNormal's bytes (point tiles' work records) pass them instead of
+  // floats: the file must be the same byte for byte.
+  const Model model = randomModel(33, 1, 3'000);
+  std::vector<Vec3f> normals = model.normals;
+  normals[0] = {0, 0, 0};  // zero and unnormalised normals too
+  normals[1] = {3, -4, 12};
+  std::vector<std::array<std::int8_t, 4>> packed;
+  for (const Vec3f& n : normals) packed.push_back(glbPackNormal(n));
+  EXPECT_EQ(packed[0], (std::array<std::int8_t, 4>{0, 0, 127, 0}));     // the fallback, +z
+  EXPECT_EQ(packed[1], (std::array<std::int8_t, 4>{29, -39, 117, 0}));  // (3, −4, 12) / 13
+  test::TempDir dir;
+  const auto write = [&](const std::string& path, bool bytes) {
+    Result<GlbWriter> writer = GlbWriter::create(path, {});
+    ASSERT_TRUE(writer.ok());
+    GlbMeshData data;
+    data.positions = model.positions;
+    if (bytes)
+      data.packedNormals = packed;
+    else
+      data.normals = normals;
+    data.indices = model.indices;
+    data.quantized = true;
+    Result<std::uint32_t> mesh = writer->addMesh(data, "m");
+    ASSERT_TRUE(mesh.ok());
+    writer->addNode("m", *mesh, nullptr);
+    ASSERT_TRUE(writer->finish().ok());
+  };
+  write(dir.file("floats.glb"), false);
+  write(dir.file("bytes.glb"), true);
+  EXPECT_EQ(test::readFile(dir.file("floats.glb")), test::readFile(dir.file("bytes.glb")));
+}
+
 TEST(GlbWrite, SpillingToDiskGivesTheSameFile) {
   const Model model = randomModel(4, 20, 500);
   test::TempDir dir;

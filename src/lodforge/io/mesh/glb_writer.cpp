@@ -85,8 +85,9 @@ struct GlbWriter::State {
   std::uint64_t fallbackBytes = 0;  // meshopt: the uncompressed layout the views describe
   std::vector<std::byte> scratch, encoded;
 
-  // Room for a mesh's views at once (growing the binary copied each tile's bytes about twice);
-  // at most what stays in memory before spilling.
+  // Room for a mesh's views at once (a tile's binary grew by doubling, copying its bytes about
+  // twice), growing geometrically still for writers of many meshes; at most what stays in
+  // memory before spilling.
   void reserveFor(const GlbMeshData& mesh) {
     const std::size_t n = mesh.positions.size();
     const std::size_t position = mesh.quantized ? 8 : 12, normal = mesh.quantized ? 4 : 12;
@@ -94,7 +95,9 @@ struct GlbWriter::State {
     const std::size_t bytes = n * position + (normals ? n * normal : 0) +
                               n * (mesh.colors.empty() ? 0 : 4) + n * (mesh.uvs.empty() ? 0 : 8) +
                               n * 4 * mesh.extraAttributes.size() + mesh.indices.size() * 4;
-    binary.reserve(std::min(binary.size() + bytes, options.spillBytes + 4));
+    const std::size_t want = binary.size() + bytes;
+    if (want > binary.capacity())
+      binary.reserve(std::min(std::max(want, 2 * binary.capacity()), options.spillBytes + 4));
   }
 
   Status appendBinary(const void* data, std::size_t size) {

@@ -98,32 +98,19 @@ struct Records {
   std::size_t stride = 0;
   std::vector<CloudPoint> points;
   std::vector<std::byte> extras;
-  std::vector<std::byte> scratch;  // encoded records on their way to or from the file
+  std::vector<std::byte> scratch;  // encoded records on their way to the file
 
   std::size_t size() const { return points.size(); }
   void resize(std::size_t n) {
     points.resize(n);
     extras.resize(n * stride);
   }
-  void push(const Records& from, std::size_t i) {
-    points.push_back(from.points[i]);
-    if (stride == 0) return;
-    const auto e = from.extras.begin() + static_cast<std::ptrdiff_t>(i * stride);
-    extras.insert(extras.end(), e, e + static_cast<std::ptrdiff_t>(stride));
-  }
-  // n records from record `first` of the files (the points' slices in parallel, or not).
-  Status read(const WorkFiles& files, std::uint64_t first, std::size_t n, bool parallel = false) {
+  // n records from record `first` of the files (the points' slices in parallel).
+  Status read(const WorkFiles& files, std::uint64_t first, std::size_t n) {
     resize(n);
-    LODFORGE_TRY(parallel ? files.readPointsInParallel(first, points)
-                          : files.readPoints(first, points, scratch));
+    LODFORGE_TRY(files.readPointsInParallel(first, points));
     if (stride == 0) return {};
     return files.extras->readAt(first * stride, extras.data(), n * stride);
-  }
-  // Records [from, from + n) to record `first` of the files.
-  Status write(const WorkFiles& files, std::uint64_t first, std::size_t from, std::size_t n) {
-    LODFORGE_TRY(files.writePoints(first, std::span(points).subspan(from, n), scratch));
-    if (stride == 0) return {};
-    return files.extras->writeAt(first * stride, extras.data() + from * stride, n * stride);
   }
 };
 
@@ -500,7 +487,7 @@ Result<Partition> partitionPoints(const std::string& input, const PartitionOptio
                    fmt::format("{}: {} points share one position, more than the 2^32 that can "
                                "carry extra fields; leave them out with --attributes",
                                input, node.count)};
-    LODFORGE_TRY(records.read(files, node.first, static_cast<std::size_t>(node.count), true));
+    LODFORGE_TRY(records.read(files, node.first, static_cast<std::size_t>(node.count)));
     ids.resize(stride == 0 ? 0 : records.size());
     std::iota(ids.begin(), ids.end(), 0u);
     splitInMemory(records.points, ids, node.first, node.name,

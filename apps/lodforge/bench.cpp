@@ -185,6 +185,8 @@ nlohmann::json frameJson(const FrameTimes& t) {
           {"triangles_reformed", t.stream.trianglesReformed},
           {"triangles_kept", t.stream.trianglesKept},
           {"objects_changed", t.stream.objectsChanged},
+          {"objects_relocated", t.stream.objectsRelocated},
+          {"compacted", t.stream.compacted},
           {"vertices", t.vertices},
           {"triangles", t.triangles},
           {"visible_objects", t.visible},
@@ -208,6 +210,7 @@ nlohmann::json runJson(const BudgetRun& run) {
   add("triangles_reformed", [](const FrameTimes& t) { return t.stream.trianglesReformed; });
   add("triangles_kept", [](const FrameTimes& t) { return t.stream.trianglesKept; });
   add("objects_changed", [](const FrameTimes& t) { return t.stream.objectsChanged; });
+  add("objects_relocated", [](const FrameTimes& t) { return t.stream.objectsRelocated; });
   add("vertices", [](const FrameTimes& t) { return t.vertices; });
   add("triangles", [](const FrameTimes& t) { return t.triangles; });
   add("visible_objects", [](const FrameTimes& t) { return t.visible; });
@@ -227,7 +230,9 @@ nlohmann::json runJson(const BudgetRun& run) {
           {"p95_selection_ms",
            percentile95(run.frames, [](const FrameTimes& t) { return t.selectionMs; })},
           {"p95_generation_ms", percentile95(run.frames, generationMs)},
-          {"exact_frames", exactFrames + (run.load.exact ? 1 : 0)}};
+          {"exact_frames", exactFrames + (run.load.exact ? 1 : 0)},
+          {"compacted_frames", std::count_if(run.frames.begin(), run.frames.end(),
+                                             [](const FrameTimes& t) { return t.stream.compacted; })}};
 }
 
 std::string megabytes(double bytes) {

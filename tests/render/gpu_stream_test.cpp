@@ -1,5 +1,6 @@
 // §3.3 on the GPU against the CPU stream: after every frame of random walks, jumps and budget
-// changes, the GPU copies hold exactly what StreamBuffer holds, and only the Δ crossed over.
+// changes, the GPU copies hold exactly what StreamBuffer holds (its slots gathered in object
+// order), and only the Δ crossed over.
 #include "lodforge/render/gpu_stream.h"
 
 #include <cstring>
@@ -13,6 +14,7 @@
 #include "lodforge/runtime/path.h"
 #include "lodforge/runtime/selection.h"
 #include "render/headless.h"
+#include "runtime/compact_view.h"
 #include "runtime/packages.h"
 
 namespace lodforge {
@@ -64,24 +66,27 @@ TEST(GpuStream, EveryFrameEqualsTheCpuStreamAndReadsOnlyTheDelta) {
       }
       ASSERT_EQ(gpu->vertexCount(), cpu.vertexCount());
       ASSERT_EQ(gpu->triangleCount(), cpu.triangleCount());
+      // The GPU stream is compact (the paper's layout); the CPU one's slots, gathered, equal it.
+      const test::CompactView view = test::compactView(cpu);
       EXPECT_EQ(readBufferWords(gpu->positionBuffer(), 3 * gpu->vertexCount()),
-                words(cpu.positions()))
+                words(std::span<const Vec3f>(view.positions)))
           << key << " frame " << f;
       if (package.header().hasNormals()) {
         EXPECT_EQ(readBufferWords(gpu->normalBuffer(), 3 * gpu->vertexCount()),
-                  words(cpu.normals()));
+                  words(std::span<const Vec3f>(view.normals)));
       }
       if (package.header().hasUvs()) {
-        EXPECT_EQ(readBufferWords(gpu->uvBuffer(), 2 * gpu->vertexCount()), words(cpu.uvs()))
+        EXPECT_EQ(readBufferWords(gpu->uvBuffer(), 2 * gpu->vertexCount()),
+                  words(std::span<const Vec2f>(view.uvs)))
             << key << " frame " << f;
       }
       EXPECT_EQ(readBufferWords(gpu->sourceBuffer(), 3 * gpu->triangleCount()),
-                words(cpu.sourceTriangles()))
+                words(std::span<const std::uint32_t>(view.source)))
           << key << " frame " << f;
       // Algorithm 2 on the GPU from the GPU's own source triangles.
       reformer->reform(*gpu, renderer->indexBuffer());
       EXPECT_EQ(GpuReformer::readIndices(renderer->indexBuffer(), gpu->triangleCount()),
-                words(cpu.indices()))
+                words(std::span<const std::uint32_t>(view.indices)))
           << key << " frame " << f;
     }
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 
 #include <epoxy/gl.h>
 
@@ -11,9 +12,9 @@ namespace lodforge {
 
 namespace {
 
-// Algorithm 2, one invocation per selected triangle.
+// Algorithm 2, one invocation per triangle up to the last selected one.
 // Per selected object in `table`: first triangle in the frame, ECol offset, first vertex in the
-// frame, vc.
+// frame, vc; a row with vc = 0 marks triangles that belong to no object (between slots).
 constexpr const char* kReformMain = R"(
 layout(std430, binding = 0) readonly buffer Ecol { uint ecol[]; };      // every object, resident
 layout(std430, binding = 1) readonly buffer Source { uint source[]; };  // object-local corners
@@ -25,6 +26,7 @@ void main() {
   uint t = elementIndex();
   if (t >= triangleCount) return;
   uvec4 o = table[owner(t, objectCount)];
+  if (o.w == 0u) return;
   for (uint k = 0u; k < 3u; ++k) {
     uint c = source[3u * t + k];
     while (c >= o.w) c = ecol[o.y + c];  // chains strictly decrease (Algorithm 1)
@@ -63,8 +65,9 @@ Result<GpuReformer> GpuReformer::create(const Package& package, const StreamCapa
   // The package's ECol section is one array over all objects (each at its vertex offset).
   const std::uint32_t* ecol = package.objectCount() ? package.ecol(0).data() : nullptr;
   s->ecol = makeBuffer(vertices * sizeof(std::uint32_t), ecol, 0);  // immutable
-  s->source = makeBuffer(capacity.triangles * 3 * sizeof(std::uint32_t));
-  s->objectCapacity = package.objectCount();
+  s->source =
+      makeBuffer(capacity.arenaTriangles() * 3 * sizeof(std::uint32_t));  // a StreamBuffer's
+  s->objectCapacity = 2 * package.objectCount() + 1;  // each object, and a skip row before it
   s->objects = makeBuffer(s->objectCapacity * 16);
   return GpuReformer(std::move(s));
 }
@@ -78,29 +81,44 @@ void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
   const auto source = buffer.sourceTriangles();
   glNamedBufferSubData(state_->source, 0, static_cast<GLsizeiptr>(source.size_bytes()),
                        source.data());
-  run(state_->source, buffer.vertexCounts(), buffer.vertexStart(), buffer.triangleStart(),
+  run(state_->source,
+      {buffer.vertexCounts(), buffer.triangleCounts(), buffer.slotOrder(), buffer.vertexStart(),
+       buffer.triangleStart()},
       indexBuffer);
 }
 
 void GpuReformer::reform(const GpuStream& stream, unsigned indexBuffer) {
-  run(stream.sourceBuffer(), stream.vertexCounts(), stream.vertexStart(), stream.triangleStart(),
+  run(stream.sourceBuffer(),
+      {stream.vertexCounts(),
+       stream.triangleCounts(),
+       {},
+       stream.vertexStart(),
+       stream.triangleStart()},
       indexBuffer);
 }
 
-void GpuReformer::run(unsigned sourceBuffer, std::span<const std::uint32_t> counts,
-                      std::span<const std::uint64_t> vertexStart,
-                      std::span<const std::uint64_t> triangleStart, unsigned indexBuffer) {
+void GpuReformer::run(unsigned sourceBuffer, const Objects& objects, unsigned indexBuffer) {
   State& s = *state_;
-  const std::uint64_t triangles = triangleStart.back();
-  if (triangles == 0) return;
-  // The frame's object table: only objects with triangles, so the search needs no tie rule.
+  // The frame's object table, by first triangle: objects with triangles, and a skip row (vc = 0)
+  // wherever triangles follow that no object owns, so the search needs no tie rule.
   s.table.clear();
-  for (std::size_t i = 0; i < counts.size(); ++i) {
-    if (triangleStart[i + 1] == triangleStart[i]) continue;
-    s.table.push_back({static_cast<std::uint32_t>(triangleStart[i]),
-                       static_cast<std::uint32_t>(s.package->object(i).vertexOffset),
-                       static_cast<std::uint32_t>(vertexStart[i]), counts[i]});
+  std::uint32_t end = 0;  // past the last row's triangles
+  const std::size_t n = objects.vertexCounts.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = objects.order.empty() ? k : objects.order[k];
+    const std::uint32_t triangles = objects.triangleCounts[i];
+    if (triangles == 0) continue;
+    const auto start = static_cast<std::uint32_t>(objects.triangleStart[i]);
+    assert(start >= end);
+    if (start > end) s.table.push_back({end, 0, 0, 0});
+    s.table.push_back({start, static_cast<std::uint32_t>(s.package->object(i).vertexOffset),
+                       static_cast<std::uint32_t>(objects.vertexStart[i]),
+                       objects.vertexCounts[i]});
+    end = start + triangles;
   }
+  const std::uint64_t triangles = end;
+  if (triangles == 0) return;
+  assert(s.table.size() <= s.objectCapacity);
   glNamedBufferSubData(s.objects, 0, static_cast<GLsizeiptr>(s.table.size() * 16), s.table.data());
   const GLuint p = s.program.id();
   glUseProgram(p);

@@ -1,8 +1,8 @@
 // Algorithm 2 on the GPU, as the CAD paper runs it (§3.2): ECol of every object stays resident in
 // a shader storage buffer; per frame the stream's source triangles and a table of the selected
 // objects go up, and one compute invocation per triangle finds its object by binary search over
-// the prefix sums of the selected triangle counts, then follows ECol until every corner is below
-// the object's vertex count. The result lands in the renderer's index buffer.
+// the objects' first triangles (in the order of the stream's slots), then follows ECol until every
+// corner is below the object's vertex count. The result lands in the renderer's index buffer.
 #pragma once
 
 #include <cstdint>
@@ -25,8 +25,8 @@ class GpuReformer {
   GpuReformer& operator=(GpuReformer&&) noexcept;
   ~GpuReformer();
 
-  // Re-forms the stream buffer's source triangles into `indexBuffer` (a GL buffer of at least
-  // 3 x triangleCount uint32): the same indices the CPU path puts in buffer.indices().
+  // Re-forms the stream buffer's source triangles into `indexBuffer` (a GL buffer as large as
+  // buffer.indices()): each object's slot gets the indices the CPU path puts there.
   void reform(const StreamBuffer& buffer, unsigned indexBuffer);
   // The same from a GPU stream, whose source triangles are already on the GPU.
   void reform(const GpuStream& stream, unsigned indexBuffer);
@@ -36,9 +36,13 @@ class GpuReformer {
  private:
   struct State;
   explicit GpuReformer(std::unique_ptr<State> state);
-  void run(unsigned sourceBuffer, std::span<const std::uint32_t> counts,
-           std::span<const std::uint64_t> vertexStart, std::span<const std::uint64_t> triangleStart,
-           unsigned indexBuffer);
+  // Objects by their first triangle in `order` (empty: object order); their triangles may be
+  // apart, the gaps are skipped.
+  struct Objects {
+    std::span<const std::uint32_t> vertexCounts, triangleCounts, order;
+    std::span<const std::uint64_t> vertexStart, triangleStart;
+  };
+  void run(unsigned sourceBuffer, const Objects& objects, unsigned indexBuffer);
   std::unique_ptr<State> state_;
 };
 

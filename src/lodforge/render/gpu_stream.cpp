@@ -267,6 +267,9 @@ std::span<const std::uint64_t> GpuStream::triangleStart() const {
 std::span<const std::uint32_t> GpuStream::vertexCounts() const {
   return state_->vertexCounts;
 }
+std::span<const std::uint32_t> GpuStream::triangleCounts() const {
+  return state_->triangleCounts;
+}
 unsigned GpuStream::positionBuffer() const {
   return state_->positions.copies[static_cast<std::size_t>(state_->current)];
 }

@@ -35,6 +35,7 @@ class GpuStream {
   std::span<const std::uint64_t> vertexStart() const;    // objects + 1
   std::span<const std::uint64_t> triangleStart() const;  // objects + 1
   std::span<const std::uint32_t> vertexCounts() const;
+  std::span<const std::uint32_t> triangleCounts() const;
   // The current copy's GL buffers (0 when the package has no normals / colours / uvs).
   unsigned positionBuffer() const;
   unsigned normalBuffer() const;

@@ -253,12 +253,15 @@ Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& 
   s->ratios.assign(objects, 1.0f);
 
   if (vertexBuffers) {
-    s->positions = makeBuffer(capacity.vertices * sizeof(Vec3f));
-    if (s->normals) s->normalBuffer = makeBuffer(capacity.vertices * sizeof(Vec3f));
-    if (s->colors) s->colorBuffer = makeBuffer(capacity.vertices * sizeof(Rgba8));
-    if (s->uvs) s->uvBuffer = makeBuffer(capacity.vertices * sizeof(Vec2f));
+    const std::uint64_t vertices = capacity.arenaVertices();  // a StreamBuffer's slots
+    s->positions = makeBuffer(vertices * sizeof(Vec3f));
+    if (s->normals) s->normalBuffer = makeBuffer(vertices * sizeof(Vec3f));
+    if (s->colors) s->colorBuffer = makeBuffer(vertices * sizeof(Rgba8));
+    if (s->uvs) s->uvBuffer = makeBuffer(vertices * sizeof(Vec2f));
   }
-  s->indices = makeBuffer(capacity.triangles * 3 * sizeof(std::uint32_t));
+  // A GpuStream is compact; a StreamBuffer's slots spread over its arena.
+  const std::uint64_t triangles = vertexBuffers ? capacity.arenaTriangles() : capacity.triangles;
+  s->indices = makeBuffer(triangles * 3 * sizeof(std::uint32_t));
   s->objectColors = makeBuffer(objects * sizeof(Rgba8), s->baseColors.data());
   s->lodRatios = makeBuffer(objects * sizeof(float), s->ratios.data());
   s->commands = makeBuffer(objects * sizeof(DrawCommand));
@@ -303,7 +306,7 @@ void Renderer::upload(const StreamBuffer& buffer, bool indices) {
   if (s.uvs) upload(s.uvBuffer, buffer.uvs());
   if (indices) upload(s.indices, buffer.indices());
 
-  setCommands(buffer.vertexCounts(), buffer.triangleStart());
+  setCommands(buffer.vertexCounts(), buffer.triangleCounts(), buffer.triangleStart());
   if (s.attached) {
     // Back to the renderer's own buffers after drawing from a GPU stream.
     glVertexArrayVertexBuffer(s.vertexArray, 0, s.positions, 0, sizeof(Vec3f));
@@ -323,7 +326,7 @@ void Renderer::attach(const GpuStream& stream) {
   if (s.colors) glVertexArrayVertexBuffer(s.vertexArray, 2, stream.colorBuffer(), 0, sizeof(Rgba8));
   if (s.uvs) glVertexArrayVertexBuffer(s.vertexArray, 5, stream.uvBuffer(), 0, sizeof(Vec2f));
   s.attached = true;
-  setCommands(stream.vertexCounts(), stream.triangleStart());
+  setCommands(stream.vertexCounts(), stream.triangleCounts(), stream.triangleStart());
 }
 
 // The commands sorted by their object's image (stable: objects in order within one image),
@@ -358,12 +361,13 @@ void drawByImage(const Renderer::State& s, GLuint program) {
 }
 
 void Renderer::setCommands(std::span<const std::uint32_t> counts,
+                           std::span<const std::uint32_t> triangleCounts,
                            std::span<const std::uint64_t> triangleStart) {
   // One command per object with triangles; its base instance is the object id.
   State& s = *state_;
   s.commandList.clear();
   for (std::size_t i = 0; i < counts.size(); ++i) {
-    const std::uint64_t triangles = triangleStart[i + 1] - triangleStart[i];
+    const std::uint64_t triangles = triangleCounts[i];
     s.ratios[i] = static_cast<float>(counts[i]) /
                   static_cast<float>(std::max<std::uint32_t>(1, s.package->object(i).vertexCount));
     if (triangles == 0) continue;

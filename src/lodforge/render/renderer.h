@@ -1,5 +1,5 @@
 // Draws the streamed buffer (runtime/stream.h) with OpenGL 4.5: one vertex and one index buffer
-// sized to the stream's capacity, one multi-draw per frame whose commands are the objects'
+// sized to the stream's arena, one multi-draw per frame whose commands are the objects'
 // triangle ranges (each command's base instance is the object id, so per-object colour and LOD
 // ratio reach the shaders as instanced attributes), headlight shading. A textured package is
 // drawn one multi-draw per image, with its texture (render/textures.h). Offscreen rendering goes
@@ -62,7 +62,7 @@ struct DrawOptions {
 
 class Renderer {
  public:
-  // Needs a current GL 4.5 context. Buffers hold `capacity` (what the StreamBuffer holds).
+  // Needs a current GL 4.5 context. Buffers hold a StreamBuffer's arena for `capacity`.
   // Without `vertexBuffers` only the index buffer is made: the renderer then draws from a
   // GpuStream's buffers (attach) and upload() may not be used.
   static Result<Renderer> create(const Package& package, const StreamCapacity& capacity,
@@ -89,6 +89,7 @@ class Renderer {
   explicit Renderer(std::unique_ptr<State> state);
   std::unique_ptr<State> state_;
   void setCommands(std::span<const std::uint32_t> counts,
+                   std::span<const std::uint32_t> triangleCounts,
                    std::span<const std::uint64_t> triangleStart);
 };
 

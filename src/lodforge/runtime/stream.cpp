@@ -7,9 +7,11 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include "lodforge/simplify/reform.h"
@@ -19,76 +21,27 @@ namespace lodforge {
 namespace {
 
 constexpr std::uint64_t kTriangleBytes = 3 * sizeof(std::uint32_t);
+// Indices are 32-bit: the arena, twice the capacity, can address at most 2^32 vertices.
+constexpr std::uint64_t kMostVertices = std::uint64_t{1} << 31;
 
-// One copy of the buffer and the selection it holds.
-struct BufferCopy {
+// The arena: each array at twice the capacity (StreamCapacity::arenaVertices/arenaTriangles).
+struct Arrays {
   std::unique_ptr<Vec3f[]> positions, normals;
   std::unique_ptr<Rgba8[]> colors;
   std::unique_ptr<Vec2f[]> uvs;
   std::unique_ptr<std::uint32_t[]> source, indices;
-  std::vector<std::uint64_t> vertexStart, triangleStart;  // objects + 1
-  std::vector<std::uint32_t> vertexCounts, triangleCounts;
+};
 
-  void allocate(std::size_t objects, const StreamCapacity& capacity, bool withNormals,
-                bool withColors, bool withUvs) {
-    // Left uninitialised: only [0, count) is ever read, and it is always written first.
-    positions = std::make_unique_for_overwrite<Vec3f[]>(capacity.vertices);
-    if (withNormals) normals = std::make_unique_for_overwrite<Vec3f[]>(capacity.vertices);
-    if (withColors) colors = std::make_unique_for_overwrite<Rgba8[]>(capacity.vertices);
-    if (withUvs) uvs = std::make_unique_for_overwrite<Vec2f[]>(capacity.vertices);
-    source = std::make_unique_for_overwrite<std::uint32_t[]>(3 * capacity.triangles);
-    indices = std::make_unique_for_overwrite<std::uint32_t[]>(3 * capacity.triangles);
-    vertexStart.assign(objects + 1, 0);
-    triangleStart.assign(objects + 1, 0);
-    vertexCounts.assign(objects, 0);
-    triangleCounts.assign(objects, 0);
-  }
-  std::uint64_t vertices() const { return vertexStart.back(); }
-  std::uint64_t triangles() const { return triangleStart.back(); }
+// A changed object this frame, and where its slot was before it (equal to its start unless it
+// outgrew the slot and moved).
+struct ObjectWork {
+  std::uint32_t object = 0;
+  std::uint64_t fromVertex = 0, fromTriangle = 0;
 };
 
 double millisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
-}
-
-// The object owning element `at` of a layout given by prefix sums: the last one starting at or
-// before it (objects with nothing share their start with the next one and are passed over).
-std::size_t owner(const std::vector<std::uint64_t>& start, std::uint64_t at) {
-  return static_cast<std::size_t>(std::upper_bound(start.begin(), start.end(), at) - start.begin() -
-                                  1);
-}
-
-// §3.3's reassembly of one array: destination element e of object i at local index l takes
-// old[oldStart_i + l] when l < oldCount_i, else the package's element l of object i. Run per
-// block of destinations: one binary search for the block's first owner, then whole runs.
-template <class T, class PackageOffset>
-void reassemble(const std::vector<std::uint64_t>& newStart,
-                const std::vector<std::uint64_t>& oldStart, std::span<const std::uint32_t> oldCount,
-                const T* old, const T* package, PackageOffset packageOffset, std::size_t width,
-                T* out) {
-  const std::uint64_t total = newStart.back();
-  tbb::parallel_for(tbb::blocked_range<std::uint64_t>(0, total, 1 << 14),
-                    [&](const tbb::blocked_range<std::uint64_t>& range) {
-                      std::size_t i = owner(newStart, range.begin());
-                      for (std::uint64_t at = range.begin(); at < range.end(); ++i) {
-                        if (newStart[i + 1] <= at) continue;  // nothing selected of object i
-                        const std::uint64_t end = std::min(range.end(), newStart[i + 1]);
-                        const std::uint64_t local = at - newStart[i];
-                        const std::uint64_t keptEnd = std::min(end, newStart[i] + oldCount[i]);
-                        if (at < keptEnd) {
-                          std::memcpy(out + width * at, old + width * (oldStart[i] + local),
-                                      width * (keptEnd - at) * sizeof(T));
-                          at = keptEnd;
-                        }
-                        if (at < end) {
-                          std::memcpy(out + width * at,
-                                      package + width * (packageOffset(i) + (at - newStart[i])),
-                                      width * (end - at) * sizeof(T));
-                          at = end;
-                        }
-                      }
-                    });
 }
 
 }  // namespace
@@ -117,16 +70,16 @@ double StreamCapacity::triangleRatio(const Package& package) {
 }
 
 StreamCapacity StreamCapacity::forVertices(const Package& package, std::uint64_t vertices) {
-  // Indices are 32-bit: the buffer can address at most 2^32 vertices.
-  vertices = std::min<std::uint64_t>(vertices, std::numeric_limits<std::uint32_t>::max());
+  vertices = std::min(vertices, kMostVertices);
   const double ratio = triangleRatio(package);
   return {vertices, static_cast<std::uint64_t>(std::ceil(ratio * double(vertices)))};
 }
 
 StreamCapacity StreamCapacity::forMemory(const Package& package, std::uint64_t bytes) {
   const double ratio = triangleRatio(package);
+  // The arena holds twice the capacity (stream.h).
   const double perVertex = 2.0 * (double(vertexBytes(package)) + ratio * 2.0 * kTriangleBytes);
-  auto vertices = static_cast<std::uint64_t>(double(bytes) / perVertex);
+  auto vertices = std::min(static_cast<std::uint64_t>(double(bytes) / perVertex), kMostVertices);
   StreamCapacity capacity{vertices,
                           static_cast<std::uint64_t>(std::ceil(ratio * double(vertices)))};
   // Rounding of the triangle count may tip it over by a few bytes: step back until it fits.
@@ -144,21 +97,40 @@ std::uint64_t StreamCapacity::bytes(const Package& package) const {
 struct StreamBuffer::State {
   const Package* package = nullptr;
   StreamCapacity capacity;
-  BufferCopy copies[2];
-  int front = 0;
-
-  BufferCopy& current() { return copies[front]; }
-  const BufferCopy& current() const { return copies[front]; }
+  Arrays arrays;
+  // Per object: its slot (start and size) and what it holds.
+  std::vector<std::uint64_t> vertexStart, triangleStart;
+  std::vector<std::uint32_t> vertexSlot, triangleSlot, vertexCounts, triangleCounts;
+  // Every object by where its slot starts, as of the last settleOrder(); objects relocated
+  // since then are in `relocations` (in the order their slots were given, the last one counts).
+  std::vector<std::uint32_t> order, relocations, lastRelocation;
+  std::uint64_t vertexEnd = 0, triangleEnd = 0;      // the high-water mark: slots lie below
+  std::uint64_t vertexTotal = 0, triangleTotal = 0;  // Σ counts
+  std::vector<std::uint8_t> relocated;               // in `relocations`
+  // Scratch for one update.
+  std::vector<ObjectWork> work;
+  std::vector<std::vector<ObjectWork>> blockWork;
+  std::vector<std::uint32_t> nextOrder;
 };
 
 StreamBuffer::StreamBuffer(const Package& package, StreamCapacity capacity)
     : state_(std::make_unique<State>()) {
-  assert(capacity.vertices <= std::numeric_limits<std::uint32_t>::max());
-  state_->package = &package;
-  state_->capacity = capacity;
-  for (BufferCopy& copy : state_->copies)
-    copy.allocate(package.objectCount(), capacity, package.header().hasNormals(),
-                  package.header().hasColors(), package.header().hasUvs());
+  assert(capacity.vertices <= kMostVertices);
+  State& s = *state_;
+  s.package = &package;
+  s.capacity = capacity;
+  // Left uninitialised: only an object's [0, count) is ever read, and it is always written first.
+  const std::uint64_t vertices = capacity.arenaVertices(), triangles = capacity.arenaTriangles();
+  s.arrays.positions = std::make_unique_for_overwrite<Vec3f[]>(vertices);
+  if (package.header().hasNormals())
+    s.arrays.normals = std::make_unique_for_overwrite<Vec3f[]>(vertices);
+  if (package.header().hasColors())
+    s.arrays.colors = std::make_unique_for_overwrite<Rgba8[]>(vertices);
+  if (package.header().hasUvs()) s.arrays.uvs = std::make_unique_for_overwrite<Vec2f[]>(vertices);
+  s.arrays.source = std::make_unique_for_overwrite<std::uint32_t[]>(3 * triangles);
+  s.arrays.indices = std::make_unique_for_overwrite<std::uint32_t[]>(3 * triangles);
+  s.lastRelocation.assign(package.objectCount(), 0);
+  clear();
 }
 
 StreamBuffer::StreamBuffer(StreamBuffer&&) noexcept = default;
@@ -166,161 +138,395 @@ StreamBuffer& StreamBuffer::operator=(StreamBuffer&&) noexcept = default;
 StreamBuffer::~StreamBuffer() = default;
 
 void StreamBuffer::clear() {
-  BufferCopy& c = state_->current();
-  std::fill(c.vertexStart.begin(), c.vertexStart.end(), 0);
-  std::fill(c.triangleStart.begin(), c.triangleStart.end(), 0);
-  std::fill(c.vertexCounts.begin(), c.vertexCounts.end(), 0);
-  std::fill(c.triangleCounts.begin(), c.triangleCounts.end(), 0);
+  State& s = *state_;
+  const std::size_t n = s.package->objectCount();
+  s.vertexStart.assign(n, 0);
+  s.triangleStart.assign(n, 0);
+  s.vertexSlot.assign(n, 0);
+  s.triangleSlot.assign(n, 0);
+  s.vertexCounts.assign(n, 0);
+  s.triangleCounts.assign(n, 0);
+  s.order.resize(n);
+  std::iota(s.order.begin(), s.order.end(), 0u);
+  s.relocations.clear();
+  s.relocated.assign(n, 0);
+  s.vertexEnd = s.triangleEnd = s.vertexTotal = s.triangleTotal = 0;
 }
 
 namespace {
 
-// The new layout: prefix sums of the counts, refused when it does not fit the capacity (only the
-// back copy is touched; the front one still holds last frame).
-Status layOut(const Package& package, const StreamCapacity& capacity,
-              std::span<const std::uint32_t> vertexCounts,
-              std::span<const std::uint32_t> triangleCounts, BufferCopy& next) {
-  const std::size_t n = package.objectCount();
-  std::copy(vertexCounts.begin(), vertexCounts.end(), next.vertexCounts.begin());
-  std::copy(triangleCounts.begin(), triangleCounts.end(), next.triangleCounts.begin());
-  for (std::size_t i = 0; i < n; ++i) {
-    assert(vertexCounts[i] == 0 ? triangleCounts[i] == 0
-                                : triangleCounts[i] == package.trianglesAt(i, vertexCounts[i]));
-    next.vertexStart[i + 1] = next.vertexStart[i] + vertexCounts[i];
-    next.triangleStart[i + 1] = next.triangleStart[i] + triangleCounts[i];
-  }
-  if (next.vertices() <= capacity.vertices && next.triangles() <= capacity.triangles) return {};
-  return Error{ErrorKind::kLimit,
-               fmt::format("{}: the selection ({} vertices, {} triangles) does not fit the "
-                           "stream buffer ({} vertices, {} triangles)",
-                           package.name(), next.vertices(), next.triangles(), capacity.vertices,
-                           capacity.triangles)};
-}
+using Counts = std::span<const std::uint32_t>;
 
-// What the frame reads and moves, per object: the kept part min(old, new), the read part
-// new - kept; triangles of objects whose count changed are re-formed.
-void tallyFrame(const Package& package, const BufferCopy& old,
-                std::span<const std::uint32_t> vertexCounts,
-                std::span<const std::uint32_t> triangleCounts, FrameStats& stats) {
+// Sums of vertices and triangles.
+struct Totals {
+  std::uint64_t vertices = 0, triangles = 0;
+};
+
+// What the frame reads and keeps, per object: the kept part min(old, new), the read part
+// new - kept; triangles of objects whose count changed are re-formed, the others keep theirs.
+void tallyFrame(const Package& package, const StreamBuffer::State& s, Counts vn, Counts tn,
+                FrameStats& stats, Totals& total) {
   struct Tally {
-    std::uint64_t vertexKept = 0, vertexRead = 0, triangleKept = 0, triangleRead = 0;
-    std::uint64_t reformed = 0, indicesKept = 0, changed = 0;
+    std::uint64_t vertices = 0, triangles = 0, vertexRead = 0, triangleRead = 0, reformed = 0,
+                  indicesKept = 0, changed = 0;
   };
   const Tally tally = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, package.objectCount(), 1 << 14), Tally{},
       [&](const tbb::blocked_range<std::size_t>& range, Tally t) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
-          const std::uint32_t vo = old.vertexCounts[i], vn = vertexCounts[i];
-          const std::uint32_t to = old.triangleCounts[i], tn = triangleCounts[i];
-          t.vertexKept += std::min(vo, vn);
-          t.vertexRead += vn - std::min(vo, vn);
-          t.triangleKept += std::min(to, tn);
-          t.triangleRead += tn - std::min(to, tn);
-          if (vo == vn) {
-            t.indicesKept += tn;
+          assert(vn[i] == 0 ? tn[i] == 0 : tn[i] == package.trianglesAt(i, vn[i]));
+          const std::uint32_t vo = s.vertexCounts[i], to = s.triangleCounts[i];
+          t.vertices += vn[i];
+          t.triangles += tn[i];
+          t.vertexRead += vn[i] - std::min(vo, vn[i]);
+          t.triangleRead += tn[i] - std::min(to, tn[i]);
+          if (vo == vn[i]) {
+            t.indicesKept += tn[i];
           } else {
-            t.reformed += tn;
+            t.reformed += tn[i];
             ++t.changed;
           }
         }
         return t;
       },
       [](Tally a, const Tally& b) {
-        a.vertexKept += b.vertexKept;
+        a.vertices += b.vertices;
+        a.triangles += b.triangles;
         a.vertexRead += b.vertexRead;
-        a.triangleKept += b.triangleKept;
         a.triangleRead += b.triangleRead;
         a.reformed += b.reformed;
         a.indicesKept += b.indicesKept;
         a.changed += b.changed;
         return a;
       });
-  const std::uint64_t vertexBytes = StreamCapacity::vertexBytes(package);
+  total = {tally.vertices, tally.triangles};
   stats.verticesRead = tally.vertexRead;
   stats.trianglesRead = tally.triangleRead;
-  stats.bytesRead = tally.vertexRead * vertexBytes + tally.triangleRead * kTriangleBytes;
-  stats.bytesMoved =
-      tally.vertexKept * vertexBytes + (tally.triangleKept + tally.indicesKept) * kTriangleBytes;
+  stats.bytesRead =
+      tally.vertexRead * StreamCapacity::vertexBytes(package) + tally.triangleRead * kTriangleBytes;
   stats.trianglesReformed = tally.reformed;
   stats.trianglesKept = tally.indicesKept;
   stats.objectsChanged = tally.changed;
 }
 
-// §3.3: vertices and source triangles, each element from the old buffer or the package.
-void reassembleFrame(const Package& package, const BufferCopy& old, BufferCopy& next) {
-  const std::span<const PackageObject> objects = package.objects();
-  const auto vertexOffset = [&](std::size_t i) { return objects[i].vertexOffset; };
-  const auto triangleOffset = [&](std::size_t i) { return objects[i].triangleOffset; };
-  const std::span<const std::uint32_t> oldVertexCounts(old.vertexCounts);
-  reassemble(next.vertexStart, old.vertexStart, oldVertexCounts, old.positions.get(),
-             package.allPositions().data(), vertexOffset, 1, next.positions.get());
-  if (next.normals)
-    reassemble(next.vertexStart, old.vertexStart, oldVertexCounts, old.normals.get(),
-               package.allNormals().data(), vertexOffset, 1, next.normals.get());
-  if (next.colors)
-    reassemble(next.vertexStart, old.vertexStart, oldVertexCounts, old.colors.get(),
-               package.allColors().data(), vertexOffset, 1, next.colors.get());
-  if (next.uvs)
-    reassemble(next.vertexStart, old.vertexStart, oldVertexCounts, old.uvs.get(),
-               package.allUvs().data(), vertexOffset, 1, next.uvs.get());
-  reassemble(next.triangleStart, old.triangleStart,
-             std::span<const std::uint32_t>(old.triangleCounts), old.source.get(),
-             package.allTriangles().data(), triangleOffset, 3, next.source.get());
+// A selection beyond capacity is refused before anything changes.
+Status checkFits(const Package& package, const StreamCapacity& capacity, const Totals& total) {
+  if (total.vertices <= capacity.vertices && total.triangles <= capacity.triangles) return {};
+  return Error{ErrorKind::kLimit,
+               fmt::format("{}: the selection ({} vertices, {} triangles) does not fit the "
+                           "stream buffer ({} vertices, {} triangles)",
+                           package.name(), total.vertices, total.triangles, capacity.vertices,
+                           capacity.triangles)};
 }
 
-// Algorithm 2 over every triangle whose object changed; the others keep last frame's indices,
-// shifted by how far their object's vertices moved (beyond the paper, which re-forms all).
-void reformFrame(const Package& package, const BufferCopy& old,
-                 std::span<const std::uint32_t> vertexCounts, BufferCopy& next) {
-  const std::span<const PackageObject> objects = package.objects();
+bool outgrows(const StreamBuffer::State& s, std::size_t i, std::uint32_t vn, std::uint32_t tn) {
+  return vn > s.vertexSlot[i] || tn > s.triangleSlot[i];
+}
+
+// This frame's changed objects in object order, and what those outgrowing their slots need
+// (their exact counts; slack comes on top where it fits). Blocks of objects in parallel.
+Totals collectChanged(StreamBuffer::State& s, Counts vn, Counts tn) {
+  constexpr std::size_t kBlock = 1 << 14;
+  const std::size_t blocks = (vn.size() + kBlock - 1) / kBlock;
+  s.blockWork.resize(blocks);
+  std::vector<Totals> needs(blocks);
+  tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+    std::vector<ObjectWork>& work = s.blockWork[b];
+    work.clear();
+    for (std::size_t i = b * kBlock; i < std::min(vn.size(), (b + 1) * kBlock); ++i) {
+      if (vn[i] == s.vertexCounts[i]) continue;
+      work.push_back({static_cast<std::uint32_t>(i), s.vertexStart[i], s.triangleStart[i]});
+      if (outgrows(s, i, vn[i], tn[i])) {
+        needs[b].vertices += vn[i];
+        needs[b].triangles += tn[i];
+      }
+    }
+  });
+  s.work.clear();
+  Totals need;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    s.work.insert(s.work.end(), s.blockWork[b].begin(), s.blockWork[b].end());
+    need.vertices += needs[b].vertices;
+    need.triangles += needs[b].triangles;
+  }
+  return need;
+}
+
+// Brings `order` up to date: objects relocated since the last call go to its end, in the order
+// their slots were given (an object relocated twice, where its last slot was given). Done when the
+// order is needed (a compaction, slotOrder), not every frame.
+void settleOrder(StreamBuffer::State& s) {
+  if (s.relocations.empty()) return;
+  s.nextOrder.clear();
+  for (const std::uint32_t i : s.order)
+    if (!s.relocated[i]) s.nextOrder.push_back(i);
+  for (std::size_t k = 0; k < s.relocations.size(); ++k) {
+    const std::uint32_t i = s.relocations[k];
+    if (s.lastRelocation[i] != k) continue;
+    s.nextOrder.push_back(i);
+    s.relocated[i] = 0;
+  }
+  s.relocations.clear();
+  std::swap(s.order, s.nextOrder);
+}
+
+template <class T>
+void moveDown(T* array, std::uint64_t from, std::uint64_t to, std::uint64_t count) {
+  if (array && from != to && count) std::memmove(array + to, array + from, count * sizeof(T));
+}
+
+// After packing: the slots are their kept parts, back to back in slot order; what moved is
+// counted (a kept part whose slot moved, and its indices when either of its slots moved).
+void settleCompaction(StreamBuffer::State& s, Counts vn, Counts tn, FrameStats& stats) {
+  const std::uint64_t vertexBytes = StreamCapacity::vertexBytes(*s.package);
+  std::uint64_t vertexAt = 0, triangleAt = 0, moved = 0;
+  for (const std::uint32_t i : s.order) {
+    const std::uint32_t keptV = std::min(s.vertexCounts[i], vn[i]);
+    const std::uint32_t keptT = std::min(s.triangleCounts[i], tn[i]);
+    const bool vertexMoved = s.vertexStart[i] != vertexAt;
+    const bool triangleMoved = s.triangleStart[i] != triangleAt;
+    if (vertexMoved) moved += keptV * vertexBytes;
+    if (triangleMoved) moved += keptT * kTriangleBytes;
+    if (vertexMoved || triangleMoved) moved += keptT * kTriangleBytes;
+    s.vertexStart[i] = vertexAt;
+    s.triangleStart[i] = triangleAt;
+    s.vertexSlot[i] = keptV;
+    s.triangleSlot[i] = keptT;
+    vertexAt += keptV;
+    triangleAt += keptT;
+  }
+  s.vertexEnd = vertexAt;
+  s.triangleEnd = triangleAt;
+  stats.bytesMoved += moved;
+  stats.compacted = true;
+}
+
+// Calls f(i, from, to, kept) for every object in slot order with where its kept part of one
+// array (vertices or triangles) is and goes when the slots are packed.
+template <class F>
+void forEachPacked(const StreamBuffer::State& s, const std::vector<std::uint64_t>& start,
+                   const std::vector<std::uint32_t>& counts, Counts next, F f) {
+  std::uint64_t at = 0;
+  for (const std::uint32_t i : s.order) {
+    const std::uint32_t kept = std::min(counts[i], next[i]);
+    f(i, start[i], at, kept);
+    at += kept;
+  }
+}
+
+// The arena is full: every slot shrinks to the part this frame keeps, packed in slot order.
+// Each slot moves towards the front, so moving them in order never overwrites one not yet
+// moved. The kept indices move with it, rebased (a shrinking object re-forms from them). The
+// arrays are independent, so they are packed side by side.
+void compact(StreamBuffer::State& s, Counts vn, Counts tn, FrameStats& stats) {
+  Arrays& a = s.arrays;
+  settleOrder(s);
+  const auto packVertices = [&](auto* array) {
+    if (!array) return;
+    forEachPacked(s, s.vertexStart, s.vertexCounts, vn,
+                  [&](std::uint32_t, std::uint64_t from, std::uint64_t to, std::uint32_t kept) {
+                    moveDown(array, from, to, kept);
+                  });
+  };
+  const auto packIndices = [&] {
+    // The vertex slots' new starts first, then the indices moved and rebased by them.
+    std::vector<std::uint64_t> vertexAt(s.order.size());
+    forEachPacked(
+        s, s.vertexStart, s.vertexCounts, vn,
+        [&](std::uint32_t i, std::uint64_t, std::uint64_t to, std::uint32_t) { vertexAt[i] = to; });
+    std::uint32_t* indices = a.indices.get();
+    forEachPacked(s, s.triangleStart, s.triangleCounts, tn,
+                  [&](std::uint32_t i, std::uint64_t from, std::uint64_t to, std::uint32_t kept) {
+                    if (!kept || (from == to && vertexAt[i] == s.vertexStart[i])) return;
+                    moveDown(indices, 3 * from, 3 * to, 3 * std::uint64_t{kept});
+                    // Wraps modulo 2^32 when the vertices moved towards the front; exact.
+                    const auto shift = static_cast<std::uint32_t>(vertexAt[i] - s.vertexStart[i]);
+                    for (std::uint64_t c = 3 * to; c < 3 * (to + kept); ++c) indices[c] += shift;
+                  });
+  };
+  tbb::parallel_invoke(
+      [&] { packVertices(a.positions.get()); }, [&] { packVertices(a.normals.get()); },
+      [&] {
+        packVertices(a.colors.get());
+        packVertices(a.uvs.get());
+      },
+      [&] {
+        forEachPacked(s, s.triangleStart, s.triangleCounts, tn,
+                      [&](std::uint32_t, std::uint64_t from, std::uint64_t to, std::uint32_t kept) {
+                        moveDown(a.source.get(), 3 * from, 3 * to, 3 * std::uint64_t{kept});
+                      });
+      },
+      packIndices);
+  settleCompaction(s, vn, tn, stats);
+}
+
+// A slot with a quarter more room than the counts (no more than the whole object), so an object
+// that keeps growing does not move every frame.
+std::uint32_t withSlack(std::uint32_t count, std::uint32_t whole) {
+  return static_cast<std::uint32_t>(
+      std::min<std::uint64_t>(std::uint64_t{count} + count / 4, std::max(count, whole)));
+}
+
+// Objects that outgrew their slots get new ones at the high-water mark; their kept part is
+// counted as moved.
+void relocate(StreamBuffer::State& s, Counts vn, Counts tn, bool slack, FrameStats& stats) {
+  const Package& package = *s.package;
+  const std::uint64_t vertexBytes = StreamCapacity::vertexBytes(package);
+  for (const ObjectWork& w : s.work) {
+    const std::uint32_t i = w.object;
+    if (!outgrows(s, i, vn[i], tn[i])) continue;
+    const PackageObject& o = package.object(i);
+    s.vertexSlot[i] = slack ? withSlack(vn[i], o.vertexCount) : vn[i];
+    s.triangleSlot[i] = slack ? withSlack(tn[i], o.triangleCount) : tn[i];
+    s.vertexStart[i] = s.vertexEnd;
+    s.triangleStart[i] = s.triangleEnd;
+    s.vertexEnd += s.vertexSlot[i];
+    s.triangleEnd += s.triangleSlot[i];
+    stats.bytesMoved += std::min(s.vertexCounts[i], vn[i]) * vertexBytes +
+                        std::min(s.triangleCounts[i], tn[i]) * kTriangleBytes;
+    s.relocated[i] = 1;
+    s.lastRelocation[i] = static_cast<std::uint32_t>(s.relocations.size());
+    s.relocations.push_back(i);
+    ++stats.objectsRelocated;
+  }
+  assert(s.vertexEnd <= s.capacity.arenaVertices() && s.triangleEnd <= s.capacity.arenaTriangles());
+  if (s.relocations.size() > s.order.size()) settleOrder(s);  // the log stays bounded
+}
+
+// Gives every changed object a slot that holds its new counts: in place while they fit, else
+// at the high-water mark, after a compaction when even that is full.
+void placeChanged(StreamBuffer::State& s, Counts vn, Counts tn, FrameStats& stats) {
+  Totals need = collectChanged(s, vn, tn);
+  const auto fits = [&](std::uint64_t v, std::uint64_t t) {
+    return s.vertexEnd + v <= s.capacity.arenaVertices() &&
+           s.triangleEnd + t <= s.capacity.arenaTriangles();
+  };
+  if (!fits(need.vertices, need.triangles)) {
+    compact(s, vn, tn, stats);
+    need = collectChanged(s, vn, tn);
+  }
+  relocate(s, vn, tn, fits(need.vertices + need.vertices / 4, need.triangles + need.triangles / 4),
+           stats);
+}
+
+// One array of a changed object's slot: the kept part copied over when the slot moved, then
+// [old, new) read from the package (§3.3's Δ).
+template <class T>
+void fillSlot(T* arena, const T* package, std::uint64_t packageOffset, std::uint64_t width,
+              std::uint64_t from, std::uint64_t to, std::uint32_t oldCount,
+              std::uint32_t newCount) {
+  if (!arena) return;
+  const std::uint64_t kept = std::min(oldCount, newCount);
+  if (from != to && kept)
+    std::memcpy(arena + width * to, arena + width * from, width * kept * sizeof(T));
+  if (newCount > oldCount)
+    std::memcpy(arena + width * (to + oldCount), package + width * (packageOffset + oldCount),
+                width * (newCount - oldCount) * sizeof(T));
+}
+
+// §3.3's reassembly, for the changed objects only: the others' slots hold this frame already.
+void reassembleChanged(StreamBuffer::State& s, Counts vn, Counts tn) {
+  const Package& package = *s.package;
+  Arrays& a = s.arrays;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.work.size(), 16),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                        const ObjectWork& w = s.work[k];
+                        const std::uint32_t i = w.object;
+                        const PackageObject& o = package.object(i);
+                        const std::uint64_t v = s.vertexStart[i], vOffset = o.vertexOffset;
+                        const std::uint32_t vo = s.vertexCounts[i];
+                        fillSlot(a.positions.get(), package.allPositions().data(), vOffset, 1,
+                                 w.fromVertex, v, vo, vn[i]);
+                        fillSlot(a.normals.get(), package.allNormals().data(), vOffset, 1,
+                                 w.fromVertex, v, vo, vn[i]);
+                        fillSlot(a.colors.get(), package.allColors().data(), vOffset, 1,
+                                 w.fromVertex, v, vo, vn[i]);
+                        fillSlot(a.uvs.get(), package.allUvs().data(), vOffset, 1, w.fromVertex, v,
+                                 vo, vn[i]);
+                        fillSlot(a.source.get(), package.allTriangles().data(), o.triangleOffset, 3,
+                                 w.fromTriangle, s.triangleStart[i], s.triangleCounts[i], tn[i]);
+                      }
+                    });
+}
+
+// Starts fetching an object's ECol: a changed object's chains start with a cache miss each, and
+// its ECol (about 1 KB for a CAD part) is rarely in cache. Up to 4 KB.
+void prefetchEcol(const std::uint32_t* ecol, std::uint32_t vertices) {
+  constexpr std::uint32_t kLineWords = 16, kMaxLines = 64;
+  const std::uint32_t lines = std::min(kMaxLines, (vertices + kLineWords - 1) / kLineWords);
+  for (std::uint32_t l = 0; l < lines; ++l) __builtin_prefetch(ecol + l * kLineWords);
+}
+
+// Algorithm 2 over the changed objects' triangles (beyond the paper, which re-forms all: an
+// unchanged object's indices stay valid in its slot). A shrinking object starts each corner's
+// walk from last frame's index, which lies on the same ECol chain further down. Large objects
+// are split further.
+void reformChanged(StreamBuffer::State& s, Counts vn, Counts tn) {
+  const Package& package = *s.package;
   const std::uint32_t* ecolAll = package.allEcol().data();
-  tbb::parallel_for(
-      tbb::blocked_range<std::uint64_t>(0, next.triangles(), 1 << 13),
-      [&](const tbb::blocked_range<std::uint64_t>& range) {
-        std::size_t i = owner(next.triangleStart, range.begin());
-        for (std::uint64_t at = range.begin(); at < range.end(); ++i) {
-          if (next.triangleStart[i + 1] <= at) continue;
-          const std::uint64_t end = std::min(range.end(), next.triangleStart[i + 1]);
-          const std::uint32_t vn = vertexCounts[i];
-          // Wraps modulo 2^32 when the object moved towards the front; the sum is exact.
-          const auto base = static_cast<std::uint32_t>(next.vertexStart[i]);
-          std::uint32_t* out = next.indices.get() + 3 * at;
-          const std::size_t corners = 3 * (end - at);
-          if (old.vertexCounts[i] == vn) {
-            const std::uint32_t* from =
-                old.indices.get() + 3 * (old.triangleStart[i] + (at - next.triangleStart[i]));
-            const auto shift = static_cast<std::uint32_t>(next.vertexStart[i] - old.vertexStart[i]);
-            for (std::size_t k = 0; k < corners; ++k) out[k] = from[k] + shift;
-          } else {
-            const std::uint32_t* from = next.source.get() + 3 * at;
-            const std::uint32_t* ecol = ecolAll + objects[i].vertexOffset;
-            for (std::size_t k = 0; k < corners; ++k)
-              out[k] = reformCorner(from[k], vn, ecol) + base;
-          }
-          at = end;
-        }
-      });
+  const auto ecolOf = [&](std::uint32_t i) { return ecolAll + package.object(i).vertexOffset; };
+  const auto reformRange = [&](std::uint32_t i, std::uint64_t begin, std::uint64_t end) {
+    const std::uint32_t* ecol = ecolOf(i);
+    const auto base = static_cast<std::uint32_t>(s.vertexStart[i]);
+    std::uint32_t* out = s.arrays.indices.get() + 3 * s.triangleStart[i];
+    if (vn[i] < s.vertexCounts[i]) {
+      for (std::uint64_t k = begin; k < end; ++k)
+        out[k] = reformCorner(out[k] - base, vn[i], ecol) + base;
+      return;
+    }
+    const std::uint32_t* from = s.arrays.source.get() + 3 * s.triangleStart[i];
+    for (std::uint64_t k = begin; k < end; ++k) out[k] = reformCorner(from[k], vn[i], ecol) + base;
+  };
+  constexpr std::uint64_t kSplitCorners = 3 << 15;
+  constexpr std::size_t kPrefetchAhead = 4;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, s.work.size(), 16),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                        if (k + kPrefetchAhead < range.end()) {
+                          const std::uint32_t ahead = s.work[k + kPrefetchAhead].object;
+                          prefetchEcol(ecolOf(ahead), package.object(ahead).vertexCount);
+                        }
+                        const std::uint32_t i = s.work[k].object;
+                        const std::uint64_t corners = 3 * std::uint64_t{tn[i]};
+                        if (corners < 2 * kSplitCorners) {
+                          reformRange(i, 0, corners);
+                          continue;
+                        }
+                        tbb::parallel_for(
+                            tbb::blocked_range<std::uint64_t>(0, corners, kSplitCorners),
+                            [&](const tbb::blocked_range<std::uint64_t>& r) {
+                              reformRange(i, r.begin(), r.end());
+                            });
+                      }
+                    });
 }
 
 }  // namespace
 
 Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCounts,
                                         std::span<const std::uint32_t> triangleCounts) {
-  const Package& package = *state_->package;
+  State& s = *state_;
+  const Package& package = *s.package;
   assert(vertexCounts.size() == package.objectCount() &&
          triangleCounts.size() == package.objectCount());
-  const BufferCopy& old = state_->current();
-  BufferCopy& next = state_->copies[1 - state_->front];
   FrameStats stats;
   const auto reassemblyStart = std::chrono::steady_clock::now();
-  LODFORGE_TRY(layOut(package, state_->capacity, vertexCounts, triangleCounts, next));
-  tallyFrame(package, old, vertexCounts, triangleCounts, stats);
-  reassembleFrame(package, old, next);
+  Totals total;
+  tallyFrame(package, s, vertexCounts, triangleCounts, stats, total);
+  LODFORGE_TRY(checkFits(package, s.capacity, total));
+  placeChanged(s, vertexCounts, triangleCounts, stats);
+  reassembleChanged(s, vertexCounts, triangleCounts);
   stats.reassemblyMs = millisecondsSince(reassemblyStart);
   const auto reformationStart = std::chrono::steady_clock::now();
-  reformFrame(package, old, vertexCounts, next);
+  reformChanged(s, vertexCounts, triangleCounts);
   stats.reformationMs = millisecondsSince(reformationStart);
-  state_->front = 1 - state_->front;
+  for (const ObjectWork& w : s.work) {
+    s.vertexCounts[w.object] = vertexCounts[w.object];
+    s.triangleCounts[w.object] = triangleCounts[w.object];
+  }
+  s.vertexTotal = total.vertices;
+  s.triangleTotal = total.triangles;
   return stats;
 }
 
@@ -328,42 +534,50 @@ const StreamCapacity& StreamBuffer::capacity() const {
   return state_->capacity;
 }
 std::uint64_t StreamBuffer::vertexCount() const {
-  return state_->current().vertices();
+  return state_->vertexTotal;
 }
 std::uint64_t StreamBuffer::triangleCount() const {
-  return state_->current().triangles();
+  return state_->triangleTotal;
 }
 std::span<const Vec3f> StreamBuffer::positions() const {
-  return {state_->current().positions.get(), vertexCount()};
+  return {state_->arrays.positions.get(), state_->vertexEnd};
 }
 std::span<const Vec3f> StreamBuffer::normals() const {
-  const auto& c = state_->current();
-  return c.normals ? std::span<const Vec3f>(c.normals.get(), vertexCount())
-                   : std::span<const Vec3f>();
+  const State& s = *state_;
+  return s.arrays.normals ? std::span<const Vec3f>(s.arrays.normals.get(), s.vertexEnd)
+                          : std::span<const Vec3f>();
 }
 std::span<const Rgba8> StreamBuffer::colors() const {
-  const auto& c = state_->current();
-  return c.colors ? std::span<const Rgba8>(c.colors.get(), vertexCount())
-                  : std::span<const Rgba8>();
+  const State& s = *state_;
+  return s.arrays.colors ? std::span<const Rgba8>(s.arrays.colors.get(), s.vertexEnd)
+                         : std::span<const Rgba8>();
 }
 std::span<const Vec2f> StreamBuffer::uvs() const {
-  const auto& c = state_->current();
-  return c.uvs ? std::span<const Vec2f>(c.uvs.get(), vertexCount()) : std::span<const Vec2f>();
+  const State& s = *state_;
+  return s.arrays.uvs ? std::span<const Vec2f>(s.arrays.uvs.get(), s.vertexEnd)
+                      : std::span<const Vec2f>();
 }
 std::span<const std::uint32_t> StreamBuffer::sourceTriangles() const {
-  return {state_->current().source.get(), 3 * triangleCount()};
+  return {state_->arrays.source.get(), 3 * state_->triangleEnd};
 }
 std::span<const std::uint32_t> StreamBuffer::indices() const {
-  return {state_->current().indices.get(), 3 * triangleCount()};
+  return {state_->arrays.indices.get(), 3 * state_->triangleEnd};
 }
 std::span<const std::uint64_t> StreamBuffer::vertexStart() const {
-  return state_->current().vertexStart;
+  return state_->vertexStart;
 }
 std::span<const std::uint64_t> StreamBuffer::triangleStart() const {
-  return state_->current().triangleStart;
+  return state_->triangleStart;
 }
 std::span<const std::uint32_t> StreamBuffer::vertexCounts() const {
-  return state_->current().vertexCounts;
+  return state_->vertexCounts;
+}
+std::span<const std::uint32_t> StreamBuffer::triangleCounts() const {
+  return state_->triangleCounts;
+}
+std::span<const std::uint32_t> StreamBuffer::slotOrder() const {
+  settleOrder(*state_);
+  return state_->order;
 }
 
 }  // namespace lodforge

@@ -1,16 +1,23 @@
-// Frame-coherent streaming of the CAD paper §3.3: a buffer of fixed capacity holds the selected
-// vertices and triangles of all objects, back to back in object order (the VBO layout), and each
-// frame only the ranges that changed are read from the package; the rest is moved from last
-// frame's buffer. The buffer stands for GPU memory; the renderer uploads or maps its arrays.
+// Frame-coherent streaming after the CAD paper §3.3: a buffer of fixed capacity holds the selected
+// vertices and triangles of all objects, and each frame only the ranges that changed are read from
+// the package. The buffer stands for GPU memory; the renderer uploads or maps its arrays.
 //
-// Per object i with vc_i vertices and tc_i = map(vc_i) triangles the buffer holds
+// Beyond the paper, the buffer is updated in place: each object owns a slot, a range of the
+// vertex and triangle arrays at least as large as its counts, and keeps it while its selection
+// fits. The paper rebuilds the compact layout (objects back to back) every frame, which moves
+// every unchanged object behind the first changed one: at 18 M triangles, 1.3 GB per frame. An
+// object that outgrows its slot moves to a new one at the end of the arena; when the arena
+// (twice the capacity) is full, one compaction packs the slots in their order.
+//
+// Per object i with vc_i vertices and tc_i = map(vc_i) triangles, its slot holds
 //   vertices      positions (and normals, colors, uvs when the package has them) [0, vc_i)
 //   source        the first tc_i rearranged triangles, object-local full-detail corners
 //   indices       the same triangles re-formed at vc_i (Algorithm 2), as indices into the
-//                 whole vertex buffer, so one draw call renders the frame
+//                 whole vertex buffer, so one multi-draw (a command per object) renders the frame
 // Source triangles are streamed like vertices (only [tc_old, tc_new) is read), as in the paper,
 // where they live in GPU memory and re-formation runs there. ECol and Map are read in place
-// from the package, as the paper keeps them resident on the GPU.
+// from the package, as the paper keeps them resident on the GPU. Between slots the arrays hold
+// stale data: read an object's ranges through vertexStart/triangleStart and its counts.
 #pragma once
 
 #include <cstdint>
@@ -24,36 +31,44 @@
 
 namespace lodforge {
 
-// What one buffer copy can hold. Triangles follow from vertices by the package's largest ratio
-// of triangles to vertices over every object and level, so no selection within the vertex
-// budget can overflow them.
+// What one selection may hold. Triangles follow from vertices by the package's largest ratio of
+// triangles to vertices over every object and level, so no selection within the vertex budget
+// can overflow them. The buffer's arrays (the arena) hold twice this, so that objects which
+// outgrow their slots have room before a compaction; indices are 32-bit, so forVertices and
+// forMemory give at most 2^31 vertices.
 struct StreamCapacity {
   std::uint64_t vertices = 0;
   std::uint64_t triangles = 0;
+
+  std::uint64_t arenaVertices() const { return 2 * vertices; }
+  std::uint64_t arenaTriangles() const { return 2 * triangles; }
 
   // Bytes per vertex (position, plus normal, color and uv when the package has them).
   static std::uint64_t vertexBytes(const Package& package);
   // max over objects and levels n of map(n) / n.
   static double triangleRatio(const Package& package);
   static StreamCapacity forVertices(const Package& package, std::uint64_t vertices);
-  // The most vertices whose buffers — both copies of vertices, source triangles and indices —
-  // fit in `bytes`.
+  // The most vertices whose arena — vertices, source triangles and indices, each twice the
+  // capacity — fits in `bytes`.
   static StreamCapacity forMemory(const Package& package, std::uint64_t bytes);
-  // Bytes of both copies.
+  // Bytes of the arena.
   std::uint64_t bytes(const Package& package) const;
 };
 
 // What a frame cost. "Read" is data taken from the package (the repository); "moved" is data
-// copied from last frame's buffer.
+// copied inside the buffer: the kept part of objects that outgrew their slots and, in a frame
+// that compacts, every slot that moved (with the indices of unchanged objects rebased).
 struct FrameStats {
   std::uint64_t bytesRead = 0;
   std::uint64_t bytesMoved = 0;
   std::uint64_t verticesRead = 0, trianglesRead = 0;
   std::uint64_t trianglesReformed = 0;  // objects whose count changed: re-formed from source
-  std::uint64_t trianglesKept = 0;      // objects whose count did not: indices moved and rebased
+  std::uint64_t trianglesKept = 0;      // objects whose count did not: indices kept
   std::uint64_t objectsChanged = 0;
-  double reassemblyMs = 0;   // vertices and source triangles into the new buffer
-  double reformationMs = 0;  // indices: re-formed or kept
+  std::uint64_t objectsRelocated = 0;  // changed objects that outgrew their slot
+  bool compacted = false;              // the arena was full: slots packed in their order
+  double reassemblyMs = 0;             // vertices and source triangles into the new buffer
+  double reformationMs = 0;            // indices: re-formed or kept
 };
 
 class StreamBuffer {
@@ -65,28 +80,34 @@ class StreamBuffer {
 
   // Makes the buffer hold the objects at these counts (tc_i must be map(vc_i), 0 with vc_i = 0;
   // the sums must fit the capacity, else a kLimit error and the buffer is unchanged). Reads
-  // only what last frame's buffer lacks.
+  // only what last frame's buffer lacks; an unchanged object's slot is not touched.
   Result<FrameStats> update(std::span<const std::uint32_t> vertexCounts,
                             std::span<const std::uint32_t> triangleCounts);
   // Forgets last frame, so the next update reads everything (a from-scratch build).
   void clear();
 
   const StreamCapacity& capacity() const;
-  std::uint64_t vertexCount() const;
-  std::uint64_t triangleCount() const;
+  std::uint64_t vertexCount() const;    // Σ vc_i
+  std::uint64_t triangleCount() const;  // Σ tc_i
+  // The arrays up to the arena's high-water mark (slots and the stale space between them).
   std::span<const Vec3f> positions() const;
   std::span<const Vec3f> normals() const;                  // empty without normals in the package
   std::span<const Rgba8> colors() const;                   // empty without colors
   std::span<const Vec2f> uvs() const;                      // empty unless textured
   std::span<const std::uint32_t> sourceTriangles() const;  // 3 per triangle, object-local
   std::span<const std::uint32_t> indices() const;          // 3 per triangle, buffer-global
-  // Per object: where its vertices and triangles start (object count + 1 entries) and counts.
+  // Per object (one entry each): where its slot's vertices and triangles start, and its counts.
   std::span<const std::uint64_t> vertexStart() const;
   std::span<const std::uint64_t> triangleStart() const;
   std::span<const std::uint32_t> vertexCounts() const;
+  std::span<const std::uint32_t> triangleCounts() const;
+  // Every object once, by where its slot starts (vertices and triangles are in the same order).
+  // Brings the order up to date first, so it may not run beside update().
+  std::span<const std::uint32_t> slotOrder() const;
+
+  struct State;  // (its helpers in stream.cpp take it)
 
  private:
-  struct State;
   std::unique_ptr<State> state_;
 };
 

@@ -2,6 +2,7 @@
 // llvmpipe: identical index buffers for random selections.
 #include "lodforge/render/gpu_reform.h"
 
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include "lodforge/core/random.h"
@@ -27,7 +28,7 @@ TEST(GpuReform, EqualsTheCpuIndicesForRandomSelections) {
     auto reformer = GpuReformer::create(package, buffer.capacity());
     ASSERT_TRUE(reformer.ok()) << reformer.error().message;
     std::vector<std::uint32_t> vc(package.objectCount()), tc(package.objectCount());
-    std::uint64_t checked = 0;
+    std::uint64_t checked = 0, gaps = 0;
     for (int round = 0; round < 12; ++round) {
       // Every object at a random level of its own (0, q..p), some rounds with most objects out.
       const double absent = round % 3 == 0 ? 0.8 : 0.1;
@@ -43,20 +44,32 @@ TEST(GpuReform, EqualsTheCpuIndicesForRandomSelections) {
       }
       ASSERT_TRUE(buffer.update(vc, tc).ok());
       renderer->upload(buffer, /*indices=*/false);
+      // A marker in every word first: the gaps between slots must keep it (skipped, not
+      // re-formed from whatever source lies there).
+      const std::uint32_t marker = 0xFFFFFFFFu;
+      glClearNamedBufferData(renderer->indexBuffer(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                             &marker);
       reformer->reform(buffer, renderer->indexBuffer());
-      // Each object's slot; between slots the buffers hold whatever was there.
       const auto cpu = buffer.indices();
       const auto gpu = GpuReformer::readIndices(renderer->indexBuffer(), cpu.size() / 3);
       ASSERT_EQ(gpu.size(), cpu.size());
+      std::vector<bool> held(gpu.size(), false);
       for (std::size_t i = 0; i < vc.size(); ++i) {
         const std::size_t first = 3 * buffer.triangleStart()[i], corners = 3 * std::size_t{tc[i]};
         ASSERT_TRUE(
             std::equal(gpu.begin() + first, gpu.begin() + first + corners, cpu.begin() + first))
             << key << " round " << round << " object " << i;
+        std::fill(held.begin() + first, held.begin() + first + corners, true);
+      }
+      for (std::size_t w = 0; w < gpu.size(); ++w) {
+        if (held[w]) continue;
+        ASSERT_EQ(gpu[w], marker) << key << " round " << round << " word " << w;
+        ++gaps;
       }
       checked += buffer.triangleCount();
     }
     EXPECT_GT(checked, 0u) << key;
+    EXPECT_GT(gaps, 0u) << key;  // the slots did leave gaps
   }
 }
 

@@ -41,6 +41,7 @@ struct GpuReformer::State {
   Program program;
   GLuint ecol = 0, source = 0, objects = 0;
   std::uint64_t objectCapacity = 0;
+  std::uint64_t sourceBytes = 0;  // a StreamBuffer's source triangles (a GpuStream has its own)
   std::vector<std::array<std::uint32_t, 4>> table;
   const Package* package = nullptr;
 
@@ -59,14 +60,17 @@ Result<GpuReformer> GpuReformer::create(const Package& package, const StreamCapa
     return Error{ErrorKind::kUnsupported,
                  "GPU reformation addresses ECol with 32-bit offsets: this package has more than "
                  "4 G vertices; use the CPU path"};
+  if (!capacity.arenaFitsGpuOffsets())
+    return Error{ErrorKind::kUnsupported,
+                 "GPU reformation addresses corners with 32-bit offsets: the stream's arena is "
+                 "over 4 G of them; lower the budget or --gpu-memory"};
   auto program = Program::link({{GL_COMPUTE_SHADER, std::string(kElementGlsl) + kReformMain}});
   if (!program) return program.status();
   s->program = std::move(*program);
   // The package's ECol section is one array over all objects (each at its vertex offset).
   const std::uint32_t* ecol = package.objectCount() ? package.ecol(0).data() : nullptr;
-  s->ecol = makeBuffer(vertices * sizeof(std::uint32_t), ecol, 0);  // immutable
-  s->source =
-      makeBuffer(capacity.arenaTriangles() * 3 * sizeof(std::uint32_t));  // a StreamBuffer's
+  s->ecol = makeBuffer(vertices * sizeof(std::uint32_t), ecol, 0);         // immutable
+  s->sourceBytes = capacity.arenaTriangles() * 3 * sizeof(std::uint32_t);  // on first use
   s->objectCapacity = 2 * package.objectCount() + 1;  // each object, and a skip row before it
   s->objects = makeBuffer(s->objectCapacity * 16);
   return GpuReformer(std::move(s));
@@ -79,6 +83,7 @@ GpuReformer::~GpuReformer() = default;
 
 void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
   const auto source = buffer.sourceTriangles();
+  if (!state_->source) state_->source = makeBuffer(state_->sourceBytes);
   glNamedBufferSubData(state_->source, 0, static_cast<GLsizeiptr>(source.size_bytes()),
                        source.data());
   run(state_->source,

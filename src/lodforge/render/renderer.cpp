@@ -229,6 +229,10 @@ struct Renderer::State {
 
 Result<Renderer> Renderer::create(const Package& package, const StreamCapacity& capacity,
                                   bool vertexBuffers) {
+  if (!capacity.arenaFitsGpuOffsets())
+    return Error{ErrorKind::kUnsupported,
+                 "the stream's arena is over 4 G vertex or index offsets: lower the budget or "
+                 "--gpu-memory"};
   auto s = std::make_unique<State>();
   s->package = &package;
   s->capacity = capacity;

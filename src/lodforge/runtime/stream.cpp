@@ -119,7 +119,8 @@ StreamBuffer::StreamBuffer(const Package& package, StreamCapacity capacity)
   State& s = *state_;
   s.package = &package;
   s.capacity = capacity;
-  // Left uninitialised: only an object's [0, count) is ever read, and it is always written first.
+  // Left uninitialised: an object's [0, count) is written before anything reads it (the renderer
+  // uploads the gaps between slots too, and never draws them).
   const std::uint64_t vertices = capacity.arenaVertices(), triangles = capacity.arenaTriangles();
   s.arrays.positions = std::make_unique_for_overwrite<Vec3f[]>(vertices);
   if (package.header().hasNormals())
@@ -276,7 +277,8 @@ void moveDown(T* array, std::uint64_t from, std::uint64_t to, std::uint64_t coun
 }
 
 // After packing: the slots are their kept parts, back to back in slot order; what moved is
-// counted (a kept part whose slot moved, and its indices when either of its slots moved).
+// counted (a kept part whose slot moved, and the indices of an object that did not grow when
+// either of its slots moved).
 void settleCompaction(StreamBuffer::State& s, Counts vn, Counts tn, FrameStats& stats) {
   const std::uint64_t vertexBytes = StreamCapacity::vertexBytes(*s.package);
   std::uint64_t vertexAt = 0, triangleAt = 0, moved = 0;
@@ -287,7 +289,8 @@ void settleCompaction(StreamBuffer::State& s, Counts vn, Counts tn, FrameStats& 
     const bool triangleMoved = s.triangleStart[i] != triangleAt;
     if (vertexMoved) moved += keptV * vertexBytes;
     if (triangleMoved) moved += keptT * kTriangleBytes;
-    if (vertexMoved || triangleMoved) moved += keptT * kTriangleBytes;
+    if ((vertexMoved || triangleMoved) && vn[i] <= s.vertexCounts[i])
+      moved += keptT * kTriangleBytes;
     s.vertexStart[i] = vertexAt;
     s.triangleStart[i] = triangleAt;
     s.vertexSlot[i] = keptV;
@@ -316,8 +319,8 @@ void forEachPacked(const StreamBuffer::State& s, const std::vector<std::uint64_t
 
 // The arena is full: every slot shrinks to the part this frame keeps, packed in slot order.
 // Each slot moves towards the front, so moving them in order never overwrites one not yet
-// moved. The kept indices move with it, rebased (a shrinking object re-forms from them). The
-// arrays are independent, so they are packed side by side.
+// moved. The kept indices of an object that did not grow move with it, rebased (a shrinking
+// object re-forms from them). The arrays are independent, so they are packed side by side.
 void compact(StreamBuffer::State& s, Counts vn, Counts tn, FrameStats& stats) {
   Arrays& a = s.arrays;
   settleOrder(s);
@@ -337,7 +340,9 @@ void compact(StreamBuffer::State& s, Counts vn, Counts tn, FrameStats& stats) {
     std::uint32_t* indices = a.indices.get();
     forEachPacked(s, s.triangleStart, s.triangleCounts, tn,
                   [&](std::uint32_t i, std::uint64_t from, std::uint64_t to, std::uint32_t kept) {
-                    if (!kept || (from == to && vertexAt[i] == s.vertexStart[i])) return;
+                    // A growing object is re-formed from its source triangles after this.
+                    if (!kept || vn[i] > s.vertexCounts[i]) return;
+                    if (from == to && vertexAt[i] == s.vertexStart[i]) return;
                     moveDown(indices, 3 * from, 3 * to, 3 * std::uint64_t{kept});
                     // Wraps modulo 2^32 when the vertices moved towards the front; exact.
                     const auto shift = static_cast<std::uint32_t>(vertexAt[i] - s.vertexStart[i]);

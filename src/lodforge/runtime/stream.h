@@ -42,6 +42,11 @@ struct StreamCapacity {
 
   std::uint64_t arenaVertices() const { return 2 * vertices; }
   std::uint64_t arenaTriangles() const { return 2 * triangles; }
+  // GL draws and the GPU reformer address the arena's corners with 32-bit offsets.
+  bool arenaFitsGpuOffsets() const {
+    return arenaVertices() < (std::uint64_t{1} << 32) &&
+           3 * arenaTriangles() < (std::uint64_t{1} << 32);
+  }
 
   // Bytes per vertex (position, plus normal, color and uv when the package has them).
   static std::uint64_t vertexBytes(const Package& package);
@@ -57,7 +62,7 @@ struct StreamCapacity {
 
 // What a frame cost. "Read" is data taken from the package (the repository); "moved" is data
 // copied inside the buffer: the kept part of objects that outgrew their slots and, in a frame
-// that compacts, every slot that moved (with the indices of unchanged objects rebased).
+// that compacts, every slot that moved (with the indices of objects that did not grow, rebased).
 struct FrameStats {
   std::uint64_t bytesRead = 0;
   std::uint64_t bytesMoved = 0;
@@ -102,7 +107,7 @@ class StreamBuffer {
   std::span<const std::uint32_t> vertexCounts() const;
   std::span<const std::uint32_t> triangleCounts() const;
   // Every object once, by where its slot starts (vertices and triangles are in the same order).
-  // Brings the order up to date first, so it may not run beside update().
+  // Brings the order up to date first, so no other call may run beside it.
   std::span<const std::uint32_t> slotOrder() const;
 
   struct State;  // (its helpers in stream.cpp take it)

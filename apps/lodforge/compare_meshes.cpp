@@ -150,6 +150,12 @@ Status runCompareMeshes(const Global& global, const std::string& a, const std::s
   say(global, fmt::format("hausdorff {:.6g}  rms {:.6g}  mean {} → {}: {:.6g}  mean {} → {}: "
                           "{:.6g}  ({} samples on each)",
                           d.hausdorff, d.rms, a, b, d.meanAB, b, a, d.meanBA, samples));
+  // Where the largest distances are: a reader looks there (thin parts, rims, holes).
+  const Vec3d onA = d.farthestOnA + first->origin, onB = d.farthestOnB + first->origin;
+  detail(global,
+         fmt::format("largest {} → {}: {:.6g} at ({:.9g}, {:.9g}, {:.9g}); {} → {}: "
+                     "{:.6g} at ({:.9g}, {:.9g}, {:.9g})",
+                     a, b, d.maxAB, onA.x, onA.y, onA.z, b, a, d.maxBA, onB.x, onB.y, onB.z));
   Result<std::optional<TextureDistance>> texture =
       compareTextures(*first, fa, *second, fb, samples);
   if (!texture) return texture.status();
@@ -166,7 +172,11 @@ Status runCompareMeshes(const Global& global, const std::string& a, const std::s
                            {"hausdorff", d.hausdorff},
                            {"rms", d.rms},
                            {"mean_ab", d.meanAB},
-                           {"mean_ba", d.meanBA}};
+                           {"mean_ba", d.meanBA},
+                           {"max_ab", d.maxAB},
+                           {"max_ba", d.maxBA},
+                           {"farthest_on_a", {onA.x, onA.y, onA.z}},
+                           {"farthest_on_b", {onB.x, onB.y, onB.z}}};
   if (*texture)
     report["texture_texels"] = {
         {"mean", (*texture)->mean},       {"median", (*texture)->median},

@@ -1,15 +1,18 @@
 // `lodforge generate cad|scan|points`: deterministic synthetic inputs of any size, streamed to
-// disk (see src/lodforge/generate/).
+// disk (see src/lodforge/generate/); `points --from MESH` samples a given mesh's surface.
 #include <chrono>
 
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
 #include "lodforge/core/units.h"
 #include "lodforge/generate/cad.h"
 #include "lodforge/generate/points.h"
 #include "lodforge/generate/scan.h"
+#include "lodforge/generate/surface_samples.h"
+#include "lodforge/io/model_io.h"
 #include "outputs.h"
 
 namespace lodforge::cli {
@@ -31,8 +34,9 @@ void report(const Global& global, const std::string& path, const Result<Generate
 }
 
 template <class Generate>
-Status timed(const Global& global, const std::string& path, Generate&& generate) {
-  LODFORGE_TRY(claimOutput(path, modelFileOutput(path), {}));
+Status timed(const Global& global, const std::string& path, Generate&& generate,
+             const std::vector<std::string>& inputs = {}) {
+  LODFORGE_TRY(claimOutput(path, modelFileOutput(path), inputs));
   const auto start = std::chrono::steady_clock::now();
   Result<GenerateStats> stats = generate();
   if (!stats) return stats.status();
@@ -101,20 +105,41 @@ void addGeneratePoints(CLI::App* generate, const Global& global, Run& run) {
   struct Options {
     PointsOptions points;
     std::string output = "points.ply";
+    std::string from;  // a mesh to sample instead of the terrain
+    double noise = 0;  // with --from: a share of the mesh's bounding-box diagonal
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = generate->add_subcommand(
       "points", "A scanned-surface point cloud of N points (PLY, or LAS with lidar attributes)");
   addCountOption(*sub, "--points", options->points.points, "Number of points (default 1M)");
   sub->add_option("--seed", options->points.seed, "Random seed");
+  sub->add_option("--from", options->from,
+                  "Sample this mesh's surface by area instead (PLY with normals; its true surface "
+                  "is known, for measuring reconstruct with compare)");
+  sub->add_option("--noise", options->noise,
+                  "With --from: Gaussian noise along the normal, standard deviation as a share "
+                  "of the bounding-box diagonal (0.0005 = 0.05 %)");
   sub->add_option("-o,--output", options->output, "Output .ply or .las (default points.ply)");
   sub->add_flag("--extra-bytes", options->points.extraBytes,
                 "LAS: add described extra bytes (height above ground, echo width, range, "
                 "amplitude)");
   sub->callback([&global, &run, options] {
     run = [&global, options] {
-      return timed(global, options->output,
-                   [&] { return generatePoints(options->points, options->output); });
+      if (options->from.empty() && options->noise != 0)
+        return Status(Error{ErrorKind::kUsage, "--noise goes with --from MESH"});
+      if (options->from.empty())
+        return timed(global, options->output,
+                     [&] { return generatePoints(options->points, options->output); });
+      if (fileExtension(options->output) != "ply")
+        return Status(
+            Error{ErrorKind::kUsage, fmt::format("{}: --from writes a .ply", options->output)});
+      const auto sample = [&]() -> Result<GenerateStats> {
+        Result<Model> model = readModel(options->from);
+        if (!model) return model.status();
+        return sampleSurface(*model, {options->points.points, options->points.seed, options->noise},
+                             options->output);
+      };
+      return timed(global, options->output, sample, {options->from});
     };
   });
 }

@@ -649,6 +649,40 @@ TEST(CliPoints, ExtraBytesAreListedAndCarried) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("e.ply")));
 }
 
+// `generate points --from`: a mesh's surface sampled, then a reconstruction of it measured with
+// compare, whose JSON says where the largest distance is; misuse is refused with nothing written.
+TEST(CliPoints, SamplesAMeshAndCompareSaysWhereTheLargestDistanceIs) {
+  test::TempDir dir;
+  const std::string horse = test::dataPath("meshes/horse.ply");
+  Outcome o = lodforge(
+      "-q generate points --from " + horse + " --points 30K --noise 0.0005 -o " + dir.file("h.ply"),
+      dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_EQ(info(dir.file("h.ply"), dir)["vertices"], 30'000u);
+  o = lodforge("-q reconstruct " + dir.file("h.ply") + " -o " + dir.file("r.ply"), dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  o = lodforge("-q compare " + dir.file("r.ply") + " " + horse + " --json " + dir.file("c.json"),
+               dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  const nlohmann::json c = nlohmann::json::parse(test::readFile(dir.file("c.json")));
+  EXPECT_EQ(c["hausdorff"], std::max(c["max_ab"].get<double>(), c["max_ba"].get<double>()));
+  ASSERT_EQ(c["farthest_on_a"].size(), 3u);
+  ASSERT_EQ(c["farthest_on_b"].size(), 3u);
+  // Each farthest point lies on its own mesh's bounds (the horse's: about 0.18 long).
+  for (int k = 0; k < 3; ++k) EXPECT_LT(std::abs(c["farthest_on_b"][k].get<double>()), 0.1);
+  o = lodforge("generate points --points 5K --noise 0.01 -o " + dir.file("n.ply"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("--noise goes with --from"), std::string::npos) << o.err;
+  o = lodforge("generate points --from " + horse + " --points 5K -o " + dir.file("h.las"), dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("h.las")));
+  o = lodforge("generate points --from " + dir.file("missing.ply") + " -o " + dir.file("m.ply"),
+               dir);
+  EXPECT_EQ(o.code, 1) << o.err;  // as every command for a file that is not there
+  EXPECT_NE(o.err.find("missing.ply"), std::string::npos) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("m.ply")));
+}
+
 // `reconstruct`: a surface from generated points, its figures on the way; bad input is exit 2
 // with what would work, and nothing written.
 TEST(CliReconstruct, MakesASurfaceAndRefusesWhatCannotBeOne) {

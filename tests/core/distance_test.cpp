@@ -169,6 +169,18 @@ TEST(SurfaceDistance, CornerSamplesCatchASpikeThatAreaSamplesMiss) {
   const SurfaceDistance without = surfaceDistance(pa, ia, pb, ib, 200, 1, false);
   EXPECT_NEAR(with.hausdorff, 3.0, 1e-6);
   EXPECT_LT(without.hausdorff, 3.0);
+  // The largest distance is the spike's, from A, and it is where the spike's tip is.
+  EXPECT_EQ(with.maxAB, with.hausdorff);
+  EXPECT_LT(with.maxBA, 3.0);
+  const Vec3d tip = toDouble(pa[25 * 51 + 25]);
+  EXPECT_EQ(with.farthestOnA.x, tip.x);
+  EXPECT_EQ(with.farthestOnA.y, tip.y);
+  EXPECT_EQ(with.farthestOnA.z, tip.z);
+  // Measured the other way round, the tip is B's farthest point.
+  const SurfaceDistance swapped = surfaceDistance(pb, ib, pa, ia, 200, 1, true);
+  EXPECT_NEAR(swapped.maxBA, 3.0, 1e-6);
+  EXPECT_EQ(swapped.farthestOnB.z, tip.z);
+  EXPECT_EQ(swapped.farthestOnB.x, tip.x);
 }
 
 }  // namespace

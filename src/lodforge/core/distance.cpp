@@ -293,6 +293,7 @@ std::vector<Vec3d> samplePoints(std::span<const Vec3f> positions,
 struct OneSided {
   double max = 0, sumSquares = 0, sum = 0;
   std::size_t count = 0;
+  std::size_t farthest = 0;  // the first sample at `max`
 };
 
 // The largest of the points' distances to the grid's triangles (exact: a query stops early only
@@ -315,7 +316,10 @@ OneSided measure(const std::vector<Vec3d>& points, const TriangleGrid& grid) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
           const double squared = grid.nearestSquared(points[i]);
           const double d = std::sqrt(squared);
-          acc.max = std::max(acc.max, d);
+          if (d > acc.max || acc.count == 0) {
+            acc.max = d;
+            acc.farthest = i;
+          }
           acc.sumSquares += squared;
           acc.sum += d;
           ++acc.count;
@@ -323,7 +327,12 @@ OneSided measure(const std::vector<Vec3d>& points, const TriangleGrid& grid) {
         return acc;
       },
       [](OneSided a, const OneSided& b) {
-        a.max = std::max(a.max, b.max);
+        // The first of equal distances in sample order, however the range was split.
+        if (b.count &&
+            (a.count == 0 || b.max > a.max || (b.max == a.max && b.farthest < a.farthest))) {
+          a.max = b.max;
+          a.farthest = b.farthest;
+        }
         a.sumSquares += b.sumSquares;
         a.sum += b.sum;
         a.count += b.count;
@@ -344,11 +353,15 @@ SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
     return result;
   }
   const TriangleGrid gridA(positionsA, indicesA), gridB(positionsB, indicesB);
-  const OneSided ab =
-      measure(samplePoints(positionsA, indicesA, samplesPerMesh, seed, corners), gridB);
-  const OneSided ba =
-      measure(samplePoints(positionsB, indicesB, samplesPerMesh, seed + 1, corners), gridA);
+  const std::vector<Vec3d> onA = samplePoints(positionsA, indicesA, samplesPerMesh, seed, corners);
+  const std::vector<Vec3d> onB =
+      samplePoints(positionsB, indicesB, samplesPerMesh, seed + 1, corners);
+  const OneSided ab = measure(onA, gridB), ba = measure(onB, gridA);
   result.hausdorff = std::max(ab.max, ba.max);
+  result.maxAB = ab.max;
+  result.maxBA = ba.max;
+  result.farthestOnA = onA[ab.farthest];
+  result.farthestOnB = onB[ba.farthest];
   result.rms = std::sqrt((ab.sumSquares + ba.sumSquares) /
                          static_cast<double>(std::max<std::size_t>(1, ab.count + ba.count)));
   result.meanAB = ab.sum / static_cast<double>(std::max<std::size_t>(1, ab.count));

@@ -19,6 +19,9 @@ struct SurfaceDistance {
   double hausdorff = 0;  // max over both directions of the max sample distance
   double rms = 0;        // root mean square over all samples of both directions
   double meanAB = 0, meanBA = 0;
+  double maxAB = 0, maxBA = 0;  // each direction's largest: hausdorff is the larger
+  // Where each direction's largest is: the sample of A farthest from B, of B farthest from A.
+  Vec3d farthestOnA, farthestOnB;
 };
 
 // Distance between surfaces A and B: `samplesPerMesh` points spread over each surface by area

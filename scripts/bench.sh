@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-tiles, cad, instances, textures, textured-obj, texture-formats, gltfpack or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-closed, surface-tiles, cad, instances, textures, textured-obj, texture-formats, gltfpack or serve runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -387,6 +387,48 @@ surface_section() {
 }
 if [[ ${BENCH_ONLY:-} == surface ]]; then surface_section; exit 0; fi
 
+# A closed scan beside PoissonRecon (issue 37): 1 M points sampled from the horse scan (generate
+# points --from, noise 0.05 % of its diagonal along the normals), both tools at PoissonRecon depth
+# 9's cell (1.1 × the longest side / 512), each mesh measured against the horse, and where each
+# one's largest distance lies (compare -v).
+surface_closed_section() {
+  echo
+  echo "== a closed scan beside PoissonRecon (horse, 1 M samples; $(nproc) threads)"
+  missing_peer POISSON PoissonRecon && return
+  local data=${LODFORGE_DATA:-../shared/data}
+  [[ -d $data ]] || data=/work/shared/data
+  local mesh=$data/meshes/horse.ply cloud=$work/closed-1M.ply
+  "$lodforge" -q generate points --from "$mesh" --points 1M --noise 0.0005 -o "$cloud"
+  local voxel
+  voxel=$("$lodforge" info "$mesh" --json | awk '/"max"/ {m = 1} /"min"/ {m = 0}
+    /^ *-?[0-9.e+-]+,?$/ { v = $1 + 0; if (m) max[++a] = v; else min[++b] = v }
+    END { s = 0; for (i = 1; i <= 3; ++i) if (max[i] - min[i] > s) s = max[i] - min[i]; print s * 1.1 / 512 }')
+  printf '| %-9s | %8s | %10s | %10s | %11s | %11s | %-44s |\n' tool wall "peak RSS" triangles hausdorff rms "largest distance at"
+  printf '|%s|%s|%s|%s|%s|%s|%s|\n' ----------- ---------- ------------ ------------ ------------- ------------- ----------------------------------------------
+  for tool in lodforge poisson; do
+    local out=$work/closed-$tool.ply
+    rm -f "$out"
+    if [[ $tool == lodforge ]]; then
+      read -r seconds kib < <(timed "$lodforge" -q reconstruct "$cloud" -o "$out" --voxel "$voxel")
+    else
+      read -r seconds kib < <(timed "$POISSON" --in "$cloud" --out "$out" --depth 9)
+    fi
+    local triangles where
+    triangles=$("$lodforge" info "$out" --json | sed -n 's/.*"triangles": \([0-9]*\).*/\1/p')
+    where=$("$lodforge" -v compare "$out" "$mesh" --json "$work/closed-$tool.json" 2>&1 |
+      sed -n 's/^largest [^ ]* → [^ ]*: [0-9.e+-]* at \(([^)]*)\).*/\1/p')
+    local h r
+    h=$(sed -n 's/.*"hausdorff": \([0-9.e+-]*\).*/\1/p' "$work/closed-$tool.json")
+    r=$(sed -n 's/.*"rms": \([0-9.e+-]*\).*/\1/p' "$work/closed-$tool.json")
+    printf '| %-9s | %7ss | %6d MiB | %10s | %11.4g | %11.4g | %-44s |\n' "$tool" "$seconds" \
+      $((kib / 1024)) "$triangles" "$h" "$r" "$where"
+    rm -f "$out"
+  done
+  echo "(voxel $voxel; distances in the horse's units)"
+  rm -f "$cloud"
+}
+if [[ ${BENCH_ONLY:-} == surface-closed ]]; then surface_closed_section; exit 0; fi
+
 # `tiles --surface` (the paper's Chunk path) on generated clouds (issue 19): points/s and peak
 # RSS at 1 M and 10 M points (SURFACE_TILES_SIZES; add 100M for the large run), each at the
 # default voxel (the points' own resolution: about 10 triangles a point) and at a fixed voxel of
@@ -671,6 +713,7 @@ serve_section
 laz_section
 potree_section
 surface_section
+surface_closed_section
 surface_tiles_section
 cad_section
 instances_section

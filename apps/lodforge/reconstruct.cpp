@@ -25,6 +25,8 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
     bool resume = false;
   };
   auto options = std::make_shared<Options>();
+  // A mesh for use, not for tiling (tiles simplify anyway): thinned unless asked not to.
+  options->surface.reconstruct.decimateVoxels = kReconstructDecimateVoxels;
   CLI::App* sub = app.add_subcommand(
       "reconstruct", "A surface (triangle mesh) from a point cloud, chunk by chunk");
   sub->add_option("CLOUD", options->input, "A .las .laz .ply .xyz .txt .csv or .pts point cloud")

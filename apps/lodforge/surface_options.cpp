@@ -53,6 +53,14 @@ void addSurfaceOptions(CLI::App& sub, SurfaceCommand& options) {
                  "of the ground) or towards a viewpoint X,Y,Z");
   addCountOption(sub, "--min-triangles", options.reconstruct.minTriangles,
                  "Surface: drop connected pieces with fewer triangles (default 0: keep all)");
+  sub.add_option(
+         "--decimate", options.reconstruct.decimateVoxels,
+         fmt::format("Surface: thin each chunk's triangles by edge collapses whose removed "
+                     "vertices lie within this many voxels of the surface that replaces "
+                     "them (the surface itself moved up to 10x that on a scan; 0: keep every "
+                     "triangle; reconstruct's default {}, tiles' 0)",
+                     kReconstructDecimateVoxels))
+      ->check(CLI::Range(0.0, 4.0));
 }
 
 Result<ReconstructOptions> surfaceOptions(const SurfaceCommand& options, const std::string& input) {

@@ -11,12 +11,16 @@
 
 namespace lodforge::cli {
 
+// reconstruct's --decimate when not given: on the horse (docs/BENCHMARKS.md) 0.32x PoissonRecon
+// depth 9's triangles, the surface within 0.16 voxels of the undecimated one.
+constexpr double kReconstructDecimateVoxels = 0.02;
+
 struct SurfaceCommand {
   ReconstructOptions reconstruct;
   std::string orient = "auto";
 };
 
-// --voxel --radius --min-points --orient --min-triangles.
+// --voxel --radius --min-points --orient --min-triangles --decimate.
 void addSurfaceOptions(CLI::App& sub, SurfaceCommand& options);
 
 // The options for `input`: --orient auto turns normals up for LAS and LAZ (airborne lidar) and

@@ -335,6 +335,27 @@ TEST(Progressive, VertexCountForErrorIsTheFirstEntryThatFits) {
   }
 }
 
+// maxError refuses the collapses past it: the result's error stays within the bound, and the
+// bound is what stops it (a larger one collapses further).
+TEST(SimplifyMesh, MaxErrorHoldsTheVertexErrorWithinIt) {
+  Result<Model> model = readModel(test::dataPath("meshes/stanford-bunny.obj"));
+  ASSERT_TRUE(model.ok());
+  const PreparedObject bunny =
+      prepareObject(model->positions, {}, {}, model->indices, {.normals = false});
+  const std::size_t triangles = bunny.indices.size() / 3;
+  std::size_t previous = triangles;
+  for (const double bound : {1e-4, 1e-3, 4e-3}) {
+    ProgressiveOptions options;
+    options.maxError = bound;
+    const SimplifiedMesh mesh = simplifyMesh(bunny.positions, bunny.indices, options);
+    EXPECT_LE(mesh.error, bound);
+    EXPECT_GT(mesh.error, 0.25 * bound);  // it went close to the bound
+    EXPECT_LT(mesh.indices.size() / 3, previous) << bound;
+    previous = mesh.indices.size() / 3;
+  }
+  EXPECT_GT(previous, 100u);  // not to the minimum
+}
+
 TEST(SimplifyMesh, StopsAtTheTargetKeepsLockedVerticesAndHonoursTheNormalLimit) {
   Result<Model> model = readModel(test::dataPath("meshes/stanford-bunny.obj"));
   ASSERT_TRUE(model.ok());

@@ -204,6 +204,34 @@ TEST(Reconstruct, ManyChunksJoinWithoutACrack) {
     EXPECT_EQ(std::memcmp(&single.at(edge), &p, sizeof(Vec3d)), 0);
 }
 
+// Pieces thinned by edge collapses (--decimate) still join without a crack: every chunk-face
+// vertex is locked, so many chunks leave no more open edges than one, with far fewer triangles,
+// and the surface stays near the undecimated one.
+TEST(Reconstruct, DecimatedChunksJoinWithoutACrackNearTheFullSurface) {
+  const Sampled s = terrainSamples(20'000, 150);
+  ReconstructOptions options;
+  options.voxel = 1.2;
+  options.chunkVoxels = 1024;
+  Result<ReconstructedMesh> full = reconstructPoints(s.points, s.normals, {}, "t", options);
+  ASSERT_TRUE(full.ok()) << full.error().message;
+  options.decimateVoxels = 0.05;
+  Result<ReconstructedMesh> whole = reconstructPoints(s.points, s.normals, {}, "t", options);
+  ASSERT_TRUE(whole.ok());
+  options.chunkVoxels = 7;
+  Result<ReconstructedMesh> chunked = reconstructPoints(s.points, s.normals, {}, "t", options);
+  ASSERT_TRUE(chunked.ok());
+  EXPECT_GT(chunked->chunks, 100u);
+  EXPECT_LT(whole->indices.size(), full->indices.size() / 2);
+  EXPECT_LT(chunked->indices.size(), full->indices.size());
+  EXPECT_LE(countBoundaryEdges(chunked->indices), countBoundaryEdges(full->indices));
+  EXPECT_LE(countBoundaryEdges(whole->indices), countBoundaryEdges(full->indices));
+  for (const ReconstructedMesh* m : {&*whole, &*chunked}) {
+    const SurfaceDistance d = surfaceDistance(floats(m->positions), m->indices,
+                                              floats(full->positions), full->indices, 20'000);
+    EXPECT_LT(d.hausdorff, 0.5 * options.voxel);
+  }
+}
+
 // Points (and normals, when given) as a binary PLY point cloud.
 // With `colors`, each point gets a colour of its own (from its index), so a vertex's colour
 // shows which point it was taken from.

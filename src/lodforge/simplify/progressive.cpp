@@ -209,6 +209,7 @@ class Simplifier {
   }
   // The cheapest valid, untouched target of `from` (its ranked best first); kNone if none.
   Target validTarget(std::uint32_t from, float bestCost);
+  double errorAfter(std::uint32_t from, std::uint32_t to) const;
   void collapse(std::uint32_t from, const Target& to);
   void markChanged(std::uint32_t from, const Target& to);
   void rankNewNeighbours();
@@ -818,6 +819,22 @@ void Simplifier::rankNewNeighbours() {
   newNeighbourCount_ = 0;
 }
 
+// The error bound `to` would carry once `from` collapses into it, as collapse() sets it: what
+// `from` stood for plus its distance to the fan that replaces it (ProgressiveOptions::maxError).
+double Simplifier::errorAfter(std::uint32_t from, std::uint32_t to) const {
+  const Vec3d moved = position(from);
+  double distance = std::numeric_limits<double>::max();
+  for (std::uint32_t t : around(from)) {
+    if (!alive(t) || contains(t, to)) continue;
+    std::array<Vec3d, 3> p;
+    for (std::size_t k = 0; k < 3; ++k)
+      p[k] = position(corners_[t][k] == from ? to : corners_[t][k]);
+    distance = std::min(distance, pointTriangleDistanceSquared(moved, p[0], p[1], p[2]));
+  }
+  const double step = distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
+  return std::max(vertex_[to].error, vertex_[from].error + step);
+}
+
 void Simplifier::collapse(std::uint32_t from, const Target& target) {
   const std::uint32_t to = target.vertex;
   const Vec3d moved = position(from);
@@ -916,6 +933,7 @@ void Simplifier::collapseAll() {
         if (vertex_[from].touched == pass_ || vertex_[from].removed) continue;
         const Target to = validTarget(from, ranked[i].first);
         if (to.vertex == kNone) continue;
+        if (options_.maxError > 0 && errorAfter(from, to.vertex) > options_.maxError) continue;
         collapse(from, to);
         if (triangleCount_ - removedTriangleCount() <= options_.stopAtTriangles) return;
       }

@@ -36,6 +36,9 @@ struct ProgressiveOptions {
   std::span<const std::uint8_t> locked{};
   // Stop once the mesh has at most this many triangles (0: collapse down to the minimum).
   std::uint32_t stopAtTriangles = 0;
+  // Refuse a collapse whose vertex error bound (ProgressiveMesh::error) would pass this (model
+  // units; 0: no bound), so the result stays within it.
+  double maxError = 0;
   // Let boundary vertices collapse along their boundary into a boundary neighbour (quadrics
   // then hold planes along boundary edges, so a rim keeps its shape). Off, as the CAD paper
   // has it: boundary vertices never move. Vertices where a boundary meets itself or a

@@ -23,6 +23,7 @@
 #include "lodforge/surface/cloud_file.h"
 #include "lodforge/surface/layout.h"
 #include "lodforge/surface/mesh_join.h"
+#include "lodforge/surface/piece_decimation.h"
 #include "lodforge/surface/point_index.h"
 #include "lodforge/surface/resume_state.h"
 
@@ -127,9 +128,12 @@ Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> record
   for (std::size_t first = 0; first < chunks.size(); first += batch) {
     const std::size_t last = std::min(chunks.size(), first + batch);
     tbb::parallel_for(first, last, [&](std::size_t i) {
-      made[i - first] = members[i].empty() ? SurfacePiece{}
-                                           : heldChunkPiece(layout, chunks[i], members[i], records,
-                                                            options.distance, colors);
+      made[i - first] = members[i].empty()
+                            ? SurfacePiece{}
+                            : decimatePiece(layout,
+                                            heldChunkPiece(layout, chunks[i], members[i], records,
+                                                           options.distance, colors),
+                                            options.decimateVoxels * layout.grid.voxel);
     });
     for (std::size_t i = first; i < last; ++i) {
       LODFORGE_TRY(sink.add(chunks[i], made[i - first]));
@@ -148,7 +152,8 @@ Status streamDenseChunk(const ChunkLayout& layout, std::uint64_t chunk, const st
                         Progress& progress) {
   Result<SurfacePiece> piece = streamedChunkPiece(layout, chunk, runFile, options.distance, colors);
   if (!piece) return piece.status();
-  LODFORGE_TRY(sink.add(chunk, *piece));
+  LODFORGE_TRY(sink.add(
+      chunk, decimatePiece(layout, std::move(*piece), options.decimateVoxels * layout.grid.voxel)));
   progress.advance(1);
   return checkCancelled();
 }
@@ -346,6 +351,7 @@ nlohmann::json reconstructIdentity(const std::string& input, const ReconstructOp
       {"chunkLength", options.chunkLength},
       {"radius", options.distance.radius},
       {"minPoints", options.distance.minPoints},
+      {"decimateVoxels", options.decimateVoxels},
       {"edge", options.distance.edge},
       // How the distances are summed: runs kept by a version that summed otherwise are not ours.
       {"sums", "half-voxel point cells"},

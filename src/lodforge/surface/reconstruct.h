@@ -38,6 +38,9 @@ struct ReconstructOptions {
   std::uint64_t memoryLimit = 0;   // bytes, 0: the default budget (kDefaultRunPoints a run)
   std::uint64_t runPoints = 0;     // points a run of chunks holds; 0: from the memory limit
   std::uint64_t minTriangles = 0;  // connected pieces with fewer triangles are dropped
+  // Each chunk's piece thinned by edge collapses within this many voxels (piece_decimation.h);
+  // 0: the marching tetrahedra's triangles as they are.
+  double decimateVoxels = 0;
   bool salvageTruncated = false;
   // Keep in the work directory what lets an interrupted reconstruction go on (resume_state.h):
   // the state after the points are sorted into runs, and each finished run's pieces.

@@ -415,8 +415,13 @@ surface_closed_section() {
     fi
     local triangles where
     triangles=$("$lodforge" info "$out" --json | sed -n 's/.*"triangles": \([0-9]*\).*/\1/p')
-    where=$("$lodforge" -v compare "$out" "$mesh" --json "$work/closed-$tool.json" 2>&1 |
-      sed -n 's/^largest [^ ]* → [^ ]*: [0-9.e+-]* at \(([^)]*)\).*/\1/p')
+    # Where the larger of the two directions' largest distances lies (the Hausdorff distance's).
+    local line ab ba
+    line=$("$lodforge" -v compare "$out" "$mesh" --json "$work/closed-$tool.json" 2>&1 | grep '^largest ')
+    ab=$(sed -n 's/^largest [^ ]* → [^ ]*: \([0-9.e+-]*\) at \(([^)]*)\);.*/\1 \2/p' <<< "$line")
+    ba=$(sed -n 's/.*; [^ ]* → [^ ]*: \([0-9.e+-]*\) at \(([^)]*)\)$/\1 \2/p' <<< "$line")
+    where=$(awk -v a="$ab" -v b="$ba" 'BEGIN { split(a, x, " "); split(b, y, " ");
+      print (x[1] + 0 >= y[1] + 0 ? "mesh " x[2] x[3] x[4] : "scan " y[2] y[3] y[4]) }')
     local h r
     h=$(sed -n 's/.*"hausdorff": \([0-9.e+-]*\).*/\1/p' "$work/closed-$tool.json")
     r=$(sed -n 's/.*"rms": \([0-9.e+-]*\).*/\1/p' "$work/closed-$tool.json")

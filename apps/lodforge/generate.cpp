@@ -130,6 +130,10 @@ void addGeneratePoints(CLI::App* generate, const Global& global, Run& run) {
       if (options->from.empty())
         return timed(global, options->output,
                      [&] { return generatePoints(options->points, options->output); });
+      if (options->points.extraBytes)
+        return Status(Error{ErrorKind::kUsage,
+                            "--extra-bytes goes with the terrain's LAS, "
+                            "not --from"});
       if (fileExtension(options->output) != "ply")
         return Status(
             Error{ErrorKind::kUsage, fmt::format("{}: --from writes a .ply", options->output)});

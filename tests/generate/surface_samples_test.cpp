@@ -73,6 +73,24 @@ TEST(SurfaceSamples, SpreadByAreaWithFaceNormalsAndGaussianNoise) {
   EXPECT_NEAR(sum / 200'000.0, 0.0, 0.01 * 0.001 * diagonal);
 }
 
+// A georeferenced mesh (an origin far from zero) gives points where the mesh is.
+TEST(SurfaceSamples, AMeshWithAnOriginKeepsItsPlace) {
+  test::TempDir dir;
+  Model m = twoTriangles();
+  m.origin = {1e6, 2e6, 0};
+  ASSERT_TRUE(sampleSurface(m, {.points = 1'000, .seed = 2}, dir.file("s.ply")).ok());
+  const Model cloud = readOrFail(dir.file("s.ply"));
+  ASSERT_EQ(cloud.vertexCount(), 1'000u);
+  for (const Vec3f& p : cloud.positions) {
+    const Vec3d q = toDouble(p) + cloud.origin - m.origin;
+    ASSERT_GE(q.x, -1e-3);
+    ASSERT_LE(q.x, 8 + 1e-3);
+    ASSERT_GE(q.y, -1e-3);
+    ASSERT_LE(q.y, 1 + 1e-3);
+    ASSERT_NEAR(q.z, 0.0, 1e-3);
+  }
+}
+
 TEST(SurfaceSamples, DeterministicWhateverTheThreadCountAndSeeded) {
   test::TempDir dir;
   const Model m = twoTriangles();

@@ -350,6 +350,7 @@ SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
   SurfaceDistance result;
   if (indicesA.empty() || indicesB.empty()) {
     result.hausdorff = result.rms = std::numeric_limits<double>::infinity();
+    result.maxAB = result.maxBA = result.hausdorff;
     return result;
   }
   const TriangleGrid gridA(positionsA, indicesA), gridB(positionsB, indicesB);
@@ -360,8 +361,9 @@ SurfaceDistance surfaceDistance(std::span<const Vec3f> positionsA,
   result.hausdorff = std::max(ab.max, ba.max);
   result.maxAB = ab.max;
   result.maxBA = ba.max;
-  result.farthestOnA = onA[ab.farthest];
-  result.farthestOnB = onB[ba.farthest];
+  // (No samples where a mesh's triangles have no area: its farthest point stays at 0.)
+  if (!onA.empty()) result.farthestOnA = onA[ab.farthest];
+  if (!onB.empty()) result.farthestOnB = onB[ba.farthest];
   result.rms = std::sqrt((ab.sumSquares + ba.sumSquares) /
                          static_cast<double>(std::max<std::size_t>(1, ab.count + ba.count)));
   result.meanAB = ab.sum / static_cast<double>(std::max<std::size_t>(1, ab.count));

@@ -1,7 +1,9 @@
 #include "lodforge/generate/surface_samples.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -108,9 +110,12 @@ Result<GenerateStats> sampleSurface(const Model& model, const SurfaceSampleOptio
   const SampledSurface surface = sampledSurfaceOf(model, options.noise);
   if (surface.areaSum.empty())
     return Error{ErrorKind::kBadInput, "the mesh has no triangle with an area to sample"};
+  assert(model.positions.size() <= std::numeric_limits<std::uint32_t>::max());
   PlyLayout layout;
   layout.vertexCount = options.points;
   layout.normals = true;
+  // A georeferenced mesh (read with an origin) keeps its place: doubles, origin added back.
+  layout.doublePositions = model.origin != Vec3d{};
   layout.comments = {
       fmt::format("lodforge generate points --from (mesh) --points {} --seed {} "
                   "--noise {}",

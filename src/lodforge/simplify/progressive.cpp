@@ -933,6 +933,7 @@ void Simplifier::collapseAll() {
         if (vertex_[from].touched == pass_ || vertex_[from].removed) continue;
         const Target to = validTarget(from, ranked[i].first);
         if (to.vertex == kNone) continue;
+        // Refused past the bound; ranked again next pass (its neighbourhood may change).
         if (options_.maxError > 0 && errorAfter(from, to.vertex) > options_.maxError) continue;
         collapse(from, to);
         if (triangleCount_ - removedTriangleCount() <= options_.stopAtTriangles) return;

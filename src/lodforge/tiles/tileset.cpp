@@ -97,7 +97,8 @@ nlohmann::json surfaceIdentity(const std::optional<ReconstructOptions>& surface)
           {"minPoints", surface->distance.minPoints},
           {"orientation", static_cast<int>(surface->normals.orientation)},
           {"viewpoint", {view.x, view.y, view.z}},
-          {"minTriangles", surface->minTriangles}};
+          {"minTriangles", surface->minTriangles},
+          {"decimateVoxels", surface->decimateVoxels}};
 }
 
 // Everything the chunks depend on: a resumed run takes them only when this is unchanged.

@@ -218,6 +218,9 @@ nlohmann::json runJson(const BudgetRun& run) {
   add("render_ms", [](const FrameTimes& t) { return t.renderMs; });
   const auto exactFrames = static_cast<std::uint64_t>(std::count_if(
       run.frames.begin(), run.frames.end(), [](const FrameTimes& t) { return t.exact; }));
+  const auto compactedFrames = static_cast<std::uint64_t>(
+      std::count_if(run.frames.begin(), run.frames.end(),
+                    [](const FrameTimes& t) { return t.stream.compacted; }));
   return {{"budget", run.budget},
           {"capacity_vertices", run.capacityVertices},
           {"capacity_bytes", run.capacityBytes},
@@ -231,8 +234,7 @@ nlohmann::json runJson(const BudgetRun& run) {
            percentile95(run.frames, [](const FrameTimes& t) { return t.selectionMs; })},
           {"p95_generation_ms", percentile95(run.frames, generationMs)},
           {"exact_frames", exactFrames + (run.load.exact ? 1 : 0)},
-          {"compacted_frames", std::count_if(run.frames.begin(), run.frames.end(),
-                                             [](const FrameTimes& t) { return t.stream.compacted; })}};
+          {"compacted_frames", compactedFrames}};
 }
 
 std::string megabytes(double bytes) {

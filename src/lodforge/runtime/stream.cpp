@@ -163,51 +163,37 @@ struct Totals {
   std::uint64_t vertices = 0, triangles = 0;
 };
 
-// What the frame reads and keeps, per object: the kept part min(old, new), the read part
-// new - kept; triangles of objects whose count changed are re-formed, the others keep theirs.
-void tallyFrame(const Package& package, const StreamBuffer::State& s, Counts vn, Counts tn,
-                FrameStats& stats, Totals& total) {
-  struct Tally {
-    std::uint64_t vertices = 0, triangles = 0, vertexRead = 0, triangleRead = 0, reformed = 0,
-                  indicesKept = 0, changed = 0;
-  };
-  const Tally tally = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, package.objectCount(), 1 << 14), Tally{},
-      [&](const tbb::blocked_range<std::size_t>& range, Tally t) {
+// Σ vc and Σ tc of the new selection (checked against the capacity before anything changes).
+Totals sumCounts([[maybe_unused]] const Package& package, Counts vn, Counts tn) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, vn.size(), 1 << 14), Totals{},
+      [&](const tbb::blocked_range<std::size_t>& range, Totals t) {
         for (std::size_t i = range.begin(); i < range.end(); ++i) {
           assert(vn[i] == 0 ? tn[i] == 0 : tn[i] == package.trianglesAt(i, vn[i]));
-          const std::uint32_t vo = s.vertexCounts[i], to = s.triangleCounts[i];
           t.vertices += vn[i];
           t.triangles += tn[i];
-          t.vertexRead += vn[i] - std::min(vo, vn[i]);
-          t.triangleRead += tn[i] - std::min(to, tn[i]);
-          if (vo == vn[i]) {
-            t.indicesKept += tn[i];
-          } else {
-            t.reformed += tn[i];
-            ++t.changed;
-          }
         }
         return t;
       },
-      [](Tally a, const Tally& b) {
-        a.vertices += b.vertices;
-        a.triangles += b.triangles;
-        a.vertexRead += b.vertexRead;
-        a.triangleRead += b.triangleRead;
-        a.reformed += b.reformed;
-        a.indicesKept += b.indicesKept;
-        a.changed += b.changed;
-        return a;
+      [](Totals x, const Totals& y) {
+        return Totals{x.vertices + y.vertices, x.triangles + y.triangles};
       });
-  total = {tally.vertices, tally.triangles};
-  stats.verticesRead = tally.vertexRead;
-  stats.trianglesRead = tally.triangleRead;
-  stats.bytesRead =
-      tally.vertexRead * StreamCapacity::vertexBytes(package) + tally.triangleRead * kTriangleBytes;
-  stats.trianglesReformed = tally.reformed;
-  stats.trianglesKept = tally.indicesKept;
-  stats.objectsChanged = tally.changed;
+}
+
+// What the frame reads and re-forms, from the changed objects alone (an unchanged one reads
+// nothing and keeps its indices): the read part new - min(old, new).
+void tallyChanges(const StreamBuffer::State& s, Counts vn, Counts tn, const Totals& total,
+                  FrameStats& stats) {
+  for (const ObjectWork& w : s.work) {
+    const std::uint32_t i = w.object;
+    stats.verticesRead += vn[i] - std::min(s.vertexCounts[i], vn[i]);
+    stats.trianglesRead += tn[i] - std::min(s.triangleCounts[i], tn[i]);
+    stats.trianglesReformed += tn[i];
+  }
+  stats.bytesRead = stats.verticesRead * StreamCapacity::vertexBytes(*s.package) +
+                    stats.trianglesRead * kTriangleBytes;
+  stats.trianglesKept = total.triangles - stats.trianglesReformed;
+  stats.objectsChanged = s.work.size();
 }
 
 // A selection beyond capacity is refused before anything changes.
@@ -517,10 +503,10 @@ Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCou
          triangleCounts.size() == package.objectCount());
   FrameStats stats;
   const auto reassemblyStart = std::chrono::steady_clock::now();
-  Totals total;
-  tallyFrame(package, s, vertexCounts, triangleCounts, stats, total);
+  const Totals total = sumCounts(package, vertexCounts, triangleCounts);
   LODFORGE_TRY(checkFits(package, s.capacity, total));
   placeChanged(s, vertexCounts, triangleCounts, stats);
+  tallyChanges(s, vertexCounts, triangleCounts, total, stats);
   reassembleChanged(s, vertexCounts, triangleCounts);
   stats.reassemblyMs = millisecondsSince(reassemblyStart);
   const auto reformationStart = std::chrono::steady_clock::now();

@@ -98,6 +98,18 @@ TEST(Cluster, EstimatesNormalsByPcaOverTreeCellsFacingUp) {
   EXPECT_GT(good, ball.size() * 97 / 100);
 }
 
+// The closed-form 3×3 eigen-solve (computeDirect) stays accurate at map coordinates (UTM
+// metres, about 5e6) on a noisy survey plane, where rounding is largest.
+TEST(Cluster, PcaNormalsHoldAtMapCoordinates) {
+  std::vector<CloudPoint> plane = tiltedPlane(5'000, 0.001, 4);
+  for (CloudPoint& p : plane) p.position = p.position + Vec3d{500'000, 5'000'000, 300};
+  clusterBlock(plane, {500'005, 5'002'005, 302.5}, false);
+  const Vec3f want = toFloat(normalizeOr(Vec3d{-0.5, 0, 1}, Vec3d{}));
+  std::size_t good = 0;
+  for (const CloudPoint& p : plane) good += dot(p.normal, want) > 0.99f;
+  EXPECT_GT(good, plane.size() * 99 / 100);
+}
+
 // Leaves cover half the gap to their nearest neighbour (the clustering tree searched as a k-d
 // tree), exactly as a brute-force search finds it, duplicates included.
 TEST(Cluster, LeafRadiiAreHalfTheGapToTheNearestNeighbour) {

@@ -43,56 +43,100 @@ void followItems(std::span<const SplitItem> items, std::span<CloudPoint> points,
   applyOrder(order, ids);
 }
 
+// The items' mean colour, rounded (§4.1's node colour).
+Rgba8 meanColor(std::span<const SplitItem> items) {
+  Vec3d color;
+  for (const SplitItem& p : items)
+    color = color + Vec3d{double(p.color.r), double(p.color.g), double(p.color.b)};
+  color = color * (1 / static_cast<double>(items.size()));
+  return {static_cast<std::uint8_t>(std::lround(color.x)),
+          static_cast<std::uint8_t>(std::lround(color.y)),
+          static_cast<std::uint8_t>(std::lround(color.z)), 255};
+}
+
+// A node's bounds and coordinate sum (summed in its items' order).
+struct SplitStats {
+  Aabbd bounds;
+  Vec3d sum;
+};
+
+SplitStats statsOf(std::span<const SplitItem> items) {
+  SplitStats stats;
+  for (const SplitItem& p : items) {
+    stats.bounds.add(p.position);
+    stats.sum = stats.sum + p.position;
+  }
+  return stats;
+}
+
+// Moves `from` into `to` split by the plane (those below first, in their order; those above
+// after, in reverse order); how many are below. Branch free (Hoare's partition mispredicted
+// about every other point): each item is written to both free ends and one end advances.
+std::size_t splitInto(std::span<const SplitItem> from, std::span<SplitItem> to, SplitPlane plane) {
+  std::size_t low = 0, high = to.size();
+  for (const SplitItem& item : from) {
+    const bool below = item.position[plane.axis] < plane.value;
+    to[low] = item;
+    to[high - 1] = item;
+    low += below ? 1 : 0;
+    high -= below ? 0 : 1;
+  }
+  return low;
+}
+
 // Top-down splitting (§4.1, "Hierarchical clustering"), breadth-first: each node's centroid,
-// mean colour and count; splitting node i reorders only inside ranges[i].
+// mean colour and count; splitting node i reorders only inside ranges[i]. Each level's pass
+// moves a node's items into the other of two buffers; a leaf's item goes back to the first
+// buffer, where the points' order is read at the end.
 void splitTree(std::span<CloudPoint> points, std::span<std::uint32_t> ids, Vec3d origin,
                bool colors, std::vector<ClusterNode>& nodes, std::vector<Range>& ranges,
                std::vector<Separator>& separators) {
   nodes.reserve(2 * points.size() - 1);
   ranges.reserve(2 * points.size() - 1);
   separators.resize(2 * points.size() - 1);
-  std::vector<SplitItem> items(points.size());
-  for (std::uint32_t k = 0; k < items.size(); ++k)
-    items[k] = {points[k].position, points[k].color, k};
+  std::vector<SplitItem> buffers[2] = {std::vector<SplitItem>(points.size()),
+                                       std::vector<SplitItem>(points.size())};
+  for (std::uint32_t k = 0; k < points.size(); ++k)
+    buffers[0][k] = {points[k].position, points[k].color, k};
+  std::vector<std::uint8_t> in{0};  // which buffer holds the node's items
   nodes.emplace_back();
   ranges.push_back({0, static_cast<std::uint32_t>(points.size())});
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const Range r = ranges[i];
-    const std::span<SplitItem> mine = std::span(items).subspan(r.begin, r.size());
-    Aabbd bounds;
-    Vec3d sum, color;
-    for (const SplitItem& p : mine) {
-      bounds.add(p.position);
-      sum = sum + p.position;
-    }
+    const int from = in[i];
+    const std::span<SplitItem> mine = std::span(buffers[from]).subspan(r.begin, r.size());
+    const SplitStats stats = statsOf(mine);
     const double n = static_cast<double>(mine.size());
-    const Vec3d centroid = sum * (1 / n);
+    const Vec3d centroid = stats.sum * (1 / n);
     ClusterNode& node = nodes[i];
     node.position = toFloat(centroid - origin);
-    if (colors) {
-      for (const SplitItem& p : mine)
-        color = color + Vec3d{double(p.color.r), double(p.color.g), double(p.color.b)};
-      color = color * (1 / n);
-      node.color = {static_cast<std::uint8_t>(std::lround(color.x)),
-                    static_cast<std::uint8_t>(std::lround(color.y)),
-                    static_cast<std::uint8_t>(std::lround(color.z)), 255};
-    }
+    if (colors) node.color = meanColor(mine);
     node.pointCount = static_cast<std::uint32_t>(mine.size());
-    if (mine.size() == 1) continue;
+    if (mine.size() == 1) {
+      buffers[0][r.begin] = mine[0];
+      continue;
+    }
+    const Aabbd bounds = stats.bounds;
     const SplitPlane plane = centroidSplit(bounds, centroid);
-    // With ids the split keeps a flat node's order, as splitPoints does (the same tree either way).
-    const auto below = static_cast<std::uint32_t>(splitRecords(mine, plane, {}, !ids.empty()));
+    const std::span<SplitItem> next = std::span(buffers[1 - from]).subspan(r.begin, r.size());
+    std::size_t below = splitInto(mine, next, plane);
     // When the centroid leaves every point on one side, splitPoints splits at the median.
-    const bool median =
-        bounds.min[plane.axis] >= plane.value || bounds.max[plane.axis] < plane.value;
-    separators[i] = {plane.axis, median ? mine[below].position[plane.axis] : plane.value};
+    const bool median = below == 0 || below == mine.size();
+    if (median) {
+      // With ids the split keeps a flat node's order, as splitPoints does.
+      below = splitRecords(mine, plane, {}, !ids.empty());
+      std::copy(mine.begin(), mine.end(), next.begin());
+    }
+    separators[i] = {plane.axis, median ? next[below].position[plane.axis] : plane.value};
     node.firstChild = static_cast<std::uint32_t>(nodes.size());
-    nodes.emplace_back();
-    nodes.emplace_back();
-    ranges.push_back({r.begin, r.begin + below});
-    ranges.push_back({r.begin + below, r.end});
+    const auto cut = static_cast<std::uint32_t>(below);
+    for (std::size_t side = 0; side < 2; ++side) {
+      nodes.emplace_back();
+      ranges.push_back(side == 0 ? Range{r.begin, r.begin + cut} : Range{r.begin + cut, r.end});
+      in.push_back(static_cast<std::uint8_t>(1 - from));
+    }
   }
-  followItems(items, points, ids);
+  followItems(buffers[0], points, ids);
 }
 
 // The direction of least spread of `points` (PCA), facing +z; +z for fewer than three points.
@@ -108,7 +152,8 @@ Vec3f pcaNormal(std::span<const CloudPoint> points) {
     covariance += e * e.transpose();
   }
   // Eigenvalues come in increasing order.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance);
   Eigen::Vector3d normal = solver.eigenvectors().col(0);
   if (normal.z() < 0) normal = -normal;
   return normalizeOr(Vec3f{static_cast<float>(normal.x()), static_cast<float>(normal.y()),
@@ -153,11 +198,11 @@ void cellNormals(std::span<CloudPoint> points, std::span<const ClusterNode> node
 // duplicate), by searching the clustering tree as the k-d tree it is: up from the point's
 // leaf, into each sibling subtree only where its side of the separator is nearer than the
 // best so far. Exact, and no second spatial index per block.
-std::vector<float> halfSpacing(std::span<const CloudPoint> points,
-                               std::span<const ClusterNode> nodes, std::span<const Range> ranges,
+std::vector<float> halfSpacing(std::span<const Vec3d> positions, std::span<const ClusterNode> nodes,
+                               std::span<const Range> ranges,
                                std::span<const Separator> separators) {
-  std::vector<float> spacing(points.size(), 0);
-  if (points.size() < 2) return spacing;
+  std::vector<float> spacing(positions.size(), 0);
+  if (positions.size() < 2) return spacing;
   // The tree packed for the search, depth first (a subtree's nodes close together; the tree's
   // own breadth-first order scatters them, and the search waited on memory), with subtrees of
   // at most kBucket points as buckets searched by brute force (fewer unpredictable branches):
@@ -170,7 +215,7 @@ std::vector<float> halfSpacing(std::span<const CloudPoint> points,
     int axis;
   };
   std::vector<KdNode> kd(nodes.size());
-  std::vector<std::uint32_t> parent(nodes.size(), 0), bucketOf(points.size(), 0);
+  std::vector<std::uint32_t> parent(nodes.size(), 0), bucketOf(positions.size(), 0);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> order{{0, 0}};  // tree node, packed index
   std::uint32_t placed = 1;
   while (!order.empty()) {
@@ -187,10 +232,8 @@ std::vector<float> halfSpacing(std::span<const CloudPoint> points,
     order.emplace_back(nodes[i].firstChild, placed);
     placed += 2;
   }
-  std::vector<Vec3d> positions(points.size());
-  for (std::size_t j = 0; j < points.size(); ++j) positions[j] = points[j].position;
   tbb::parallel_for(
-      tbb::blocked_range<std::uint32_t>(0, static_cast<std::uint32_t>(points.size()), 256),
+      tbb::blocked_range<std::uint32_t>(0, static_cast<std::uint32_t>(positions.size()), 256),
       [&](const tbb::blocked_range<std::uint32_t>& range) {
         std::vector<std::pair<std::uint32_t, double>> stack;  // node, least distance² to it
         for (std::uint32_t j = range.begin(); j < range.end(); ++j) {
@@ -228,9 +271,10 @@ std::vector<float> halfSpacing(std::span<const CloudPoint> points,
   return spacing;
 }
 
-// Node normals bottom-up: the normalised sum of their points' normals (the paper's V).
-void nodeNormals(std::span<const CloudPoint> points, std::span<ClusterNode> nodes,
-                 std::span<const Range> ranges) {
+// Node normals bottom-up: the normalised sum of their points' normals (the paper's V); the
+// sums, which the errors read.
+std::vector<Vec3d> nodeNormals(std::span<const CloudPoint> points, std::span<ClusterNode> nodes,
+                               std::span<const Range> ranges) {
   std::vector<Vec3d> sums(nodes.size());
   for (std::size_t i = nodes.size(); i-- > 0;) {
     ClusterNode& node = nodes[i];
@@ -238,6 +282,7 @@ void nodeNormals(std::span<const CloudPoint> points, std::span<ClusterNode> node
     sums[i] = node.leaf() ? toDouble(first) : sums[node.firstChild] + sums[node.firstChild + 1];
     node.normal = toFloat(normalizeOr(sums[i], toDouble(first)));
   }
+  return sums;
 }
 
 // Radii bottom-up: a leaf covers half the gap to its nearest neighbour, a parent covers its
@@ -261,19 +306,20 @@ void nodeRadii(std::span<ClusterNode> nodes, std::span<const Range> ranges,
 }
 
 // Fitting error (§4.1, the paper's E with α1 = α2 = 0.5), then made monotone bottom-up.
-void nodeErrors(std::span<const CloudPoint> points, Vec3d origin, std::span<ClusterNode> nodes,
-                std::span<const Range> ranges, const ClusterOptions& options) {
+// The turn, Σ (1 − n_k · n), is |node| − (Σ n_k) · n: the normals' sums make it one product.
+void nodeErrors(std::span<const Vec3d> positions, Vec3d origin, std::span<ClusterNode> nodes,
+                std::span<const Range> ranges, std::span<const Vec3d> normalSums,
+                const ClusterOptions& options) {
   tbb::parallel_for(std::size_t{0}, nodes.size(), [&](std::size_t i) {
     ClusterNode& node = nodes[i];
     if (node.leaf()) return;
     const Vec3d c = origin + toDouble(node.position);
     const Vec3d normal = toDouble(node.normal);
-    double distance = 0, turn = 0;
-    for (std::uint32_t k = ranges[i].begin; k < ranges[i].end; ++k) {
-      distance += std::abs(dot(points[k].position - c, normal));
-      turn += 1 - dot(toDouble(points[k].normal), normal);
-    }
+    double distance = 0;
+    for (std::uint32_t k = ranges[i].begin; k < ranges[i].end; ++k)
+      distance += std::abs(dot(positions[k] - c, normal));
     const double n = static_cast<double>(ranges[i].size());
+    const double turn = std::max(0.0, n - dot(normalSums[i], normal));  // no rounding below 0
     node.error =
         static_cast<float>(options.alpha1 * distance / n + options.alpha2 * node.radius * turn / n);
   });
@@ -298,10 +344,13 @@ std::vector<ClusterNode> clusterBlock(std::span<CloudPoint> points, Vec3d origin
   splitTree(points, ids, origin, options.colors, nodes, ranges, separators);
   if (!hasNormals)
     cellNormals(points, nodes, ranges, static_cast<std::uint32_t>(std::max(3, options.neighbours)));
-  const std::vector<float> spacing = halfSpacing(points, nodes, ranges, separators);
-  nodeNormals(points, nodes, ranges);
+  // The positions alone, packed: the search and the errors read nothing else of a point.
+  std::vector<Vec3d> positions(points.size());
+  for (std::size_t j = 0; j < points.size(); ++j) positions[j] = points[j].position;
+  const std::vector<float> spacing = halfSpacing(positions, nodes, ranges, separators);
+  const std::vector<Vec3d> normalSums = nodeNormals(points, nodes, ranges);
   nodeRadii(nodes, ranges, spacing);
-  nodeErrors(points, origin, nodes, ranges, options);
+  nodeErrors(positions, origin, nodes, ranges, normalSums, options);
   if (firstPoint) {
     firstPoint->resize(nodes.size());
     for (std::size_t i = 0; i < nodes.size(); ++i) (*firstPoint)[i] = ranges[i].begin;

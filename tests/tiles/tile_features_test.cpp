@@ -160,7 +160,8 @@ TilesOptions assemblyOptions() {
 // box); the leaves hold every part; parts.json says which parts each level lost, exactly as the
 // tiles show.
 TEST(TileFeatures, EveryVertexOfEveryTileNamesItsPart) {
-  const fs::path root = fs::path(::testing::TempDir()) / "tile-features";
+  const test::TempDir temp;  // removed with the test
+  const fs::path root = temp.path() / "tile-features";
   fs::remove_all(root);
   fs::create_directories(root);
   const std::string input = (root / "cad.glb").string();
@@ -238,7 +239,8 @@ TEST(TileFeatures, EveryVertexOfEveryTileNamesItsPart) {
 // A STEP assembly's CAD layers reach the tiles: every row of every tile's property table has its
 // part's layer, and parts.json lists it beside the name.
 TEST(TileFeatures, CadLayersReachEveryTileAndPartsJson) {
-  const fs::path root = fs::path(::testing::TempDir()) / "tile-layers";
+  const test::TempDir temp;  // removed with the test
+  const fs::path root = temp.path() / "tile-layers";
   fs::remove_all(root);
   fs::create_directories(root);
   const std::string input = (root / "cad.step").string();
@@ -270,7 +272,8 @@ TEST(TileFeatures, CadLayersReachEveryTileAndPartsJson) {
 // colours) stays translucent at every level that still holds it, in a primitive of its own
 // drawing only glass; metal keeps its metallic-roughness; the table names each part's material.
 TEST(TileFeatures, EveryPartKeepsItsMaterialAtEveryLevel) {
-  const fs::path root = fs::path(::testing::TempDir()) / "tile-materials";
+  const test::TempDir temp;  // removed with the test
+  const fs::path root = temp.path() / "tile-materials";
   fs::remove_all(root);
   fs::create_directories(root);
   ASSERT_TRUE(generateCad({.objects = 300, .seed = 4}, (root / "plain.glb").string()).ok());
@@ -355,7 +358,8 @@ TEST(TileFeatures, EveryPartKeepsItsMaterialAtEveryLevel) {
 // An OBJ of two groups sharing a seam is a scan split in two by default: no parts, welded as
 // one surface; asked for, its groups become parts that weld apart.
 TEST(TileFeatures, ObjectsOfAScanBecomePartsOnlyWhenAsked) {
-  const fs::path root = fs::path(::testing::TempDir()) / "tile-features-obj";
+  const test::TempDir temp;  // removed with the test
+  const fs::path root = temp.path() / "tile-features-obj";
   fs::remove_all(root);
   fs::create_directories(root);
   std::ofstream obj(root / "two.obj");
@@ -382,7 +386,8 @@ TEST(TileFeatures, ObjectsOfAScanBecomePartsOnlyWhenAsked) {
 
 // A mesh of one object (a scan) gets no features: nothing to pick, no bytes spent.
 TEST(TileFeatures, AnInputOfOneObjectHasNone) {
-  const fs::path root = fs::path(::testing::TempDir()) / "tile-features-one";
+  const test::TempDir temp;  // removed with the test
+  const fs::path root = temp.path() / "tile-features-one";
   fs::remove_all(root);
   Result<TilesStats> stats =
       writeTiles(test::dataPath("meshes/horse.ply"), (root / "tiles").string(), TilesOptions{});

@@ -64,7 +64,8 @@ void checkTile(const nlohmann::json& tile, const fs::path& directory, double par
 }
 
 TEST(Tiles, HorseTilesetFollowsTheRules) {
-  const fs::path out = fs::path(::testing::TempDir()) / "horse-tiles";
+  const test::TempDir temp;  // removed with the test
+  const fs::path out = temp.path() / "horse-tiles";
   fs::remove_all(out);
   TilesOptions options;
   options.input.chunkSize = 0.05;  // the horse is ~0.2 m long: a few chunks per axis
@@ -92,7 +93,8 @@ TEST(Tiles, QuantizedContentsStayWithinTheErrorTheyAddToTheTileset) {
   // The same horse tileset with and without KHR_mesh_quantization: the contents hold the same
   // vertices in the same order, each quantised one within the error the tile's geometricError
   // gained, and the tileset is smaller.
-  const fs::path root = fs::path(::testing::TempDir()) / "quantized";
+  const test::TempDir temp;  // removed with the test
+  const fs::path root = temp.path() / "quantized";
   fs::remove_all(root);
   TilesOptions options;
   options.input.chunkSize = 0.05;
@@ -147,7 +149,8 @@ TEST(Tiles, NeighbouringTilesAgreeOnTheNormalsOfTheirSharedVertices) {
   // same in each (the input's, not one from each tile's half of its fan). The horse has normals
   // in its file; the bunny has none, so they are computed over the whole input.
   for (const char* name : {"meshes/horse.ply", "meshes/stanford-bunny.obj"}) {
-    const fs::path out = fs::path(::testing::TempDir()) / "normals";
+    const test::TempDir temp;  // removed with the test
+    const fs::path out = temp.path() / "normals";
     fs::remove_all(out);
     TilesOptions options;
     options.input.chunkSize = std::string(name).find("horse") != std::string::npos ? 0.04 : 0.03;
@@ -198,7 +201,8 @@ TEST(Tiles, ContentsAreInVertexCacheAndFetchOrder) {
   // Triangles ordered for the GPU's post-transform cache, vertices in order of first use. The
   // horse's own order (chunks keep it) misses a 16-entry FIFO 2.7 times per triangle, the tiles
   // ~0.7 times.
-  const fs::path out = fs::path(::testing::TempDir()) / "cache-order";
+  const test::TempDir temp;  // removed with the test
+  const fs::path out = temp.path() / "cache-order";
   fs::remove_all(out);
   TilesOptions options;
   options.input.chunkSize = 0.05;
@@ -244,7 +248,8 @@ TEST(Tiles, AssembliesAndPackagesAreTiledByPart) {
   // A generated 600-part assembly as GLB and as a progressive package (.lfp, read at full
   // detail): the same leaves, tilesets that follow the rules, and coarse tiles that shrink
   // because parents leave out the smallest whole parts.
-  const fs::path root = fs::path(::testing::TempDir()) / "assembly";
+  const test::TempDir temp;  // removed with the test
+  const fs::path root = temp.path() / "assembly";
   fs::remove_all(root);
   fs::create_directories(root);
   ASSERT_TRUE(generateCad({.objects = 600, .seed = 9}, (root / "cad.glb").string()).ok());
@@ -273,7 +278,8 @@ TEST(Tiles, AssembliesAndPackagesAreTiledByPart) {
 }
 
 TEST(Tiles, GeoreferencedByOriginOrByCrs) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "geo-tiles";
+  const test::TempDir temp;  // removed with the test
+  const fs::path dir = temp.path() / "geo-tiles";
   fs::remove_all(dir);
   fs::create_directories(dir);
   // A 200 m x 200 m terrain patch in UTM 33N, in doubles (centimetres matter at 5e6 m).
@@ -330,7 +336,8 @@ TEST(Tiles, GeoreferencedByOriginOrByCrs) {
 }
 
 TEST(Tiles, BadInputIsRefusedWithoutLeavingAnything) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "bad-tiles";
+  const test::TempDir temp;  // removed with the test
+  const fs::path dir = temp.path() / "bad-tiles";
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path input = dir / "broken.ply";
@@ -344,7 +351,8 @@ TEST(Tiles, BadInputIsRefusedWithoutLeavingAnything) {
 }
 
 TEST(Tiles, RefusesToOverwriteADirectoryThatIsNotATileset) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "not-a-tileset";
+  const test::TempDir temp;  // removed with the test
+  const fs::path dir = temp.path() / "not-a-tileset";
   fs::remove_all(dir);
   fs::create_directories(dir);
   std::ofstream(dir / "precious.txt") << "keep me";

@@ -235,8 +235,8 @@ TEST(Octree, AnyMixOfLevelsHasNoBoundaryTheInputDidNotHave) {
     const MeshPart input = open ? heightfield(120) : horse();
     Aabbd box;
     for (const Vec3d& p : input.positions) box.add(p);
-    const Built built =
-        build(input, box.longestSide() / 7.5, options, ::testing::TempDir() + "/octree-mix");
+    const test::TempDir temp;  // removed with the test
+    const Built built = build(input, box.longestSide() / 7.5, options, temp.file("octree-mix"));
     ASSERT_GE(built.tree.levels, 2);
     const std::set<Edge, EdgeLess> original = boundaryEdges(input);
     // The input's rim, cut at the chunk planes, is made of pieces of the original edges: compare
@@ -274,7 +274,8 @@ TEST(Octree, AReconstructedScanHasNoCrackInAnyMix) {
     const double x = random.uniform(0, 80), y = random.uniform(0, 50);
     points.push_back(toFloat(Vec3d{x, y, 3 * std::sin(x / 9) * std::cos(y / 7)}));
   }
-  const std::string work = ::testing::TempDir() + "/octree-surface";
+  const test::TempDir temp;  // removed with the test
+  const std::string work = temp.file("octree-surface");
   fs::remove_all(work);
   fs::create_directories(work);
   Result<PlyWriter> writer = PlyWriter::create(work + "/cloud.ply", layout);
@@ -304,7 +305,8 @@ TEST(Octree, ParentsAreSimplerAndTheirErrorBoundsTheirChildren) {
   OctreeOptions options;
   options.errorSamples = 4000;
   const MeshPart input = heightfield(160);
-  const Built built = build(input, 20, options, ::testing::TempDir() + "/octree-error");
+  const test::TempDir temp;  // removed with the test
+  const Built built = build(input, 20, options, temp.file("octree-error"));
   ASSERT_GE(built.tree.levels, 2);
   std::uint64_t leafTriangles = 0;
   for (const OctreeNode& node : built.tree.nodes) {
@@ -357,7 +359,8 @@ TEST(Octree, SmallSegmentsLeaveCoarseTilesWithinTheErrorAndWithoutCracks) {
   OctreeOptions options;
   options.errorSamples = 2000;
   const MeshPart input = heightfieldWithCubes(120, 400, 3);
-  const Built built = build(input, 16, options, ::testing::TempDir() + "/octree-cubes", true);
+  const test::TempDir temp;  // removed with the test
+  const Built built = build(input, 16, options, temp.file("octree-cubes"), true);
   ASSERT_GE(built.tree.levels, 2);
   std::uint64_t dropped = 0, leafTriangles = 0;
   for (const OctreeNode& node : built.tree.nodes) {
@@ -392,7 +395,8 @@ TEST(Octree, LevelsOptionStopsBelowTheRootWithAContentlessRoot) {
   OctreeOptions options;
   options.errorSamples = 1000;
   options.levels = 1;
-  const Built built = build(heightfield(100), 12, options, ::testing::TempDir() + "/octree-lv");
+  const test::TempDir temp;  // removed with the test
+  const Built built = build(heightfield(100), 12, options, temp.file("octree-lv"));
   EXPECT_EQ(built.tree.levels, 1);
   const OctreeNode& root = built.tree.nodes[built.tree.root];
   EXPECT_GT(root.children.size(), 1u);
@@ -411,7 +415,8 @@ TEST(Octree, NodesFollowTheirChildrenWithinTheBudgetAndTheTreeIsTheSameForAnySch
     int mostAtOnce = 0;
   };
   const auto run = [&](int threads, std::uint64_t budget, const std::string& name) {
-    const std::string work = ::testing::TempDir() + "/octree-schedule-" + name;
+    const test::TempDir temp;  // removed with the test
+    const std::string work = temp.file("octree-schedule-") + name;
     fs::remove_all(work);
     const std::unique_ptr<ChunkWriter> chunks = chunksOf(input, 10, work + "/chunks");
     OctreeOptions options;
@@ -477,7 +482,8 @@ TEST(Octree, AResumedBuildSkipsFinishedNodesWhoseWorkFilesAreGone) {
   // meshes below level 1 are already removed. Resumed, only the root is built, the same as
   // in an uninterrupted run.
   const MeshPart input = heightfield(100);
-  const std::string work = ::testing::TempDir() + "/octree-resume";
+  const test::TempDir temp;  // removed with the test
+  const std::string work = temp.file("octree-resume");
   fs::remove_all(work);
   const std::unique_ptr<ChunkWriter> chunks = chunksOf(input, 10, work + "/chunks");
   OctreeOptions options;

@@ -50,16 +50,18 @@ TEST(PlanTilesMemory, MinimalIsOneThreadAndSmallBuffersOnDisk) {
   EXPECT_EQ(p.input.vertexCacheBytes, 4 * kMiB);
 }
 
-// Moderate: --threads, or a quarter of the cores (at least one); buffers as given, on disk.
-TEST(PlanTilesMemory, ModerateIsAQuarterOfTheCoresOrTheThreadsGiven) {
-  const Plan quarter = plan(TilesMemory::kModerate);
-  ASSERT_TRUE(quarter.status.ok());
-  EXPECT_EQ(quarter.octree.threads, std::max(1, cores() / 4));
-  EXPECT_EQ(quarter.input.threads, quarter.octree.threads);
-  EXPECT_EQ(quarter.input.chunkBufferBytes, ChunkInputOptions{}.chunkBufferBytes);
-  EXPECT_EQ(quarter.input.vertexCacheBytes, ChunkInputOptions{}.vertexCacheBytes);
-  EXPECT_FALSE(quarter.input.keepInMemory);
-  EXPECT_FALSE(quarter.octree.keepInMemory);
+// Moderate: --threads, or every core, with the nodes in flight held to a budget; buffers as
+// given, on disk.
+TEST(PlanTilesMemory, ModerateIsEveryCoreWithinANodeBudgetOrTheThreadsGiven) {
+  const Plan every = plan(TilesMemory::kModerate);
+  ASSERT_TRUE(every.status.ok());
+  EXPECT_EQ(every.octree.threads, std::max(1, cores()));
+  EXPECT_EQ(every.octree.memoryBudget, kModerateNodeBytes);
+  EXPECT_EQ(every.input.threads, every.octree.threads);
+  EXPECT_EQ(every.input.chunkBufferBytes, ChunkInputOptions{}.chunkBufferBytes);
+  EXPECT_EQ(every.input.vertexCacheBytes, ChunkInputOptions{}.vertexCacheBytes);
+  EXPECT_FALSE(every.input.keepInMemory);
+  EXPECT_FALSE(every.octree.keepInMemory);
   const Plan given = plan(TilesMemory::kModerate, 0, 5);
   EXPECT_EQ(given.octree.threads, 5);
   EXPECT_EQ(given.input.threads, 5);
@@ -94,9 +96,14 @@ TEST(PlanTilesMemory, ALimitSplitsWhatIsLeftAfterTheProgram) {
     EXPECT_FALSE(p.input.keepInMemory);
     EXPECT_FALSE(p.octree.keepInMemory);
   }
+  // Without --threads, a thread for every 64 MiB of the nodes' share: one under 96M.
+  EXPECT_EQ(plan(TilesMemory::kModerate, 96 * kMiB).octree.threads, 1);
+  EXPECT_EQ(plan(TilesMemory::kModerate, 96 * kMiB, 2).octree.threads, 2);
   // A large limit lowers nothing below the defaults, and the leaves keep their size.
   const Plan large = plan(TilesMemory::kModerate, 4096 * kMiB);
   ASSERT_TRUE(large.status.ok());
+  EXPECT_EQ(large.octree.threads, std::clamp(2032 / 64, 1, cores()));
+  EXPECT_EQ(large.input.threads, large.octree.threads);
   EXPECT_EQ(large.input.chunkBufferBytes, ChunkInputOptions{}.chunkBufferBytes);
   EXPECT_EQ(large.input.vertexCacheBytes, ChunkInputOptions{}.vertexCacheBytes);
   EXPECT_EQ(large.octree.memoryBudget, 4064 * kMiB / 2);

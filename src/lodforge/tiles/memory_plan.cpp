@@ -19,7 +19,8 @@ Status planTilesMemory(TilesMemory mode, std::uint64_t memoryLimit, int threads,
       input.vertexCacheBytes = std::min<std::uint64_t>(input.vertexCacheBytes, 32 << 20);
       break;
     case TilesMemory::kModerate:
-      octree.threads = threads > 0 ? threads : std::max(1, cores / 4);
+      octree.threads = threads > 0 ? threads : std::max(1, cores);
+      octree.memoryBudget = kModerateNodeBytes;
       break;
     case TilesMemory::kUnbounded:
       octree.threads = threads > 0 ? threads : cores;
@@ -41,6 +42,12 @@ Status planTilesMemory(TilesMemory mode, std::uint64_t memoryLimit, int threads,
     input.chunkBufferBytes = std::min(input.chunkBufferBytes, usable / 4);
     input.vertexCacheBytes = std::min(input.vertexCacheBytes, usable / 8);
     octree.memoryBudget = usable / 2;
+    // Each thread beyond the first costs its own buffers and a node of its own (two threads under
+    // 96M peaked at 88-94 MiB, one at 68): unless --threads says otherwise, a thread for every
+    // kNodeBytesPerThread of the nodes' share.
+    if (threads == 0)
+      octree.threads = static_cast<int>(std::clamp<std::uint64_t>(
+          octree.memoryBudget / kNodeBytesPerThread, 1, static_cast<std::uint64_t>(octree.threads)));
     // A parent holds about four children (eight in a volume) while it is simplified, at ~200
     // bytes per triangle: smaller leaves when the budget cannot hold that for the default size.
     if (input.chunkSize == 0) {

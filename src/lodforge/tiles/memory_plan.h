@@ -12,9 +12,16 @@
 
 namespace lodforge {
 
-// The paper's memory modes (§3.4): one thread; a few threads (25 % of the cores unless
-// --threads says otherwise); every core with chunks and node meshes kept in memory.
+// The paper's memory modes (§3.4): one thread; every core (or --threads) with the nodes in
+// flight held to kModerateNodeBytes (the paper's moderate takes 25 % of the cores instead, which
+// left one of two cores idle here); every core with chunks and node meshes kept in memory.
 enum class TilesMemory : std::uint8_t { kMinimal, kModerate, kUnbounded };
+
+// The moderate mode's bound on the nodes being built at once, without --memory-limit (their
+// estimated bytes, as the octree counts them): more cores build more nodes only while they fit.
+inline constexpr std::uint64_t kModerateNodeBytes = std::uint64_t{512} << 20;
+// Under --memory-limit, without --threads: a thread for each this much of the nodes' share.
+inline constexpr std::uint64_t kNodeBytesPerThread = std::uint64_t{64} << 20;
 
 // Sets the threads, buffers and leaf size of `input` and `octree` for `mode` and `memoryLimit`
 // (bytes, 0: none; `threads` 0: the mode's default). A limit too small to work with is refused

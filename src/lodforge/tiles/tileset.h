@@ -29,7 +29,7 @@ struct TilesOptions {
   OctreeOptions octree;     // reduction, normal limit, levels, error samples
   TilesMemory memory = TilesMemory::kModerate;
   std::uint64_t memoryLimit = 0;  // bytes for the whole build, 0: none
-  int threads = 0;                // moderate mode: 0 means 25 % of the cores
+  int threads = 0;                // moderate mode: 0 means every core
   // Continue an interrupted build from <out>.work: finished chunks and tiles are kept when the
   // input and the options are the same.
   bool resume = false;

@@ -101,7 +101,8 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
       ->check(CLI::Range(0.0, 90.0));
   sub.add_option("--memory", options.memory,
                  "minimal (one thread), moderate (--threads, default every core, the nodes being "
-                 "built at once held to 512 MiB) or unbounded (every core, chunks kept in memory); --memory-limit caps the whole "
+                 "built at once held to 512 MiB) or unbounded (every core, chunks kept in memory); "
+                 "--memory-limit caps the whole "
                  "build")
       ->check(CLI::IsMember({"minimal", "moderate", "unbounded"}));
   sub.add_option("--origin", options.origin,

@@ -46,8 +46,9 @@ Status planTilesMemory(TilesMemory mode, std::uint64_t memoryLimit, int threads,
     // 96M peaked at 88-94 MiB, one at 68): unless --threads says otherwise, a thread for every
     // kNodeBytesPerThread of the nodes' share.
     if (threads == 0)
-      octree.threads = static_cast<int>(std::clamp<std::uint64_t>(
-          octree.memoryBudget / kNodeBytesPerThread, 1, static_cast<std::uint64_t>(octree.threads)));
+      octree.threads =
+          static_cast<int>(std::clamp<std::uint64_t>(octree.memoryBudget / kNodeBytesPerThread, 1,
+                                                     static_cast<std::uint64_t>(octree.threads)));
     // A parent holds about four children (eight in a volume) while it is simplified, at ~200
     // bytes per triangle: smaller leaves when the budget cannot hold that for the default size.
     if (input.chunkSize == 0) {

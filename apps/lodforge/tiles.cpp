@@ -102,8 +102,7 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
   sub.add_option("--memory", options.memory,
                  "minimal (one thread), moderate (--threads, default every core, the nodes being "
                  "built at once held to 512 MiB) or unbounded (every core, chunks kept in memory); "
-                 "--memory-limit caps the whole "
-                 "build")
+                 "--memory-limit caps the whole build")
       ->check(CLI::IsMember({"minimal", "moderate", "unbounded"}));
   sub.add_option("--origin", options.origin,
                  "Place the model's (0,0,0) at LON,LAT,HEIGHT (degrees, metres) with x east, y "

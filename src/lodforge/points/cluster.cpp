@@ -99,6 +99,7 @@ void splitTree(std::span<CloudPoint> points, std::span<std::uint32_t> ids, Vec3d
   for (std::uint32_t k = 0; k < points.size(); ++k)
     buffers[0][k] = {points[k].position, points[k].color, k};
   std::vector<std::uint8_t> in{0};  // which buffer holds the node's items
+  in.reserve(2 * points.size() - 1);
   nodes.emplace_back();
   ranges.push_back({0, static_cast<std::uint32_t>(points.size())});
   for (std::size_t i = 0; i < nodes.size(); ++i) {

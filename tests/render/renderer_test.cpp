@@ -48,6 +48,20 @@ TEST(Context, HeadlessOpenGl45) {
   EXPECT_EQ(gl.glfwWindow(), nullptr);
 }
 
+// The device platform is how NVIDIA's driver opens headless; Mesa offers it too (its software
+// device), so the path runs here. The shared context is made current again afterwards.
+TEST(Context, TheDevicePlatformAlsoGivesOpenGl45) {
+  GlContext& shared = test::headlessContext();
+  {
+    auto device = GlContext::headless(EglPlatform::kDevice);
+    ASSERT_TRUE(device.ok()) << device.error().message;
+    EXPECT_FALSE((*device)->renderer().empty());
+    EXPECT_NE((*device)->version().find("4."), std::string::npos) << (*device)->version();
+  }
+  shared.makeCurrent();
+  EXPECT_FALSE(shared.renderer().empty());
+}
+
 TEST(Renderer, ASquareCoversTheShareItsProjectionPredicts) {
   test::headlessContext();
   test::TempDir folder;
@@ -122,6 +136,51 @@ TEST(Renderer, FullBudgetAfterCoherentFramesEqualsTheReferenceRender) {
       EXPECT_GT(coverage(b), 0.004) << key << ": the model should be in view";
     }
   }
+}
+
+// A renderer that keeps its buffers between frames uploads only what each update wrote; it
+// must draw every frame as a renderer given the whole arena does, compactions included.
+TEST(Renderer, UploadingOnlyWhatChangedDrawsTheSameFrames) {
+  test::headlessContext();
+  const Package& package = test::RuntimePackages::get("engine");
+  const LodScene scene = LodScene::fromPackage(package);
+  const std::uint64_t full = scene.totalMaxVertices();
+  // A capacity near the budgets: the arena fills and compacts along the way.
+  StreamBuffer buffer(package, StreamCapacity::forVertices(package, full * 3 / 10));
+  auto kept = Renderer::create(package, buffer.capacity());
+  ASSERT_TRUE(kept.ok()) << kept.error().message;
+  auto target = Framebuffer::create(320, 240);
+  ASSERT_TRUE(target.ok());
+  const auto path =
+      orbitPath(test::packageBounds(package), {.frames = 18, .width = 320, .height = 240});
+  Selection selection;
+  std::uint64_t partialFrames = 0, compactions = 0, sentBytes = 0, wholeBytes = 0;
+  for (std::size_t f = 0; f < path.size(); ++f) {
+    // Budgets ramping up twice: growing objects outgrow their slots until the arena is full.
+    const double share = 0.03 + 0.27 * static_cast<double>(f % 6) / 5.0;
+    selectTwoPass(scene, path[f], static_cast<std::uint64_t>(share * static_cast<double>(full)), {},
+                  selection);
+    Result<FrameStats> stats = buffer.update(selection.vertexCounts, selection.triangleCounts);
+    ASSERT_TRUE(stats.ok()) << stats.error().message;
+    compactions += stats->compacted ? 1 : 0;
+    kept->upload(buffer);
+    target->bind();
+    kept->draw(path[f], {});
+    const Image a = target->read();
+    const Image b = render(package, buffer, path[f]);  // a fresh renderer: the whole arena
+    EXPECT_EQ(compareImages(a, b).maxDeltaE, 0.0) << "frame " << f;
+    const std::uint64_t whole = buffer.positions().size_bytes() + buffer.normals().size_bytes() +
+                                buffer.colors().size_bytes() + buffer.indices().size_bytes();
+    if (f > 0 && kept->uploadedBytes() < whole) ++partialFrames;
+    sentBytes += kept->uploadedBytes();
+    wholeBytes += whole;
+  }
+  EXPECT_GT(compactions, 0u);
+  EXPECT_GT(partialFrames, 0u);
+  EXPECT_LT(sentBytes, wholeBytes / 2);
+  // Nothing changed: nothing to send.
+  kept->upload(buffer);
+  EXPECT_LT(kept->uploadedBytes(), 4096u);
 }
 
 TEST(Renderer, LowerBudgetsStayWithinStatedImageDifference) {

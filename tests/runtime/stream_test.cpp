@@ -139,8 +139,68 @@ std::vector<Camera> testPath(const Aabbd& bounds, Random& random) {
   return path;
 }
 
+// A copy of the arrays that takes only what each update wrote, as the renderer's GPU buffers do:
+// after every frame each object's slot must read the same in the copy as in the buffer.
+struct Mirror {
+  std::vector<Vec3f> positions, normals;
+  std::vector<Rgba8> colors;
+  std::vector<std::uint32_t> source, indices;
+  std::uint64_t held = 0;  // the update the copy holds
+  std::uint64_t bytes = 0, wholeBytes = 0;
+
+  template <class T>
+  static std::uint64_t take(std::vector<T>& into, std::span<const T> from, std::uint64_t width,
+                            std::span<const StreamBuffer::Range> ranges) {
+    if (from.empty()) return 0;  // the package lacks the attribute
+    if (into.size() < from.size()) into.resize(from.size());
+    std::uint64_t bytes = 0;
+    for (const StreamBuffer::Range& r : ranges) {
+      std::copy(from.begin() + width * r.begin, from.begin() + width * r.end,
+                into.begin() + width * r.begin);
+      bytes += (r.end - r.begin) * width * sizeof(T);
+    }
+    return bytes;
+  }
+
+  void follow(const StreamBuffer& b, std::size_t maxRanges, const std::string& where) {
+    ASSERT_EQ(b.previousUpdate(), held) << where;
+    std::vector<StreamBuffer::Range> v, t;
+    b.writtenRanges(maxRanges, v, t);
+    ASSERT_LE(v.size(), maxRanges) << where;
+    ASSERT_LE(t.size(), maxRanges) << where;
+    for (std::size_t k = 1; k < v.size(); ++k) ASSERT_GT(v[k].begin, v[k - 1].end) << where;
+    for (std::size_t k = 1; k < t.size(); ++k) ASSERT_GT(t[k].begin, t[k - 1].end) << where;
+    bytes += take(positions, b.positions(), 1, v) + take(normals, b.normals(), 1, v) +
+             take(colors, b.colors(), 1, v) + take(source, b.sourceTriangles(), 3, t) +
+             take(indices, b.indices(), 3, t);
+    wholeBytes += b.positions().size_bytes() + b.normals().size_bytes() + b.colors().size_bytes() +
+                  b.sourceTriangles().size_bytes() + b.indices().size_bytes();
+    held = b.lastUpdate();
+  }
+
+  template <class T>
+  static bool sameSlot(const std::vector<T>& copy, std::span<const T> array, std::uint64_t begin,
+                       std::uint64_t end) {
+    return array.empty() ||
+           std::equal(array.begin() + begin, array.begin() + end, copy.begin() + begin);
+  }
+
+  void expectSameSlots(const StreamBuffer& b, const std::string& where) const {
+    for (std::size_t i = 0; i < b.vertexCounts().size(); ++i) {
+      const std::uint64_t v = b.vertexStart()[i], vEnd = v + b.vertexCounts()[i];
+      const std::uint64_t t = 3 * b.triangleStart()[i], tEnd = t + 3 * b.triangleCounts()[i];
+      ASSERT_TRUE(sameSlot(positions, b.positions(), v, vEnd)) << where << " object " << i;
+      ASSERT_TRUE(sameSlot(normals, b.normals(), v, vEnd)) << where << " object " << i;
+      ASSERT_TRUE(sameSlot(colors, b.colors(), v, vEnd)) << where << " object " << i;
+      ASSERT_TRUE(sameSlot(source, b.sourceTriangles(), t, tEnd)) << where << " object " << i;
+      ASSERT_TRUE(sameSlot(indices, b.indices(), t, tEnd)) << where << " object " << i;
+    }
+  }
+};
+
 struct PathTally {
   std::uint64_t reformed = 0, kept = 0, relocated = 0, compactions = 0;
+  std::uint64_t copiedBytes = 0, wholeBytes = 0;  // by the mirror, and had it taken all
 };
 
 // One package along the test path with a budget drifting up to `maxShare` of the full model, in
@@ -155,6 +215,9 @@ PathTally runPath(const char* key, double capacityShare, double maxShare, Random
   Selection s;
   std::vector<std::uint32_t> lastV(scene.size(), 0), lastT(scene.size(), 0);
   PathTally tally;
+  Mirror mirror;
+  // From 1 to 64 ranges a frame, apart from the path's own random numbers.
+  const std::size_t maxRanges = 1 + Random::forItem(7, std::string_view(key).size()).below(64);
   for (std::size_t f = 0; f < path.size(); ++f) {
     // The budget drifts too, as a user drags the slider.
     const auto budget = static_cast<std::uint64_t>(double(full) * random.uniform(0.02, maxShare));
@@ -168,6 +231,8 @@ PathTally runPath(const char* key, double capacityShare, double maxShare, Random
     // Slots checked every third frame, so objects relocate more than once between two looks.
     expectEqualsReference(buffer, package, s, where, f % 3 == 2 || f + 1 == path.size());
     expectMoves(package, before, buffer, lastV, lastT, *stats, where);
+    mirror.follow(buffer, maxRanges, where);
+    mirror.expectSameSlots(buffer, where);
     const FrameStats e = expectedStats(package, lastV, lastT, s.vertexCounts, s.triangleCounts);
     EXPECT_EQ(stats->bytesRead, e.bytesRead) << where;
     EXPECT_EQ(stats->verticesRead, e.verticesRead) << where;
@@ -184,6 +249,8 @@ PathTally runPath(const char* key, double capacityShare, double maxShare, Random
     lastV = s.vertexCounts;
     lastT = s.triangleCounts;
   }
+  tally.copiedBytes = mirror.bytes;
+  tally.wholeBytes = mirror.wholeBytes;
   return tally;
 }
 
@@ -197,6 +264,8 @@ TEST(Stream, EveryFrameEqualsAFreshBuildAlongRandomPaths) {
       EXPECT_GT(tally.kept, 0u) << key;
     }
     EXPECT_GT(tally.relocated, 0u) << key;
+    // What the frames wrote is less than the arrays they span.
+    EXPECT_LT(tally.copiedBytes, tally.wholeBytes) << key;
   }
 }
 
@@ -247,8 +316,11 @@ TEST(Stream, ASelectionBeyondCapacityIsRefusedAndTheBufferKeepsLastFrame) {
   selectTwoPass(scene, camera, capacity, {}, small);
   ASSERT_TRUE(buffer.update(small.vertexCounts, small.triangleCounts).ok());
   selectTwoPass(scene, camera, capacity + 1, {}, big);
+  const std::uint64_t last = buffer.lastUpdate(), previous = buffer.previousUpdate();
   Result<FrameStats> refused = buffer.update(big.vertexCounts, big.triangleCounts);
   ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(buffer.lastUpdate(), last);  // nothing written: a copy stays valid
+  EXPECT_EQ(buffer.previousUpdate(), previous);
   EXPECT_EQ(refused.error().kind, ErrorKind::kLimit);
   EXPECT_NE(refused.error().message.find("does not fit the stream buffer"), std::string::npos);
   expectEqualsReference(buffer, package, small, "after refusal");

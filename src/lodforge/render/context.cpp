@@ -48,18 +48,59 @@ GlContext::~GlContext() {
   }
 }
 
-Result<std::unique_ptr<GlContext>> GlContext::headless() {
-  auto state = std::make_unique<State>();
-  // Surfaceless: no window system at all; rendering goes to framebuffer objects.
-  // The EXT entry point: libepoxy resolves it from the client extensions, before any display
-  // exists to tell the EGL version.
+namespace {
+
+// Mesa's surfaceless platform: no window system at all; rendering goes to framebuffer objects.
+// The EXT entry points: libepoxy resolves them from the client extensions, before any display
+// exists to tell the EGL version.
+Result<EGLDisplay> surfacelessDisplay() {
   if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_MESA_platform_surfaceless"))
     return Error{ErrorKind::kUnsupported,
                  "headless OpenGL: EGL lacks EGL_MESA_platform_surfaceless (Mesa's libegl1 and "
                  "libgl1-mesa-dri provide it; scripts/install-deps.sh installs them)"};
-  state->display =
+  EGLDisplay display =
       eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  if (state->display == EGL_NO_DISPLAY) return eglError("eglGetPlatformDisplay(surfaceless)");
+  if (display == EGL_NO_DISPLAY) return eglError("eglGetPlatformDisplay(surfaceless)");
+  return display;
+}
+
+// The device platform: the first EGL device that initialises. NVIDIA's driver offers this one
+// headless, and Mesa offers it too (its software device).
+Result<EGLDisplay> deviceDisplay() {
+  if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_platform_device") ||
+      !epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_device_enumeration"))
+    return Error{ErrorKind::kUnsupported,
+                 "headless OpenGL: EGL lacks EGL_EXT_platform_device and "
+                 "EGL_MESA_platform_surfaceless"};
+  constexpr EGLint kMaxDevices = 16;
+  EGLDeviceEXT devices[kMaxDevices];
+  EGLint count = 0;
+  if (!eglQueryDevicesEXT(kMaxDevices, devices, &count)) return eglError("eglQueryDevicesEXT");
+  for (EGLint i = 0; i < count; ++i) {
+    EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
+    EGLint major = 0, minor = 0;
+    if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor)) return display;
+  }
+  return eglError("eglGetPlatformDisplay(device) on every EGL device");
+}
+
+Result<EGLDisplay> platformDisplay(EglPlatform platform) {
+  if (platform == EglPlatform::kSurfaceless) return surfacelessDisplay();
+  if (platform == EglPlatform::kDevice) return deviceDisplay();
+  auto surfaceless = surfacelessDisplay();
+  if (surfaceless) return surfaceless;
+  auto device = deviceDisplay();
+  if (device) return device;
+  return surfaceless.error();
+}
+
+}  // namespace
+
+Result<std::unique_ptr<GlContext>> GlContext::headless(EglPlatform platform) {
+  auto state = std::make_unique<State>();
+  auto display = platformDisplay(platform);
+  if (!display) return display.error();
+  state->display = *display;
   EGLint major = 0, minor = 0;
   if (!eglInitialize(state->display, &major, &minor)) return eglError("eglInitialize");
   if (!eglBindAPI(EGL_OPENGL_API)) return eglError("eglBindAPI(OpenGL)");

@@ -1,5 +1,6 @@
-// OpenGL 4.5 core contexts: EGL surfaceless for headless work (Mesa's llvmpipe provides 4.5
-// without a GPU, CI included) and a GLFW window for the viewer. GL calls go through libepoxy.
+// OpenGL 4.5 core contexts: EGL surfaceless or an EGL device for headless work (Mesa's llvmpipe
+// provides 4.5 without a GPU, CI included; NVIDIA's driver through the device platform) and a GLFW
+// window for the viewer. GL calls go through libepoxy.
 #pragma once
 
 #include <cstdint>
@@ -12,10 +13,14 @@ struct GLFWwindow;
 
 namespace lodforge {
 
+// Where a headless context comes from: Mesa's surfaceless platform, an EGL device (NVIDIA's
+// driver headless), or the first of them that works.
+enum class EglPlatform { kAny, kSurfaceless, kDevice };
+
 class GlContext {
  public:
   // Offscreen: draw into a Framebuffer (renderer.h).
-  static Result<std::unique_ptr<GlContext>> headless();
+  static Result<std::unique_ptr<GlContext>> headless(EglPlatform platform = EglPlatform::kAny);
   // A window; kUnsupported when there is no display to open it on.
   static Result<std::unique_ptr<GlContext>> window(std::uint32_t width, std::uint32_t height,
                                                    const std::string& title);

@@ -105,6 +105,7 @@ Result<FrameStats> FramePipeline::update(std::span<const std::uint32_t> vertexCo
   const bool gpuReform = s.mode == Streaming::kCpuGpuReform;
   s.renderer->upload(*s.cpu, !gpuReform);
   s.timings.uploadMs = millisecondsSince(start);
+  s.timings.uploadedBytes = s.renderer->uploadedBytes();
   if (gpuReform) {
     s.reformer->reform(*s.cpu, s.renderer->indexBuffer());
     s.timings.reformMs = millisecondsSince(start);

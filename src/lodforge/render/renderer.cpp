@@ -214,7 +214,12 @@ struct Renderer::State {
   std::vector<Rgba8> baseColors, idColors;
   std::vector<float> ratios;
   std::uint64_t uploaded = 0;
-  bool attached = false;                  // drawing from a GpuStream's buffers
+  bool attached = false;  // drawing from a GpuStream's buffers
+  // What the buffers hold: a stream's update (StreamBuffer::lastUpdate) and whether its indices
+  // came with it. 0 when unknown (never uploaded, or a GPU stream wrote the indices).
+  std::uint64_t heldUpdate = 0;
+  bool heldIndices = false;
+  std::vector<StreamBuffer::Range> vertexRanges, triangleRanges;
   mutable bool idColorsUploaded = false;  // which colours the object colour buffer holds
 
   ~State() {
@@ -295,20 +300,52 @@ Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 Renderer::~Renderer() = default;
 
+namespace {
+
+// Copies per array and frame at most: each is a driver call, so 18,000 changed objects (718 K
+// parts at 18 M) are merged into this many ranges, the closest first.
+constexpr std::size_t kMaxUploadRanges = 512;
+
+// Copies `ranges` (in elements of `width` values) of the array into the GL buffer; the bytes.
+template <class T>
+std::uint64_t uploadRanges(GLuint target, std::span<const T> array, std::uint64_t width,
+                           std::span<const StreamBuffer::Range> ranges) {
+  std::uint64_t bytes = 0;
+  for (const StreamBuffer::Range& r : ranges) {
+    const std::uint64_t offset = r.begin * width * sizeof(T),
+                        size = (r.end - r.begin) * width * sizeof(T);
+    assert(offset + size <= array.size_bytes());
+    glNamedBufferSubData(target, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(size),
+                         reinterpret_cast<const std::byte*>(array.data()) + offset);
+    bytes += size;
+  }
+  return bytes;
+}
+
+}  // namespace
+
+// The whole used arena when the buffers do not hold the frame before; else only what the last
+// update wrote (on a real GPU the copy across the bus is most of the frame: 1 GB at 18 M).
 void Renderer::upload(const StreamBuffer& buffer, bool indices) {
   State& s = *state_;
   assert(s.positions != 0 && "created without vertex buffers: attach a GpuStream instead");
-  const auto upload = [&](GLuint target, const auto& span) {
-    if (span.empty()) return;
-    glNamedBufferSubData(target, 0, static_cast<GLsizeiptr>(span.size_bytes()), span.data());
-    s.uploaded += span.size_bytes();
-  };
-  s.uploaded = 0;
-  upload(s.positions, buffer.positions());
-  if (s.normals) upload(s.normalBuffer, buffer.normals());
-  if (s.colors) upload(s.colorBuffer, buffer.colors());
-  if (s.uvs) upload(s.uvBuffer, buffer.uvs());
-  if (indices) upload(s.indices, buffer.indices());
+  const bool same = s.heldUpdate != 0 && s.heldIndices == indices;
+  if (same && buffer.lastUpdate() == s.heldUpdate) {
+    s.vertexRanges.clear();  // uploaded already
+    s.triangleRanges.clear();
+  } else if (same && buffer.previousUpdate() == s.heldUpdate) {
+    buffer.writtenRanges(kMaxUploadRanges, s.vertexRanges, s.triangleRanges);
+  } else {
+    s.vertexRanges.assign(1, {0, buffer.positions().size()});
+    s.triangleRanges.assign(1, {0, buffer.indices().size() / 3});
+  }
+  s.uploaded = uploadRanges(s.positions, buffer.positions(), 1, s.vertexRanges);
+  if (s.normals) s.uploaded += uploadRanges(s.normalBuffer, buffer.normals(), 1, s.vertexRanges);
+  if (s.colors) s.uploaded += uploadRanges(s.colorBuffer, buffer.colors(), 1, s.vertexRanges);
+  if (s.uvs) s.uploaded += uploadRanges(s.uvBuffer, buffer.uvs(), 1, s.vertexRanges);
+  if (indices) s.uploaded += uploadRanges(s.indices, buffer.indices(), 3, s.triangleRanges);
+  s.heldUpdate = buffer.lastUpdate();
+  s.heldIndices = indices;
 
   setCommands(buffer.vertexCounts(), buffer.triangleCounts(), buffer.triangleStart());
   if (s.attached) {
@@ -324,6 +361,7 @@ void Renderer::upload(const StreamBuffer& buffer, bool indices) {
 void Renderer::attach(const GpuStream& stream) {
   State& s = *state_;
   s.uploaded = 0;
+  s.heldUpdate = 0;  // the GPU stream's reformer writes the index buffer
   glVertexArrayVertexBuffer(s.vertexArray, 0, stream.positionBuffer(), 0, sizeof(Vec3f));
   if (s.normals)
     glVertexArrayVertexBuffer(s.vertexArray, 1, stream.normalBuffer(), 0, sizeof(Vec3f));

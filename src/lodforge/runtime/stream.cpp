@@ -107,6 +107,8 @@ struct StreamBuffer::State {
   std::uint64_t vertexEnd = 0, triangleEnd = 0;      // the high-water mark: slots lie below
   std::uint64_t vertexTotal = 0, triangleTotal = 0;  // Σ counts
   std::vector<std::uint8_t> relocated;               // in `relocations`
+  std::uint64_t update = 0, previous = 0;            // lastUpdate(), previousUpdate()
+  bool compacted = false;                            // the last update packed the arena
   // Scratch for one update.
   std::vector<ObjectWork> work;
   std::vector<std::vector<ObjectWork>> blockWork;
@@ -152,6 +154,8 @@ void StreamBuffer::clear() {
   s.relocations.clear();
   s.relocated.assign(n, 0);
   s.vertexEnd = s.triangleEnd = s.vertexTotal = s.triangleTotal = 0;
+  s.work.clear();
+  s.compacted = false;
 }
 
 namespace {
@@ -518,7 +522,74 @@ Result<FrameStats> StreamBuffer::update(std::span<const std::uint32_t> vertexCou
   }
   s.vertexTotal = total.vertices;
   s.triangleTotal = total.triangles;
+  s.compacted = stats.compacted;
+  static std::atomic<std::uint64_t> updates{0};
+  s.previous = s.update;
+  s.update = ++updates;
   return stats;
+}
+
+std::uint64_t StreamBuffer::lastUpdate() const {
+  return state_->update;
+}
+std::uint64_t StreamBuffer::previousUpdate() const {
+  return state_->previous;
+}
+
+namespace {
+
+// Sorts the ranges and merges touching ones, then those closest together until at most
+// `maxRanges` are left, in place.
+void mergeRanges(std::vector<StreamBuffer::Range>& ranges, std::size_t maxRanges,
+                 std::vector<std::uint64_t>& gaps) {
+  assert(maxRanges > 0);
+  std::sort(ranges.begin(), ranges.end(),
+            [](const auto& a, const auto& b) { return a.begin < b.begin; });
+  const auto mergeUpTo = [&](std::uint64_t gap) {
+    std::size_t out = 0;
+    for (const StreamBuffer::Range& r : ranges) {
+      if (out > 0 && r.begin <= ranges[out - 1].end + gap) {
+        ranges[out - 1].end = std::max(ranges[out - 1].end, r.end);
+      } else {
+        ranges[out++] = r;
+      }
+    }
+    ranges.resize(out);
+  };
+  mergeUpTo(0);
+  if (ranges.size() <= maxRanges) return;
+  // The (n - maxRanges)-th smallest gap: merging every gap up to it leaves at most maxRanges.
+  gaps.resize(ranges.size() - 1);
+  for (std::size_t k = 0; k + 1 < ranges.size(); ++k) gaps[k] = ranges[k + 1].begin - ranges[k].end;
+  const std::size_t cut = ranges.size() - maxRanges - 1;
+  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(cut), gaps.end());
+  mergeUpTo(gaps[cut]);
+}
+
+}  // namespace
+
+void StreamBuffer::writtenRanges(std::size_t maxRanges, std::vector<Range>& vertices,
+                                 std::vector<Range>& triangles) const {
+  const State& s = *state_;
+  vertices.clear();
+  triangles.clear();
+  if (s.compacted) {
+    // Packing moved every slot.
+    if (s.vertexEnd) vertices.push_back({0, s.vertexEnd});
+    if (s.triangleEnd) triangles.push_back({0, s.triangleEnd});
+    return;
+  }
+  // Only the changed objects' slots were written (reassembly, relocation and re-formation).
+  for (const ObjectWork& w : s.work) {
+    const std::uint32_t i = w.object;
+    if (s.vertexCounts[i])
+      vertices.push_back({s.vertexStart[i], s.vertexStart[i] + s.vertexCounts[i]});
+    if (s.triangleCounts[i])
+      triangles.push_back({s.triangleStart[i], s.triangleStart[i] + s.triangleCounts[i]});
+  }
+  std::vector<std::uint64_t> gaps;
+  mergeRanges(vertices, maxRanges, gaps);
+  mergeRanges(triangles, maxRanges, gaps);
 }
 
 const StreamCapacity& StreamBuffer::capacity() const {

@@ -91,6 +91,21 @@ class StreamBuffer {
   // Forgets last frame, so the next update reads everything (a from-scratch build).
   void clear();
 
+  // The last successful update, by a number unique in the process (0 before any), and the one
+  // it followed. A copy of the arrays (the GPU's) that held them after update `previousUpdate()`
+  // holds them after `lastUpdate()` once it takes what writtenRanges() gives.
+  std::uint64_t lastUpdate() const;
+  std::uint64_t previousUpdate() const;
+  // [begin, end) in elements: vertices for the vertex arrays, triangles for source and indices.
+  struct Range {
+    std::uint64_t begin = 0, end = 0;
+  };
+  // What the last update wrote, as sorted disjoint ranges: every changed object's slot, or the
+  // whole used arena when it compacted. At most `maxRanges` of each: the closest are merged
+  // (a copy of the stale space between them costs less than a call per object).
+  void writtenRanges(std::size_t maxRanges, std::vector<Range>& vertices,
+                     std::vector<Range>& triangles) const;
+
   const StreamCapacity& capacity() const;
   std::uint64_t vertexCount() const;    // Σ vc_i
   std::uint64_t triangleCount() const;  // Σ tc_i

@@ -209,8 +209,9 @@ class Simplifier {
   }
   // The cheapest valid, untouched target of `from` (its ranked best first); kNone if none.
   Target validTarget(std::uint32_t from, float bestCost);
-  double errorAfter(std::uint32_t from, std::uint32_t to) const;
-  void collapse(std::uint32_t from, const Target& to);
+  double stepDistance(std::uint32_t from, std::uint32_t to) const;
+  // `step`: stepDistance(from, to) when already measured, else negative (measured here).
+  void collapse(std::uint32_t from, const Target& to, double step = -1);
   void markChanged(std::uint32_t from, const Target& to);
   void rankNewNeighbours();
 
@@ -819,9 +820,9 @@ void Simplifier::rankNewNeighbours() {
   newNeighbourCount_ = 0;
 }
 
-// The error bound `to` would carry once `from` collapses into it, as collapse() sets it: what
-// `from` stood for plus its distance to the fan that replaces it (ProgressiveOptions::maxError).
-double Simplifier::errorAfter(std::uint32_t from, std::uint32_t to) const {
+// How far `from` lies from the fan that replaces it once it collapses into `to` (model units):
+// what its collapse adds to the error it already stands for.
+double Simplifier::stepDistance(std::uint32_t from, std::uint32_t to) const {
   const Vec3d moved = position(from);
   double distance = std::numeric_limits<double>::max();
   for (std::uint32_t t : around(from)) {
@@ -831,12 +832,12 @@ double Simplifier::errorAfter(std::uint32_t from, std::uint32_t to) const {
       p[k] = position(corners_[t][k] == from ? to : corners_[t][k]);
     distance = std::min(distance, pointTriangleDistanceSquared(moved, p[0], p[1], p[2]));
   }
-  const double step = distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
-  return std::max(vertex_[to].error, vertex_[from].error + step);
+  return distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
 }
 
-void Simplifier::collapse(std::uint32_t from, const Target& target) {
+void Simplifier::collapse(std::uint32_t from, const Target& target, double step) {
   const std::uint32_t to = target.vertex;
+  const bool measure = step < 0;
   const Vec3d moved = position(from);
   double distance = std::numeric_limits<double>::max();
   // Only the two ends are off limits for the rest of the pass: `to` is the one vertex whose fan
@@ -857,10 +858,12 @@ void Simplifier::collapse(std::uint32_t from, const Target& target) {
     for (std::uint32_t& c : corners_[t]) {
       if (c == from) c = to;
     }
-    // How far the vanished vertex lies from the surface that now replaces it.
-    distance = std::min(
-        distance, pointTriangleDistanceSquared(moved, position(corners_[t][0]),
-                                               position(corners_[t][1]), position(corners_[t][2])));
+    // How far the vanished vertex lies from the surface that now replaces it (stepDistance's
+    // triangles, in the same order).
+    if (measure)
+      distance = std::min(distance, pointTriangleDistanceSquared(moved, position(corners_[t][0]),
+                                                                 position(corners_[t][1]),
+                                                                 position(corners_[t][2])));
   }
   mergeFans(from, to);
   vertex_[from].removed = 1;
@@ -869,7 +872,7 @@ void Simplifier::collapse(std::uint32_t from, const Target& target) {
   vertex_[to].selfCost = quadrics_[to].evaluate(position(to));
   // Per-vertex error bound: what `from` already stood for, plus how far it just moved off the
   // surface (model units). The table keeps the running maximum so it is monotone.
-  const double step = distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
+  if (measure) step = distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
   vertex_[to].error = std::max(vertex_[to].error, vertex_[from].error + step);
   maxError_ = std::max(maxError_, vertex_[to].error);
   collapsed_.push_back(from);
@@ -933,9 +936,16 @@ void Simplifier::collapseAll() {
         if (vertex_[from].touched == pass_ || vertex_[from].removed) continue;
         const Target to = validTarget(from, ranked[i].first);
         if (to.vertex == kNone) continue;
-        // Refused past the bound; ranked again next pass (its neighbourhood may change).
-        if (options_.maxError > 0 && errorAfter(from, to.vertex) > options_.maxError) continue;
-        collapse(from, to);
+        if (options_.maxError > 0) {
+          // The error `to` would carry, as collapse() sets it. Refused past the bound; ranked
+          // again next pass (its neighbourhood may change).
+          const double step = stepDistance(from, to.vertex);
+          if (std::max(vertex_[to.vertex].error, vertex_[from].error + step) > options_.maxError)
+            continue;
+          collapse(from, to, step);
+        } else {
+          collapse(from, to);
+        }
         if (triangleCount_ - removedTriangleCount() <= options_.stopAtTriangles) return;
       }
       if (collapsed_.size() > before) break;

@@ -15,8 +15,10 @@ echo "== machine"
 echo "$(nproc) cores, $(free -g | awk '/Mem:/ {print $2}') GiB, $(lscpu | sed -n 's/^Model name: *//p')"
 
 echo
-echo "== kernels (Google Benchmark)"
-[[ -n ${BENCH_ONLY:-} ]] || build/release/bench/bench_kernels --benchmark_min_time=0.5
+if [[ -z ${BENCH_ONLY:-} ]]; then
+  echo "== kernels (Google Benchmark)"
+  build/release/bench/bench_kernels --benchmark_min_time=0.5
+fi
 
 missing_peer() {  # VARIABLE name; true (after saying so) when $VARIABLE is no executable
   local variable=$1 name=$2

@@ -336,8 +336,8 @@ Status runBench(const Global& global, const BenchOptions& o) {
     auto framebuffer = Framebuffer::create(cameras->front().width, cameras->front().height);
     if (!framebuffer) return framebuffer.status();
     rendererName = (*context)->renderer();
+    say(global, "rendering on " + rendererName + " (" + (*context)->platform() + ")");
     target.emplace(RenderTarget{std::move(*context), std::move(*framebuffer)});
-    say(global, "rendering on " + rendererName);
   }
   nlohmann::json runs = nlohmann::json::array();
   Progress progress("frames", budgets.size() * cameras->size());

@@ -2017,6 +2017,17 @@ TEST(CliBench, RenderAddsTheOpenGlColumn) {
     EXPECT_EQ(j["runs"][1]["mean"]["bytes_read"], 0.0)
         << "100 % after the first frame reads nothing";
     for (const auto& run : j["runs"]) EXPECT_GT(run["mean"]["render_ms"].get<double>(), 0.0);
+    EXPECT_NE(o.out.find("(EGL surfaceless)"), std::string::npos) << o.out;
+    // The CPU stream sends what changed: at 10 % some, at 100 % (unchanged) only the commands.
+    const auto sent = [&](int run) {
+      return j["runs"][run]["mean"]["uploaded_bytes"].get<double>();
+    };
+    if (mode == " --gpu-stream") {
+      EXPECT_EQ(sent(0), 0.0);
+    } else {
+      EXPECT_GT(sent(0), sent(1));
+      EXPECT_GT(sent(1), 0.0);
+    }
   }
   // Without --render the column stays empty and --gpu-reform alone is a usage error.
   EXPECT_EQ(lodforge("bench " + package + " --frames 2 --gpu-reform", dir).code, 2);

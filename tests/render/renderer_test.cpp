@@ -46,6 +46,7 @@ TEST(Context, HeadlessOpenGl45) {
   EXPECT_FALSE(gl.renderer().empty());
   EXPECT_NE(gl.version().find("4."), std::string::npos) << gl.version();
   EXPECT_EQ(gl.glfwWindow(), nullptr);
+  EXPECT_EQ(gl.platform(), "EGL surfaceless");  // Mesa's, tried first
 }
 
 // The device platform is how NVIDIA's driver opens headless; Mesa offers it too (its software
@@ -57,6 +58,7 @@ TEST(Context, TheDevicePlatformAlsoGivesOpenGl45) {
     ASSERT_TRUE(device.ok()) << device.error().message;
     EXPECT_FALSE((*device)->renderer().empty());
     EXPECT_NE((*device)->version().find("4."), std::string::npos) << (*device)->version();
+    EXPECT_EQ((*device)->platform(), "EGL device");
   }
   shared.makeCurrent();
   EXPECT_FALSE(shared.renderer().empty());

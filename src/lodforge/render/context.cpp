@@ -1,6 +1,9 @@
 #include "lodforge/render/context.h"
 
 #include <cstdlib>
+#include <optional>
+#include <tuple>
+#include <utility>
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
@@ -13,6 +16,7 @@ struct GlContext::State {
   EGLDisplay display = EGL_NO_DISPLAY;
   EGLContext context = EGL_NO_CONTEXT;
   GLFWwindow* window = nullptr;
+  const char* platform = "GLFW window";
 };
 
 namespace {
@@ -84,14 +88,19 @@ Result<EGLDisplay> deviceDisplay() {
   return eglError("eglGetPlatformDisplay(device) on every EGL device");
 }
 
-Result<EGLDisplay> platformDisplay(EglPlatform platform) {
-  if (platform == EglPlatform::kSurfaceless) return surfacelessDisplay();
-  if (platform == EglPlatform::kDevice) return deviceDisplay();
-  auto surfaceless = surfacelessDisplay();
-  if (surfaceless) return surfaceless;
+// The display and the platform's name. Under kAny a failure names surfaceless's reason, the
+// platform expected on machines without a GPU.
+Result<std::pair<EGLDisplay, const char*>> platformDisplay(EglPlatform platform) {
+  std::optional<Error> first;
+  if (platform != EglPlatform::kDevice) {
+    auto display = surfacelessDisplay();
+    if (display) return std::pair<EGLDisplay, const char*>{*display, "EGL surfaceless"};
+    if (platform == EglPlatform::kSurfaceless) return display.error();
+    first = display.error();
+  }
   auto device = deviceDisplay();
-  if (device) return device;
-  return surfaceless.error();
+  if (device) return std::pair<EGLDisplay, const char*>{*device, "EGL device"};
+  return first ? *first : device.error();
 }
 
 }  // namespace
@@ -100,7 +109,7 @@ Result<std::unique_ptr<GlContext>> GlContext::headless(EglPlatform platform) {
   auto state = std::make_unique<State>();
   auto display = platformDisplay(platform);
   if (!display) return display.error();
-  state->display = *display;
+  std::tie(state->display, state->platform) = *display;
   EGLint major = 0, minor = 0;
   if (!eglInitialize(state->display, &major, &minor)) return eglError("eglInitialize");
   if (!eglBindAPI(EGL_OPENGL_API)) return eglError("eglBindAPI(OpenGL)");
@@ -159,6 +168,10 @@ void GlContext::finish() {
 std::string GlContext::renderer() const {
   const auto* text = glGetString(GL_RENDERER);
   return text ? reinterpret_cast<const char*>(text) : "";
+}
+
+std::string GlContext::platform() const {
+  return state_->platform;
 }
 
 std::string GlContext::version() const {

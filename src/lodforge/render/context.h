@@ -32,6 +32,7 @@ class GlContext {
   void finish();                   // glFinish: waits until every command issued so far has run
   std::string renderer() const;    // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
   std::string version() const;     // GL_VERSION
+  std::string platform() const;    // "EGL surfaceless", "EGL device" or "GLFW window"
   GLFWwindow* glfwWindow() const;  // null when headless
 
  private:

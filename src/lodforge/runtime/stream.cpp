@@ -536,38 +536,6 @@ std::uint64_t StreamBuffer::previousUpdate() const {
   return state_->previous;
 }
 
-namespace {
-
-// Sorts the ranges and merges touching ones, then those closest together until at most
-// `maxRanges` are left, in place.
-void mergeRanges(std::vector<StreamBuffer::Range>& ranges, std::size_t maxRanges,
-                 std::vector<std::uint64_t>& gaps) {
-  assert(maxRanges > 0);
-  std::sort(ranges.begin(), ranges.end(),
-            [](const auto& a, const auto& b) { return a.begin < b.begin; });
-  const auto mergeUpTo = [&](std::uint64_t gap) {
-    std::size_t out = 0;
-    for (const StreamBuffer::Range& r : ranges) {
-      if (out > 0 && r.begin <= ranges[out - 1].end + gap) {
-        ranges[out - 1].end = std::max(ranges[out - 1].end, r.end);
-      } else {
-        ranges[out++] = r;
-      }
-    }
-    ranges.resize(out);
-  };
-  mergeUpTo(0);
-  if (ranges.size() <= maxRanges) return;
-  // The (n - maxRanges)-th smallest gap: merging every gap up to it leaves at most maxRanges.
-  gaps.resize(ranges.size() - 1);
-  for (std::size_t k = 0; k + 1 < ranges.size(); ++k) gaps[k] = ranges[k + 1].begin - ranges[k].end;
-  const std::size_t cut = ranges.size() - maxRanges - 1;
-  std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(cut), gaps.end());
-  mergeUpTo(gaps[cut]);
-}
-
-}  // namespace
-
 void StreamBuffer::writtenRanges(std::size_t maxRanges, std::vector<Range>& vertices,
                                  std::vector<Range>& triangles) const {
   const State& s = *state_;

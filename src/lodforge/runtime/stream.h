@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "lodforge/core/math.h"
+#include "lodforge/core/ranges.h"
 #include "lodforge/core/status.h"
 #include "lodforge/simplify/package.h"
 
@@ -96,10 +97,8 @@ class StreamBuffer {
   // holds them after `lastUpdate()` once it takes what writtenRanges() gives.
   std::uint64_t lastUpdate() const;
   std::uint64_t previousUpdate() const;
-  // [begin, end) in elements: vertices for the vertex arrays, triangles for source and indices.
-  struct Range {
-    std::uint64_t begin = 0, end = 0;
-  };
+  // In elements: vertices for the vertex arrays, triangles for source and indices.
+  using Range = ElementRange;
   // What the last update wrote, as sorted disjoint ranges: every changed object's slot, or the
   // whole used arena when it compacted. At most `maxRanges` of each: the closest are merged
   // (a copy of the stale space between them costs less than a call per object).

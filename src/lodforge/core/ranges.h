@@ -1,0 +1,20 @@
+// Runs of array elements to copy, as [begin, end) in elements: what changed in an array that a
+// copy (the GPU's) must take again. Each range costs a call, so close ones are merged.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace lodforge {
+
+struct ElementRange {
+  std::uint64_t begin = 0, end = 0;
+};
+
+// Sorts `ranges` and merges those that touch or overlap, then those closest together until at
+// most `maxRanges` (> 0) are left. The result covers every element the input covered, sorted
+// with gaps between; `gaps` is scratch.
+void mergeRanges(std::vector<ElementRange>& ranges, std::size_t maxRanges,
+                 std::vector<std::uint64_t>& gaps);
+
+}  // namespace lodforge

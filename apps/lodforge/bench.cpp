@@ -59,9 +59,9 @@ struct FrameTimes {
   FrameStats stream;
   std::uint64_t vertices = 0, triangles = 0, visible = 0;
   bool exact = true;
-  double uploadMs = 0;              // --render: buffers to the GL (and the GPU reformation)
-  std::uint64_t uploadedBytes = 0;  // --render, CPU stream: bytes copied to the GL
-  double renderMs = 0;              // --render: the draw, to glFinish
+  double uploadMs = 0;  // --render: buffers to the GL (and the GPU reformation)
+  std::optional<std::uint64_t> uploadedBytes;  // --render, CPU stream: bytes copied to the GL
+  double renderMs = 0;                         // --render: the draw, to glFinish
 };
 
 // A budget's run: the first frame (everything read) apart from the coherent frames after it.
@@ -112,7 +112,7 @@ Result<FrameTimes> runFrame(const BenchOptions& o, const LodScene& scene, const 
   }
   t.uploadMs = p.uploadMs + (pipeline->streaming() == Streaming::kCpuGpuReform ? p.reformMs : 0);
   t.renderMs = p.drawMs;
-  t.uploadedBytes = pipeline->streaming() == Streaming::kGpu ? 0 : p.uploadedBytes;
+  if (pipeline->streaming() != Streaming::kGpu) t.uploadedBytes = p.uploadedBytes;
   return t;
 }
 
@@ -193,7 +193,7 @@ nlohmann::json frameJson(const FrameTimes& t) {
           {"triangles", t.triangles},
           {"visible_objects", t.visible},
           {"upload_ms", t.uploadMs},
-          {"uploaded_bytes", t.uploadedBytes},
+          {"uploaded_bytes", t.uploadedBytes ? nlohmann::json(*t.uploadedBytes) : nullptr},
           {"render_ms", t.renderMs}};
 }
 
@@ -218,7 +218,11 @@ nlohmann::json runJson(const BudgetRun& run) {
   add("triangles", [](const FrameTimes& t) { return t.triangles; });
   add("visible_objects", [](const FrameTimes& t) { return t.visible; });
   add("upload_ms", [](const FrameTimes& t) { return t.uploadMs; });
-  add("uploaded_bytes", [](const FrameTimes& t) { return t.uploadedBytes; });
+  if (!run.frames.empty() && run.frames.front().uploadedBytes) {
+    add("uploaded_bytes", [](const FrameTimes& t) { return t.uploadedBytes.value_or(0); });
+  } else {
+    means["uploaded_bytes"] = nullptr;  // not measured (no --render, or the GPU stream)
+  }
   add("render_ms", [](const FrameTimes& t) { return t.renderMs; });
   const auto exactFrames = static_cast<std::uint64_t>(std::count_if(
       run.frames.begin(), run.frames.end(), [](const FrameTimes& t) { return t.exact; }));

@@ -216,8 +216,8 @@ PathTally runPath(const char* key, double capacityShare, double maxShare, Random
   std::vector<std::uint32_t> lastV(scene.size(), 0), lastT(scene.size(), 0);
   PathTally tally;
   Mirror mirror;
-  // From 1 to 64 ranges a frame, apart from the path's own random numbers.
-  const std::size_t maxRanges = 1 + Random::forItem(7, std::string_view(key).size()).below(64);
+  // From 1 to 64 ranges a frame, drawn apart from the path's own random numbers.
+  Random rangeCounts = Random::forItem(7, std::string_view(key).size());
   for (std::size_t f = 0; f < path.size(); ++f) {
     // The budget drifts too, as a user drags the slider.
     const auto budget = static_cast<std::uint64_t>(double(full) * random.uniform(0.02, maxShare));
@@ -231,7 +231,7 @@ PathTally runPath(const char* key, double capacityShare, double maxShare, Random
     // Slots checked every third frame, so objects relocate more than once between two looks.
     expectEqualsReference(buffer, package, s, where, f % 3 == 2 || f + 1 == path.size());
     expectMoves(package, before, buffer, lastV, lastT, *stats, where);
-    mirror.follow(buffer, maxRanges, where);
+    mirror.follow(buffer, 1 + rangeCounts.below(64), where);
     mirror.expectSameSlots(buffer, where);
     const FrameStats e = expectedStats(package, lastV, lastT, s.vertexCounts, s.triangleCounts);
     EXPECT_EQ(stats->bytesRead, e.bytesRead) << where;
@@ -298,12 +298,30 @@ TEST(Stream, AnUnchangedSelectionReadsNothingAndClearReadsEverything) {
   EXPECT_EQ(again->trianglesReformed, 0u);
   EXPECT_EQ(again->trianglesKept, s.totalTriangles);
   expectEqualsReference(buffer, package, s, "unchanged");
+  std::vector<StreamBuffer::Range> vertices, triangles;
+  buffer.writtenRanges(StreamBuffer::kUploadRanges, vertices, triangles);
+  EXPECT_TRUE(vertices.empty() && triangles.empty()) << "an unchanged frame writes nothing";
   buffer.clear();
   Result<FrameStats> fresh = buffer.update(s.vertexCounts, s.triangleCounts);
   ASSERT_TRUE(fresh.ok());
   EXPECT_EQ(fresh->bytesRead, first->bytesRead);
   EXPECT_EQ(fresh->trianglesReformed, s.totalTriangles);
   expectEqualsReference(buffer, package, s, "after clear");
+  // After clear every object's slot was written again.
+  buffer.writtenRanges(StreamBuffer::kUploadRanges, vertices, triangles);
+  const auto inside = [](const std::vector<StreamBuffer::Range>& ranges, std::uint64_t begin,
+                         std::uint64_t end) {
+    return std::any_of(ranges.begin(), ranges.end(),
+                       [&](const auto& r) { return r.begin <= begin && end <= r.end; });
+  };
+  for (std::size_t i = 0; i < s.vertexCounts.size(); ++i) {
+    if (s.vertexCounts[i] == 0) continue;
+    const std::uint64_t v = buffer.vertexStart()[i], t = buffer.triangleStart()[i];
+    EXPECT_TRUE(inside(vertices, v, v + s.vertexCounts[i])) << "object " << i;
+    if (s.triangleCounts[i]) {
+      EXPECT_TRUE(inside(triangles, t, t + s.triangleCounts[i])) << "object " << i;
+    }
+  }
 }
 
 TEST(Stream, ASelectionBeyondCapacityIsRefusedAndTheBufferKeepsLastFrame) {

@@ -1,9 +1,11 @@
 #include "lodforge/render/context.h"
 
 #include <cstdlib>
-#include <optional>
-#include <tuple>
-#include <utility>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
@@ -22,10 +24,8 @@ struct GlContext::State {
 namespace {
 
 Error eglError(const char* what) {
-  return Error{ErrorKind::kUnsupported,
-               fmt::format("headless OpenGL: {} failed (EGL error 0x{:x}); Mesa's EGL and "
-                           "libgl1-mesa-dri provide it (scripts/install-deps.sh)",
-                           what, static_cast<unsigned>(eglGetError()))};
+  return Error{ErrorKind::kUnsupported, fmt::format("{} failed (EGL error 0x{:x})", what,
+                                                    static_cast<unsigned>(eglGetError()))};
 }
 
 Status requireVersion45() {
@@ -54,64 +54,61 @@ GlContext::~GlContext() {
 
 namespace {
 
+// A display to try, and its platform's name.
+struct Candidate {
+  EGLDisplay display;
+  const char* platform;
+};
+
 // Mesa's surfaceless platform: no window system at all; rendering goes to framebuffer objects.
 // The EXT entry points: libepoxy resolves them from the client extensions, before any display
 // exists to tell the EGL version.
-Result<EGLDisplay> surfacelessDisplay() {
-  if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_MESA_platform_surfaceless"))
-    return Error{ErrorKind::kUnsupported,
-                 "headless OpenGL: EGL lacks EGL_MESA_platform_surfaceless (Mesa's libegl1 and "
-                 "libgl1-mesa-dri provide it; scripts/install-deps.sh installs them)"};
+void addSurfaceless(std::vector<Candidate>& out, std::vector<std::string>& why) {
+  if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_MESA_platform_surfaceless")) {
+    why.push_back("EGL lacks EGL_MESA_platform_surfaceless");
+    return;
+  }
   EGLDisplay display =
       eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-  if (display == EGL_NO_DISPLAY) return eglError("eglGetPlatformDisplay(surfaceless)");
-  return display;
+  if (display == EGL_NO_DISPLAY) {
+    why.push_back("surfaceless: " + eglError("eglGetPlatformDisplay").message);
+    return;
+  }
+  out.push_back({display, "EGL surfaceless"});
 }
 
-// The device platform: the first EGL device that initialises. NVIDIA's driver offers this one
-// headless, and Mesa offers it too (its software device).
-Result<EGLDisplay> deviceDisplay() {
-  if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_platform_device") ||
-      !epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_device_enumeration"))
-    return Error{ErrorKind::kUnsupported,
-                 "headless OpenGL: EGL lacks EGL_EXT_platform_device and "
-                 "EGL_MESA_platform_surfaceless"};
+// Every EGL device: NVIDIA's driver renders without a display through one, and Mesa offers its
+// software device too.
+void addDevices(std::vector<Candidate>& out, std::vector<std::string>& why) {
+  for (const char* extension : {"EGL_EXT_platform_device", "EGL_EXT_device_enumeration"}) {
+    if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, extension)) {
+      why.push_back(fmt::format("EGL lacks {}", extension));
+      return;
+    }
+  }
   constexpr EGLint kMaxDevices = 16;
   EGLDeviceEXT devices[kMaxDevices];
   EGLint count = 0;
-  if (!eglQueryDevicesEXT(kMaxDevices, devices, &count)) return eglError("eglQueryDevicesEXT");
+  if (!eglQueryDevicesEXT(kMaxDevices, devices, &count)) {
+    why.push_back(eglError("eglQueryDevicesEXT").message);
+    return;
+  }
+  if (count == 0) why.push_back("no EGL device");
   for (EGLint i = 0; i < count; ++i) {
     EGLDisplay display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr);
-    EGLint major = 0, minor = 0;
-    if (display != EGL_NO_DISPLAY && eglInitialize(display, &major, &minor)) return display;
+    if (display == EGL_NO_DISPLAY) {
+      why.push_back(fmt::format("device {}: {}", i, eglError("eglGetPlatformDisplay").message));
+      continue;
+    }
+    out.push_back({display, "EGL device"});
   }
-  return eglError("eglGetPlatformDisplay(device) on every EGL device");
 }
 
-// The display and the platform's name. Under kAny a failure names surfaceless's reason, the
-// platform expected on machines without a GPU.
-Result<std::pair<EGLDisplay, const char*>> platformDisplay(EglPlatform platform) {
-  std::optional<Error> first;
-  if (platform != EglPlatform::kDevice) {
-    auto display = surfacelessDisplay();
-    if (display) return std::pair<EGLDisplay, const char*>{*display, "EGL surfaceless"};
-    if (platform == EglPlatform::kSurfaceless) return display.error();
-    first = display.error();
-  }
-  auto device = deviceDisplay();
-  if (device) return std::pair<EGLDisplay, const char*>{*device, "EGL device"};
-  return first ? *first : device.error();
-}
-
-}  // namespace
-
-Result<std::unique_ptr<GlContext>> GlContext::headless(EglPlatform platform) {
-  auto state = std::make_unique<State>();
-  auto display = platformDisplay(platform);
-  if (!display) return display.error();
-  std::tie(state->display, state->platform) = *display;
+// An OpenGL 4.5 core context current on `display`, or why not; a context that fails after its
+// creation is destroyed.
+Result<EGLContext> currentContext(EGLDisplay display) {
   EGLint major = 0, minor = 0;
-  if (!eglInitialize(state->display, &major, &minor)) return eglError("eglInitialize");
+  if (!eglInitialize(display, &major, &minor)) return eglError("eglInitialize");
   if (!eglBindAPI(EGL_OPENGL_API)) return eglError("eglBindAPI(OpenGL)");
   const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION,
                                4,
@@ -120,12 +117,42 @@ Result<std::unique_ptr<GlContext>> GlContext::headless(EglPlatform platform) {
                                EGL_CONTEXT_OPENGL_PROFILE_MASK,
                                EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                EGL_NONE};
-  state->context = eglCreateContext(state->display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
-  if (state->context == EGL_NO_CONTEXT) return eglError("eglCreateContext(OpenGL 4.5 core)");
-  if (!eglMakeCurrent(state->display, EGL_NO_SURFACE, EGL_NO_SURFACE, state->context))
-    return eglError("eglMakeCurrent");
-  LODFORGE_TRY(requireVersion45());
-  return std::unique_ptr<GlContext>(new GlContext(std::move(state)));
+  EGLContext context = eglCreateContext(display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attributes);
+  if (context == EGL_NO_CONTEXT) return eglError("eglCreateContext(OpenGL 4.5 core)");
+  Status made = eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)
+                    ? requireVersion45()
+                    : Status(eglError("eglMakeCurrent"));
+  if (made.ok()) return context;
+  eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  eglDestroyContext(display, context);
+  return made.error();
+}
+
+}  // namespace
+
+// Each candidate in turn, to the first that gives a 4.5 core context: surfaceless first (Mesa,
+// machines without a GPU), then the EGL devices.
+Result<std::unique_ptr<GlContext>> GlContext::headless(EglPlatform platform) {
+  std::vector<Candidate> candidates;
+  std::vector<std::string> why;
+  if (platform != EglPlatform::kDevice) addSurfaceless(candidates, why);
+  if (platform != EglPlatform::kSurfaceless) addDevices(candidates, why);
+  for (const Candidate& c : candidates) {
+    Result<EGLContext> context = currentContext(c.display);
+    if (!context) {
+      why.push_back(fmt::format("{}: {}", c.platform, context.error().message));
+      continue;
+    }
+    auto state = std::make_unique<State>();
+    state->display = c.display;
+    state->context = *context;
+    state->platform = c.platform;
+    return std::unique_ptr<GlContext>(new GlContext(std::move(state)));
+  }
+  return Error{ErrorKind::kUnsupported,
+               fmt::format("headless OpenGL 4.5: no EGL platform gave a context ({}); Mesa's "
+                           "libegl1 and libgl1-mesa-dri provide one (scripts/install-deps.sh)",
+                           fmt::join(why, "; "))};
 }
 
 Result<std::unique_ptr<GlContext>> GlContext::window(std::uint32_t width, std::uint32_t height,

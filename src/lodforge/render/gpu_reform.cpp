@@ -44,6 +44,9 @@ struct GpuReformer::State {
   std::uint64_t sourceBytes = 0;  // a StreamBuffer's source triangles (a GpuStream has its own)
   std::vector<std::array<std::uint32_t, 4>> table;
   const Package* package = nullptr;
+  std::uint64_t heldUpdate = 0;  // the StreamBuffer update the source buffer holds (0: none)
+  std::vector<ElementRange> ranges, vertexRanges;  // vertexRanges: unused, the stream gives both
+  std::uint64_t uploaded = 0;                      // by the last reform
 
   ~State() {
     for (GLuint b : {ecol, source, objects}) {
@@ -77,15 +80,36 @@ Result<GpuReformer> GpuReformer::create(const Package& package, const StreamCapa
 }
 
 GpuReformer::GpuReformer(std::unique_ptr<State> state) : state_(std::move(state)) {}
+
+std::uint64_t GpuReformer::uploadedBytes() const {
+  return state_->uploaded;
+}
 GpuReformer::GpuReformer(GpuReformer&&) noexcept = default;
 GpuReformer& GpuReformer::operator=(GpuReformer&&) noexcept = default;
 GpuReformer::~GpuReformer() = default;
 
 void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
+  State& s = *state_;
   const auto source = buffer.sourceTriangles();
-  if (!state_->source) state_->source = makeBuffer(state_->sourceBytes);
-  glNamedBufferSubData(state_->source, 0, static_cast<GLsizeiptr>(source.size_bytes()),
-                       source.data());
+  if (!s.source) s.source = makeBuffer(s.sourceBytes);
+  // The source triangles the last update wrote when the buffer holds the update before, as the
+  // renderer sends its arrays; else all of them.
+  if (s.heldUpdate != 0 && buffer.lastUpdate() == s.heldUpdate) {
+    s.ranges.clear();
+  } else if (s.heldUpdate != 0 && buffer.previousUpdate() == s.heldUpdate) {
+    buffer.writtenRanges(StreamBuffer::kUploadRanges, s.vertexRanges, s.ranges);
+  } else {
+    s.ranges.assign(1, {0, source.size() / 3});
+  }
+  s.uploaded = 0;
+  for (const ElementRange& r : s.ranges) {
+    const std::uint64_t offset = 3 * r.begin * sizeof(std::uint32_t);
+    const std::uint64_t size = 3 * (r.end - r.begin) * sizeof(std::uint32_t);
+    glNamedBufferSubData(s.source, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(size),
+                         source.data() + 3 * r.begin);
+    s.uploaded += size;
+  }
+  s.heldUpdate = buffer.lastUpdate();
   run(state_->source,
       {buffer.vertexCounts(), buffer.triangleCounts(), buffer.slotOrder(), buffer.vertexStart(),
        buffer.triangleStart()},
@@ -93,6 +117,7 @@ void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
 }
 
 void GpuReformer::reform(const GpuStream& stream, unsigned indexBuffer) {
+  state_->uploaded = 0;
   run(stream.sourceBuffer(),
       {stream.vertexCounts(),
        stream.triangleCounts(),
@@ -125,6 +150,7 @@ void GpuReformer::run(unsigned sourceBuffer, const Objects& objects, unsigned in
   if (triangles == 0) return;
   assert(s.table.size() <= s.objectCapacity);
   glNamedBufferSubData(s.objects, 0, static_cast<GLsizeiptr>(s.table.size() * 16), s.table.data());
+  s.uploaded += s.table.size() * 16;
   const GLuint p = s.program.id();
   glUseProgram(p);
   glUniform1ui(glGetUniformLocation(p, "triangleCount"), static_cast<GLuint>(triangles));

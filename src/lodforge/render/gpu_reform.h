@@ -30,6 +30,9 @@ class GpuReformer {
   void reform(const StreamBuffer& buffer, unsigned indexBuffer);
   // The same from a GPU stream, whose source triangles are already on the GPU.
   void reform(const GpuStream& stream, unsigned indexBuffer);
+  // Bytes the last reform copied to the GL: the source triangles the stream's update wrote (all
+  // of them when the GL copy is not the update before) and the object table.
+  std::uint64_t uploadedBytes() const;
   // Reads back the first `triangles` triangles of a GL index buffer (tests, debugging).
   static std::vector<std::uint32_t> readIndices(unsigned indexBuffer, std::uint64_t triangles);
 

@@ -109,6 +109,7 @@ Result<FrameStats> FramePipeline::update(std::span<const std::uint32_t> vertexCo
   if (gpuReform) {
     s.reformer->reform(*s.cpu, s.renderer->indexBuffer());
     s.timings.reformMs = millisecondsSince(start);
+    s.timings.uploadedBytes += s.reformer->uploadedBytes();
   }
   return stats;
 }

@@ -22,10 +22,12 @@ enum class Streaming : std::uint8_t { kCpu, kCpuGpuReform, kGpu };
 const char* streamingName(Streaming mode);  // "cpu", "cpu-stream-gpu-reform", "gpu"
 
 struct PipelineTimings {
-  double streamMs = 0;              // CPU: reassembly + reformation; GPU: Δ upload + reassembly
-  double uploadMs = 0;              // CPU stream: what the last update wrote to the GL
-  std::uint64_t uploadedBytes = 0;  // by that upload (the vertex and index arrays, the commands)
-  double reformMs = 0;              // GPU reformation (0 when the CPU re-forms, inside streamMs)
+  double streamMs = 0;  // CPU: reassembly + reformation; GPU: Δ upload + reassembly
+  double uploadMs = 0;  // CPU stream: what the last update wrote to the GL
+  // CPU stream: bytes that upload (the vertex and index arrays, the commands) and the GPU
+  // reformer (source triangles, object table) copied to the GL. Not counted for the GPU stream.
+  std::uint64_t uploadedBytes = 0;
+  double reformMs = 0;  // GPU reformation (0 when the CPU re-forms, inside streamMs)
   double drawMs = 0;
 };
 

@@ -302,16 +302,13 @@ Renderer::~Renderer() = default;
 
 namespace {
 
-// Copies per array and frame at most: each is a driver call, so 18,000 changed objects (718 K
-// parts at 18 M) are merged into this many ranges, the closest first.
-constexpr std::size_t kMaxUploadRanges = 512;
-
 // Copies `ranges` (in elements of `width` values) of the array into the GL buffer; the bytes.
 template <class T>
 std::uint64_t uploadRanges(GLuint target, std::span<const T> array, std::uint64_t width,
                            std::span<const StreamBuffer::Range> ranges) {
   std::uint64_t bytes = 0;
   for (const StreamBuffer::Range& r : ranges) {
+    if (r.end == r.begin) continue;
     const std::uint64_t offset = r.begin * width * sizeof(T),
                         size = (r.end - r.begin) * width * sizeof(T);
     assert(offset + size <= array.size_bytes());
@@ -329,12 +326,12 @@ std::uint64_t uploadRanges(GLuint target, std::span<const T> array, std::uint64_
 void Renderer::upload(const StreamBuffer& buffer, bool indices) {
   State& s = *state_;
   assert(s.positions != 0 && "created without vertex buffers: attach a GpuStream instead");
-  const bool same = s.heldUpdate != 0 && s.heldIndices == indices;
-  if (same && buffer.lastUpdate() == s.heldUpdate) {
+  const bool holdsStream = s.heldUpdate != 0 && s.heldIndices == indices;
+  if (holdsStream && buffer.lastUpdate() == s.heldUpdate) {
     s.vertexRanges.clear();  // uploaded already
     s.triangleRanges.clear();
-  } else if (same && buffer.previousUpdate() == s.heldUpdate) {
-    buffer.writtenRanges(kMaxUploadRanges, s.vertexRanges, s.triangleRanges);
+  } else if (holdsStream && buffer.previousUpdate() == s.heldUpdate) {
+    buffer.writtenRanges(StreamBuffer::kUploadRanges, s.vertexRanges, s.triangleRanges);
   } else {
     s.vertexRanges.assign(1, {0, buffer.positions().size()});
     s.triangleRanges.assign(1, {0, buffer.indices().size() / 3});

@@ -109,8 +109,10 @@ struct StreamBuffer::State {
   std::vector<std::uint8_t> relocated;               // in `relocations`
   std::uint64_t update = 0, previous = 0;            // lastUpdate(), previousUpdate()
   bool compacted = false;                            // the last update packed the arena
-  // Scratch for one update.
+  // The objects the last update changed: it works on them, and writtenRanges reads them after.
   std::vector<ObjectWork> work;
+  mutable RangeScratch mergeScratch;  // writtenRanges's
+  // Scratch for one update.
   std::vector<std::vector<ObjectWork>> blockWork;
   std::vector<std::uint32_t> nextOrder;
 };
@@ -555,9 +557,8 @@ void StreamBuffer::writtenRanges(std::size_t maxRanges, std::vector<Range>& vert
     if (s.triangleCounts[i])
       triangles.push_back({s.triangleStart[i], s.triangleStart[i] + s.triangleCounts[i]});
   }
-  std::vector<std::uint64_t> gaps;
-  mergeRanges(vertices, maxRanges, gaps);
-  mergeRanges(triangles, maxRanges, gaps);
+  mergeRanges(vertices, maxRanges, s.mergeScratch);
+  mergeRanges(triangles, maxRanges, s.mergeScratch);
 }
 
 const StreamCapacity& StreamBuffer::capacity() const {

@@ -210,8 +210,8 @@ class Simplifier {
   // The cheapest valid, untouched target of `from` (its ranked best first); kNone if none.
   Target validTarget(std::uint32_t from, float bestCost);
   double stepDistance(std::uint32_t from, std::uint32_t to) const;
-  // `step`: stepDistance(from, to) when already measured, else negative (measured here).
-  void collapse(std::uint32_t from, const Target& to, double step = -1);
+  // `step`: stepDistance(from, to) when already measured, else measured here.
+  void collapse(std::uint32_t from, const Target& to, std::optional<double> step = std::nullopt);
   void markChanged(std::uint32_t from, const Target& to);
   void rankNewNeighbours();
 
@@ -835,9 +835,9 @@ double Simplifier::stepDistance(std::uint32_t from, std::uint32_t to) const {
   return distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
 }
 
-void Simplifier::collapse(std::uint32_t from, const Target& target, double step) {
+void Simplifier::collapse(std::uint32_t from, const Target& target, std::optional<double> step) {
   const std::uint32_t to = target.vertex;
-  const bool measure = step < 0;
+  const bool measure = !step;
   const Vec3d moved = position(from);
   double distance = std::numeric_limits<double>::max();
   // Only the two ends are off limits for the rest of the pass: `to` is the one vertex whose fan
@@ -873,7 +873,7 @@ void Simplifier::collapse(std::uint32_t from, const Target& target, double step)
   // Per-vertex error bound: what `from` already stood for, plus how far it just moved off the
   // surface (model units). The table keeps the running maximum so it is monotone.
   if (measure) step = distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
-  vertex_[to].error = std::max(vertex_[to].error, vertex_[from].error + step);
+  vertex_[to].error = std::max(vertex_[to].error, vertex_[from].error + *step);
   maxError_ = std::max(maxError_, vertex_[to].error);
   collapsed_.push_back(from);
   trianglesAfter_.push_back(triangleCount_ - static_cast<std::uint32_t>(removedTriangles_.size()));

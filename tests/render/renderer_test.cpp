@@ -183,6 +183,15 @@ TEST(Renderer, UploadingOnlyWhatChangedDrawsTheSameFrames) {
   // Nothing changed: only the draw commands and LOD ratios go again (67 objects: 1.6 KB).
   kept->upload(buffer);
   EXPECT_LT(kept->uploadedBytes(), 4096u);
+  // Without the indices (the GPU reformer writes them) and back: the index buffer is not the
+  // stream's any more, so everything goes again, and the frame is still drawn the same.
+  kept->upload(buffer, /*indices=*/false);
+  EXPECT_GE(kept->uploadedBytes(), buffer.positions().size_bytes());
+  kept->upload(buffer);
+  EXPECT_GE(kept->uploadedBytes(), buffer.positions().size_bytes() + buffer.indices().size_bytes());
+  target->bind();
+  kept->draw(path.back(), {});
+  EXPECT_EQ(compareImages(target->read(), render(package, buffer, path.back())).maxDeltaE, 0.0);
 }
 
 TEST(Renderer, LowerBudgetsStayWithinStatedImageDifference) {

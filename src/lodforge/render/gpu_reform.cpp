@@ -92,23 +92,9 @@ void GpuReformer::reform(const StreamBuffer& buffer, unsigned indexBuffer) {
   State& s = *state_;
   const auto source = buffer.sourceTriangles();
   if (!s.source) s.source = makeBuffer(s.sourceBytes);
-  // The source triangles the last update wrote when the buffer holds the update before, as the
-  // renderer sends its arrays; else all of them.
-  if (s.heldUpdate != 0 && buffer.lastUpdate() == s.heldUpdate) {
-    s.ranges.clear();
-  } else if (s.heldUpdate != 0 && buffer.previousUpdate() == s.heldUpdate) {
-    buffer.writtenRanges(StreamBuffer::kUploadRanges, s.vertexRanges, s.ranges);
-  } else {
-    s.ranges.assign(1, {0, source.size() / 3});
-  }
-  s.uploaded = 0;
-  for (const ElementRange& r : s.ranges) {
-    const std::uint64_t offset = 3 * r.begin * sizeof(std::uint32_t);
-    const std::uint64_t size = 3 * (r.end - r.begin) * sizeof(std::uint32_t);
-    glNamedBufferSubData(s.source, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(size),
-                         source.data() + 3 * r.begin);
-    s.uploaded += size;
-  }
+  // Only the source triangles the stream's update wrote, as the renderer sends its arrays.
+  buffer.rangesSince(s.heldUpdate, StreamBuffer::kUploadRanges, s.vertexRanges, s.ranges);
+  s.uploaded = uploadRanges(s.source, std::as_bytes(source), 3 * sizeof(std::uint32_t), s.ranges);
   s.heldUpdate = buffer.lastUpdate();
   run(state_->source,
       {buffer.vertexCounts(), buffer.triangleCounts(), buffer.slotOrder(), buffer.vertexStart(),

@@ -300,47 +300,24 @@ Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 Renderer::~Renderer() = default;
 
-namespace {
-
-// Copies `ranges` (in elements of `width` values) of the array into the GL buffer; the bytes.
-template <class T>
-std::uint64_t uploadRanges(GLuint target, std::span<const T> array, std::uint64_t width,
-                           std::span<const StreamBuffer::Range> ranges) {
-  std::uint64_t bytes = 0;
-  for (const StreamBuffer::Range& r : ranges) {
-    if (r.end == r.begin) continue;
-    const std::uint64_t offset = r.begin * width * sizeof(T),
-                        size = (r.end - r.begin) * width * sizeof(T);
-    assert(offset + size <= array.size_bytes());
-    glNamedBufferSubData(target, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(size),
-                         reinterpret_cast<const std::byte*>(array.data()) + offset);
-    bytes += size;
-  }
-  return bytes;
-}
-
-}  // namespace
-
 // The whole used arena when the buffers do not hold the frame before; else only what the last
 // update wrote (on a real GPU the copy across the bus is most of the frame: 1 GB at 18 M).
 void Renderer::upload(const StreamBuffer& buffer, bool indices) {
   State& s = *state_;
   assert(s.positions != 0 && "created without vertex buffers: attach a GpuStream instead");
-  const bool holdsStream = s.heldUpdate != 0 && s.heldIndices == indices;
-  if (holdsStream && buffer.lastUpdate() == s.heldUpdate) {
-    s.vertexRanges.clear();  // uploaded already
-    s.triangleRanges.clear();
-  } else if (holdsStream && buffer.previousUpdate() == s.heldUpdate) {
-    buffer.writtenRanges(StreamBuffer::kUploadRanges, s.vertexRanges, s.triangleRanges);
-  } else {
-    s.vertexRanges.assign(1, {0, buffer.positions().size()});
-    s.triangleRanges.assign(1, {0, buffer.indices().size() / 3});
-  }
-  s.uploaded = uploadRanges(s.positions, buffer.positions(), 1, s.vertexRanges);
-  if (s.normals) s.uploaded += uploadRanges(s.normalBuffer, buffer.normals(), 1, s.vertexRanges);
-  if (s.colors) s.uploaded += uploadRanges(s.colorBuffer, buffer.colors(), 1, s.vertexRanges);
-  if (s.uvs) s.uploaded += uploadRanges(s.uvBuffer, buffer.uvs(), 1, s.vertexRanges);
-  if (indices) s.uploaded += uploadRanges(s.indices, buffer.indices(), 3, s.triangleRanges);
+  // Indices the GPU reformer wrote are not the stream's: then everything goes again.
+  buffer.rangesSince(s.heldIndices == indices ? s.heldUpdate : 0, StreamBuffer::kUploadRanges,
+                     s.vertexRanges, s.triangleRanges);
+  const auto vertexArray = [&](GLuint target, auto array) {
+    return uploadRanges(target, std::as_bytes(array), sizeof(array[0]), s.vertexRanges);
+  };
+  s.uploaded = vertexArray(s.positions, buffer.positions());
+  if (s.normals) s.uploaded += vertexArray(s.normalBuffer, buffer.normals());
+  if (s.colors) s.uploaded += vertexArray(s.colorBuffer, buffer.colors());
+  if (s.uvs) s.uploaded += vertexArray(s.uvBuffer, buffer.uvs());
+  if (indices)
+    s.uploaded += uploadRanges(s.indices, std::as_bytes(buffer.indices()),
+                               3 * sizeof(std::uint32_t), s.triangleRanges);
   s.heldUpdate = buffer.lastUpdate();
   s.heldIndices = indices;
 

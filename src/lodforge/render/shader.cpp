@@ -1,5 +1,7 @@
 #include "lodforge/render/shader.h"
 
+#include <cassert>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstring>
@@ -52,6 +54,20 @@ Result<Program> Program::link(std::initializer_list<Stage> stages) {
   for (GLuint shader : shaders) glDeleteShader(shader);
   if (!status.ok()) return status;
   return program;
+}
+
+std::uint64_t uploadRanges(unsigned buffer, std::span<const std::byte> array,
+                           std::uint64_t elementBytes, std::span<const ElementRange> ranges) {
+  std::uint64_t bytes = 0;
+  for (const ElementRange& r : ranges) {
+    if (r.end == r.begin) continue;
+    const std::uint64_t offset = r.begin * elementBytes, size = (r.end - r.begin) * elementBytes;
+    assert(offset + size <= array.size());
+    glNamedBufferSubData(buffer, static_cast<GLintptr>(offset), static_cast<GLsizeiptr>(size),
+                         array.data() + offset);
+    bytes += size;
+  }
+  return bytes;
 }
 
 unsigned makeBuffer(std::uint64_t bytes, const void* data, unsigned flags) {

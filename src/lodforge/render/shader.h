@@ -1,12 +1,15 @@
 // A linked GLSL program; compile and link errors come back with the driver's log.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "lodforge/core/ranges.h"
 #include "lodforge/core/status.h"
 
 namespace lodforge {
@@ -34,6 +37,11 @@ class Program {
 // A GL buffer of `bytes` (at least 16: a zero-size store is an error), filled from `data` if given.
 unsigned makeBuffer(std::uint64_t bytes, const void* data = nullptr,
                     unsigned flags = 0x0100 /* GL_DYNAMIC_STORAGE_BIT */);
+
+// Copies `ranges` of `array` (elements of `elementBytes` each) to the same offsets of a GL
+// buffer; the bytes copied. How a copy on the GPU follows a changing array (runtime/stream.h).
+std::uint64_t uploadRanges(unsigned buffer, std::span<const std::byte> array,
+                           std::uint64_t elementBytes, std::span<const ElementRange> ranges);
 
 // Compute shaders over `elements` items, 256 per group, groups spread over x and y past the
 // 65,535 per dimension GL 4.5 guarantees. Shaders start with kElementGlsl to get the index.

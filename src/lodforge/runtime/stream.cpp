@@ -561,6 +561,20 @@ void StreamBuffer::writtenRanges(std::size_t maxRanges, std::vector<Range>& vert
   mergeRanges(triangles, maxRanges, s.mergeScratch);
 }
 
+void StreamBuffer::rangesSince(std::uint64_t held, std::size_t maxRanges,
+                               std::vector<Range>& vertices, std::vector<Range>& triangles) const {
+  const State& s = *state_;
+  if (held != 0 && held == s.update) {
+    vertices.clear();
+    triangles.clear();
+  } else if (held != 0 && held == s.previous) {
+    writtenRanges(maxRanges, vertices, triangles);
+  } else {
+    vertices.assign(1, {0, s.vertexEnd});
+    triangles.assign(1, {0, s.triangleEnd});
+  }
+}
+
 const StreamCapacity& StreamBuffer::capacity() const {
   return state_->capacity;
 }

@@ -104,6 +104,11 @@ class StreamBuffer {
   // (a copy of the stale space between them costs less than a call per object).
   void writtenRanges(std::size_t maxRanges, std::vector<Range>& vertices,
                      std::vector<Range>& triangles) const;
+  // What a copy that holds update `held` (0: nothing known) must take to hold lastUpdate():
+  // nothing when it holds it, writtenRanges after the update before, else the arrays up to the
+  // high-water mark whole.
+  void rangesSince(std::uint64_t held, std::size_t maxRanges, std::vector<Range>& vertices,
+                   std::vector<Range>& triangles) const;
   // The ranges a GL copy takes per array and frame at most: each is a driver call, so the 18,000
   // changed objects of a frame at 718 K parts are merged into this many, the closest first.
   static constexpr std::size_t kUploadRanges = 512;

@@ -210,8 +210,8 @@ class Simplifier {
   // The cheapest valid, untouched target of `from` (its ranked best first); kNone if none.
   Target validTarget(std::uint32_t from, float bestCost);
   double stepDistance(std::uint32_t from, std::uint32_t to) const;
-  // `step`: stepDistance(from, to) when already measured, else measured here.
-  void collapse(std::uint32_t from, const Target& to, std::optional<double> step = std::nullopt);
+  // `step`: stepDistance(from, to), measured before the fan changes.
+  void collapse(std::uint32_t from, const Target& to, double step);
   void markChanged(std::uint32_t from, const Target& to);
   void rankNewNeighbours();
 
@@ -835,11 +835,8 @@ double Simplifier::stepDistance(std::uint32_t from, std::uint32_t to) const {
   return distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
 }
 
-void Simplifier::collapse(std::uint32_t from, const Target& target, std::optional<double> step) {
+void Simplifier::collapse(std::uint32_t from, const Target& target, double step) {
   const std::uint32_t to = target.vertex;
-  const bool measure = !step;
-  const Vec3d moved = position(from);
-  double distance = std::numeric_limits<double>::max();
   // Only the two ends are off limits for the rest of the pass: `to` is the one vertex whose fan
   // grows (merged below) and whose quadric changes, so its ranked costs are stale. Every other
   // vertex keeps a complete fan (dead triangles are skipped, moved corners are updated in
@@ -858,12 +855,6 @@ void Simplifier::collapse(std::uint32_t from, const Target& target, std::optiona
     for (std::uint32_t& c : corners_[t]) {
       if (c == from) c = to;
     }
-    // How far the vanished vertex lies from the surface that now replaces it (stepDistance's
-    // triangles, in the same order).
-    if (measure)
-      distance = std::min(distance, pointTriangleDistanceSquared(moved, position(corners_[t][0]),
-                                                                 position(corners_[t][1]),
-                                                                 position(corners_[t][2])));
   }
   mergeFans(from, to);
   vertex_[from].removed = 1;
@@ -872,8 +863,7 @@ void Simplifier::collapse(std::uint32_t from, const Target& target, std::optiona
   vertex_[to].selfCost = quadrics_[to].evaluate(position(to));
   // Per-vertex error bound: what `from` already stood for, plus how far it just moved off the
   // surface (model units). The table keeps the running maximum so it is monotone.
-  if (measure) step = distance == std::numeric_limits<double>::max() ? 0.0 : std::sqrt(distance);
-  vertex_[to].error = std::max(vertex_[to].error, vertex_[from].error + *step);
+  vertex_[to].error = std::max(vertex_[to].error, vertex_[from].error + step);
   maxError_ = std::max(maxError_, vertex_[to].error);
   collapsed_.push_back(from);
   trianglesAfter_.push_back(triangleCount_ - static_cast<std::uint32_t>(removedTriangles_.size()));
@@ -936,16 +926,13 @@ void Simplifier::collapseAll() {
         if (vertex_[from].touched == pass_ || vertex_[from].removed) continue;
         const Target to = validTarget(from, ranked[i].first);
         if (to.vertex == kNone) continue;
-        if (options_.maxError > 0) {
-          // The error `to` would carry, as collapse() sets it. Refused past the bound; ranked
-          // again next pass (its neighbourhood may change).
-          const double step = stepDistance(from, to.vertex);
-          if (std::max(vertex_[to.vertex].error, vertex_[from].error + step) > options_.maxError)
-            continue;
-          collapse(from, to, step);
-        } else {
-          collapse(from, to);
-        }
+        // The error `to` would carry, as collapse() sets it. Refused past the bound; ranked
+        // again next pass (its neighbourhood may change).
+        const double step = stepDistance(from, to.vertex);
+        if (options_.maxError > 0 &&
+            std::max(vertex_[to.vertex].error, vertex_[from].error + step) > options_.maxError)
+          continue;
+        collapse(from, to, step);
         if (triangleCount_ - removedTriangleCount() <= options_.stopAtTriangles) return;
       }
       if (collapsed_.size() > before) break;

@@ -696,6 +696,30 @@ print("%.4g %.4g %.3g %.3g" % (j["hausdorff"], j["rms"], t["mean"], t["p95"]))' 
 }
 if [[ ${BENCH_ONLY:-} == gltfpack ]]; then gltfpack_section; exit 0; fi
 
+# Declared against measured geometric error of mesh tilesets (issue 38): every tile with
+# children against the union of the leaves under it, by dense sampling (bench_tile_error).
+tile_error_section() {
+  echo
+  echo "== tile geometric error: measured (symmetric Hausdorff to the leaves below) / declared"
+  local data=${LODFORGE_DATA:-../shared/data}
+  [[ -d $data ]] || data=/work/shared/data
+  local sets=()
+  for mesh in horse.ply stanford-bunny.obj; do
+    "$lodforge" -q tiles "$data/meshes/$mesh" -o "$work/te-${mesh%%.*}"
+    sets+=("$work/te-${mesh%%.*}")
+  done
+  "$lodforge" -q generate cad --objects 2K -o "$work/te-cad.ply"
+  "$lodforge" -q tiles "$work/te-cad.ply" -o "$work/te-cad2k"
+  for n in 1M 10M; do
+    "$lodforge" -q generate scan --triangles "$n" -o "$work/te-scan.ply"
+    "$lodforge" -q tiles "$work/te-scan.ply" -o "$work/te-scan$n"
+    sets+=("$work/te-scan$n")
+  done
+  build/release/bench/bench_tile_error "$work/te-cad2k" "${sets[@]}"
+  rm -rf "$work"/te-*
+}
+if [[ ${BENCH_ONLY:-} == tile-error ]]; then tile_error_section; exit 0; fi
+
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 
 echo
@@ -728,5 +752,6 @@ textures_section
 textured_obj_section
 texture_formats_section
 gltfpack_section
+tile_error_section
 render_section
 runtime_section

@@ -6,6 +6,8 @@
 // points on each side plus every triangle's corner, exact point-to-triangle distances) and
 // compared with its declared geometricError, per level of the tree.
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -84,13 +86,72 @@ void appendLeaves(Tileset& set, std::size_t tile, Mesh& out) {
   for (std::size_t c : set.tiles[tile].children) appendLeaves(set, c, out);
 }
 
+// sup over A of the distance to B, bracketed by branch and bound: `lower` is a distance some
+// point of A has (vertices and piece centroids, measured exactly), `upper` one no point of A
+// exceeds. A piece of a triangle of A is bounded through the triangle of B nearest its centroid:
+// the distance to one triangle is convex, so its largest over the piece is at a corner. The
+// piece with the largest bound is split in four until the bound is within `ratio` of the lower
+// one or `budget` pieces were made (then the bound is valid but looser).
+struct Bracket {
+  double lower = 0, upper = 0;
+  std::size_t pieces = 0;
+};
+
+struct Piece {
+  double upper;
+  std::array<Vec3d, 3> p;
+  bool operator<(const Piece& o) const { return upper < o.upper; }
+};
+
+Bracket directedBound(const Mesh& a, const Mesh& b, double ratio, std::size_t budget) {
+  const NearestTriangles nearest(b.positions, b.indices);
+  Bracket out;
+  std::uint32_t f = 0;
+  for (const Vec3f& v : a.positions)
+    out.lower = std::max(out.lower, std::sqrt(nearest.nearestSquared(toDouble(v), f)));
+  const auto corner = [&](std::uint32_t t, int k) {
+    return toDouble(b.positions[b.indices[3 * t + static_cast<std::size_t>(k)]]);
+  };
+  const auto bound = [&](const std::array<Vec3d, 3>& p) {
+    const Vec3d g = (p[0] + p[1] + p[2]) / 3.0;
+    out.lower = std::max(out.lower, std::sqrt(nearest.nearestSquared(g, f)));
+    double worst = 0;
+    for (const Vec3d& q : p)
+      worst = std::max(worst,
+                       pointTriangleDistanceSquared(q, corner(f, 0), corner(f, 1), corner(f, 2)));
+    ++out.pieces;
+    return Piece{std::sqrt(worst), p};
+  };
+  std::vector<Piece> heap;
+  for (std::size_t t = 0; t + 2 < a.indices.size(); t += 3) {
+    heap.push_back(
+        bound({toDouble(a.positions[a.indices[t]]), toDouble(a.positions[a.indices[t + 1]]),
+               toDouble(a.positions[a.indices[t + 2]])}));
+  }
+  std::make_heap(heap.begin(), heap.end());
+  while (!heap.empty() && heap.front().upper > ratio * out.lower && out.pieces < budget) {
+    std::pop_heap(heap.begin(), heap.end());
+    const std::array<Vec3d, 3> p = heap.back().p;
+    heap.pop_back();
+    const Vec3d m01 = (p[0] + p[1]) / 2.0, m12 = (p[1] + p[2]) / 2.0, m20 = (p[2] + p[0]) / 2.0;
+    for (const std::array<Vec3d, 3>& q : {std::array{p[0], m01, m20}, std::array{m01, p[1], m12},
+                                          std::array{m20, m12, p[2]}, std::array{m01, m12, m20}}) {
+      heap.push_back(bound(q));
+      std::push_heap(heap.begin(), heap.end());
+    }
+  }
+  out.upper = std::max(out.lower, heap.empty() ? 0.0 : heap.front().upper);
+  return out;
+}
+
 struct LevelStats {
   std::vector<double> ratios;  // measured / declared
   std::size_t under = 0;       // measured above declared
   std::size_t notMonotonic = 0;
+  std::vector<double> bracket, overCertified;  // --certify: upper / lower, declared / upper
 };
 
-void measure(const fs::path& directory, std::uint32_t samples) {
+void measure(const fs::path& directory, std::uint32_t samples, bool certify) {
   std::ifstream in(directory / "tileset.json");
   const nlohmann::json json = nlohmann::json::parse(in);
   Tileset set{directory, {}, false, {}};
@@ -107,6 +168,20 @@ void measure(const fs::path& directory, std::uint32_t samples) {
     const SurfaceDistance d = surfaceDistance(content.positions, content.indices, finest.positions,
                                               finest.indices, samples, t + 1);
     stats.ratios.push_back(d.hausdorff / tile.declared);
+    if (certify) {
+      const std::size_t budget = 64 * (content.indices.size() + finest.indices.size());
+      const Bracket ab = directedBound(content, finest, 1.2, budget);
+      const Bracket ba = directedBound(finest, content, 1.2, budget);
+      const double lower = std::max(ab.lower, ba.lower), upper = std::max(ab.upper, ba.upper);
+      stats.bracket.push_back(upper / lower);
+      stats.overCertified.push_back(tile.declared / upper);
+      fmt::print(
+          "  {}: declared {:.4g}, sampled {:.4g}, certified [{:.4g}, {:.4g}] "
+          "(content to leaves [{:.4g}, {:.4g}] in {} pieces, leaves to content "
+          "[{:.4g}, {:.4g}] in {})\n",
+          tile.uri, tile.declared, d.hausdorff, lower, upper, ab.lower, ab.upper, ab.pieces,
+          ba.lower, ba.upper, ba.pieces);
+    }
     if (d.hausdorff > tile.declared) {
       ++stats.under;
       fmt::print(
@@ -129,6 +204,19 @@ void measure(const fs::path& directory, std::uint32_t samples) {
                100.0 * static_cast<double>(half) / static_cast<double>(r.size()), stats.under,
                stats.notMonotonic);
   }
+  if (certify) {
+    fmt::print(
+        "| depth | certified upper / lower: max | declared / certified upper: min / "
+        "median / max |\n|---|---|---|\n");
+    for (auto& [depth, stats] : levels) {
+      if (stats.bracket.empty()) continue;
+      std::sort(stats.overCertified.begin(), stats.overCertified.end());
+      const std::vector<double>& o = stats.overCertified;
+      fmt::print("| {} | {:.3f} | {:.2f} / {:.2f} / {:.2f} |\n", depth,
+                 *std::max_element(stats.bracket.begin(), stats.bracket.end()), o.front(),
+                 o[o.size() / 2], o.back());
+    }
+  }
   std::fflush(stdout);
 }
 
@@ -137,10 +225,13 @@ void measure(const fs::path& directory, std::uint32_t samples) {
 
 int main(int argc, char** argv) {
   std::uint32_t samples = 100'000;
+  bool certify = false;
   std::vector<std::string> directories;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--samples" && i + 1 < argc)
+    if (arg == "--certify")
+      certify = true;
+    else if (arg == "--samples" && i + 1 < argc)
       samples = static_cast<std::uint32_t>(std::stoul(argv[++i]));
     else
       directories.push_back(arg);
@@ -149,5 +240,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: bench_tile_error [--samples N] TILESET_DIR...\n");
     return 2;
   }
-  for (const std::string& d : directories) lodforge::measure(d, samples);
+  for (const std::string& d : directories) lodforge::measure(d, samples, certify);
 }

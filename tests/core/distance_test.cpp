@@ -133,6 +133,31 @@ TEST(FarthestDistance, EqualsTheBruteForceFarthestOfRandomPoints) {
   EXPECT_TRUE(std::isinf(farthestDistance(points, positions, {})));
 }
 
+TEST(NearestTriangles, FindsTheBruteForceNearestTriangleOfRandomPoints) {
+  // A wavy surface and 500 random points in and far around it: the distance equals the
+  // brute-force nearest over every triangle, and the triangle it names is at that distance.
+  Random random(29);
+  std::vector<Vec3f> positions;
+  std::vector<std::uint32_t> indices;
+  plane(12, 5, 0, positions, indices);
+  for (Vec3f& p : positions) p.z = float(0.3 * std::cos(3 * p.x) * std::sin(2 * p.y));
+  const NearestTriangles nearest(positions, indices);
+  const auto distanceTo = [&](Vec3d p, std::size_t t) {
+    return pointTriangleDistanceSquared(p, toDouble(positions[indices[3 * t]]),
+                                        toDouble(positions[indices[3 * t + 1]]),
+                                        toDouble(positions[indices[3 * t + 2]]));
+  };
+  for (int i = 0; i < 500; ++i) {
+    const Vec3d p{random.uniform(-4, 9), random.uniform(-4, 9), random.uniform(-3, 3)};
+    double want = std::numeric_limits<double>::max();
+    for (std::size_t t = 0; t < indices.size() / 3; ++t) want = std::min(want, distanceTo(p, t));
+    std::uint32_t triangle = ~0u;
+    EXPECT_DOUBLE_EQ(nearest.nearestSquared(p, triangle), want);
+    ASSERT_LT(triangle, indices.size() / 3);
+    EXPECT_DOUBLE_EQ(distanceTo(p, triangle), want);
+  }
+}
+
 TEST(SampledHausdorff, EqualsTheFullMeasureOnRandomSurfaces) {
   // The early-ending searches must give exactly the maximum the full measure finds, on rough
   // surfaces partly beside each other, with and without corner samples.

@@ -72,7 +72,7 @@ Vec3d closestPointWeights(Vec3d p, Vec3d a, Vec3d b, Vec3d c) {
   return {1 - v - w, v, w};
 }
 
-namespace {
+namespace detail {
 
 // Triangles bucketed by the cells their bounding boxes touch; queries search growing shells of
 // cells until no closer triangle can exist.
@@ -251,6 +251,22 @@ class TriangleGrid {
   int dims_[3] = {1, 1, 1};
   std::vector<std::uint32_t> start_, items_;
 };
+
+}  // namespace detail
+
+NearestTriangles::NearestTriangles(std::span<const Vec3f> positions,
+                                   std::span<const std::uint32_t> indices)
+    : grid_(std::make_unique<detail::TriangleGrid>(positions, indices)) {}
+
+NearestTriangles::~NearestTriangles() = default;
+
+double NearestTriangles::nearestSquared(Vec3d p, std::uint32_t& triangle) const {
+  return grid_->nearestSquared(p, -1, &triangle);
+}
+
+namespace {
+
+using detail::TriangleGrid;
 
 // Area-uniform sample points on a mesh.
 std::vector<Vec3d> samplePoints(std::span<const Vec3f> positions,

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 
 #include "lodforge/core/math.h"
@@ -22,6 +23,26 @@ struct SurfaceDistance {
   double maxAB = 0, maxBA = 0;  // each direction's largest: hausdorff is the larger
   // Where each direction's largest is: the sample of A farthest from B, of B farthest from A.
   Vec3d farthestOnA, farthestOnB;
+};
+
+namespace detail {
+class TriangleGrid;
+}
+
+// The nearest triangle of one mesh to any point: the uniform grid surfaceDistance searches.
+// The mesh's arrays must outlive it.
+class NearestTriangles {
+ public:
+  NearestTriangles(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices);
+  ~NearestTriangles();
+  NearestTriangles(const NearestTriangles&) = delete;
+  NearestTriangles& operator=(const NearestTriangles&) = delete;
+  // The squared distance from p to the mesh (which must have a triangle); the nearest triangle
+  // goes to `triangle`.
+  double nearestSquared(Vec3d p, std::uint32_t& triangle) const;
+
+ private:
+  std::unique_ptr<detail::TriangleGrid> grid_;
 };
 
 // Distance between surfaces A and B: `samplesPerMesh` points spread over each surface by area

@@ -235,6 +235,31 @@ TEST(GltfRead, StripsFansSparseAccessorsAndNonIndexedPrimitives) {
   EXPECT_EQ(model->positions[5], (Vec3f{0, 0, 0}));
 }
 
+TEST(GltfRead, PointAndLinePrimitivesAreReportedNotDroppedInSilence) {
+  // The triangle, plus its three corners again as a point primitive and twice as lines (a CAD
+  // export's edges): the triangle is read, and the warnings count what was not.
+  json doc = triangleDocument();
+  doc["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", 0}}}, {"mode", 0}});
+  doc["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", 0}}}, {"mode", 1}});
+  doc["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", 0}}}, {"mode", 3}});
+  std::vector<std::string> warnings;
+  Result<Model> model =
+      readGltfFromMemory(test::bytesOf(makeGlb(doc, triangleBinary())), "edges.glb",
+                         {.allowExternalFiles = false, .warnings = &warnings});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(model->triangleCount(), 1u);
+  EXPECT_EQ(model->vertexCount(), 3u);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_EQ(warnings[0], "edges.glb: 1 point primitive (3 vertices) not read: only triangles are");
+  EXPECT_EQ(warnings[1], "edges.glb: 2 line primitives (6 vertices) not read: only triangles are");
+  // Triangles alone: no warning.
+  warnings.clear();
+  ASSERT_TRUE(readGltfFromMemory(test::bytesOf(makeGlb(triangleDocument(), triangleBinary())),
+                                 "plain.glb", {.allowExternalFiles = false, .warnings = &warnings})
+                  .ok());
+  EXPECT_TRUE(warnings.empty());
+}
+
 TEST(GltfRead, GpuInstancingExpandsIntoObjects) {
   json doc = triangleDocument();
   doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};

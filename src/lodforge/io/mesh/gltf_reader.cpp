@@ -20,7 +20,7 @@ namespace lodforge {
 
 namespace {
 
-constexpr int kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
+constexpr int kModePoints = 0, kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
 using namespace gltf;  // the component types and chunk magics
 // Debian's tinygltf (2.8) sizes the BIN chunk as everything after the JSON chunk, its 8-byte
 // header included, so it copies a buffer up to 8 bytes longer than the chunk from past the end
@@ -117,6 +117,7 @@ class Loader {
     decideColors();
     traverseScene();
     placeAtOrigin();
+    warnSkipped();
     return std::move(model_);
   }
 
@@ -424,7 +425,10 @@ class Loader {
     const auto& primitive = mesh.primitives[p];
     const std::string where = fmt::format("mesh {} primitive {}", meshIndex, p);
     const int mode = primitive.mode < 0 ? kModeTriangles : primitive.mode;
-    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) return;  // points, lines
+    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
+      skip(primitive, mode);
+      return;
+    }
     PrimitiveData data = primitive.extensions.count("KHR_draco_mesh_compression")
                              ? decodeDraco(primitive, where)
                              : readPrimitive(primitive, mode, where);
@@ -442,6 +446,28 @@ class Loader {
                          vertexCount));
       if (mirrored) std::swap(b, c);
       model_.indices.insert(model_.indices.end(), {base + a, base + b, base + c});
+    }
+  }
+
+  // Points and lines (a CAD export's edges, a scan's stray points) are not surfaces: they are
+  // counted, per placed instance, and reported, not dropped in silence.
+  void skip(const tinygltf::Primitive& primitive, int mode) {
+    Skipped& skipped = mode == kModePoints ? skippedPoints_ : skippedLines_;
+    ++skipped.primitives;
+    const auto position = primitive.attributes.find("POSITION");
+    if (position != primitive.attributes.end() && position->second >= 0 &&
+        static_cast<std::size_t>(position->second) < gltf_.accessors.size())
+      skipped.vertices += gltf_.accessors[static_cast<std::size_t>(position->second)].count;
+  }
+
+  void warnSkipped() const {
+    if (warnings_ == nullptr) return;
+    for (const auto& [skipped, kind] :
+         {std::pair{&skippedPoints_, "point"}, std::pair{&skippedLines_, "line"}}) {
+      if (skipped->primitives == 0) continue;
+      warnings_->push_back(fmt::format(
+          "{}: {} {} primitive{} ({} vertices) not read: only triangles are", name_,
+          skipped->primitives, kind, skipped->primitives == 1 ? "" : "s", skipped->vertices));
     }
   }
 
@@ -665,6 +691,10 @@ class Loader {
   std::uint64_t binOffset_;
   std::string baseDir_;  // where external images lie; empty: none may be read
   std::vector<std::string>* warnings_;
+  struct Skipped {
+    std::uint64_t primitives = 0, vertices = 0;
+  };
+  Skipped skippedPoints_, skippedLines_;
   GltfTexturing texturing_;
   Model model_;
   std::vector<Vec3d> world_;

@@ -19,7 +19,8 @@ struct GltfReadOptions {
   // Load buffers named by relative URIs beside the file. Off for untrusted in-memory input.
   bool allowExternalFiles = true;
   // What was read with a loss: a texture image missing or unreadable (its material then draws
-  // without it), a textured primitive without texture coordinates.
+  // without it), a textured primitive without texture coordinates, point and line primitives
+  // (not read: counted, with their vertices).
   std::vector<std::string>* warnings = nullptr;
 };
 

@@ -149,6 +149,21 @@ TEST(AssimpRead, OffQuadsBecomeTriangles) {
   EXPECT_EQ(model->objects[0].material, kNoMaterial);
 }
 
+TEST(AssimpRead, PointAndLineFacesAreReportedNotDroppedInSilence) {
+  // An OFF square (two triangles) with a two-corner face (an edge) and a one-corner face.
+  test::TempDir dir;
+  test::writeFile(dir.file("edges.off"),
+                  "OFF\n4 4 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n2 0 2\n1 3\n");
+  std::vector<std::string> warnings;
+  ReadOptions options;
+  options.warnings = &warnings;
+  Result<Model> model = readModel(dir.file("edges.off"), options);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(model->triangleCount(), 2u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("2 point and line faces not read"), std::string::npos) << warnings[0];
+}
+
 // Files assimp cannot read are bad input naming the file; a scene without triangles too.
 TEST(AssimpRead, BadFilesAreBadInputNamingTheFile) {
   test::TempDir dir;

@@ -91,6 +91,25 @@ TEST(ObjRead, MaterialDiffuseColourBecomesVertexColour) {
   EXPECT_EQ(model->colors[i[3]], (Rgba8{0, 0, 255, 255}));
 }
 
+TEST(ObjRead, LinesAndPointsBesideFacesAreReportedNotDroppedInSilence) {
+  test::TempDir dir;
+  test::writeFile(dir.file("edges.obj"),
+                  "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\nl 1 2 3\nl 3 4\np 2\n");
+  std::vector<std::string> warnings;
+  Result<Model> model = readObj(dir.file("edges.obj"), &warnings);
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(model->triangleCount(), 2u);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("2 line elements (5 vertices) and 1 points not read"),
+            std::string::npos)
+      << warnings[0];
+  // Faces alone: no warning.
+  test::writeFile(dir.file("plain.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n");
+  warnings.clear();
+  ASSERT_TRUE(readObj(dir.file("plain.obj"), &warnings).ok());
+  EXPECT_TRUE(warnings.empty());
+}
+
 TEST(ObjRoundTrip, WriterOutputReadsBack) {
   Result<Model> bunny = readObj(test::dataPath("meshes/stanford-bunny.obj"));
   ASSERT_TRUE(bunny.ok());

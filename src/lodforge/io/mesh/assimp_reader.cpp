@@ -118,6 +118,9 @@ class SceneConverter {
     if (model_.triangleCount() == 0)
       return badInput(path_, "the scene holds no triangles (only points, lines or nothing)");
     placeAtOrigin();
+    if (warnings_ != nullptr && skippedFaces_ > 0)
+      warnings_->push_back(fmt::format("{}: {} point and line faces not read: only triangles are",
+                                       path_, skippedFaces_));
     return std::move(model_);
   }
 
@@ -170,6 +173,11 @@ class SceneConverter {
                  const Mat4d& world) {
     if (meshIndex >= scene_.mNumMeshes) return;
     const aiMesh& mesh = *scene_.mMeshes[meshIndex];
+    // SortByPType gave points and lines meshes of their own: not surfaces, counted.
+    if ((mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) {
+      skippedFaces_ += mesh.mNumFaces;
+      return;
+    }
     ModelBuilder builder(model_);
     builder.beginObject(name, path);
     const std::uint32_t material =
@@ -207,7 +215,10 @@ class SceneConverter {
     }
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines (triangulated before)
+      if (face.mNumIndices != 3) {  // points and lines (triangulated before): counted
+        ++skippedFaces_;
+        continue;
+      }
       std::uint32_t a = face.mIndices[0], b = face.mIndices[1], c = face.mIndices[2];
       if (std::max({a, b, c}) >= mesh.mNumVertices) continue;  // validated by assimp
       if (mirrored) std::swap(b, c);
@@ -241,6 +252,7 @@ class SceneConverter {
   std::vector<Vec3f> normals_;
   std::vector<std::uint32_t> materialOf_;  // a scene material's index in the model's, or none
   std::vector<std::string>* warnings_;
+  std::uint64_t skippedFaces_ = 0;  // per placed instance
   AssimpTexturing texturing_;
   bool withColors_ = false;
   bool withUvs_ = false;
@@ -262,8 +274,6 @@ Result<Model> import(const std::string& name, std::vector<std::string>* warnings
   try {
     Assimp::Importer importer;
     importer.SetProgressHandler(new CancelOnInterrupt);  // the importer owns and deletes it
-    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                                aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const aiScene* scene =
         read(importer, aiProcess_Triangulate | aiProcess_SortByPType |
                            aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure);

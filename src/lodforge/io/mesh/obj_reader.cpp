@@ -341,6 +341,23 @@ std::vector<std::string> textureDirectories(std::string_view text, const std::st
   return directories;
 }
 
+// Line (l) and point (p) elements beside faces are not surfaces: counted and reported, not
+// dropped in silence. (A file of vertices without faces is read as a point set instead.)
+void warnLinesAndPoints(const std::vector<tinyobj::shape_t>& shapes, const std::string& name,
+                        std::vector<std::string>* warnings) {
+  std::uint64_t lines = 0, lineVertices = 0, points = 0;
+  for (const tinyobj::shape_t& shape : shapes) {
+    lines += shape.lines.num_line_vertices.size();
+    lineVertices += shape.lines.indices.size();
+    points += shape.points.indices.size();
+  }
+  if (warnings == nullptr || lines + points == 0) return;
+  warnings->push_back(
+      fmt::format("{}: {} line elements ({} vertices) and {} points not read: "
+                  "only faces are",
+                  name, lines, lineVertices, points));
+}
+
 Result<Model> build(const std::string& text, const std::string& name, const std::string& baseDir,
                     std::vector<std::string>* warnings) {
   LODFORGE_TRY(checkCoordinates(text, name));
@@ -368,6 +385,7 @@ Result<Model> build(const std::string& text, const std::string& name, const std:
     addVerticesOnly(model, obj->attrib, name);
     return model;
   }
+  warnLinesAndPoints(obj->shapes, name, warnings);
   ModelBuilder builder(model);
   const ObjContext context{*obj, *summary, textures};
   for (std::size_t s = 0; s < obj->shapes.size(); ++s) {

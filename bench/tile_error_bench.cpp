@@ -1,16 +1,19 @@
 // How honest and how tight a mesh tileset's geometric errors are (issue 38), measured from the
-// tileset alone: bench_tile_error [--samples N] TILESET_DIR...
+// tileset alone: bench_tile_error [--samples N] [--certify] TILESET_DIR...
 // Under REPLACE refinement the full-resolution surface a tile stands for is the union of the
 // leaf contents under it. For every tile with content and children, the symmetric Hausdorff
 // distance between its content and that union is measured by dense sampling (N area-uniform
 // points on each side plus every triangle's corner, exact point-to-triangle distances) and
-// compared with its declared geometricError, per level of the tree.
+// compared with its declared geometricError, per level of the tree. --certify adds a bracket of
+// each distance that does not depend on sampling (directedBound).
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -104,8 +107,12 @@ struct Piece {
 };
 
 Bracket directedBound(const Mesh& a, const Mesh& b, double ratio, std::size_t budget) {
-  const NearestTriangles nearest(b.positions, b.indices);
   Bracket out;
+  if (b.indices.empty()) {  // nothing to be near: no finite bound
+    out.lower = out.upper = a.indices.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+    return out;
+  }
+  const NearestTriangles nearest(b.positions, b.indices);
   std::uint32_t f = 0;
   for (const Vec3f& v : a.positions)
     out.lower = std::max(out.lower, std::sqrt(nearest.nearestSquared(toDouble(v), f)));
@@ -173,7 +180,7 @@ void measure(const fs::path& directory, std::uint32_t samples, bool certify) {
       const Bracket ab = directedBound(content, finest, 1.2, budget);
       const Bracket ba = directedBound(finest, content, 1.2, budget);
       const double lower = std::max(ab.lower, ba.lower), upper = std::max(ab.upper, ba.upper);
-      stats.bracket.push_back(upper / lower);
+      stats.bracket.push_back(upper > lower ? upper / lower : 1.0);  // 0 / 0: exact
       stats.overCertified.push_back(tile.declared / upper);
       fmt::print(
           "  {}: declared {:.4g}, sampled {:.4g}, certified [{:.4g}, {:.4g}] "
@@ -237,7 +244,7 @@ int main(int argc, char** argv) {
       directories.push_back(arg);
   }
   if (directories.empty()) {
-    std::fprintf(stderr, "usage: bench_tile_error [--samples N] TILESET_DIR...\n");
+    std::fprintf(stderr, "usage: bench_tile_error [--samples N] [--certify] TILESET_DIR...\n");
     return 2;
   }
   for (const std::string& d : directories) lodforge::measure(d, samples, certify);

@@ -703,17 +703,14 @@ tile_error_section() {
   echo "== tile geometric error: measured (symmetric Hausdorff to the leaves below) / declared"
   local data=${LODFORGE_DATA:-../shared/data}
   [[ -d $data ]] || data=/work/shared/data
-  local sets=()
   for mesh in horse.ply stanford-bunny.obj; do
     "$lodforge" -q tiles "$data/meshes/$mesh" -o "$work/te-${mesh%%.*}"
-    sets+=("$work/te-${mesh%%.*}")
   done
   "$lodforge" -q generate cad --objects 2K -o "$work/te-cad.ply"
   "$lodforge" -q tiles "$work/te-cad.ply" -o "$work/te-cad2k"
   for n in 1M 10M; do
     "$lodforge" -q generate scan --triangles "$n" -o "$work/te-scan.ply"
     "$lodforge" -q tiles "$work/te-scan.ply" -o "$work/te-scan$n"
-    sets+=("$work/te-scan$n")
   done
   build/release/bench/bench_tile_error "$work/te-cad2k" "$work/te-scan10M"
   # With certified brackets (branch and bound; the assembly's flat faces take minutes, left out).

@@ -160,6 +160,10 @@ TEST(AssimpRead, PointAndLineFacesAreReportedNotDroppedInSilence) {
   Result<Model> model = readModel(dir.file("edges.off"), options);
   ASSERT_TRUE(model.ok()) << model.error().message;
   EXPECT_EQ(model->triangleCount(), 2u);
+  ASSERT_EQ(model->objectCount(), 1u);
+  // Named as without the edges: the point and line meshes assimp sorts out are not numbered.
+  EXPECT_EQ(model->objectName(0).find('#'), std::string_view::npos) << model->objectName(0);
+  EXPECT_TRUE(model->colors.empty());
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("2 point and line faces not read"), std::string::npos) << warnings[0];
 }

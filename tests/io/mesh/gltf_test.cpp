@@ -236,12 +236,17 @@ TEST(GltfRead, StripsFansSparseAccessorsAndNonIndexedPrimitives) {
 }
 
 TEST(GltfRead, PointAndLinePrimitivesAreReportedNotDroppedInSilence) {
-  // The triangle, plus its three corners again as a point primitive and twice as lines (a CAD
-  // export's edges): the triangle is read, and the warnings count what was not.
+  // The triangle, plus its three corners again as a point primitive and as a line strip, and
+  // two of them as an indexed loop (a CAD export's edges share the faces' vertices): the
+  // triangle is read, and the warnings count the corners that were not.
   json doc = triangleDocument();
   doc["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", 0}}}, {"mode", 0}});
   doc["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", 0}}}, {"mode", 1}});
-  doc["meshes"][0]["primitives"].push_back({{"attributes", {{"POSITION", 0}}}, {"mode", 3}});
+  doc["meshes"][0]["primitives"].push_back(
+      {{"attributes", {{"POSITION", 0}}}, {"mode", 3}, {"indices", 2}});  // 2 of the 3 corners
+  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 4}});
+  doc["accessors"].push_back(
+      {{"bufferView", 2}, {"componentType", 5123}, {"count", 2}, {"type", "SCALAR"}});
   std::vector<std::string> warnings;
   Result<Model> model =
       readGltfFromMemory(test::bytesOf(makeGlb(doc, triangleBinary())), "edges.glb",
@@ -250,8 +255,8 @@ TEST(GltfRead, PointAndLinePrimitivesAreReportedNotDroppedInSilence) {
   EXPECT_EQ(model->triangleCount(), 1u);
   EXPECT_EQ(model->vertexCount(), 3u);
   ASSERT_EQ(warnings.size(), 2u);
-  EXPECT_EQ(warnings[0], "edges.glb: 1 point primitive (3 vertices) not read: only triangles are");
-  EXPECT_EQ(warnings[1], "edges.glb: 2 line primitives (6 vertices) not read: only triangles are");
+  EXPECT_EQ(warnings[0], "edges.glb: 1 point primitive (3 corners) not read: only triangles are");
+  EXPECT_EQ(warnings[1], "edges.glb: 2 line primitives (5 corners) not read: only triangles are");
   // Triangles alone: no warning.
   warnings.clear();
   ASSERT_TRUE(readGltfFromMemory(test::bytesOf(makeGlb(triangleDocument(), triangleBinary())),

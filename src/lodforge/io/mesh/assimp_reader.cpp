@@ -110,9 +110,11 @@ class SceneConverter {
       texturing_ = readAssimpTextures(scene_, materialOf_, path_, model_, warnings_);
     withUvs_ = std::any_of(texturing_.uvChannel.begin(), texturing_.uvChannel.end(),
                            [](int channel) { return channel >= 0; });
-    withColors_ = !model_.materials.empty() ||
-                  std::any_of(scene_.mMeshes, scene_.mMeshes + scene_.mNumMeshes,
-                              [](const aiMesh* mesh) { return mesh->HasVertexColors(0); });
+    withColors_ =
+        !model_.materials.empty() ||
+        std::any_of(scene_.mMeshes, scene_.mMeshes + scene_.mNumMeshes, [](const aiMesh* mesh) {
+          return hasTriangles(*mesh) && mesh->HasVertexColors(0);
+        });
     walk();
     if (!problem_.empty()) return badInput(path_, problem_);
     if (model_.triangleCount() == 0)
@@ -156,28 +158,43 @@ class SceneConverter {
       const std::string name =
           node.mName.length > 0 ? node.mName.C_Str() : fmt::format("node {}", visited);
       ++visited;
-      const bool container = &node == scene_.mRootNode && node.mNumMeshes == 0;
+      const std::vector<unsigned> surfaces = surfaceMeshes(node);
+      const bool container = &node == scene_.mRootNode && surfaces.empty();
       const std::string path = container            ? std::string{}
                                : visit.path.empty() ? name
                                                     : visit.path + "/" + name;
-      for (unsigned k = 0; k < node.mNumMeshes; ++k) {
-        const std::string suffix = node.mNumMeshes > 1 ? fmt::format("#{}", k) : std::string{};
-        addObject(name + suffix, path + suffix, node.mMeshes[k], world);
+      for (std::size_t k = 0; k < surfaces.size(); ++k) {
+        const std::string suffix = surfaces.size() > 1 ? fmt::format("#{}", k) : std::string{};
+        addObject(name + suffix, path + suffix, surfaces[k], world);
       }
       for (unsigned c = node.mNumChildren; c-- > 0;)
         stack.push_back({node.mChildren[c], world, path});
     }
   }
 
+  // The node's meshes with triangles, in order. SortByPType gave points and lines meshes of
+  // their own: they are not surfaces, and are counted (numbering skips them, as when assimp
+  // removed them).
+  std::vector<unsigned> surfaceMeshes(const aiNode& node) {
+    std::vector<unsigned> surfaces;
+    for (unsigned k = 0; k < node.mNumMeshes; ++k) {
+      const unsigned m = node.mMeshes[k];
+      if (m >= scene_.mNumMeshes) continue;
+      if (hasTriangles(*scene_.mMeshes[m]))
+        surfaces.push_back(m);
+      else
+        skippedFaces_ += scene_.mMeshes[m]->mNumFaces;
+    }
+    return surfaces;
+  }
+  static bool hasTriangles(const aiMesh& mesh) {
+    return (mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) != 0;
+  }
+
   void addObject(const std::string& name, const std::string& path, unsigned meshIndex,
                  const Mat4d& world) {
     if (meshIndex >= scene_.mNumMeshes) return;
     const aiMesh& mesh = *scene_.mMeshes[meshIndex];
-    // SortByPType gave points and lines meshes of their own: not surfaces, counted.
-    if ((mesh.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) {
-      skippedFaces_ += mesh.mNumFaces;
-      return;
-    }
     ModelBuilder builder(model_);
     builder.beginObject(name, path);
     const std::uint32_t material =

@@ -425,6 +425,8 @@ class Loader {
     const auto& primitive = mesh.primitives[p];
     const std::string where = fmt::format("mesh {} primitive {}", meshIndex, p);
     const int mode = primitive.mode < 0 ? kModeTriangles : primitive.mode;
+    if (mode < kModePoints || mode > kModeFan)
+      fail(fmt::format("{}: mode {} is no glTF primitive mode", where, mode));
     if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
       skip(primitive, mode);
       return;
@@ -451,13 +453,18 @@ class Loader {
 
   // Points and lines (a CAD export's edges, a scan's stray points) are not surfaces: they are
   // counted, per placed instance, and reported, not dropped in silence.
+  // What is lost is what the primitive draws: its indices (edges often share the faces'
+  // vertices), or its vertices when it has none.
   void skip(const tinygltf::Primitive& primitive, int mode) {
     Skipped& skipped = mode == kModePoints ? skippedPoints_ : skippedLines_;
     ++skipped.primitives;
-    const auto position = primitive.attributes.find("POSITION");
-    if (position != primitive.attributes.end() && position->second >= 0 &&
-        static_cast<std::size_t>(position->second) < gltf_.accessors.size())
-      skipped.vertices += gltf_.accessors[static_cast<std::size_t>(position->second)].count;
+    int accessor = primitive.indices;
+    if (accessor < 0) {
+      const auto position = primitive.attributes.find("POSITION");
+      if (position != primitive.attributes.end()) accessor = position->second;
+    }
+    if (accessor >= 0 && static_cast<std::size_t>(accessor) < gltf_.accessors.size())
+      skipped.vertices += gltf_.accessors[static_cast<std::size_t>(accessor)].count;
   }
 
   void warnSkipped() const {
@@ -466,7 +473,7 @@ class Loader {
          {std::pair{&skippedPoints_, "point"}, std::pair{&skippedLines_, "line"}}) {
       if (skipped->primitives == 0) continue;
       warnings_->push_back(fmt::format(
-          "{}: {} {} primitive{} ({} vertices) not read: only triangles are", name_,
+          "{}: {} {} primitive{} ({} corners) not read: only triangles are", name_,
           skipped->primitives, kind, skipped->primitives == 1 ? "" : "s", skipped->vertices));
     }
   }

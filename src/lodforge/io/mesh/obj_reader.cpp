@@ -8,6 +8,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tiny_obj_loader.h>
 
 #include "lodforge/core/file.h"
@@ -341,21 +343,30 @@ std::vector<std::string> textureDirectories(std::string_view text, const std::st
   return directories;
 }
 
-// Line (l) and point (p) elements beside faces are not surfaces: counted and reported, not
+// Line (l) and point (p) elements beside faces are not surfaces: counted from the text (as
+// tinyobjloader regroups them, its shapes neither keep nor count them all) and reported, not
 // dropped in silence. (A file of vertices without faces is read as a point set instead.)
-void warnLinesAndPoints(const std::vector<tinyobj::shape_t>& shapes, const std::string& name,
+void warnLinesAndPoints(std::string_view text, const std::string& name,
                         std::vector<std::string>* warnings) {
+  if (warnings == nullptr) return;
   std::uint64_t lines = 0, lineVertices = 0, points = 0;
-  for (const tinyobj::shape_t& shape : shapes) {
-    lines += shape.lines.num_line_vertices.size();
-    lineVertices += shape.lines.indices.size();
-    points += shape.points.indices.size();
-  }
-  if (warnings == nullptr || lines + points == 0) return;
+  forEachLine(text, [&](std::uint64_t, const std::vector<std::string_view>& words) {
+    if (!words.empty() && words[0] == "l") {
+      ++lines;
+      lineVertices += words.size() - 1;
+    } else if (!words.empty() && words[0] == "p") {
+      points += words.size() - 1;
+    }
+    return true;
+  });
+  std::vector<std::string> parts;
+  if (lines > 0)
+    parts.push_back(
+        fmt::format("{} line element{} ({} vertices)", lines, lines == 1 ? "" : "s", lineVertices));
+  if (points > 0) parts.push_back(fmt::format("{} point{}", points, points == 1 ? "" : "s"));
+  if (parts.empty()) return;
   warnings->push_back(
-      fmt::format("{}: {} line elements ({} vertices) and {} points not read: "
-                  "only faces are",
-                  name, lines, lineVertices, points));
+      fmt::format("{}: {} not read: only faces are", name, fmt::join(parts, " and ")));
 }
 
 Result<Model> build(const std::string& text, const std::string& name, const std::string& baseDir,
@@ -385,7 +396,7 @@ Result<Model> build(const std::string& text, const std::string& name, const std:
     addVerticesOnly(model, obj->attrib, name);
     return model;
   }
-  warnLinesAndPoints(obj->shapes, name, warnings);
+  warnLinesAndPoints(text, name, warnings);
   ModelBuilder builder(model);
   const ObjContext context{*obj, *summary, textures};
   for (std::size_t s = 0; s < obj->shapes.size(); ++s) {

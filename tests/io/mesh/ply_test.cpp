@@ -181,7 +181,7 @@ TEST(PlyRead, EveryFormatAndScalarTypeGivesTheSameMesh) {
   }
 }
 
-TEST(PlyRead, AnyPropertyOrderExtraPropertiesAndElementsAreSkipped) {
+TEST(PlyRead, AnyPropertyOrderExtraPropertiesAndElementsAreSkippedWithAWarning) {
   for (PlyFormat format : {PlyFormat::kAscii, PlyFormat::kBinaryBigEndian}) {
     // Hand-encoded: shuffled vertex properties (one a list), an unknown element before the faces,
     // and unknown face properties around the index list.
@@ -216,11 +216,16 @@ TEST(PlyRead, AnyPropertyOrderExtraPropertiesAndElementsAreSkipped) {
       encodeValue(text, format, PlyType::kFloat32, 0.25);
       if (format == PlyFormat::kAscii) text += "\n";
     }
-    Result<Model> model = readPlyText(text);
+    std::vector<std::string> warnings;
+    PlyReadOptions options;
+    options.warnings = &warnings;
+    Result<Model> model = readPlyFromMemory(test::bytesOf(text), "test.ply", options);
     ASSERT_TRUE(model.ok()) << model.error().message;
     ASSERT_EQ(model->vertexCount(), 3u);
     EXPECT_EQ(model->positions[1], (Vec3f{4, 5, 6}));
     EXPECT_EQ(model->indices, (std::vector<std::uint32_t>{2, 1, 0}));
+    // The skipped element is named, not dropped in silence.
+    EXPECT_EQ(warnings, (std::vector<std::string>{"test.ply: element not read: 'edge' (1)"}));
   }
 }
 

@@ -451,10 +451,9 @@ class Loader {
     }
   }
 
-  // Points and lines (a CAD export's edges, a scan's stray points) are not surfaces: they are
-  // counted, per placed instance, and reported, not dropped in silence.
-  // What is lost is what the primitive draws: its indices (edges often share the faces'
-  // vertices), or its vertices when it has none.
+  // Points and lines (a CAD export's edges, a scan's stray points) are not surfaces: counted per
+  // placed instance and reported, not dropped in silence. What is lost is the corners the
+  // primitive draws: its indices (edges often share the faces' vertices), else its vertices.
   void skip(const tinygltf::Primitive& primitive, int mode) {
     Skipped& skipped = mode == kModePoints ? skippedPoints_ : skippedLines_;
     ++skipped.primitives;

@@ -20,7 +20,7 @@ struct GltfReadOptions {
   bool allowExternalFiles = true;
   // What was read with a loss: a texture image missing or unreadable (its material then draws
   // without it), a textured primitive without texture coordinates, point and line primitives
-  // (not read: counted, with their vertices).
+  // (not read: counted, with the corners they draw).
   std::vector<std::string>* warnings = nullptr;
 };
 

@@ -43,11 +43,26 @@ void forEachLine(std::string_view text, Fn&& fn) {
   }
 }
 
+// Line (l) and point (p) elements: not surfaces, and tinyobjloader's shapes neither keep nor
+// count them all (it drops an edges-only group at the next `g` and repeats lines at each
+// `usemtl`), so they are counted from the text.
+struct NonFaceElements {
+  std::uint64_t lines = 0, lineVertices = 0, points = 0;
+};
+
 // tinyobjloader reads an unparseable number ("nan", "1e999", "abc") as 0 without a word, so the
-// coordinates are checked here first: bad input must fail loudly, not become a vertex at 0.
-Status checkCoordinates(std::string_view text, const std::string& name) {
+// coordinates are checked here first: bad input must fail loudly, not become a vertex at 0. The
+// same pass counts the line and point elements.
+Result<NonFaceElements> checkCoordinates(std::string_view text, const std::string& name) {
   Status status;
+  NonFaceElements counted;
   forEachLine(text, [&](std::uint64_t line, const std::vector<std::string_view>& words) {
+    if (!words.empty() && words[0] == "l") {
+      ++counted.lines;
+      counted.lineVertices += words.size() - 1;
+    } else if (!words.empty() && words[0] == "p") {
+      counted.points += words.size() - 1;
+    }
     if (words.empty() || (words[0] != "v" && words[0] != "vn" && words[0] != "vt")) return true;
     const bool texture = words[0] == "vt";
     if (words.size() < (texture ? 2u : 4u)) {
@@ -70,7 +85,8 @@ Status checkCoordinates(std::string_view text, const std::string& name) {
     }
     return true;
   });
-  return status;
+  if (!status.ok()) return status;
+  return counted;
 }
 
 // The line of the n-th face tinyobjloader kept (it drops faces with fewer than 3 corners).
@@ -343,35 +359,25 @@ std::vector<std::string> textureDirectories(std::string_view text, const std::st
   return directories;
 }
 
-// Line (l) and point (p) elements beside faces are not surfaces: counted from the text (as
-// tinyobjloader regroups them, its shapes neither keep nor count them all) and reported, not
-// dropped in silence. (A file of vertices without faces is read as a point set instead.)
-void warnLinesAndPoints(std::string_view text, const std::string& name,
+// Line and point elements beside faces are reported, not dropped in silence. (A file of
+// vertices without faces is read as a point set instead.)
+void warnLinesAndPoints(const NonFaceElements& counted, const std::string& name,
                         std::vector<std::string>* warnings) {
-  if (warnings == nullptr) return;
-  std::uint64_t lines = 0, lineVertices = 0, points = 0;
-  forEachLine(text, [&](std::uint64_t, const std::vector<std::string_view>& words) {
-    if (!words.empty() && words[0] == "l") {
-      ++lines;
-      lineVertices += words.size() - 1;
-    } else if (!words.empty() && words[0] == "p") {
-      points += words.size() - 1;
-    }
-    return true;
-  });
   std::vector<std::string> parts;
-  if (lines > 0)
-    parts.push_back(
-        fmt::format("{} line element{} ({} vertices)", lines, lines == 1 ? "" : "s", lineVertices));
-  if (points > 0) parts.push_back(fmt::format("{} point{}", points, points == 1 ? "" : "s"));
-  if (parts.empty()) return;
+  if (counted.lines > 0)
+    parts.push_back(fmt::format("{} line element{} ({} vertices)", counted.lines,
+                                counted.lines == 1 ? "" : "s", counted.lineVertices));
+  if (counted.points > 0)
+    parts.push_back(fmt::format("{} point{}", counted.points, counted.points == 1 ? "" : "s"));
+  if (warnings == nullptr || parts.empty()) return;
   warnings->push_back(
       fmt::format("{}: {} not read: only faces are", name, fmt::join(parts, " and ")));
 }
 
 Result<Model> build(const std::string& text, const std::string& name, const std::string& baseDir,
                     std::vector<std::string>* warnings) {
-  LODFORGE_TRY(checkCoordinates(text, name));
+  Result<NonFaceElements> nonFaces = checkCoordinates(text, name);
+  if (!nonFaces) return nonFaces.status();
   Result<ParsedObj> obj = parseObj(text, name, baseDir);
   if (!obj) return obj.status();
   Model model;
@@ -396,7 +402,7 @@ Result<Model> build(const std::string& text, const std::string& name, const std:
     addVerticesOnly(model, obj->attrib, name);
     return model;
   }
-  warnLinesAndPoints(text, name, warnings);
+  warnLinesAndPoints(*nonFaces, name, warnings);
   ModelBuilder builder(model);
   const ObjContext context{*obj, *summary, textures};
   for (std::size_t s = 0; s < obj->shapes.size(); ++s) {

@@ -215,12 +215,15 @@ Result<BuildStats> buildPackage(const std::string& input, const std::string& out
     return stats;
   };
   ObjectStreamOptions streamOptions{options.read, false};
+  std::vector<std::string>* warnings = options.read.warnings;
+  const std::size_t warned = warnings != nullptr ? warnings->size() : 0;
   Result<std::unique_ptr<ObjectStream>> stream = openObjectStream(input, streamOptions);
   if (!stream) return stream.status();
   Result<BuildStats> stats = build(input, **stream, output, options);
   if (stats.ok() || stats.error().kind != ErrorKind::kUnsupported) return timed(std::move(stats));
   // The PLY's objects are not grouped: load it whole instead of streaming (objects get grouped
-  // by the reader), as long as it fits.
+  // by the reader), as long as it fits. The whole read warns again about what it sees.
+  if (warnings != nullptr) warnings->resize(warned);
   streamOptions.load = true;
   stream = openObjectStream(input, streamOptions);
   if (!stream) return stream.status();

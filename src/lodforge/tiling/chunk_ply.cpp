@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <limits>
 #include <mutex>
+#include <optional>
+#include <string>
 #include <unordered_map>
 
 #include <tbb/parallel_pipeline.h>
@@ -119,6 +121,8 @@ Status PlyChunking::openVertices() {
   vertices_ = std::move(*vertices);
   header_ = vertices_->header();
   if (header_.faceCount == 0) return badInput(path_, "no faces: a tileset needs a mesh");
+  if (std::optional<std::string> unread = unreadPlyElements(header_, path_))
+    input_.warnings.push_back(std::move(*unread));
   input_.colors = header_.hasColors;
   if (plyTextured(header_)) {
     PlyTextures textures = readPlyTextures(header_, path_, &input_.warnings);

@@ -1,6 +1,8 @@
 #include "lodforge/io/mesh/object_stream.h"
 
 #include <algorithm>
+#include <optional>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -72,6 +74,8 @@ class GroupedPlyStream final : public ObjectStream {
     if (!vertices) return vertices.status();
     Result<PlyReader> faces = PlyReader::open(path, faceOptions);
     if (!faces) return faces.status();
+    std::optional<std::string> unread = unreadPlyElements(vertices->header(), path);
+    if (unread && read.warnings != nullptr) read.warnings->push_back(std::move(*unread));
     auto stream = std::unique_ptr<GroupedPlyStream>(
         new GroupedPlyStream(path, std::move(vertices.value()), std::move(faces.value())));
     LODFORGE_TRY(stream->readVertices());  // the first batch decides the origin

@@ -5,9 +5,12 @@
 #include <charconv>
 #include <limits>
 #include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 namespace lodforge {
 
@@ -356,6 +359,17 @@ void checkPlyCountsFitFile(const PlyHeader& header, std::uint64_t fileSize,
     }
     needed += e.count * minBytes;
   }
+}
+
+std::optional<std::string> unreadPlyElements(const PlyHeader& header, const std::string& name) {
+  std::vector<std::string> skipped;
+  for (const PlyElement& e : header.elements) {
+    if (e.count > 0 && e.name != "vertex" && e.name != "face" && e.name != "tristrips")
+      skipped.push_back(fmt::format("'{}' ({})", e.name, e.count));
+  }
+  if (skipped.empty()) return std::nullopt;
+  return fmt::format("{}: element{} not read: {}", name, skipped.size() == 1 ? "" : "s",
+                     fmt::join(skipped, ", "));
 }
 
 }  // namespace lodforge

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -103,6 +104,10 @@ PlyHeader parsePlyHeader(ByteSource& source, std::uint64_t& lineNumber);
 // allocated.
 void checkPlyCountsFitFile(const PlyHeader& header, std::uint64_t fileSize,
                            const std::string& name);
+
+// Elements other than vertex, face and tristrips (edges, materials, a tool's own) are not read:
+// a warning naming them with their counts ("x.ply: element not read: 'edge' (12)"), or nothing.
+std::optional<std::string> unreadPlyElements(const PlyHeader& header, const std::string& name);
 
 // Which property is what. Fills the header's counts and flags, and with `readExtras` its extras
 // (the vertex's other scalar properties); a face's object id is the first scalar property named

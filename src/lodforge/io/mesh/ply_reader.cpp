@@ -4,7 +4,6 @@
 #include <filesystem>
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
@@ -240,25 +239,11 @@ void dropMissingVertices(Gathered& g) {
   if (!g.cornerUvs.empty()) g.cornerUvs.resize(3 * kept);
 }
 
-// Elements other than vertex, face and tristrips (edges, materials, a tool's own) are not
-// read: named with their counts, not skipped in silence.
-void warnSkippedElements(const PlyHeader& header, const std::string& name,
-                         std::vector<std::string>* warnings) {
-  if (warnings == nullptr) return;
-  std::vector<std::string> skipped;
-  for (const PlyElement& e : header.elements) {
-    if (e.count > 0 && e.name != "vertex" && e.name != "face" && e.name != "tristrips")
-      skipped.push_back(fmt::format("'{}' ({})", e.name, e.count));
-  }
-  if (!skipped.empty())
-    warnings->push_back(fmt::format("{}: element{} not read: {}", name,
-                                    skipped.size() == 1 ? "" : "s", fmt::join(skipped, ", ")));
-}
-
 Result<Model> readAll(PlyReader& reader, const std::string& name,
                       std::vector<std::string>* warnings) {
   const PlyHeader& header = reader.header();
-  warnSkippedElements(header, name, warnings);
+  if (std::optional<std::string> unread = unreadPlyElements(header, name); unread && warnings)
+    warnings->push_back(std::move(*unread));
   Model model;
   Gathered g;
   LODFORGE_TRY(gather(reader, name, model, g));

@@ -1,5 +1,7 @@
 #include "lodforge/io/points/point_reader.h"
 
+#include <optional>
+#include <string>
 #include <variant>
 
 #include "lodforge/core/file.h"
@@ -75,6 +77,8 @@ Result<PointReader> PointReader::open(const std::string& path, const PointReadOp
     info.hasColors = h.hasColors;
     info.extras = h.extras;
     if (!info.extras.fields.empty()) info.attributes |= kAttrExtras;
+    if (std::optional<std::string> unread = unreadPlyElements(h, path))
+      info.warnings.push_back(std::move(*unread));
     return PointReader(std::make_unique<State>(State{std::move(*ply), std::move(info), {}}));
   }
   if (isPointCloudPath(path)) {

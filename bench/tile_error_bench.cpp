@@ -5,7 +5,9 @@
 // distance between its content and that union is measured by dense sampling (N area-uniform
 // points on each side plus every triangle's corner, exact point-to-triangle distances) and
 // compared with its declared geometricError, per level of the tree. --certify adds a bracket of
-// each distance that does not depend on sampling (directedBound).
+// each distance that does not depend on sampling (directedBound). --chain F tries the bound
+// issue 38 proposes for the builder (chainTile): each tile against its children only, with a
+// value per triangle carried up the tree, pieces split to F times the tile's error.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,6 +17,8 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -22,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/distance.h"
+#include "lodforge/core/distance_bound.h"
 #include "lodforge/io/mesh/gltf_reader.h"
 
 namespace lodforge {
@@ -151,6 +156,107 @@ Bracket directedBound(const Mesh& a, const Mesh& b, double ratio, std::size_t bu
   return out;
 }
 
+// Each tile's error bounded level by level with per-triangle values carried up the tree (the
+// triangle inequality applied locally, not to the tile's largest). reach[t]: no point of triangle t
+// is farther than it from the finest surface; cover[t]: every finest point chained to t is within
+// it of t.
+struct Chain {
+  Mesh mesh;
+  std::vector<double> reach, cover;
+};
+
+// Splits each triangle of A into pieces (PieceBounds over B, with B's `carried` values) until the
+// bound is within `tol` of the piece's exact corner values or `cap` pieces were made for the
+// triangle; `visit(t, bound)` gets each final piece of A's triangle t.
+template <class Visit>
+std::size_t chainPieces(const Mesh& a, const Mesh& b, std::span<const double> carried, double tol,
+                        std::size_t cap, Visit visit) {
+  std::size_t pieces = 0;
+  std::vector<std::array<Vec3d, 3>> stack;
+  const PieceBounds bounds(b.positions, b.indices);
+  for (std::size_t t = 0; t + 2 < a.indices.size(); t += 3) {
+    stack.push_back({toDouble(a.positions[a.indices[t]]), toDouble(a.positions[a.indices[t + 1]]),
+                     toDouble(a.positions[a.indices[t + 2]])});
+    std::size_t made = 1;
+    while (!stack.empty()) {
+      const std::array<Vec3d, 3> p = stack.back();
+      stack.pop_back();
+      ++pieces;
+      const PieceBound bound = bounds.bound(p, carried);
+      if (bound.upper - bound.lower > tol && made < cap) {
+        const Vec3d m01 = (p[0] + p[1]) / 2.0, m12 = (p[1] + p[2]) / 2.0, m20 = (p[2] + p[0]) / 2.0;
+        stack.push_back({p[0], m01, m20});
+        stack.push_back({m01, p[1], m12});
+        stack.push_back({m20, m12, p[2]});
+        stack.push_back({m01, m12, m20});
+        made += 3;
+        continue;
+      }
+      visit(t / 3, bound);
+    }
+  }
+  return pieces;
+}
+
+// The tile's chain from its content and its children's chains (concatenated in `below`).
+Chain chainUp(Mesh content, const Chain& below, double tolFraction, std::size_t& pieces) {
+  Chain out;
+  out.mesh = std::move(content);
+  const std::size_t n = out.mesh.indices.size() / 3;
+  out.reach.assign(n, 0);
+  out.cover.assign(n, 0);
+  const double carried = std::max(
+      below.reach.empty() ? 0.0 : *std::max_element(below.reach.begin(), below.reach.end()),
+      below.cover.empty() ? 0.0 : *std::max_element(below.cover.begin(), below.cover.end()));
+  const double sampled = sampledHausdorff(out.mesh.positions, out.mesh.indices,
+                                          below.mesh.positions, below.mesh.indices, 10'000, 1);
+  const double tol = tolFraction * (sampled + carried);
+  const std::size_t cap = 1 << 14;
+  // reach: the tile's pieces through the children's triangles; cover: the children's pieces
+  // through the tile's triangles.
+  pieces += chainPieces(
+      out.mesh, below.mesh, below.reach, tol, cap,
+      [&](std::size_t t, const PieceBound& b) { out.reach[t] = std::max(out.reach[t], b.upper); });
+  // Every finest point chained to a child's piece is within its cover of the piece, and every
+  // point of the piece within `upper` of one of the tile's triangles used.
+  pieces +=
+      chainPieces(below.mesh, out.mesh, {}, tol, cap, [&](std::size_t a, const PieceBound& b) {
+        for (std::uint32_t t : b.used)
+          out.cover[t] = std::max(out.cover[t], b.upper + below.cover[a]);
+      });
+  return out;
+}
+
+// Post order: every tile's chain; `bound[t]` gets the tile's chained error.
+Chain chainTile(Tileset& set, std::size_t t, std::vector<double>& bound, double tolFraction,
+                std::size_t& pieces) {
+  const Tile tile = set.tiles[t];
+  Mesh content;
+  if (!tile.uri.empty()) appendContent(set, tile.uri, content);
+  if (tile.children.empty()) {
+    Chain leaf;
+    leaf.reach.assign(content.indices.size() / 3, 0);
+    leaf.cover = leaf.reach;
+    leaf.mesh = std::move(content);
+    return leaf;
+  }
+  Chain below;
+  for (std::size_t c : tile.children) {
+    Chain child = chainTile(set, c, bound, tolFraction, pieces);
+    const auto base = static_cast<std::uint32_t>(below.mesh.positions.size());
+    below.mesh.positions.insert(below.mesh.positions.end(), child.mesh.positions.begin(),
+                                child.mesh.positions.end());
+    for (std::uint32_t i : child.mesh.indices) below.mesh.indices.push_back(base + i);
+    below.reach.insert(below.reach.end(), child.reach.begin(), child.reach.end());
+    below.cover.insert(below.cover.end(), child.cover.begin(), child.cover.end());
+  }
+  if (tile.uri.empty()) return below;
+  Chain out = chainUp(std::move(content), below, tolFraction, pieces);
+  bound[t] = std::max(*std::max_element(out.reach.begin(), out.reach.end()),
+                      *std::max_element(out.cover.begin(), out.cover.end()));
+  return out;
+}
+
 struct LevelStats {
   std::vector<double> ratios;  // measured / declared
   std::size_t under = 0;       // measured above declared
@@ -158,12 +264,18 @@ struct LevelStats {
   std::vector<double> bracket, overCertified;  // --certify: upper / lower, declared / upper
 };
 
-void measure(const fs::path& directory, std::uint32_t samples, bool certify) {
+void measure(const fs::path& directory, std::uint32_t samples, bool certify, double chainFraction) {
   std::ifstream in(directory / "tileset.json");
   const nlohmann::json json = nlohmann::json::parse(in);
   Tileset set{directory, {}, false, {}};
   addTile(json.at("root"), 0, set);
   std::map<int, LevelStats> levels;
+  std::vector<double> chained(set.tiles.size(), -1);
+  if (chainFraction > 0) {
+    std::size_t pieces = 0;
+    chainTile(set, 0, chained, chainFraction, pieces);
+    fmt::print("chained: {} pieces\n", pieces);
+  }
   for (std::size_t t = 0; t < set.tiles.size(); ++t) {
     const Tile& tile = set.tiles[t];
     LevelStats& stats = levels[tile.depth];
@@ -177,11 +289,14 @@ void measure(const fs::path& directory, std::uint32_t samples, bool certify) {
     stats.ratios.push_back(d.hausdorff / tile.declared);
     if (certify) {
       const std::size_t budget = 64 * (content.indices.size() + finest.indices.size());
-      const Bracket ab = directedBound(content, finest, 1.2, budget);
-      const Bracket ba = directedBound(finest, content, 1.2, budget);
+      const Bracket ab = directedBound(content, finest, 1.05, budget);
+      const Bracket ba = directedBound(finest, content, 1.05, budget);
       const double lower = std::max(ab.lower, ba.lower), upper = std::max(ab.upper, ba.upper);
       stats.bracket.push_back(upper > lower ? upper / lower : 1.0);  // 0 / 0: exact
       stats.overCertified.push_back(tile.declared / upper);
+      if (chained[t] >= 0)
+        fmt::print("  {} chained {:.4g}: / certified upper {:.3f}, / lower {:.3f}\n", tile.uri,
+                   chained[t], chained[t] / upper, chained[t] / lower);
       fmt::print(
           "  {}: declared {:.4g}, sampled {:.4g}, certified [{:.4g}, {:.4g}] "
           "(content to leaves [{:.4g}, {:.4g}] in {} pieces, leaves to content "
@@ -233,19 +348,23 @@ void measure(const fs::path& directory, std::uint32_t samples, bool certify) {
 int main(int argc, char** argv) {
   std::uint32_t samples = 100'000;
   bool certify = false;
+  double chainFraction = 0;
   std::vector<std::string> directories;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--certify")
       certify = true;
+    else if (arg == "--chain" && i + 1 < argc)
+      chainFraction = std::stod(argv[++i]);
     else if (arg == "--samples" && i + 1 < argc)
       samples = static_cast<std::uint32_t>(std::stoul(argv[++i]));
     else
       directories.push_back(arg);
   }
   if (directories.empty()) {
-    std::fprintf(stderr, "usage: bench_tile_error [--samples N] [--certify] TILESET_DIR...\n");
+    std::fprintf(stderr,
+                 "usage: bench_tile_error [--samples N] [--certify] [--chain F] TILESET_DIR...\n");
     return 2;
   }
-  for (const std::string& d : directories) lodforge::measure(d, samples, certify);
+  for (const std::string& d : directories) lodforge::measure(d, samples, certify, chainFraction);
 }

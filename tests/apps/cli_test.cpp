@@ -607,6 +607,27 @@ TEST(CliPoints, BuildsAPackageFromLasAndInfoReportsBoth) {
   EXPECT_EQ(info(dir.file("p.lfc"), dir)["points"], 20'000);
 }
 
+// Our point tiles read back as point sets: info on every tile of a point tileset counts each
+// input point once (every point is in exactly one tile), and no triangles.
+TEST(CliTiles, InfoReadsEveryPointTileAndTheirPointsAddUpToTheCloud) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate points --points 20K -o " + dir.file("p.ply"), dir).code, 0);
+  const Outcome tiles = lodforge(
+      "-q tiles " + dir.file("p.ply") + " --block-size 2K --tile-points 2K -o " + dir.file("t"),
+      dir);
+  ASSERT_EQ(tiles.code, 0) << tiles.err;
+  std::uint64_t points = 0, files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.file("t/tiles"))) {
+    const nlohmann::json j = info(entry.path().string(), dir);
+    EXPECT_EQ(j["triangles"], 0) << entry.path();
+    EXPECT_GT(j["vertices"].get<std::uint64_t>(), 0u) << entry.path();
+    points += j["vertices"].get<std::uint64_t>();
+    ++files;
+  }
+  EXPECT_GT(files, 4u);
+  EXPECT_EQ(points, 20'000u);
+}
+
 // Described extra bytes: generated, listed by info with their ranges, carried by tiles.
 TEST(CliPoints, ExtraBytesAreListedAndCarried) {
   test::TempDir dir;

@@ -265,6 +265,30 @@ TEST(GltfRead, PointAndLinePrimitivesAreReportedNotDroppedInSilence) {
   EXPECT_TRUE(warnings.empty());
 }
 
+// A file that draws only points (our point tiles, a scan exported as glTF) is a point set, read
+// as a PLY without faces is; an indexed point primitive is not read, and says so.
+TEST(GltfRead, AFileOfPointsAloneIsReadAsAPointSet) {
+  json doc = triangleDocument();
+  doc["meshes"][0]["primitives"][0] = {{"attributes", {{"POSITION", 0}}}, {"mode", 0}};
+  std::vector<std::string> warnings;
+  Result<Model> model =
+      readGltfFromMemory(test::bytesOf(makeGlb(doc, triangleBinary())), "points.glb",
+                         {.allowExternalFiles = false, .warnings = &warnings});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(model->triangleCount(), 0u);
+  ASSERT_EQ(model->vertexCount(), 3u);
+  EXPECT_EQ(toDouble(model->positions[1]) + model->origin, (Vec3d{1, 0, 0}));
+  EXPECT_TRUE(warnings.empty());
+  doc["meshes"][0]["primitives"][0]["indices"] = 1;
+  model = readGltfFromMemory(test::bytesOf(makeGlb(doc, triangleBinary())), "indexed.glb",
+                             {.allowExternalFiles = false, .warnings = &warnings});
+  ASSERT_TRUE(model.ok()) << model.error().message;
+  EXPECT_EQ(model->vertexCount(), 0u);
+  EXPECT_EQ(warnings,
+            (std::vector<std::string>{
+                "indexed.glb: 1 point primitive (3 corners) not read: only triangles are"}));
+}
+
 TEST(GltfRead, GpuInstancingExpandsIntoObjects) {
   json doc = triangleDocument();
   doc["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};

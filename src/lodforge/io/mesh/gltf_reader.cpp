@@ -115,6 +115,7 @@ class Loader {
     readMaterials();
     texturing_ = readGltfTextures(gltf_, baseDir_, name_, model_, warnings_);
     decideColors();
+    pointsOnly_ = drawsPointsOnly();
     traverseScene();
     placeAtOrigin();
     warnSkipped();
@@ -421,12 +422,41 @@ class Loader {
     }
   }
 
+  // A file whose every drawn primitive is points (a point tile, a scan exported as glTF) is read
+  // as a point set, as a PLY without faces is; beside triangles, points are reported (skip).
+  bool drawsPointsOnly() const {
+    bool points = false;
+    for (const tinygltf::Mesh& mesh : gltf_.meshes) {
+      for (const tinygltf::Primitive& primitive : mesh.primitives) {
+        const int mode = primitive.mode < 0 ? kModeTriangles : primitive.mode;
+        if (mode == kModeTriangles || mode == kModeStrip || mode == kModeFan) return false;
+        points |= mode == kModePoints;
+      }
+    }
+    return points;
+  }
+
+  // An unindexed point primitive of a points-only file: its vertices are the points.
+  void addPoints(const tinygltf::Primitive& primitive, const Mat4d& world,
+                 const std::string& where) {
+    const PrimitiveData data = readPrimitive(primitive, kModePoints, where);
+    const std::size_t base = model_.positions.size() - model_.objects.back().vertexOffset;
+    if (data.positions.size() / 3 > std::numeric_limits<std::uint32_t>::max() - base)
+      fail(fmt::format("{}: too many vertices in one object", where));
+    addVertices(data, world, primitive.material, where);
+  }
+
   void addPrimitive(int meshIndex, const tinygltf::Mesh& mesh, std::size_t p, const Mat4d& world) {
     const auto& primitive = mesh.primitives[p];
     const std::string where = fmt::format("mesh {} primitive {}", meshIndex, p);
     const int mode = primitive.mode < 0 ? kModeTriangles : primitive.mode;
     if (mode < kModePoints || mode > kModeFan)
       fail(fmt::format("{}: mode {} is no glTF primitive mode", where, mode));
+    if (mode == kModePoints && pointsOnly_ && primitive.indices < 0 &&
+        primitive.extensions.count("KHR_draco_mesh_compression") == 0) {
+      addPoints(primitive, world, where);
+      return;
+    }
     if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
       skip(primitive, mode);
       return;
@@ -578,7 +608,7 @@ class Loader {
       indices.resize(vertexCount);
       for (std::uint32_t i = 0; i < indices.size(); ++i) indices[i] = i;
     }
-    data.triangles = toTriangles(indices, mode);
+    if (mode != kModePoints) data.triangles = toTriangles(indices, mode);
     return data;
   }
 
@@ -710,6 +740,7 @@ class Loader {
   bool withColors_ = false;
   bool withUvs_ = false;
   bool missingNormals_ = false;
+  bool pointsOnly_ = false;  // drawsPointsOnly()
 };
 
 // Checks the GLB container before tinygltf does, so errors carry byte offsets.

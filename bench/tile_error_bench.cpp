@@ -4,7 +4,8 @@
 // leaf contents under it. For every tile with content and children, the symmetric Hausdorff
 // distance between its content and that union is measured by dense sampling (N area-uniform
 // points on each side plus every triangle's corner, exact point-to-triangle distances) and
-// compared with its declared geometricError, per level of the tree. --certify adds a bracket of
+// compared with its declared geometricError, per level of the tree. A point tileset (refine ADD)
+// is measured by issue 38's definition for points (measurePointTile). --certify adds a bracket of
 // each distance that does not depend on sampling (directedBound). --chain F tries the bound
 // issue 38 proposes for the builder (chainTile): each tile against its children only, with a
 // value per triangle carried up the tree, pieces split to F times the tile's error.
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <nanoflann.hpp>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/distance.h"
@@ -264,12 +266,107 @@ struct LevelStats {
   std::vector<double> bracket, overCertified;  // --certify: upper / lower, declared / upper
 };
 
+// The table per depth (and with --certify the brackets').
+void printLevels(const fs::path& directory, const Tileset& set, std::map<int, LevelStats>& levels,
+                 bool certify) {
+  fmt::print("\n{}: {} tiles\n", directory.string(), set.tiles.size());
+  fmt::print(
+      "| depth | tiles measured | measured/declared min / median / max | under half | "
+      "under-declared | child above parent |\n|---|---|---|---|---|---|\n");
+  for (auto& [depth, stats] : levels) {
+    std::vector<double>& r = stats.ratios;
+    if (r.empty()) continue;
+    std::sort(r.begin(), r.end());
+    const auto half = std::count_if(r.begin(), r.end(), [](double x) { return x < 0.5; });
+    fmt::print("| {} | {} | {:.2f} / {:.2f} / {:.2f} | {:.0f} % | {} | {} |\n", depth, r.size(),
+               r.front(), r[r.size() / 2], r.back(),
+               100.0 * static_cast<double>(half) / static_cast<double>(r.size()), stats.under,
+               stats.notMonotonic);
+  }
+  if (certify) {
+    fmt::print(
+        "| depth | certified upper / lower: max | declared / certified upper: min / "
+        "median / max |\n|---|---|---|\n");
+    for (auto& [depth, stats] : levels) {
+      if (stats.bracket.empty()) continue;
+      std::sort(stats.overCertified.begin(), stats.overCertified.end());
+      const std::vector<double>& o = stats.overCertified;
+      fmt::print("| {} | {:.3f} | {:.2f} / {:.2f} / {:.2f} |\n", depth,
+                 *std::max_element(stats.bracket.begin(), stats.bracket.end()), o.front(),
+                 o[o.size() / 2], o.back());
+    }
+  }
+  std::fflush(stdout);
+}
+
+// Points of the tiles under `tile` (not its own).
+void appendDescendants(Tileset& set, std::size_t tile, Mesh& out) {
+  for (std::size_t c : set.tiles[tile].children) {
+    if (!set.tiles[c].uri.empty()) appendContent(set, set.tiles[c].uri, out);
+    appendDescendants(set, c, out);
+  }
+}
+
+struct Cloud {
+  const std::vector<Vec3f>& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  float kdtree_get_pt(std::size_t i, std::size_t axis) const {
+    return axis == 0 ? points[i].x : axis == 1 ? points[i].y : points[i].z;
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using CloudTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>,
+                                                      Cloud, 3, std::uint32_t>;
+
+// A point tileset refines by adding: a tile drawn without its children shows its own and its
+// ancestors' points (`shown`), and drops every point below it. Its error as issue 38 defines it
+// for points: the largest distance from a dropped point to the nearest shown one (exact, by a
+// k-d tree over the shown points).
+void measurePointTile(Tileset& set, std::size_t t, std::vector<Vec3f>& shown,
+                      std::map<int, LevelStats>& levels) {
+  const Tile tile = set.tiles[t];
+  const std::size_t before = shown.size();
+  Mesh own;
+  if (!tile.uri.empty()) appendContent(set, tile.uri, own);
+  shown.insert(shown.end(), own.positions.begin(), own.positions.end());
+  LevelStats& stats = levels[tile.depth];
+  for (std::size_t c : tile.children) stats.notMonotonic += set.tiles[c].declared > tile.declared;
+  if (!tile.children.empty() && !shown.empty()) {
+    Mesh dropped;
+    appendDescendants(set, t, dropped);
+    const Cloud cloud{shown};
+    const CloudTree tree(3, cloud);
+    float farthest = 0;
+    for (const Vec3f& p : dropped.positions) {
+      const float query[3] = {p.x, p.y, p.z};
+      std::uint32_t nearest = 0;
+      float squared = 0;
+      tree.knnSearch(query, 1, &nearest, &squared);
+      farthest = std::max(farthest, squared);
+    }
+    const double measured = std::sqrt(static_cast<double>(farthest));
+    stats.ratios.push_back(measured / tile.declared);
+    stats.under += measured > tile.declared;
+  }
+  for (std::size_t c : tile.children) measurePointTile(set, c, shown, levels);
+  shown.resize(before);
+}
+
 void measure(const fs::path& directory, std::uint32_t samples, bool certify, double chainFraction) {
   std::ifstream in(directory / "tileset.json");
   const nlohmann::json json = nlohmann::json::parse(in);
   Tileset set{directory, {}, false, {}};
   addTile(json.at("root"), 0, set);
   std::map<int, LevelStats> levels;
+  if (json.at("root").value("refine", "") == "ADD") {
+    std::vector<Vec3f> shown;
+    measurePointTile(set, 0, shown, levels);
+    printLevels(directory, set, levels, false);
+    return;
+  }
   std::vector<double> chained(set.tiles.size(), -1);
   if (chainFraction > 0) {
     std::size_t pieces = 0;
@@ -312,33 +409,7 @@ void measure(const fs::path& directory, std::uint32_t samples, bool certify, dou
           tile.uri, tile.declared, d.hausdorff, d.maxAB, d.maxBA);
     }
   }
-  fmt::print("\n{}: {} tiles\n", directory.string(), set.tiles.size());
-  fmt::print(
-      "| depth | tiles measured | measured/declared min / median / max | under half | "
-      "under-declared | child above parent |\n|---|---|---|---|---|---|\n");
-  for (auto& [depth, stats] : levels) {
-    std::vector<double>& r = stats.ratios;
-    if (r.empty()) continue;
-    std::sort(r.begin(), r.end());
-    const auto half = std::count_if(r.begin(), r.end(), [](double x) { return x < 0.5; });
-    fmt::print("| {} | {} | {:.2f} / {:.2f} / {:.2f} | {:.0f} % | {} | {} |\n", depth, r.size(),
-               r.front(), r[r.size() / 2], r.back(),
-               100.0 * static_cast<double>(half) / static_cast<double>(r.size()), stats.under,
-               stats.notMonotonic);
-  }
-  if (certify) {
-    fmt::print(
-        "| depth | certified upper / lower: max | declared / certified upper: min / "
-        "median / max |\n|---|---|---|\n");
-    for (auto& [depth, stats] : levels) {
-      if (stats.bracket.empty()) continue;
-      std::sort(stats.overCertified.begin(), stats.overCertified.end());
-      const std::vector<double>& o = stats.overCertified;
-      fmt::print("| {} | {:.3f} | {:.2f} / {:.2f} / {:.2f} |\n", depth,
-                 *std::max_element(stats.bracket.begin(), stats.bracket.end()), o.front(),
-                 o[o.size() / 2], o.back());
-    }
-  }
+  printLevels(directory, set, levels, certify);
   std::fflush(stdout);
 }
 

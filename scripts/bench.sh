@@ -713,6 +713,11 @@ tile_error_section() {
     "$lodforge" -q tiles "$work/te-scan.ply" -o "$work/te-scan$n"
   done
   build/release/bench/bench_tile_error "$work/te-cad2k" "$work/te-scan10M"
+  # Point tiles: a dropped point's distance to the nearest shown one.
+  "$lodforge" -q tiles "$data/points/autzen_trim.laz" -o "$work/te-autzen"
+  "$lodforge" -q generate points --points 1M -o "$work/te-points.ply"
+  "$lodforge" -q tiles "$work/te-points.ply" -o "$work/te-points1M"
+  build/release/bench/bench_tile_error "$work/te-autzen" "$work/te-points1M"
   # With certified brackets (branch and bound; the assembly's flat faces take minutes, left out)
   # and the bound chained per triangle.
   build/release/bench/bench_tile_error --certify --chain 0.1 "$work/te-horse" \

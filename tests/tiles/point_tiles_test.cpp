@@ -12,10 +12,12 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nanoflann.hpp>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/random.h"
 #include "lodforge/generate/points.h"
+#include "lodforge/io/mesh/gltf_reader.h"
 #include "lodforge/io/points/las_reader.h"
 #include "lodforge/tiles/point_attributes.h"
 #include "test_support.h"
@@ -77,9 +79,25 @@ std::vector<Vec3d> readPointGlb(const std::string& path, nlohmann::json* gltfOut
   return points;
 }
 
-// Walks a tileset: boxes nest, errors do not grow downwards, every content exists.
+// The largest quantisation error of a point tileset's leaves: half a step of the root box's grid
+// on each axis for the shown point, as much for its own (docs/points.md).
+double leafQuantizationError(const nlohmann::json& rootBox) {
+  double longest = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double half = std::sqrt(std::pow(rootBox[3 + 3 * k].get<double>(), 2) +
+                                  std::pow(rootBox[4 + 3 * k].get<double>(), 2) +
+                                  std::pow(rootBox[5 + 3 * k].get<double>(), 2));
+    longest = std::max(longest, 2 * half);
+  }
+  return std::sqrt(3.0) * longest / 65535;
+}
+
+// Walks a tileset: boxes nest, errors do not grow downwards, every content exists, and a leaf
+// (a block's tile: every point left) declares no more than its quantisation.
 void checkTileset(const nlohmann::json& tile, const fs::path& root, double parentError,
-                  const nlohmann::json* parentBox, std::vector<std::string>& uris) {
+                  const nlohmann::json* parentBox, std::vector<std::string>& uris,
+                  double leafError = -1) {
+  if (leafError < 0) leafError = leafQuantizationError(tile["boundingVolume"]["box"]);
   const double error = tile["geometricError"];
   EXPECT_LE(error, parentError);
   const auto& box = tile["boundingVolume"]["box"];
@@ -99,10 +117,105 @@ void checkTileset(const nlohmann::json& tile, const fs::path& root, double paren
     uris.push_back(uri);
   }
   if (tile.contains("children")) {
-    for (const auto& child : tile["children"]) checkTileset(child, root, error, &box, uris);
+    for (const auto& child : tile["children"])
+      checkTileset(child, root, error, &box, uris, leafError);
   } else {
-    EXPECT_EQ(error, 0) << "a block's tile holds every point left";
+    EXPECT_LE(error, leafError * (1 + 1e-9)) << "a block's tile holds every point left";
   }
+}
+
+// Every point of a tile's content, in one frame (the reader's origin added back).
+std::vector<Vec3d> contentPoints(const fs::path& file) {
+  Result<Model> model = readGltf(file.string());
+  EXPECT_TRUE(model.ok()) << (model.ok() ? "" : model.error().message);
+  std::vector<Vec3d> out;
+  if (model.ok())
+    for (const Vec3f& p : model->positions) out.push_back(toDouble(p) + model->origin);
+  return out;
+}
+
+struct PointSet {
+  const std::vector<Vec3d>& points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  double kdtree_get_pt(std::size_t i, std::size_t axis) const { return points[i][int(axis)]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+
+// Measured as issue 38 defines a point tile's error, independently of the builder: a tile drawn
+// without its children shows its own and its ancestors' points (refine ADD) and drops every
+// point below it; the largest distance from a dropped point to the nearest shown one.
+void measureTile(const nlohmann::json& tile, const fs::path& root, std::vector<Vec3d>& shown,
+                 std::vector<double>& ratios) {
+  const std::size_t before = shown.size();
+  if (tile.contains("content")) {
+    const std::vector<Vec3d> own = contentPoints(root / tile["content"]["uri"].get<std::string>());
+    shown.insert(shown.end(), own.begin(), own.end());
+  }
+  if (tile.contains("children")) {
+    std::vector<Vec3d> dropped;
+    std::vector<const nlohmann::json*> below;
+    for (const auto& child : tile["children"]) below.push_back(&child);
+    while (!below.empty()) {
+      const nlohmann::json& t = *below.back();
+      below.pop_back();
+      if (t.contains("content")) {
+        const std::vector<Vec3d> points =
+            contentPoints(root / t["content"]["uri"].get<std::string>());
+        dropped.insert(dropped.end(), points.begin(), points.end());
+      }
+      if (t.contains("children"))
+        for (const auto& child : t["children"]) below.push_back(&child);
+    }
+    const PointSet set{shown};
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointSet>, PointSet, 3,
+                                        std::uint32_t>
+        tree(3, set);
+    double farthest = 0;
+    for (const Vec3d& p : dropped) {
+      const double query[3] = {p.x, p.y, p.z};
+      std::uint32_t nearest = 0;
+      double squared = 0;
+      tree.knnSearch(query, 1, &nearest, &squared);
+      farthest = std::max(farthest, std::sqrt(squared));
+    }
+    ratios.push_back(farthest / tile["geometricError"].get<double>());
+    for (const auto& child : tile["children"]) measureTile(child, root, shown, ratios);
+  }
+  shown.resize(before);
+}
+
+// Honest errors (issue 38): no point a tile drops lies farther from the points it shows than the
+// tile declares, quantised positions included; and the check would catch a tile declaring a
+// tenth too little (some tile's measured distance is above 0.9 of its declared error).
+TEST(PointTiles, NoDroppedPointIsFartherFromAShownOneThanItsTileDeclares) {
+  test::TempDir dir;
+  Random random(38);
+  {
+    std::ofstream out(dir.file("cloud.xyz"));
+    out.precision(12);
+    for (int i = 0; i < 20'000; ++i) {
+      const double x = random.uniform(0, 400), y = random.uniform(0, 300);
+      // A bumpy surface, and one point in a hundred a spike above it.
+      const double spike = i % 100 == 0 ? random.uniform(0, 30) : 0;
+      out << x << ' ' << y << ' ' << 10 * std::sin(x / 40) + random.uniform(0, 0.5) + spike << '\n';
+    }
+  }
+  PointTilesOptions options;
+  options.blockSize = 2'000;
+  options.tilePoints = 1'500;
+  Result<PointTilesStats> stats = writePointTiles(dir.file("cloud.xyz"), dir.file("t"), options);
+  ASSERT_TRUE(stats.ok()) << stats.error().message;
+  ASSERT_GE(stats->depth, 3);
+  const auto tileset = nlohmann::json::parse(test::readFile(dir.file("t/tileset.json")));
+  std::vector<Vec3d> shown;
+  std::vector<double> ratios;
+  measureTile(tileset["root"], dir.file("t"), shown, ratios);
+  ASSERT_GE(ratios.size(), 7u);
+  for (std::size_t i = 0; i < ratios.size(); ++i) EXPECT_LE(ratios[i], 1.0) << "tile " << i;
+  EXPECT_GT(*std::max_element(ratios.begin(), ratios.end()), 0.9);
 }
 
 TEST(PointTiles, EveryPointIsInExactlyOneTileOfAnAddTree) {
@@ -203,6 +316,54 @@ std::set<std::uint32_t> cutRepresentatives(const std::vector<ClusterNode>& tree,
   return out;
 }
 
+// Each node's error replaced by its tile error, as ranking a block does.
+void withTileErrors(std::vector<ClusterNode>& tree, std::span<const std::uint32_t> reps,
+                    std::span<const CloudPoint> points) {
+  const std::vector<float> reach = representativeReach(tree, reps, points);
+  for (std::size_t i = 0; i < tree.size(); ++i) tree[i].error = pointTileError(tree[i], reach[i]);
+}
+
+// The points a node stands for: its leaves' own.
+void pointsUnder(std::span<const ClusterNode> tree, std::span<const std::uint32_t> first,
+                 std::size_t node, std::vector<std::uint32_t>& out) {
+  if (tree[node].leaf()) {
+    out.push_back(first[node]);
+    return;
+  }
+  pointsUnder(tree, first, tree[node].firstChild, out);
+  pointsUnder(tree, first, tree[node].firstChild + 1, out);
+}
+
+// What a tile's error promises for points: every point a cut node stands for lies within its
+// tile error of the one point kept for it (its representative), measured point by point. The
+// radius and E alone did not promise it (Autzen's tiles dropped points 1.9-2.8 times farther).
+TEST(PointTiles, EveryPointOfANodeIsWithinItsTileErrorOfItsRepresentative) {
+  Random random(38);
+  std::vector<CloudPoint> points(2'000);
+  for (CloudPoint& p : points) {
+    const double x = random.uniform(0, 10), y = random.uniform(0, 10);
+    p.position = {x, y, std::sin(x) * std::cos(y) + random.uniform(0, 0.2)};
+  }
+  std::vector<std::uint32_t> first;
+  std::vector<ClusterNode> tree = clusterBlock(points, {5, 5, 0}, false, {}, &first);
+  const std::vector<std::uint32_t> reps = clusterRepresentatives(tree, points, first, {5, 5, 0});
+  const std::vector<ClusterNode> plain = tree;
+  withTileErrors(tree, reps, points);
+  std::size_t beyondRadiusAndE = 0;
+  for (std::size_t i = 0; i < tree.size(); ++i) {
+    std::vector<std::uint32_t> under;
+    pointsUnder(tree, first, i, under);
+    double farthest = 0;
+    for (std::uint32_t p : under)
+      farthest = std::max(farthest, length(points[p].position - points[reps[i]].position));
+    ASSERT_LE(farthest, static_cast<double>(tree[i].error)) << "node " << i;
+    // The old tile error, max(E, radius), promised too little for some nodes.
+    if (farthest > static_cast<double>(std::max(plain[i].error, plain[i].radius)))
+      ++beyondRadiusAndE;
+  }
+  EXPECT_GT(beyondRadiusAndE, 0u);
+}
+
 TEST(PointTiles, RepresentativesMakeCoarserCutsSubsetsOfFinerOnes) {
   Random random(6);
   std::vector<CloudPoint> points(3'000);
@@ -210,8 +371,8 @@ TEST(PointTiles, RepresentativesMakeCoarserCutsSubsetsOfFinerOnes) {
     p.position = {random.uniform(0, 10), random.uniform(0, 10), random.uniform(0, 0.3)};
   std::vector<std::uint32_t> first;
   std::vector<ClusterNode> tree = clusterBlock(points, {5, 5, 0}, false, {}, &first);
-  for (ClusterNode& n : tree) n.error = pointTileError(n);
   const std::vector<std::uint32_t> reps = clusterRepresentatives(tree, points, first, {5, 5, 0});
+  withTileErrors(tree, reps, points);
   for (std::size_t i = 0; i < tree.size(); ++i) {
     if (tree[i].leaf()) {
       EXPECT_EQ(reps[i], first[i]);
@@ -245,8 +406,8 @@ TEST(PointTiles, KeysHoldExactlyTheCutsRepresentatives) {
   points[7].position = points[9].position;  // a duplicate: a leaf of radius 0
   std::vector<std::uint32_t> first;
   std::vector<ClusterNode> tree = clusterBlock(points, {5, 5, 0}, false, {}, &first);
-  for (ClusterNode& n : tree) n.error = pointTileError(n);
   const std::vector<std::uint32_t> reps = clusterRepresentatives(tree, points, first, {5, 5, 0});
+  withTileErrors(tree, reps, points);
   const std::vector<float> keys = pointKeys(tree, reps);
   ASSERT_EQ(keys.size(), points.size());
   std::set<float> errors;

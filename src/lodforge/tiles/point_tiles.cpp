@@ -6,6 +6,7 @@
 #include <bit>
 #include <cassert>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -47,10 +48,13 @@ int depthOf(const PointBlock& block) {
   return static_cast<int>(block.name.size()) - 1;
 }
 
-// The clustering tree with each node's error replaced by its tile error (still monotone: both
-// the error and the radius are).
-std::vector<ClusterNode> tileErrorTree(std::vector<ClusterNode> tree) {
-  for (ClusterNode& n : tree) n.error = pointTileError(n);
+// The clustering tree with each node's error replaced by its tile error (still monotone: the
+// error, the radius and the reach are).
+std::vector<ClusterNode> tileErrorTree(std::vector<ClusterNode> tree,
+                                       std::span<const std::uint32_t> reps,
+                                       std::span<const CloudPoint> points) {
+  const std::vector<float> reach = representativeReach(tree, reps, points);
+  for (std::size_t i = 0; i < tree.size(); ++i) tree[i].error = pointTileError(tree[i], reach[i]);
   return tree;
 }
 
@@ -103,10 +107,11 @@ Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
   std::vector<std::uint32_t> firstPoint;
   ClusterOptions cluster = options.cluster;
   cluster.colors = false;  // tiles draw the points' own colours
-  const std::vector<ClusterNode> tree =
-      tileErrorTree(clusterBlock(points, block.centroid, hasNormals, cluster, &firstPoint, ids));
+  std::vector<ClusterNode> tree =
+      clusterBlock(points, block.centroid, hasNormals, cluster, &firstPoint, ids);
   const std::vector<std::uint32_t> reps =
       clusterRepresentatives(tree, points, firstPoint, block.centroid);
+  tree = tileErrorTree(std::move(tree), reps, points);
   std::vector<float> key = pointKeys(tree, reps);
   out.leastError = tree.front().error;
   for (const ClusterNode& node : tree) out.leastError = std::min(out.leastError, node.error);
@@ -287,8 +292,29 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
 
 }  // namespace
 
-float pointTileError(const ClusterNode& node) {
-  return std::max(node.error, node.radius);
+float pointTileError(const ClusterNode& node, float reach) {
+  return std::max({node.error, node.radius, reach});
+}
+
+std::vector<float> representativeReach(std::span<const ClusterNode> tree,
+                                       std::span<const std::uint32_t> reps,
+                                       std::span<const CloudPoint> points) {
+  assert(reps.size() == tree.size());
+  std::vector<float> reach(tree.size(), 0.0f);
+  for (std::size_t i = tree.size(); i-- > 0;) {
+    const ClusterNode& node = tree[i];
+    if (node.leaf()) continue;
+    double farthest = 0;
+    for (std::uint32_t c = node.firstChild; c < node.firstChild + 2; ++c)
+      farthest = std::max(farthest, length(points[reps[c]].position - points[reps[i]].position) +
+                                        static_cast<double>(reach[c]));
+    // Rounded up: a bound must not lose its last bit to the float.
+    float up = static_cast<float>(farthest);
+    if (static_cast<double>(up) < farthest)
+      up = std::nextafter(up, std::numeric_limits<float>::max());
+    reach[i] = up;
+  }
+  return reach;
 }
 
 std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> tree,
@@ -420,18 +446,26 @@ Result<std::uint64_t> writeContents(std::map<std::string, TileNode>& nodes,
 }
 
 // tileset.json: ADD refinement; a tile at depth d stands for the cut at τ_d, a block's tile for
-// every point (error 0); the root placed by the local frame or --origin.
+// every point (error 0); the root placed by the local frame or --origin. Quantised positions
+// move each point by up to half a step of its tile's grid on each axis: a tile's error adds that
+// of the largest box showing points with it (the root's, its ancestors' boxes hold its own)
+// for the shown point, and its own for the dropped one as the finer tiles show it. The same
+// for every tile under one root, so errors still never grow from parent to child.
 Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
                              const std::vector<BlockTiles>& blocks, const std::vector<float>& taus,
-                             const std::optional<Mat4d>& rootTransform, const std::string& path) {
+                             const std::optional<Mat4d>& rootTransform, bool quantized,
+                             const std::string& path) {
   float rootError = 0;
   for (const BlockTiles& b : blocks) rootError = std::max(rootError, b.rootError);
+  const auto stepError = [&](const TileNode& node) {
+    return quantized ? 0.5 * std::sqrt(3.0) * glbQuantizationStep(node.bounds) : 0.0;
+  };
+  const double shownError = stepError(nodes.at("b"));
   const std::function<nlohmann::json(const TileNode&)> tile = [&](const TileNode& node) {
     const bool leaf = node.children.empty();
-    nlohmann::json t = {
-        {"boundingVolume", {{"box", tileBox(node.bounds)}}},
-        {"geometricError",
-         leaf ? 0.0 : static_cast<double>(taus[static_cast<std::size_t>(node.depth)])}};
+    const double tau = leaf ? 0.0 : static_cast<double>(taus[static_cast<std::size_t>(node.depth)]);
+    nlohmann::json t = {{"boundingVolume", {{"box", tileBox(node.bounds)}}},
+                        {"geometricError", tau + shownError + stepError(node)}};
     if (!node.uri.empty()) t["content"] = {{"uri", node.uri}};
     if (!leaf) {
       t["children"] = nlohmann::json::array();
@@ -555,7 +589,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
   if (!tiles) return tiles.status();
   stats.tiles = *tiles;
   LODFORGE_TRY(writePointTilesetJson(nodes, blocks, *taus, rootTransformOf(*frame, options),
-                                     staging.path + "/tileset.json"));
+                                     options.quantize, staging.path + "/tileset.json"));
   stats.outputBytes = directoryBytes(staging.path);
 
   // Complete: replace the previous tileset, if any, by the new one.

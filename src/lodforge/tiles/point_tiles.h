@@ -44,9 +44,10 @@ struct PointTilesStats {
   double seconds = 0;
 };
 
-// A node's "tile error" for point tiles: the clustering error E and the square's radius, the
-// larger (a flat cluster is fitted well but still stands for a patch that wide).
-float pointTileError(const ClusterNode& node);
+// A node's "tile error" for point tiles: the largest of the clustering error E, the square's
+// radius (a flat cluster is fitted well but still stands for a patch that wide) and `reach`
+// (representativeReach: no point the node stands for is farther from the one point kept for it).
+float pointTileError(const ClusterNode& node, float reach);
 
 // One representative input point per cluster node (indices into the block's points, as
 // clusterBlock left them): a leaf's own point; a parent's, the child representative nearest
@@ -55,6 +56,14 @@ std::vector<std::uint32_t> clusterRepresentatives(std::span<const ClusterNode> t
                                                   std::span<const CloudPoint> points,
                                                   std::span<const std::uint32_t> firstPoint,
                                                   Vec3d origin);
+
+// Per node, a bound on how far any point under it is from its representative (`reps`): 0 at a
+// leaf, and at a parent the largest over its children of the distance between the two
+// representatives plus the child's reach (the triangle inequality), rounded up to float.
+// Non-decreasing towards the root.
+std::vector<float> representativeReach(std::span<const ClusterNode> tree,
+                                       std::span<const std::uint32_t> reps,
+                                       std::span<const CloudPoint> points);
 
 // Each point's key (indexed like `points`, from the tree's representatives `reps`): the tile
 // error of the parent of the highest node the point represents, +∞ for the root's. The cut of

@@ -14,17 +14,24 @@ bool positionLess(Vec3f a, Vec3f b) {
   return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
 }
 
-// Keeps the part of convex polygon `poly` where dot(x - o, n) >= 0.
-void clipPolygon(std::vector<Vec3d>& poly, Vec3d o, Vec3d n) {
-  std::vector<Vec3d> out;
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Vec3d& a = poly[i];
-    const Vec3d& b = poly[(i + 1) % poly.size()];
+// A convex polygon of at most 8 corners: a triangle cut by a few planes.
+struct Polygon {
+  std::array<Vec3d, 8> corners;
+  std::size_t count = 0;
+};
+
+// Keeps the part of `poly` where dot(x - o, n) >= 0 (a plane adds at most one corner).
+void clipPolygon(Polygon& poly, Vec3d o, Vec3d n) {
+  Polygon out;
+  for (std::size_t i = 0; i < poly.count && out.count + 2 <= out.corners.size(); ++i) {
+    const Vec3d& a = poly.corners[i];
+    const Vec3d& b = poly.corners[(i + 1) % poly.count];
     const double sa = dot(a - o, n), sb = dot(b - o, n);
-    if (sa >= 0) out.push_back(a);
-    if ((sa > 0 && sb < 0) || (sa < 0 && sb > 0)) out.push_back(a + (b - a) * (sa / (sa - sb)));
+    if (sa >= 0) out.corners[out.count++] = a;
+    if ((sa > 0 && sb < 0) || (sa < 0 && sb > 0))
+      out.corners[out.count++] = a + (b - a) * (sa / (sa - sb));
   }
-  poly = std::move(out);
+  poly = out;
 }
 
 // A star triangle's angular span about the axis: from `from`, `width` radians counterclockwise.
@@ -38,7 +45,9 @@ std::uint32_t spanningTriangle(std::span<const Span> spans, double angle) {
   std::uint32_t best = spans[0].triangle;
   double bestOff = std::numeric_limits<double>::max();
   for (const Span& s : spans) {
-    const double off = std::remainder(angle - s.from, kTurn);
+    double off = angle - s.from;  // both within a turn and a half of -pi
+    while (off < -std::numbers::pi) off += kTurn;
+    while (off >= std::numbers::pi) off -= kTurn;
     const double outside = off < 0 ? -off : off > s.width ? off - s.width : 0;
     if (outside < bestOff) {
       bestOff = outside;
@@ -46,6 +55,32 @@ std::uint32_t spanningTriangle(std::span<const Span> spans, double angle) {
     }
   }
   return best;
+}
+
+// The piece cut into the sectors between consecutive angles of `cuts` (about `axis` through v,
+// angles measured from u towards w), each bounded through the star triangle spanning it.
+// `distanceTo(x, t)` bounds a point through triangle t.
+template <class Distance>
+double sectorBound(const std::array<Vec3d, 3>& p, Vec3d v, Vec3d axis, Vec3d u, Vec3d w,
+                   std::span<const double> angles, std::span<const Span> spans,
+                   std::vector<std::uint32_t>& used, Distance distanceTo) {
+  const auto direction = [&](double a) { return u * std::cos(a) + w * std::sin(a); };
+  double worst = 0;
+  for (std::size_t i = 0; i < angles.size(); ++i) {
+    const double from = angles[i], to = i + 1 < angles.size() ? angles[i + 1] : angles[0] + kTurn;
+    if (!(to > from)) continue;
+    Polygon sector;
+    for (const Vec3d& c : p) sector.corners[sector.count++] = c;
+    clipPolygon(sector, v, cross(axis, direction(from)));
+    if (sector.count == 0) continue;
+    clipPolygon(sector, v, cross(direction(to), axis));
+    if (sector.count == 0) continue;
+    const std::uint32_t t = spanningTriangle(spans, (from + to) / 2);
+    for (std::size_t c = 0; c < sector.count; ++c)
+      worst = std::max(worst, distanceTo(sector.corners[c], t));
+    if (std::find(used.begin(), used.end(), t) == used.end()) used.push_back(t);
+  }
+  return worst;
 }
 
 }  // namespace
@@ -77,8 +112,15 @@ PieceBound PieceBounds::bound(const std::array<Vec3d, 3>& p,
     const double d = std::sqrt(nearest_.nearestSquared(p[i], f[i]));
     out.lower = std::max(out.lower, d + (carried.empty() ? 0.0 : carried[f[i]]));
   }
+  // All three corners nearest one triangle: their distances bound the piece (exact).
+  if (f[0] == f[1] && f[1] == f[2]) {
+    out.upper = out.lower;
+    out.used = {f[0]};
+    return out;
+  }
+  // Otherwise the least of: the best single corner triangle, and where they apply, the cut at
+  // the plane bisecting a shared edge and the sectors around a shared vertex.
   out.upper = std::numeric_limits<double>::max();
-  // The best single corner triangle (all three corners' own when they agree: exact).
   for (std::uint32_t t : f) {
     const double d = std::max(
         {distance(p[0], t, carried), distance(p[1], t, carried), distance(p[2], t, carried)});
@@ -87,8 +129,14 @@ PieceBound PieceBounds::bound(const std::array<Vec3d, 3>& p,
       out.used = {t};
     }
   }
-  if (f[0] == f[1] && f[1] == f[2]) return out;
-  // A corner position every distinct nearest triangle has: bound around that vertex.
+  const std::uint32_t g = f[0], h = f[1] != g ? f[1] : f[2];
+  if (f[1] == g || f[2] == g || f[1] == f[2]) {
+    const double d = edgeBound(p, g, h, carried);
+    if (d < out.upper) {
+      out.upper = d;
+      out.used = {g, h};
+    }
+  }
   for (int k = 0; k < 3; ++k) {
     const Vec3d v = corner(f[0], k);
     const auto has = [&](std::uint32_t t) {
@@ -102,14 +150,6 @@ PieceBound PieceBounds::bound(const std::array<Vec3d, 3>& p,
       out.used = std::move(used);
     }
     break;
-  }
-  // Two distinct triangles: they may share an edge.
-  const std::uint32_t g = f[0], h = f[1] != g ? f[1] : f[2];
-  if (f[1] != g && f[2] != g && f[1] != f[2]) return out;
-  const double d = edgeBound(p, g, h, carried);
-  if (d < out.upper) {
-    out.upper = d;
-    out.used = {g, h};
   }
   return out;
 }
@@ -161,10 +201,13 @@ double PieceBounds::vertexBound(const std::array<Vec3d, 3>& p, std::uint32_t tri
   constexpr double kNone = std::numeric_limits<double>::max();
   const Vec3f key = positions_[indices_[3 * std::size_t{triangle} + static_cast<std::size_t>(k)]];
   const Vec3d v = toDouble(key);
+  thread_local std::vector<std::uint32_t> star;
+  thread_local std::vector<Span> spans;
+  thread_local std::vector<double> cuts;
+  star.clear();
   auto it = std::lower_bound(
       cornersByPosition_.begin(), cornersByPosition_.end(), key,
       [&](std::uint32_t c, Vec3f q) { return positionLess(positions_[indices_[c]], q); });
-  std::vector<std::uint32_t> star;
   for (; it != cornersByPosition_.end() && positions_[indices_[*it]] == key; ++it)
     star.push_back(*it / 3);
   Vec3d axis{0, 0, 0};
@@ -176,38 +219,32 @@ double PieceBounds::vertexBound(const std::array<Vec3d, 3>& p, std::uint32_t tri
                               Vec3d{0, 0, 0});
   const Vec3d w = cross(axis, u);
   const auto angleOf = [&](Vec3d d) { return std::atan2(dot(d, w), dot(d, u)); };
-  std::vector<Span> spans;
-  std::vector<double> cuts;
+  spans.clear();
+  cuts.clear();
   for (std::uint32_t t : star) {
-    std::vector<double> edges;
+    std::array<double, 3> edges{};
+    std::size_t n = 0;
     for (int c = 0; c < 3; ++c)
-      if (corner(t, c) != v) edges.push_back(angleOf(corner(t, c) - v));
-    if (edges.size() != 2) continue;
+      if (corner(t, c) != v && n < 3) edges[n++] = angleOf(corner(t, c) - v);
+    if (n != 2) continue;
     const double width = std::remainder(edges[1] - edges[0], kTurn);
     spans.push_back({width >= 0 ? edges[0] : edges[1], std::abs(width), t});
-    cuts.insert(cuts.end(), edges.begin(), edges.end());
+    cuts.push_back(edges[0]);
+    cuts.push_back(edges[1]);
   }
   if (spans.empty()) return kNone;
   std::sort(cuts.begin(), cuts.end());
+  cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+  // No sector as wide as half a turn (it would not be convex): gaps over a quarter are halved
+  // until they are not.
   for (std::size_t i = 0, n = cuts.size(); i < n; ++i) {
     const double next = i + 1 < n ? cuts[i + 1] : cuts[0] + kTurn;
-    for (int q = 1; q < 4; ++q) cuts.push_back(cuts[i] + (next - cuts[i]) * q / 4);
+    const int parts = static_cast<int>(std::ceil((next - cuts[i]) / (kTurn / 4)));
+    for (int q = 1; q < parts; ++q) cuts.push_back(cuts[i] + (next - cuts[i]) * q / parts);
   }
   std::sort(cuts.begin(), cuts.end());
-  const auto direction = [&](double a) { return u * std::cos(a) + w * std::sin(a); };
-  double worst = 0;
-  for (std::size_t i = 0; i < cuts.size(); ++i) {
-    const double from = cuts[i], to = i + 1 < cuts.size() ? cuts[i + 1] : cuts[0] + kTurn;
-    if (!(to > from)) continue;
-    const std::uint32_t t = spanningTriangle(spans, (from + to) / 2);
-    std::vector<Vec3d> sector(p.begin(), p.end());
-    clipPolygon(sector, v, cross(axis, direction(from)));
-    clipPolygon(sector, v, cross(direction(to), axis));
-    if (sector.empty()) continue;
-    for (const Vec3d& x : sector) worst = std::max(worst, distance(x, t, carried));
-    if (std::find(used.begin(), used.end(), t) == used.end()) used.push_back(t);
-  }
-  return worst;
+  return sectorBound(p, v, axis, u, w, cuts, spans, used,
+                     [&](Vec3d x, std::uint32_t t) { return distance(x, t, carried); });
 }
 
 }  // namespace lodforge

@@ -29,10 +29,11 @@ class PieceBounds {
   // corner are found by position, so the mesh need not be welded.
   PieceBounds(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices);
 
-  // Three cases by the corners' nearest triangles: one for all (its corners bound the piece:
-  // upper = lower), two sharing an edge (the piece cut by the plane bisecting their dihedral
-  // angle), all around one vertex (cut into angular sectors about the vertex's mean normal, each
-  // bounded through the triangle spanning it); otherwise the best single corner triangle.
+  // By the corners' nearest triangles: one for all, its corners bound the piece (upper =
+  // lower); otherwise the least of the best single corner triangle, and where they apply, two
+  // sharing an edge (the piece cut by the plane bisecting their dihedral angle) and all around
+  // one vertex (cut into angular sectors about the vertex's mean normal, each bounded through
+  // the triangle spanning it).
   // With `carried` (a value per triangle of the mesh, or empty), a point bounded through
   // triangle t counts its distance plus carried[t]: a bound on a distance chained through t.
   PieceBound bound(const std::array<Vec3d, 3>& piece, std::span<const double> carried = {}) const;

@@ -24,12 +24,12 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <nanoflann.hpp>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/distance.h"
 #include "lodforge/core/distance_bound.h"
 #include "lodforge/io/mesh/gltf_reader.h"
+#include "lodforge/surface/point_index.h"
 
 namespace lodforge {
 namespace {
@@ -307,20 +307,6 @@ void appendDescendants(Tileset& set, std::size_t tile, Mesh& out) {
   }
 }
 
-struct Cloud {
-  const std::vector<Vec3f>& points;
-  std::size_t kdtree_get_point_count() const { return points.size(); }
-  float kdtree_get_pt(std::size_t i, std::size_t axis) const {
-    return axis == 0 ? points[i].x : axis == 1 ? points[i].y : points[i].z;
-  }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-using CloudTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>,
-                                                      Cloud, 3, std::uint32_t>;
-
 // A point tileset refines by adding: a tile drawn without its children shows its own and its
 // ancestors' points (`shown`), and drops every point below it. Its error as issue 38 defines it
 // for points: the largest distance from a dropped point to the nearest shown one (exact, by a
@@ -337,17 +323,17 @@ void measurePointTile(Tileset& set, std::size_t t, std::vector<Vec3f>& shown,
   if (!tile.children.empty() && !shown.empty()) {
     Mesh dropped;
     appendDescendants(set, t, dropped);
-    const Cloud cloud{shown};
-    const CloudTree tree(3, cloud);
-    float farthest = 0;
+    std::vector<Vec3d> shownPoints(shown.size());
+    for (std::size_t i = 0; i < shown.size(); ++i) shownPoints[i] = toDouble(shown[i]);
+    const PointIndex index(shownPoints);
+    double farthest = 0;
     for (const Vec3f& p : dropped.positions) {
-      const float query[3] = {p.x, p.y, p.z};
       std::uint32_t nearest = 0;
-      float squared = 0;
-      tree.knnSearch(query, 1, &nearest, &squared);
+      double squared = 0;
+      index.nearest(toDouble(p), 1, &nearest, &squared);
       farthest = std::max(farthest, squared);
     }
-    const double measured = std::sqrt(static_cast<double>(farthest));
+    const double measured = std::sqrt(farthest);
     stats.ratios.push_back(measured / tile.declared);
     stats.under += measured > tile.declared;
   }

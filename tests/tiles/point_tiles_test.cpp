@@ -12,13 +12,13 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
-#include <nanoflann.hpp>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/random.h"
 #include "lodforge/generate/points.h"
 #include "lodforge/io/mesh/gltf_reader.h"
 #include "lodforge/io/points/las_reader.h"
+#include "lodforge/surface/point_index.h"
 #include "lodforge/tiles/point_attributes.h"
 #include "test_support.h"
 
@@ -134,16 +134,6 @@ std::vector<Vec3d> contentPoints(const fs::path& file) {
   return out;
 }
 
-struct PointSet {
-  const std::vector<Vec3d>& points;
-  std::size_t kdtree_get_point_count() const { return points.size(); }
-  double kdtree_get_pt(std::size_t i, std::size_t axis) const { return points[i][int(axis)]; }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-
 // Measured as issue 38 defines a point tile's error, independently of the builder: a tile drawn
 // without its children shows its own and its ancestors' points (refine ADD) and drops every
 // point below it; the largest distance from a dropped point to the nearest shown one.
@@ -169,16 +159,12 @@ void measureTile(const nlohmann::json& tile, const fs::path& root, std::vector<V
       if (t.contains("children"))
         for (const auto& child : t["children"]) below.push_back(&child);
     }
-    const PointSet set{shown};
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointSet>, PointSet, 3,
-                                        std::uint32_t>
-        tree(3, set);
+    const PointIndex index(shown);
     double farthest = 0;
     for (const Vec3d& p : dropped) {
-      const double query[3] = {p.x, p.y, p.z};
       std::uint32_t nearest = 0;
       double squared = 0;
-      tree.knnSearch(query, 1, &nearest, &squared);
+      index.nearest(p, 1, &nearest, &squared);
       farthest = std::max(farthest, std::sqrt(squared));
     }
     ratios.push_back(farthest / tile["geometricError"].get<double>());

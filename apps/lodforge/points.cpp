@@ -60,6 +60,8 @@ void addPoints(CLI::App& app, const Global& global, Run& run) {
       if (stats->truncation)
         fmt::print(stderr, "lodforge: warning: {}; built from what came before\n",
                    *stats->truncation);
+      for (const std::string& warning : stats->warnings)
+        fmt::print(stderr, "lodforge: warning: {}\n", warning);
       say(global,
           fmt::format("wrote {}: {} points in {} blocks, Part II {} nodes, Part III {}, {} in "
                       "{:.1f} s ({} points/s)",

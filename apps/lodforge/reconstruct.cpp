@@ -71,6 +71,8 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
                      work);
         return mesh.status();
       }
+      for (const std::string& warning : mesh->warnings)
+        fmt::print(stderr, "lodforge: warning: {}\n", warning);
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       say(global,

@@ -254,7 +254,8 @@ TEST(OddInput, AnOffWithoutColoursSaysNone) {
 }
 
 // A PLY element none of our readers reads (edges here) is named in a warning on every path that
-// streams a PLY: a mesh into tiles, a point cloud into tiles, objects into a package.
+// streams a PLY: a mesh into tiles, a point cloud into tiles, a cloud package or a surface,
+// objects into a package.
 TEST(OddInput, AnUnreadPlyElementIsNamedByEveryStreamingReader) {
   test::TempDir dir;
   const std::string vertices =
@@ -268,10 +269,22 @@ TEST(OddInput, AnUnreadPlyElementIsNamedByEveryStreamingReader) {
                       points + "0 1\n1 2\n3 0 1 2 0\n3 0 2 3 1\n");
   test::writeFile(dir.file("cloud.ply"), "ply\nformat ascii 1.0\n" + vertices + edges +
                                              "end_header\n" + points + "0 1\n1 2\n");
+  // A generated cloud with two edges after its vertices, for the commands that need a surface's
+  // worth of points.
+  ASSERT_EQ(lodforge("-q generate points --points 3K -o " + dir.file("g.ply"), dir).code, 0);
+  std::string generated = test::readFile(dir.file("g.ply"));
+  const std::size_t header = generated.find("end_header\n");
+  ASSERT_NE(header, std::string::npos);
+  generated.insert(header, edges);
+  generated += std::string(16, '\0');  // two edges of two ints
+  test::writeFile(dir.file("edges.ply"), generated);
   for (const std::string& command :
        {"tiles " + dir.file("mesh.ply") + " -o " + dir.file("mesh-tiles"),
         "tiles " + dir.file("cloud.ply") + " -o " + dir.file("cloud-tiles"),
-        "build " + dir.file("mesh.ply") + " -o " + dir.file("mesh.lfp")}) {
+        "build " + dir.file("mesh.ply") + " -o " + dir.file("mesh.lfp"),
+        "points " + dir.file("edges.ply") + " -o " + dir.file("edges.lfc"),
+        "reconstruct " + dir.file("edges.ply") + " -o " + dir.file("surface.ply"),
+        "tiles --surface " + dir.file("edges.ply") + " -o " + dir.file("surface-tiles")}) {
     const Outcome o = lodforge(command, dir);
     ASSERT_EQ(o.code, 0) << command << "\n" << o.err;
     // Once: a package's ungrouped PLY is read again whole, which must not warn twice.
@@ -279,6 +292,25 @@ TEST(OddInput, AnUnreadPlyElementIsNamedByEveryStreamingReader) {
     const std::size_t first = o.err.find(warning);
     EXPECT_NE(first, std::string::npos) << command << "\n" << o.err;
     EXPECT_EQ(o.err.find(warning, first + 1), std::string::npos) << command << "\n" << o.err;
+  }
+}
+
+// A point cloud cut short and read with --salvage says so in every command that reads clouds.
+TEST(DamagedInput, ASalvagedCloudCutShortIsNamedByEveryCloudCommand) {
+  test::TempDir dir;
+  ASSERT_EQ(lodforge("-q generate points --points 3K -o " + dir.file("c.ply"), dir).code, 0);
+  const std::string whole = test::readFile(dir.file("c.ply"));
+  test::writeFile(dir.file("cut.ply"), whole.substr(0, whole.size() * 3 / 4));
+  for (const std::string& command :
+       {"points --salvage " + dir.file("cut.ply") + " -o " + dir.file("c.lfc"),
+        "reconstruct --salvage " + dir.file("cut.ply") + " -o " + dir.file("surface.ply"),
+        "tiles --surface --salvage " + dir.file("cut.ply") + " -o " + dir.file("s"),
+        "tiles --salvage " + dir.file("cut.ply") + " -o " + dir.file("t")}) {
+    const Outcome o = lodforge(command, dir);
+    ASSERT_EQ(o.code, 0) << command << "\n" << o.err;
+    EXPECT_NE(o.err.find("warning: " + dir.file("cut.ply")), std::string::npos) << command << "\n"
+                                                                                << o.err;
+    EXPECT_NE(o.err.find("file ends inside"), std::string::npos) << command << "\n" << o.err;
   }
 }
 

@@ -1,6 +1,7 @@
 #include "lodforge/core/distance_bound.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -23,7 +24,9 @@ struct Polygon {
 // Keeps the part of `poly` where dot(x - o, n) >= 0 (a plane adds at most one corner).
 void clipPolygon(Polygon& poly, Vec3d o, Vec3d n) {
   Polygon out;
-  for (std::size_t i = 0; i < poly.count && out.count + 2 <= out.corners.size(); ++i) {
+  // A triangle cut by two planes has at most five corners.
+  assert(poly.count + 1 <= out.corners.size());
+  for (std::size_t i = 0; i < poly.count; ++i) {
     const Vec3d& a = poly.corners[i];
     const Vec3d& b = poly.corners[(i + 1) % poly.count];
     const double sa = dot(a - o, n), sb = dot(b - o, n);
@@ -106,6 +109,7 @@ double PieceBounds::distance(Vec3d p, std::uint32_t t, std::span<const double> c
 
 PieceBound PieceBounds::bound(const std::array<Vec3d, 3>& p,
                               std::span<const double> carried) const {
+  assert(carried.empty() || carried.size() == indices_.size() / 3);
   std::array<std::uint32_t, 3> f{};
   PieceBound out;
   for (std::size_t i = 0; i < 3; ++i) {
@@ -181,7 +185,9 @@ double PieceBounds::edgeBound(const std::array<Vec3d, 3>& p, std::uint32_t g, st
   for (std::size_t i = 0; i < 3; ++i) s[i] = gSide * dot(m, p[i] - edge[0]);
   double worst = 0;
   for (std::size_t i = 0; i < 3; ++i) {
-    worst = std::max(worst, distance(p[i], s[i] >= 0 ? g : h, carried));
+    // A corner on the plane is a corner of both sides' polygons.
+    if (s[i] >= 0) worst = std::max(worst, distance(p[i], g, carried));
+    if (s[i] <= 0) worst = std::max(worst, distance(p[i], h, carried));
     const std::size_t j = (i + 1) % 3;
     if ((s[i] > 0 && s[j] < 0) || (s[i] < 0 && s[j] > 0)) {
       const Vec3d x = p[i] + (p[j] - p[i]) * (s[i] / (s[i] - s[j]));
@@ -193,8 +199,9 @@ double PieceBounds::edgeBound(const std::array<Vec3d, 3>& p, std::uint32_t g, st
 
 // Around corner k of `triangle` (vertex v): the triangles with a corner at v, the axis their
 // summed normals, and the piece cut into sectors of a pencil of planes through the axis (which
-// cover space) at every edge direction from v and at quarters between (so none is half a turn,
-// each convex); each sector bounded through the triangle spanning its middle direction.
+// cover space) at every edge direction from v, gaps wider than a quarter turn cut into equal
+// parts (so none is half a turn: each is convex); each sector bounded through the triangle
+// spanning its middle direction.
 double PieceBounds::vertexBound(const std::array<Vec3d, 3>& p, std::uint32_t triangle, int k,
                                 std::span<const double> carried,
                                 std::vector<std::uint32_t>& used) const {
@@ -235,8 +242,8 @@ double PieceBounds::vertexBound(const std::array<Vec3d, 3>& p, std::uint32_t tri
   if (spans.empty()) return kNone;
   std::sort(cuts.begin(), cuts.end());
   cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
-  // No sector as wide as half a turn (it would not be convex): gaps over a quarter are halved
-  // until they are not.
+  // No sector as wide as half a turn (it would not be convex): a gap over a quarter turn is cut
+  // into equal parts of at most a quarter.
   for (std::size_t i = 0, n = cuts.size(); i < n; ++i) {
     const double next = i + 1 < n ? cuts[i + 1] : cuts[0] + kTurn;
     const int parts = static_cast<int>(std::ceil((next - cuts[i]) / (kTurn / 4)));

@@ -90,6 +90,7 @@ void countPartition(const Partition& partition, PointsBuildStats& stats) {
   stats.blocks = partition.blocks.size();
   stats.streamedPasses = partition.streamedPasses;
   stats.truncation = partition.truncation;
+  stats.warnings = partition.info.warnings;
   stats.minBlock = stats.points;
   for (const PointBlock& b : partition.blocks) {
     stats.minBlock = std::min(stats.minBlock, b.count);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lodforge/core/status.h"
 #include "lodforge/points/cluster.h"
@@ -45,6 +46,7 @@ struct PointsBuildStats {
   double seconds = 0, partitionSeconds = 0;
   std::uint64_t outputBytes = 0;          // package and segment files
   std::optional<std::string> truncation;  // where a salvaged input was cut short
+  std::vector<std::string> warnings;      // what the reader read past (PointCloudInfo)
 };
 
 Result<PointsBuildStats> buildPointCloud(const std::string& input, const std::string& output,

@@ -91,6 +91,9 @@ Result<CloudSummary> copyCloud(const std::string& input, const std::string& path
   }
   progress.finish();
   LODFORGE_TRY(out->finish());
+  cloud.warnings = reader->info().warnings;
+  if (reader->truncation())
+    cloud.warnings.push_back(*reader->truncation() + "; read what came before");
   return cloud;
 }
 

@@ -31,6 +31,9 @@ struct CloudSummary {
   // The local frame's length of one of the input's units (0.3048 for a CRS in feet; 1 without
   // a transform): lengths the user gives in the cloud's units are multiplied by it.
   double unitScale = 1;
+  // What the reader read past (a PLY's other elements, a LAS's unreadable extra bytes) and where
+  // a salvaged input was cut short: for the command to print.
+  std::vector<std::string> warnings;
 };
 
 // Reads `input` (any point format) into the record file `path`, normals made unit (+z where the

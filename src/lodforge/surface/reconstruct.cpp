@@ -417,8 +417,13 @@ Result<ReconstructState> sortIntoRuns(const std::string& input, const std::strin
   LODFORGE_TRY(writeRuns(cloudPath, *layout, reach, *runs, workDirectory));
   std::error_code error;
   std::filesystem::remove(cloudPath, error);
-  return ReconstructState{*layout,          std::move(*runs),   cloud->count,
-                          cloud->hasColors, !cloud->hasNormals, cloud->unitScale};
+  return ReconstructState{*layout,
+                          std::move(*runs),
+                          cloud->count,
+                          cloud->hasColors,
+                          !cloud->hasNormals,
+                          cloud->unitScale,
+                          std::move(cloud->warnings)};
 }
 
 // Passes each piece on and keeps it in the run's pieces file.
@@ -513,6 +518,7 @@ Result<ReconstructStats> reconstructPieces(const std::string& input,
   stats.runs = state->runs.runCount();
   stats.hasColors = state->hasColors;
   stats.estimatedNormals = state->estimatedNormals;
+  stats.warnings = state->warnings;
   LODFORGE_TRY(sink.begin(state->layout, state->hasColors));
   LODFORGE_TRY(makeRuns(*state, workDirectory, options, sink, stats));
   return stats;

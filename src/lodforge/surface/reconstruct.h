@@ -66,7 +66,8 @@ struct ReconstructStats {
   std::uint64_t streamedChunks = 0;  // chunks denser than a run, streamed from their run file
   std::uint64_t resumedRuns = 0;     // runs whose pieces an interrupted reconstruction kept
   bool estimatedNormals = false;
-  bool hasColors = false;  // the points had colours, and so do the vertices
+  bool hasColors = false;             // the points had colours, and so do the vertices
+  std::vector<std::string> warnings;  // the input's reading (CloudSummary::warnings)
 };
 
 // The mesh in memory (tests, small clouds): pieces joined by vertex name.

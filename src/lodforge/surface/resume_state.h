@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -25,6 +26,7 @@ struct ReconstructState {
   std::uint64_t points = 0;
   bool hasColors = false, estimatedNormals = false;
   double unitScale = 1;  // the frame's length of one of the cloud's units (CloudSummary)
+  std::vector<std::string> warnings;  // the reading's (CloudSummary); not kept for --resume
 };
 
 // The state file in a reconstruction's work directory.

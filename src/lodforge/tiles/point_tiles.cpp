@@ -446,7 +446,7 @@ Result<std::uint64_t> writeContents(std::map<std::string, TileNode>& nodes,
 }
 
 // tileset.json: ADD refinement; a tile at depth d stands for the cut at τ_d, a block's tile for
-// every point (error 0); the root placed by the local frame or --origin. Quantised positions
+// every point (τ = 0); the root placed by the local frame or --origin. Quantised positions
 // move each point by up to half a step of its tile's grid on each axis: a tile's error adds that
 // of the largest box showing points with it (the root's, its ancestors' boxes hold its own)
 // for the shown point, and its own for the dropped one as the finer tiles show it. The same
@@ -457,8 +457,11 @@ Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
                              const std::string& path) {
   float rootError = 0;
   for (const BlockTiles& b : blocks) rootError = std::max(rootError, b.rootError);
+  // (A box without extent quantises its one position exactly.)
   const auto stepError = [&](const TileNode& node) {
-    return quantized ? 0.5 * std::sqrt(3.0) * glbQuantizationStep(node.bounds) : 0.0;
+    return quantized && node.bounds.longestSide() > 0
+               ? 0.5 * std::sqrt(3.0) * glbQuantizationStep(node.bounds)
+               : 0.0;
   };
   const double shownError = stepError(nodes.at("b"));
   const std::function<nlohmann::json(const TileNode&)> tile = [&](const TileNode& node) {
@@ -532,6 +535,8 @@ void noteStats(const Partition& partition, const PointTilesOptions& options,
   stats.points = partition.pointCount;
   stats.attributes = partition.info.attributes & options.attributes;
   stats.warnings = partition.info.warnings;
+  if (partition.truncation)
+    stats.warnings.push_back(*partition.truncation + "; built from what came before");
   if (const std::size_t count = vertexAttributeCount(partition.info, stats.attributes);
       count > kViewerVertexAttributes)
     stats.warnings.push_back(fmt::format(

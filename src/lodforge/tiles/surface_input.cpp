@@ -133,6 +133,7 @@ Result<ChunkInput> surfaceChunkInput(const std::string& path, const ChunkInputOp
   input.inputTriangles = sink.triangles();
   input.bounds = sink.bounds();
   input.colors = sink.colors();
+  input.warnings = stats.warnings;
   input.streamed = true;
   return input;
 }

@@ -284,9 +284,9 @@ TEST(GltfRead, AFileOfPointsAloneIsReadAsAPointSet) {
                              {.allowExternalFiles = false, .warnings = &warnings});
   ASSERT_TRUE(model.ok()) << model.error().message;
   EXPECT_EQ(model->vertexCount(), 0u);
-  EXPECT_EQ(warnings,
-            (std::vector<std::string>{
-                "indexed.glb: 1 point primitive (3 corners) not read: only triangles are"}));
+  EXPECT_EQ(warnings, (std::vector<std::string>{
+                          "indexed.glb: 1 point primitive (3 corners) not read: only unindexed, "
+                          "uncompressed point primitives with positions are"}));
 }
 
 TEST(GltfRead, GpuInstancingExpandsIntoObjects) {

@@ -422,8 +422,9 @@ class Loader {
     }
   }
 
-  // A file whose every drawn primitive is points (a point tile, a scan exported as glTF) is read
-  // as a point set, as a PLY without faces is; beside triangles, points are reported (skip).
+  // A file whose meshes (drawn or not) hold no triangles but points (a point tile, a scan
+  // exported as glTF) is read as a point set, as a PLY without faces is; beside triangles,
+  // points are reported (skip).
   bool drawsPointsOnly() const {
     bool points = false;
     for (const tinygltf::Mesh& mesh : gltf_.meshes) {
@@ -453,7 +454,8 @@ class Loader {
     if (mode < kModePoints || mode > kModeFan)
       fail(fmt::format("{}: mode {} is no glTF primitive mode", where, mode));
     if (mode == kModePoints && pointsOnly_ && primitive.indices < 0 &&
-        primitive.extensions.count("KHR_draco_mesh_compression") == 0) {
+        primitive.extensions.count("KHR_draco_mesh_compression") == 0 &&
+        primitive.attributes.count("POSITION") != 0) {
       addPoints(primitive, world, where);
       return;
     }
@@ -501,9 +503,12 @@ class Loader {
     for (const auto& [skipped, kind] :
          {std::pair{&skippedPoints_, "point"}, std::pair{&skippedLines_, "line"}}) {
       if (skipped->primitives == 0) continue;
+      // A points-only file reads its plain point primitives (drawsPointsOnly).
+      const bool pointSet = pointsOnly_ && skipped == &skippedPoints_;
       warnings_->push_back(fmt::format(
-          "{}: {} {} primitive{} ({} corners) not read: only triangles are", name_,
-          skipped->primitives, kind, skipped->primitives == 1 ? "" : "s", skipped->vertices));
+          "{}: {} {} primitive{} ({} corners) not read: only {} are", name_, skipped->primitives,
+          kind, skipped->primitives == 1 ? "" : "s", skipped->vertices,
+          pointSet ? "unindexed, uncompressed point primitives with positions" : "triangles"));
     }
   }
 

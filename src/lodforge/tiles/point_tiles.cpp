@@ -457,11 +457,8 @@ Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
                              const std::string& path) {
   float rootError = 0;
   for (const BlockTiles& b : blocks) rootError = std::max(rootError, b.rootError);
-  // (A box without extent quantises its one position exactly.)
   const auto stepError = [&](const TileNode& node) {
-    return quantized && node.bounds.longestSide() > 0
-               ? 0.5 * std::sqrt(3.0) * glbQuantizationStep(node.bounds)
-               : 0.0;
+    return quantized ? glbQuantizationError(node.bounds) : 0.0;
   };
   const double shownError = stepError(nodes.at("b"));
   const std::function<nlohmann::json(const TileNode&)> tile = [&](const TileNode& node) {

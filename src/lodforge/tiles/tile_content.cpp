@@ -158,9 +158,8 @@ bool tileQuantized(const OctreeNode& node) {
 }
 
 double tileQuantizationError(const OctreeNode& node, bool quantize) {
-  // (A box without extent quantises its one position exactly.)
-  if (!quantize || node.triangles == 0 || !(node.bounds.longestSide() > 0)) return 0;
-  return 0.5 * std::sqrt(3.0) * glbQuantizationStep(node.bounds);
+  if (!quantize || node.triangles == 0) return 0;
+  return glbQuantizationError(node.bounds);
 }
 
 }  // namespace lodforge

@@ -1,6 +1,7 @@
 #include "lodforge/io/mesh/glb_writer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -35,6 +36,10 @@ std::size_t elementBytes(int componentType, std::string_view type) {
 double glbQuantizationStep(const Aabbd& bounds) {
   const double side = bounds.longestSide();
   return side > 0 ? side / 65535.0 : 1.0;
+}
+
+double glbQuantizationError(const Aabbd& bounds) {
+  return bounds.longestSide() > 0 ? 0.5 * std::sqrt(3.0) * glbQuantizationStep(bounds) : 0.0;
 }
 
 struct GlbWriter::State {

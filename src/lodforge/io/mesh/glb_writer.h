@@ -70,6 +70,9 @@ std::array<std::int8_t, 4> glbPackNormal(Vec3f normal);
 
 // The grid step of a quantised mesh inside `bounds`: its longest side over 65535.
 double glbQuantizationStep(const Aabbd& bounds);
+// The farthest a quantised position inside `bounds` moves: half a step on each axis, √3/2 of a
+// step; 0 for a box without extent (its one position is the grid's origin, kept exactly).
+double glbQuantizationError(const Aabbd& bounds);
 
 struct GlbWriteOptions {
   // The default material (objects without one of their own) draws both sides: a PLY, OBJ or

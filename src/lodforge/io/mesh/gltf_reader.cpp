@@ -437,29 +437,17 @@ class Loader {
     return points;
   }
 
-  // An unindexed point primitive of a points-only file: its vertices are the points.
-  void addPoints(const tinygltf::Primitive& primitive, const Mat4d& world,
-                 const std::string& where) {
-    const PrimitiveData data = readPrimitive(primitive, kModePoints, where);
-    const std::size_t base = model_.positions.size() - model_.objects.back().vertexOffset;
-    if (data.positions.size() / 3 > std::numeric_limits<std::uint32_t>::max() - base)
-      fail(fmt::format("{}: too many vertices in one object", where));
-    addVertices(data, world, primitive.material, where);
-  }
-
   void addPrimitive(int meshIndex, const tinygltf::Mesh& mesh, std::size_t p, const Mat4d& world) {
     const auto& primitive = mesh.primitives[p];
     const std::string where = fmt::format("mesh {} primitive {}", meshIndex, p);
     const int mode = primitive.mode < 0 ? kModeTriangles : primitive.mode;
     if (mode < kModePoints || mode > kModeFan)
       fail(fmt::format("{}: mode {} is no glTF primitive mode", where, mode));
-    if (mode == kModePoints && pointsOnly_ && primitive.indices < 0 &&
-        primitive.extensions.count("KHR_draco_mesh_compression") == 0 &&
-        primitive.attributes.count("POSITION") != 0) {
-      addPoints(primitive, world, where);
-      return;
-    }
-    if (mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
+    // An unindexed point primitive of a points-only file: its vertices are the points.
+    const bool points = mode == kModePoints && pointsOnly_ && primitive.indices < 0 &&
+                        primitive.extensions.count("KHR_draco_mesh_compression") == 0 &&
+                        primitive.attributes.count("POSITION") != 0;
+    if (!points && mode != kModeTriangles && mode != kModeStrip && mode != kModeFan) {
       skip(primitive, mode);
       return;
     }

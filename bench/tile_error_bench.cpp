@@ -18,7 +18,6 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <span>
 #include <string>
 #include <vector>
@@ -96,6 +95,21 @@ void appendLeaves(Tileset& set, std::size_t tile, Mesh& out) {
   for (std::size_t c : set.tiles[tile].children) appendLeaves(set, c, out);
 }
 
+using Piece3 = std::array<Vec3d, 3>;
+
+// Triangle t (its first index) of a mesh, in double.
+Piece3 triangleAt(const Mesh& m, std::size_t t) {
+  return {toDouble(m.positions[m.indices[t]]), toDouble(m.positions[m.indices[t + 1]]),
+          toDouble(m.positions[m.indices[t + 2]])};
+}
+
+// A piece split at its edges' midpoints: three corner pieces and the middle one.
+std::array<Piece3, 4> quarters(const Piece3& p) {
+  const Vec3d m01 = (p[0] + p[1]) / 2.0, m12 = (p[1] + p[2]) / 2.0, m20 = (p[2] + p[0]) / 2.0;
+  return {Piece3{p[0], m01, m20}, Piece3{m01, p[1], m12}, Piece3{m20, m12, p[2]},
+          Piece3{m01, m12, m20}};
+}
+
 // sup over A of the distance to B, bracketed by branch and bound: `lower` is a distance some
 // point of A has (vertices and piece centroids, measured exactly), `upper` one no point of A
 // exceeds. A piece of a triangle of A is bounded through the triangle of B nearest its centroid:
@@ -137,19 +151,13 @@ Bracket directedBound(const Mesh& a, const Mesh& b, double ratio, std::size_t bu
     return Piece{std::sqrt(worst), p};
   };
   std::vector<Piece> heap;
-  for (std::size_t t = 0; t + 2 < a.indices.size(); t += 3) {
-    heap.push_back(
-        bound({toDouble(a.positions[a.indices[t]]), toDouble(a.positions[a.indices[t + 1]]),
-               toDouble(a.positions[a.indices[t + 2]])}));
-  }
+  for (std::size_t t = 0; t + 2 < a.indices.size(); t += 3) heap.push_back(bound(triangleAt(a, t)));
   std::make_heap(heap.begin(), heap.end());
   while (!heap.empty() && heap.front().upper > ratio * out.lower && out.pieces < budget) {
     std::pop_heap(heap.begin(), heap.end());
     const std::array<Vec3d, 3> p = heap.back().p;
     heap.pop_back();
-    const Vec3d m01 = (p[0] + p[1]) / 2.0, m12 = (p[1] + p[2]) / 2.0, m20 = (p[2] + p[0]) / 2.0;
-    for (const std::array<Vec3d, 3>& q : {std::array{p[0], m01, m20}, std::array{m01, p[1], m12},
-                                          std::array{m20, m12, p[2]}, std::array{m01, m12, m20}}) {
+    for (const Piece3& q : quarters(p)) {
       heap.push_back(bound(q));
       std::push_heap(heap.begin(), heap.end());
     }
@@ -177,8 +185,7 @@ std::size_t chainPieces(const Mesh& a, const Mesh& b, std::span<const double> ca
   std::vector<std::array<Vec3d, 3>> stack;
   const PieceBounds bounds(b.positions, b.indices);
   for (std::size_t t = 0; t + 2 < a.indices.size(); t += 3) {
-    stack.push_back({toDouble(a.positions[a.indices[t]]), toDouble(a.positions[a.indices[t + 1]]),
-                     toDouble(a.positions[a.indices[t + 2]])});
+    stack.push_back(triangleAt(a, t));
     std::size_t made = 1;
     while (!stack.empty()) {
       const std::array<Vec3d, 3> p = stack.back();
@@ -186,11 +193,7 @@ std::size_t chainPieces(const Mesh& a, const Mesh& b, std::span<const double> ca
       ++pieces;
       const PieceBound bound = bounds.bound(p, carried);
       if (bound.upper - bound.lower > tol && made < cap) {
-        const Vec3d m01 = (p[0] + p[1]) / 2.0, m12 = (p[1] + p[2]) / 2.0, m20 = (p[2] + p[0]) / 2.0;
-        stack.push_back({p[0], m01, m20});
-        stack.push_back({m01, p[1], m12});
-        stack.push_back({m20, m12, p[2]});
-        stack.push_back({m01, m12, m20});
+        for (const Piece3& q : quarters(p)) stack.push_back(q);
         made += 3;
         continue;
       }

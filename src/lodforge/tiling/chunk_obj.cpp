@@ -312,8 +312,8 @@ Status ObjChunking::copyRecords() {
   LODFORGE_TRY(flushRecords(normalFd_, pendingNormals_, "normals.bin"));
   if (triangles_ == 0) return badInput(path_, "no faces: a tileset needs a mesh");
   total_ = counts_;
-  vertices_.emplace(vertexFd_, total_.v, options_.vertexCacheBytes, kVertexBytes);
-  uvs_.emplace(uvFd_, total_.vt, options_.vertexCacheBytes / 4, kUvBytes);
+  vertices_.emplace(vertexFd_, total_.v, options_.vertexCacheBytes, VertexLayout{});
+  uvs_.emplace(uvFd_, total_.vt, options_.vertexCacheBytes / 4, sizeof(Vec2f));
   normals_.emplace(normalFd_, total_.vn, options_.vertexCacheBytes / 4, sizeof(Vec3f));
   input_.colors = vertexColors_;
   return {};
@@ -357,8 +357,8 @@ Status ObjChunking::addVertex(std::uint64_t line, std::span<const std::string_vi
                                        "tileset's frame (outside the coordinate system?)",
                                        line));
   input_.bounds.add(p);
-  std::array<std::byte, kVertexBytes> record{};
-  writeVertexRecord(record.data(), p, toRgba8(rgb[0], rgb[1], rgb[2]), Vec3f{});
+  std::array<std::byte, VertexLayout{}.bytes()> record{};
+  writeVertexRecord(record.data(), VertexLayout{}, p, toRgba8(rgb[0], rgb[1], rgb[2]), Vec3f{});
   ++counts_.v;
   return appendRecord(vertexFd_, pendingVertices_, record.data(), record.size(), "vertices.bin");
 }

@@ -95,7 +95,7 @@ class PlyChunking {
   const std::string& path_;
   const ChunkInputOptions& options_;
   const std::string vertexPath_;
-  std::size_t recordBytes_ = kVertexBytes;  // more with a texture coordinate per vertex
+  VertexLayout layout_;  // of the vertex work file
   std::optional<PlyReader> vertices_, faces_;
   PlyHeader header_;
   int fd_ = -1;
@@ -129,13 +129,15 @@ Status PlyChunking::openVertices() {
     // A texture that cannot be read draws grey: in the vertex colours.
     for (const Material& m : textures.materials) input_.colors |= m.baseColorImage == kNoImage;
     input_.textures = {std::move(textures.materials), std::move(textures.images)};
-    recordBytes_ = kVertexBytes + (header_.hasUvs ? kUvBytes : 0);
+    layout_.uvs = header_.hasUvs;
   } else if (header_.hasUvs || header_.hasFaceUvs) {
     input_.warnings.push_back(
         fmt::format("{}: texture coordinates but no texture (no 'comment "
                     "TextureFile' line): drawn without one",
                     path_));
   }
+  // Float positions stay floats in the work file, unless a transform makes doubles of them.
+  layout_.floatPositions = header_.floatPositions && !options_.transform;
   fd_ = ::open(vertexPath_.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
   if (fd_ < 0) return ioErrorFromErrno(vertexPath_, "create");
   return {};
@@ -162,7 +164,7 @@ Status PlyChunking::copyVertices() {
   LODFORGE_TRY(failure_.status());
   progress_->finish();
   if (input_.bounds.empty()) return badInput(path_, "no vertices");
-  cache_.emplace(fd_, header_.vertexCount, options_.vertexCacheBytes, recordBytes_);
+  cache_.emplace(fd_, header_.vertexCount, options_.vertexCacheBytes, layout_);
   return {};
 }
 
@@ -187,7 +189,7 @@ std::shared_ptr<PlyBatch> PlyChunking::readVertexBatch(tbb::flow_control& contro
 
 void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>& buffer) {
   if (failure_.failed()) return;
-  buffer.resize(batch.positions.size() * recordBytes_);
+  buffer.resize(batch.positions.size() * layout_.bytes());
   for (std::size_t i = 0; i < batch.positions.size(); ++i) {
     Vec3d p = batch.positions[i];
     if (options_.transform && !options_.transform(batch.positions[i], p)) {
@@ -203,12 +205,8 @@ void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>
     const Vec3f n = batch.normals.empty()
                         ? Vec3f{}
                         : transformNormal(options_, batch.positions[i], p, batch.normals[i]);
-    std::byte* record = buffer.data() + i * recordBytes_;
-    writeVertexRecord(record, p, color, n);
-    if (recordBytes_ > kVertexBytes) {
-      const Vec2f uv = batch.uvs.empty() ? Vec2f{} : batch.uvs[i];
-      std::memcpy(record + kVertexBytes, &uv, kUvBytes);
-    }
+    const Vec2f uv = batch.uvs.empty() ? Vec2f{} : batch.uvs[i];
+    writeVertexRecord(buffer.data() + i * layout_.bytes(), layout_, p, color, n, uv);
   }
   if (::write(fd_, buffer.data(), buffer.size()) != static_cast<ssize_t>(buffer.size())) {
     failure_.fail(batch.first, ioErrorFromErrno(vertexPath_, "write"));

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 
 namespace lodforge {
@@ -12,12 +13,25 @@ constexpr std::uint64_t kBlockVertices = 1 << 14;
 
 }  // namespace
 
-void writeVertexRecord(std::byte* record, Vec3d position, Rgba8 color, Vec3f normal) {
-  const double xyz[3] = {position.x, position.y, position.z};
+void writeVertexRecord(std::byte* record, const VertexLayout& layout, Vec3d position, Rgba8 color,
+                       Vec3f normal, Vec2f uv) {
+  if (layout.floatPositions) {
+    const float xyz[3] = {static_cast<float>(position.x), static_cast<float>(position.y),
+                          static_cast<float>(position.z)};
+    std::memcpy(record, xyz, sizeof xyz);
+  } else {
+    const double xyz[3] = {position.x, position.y, position.z};
+    std::memcpy(record, xyz, sizeof xyz);
+  }
   const float n[3] = {normal.x, normal.y, normal.z};
-  std::memcpy(record, xyz, sizeof xyz);
-  std::memcpy(record + sizeof xyz, &color, sizeof color);
-  std::memcpy(record + kNormalOffset, n, sizeof n);
+  std::memcpy(record + layout.positionBytes(), &color, sizeof color);
+  std::memcpy(record + layout.normalOffset(), n, sizeof n);
+  if (layout.uvs) std::memcpy(record + layout.uvOffset(), &uv, sizeof uv);
+}
+
+VertexCache::VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes, VertexLayout layout)
+    : VertexCache(fd, vertices, bytes, layout.bytes()) {
+  layout_ = layout;
 }
 
 VertexCache::VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes,
@@ -31,27 +45,35 @@ VertexCache::VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes,
 }
 
 bool VertexCache::fetch(std::uint64_t vertex, CutCorner& out) {
+  assert(layout_);
   const std::byte* at = record(vertex);
   if (at == nullptr) return false;
-  double xyz[3];
+  if (layout_->floatPositions) {
+    float xyz[3];
+    std::memcpy(xyz, at, sizeof xyz);
+    out.position = {xyz[0], xyz[1], xyz[2]};
+  } else {
+    double xyz[3];
+    std::memcpy(xyz, at, sizeof xyz);
+    out.position = {xyz[0], xyz[1], xyz[2]};
+  }
   float normal[3];
-  std::memcpy(xyz, at, sizeof xyz);
-  std::memcpy(&out.color, at + sizeof xyz, sizeof(Rgba8));
-  std::memcpy(normal, at + kNormalOffset, sizeof normal);
-  out.position = {xyz[0], xyz[1], xyz[2]};
+  std::memcpy(&out.color, at + layout_->positionBytes(), sizeof(Rgba8));
+  std::memcpy(normal, at + layout_->normalOffset(), sizeof normal);
   out.normal = normalizeOr(Vec3f{normal[0], normal[1], normal[2]}, Vec3f{0, 0, 1});
-  if (recordBytes_ > kVertexBytes) std::memcpy(&out.uv, at + kVertexBytes, kUvBytes);
+  if (layout_->uvs) std::memcpy(&out.uv, at + layout_->uvOffset(), sizeof(Vec2f));
   out.source = vertex;
   return true;
 }
 
 bool VertexCache::addNormal(std::uint64_t vertex, Vec3f add) {
+  assert(layout_);
   std::byte* at = record(vertex);
   if (at == nullptr) return false;
   float normal[3];
-  std::memcpy(normal, at + kNormalOffset, sizeof normal);
+  std::memcpy(normal, at + layout_->normalOffset(), sizeof normal);
   normal[0] += add.x, normal[1] += add.y, normal[2] += add.z;
-  std::memcpy(at + kNormalOffset, normal, sizeof normal);
+  std::memcpy(at + layout_->normalOffset(), normal, sizeof normal);
   dirty_[vertex / kBlockVertices % slots_] = 1;
   return true;
 }

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "lodforge/core/math.h"
@@ -13,18 +14,29 @@
 
 namespace lodforge {
 
-// A vertex record: position (3 doubles), colour, normal (3 floats; a sum of face normals while a
-// normals pass accumulates it); for a textured PLY then its texture coordinate (2 floats).
-inline constexpr std::size_t kVertexBytes = 3 * sizeof(double) + sizeof(Rgba8) + 3 * sizeof(float);
-inline constexpr std::size_t kNormalOffset = 3 * sizeof(double) + sizeof(Rgba8);
-inline constexpr std::size_t kUvBytes = sizeof(Vec2f);
+// A vertex record: position (3 doubles, or 3 floats when the input's are floats: exact, and the
+// work file of a 500 M-vertex scan 6 GB smaller), colour, normal (3 floats; a sum of face normals
+// while a normals pass accumulates it), then in a textured PLY's its texture coordinate.
+struct VertexLayout {
+  bool floatPositions = false;
+  bool uvs = false;
 
-// Writes vertex records in the layout above.
-void writeVertexRecord(std::byte* record, Vec3d position, Rgba8 color, Vec3f normal);
+  constexpr std::size_t positionBytes() const { return (floatPositions ? 4 : 8) * std::size_t{3}; }
+  constexpr std::size_t normalOffset() const { return positionBytes() + sizeof(Rgba8); }
+  constexpr std::size_t uvOffset() const { return normalOffset() + 3 * sizeof(float); }
+  constexpr std::size_t bytes() const { return uvOffset() + (uvs ? sizeof(Vec2f) : 0); }
+};
+
+// Writes a vertex record in `layout` (`uv` only where the layout has one).
+void writeVertexRecord(std::byte* record, const VertexLayout& layout, Vec3d position, Rgba8 color,
+                       Vec3f normal, Vec2f uv = {});
 
 class VertexCache {
  public:
-  // `fd` holds `vertices` records of `recordBytes`; the cache takes about `bytes`.
+  // `fd` holds `vertices` records in `layout`; the cache takes about `bytes`.
+  VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes, VertexLayout layout);
+  // Records of another kind (an OBJ's texture coordinates, normals), `recordBytes` each: read
+  // through at() only.
   VertexCache(int fd, std::uint64_t vertices, std::uint64_t bytes, std::size_t recordBytes);
 
   // A vertex record's position, colour, normal (normalized) and, in longer records, texture
@@ -44,6 +56,7 @@ class VertexCache {
 
   int fd_;
   std::uint64_t vertices_;
+  std::optional<VertexLayout> layout_;  // none for records of another kind
   std::size_t recordBytes_;
   std::uint64_t slots_ = 0;
   std::vector<std::byte> data_;

@@ -312,8 +312,11 @@ PlyRoles assignPlyRoles(PlyHeader& header, const std::string& name, bool readExt
     if (comment.starts_with("TextureFile ")) header.textureFiles.push_back(comment.substr(12));
   }
   if (readExtras) planExtras(v, roles, header.extras);
-  header.doublePositions =
-      v.properties[static_cast<std::size_t>(roles.x)].type == PlyType::kFloat64;
+  const auto typeOf = [&](int role) { return v.properties[static_cast<std::size_t>(role)].type; };
+  header.doublePositions = typeOf(roles.x) == PlyType::kFloat64;
+  header.floatPositions = typeOf(roles.x) == PlyType::kFloat32 &&
+                          typeOf(roles.y) == PlyType::kFloat32 &&
+                          typeOf(roles.z) == PlyType::kFloat32;
   if (header.vertexCount > std::numeric_limits<std::uint32_t>::max()) {
     throw ErrorException{badInput(name, fmt::format("{} vertices: lodforge indexes at most 2^32-1 "
                                                     "vertices per file",

@@ -69,6 +69,7 @@ struct PlyHeader {
   bool hasTextureNumbers = false;
   std::vector<std::string> textureFiles;
   bool doublePositions = false;  // x y z stored as double: keep the double origin
+  bool floatPositions = false;   // x y z all stored as float: floats hold them exactly
   // The vertex's other scalar properties (label, segment_index, …), with readExtras.
   PointExtras extras;
 };

@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-closed, surface-tiles, cad, instances, textures, textured-obj, texture-formats, gltfpack or serve runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-closed, surface-tiles, cad, instances, textures, textured-obj, texture-formats, gltfpack, serve, tile-error, implicit or billion runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -725,6 +725,50 @@ tile_error_section() {
   rm -rf "$work"/te-*
 }
 if [[ ${BENCH_ONLY:-} == tile-error ]]; then tile_error_section; exit 0; fi
+
+# Explicit against implicit tiling (issue 38): the same scan tiled both ways, tileset.json size
+# and CesiumJS's time to its first frame (bench/cesium_first_frame.mjs, headless chromium).
+implicit_section() {
+  echo
+  local n=${IMPLICIT_TRIANGLES:-10M}
+  echo "== explicit against implicit tiling: a $n-triangle scan in CesiumJS"
+  "$lodforge" -q generate scan --triangles "$n" -o "$work/im-scan.ply"
+  for mode in off on; do
+    read -r s kib < <(timed "$lodforge" -q tiles "$work/im-scan.ply" -o "$work/im-$mode" \
+      --implicit-tiling "$mode" --origin 8.54,47.37,400)
+    echo "tiles --implicit-tiling $mode: $s s, $((kib / 1024)) MiB peak, $(du -sh "$work/im-$mode" | cut -f1)," \
+      "tileset.json $(stat -c %s "$work/im-$mode/tileset.json") bytes"
+  done
+  node bench/cesium_first_frame.mjs --runs "${IMPLICIT_RUNS:-3}" "$work/im-off" "$work/im-on"
+  rm -rf "$work"/im-*
+}
+if [[ ${BENCH_ONLY:-} == implicit ]]; then implicit_section; exit 0; fi
+
+# A billion triangles end to end (issue 37; about 80 GB of disk at its peak): generation, then
+# tiles with the work directory's size, the process's bytes read and written, its memory and
+# the stage it is in polled every 5 s into build/bench/billion-poll.log.
+billion_section() {
+  echo
+  echo "== a billion-triangle scan end to end"
+  read -r s kib < <(timed "$lodforge" generate scan --triangles 1G -o "$work/scan1g.ply")
+  echo "generate scan --triangles 1G: $s s, $((kib / 1024)) MiB peak"
+  /usr/bin/time -v "$lodforge" -v tiles "$work/scan1g.ply" -o "$work/tiles1g" 2> "$work/billion.log" &
+  local timer=$! pid=""
+  while kill -0 $timer 2> /dev/null; do
+    [[ -n $pid ]] || pid=$(pgrep -P $timer || true)
+    if [[ -n $pid && -r /proc/$pid/io ]]; then
+      echo "$(date +%s) $(awk '/^(read|write)_bytes/ {printf "%s=%s ", $1, $2}' /proc/$pid/io)" \
+        "rss=$(awk '/VmRSS/ {print $2}' /proc/$pid/status) work=$(du -sb "$work/tiles1g.work" | cut -f1)" \
+        "| $(tr '\r' '\n' < "$work/billion.log" | grep '^tiles' | tail -1)" >> "$work/billion-poll.log"
+    fi
+    sleep 5
+  done
+  wait $timer
+  read -r s kib < <(seconds_and_kib "$work/billion.log")
+  echo "tiles: $s s, $((kib / 1024)) MiB peak, $(du -sh "$work/tiles1g" | cut -f1) written"
+  rm -rf "$work/scan1g.ply" "$work/tiles1g"
+}
+if [[ ${BENCH_ONLY:-} == billion ]]; then billion_section; exit 0; fi
 
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 

@@ -2,9 +2,9 @@
 # Tilesets lodforge writes, loaded by CesiumJS in Debian's headless chromium from a local HTTP
 # server (tests/js/cesium-tiles.mjs): the horse georeferenced with --origin, and a generated scan
 # with meshopt-compressed contents, both with KHR_mesh_quantization (the default), and a
-# generated 2,000-part assembly (tiled by part, colours per part), and a LAS point cloud placed from
-# its own coordinate system. Fails on any tile failure, failed request or console error,
-# or if the screenshot does not show the model.
+# generated 2,000-part assembly (tiled by part, colours per part), a LAS point cloud placed from
+# its own coordinate system, and the scan again with implicit tiling. Fails on any tile failure,
+# failed request or console error, or if the screenshot does not show the model.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -21,6 +21,12 @@ node "$here/js/cesium-tiles.mjs" "$out/horse" "$out/horse.png" --min-coverage 0.
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan" --chunk-size 150 --compress meshopt \
   --origin -122.4,37.8,10
 node "$here/js/cesium-tiles.mjs" "$out/scan" "$out/scan.png" --min-coverage 0.2
+# The same scan with implicit tiling (subtree files, errors and boxes as tile metadata): CesiumJS
+# must fetch the same contents and draw the same picture.
+"$lodforge" -q tiles "$out/scan.ply" -o "$out/scan-implicit" --chunk-size 150 --compress meshopt \
+  --origin -122.4,37.8,10 --implicit-tiling on
+node "$here/js/cesium-tiles.mjs" "$out/scan-implicit" "$out/scan-implicit.png" --min-coverage 0.2 \
+  --same-as "$out/scan.png"
 "$lodforge" -q generate cad --objects 2000 --seed 5 -o "$out/cad.glb"
 "$lodforge" -q tiles "$out/cad.glb" -o "$out/cad" --origin 2.35,48.85,35
 node "$here/js/cesium-tiles.mjs" "$out/cad" "$out/cad.png" --min-coverage 0.05

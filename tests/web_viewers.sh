@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # The browser viewers end to end (tests/js/web-viewers.mjs): `lodforge serve` on a free loopback
 # port, the CesiumJS and the three.js page in headless chromium, for a mesh tileset (the horse,
-# georeferenced, meshopt-compressed), a point tileset (a LAS placed from its own CRS) and the
-# surface reconstructed from a LAZ scan (tiles --surface, placed from the file's CRS), and a STEP
-# assembly whose parts are picked, found, highlighted and hidden in both viewers, and a generated
-# STEP assembly whose parts are also hidden by CAD layer, and a textured OBJ (a red and blue
-# checker) whose texture both viewers must draw.
+# georeferenced, meshopt-compressed, and again with implicit tiling), a point tileset (a LAS
+# placed from its own CRS) and the surface reconstructed from a LAZ scan (tiles --surface, placed
+# from the file's CRS), and a STEP assembly whose parts are picked, found, highlighted and hidden
+# in both viewers, and a generated STEP assembly whose parts are also hidden by CAD layer, and a
+# textured OBJ (a red and blue checker) whose texture both viewers must draw.
 set -euo pipefail
 lodforge=$1 data=$2 out=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -18,6 +18,13 @@ rm -rf "$out" && mkdir -p "$out/horse-shots" "$out/autzen-shots" "$out/surface-s
 "$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse" --chunk-size 0.05 \
   --origin 8.5417,47.3769,408 --compress meshopt
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/horse" "$out/horse-shots" --min-coverage 0.03
+# The horse again with implicit tiling (subtree files; the three.js page reads their metadata, so
+# both viewers take the same errors and draw the same triangles).
+mkdir -p "$out/horse-implicit-shots"
+"$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse-implicit" --chunk-size 0.02 \
+  --origin 8.5417,47.3769,408 --implicit-tiling on
+node "$here/js/web-viewers.mjs" "$lodforge" "$out/horse-implicit" "$out/horse-implicit-shots" \
+  --min-coverage 0.03 --same-drawn
 "$lodforge" -q tiles "$here/data/textured/checker-plane.obj" -o "$out/checker" --chunk-size 30 \
   --origin 8.5417,47.3769,408
 node "$here/js/web-viewers.mjs" "$lodforge" "$out/checker" "$out/checker-shots" --min-coverage 0.1 \

@@ -64,6 +64,7 @@ struct TilesCommand {
   bool resume = false;
   std::string origin, crs;
   std::string compress = "none";
+  std::string implicitTiling = "auto";
   bool noQuantization = false;
   std::string parts = "auto";
   std::uint64_t blockSize = 50'000;
@@ -113,6 +114,11 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
                  "none, or meshopt: EXT_meshopt_compression (smaller tiles; CesiumJS and "
                  "three.js decode it)")
       ->check(CLI::IsMember({"none", "meshopt"}));
+  sub.add_option("--implicit-tiling", options.implicitTiling,
+                 "Meshes: on (tileset.json holds the root; subtree files say which tiles exist, "
+                 "each tile's error and box in their metadata), off (every tile listed), or auto "
+                 "(on above 10,000 tiles)")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   sub.add_flag("--no-quantization", options.noQuantization,
                "Float positions and normals everywhere instead of KHR_mesh_quantization (16-bit "
                "positions, 8-bit normals) in the tiles where it is invisible");
@@ -174,6 +180,13 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
   tiles.crs = options.crs;
   tiles.meshoptCompression = options.compress == "meshopt";
   tiles.quantize = !options.noQuantization;
+  tiles.implicitTiling = options.implicitTiling == "on"    ? ImplicitTiling::kOn
+                         : options.implicitTiling == "off" ? ImplicitTiling::kOff
+                                                           : ImplicitTiling::kAuto;
+  if (tiles.implicitTiling == ImplicitTiling::kOn && options.levels > 0)
+    return Error{ErrorKind::kUsage,
+                 "--implicit-tiling on and --levels: implicit tiling needs the octree up to a "
+                 "single root"};
   tiles.atlas.maxSize = options.textureSize;
   tiles.textureEncoding = {.format = options.textureFormat == "png"    ? ImageFormat::kPng
                                      : options.textureFormat == "webp" ? ImageFormat::kWebp
@@ -198,6 +211,12 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: a point cloud; --levels, --chunk-size and --resume are for "
                              "meshes (a point tileset's depth follows --block-size)",
+                             options.input)};
+  if (options.implicitTiling == "on")
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: a point cloud; --implicit-tiling is for meshes (point tiles "
+                             "split at centroids, not into the equal octants implicit tiling "
+                             "describes)",
                              options.input)};
   PointTilesOptions points;
   points.blockSize = std::max<std::uint64_t>(1, options.blockSize);
@@ -245,9 +264,10 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
                         : ""));
   }
   say(global,
-      fmt::format("wrote {}: {} tiles ({} leaves, {} levels above them){}, {} in {:.1f} s ({} "
+      fmt::format("wrote {}: {} tiles ({} leaves, {} levels above them{}){}, {} in {:.1f} s ({} "
                   "input triangles/s)",
                   options.output, formatCount(stats.tiles), formatCount(stats.leaves), stats.levels,
+                  stats.implicitTiling ? "; implicit tiling" : "",
                   stats.parts > 0 ? fmt::format(", {} named parts ({} in the coarsest tiles; {})",
                                                 formatCount(stats.parts),
                                                 formatCount(stats.partsInRoot), kPartsFileName)

@@ -1,17 +1,22 @@
 // Loads a tileset lodforge wrote in CesiumJS, in Debian's headless chromium (playwright-core),
 // from a local HTTP server: waits until every tile is loaded, fails on any tile failure, failed
-// request or console error, and checks that the screenshot shows the model.
-//   node cesium-tiles.mjs TILESET_DIR SCREENSHOT.png [--min-coverage 0.02]
+// request or console error, and checks that the screenshot shows the model. Writes beside the
+// screenshot SCREENSHOT.json: the contents fetched and their bytes. With --same-as OTHER.png
+// (a run on the same model written another way: implicit tiling), seen from that run's camera,
+// the picture must match that one's and the same contents must have been fetched.
+//   node cesium-tiles.mjs TILESET_DIR SCREENSHOT.png [--min-coverage 0.02] [--same-as OTHER.png]
 import http from 'node:http';
 import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { coverageOf, keepLocal, launchChromium } from './chromium.mjs';
+import { coverageOf, differenceOf, keepLocal, launchChromium } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const [tilesetDir, screenshot] = process.argv.slice(2);
 const coverageArg = process.argv.indexOf('--min-coverage');
 const minCoverage = coverageArg > 0 ? Number(process.argv[coverageArg + 1]) : 0.02;
+const sameArg = process.argv.indexOf('--same-as');
+const sameAs = sameArg > 0 ? process.argv[sameArg + 1] : null;
 if (!tilesetDir || !screenshot) {
   console.error('usage: node cesium-tiles.mjs TILESET_DIR SCREENSHOT.png [--min-coverage F]');
   process.exit(2);
@@ -40,7 +45,20 @@ window.report = { failed: [], loaded: false, error: null };
                                                          { maximumScreenSpaceError: 4 });
     tileset.tileFailed.addEventListener((e) => window.report.failed.push(e.url + ': ' + e.message));
     viewer.scene.primitives.add(tileset);
-    await viewer.zoomTo(tileset);
+    // The other run's camera (--same-as): an implicit tileset's root volume is the whole octree
+    // cube, so zooming to it would frame the model differently.
+    const camera = await (await fetch('/camera.json')).json();
+    if (camera) {
+      viewer.camera.setView({ destination: Cesium.Cartesian3.fromArray(camera.position),
+                              orientation: { direction: Cesium.Cartesian3.fromArray(camera.direction),
+                                             up: Cesium.Cartesian3.fromArray(camera.up) } });
+    } else {
+      await viewer.zoomTo(tileset);
+    }
+    const c = viewer.camera;
+    window.report.camera = { position: Cesium.Cartesian3.pack(c.position, []),
+                             direction: Cesium.Cartesian3.pack(c.direction, []),
+                             up: Cesium.Cartesian3.pack(c.up, []) };
     tileset.allTilesLoaded.addEventListener(() => { window.report.loaded = true; });
   } catch (e) {
     window.report.error = String(e && e.stack || e);
@@ -52,6 +70,7 @@ const types = { '.json': 'application/json', '.glb': 'model/gltf-binary', '.js':
                 '.css': 'text/css', '.png': 'image/png', '.wasm': 'application/wasm',
                 '.html': 'text/html', '.xml': 'application/xml', '.jpg': 'image/jpeg' };
 const failedRequests = [];
+const fetched = { contents: [], bytes: 0 };
 const server = http.createServer(async (request, response) => {
   const url = decodeURIComponent(new URL(request.url, 'http://localhost').pathname);
   let file = null;
@@ -64,8 +83,18 @@ const server = http.createServer(async (request, response) => {
       response.end(page);
       return;
     }
+    if (url === '/camera.json') {
+      const other = sameAs ? JSON.parse(await readFile(sameAs.replace(/\.png$/, '.json'), 'utf8')) : null;
+      response.writeHead(200, { 'content-type': 'application/json' });
+      response.end(JSON.stringify(other ? other.camera : null));
+      return;
+    }
     if (!file || file.includes('..')) throw new Error('outside');
     const body = await readFile(file);
+    if (url.endsWith('.glb')) {
+      fetched.contents.push(path.relative(tilesetDir, file));
+      fetched.bytes += body.length;
+    }
     response.writeHead(200, { 'content-type': types[path.extname(file)] ?? 'application/octet-stream' });
     response.end(body);
   } catch {
@@ -98,6 +127,18 @@ try {
   const coverage = await coverageOf(tab, png, [0, 0, 0]);
   console.log(`coverage ${(100 * coverage).toFixed(1)} % of the pixels; screenshot ${screenshot}`);
   if (coverage < minCoverage) problems.push(`the model covers ${(100 * coverage).toFixed(2)} % of the view`);
+  await writeFile(screenshot.replace(/\.png$/, '.json'),
+                  JSON.stringify({ contents: fetched.contents.length, bytes: fetched.bytes,
+                                   camera: report.camera }));
+  console.log(`fetched ${fetched.contents.length} contents, ${fetched.bytes} bytes`);
+  if (sameAs) {
+    const other = JSON.parse(await readFile(sameAs.replace(/\.png$/, '.json'), 'utf8'));
+    const difference = await differenceOf(tab, png, await readFile(sameAs));
+    console.log(`${(100 * difference).toFixed(2)} % of the pixels differ from ${sameAs}`);
+    if (difference > 0.005) problems.push(`the picture differs from ${sameAs} in ${(100 * difference).toFixed(2)} % of its pixels`);
+    if (other.contents !== fetched.contents.length || other.bytes !== fetched.bytes)
+      problems.push(`fetched ${fetched.contents.length} contents (${fetched.bytes} bytes), ${sameAs} ${other.contents} (${other.bytes} bytes)`);
+  }
 } catch (e) {
   problems.push(String(e));
 } finally {

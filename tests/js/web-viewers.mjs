@@ -6,6 +6,7 @@
 // and hiding every class in the legend must empty the view.
 // With --texture-hues, the tileset's texture is red and blue: both colours must show.
 //   node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage 0.02] [--texture-hues F]
+//                        [--same-drawn]
 import { spawn } from 'node:child_process';
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
@@ -18,6 +19,10 @@ const minCoverage = coverageArg > 0 ? Number(process.argv[coverageArg + 1]) : 0.
 // model's pixels.
 const huesArg = process.argv.indexOf('--texture-hues');
 const minHue = huesArg > 0 ? Number(process.argv[huesArg + 1]) : 0;
+// With --same-drawn, both viewers must draw the same triangles (tiles whose errors both read
+// from the same place: an implicit tileset's metadata).
+const sameDrawn = process.argv.includes('--same-drawn');
+const drawnTriangles = {};
 if (!lodforge || !tilesetDir || !outDir) {
   console.error('usage: node web-viewers.mjs LODFORGE TILESET_DIR OUT_DIR [--min-coverage F]');
   process.exit(2);
@@ -201,6 +206,7 @@ try {
     const twice = [...tileGets].filter(([, n]) => n > 1);
     if (viewer === 'three' && twice.length > 0) mine(`${twice.length} tile(s) downloaded more than once, e.g. ${twice[0][0]}`);
     const stats = await tab.evaluate(() => document.getElementById('stats').textContent);
+    drawnTriangles[viewer] = (stats.match(/([\d,]+) triangles/) ?? [, 'none'])[1];
     const png = await tab.screenshot();
     const shot = path.join(outDir, `${viewer}.png`);
     writeFileSync(shot, png);
@@ -227,6 +233,8 @@ try {
     }
     await tab.close();
   }
+  if (sameDrawn && drawnTriangles.cesium !== drawnTriangles.three)
+    problems.push(`CesiumJS draws ${drawnTriangles.cesium} triangles, three.js ${drawnTriangles.three}`);
 } catch (e) {
   problems.push(String(e));
 } finally {

@@ -12,6 +12,8 @@ const report = (window.lodforge = { loaded: false, failed: [], error: null, tile
 // points are spread over the whole cloud, so its classes are the common ones).
 async function rootContent(tileset) {
   const json = await (await fetch('/tiles/tileset.json')).json();
+  // Implicit tiling is for meshes only: no point fields to colour.
+  if (json.root.implicitTiling) return null;
   let tile = json.root;
   while (!tile.content && tile.children) tile = tile.children[0];
   if (!tile.content) return null;
@@ -195,13 +197,17 @@ async function main() {
     pointCloudShading: { attenuation: true, maximumAttenuation: 6 },
   });
   viewer.scene.primitives.add(tileset);
-  frameTileset(viewer, tileset);
+  // Loaded once the final framing's tiles are in (an implicit tileset is framed twice).
+  let framed = false, setUp = false;
+  frameTileset(viewer, tileset, () => {
+    framed = true;
+    if (setUp) report.loaded = true;
+  });
   report.rootCorners = () => rootCorners(viewer, tileset);
   tileset.tileFailed.addEventListener((e) => report.failed.push(`${e.url}: ${e.message}`));
   tileset.tileLoad.addEventListener(() => { report.tilesLoaded += 1; });
   // Loaded: every tile the view needs, once the panels are set up too (the tiles may be in first).
-  let setUp = false;
-  tileset.allTilesLoaded.addEventListener(() => { if (setUp) report.loaded = true; });
+  tileset.allTilesLoaded.addEventListener(() => { if (setUp && framed) report.loaded = true; });
   // What is drawn this frame: tiles, and their triangles or points.
   let drawn = { tiles: 0, triangles: 0, points: 0 };
   tileset.tileVisible.addEventListener((tile) => {
@@ -226,14 +232,41 @@ async function main() {
   await addColouring(viewer.scene, tileset);
   await addParts(viewer, tileset);
   setUp = true;
-  if (tileset.tilesLoaded) report.loaded = true;
+  if (tileset.tilesLoaded && framed) report.loaded = true;
 }
 
 // The camera looks down at 45 degrees from where the root's bounding sphere just fills the
 // narrower field of view, so the whole tileset is on screen when it opens (viewer.flyTo
 // zoomed into big tilesets: an airborne cloud opened on a few trees at ground level).
-function frameTileset(viewer, tileset) {
-  const sphere = tileset.boundingSphere;
+// `done` is called once the framing is final and its tiles are loaded.
+function frameTileset(viewer, tileset, done) {
+  frameSphere(viewer, tileset.boundingSphere);
+  // An implicit tileset's root volume is its whole octree cube: once the first subtree is in,
+  // its root tile's own volume (the tight box of the subtree's metadata) frames the view.
+  if (!tileset.root.implicitTileset) {
+    done();
+    return;
+  }
+  const remove = viewer.scene.postRender.addEventListener(() => {
+    const first = tileset.root.children[0];
+    if (!first) return;
+    remove();
+    frameSphere(viewer, first.boundingSphere);
+    let frames = 0;
+    const settle = viewer.scene.postRender.addEventListener(() => {
+      if (++frames < 2) {
+        viewer.scene.requestRender();  // a frame of the new view first
+        return;
+      }
+      if (!tileset.tilesLoaded) return;
+      settle();
+      done();
+    });
+    viewer.scene.requestRender();
+  });
+}
+
+function frameSphere(viewer, sphere) {
   // Cesium's `fov` is the wider of the two angles; `fovy` the vertical.
   const frustum = viewer.camera.frustum;
   const half = Math.min(frustum.fov, frustum.fovy) / 2;
@@ -247,7 +280,9 @@ function frameTileset(viewer, tileset) {
 // For tests: the root's bounding box corners in CSS pixels of the canvas (null: behind the
 // camera).
 function rootCorners(viewer, tileset) {
-  const volume = tileset.root.boundingVolume.boundingVolume;
+  const root = tileset.root.implicitTileset ? tileset.root.children[0] : tileset.root;
+  if (!root) return [];
+  const volume = root.boundingVolume.boundingVolume;
   const corners = [];
   if (volume instanceof Cesium.OrientedBoundingBox) {
     const axes = [0, 1, 2].map((c) => Cesium.Matrix3.getColumn(volume.halfAxes, c, new Cesium.Cartesian3()));

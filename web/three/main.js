@@ -6,7 +6,8 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { MeshoptDecoder } from 'three/examples/jsm/libs/meshopt_decoder.module.js';
 import { TilesRenderer } from '3d-tiles-renderer';
-import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
+import { GLTFExtensionsPlugin, ImplicitTilingPlugin } from '3d-tiles-renderer/plugins';
+import { ImplicitMetadataPlugin } from './implicit_metadata.js';
 import { drawnSummary, formatBytes, formatCount, onScreenSpaceError } from '../format.js';
 import { boundsOf, loadParts, partsPanel } from '../parts_panel.js';
 import { classColor, colorModes, colorPanel, intensityGrey, ramp } from '../point_colors.js';
@@ -262,6 +263,9 @@ function main() {
   const tiles = new TilesRenderer('/tiles/tileset.json');
   // EXT_meshopt_compression contents (lodforge tiles --compress meshopt).
   tiles.registerPlugin(new GLTFExtensionsPlugin({ meshoptDecoder: MeshoptDecoder, plugins: [partIdsPlugin] }));
+  // Implicit tilesets (lodforge tiles --implicit-tiling): the metadata first, then the subtrees.
+  tiles.registerPlugin(new ImplicitMetadataPlugin());
+  tiles.registerPlugin(new ImplicitTilingPlugin());
   tiles.errorTarget = 16;
   tiles.setCamera(camera);
   tiles.setResolutionFromRenderer(camera, renderer);
@@ -272,6 +276,14 @@ function main() {
   // Framed once the root is in: its bounding sphere, in the tileset's local frame (the root
   // transform undone, z-up turned to y-up).
   let framed = false;
+  // The tile whose volume frames the view: the root, or for an implicit tileset (its root volume
+  // is the whole octree cube) the root's own content tile once the first subtree is in, whose
+  // volume is the tight box of the subtree's metadata.
+  const framingTile = () => {
+    const root = tiles.rootTileSet && tiles.rootTileSet.root;
+    const tile = root && root.implicitTiling ? root.children[0] : root;
+    return tile && tile.cached && tile.cached.boundingVolume ? tile : null;
+  };
   const frame = () => {
     const rootTransform = tiles.rootTileSet && tiles.rootTileSet.root && tiles.rootTileSet.root.transform;
     if (rootTransform) {
@@ -281,7 +293,9 @@ function main() {
     pivot.rotation.x = -Math.PI / 2;  // 3D Tiles are z-up, three.js is y-up
     pivot.updateMatrixWorld(true);
     const sphere = new THREE.Sphere();
-    if (!tiles.getBoundingSphere(sphere)) return false;
+    const tile = framingTile();
+    if (!tile) return false;
+    tile.cached.boundingVolume.getSphere(sphere);
     sphere.applyMatrix4(tiles.group.matrixWorld);
     controls.target.copy(sphere.center);
     camera.position.copy(sphere.center)
@@ -293,10 +307,11 @@ function main() {
     colouring.heights = [sphere.center.y - sphere.radius, sphere.center.y + sphere.radius];
     return true;
   };
-  // For tests: the root's bounding box corners in CSS pixels (null: behind the camera).
+  // For tests: the framing tile's bounding box corners in CSS pixels (null: behind the camera).
   report.rootCorners = () => {
     const root = tiles.rootTileSet && tiles.rootTileSet.root;
-    const box = root && root.boundingVolume && root.boundingVolume.box;
+    const tile = framingTile();
+    const box = tile && tile.boundingVolume && tile.boundingVolume.box;
     if (!box) return [];
     const toTiles = root.transform ? new THREE.Matrix4().fromArray(root.transform) : new THREE.Matrix4();
     const corners = [];

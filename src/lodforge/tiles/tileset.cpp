@@ -166,6 +166,18 @@ Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& op
   return fresh;
 }
 
+// Whether the tileset goes out with implicit tiling: asked for (refused where the octree is no
+// single subdivision), or by its size.
+Result<bool> implicitTilingWanted(ImplicitTiling wanted, const OctreeResult& tree) {
+  const bool fits = implicitTilingFits(tree);
+  if (wanted == ImplicitTiling::kOn && !fits)
+    return Error{ErrorKind::kUsage,
+                 "implicit tiling needs the octree up to a single root; --levels stopped it "
+                 "below one"};
+  if (wanted != ImplicitTiling::kAuto) return wanted == ImplicitTiling::kOn;
+  return fits && tree.nodes.size() > kImplicitTilingAboveTiles;
+}
+
 // The octree over the chunks, each tile written into the staged tileset as soon as it is built.
 Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& options,
                                 const OctreeOptions& octree, const std::string& tilesetDirectory,
@@ -295,8 +307,16 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
       buildTiles(*chunked, options, octree, place.staging.path, *pyramid ? &texturing : nullptr);
   if (!tree) return tree.status();
   const std::string partsUri = chunked->parts.empty() ? "" : kPartsFileName;
-  LODFORGE_TRY(writeTilesetJson(*tree, place.staging.path + "/tileset.json", chunked->frame,
-                                options.quantize, partsUri));
+  Result<bool> implicit = implicitTilingWanted(options.implicitTiling, *tree);
+  if (!implicit) return implicit.status();
+  stats.implicitTiling = *implicit;
+  if (*implicit)
+    LODFORGE_TRY(writeImplicitTileset(*tree, chunked->chunks->grid(), place.staging.path,
+                                      chunked->frame, options.quantize, partsUri,
+                                      options.subtreeLevels));
+  else
+    LODFORGE_TRY(writeTilesetJson(*tree, place.staging.path + "/tileset.json", chunked->frame,
+                                  options.quantize, partsUri));
   if (!partsUri.empty())
     LODFORGE_TRY(writePartsJson(*tree, chunked->parts, place.staging.path + "/" + partsUri));
   countTiles(*tree, stats);

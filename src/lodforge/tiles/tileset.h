@@ -14,6 +14,7 @@
 #include "lodforge/io/image/image_codec.h"
 #include "lodforge/surface/reconstruct.h"
 #include "lodforge/tiles/georeference.h"
+#include "lodforge/tiles/implicit_tiling.h"
 #include "lodforge/tiles/memory_plan.h"
 #include "lodforge/tiles/tile_atlas.h"
 #include "lodforge/tiles/tile_content.h"
@@ -23,6 +24,12 @@
 #include "lodforge/tiling/octree.h"
 
 namespace lodforge {
+
+// tileset.json listing every tile, or an implicit one (implicit_tiling.h): its root and subtree
+// files. Auto: implicit above kImplicitTilingAboveTiles tiles, where a listing grows to
+// megabytes that a viewer reads whole before its first frame.
+enum class ImplicitTiling : std::uint8_t { kAuto, kOn, kOff };
+inline constexpr std::uint64_t kImplicitTilingAboveTiles = 10'000;
 
 struct TilesOptions {
   ChunkInputOptions input;  // chunk size, buffers (its work directory is set by writeTiles)
@@ -40,6 +47,8 @@ struct TilesOptions {
   std::string crsFrom = "--crs";    // where `crs` came from, for messages ("the CRS in x.laz")
   bool meshoptCompression = false;  // --compress meshopt: EXT_meshopt_compression contents
   bool quantize = true;             // KHR_mesh_quantization where it is invisible (tileQuantized)
+  ImplicitTiling implicitTiling = ImplicitTiling::kAuto;
+  int subtreeLevels = kSubtreeLevels;  // levels per subtree file of an implicit tileset
   // A point cloud: its surface reconstructed chunk by chunk into the leaves (surface_input.h).
   std::optional<ReconstructOptions> surface;
   // A textured input's: tile texture pages (size cap, gutters), their encoding, and the bytes
@@ -56,6 +65,7 @@ struct TilesStats {
   std::uint64_t leafTriangles = 0;  // after cutting at the chunk planes
   std::uint64_t tiles = 0, leaves = 0;
   int levels = 0;
+  bool implicitTiling = false;  // written with implicit tiling (subtree files)
   double chunkSize = 0;
   std::uint64_t outputBytes = 0;
   double seconds = 0, chunkSeconds = 0;  // all, and reading + cutting into chunks

@@ -29,23 +29,34 @@ std::string tileContentUri(const OctreeNode& node) {
   return fmt::format("tiles/{}-{}-{}-{}.glb", node.level, node.cell[0], node.cell[1], node.cell[2]);
 }
 
-Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
-                        const std::optional<Mat4d>& rootTransform, bool quantized,
-                        const std::string& partsUri) {
+std::vector<double> declaredTileErrors(const OctreeResult& octree, bool quantized) {
   // Children come before their parents in the node list: one pass collects each subtree's
   // largest quantisation error.
   std::vector<double> quantization(octree.nodes.size(), 0.0);
+  std::vector<double> errors(octree.nodes.size());
   for (std::size_t i = 0; i < octree.nodes.size(); ++i) {
     const OctreeNode& node = octree.nodes[i];
     quantization[i] = tileQuantizationError(node, quantized && tileQuantized(node));
     for (std::uint32_t c : node.children)
       quantization[i] = std::max(quantization[i], quantization[c]);
+    errors[i] = node.geometricError + quantization[i];
   }
+  return errors;
+}
+
+double nothingShownError(const OctreeResult& octree, double rootError) {
+  return std::max(rootError * 2, length(octree.nodes[octree.root].bounds.size()));
+}
+
+Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
+                        const std::optional<Mat4d>& rootTransform, bool quantized,
+                        const std::string& partsUri) {
+  const std::vector<double> errors = declaredTileErrors(octree, quantized);
   // Depth first; children listed in node order.
   std::function<nlohmann::json(std::uint32_t)> tile = [&](std::uint32_t index) {
     const OctreeNode& node = octree.nodes[index];
     nlohmann::json out = {{"boundingVolume", boxOf(node.bounds)},
-                          {"geometricError", node.geometricError + quantization[index]},
+                          {"geometricError", errors[index]},
                           {"refine", "REPLACE"}};
     if (node.triangles > 0 && !node.meshPath.empty())
       out["content"] = {{"uri", tileContentUri(node)}};
@@ -55,14 +66,10 @@ Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
     }
     return out;
   };
-  const OctreeNode& root = octree.nodes[octree.root];
   // Above the root: the error of showing nothing at all, the size of the model.
-  const Vec3d size = root.bounds.size();
-  const double nothing =
-      std::max((root.geometricError + quantization[octree.root]) * 2, length(size));
   nlohmann::json tileset = {
       {"asset", {{"version", "1.1"}, {"generator", "lodforge " LODFORGE_VERSION}}},
-      {"geometricError", nothing},
+      {"geometricError", nothingShownError(octree, errors[octree.root])},
       {"root", tile(octree.root)}};
   if (rootTransform) tileset["root"]["transform"] = rootTransform->m;
   if (!partsUri.empty()) tileset["asset"]["extras"]["parts"] = partsUri;

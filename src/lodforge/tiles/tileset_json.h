@@ -5,6 +5,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "lodforge/core/math.h"
 #include "lodforge/core/status.h"
@@ -20,6 +21,14 @@ namespace lodforge {
 Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
                         const std::optional<Mat4d>& rootTransform = std::nullopt,
                         bool quantized = false, const std::string& partsUri = {});
+
+// Each node's declared geometric error: its own plus, with `quantized` contents, the largest
+// quantisation error in its subtree (still non-increasing parent to child).
+std::vector<double> declaredTileErrors(const OctreeResult& octree, bool quantized);
+
+// The tileset's own geometricError (showing nothing at all): the size of the model, or twice the
+// root's declared error if larger.
+double nothingShownError(const OctreeResult& octree, double rootError);
 
 // A tile's "box" bounding volume for axis-aligned bounds: centre, then three half-axes.
 std::array<double, 12> tileBox(const Aabbd& bounds);

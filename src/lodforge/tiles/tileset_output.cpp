@@ -1,11 +1,42 @@
 #include "lodforge/tiles/tileset_output.h"
 
+#include <string_view>
+
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
 #include "lodforge/tiles/tileset_parts.h"
 
 namespace lodforge {
+
+namespace {
+
+// An implicit tileset's folders FOLDER/L, FOLDER/L/X, FOLDER/L/X/Y and files FOLDER/L/X/Y/Z.EXT
+// (implicit_tiling.h), every name a number.
+bool implicitEntry(std::string_view relative, std::string_view folder, std::string_view extension,
+                   bool isDirectory) {
+  if (!relative.starts_with(folder) || relative.size() <= folder.size() + 1 ||
+      relative[folder.size()] != '/')
+    return false;
+  std::string_view rest = relative.substr(folder.size() + 1);
+  if (!isDirectory) {
+    if (!rest.ends_with(extension)) return false;
+    rest.remove_suffix(extension.size());
+  }
+  int names = 0;
+  while (true) {
+    const std::size_t slash = rest.find('/');
+    const std::string_view name = rest.substr(0, slash);
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string_view::npos)
+      return false;
+    ++names;
+    if (slash == std::string_view::npos) break;
+    rest.remove_prefix(slash + 1);
+  }
+  return isDirectory ? names <= 3 : names == 4;
+}
+
+}  // namespace
 
 bool isLodforgeTileset(const std::string& directory) {
   Result<std::string> text = readFileToString(directory + "/tileset.json", std::uint64_t{1} << 28);
@@ -20,7 +51,10 @@ bool isLodforgeTileset(const std::string& directory) {
     return false;
   return directoryHoldsOnly(directory, [](const std::string& relative, bool isDirectory) {
     if (relative == "tileset.json" || relative == kPartsFileName) return !isDirectory;
-    if (relative == "tiles") return isDirectory;
+    if (relative == "tiles" || relative == "subtrees") return isDirectory;
+    if (implicitEntry(relative, "tiles", ".glb", isDirectory) ||
+        implicitEntry(relative, "subtrees", ".subtree", isDirectory))
+      return true;
     return relative.starts_with("tiles/") && relative.ends_with(".glb") && !isDirectory &&
            relative.find('/', 6) == std::string::npos;
   });

@@ -115,6 +115,7 @@ Status PlyChunking::openVertices() {
   input_.streamed = true;
   PlyReadOptions read;
   read.readFaces = false;
+  read.stopAfterDelivered = true;  // the face pass reads the faces
   read.salvageTruncated = options_.salvageTruncated;
   Result<PlyReader> vertices = PlyReader::open(path_, read);
   if (!vertices) return vertices.status();

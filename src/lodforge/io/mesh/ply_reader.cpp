@@ -25,6 +25,19 @@ struct PlyReader::State {
   bool next(PlyBatch& batch);
 };
 
+namespace {
+
+// Whether an element after `element` is one the options deliver.
+bool deliversAfter(const PlyRecords& in, std::size_t element) {
+  const auto after = [&](int role) {
+    return role >= 0 && static_cast<std::size_t>(role) > element;
+  };
+  return (in.options.readVertices && after(in.roles.vertexElement)) ||
+         (in.options.readFaces && (after(in.roles.faceElement) || after(in.roles.stripElement)));
+}
+
+}  // namespace
+
 bool PlyReader::State::next(PlyBatch& batch) {
   batch.positions.clear();
   batch.normals.clear();
@@ -47,6 +60,7 @@ bool PlyReader::State::next(PlyBatch& batch) {
       const bool isStrip =
           static_cast<int>(in.element) == in.roles.stripElement && in.options.readFaces;
       if (in.elementDone == e.count || (!isVertex && !isFace && !isStrip)) {
+        if (in.options.stopAfterDelivered && !deliversAfter(in, in.element)) break;
         if (in.elementDone < e.count) in.skipElement(e);
         ++in.element;
         in.elementDone = 0;

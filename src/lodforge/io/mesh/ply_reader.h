@@ -28,6 +28,10 @@ struct PlyReadOptions {
   // Which elements to deliver; the others are skipped (binary fixed-size ones by seeking).
   bool readVertices = true;
   bool readFaces = true;
+  // End once the delivered elements are done instead of reading past the rest (a face list has
+  // no fixed size to seek over: skipping a billion faces reads 13 GB). For a pass whose
+  // partner pass reads, and checks, what follows.
+  bool stopAfterDelivered = false;
   bool readExtras = false;  // deliver the vertices' other scalar properties (PlyBatch::extras)
   std::vector<std::string>* warnings = nullptr;  // readPly adds what it salvaged, if anything
   // Face properties recognised as an object (part) id, first match wins.

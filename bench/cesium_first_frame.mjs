@@ -1,0 +1,128 @@
+// Time to the first frame in CesiumJS, explicit against implicit tiling (issue 38): each tileset
+// directory is opened in Debian's headless chromium from a local HTTP server, several times,
+// interleaved; per run the time until Cesium3DTileset.fromUrl resolves (tileset.json fetched and
+// parsed, the tile tree made), until the first tile content is loaded, and until the initial
+// view is complete (initialTilesLoaded), with the bytes of tileset.json, subtree files and
+// contents fetched by then. Prints a markdown table of the medians.
+//   node bench/cesium_first_frame.mjs [--runs 3] TILESET_DIR...
+import http from 'node:http';
+import { readFile } from 'node:fs/promises';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { keepLocal, launchChromium } from '../tests/js/chromium.mjs';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const cesiumDir = path.join(here, '../tests/js/node_modules/cesium/Build/Cesium');
+const args = process.argv.slice(2);
+const runsArg = args.indexOf('--runs');
+const runs = runsArg >= 0 ? Number(args.splice(runsArg, 2)[1]) : 3;
+const directories = args;
+if (directories.length === 0) {
+  console.error('usage: node bench/cesium_first_frame.mjs [--runs N] TILESET_DIR...');
+  process.exit(2);
+}
+
+const page = `<!doctype html>
+<html><head><meta charset="utf-8">
+<script>window.CESIUM_BASE_URL = '/cesium/';</script>
+<script src="/cesium/Cesium.js"></script>
+<style>html, body, #view { margin: 0; width: 100%; height: 100%; overflow: hidden; }</style>
+</head><body><div id="view"></div><script>
+window.report = { error: null };
+(async () => {
+  try {
+    const viewer = new Cesium.Viewer('view', {
+      baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false,
+      animation: false, homeButton: false, sceneModePicker: false, navigationHelpButton: false,
+      fullscreenButton: false, infoBox: false, selectionIndicator: false,
+      terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false, skyAtmosphere: false,
+    });
+    viewer.scene.globe.show = false;
+    const start = performance.now();
+    const tileset = await Cesium.Cesium3DTileset.fromUrl('/tileset/tileset.json');
+    window.report.parsed = performance.now() - start;
+    tileset.tileLoad.addEventListener(() => {
+      if (window.report.firstContent === undefined) window.report.firstContent = performance.now() - start;
+    });
+    tileset.initialTilesLoaded.addEventListener(() => {
+      window.report.initial = performance.now() - start;
+      window.report.initialBytes = window.fetchedBytes();
+    });
+    viewer.scene.primitives.add(tileset);
+    viewer.zoomTo(tileset);
+  } catch (e) {
+    window.report.error = String(e && e.stack || e);
+  }
+})();
+</script></body></html>`;
+
+// Bytes served per kind, reset per run.
+let served = { json: 0, subtree: 0, glb: 0 };
+let tilesetDir = null;
+const server = http.createServer(async (request, response) => {
+  const url = decodeURIComponent(new URL(request.url, 'http://localhost').pathname);
+  try {
+    if (url === '/') {
+      response.writeHead(200, { 'content-type': 'text/html' });
+      response.end(page);
+      return;
+    }
+    if (url === '/bytes') {
+      response.writeHead(200, { 'content-type': 'application/json' });
+      response.end(JSON.stringify(served));
+      return;
+    }
+    let file = null;
+    if (url.startsWith('/cesium/')) file = path.join(cesiumDir, url.slice('/cesium/'.length));
+    else if (url.startsWith('/tileset/')) file = path.join(tilesetDir, url.slice('/tileset/'.length));
+    if (!file || file.includes('..')) throw new Error('outside');
+    const body = await readFile(file);
+    if (url.startsWith('/tileset/')) {
+      const kind = url.endsWith('.json') ? 'json' : url.endsWith('.subtree') ? 'subtree' : 'glb';
+      served[kind] += body.length;
+    }
+    response.writeHead(200);
+    response.end(body);
+  } catch {
+    response.writeHead(404);
+    response.end();
+  }
+});
+await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+const port = server.address().port;
+
+async function measure(directory) {
+  tilesetDir = directory;
+  served = { json: 0, subtree: 0, glb: 0 };
+  const { context, close } = await launchChromium();
+  try {
+    const tab = context.pages()[0] ?? await context.newPage();
+    await keepLocal(tab, (p) => { throw new Error(p); });
+    await tab.exposeFunction('fetchedBytes', () => ({ ...served }));
+    await tab.goto(`http://127.0.0.1:${port}/`);
+    await tab.waitForFunction(() => window.report.error || window.report.initial !== undefined, null,
+                              { timeout: 600000 });
+    const report = await tab.evaluate(() => window.report);
+    if (report.error) throw new Error(report.error);
+    return report;
+  } finally {
+    await close();
+  }
+}
+
+const median = (values) => [...values].sort((a, b) => a - b)[Math.floor(values.length / 2)];
+const results = new Map(directories.map((d) => [d, []]));
+for (let r = 0; r < runs; r++)
+  for (const d of directories) results.get(d).push(await measure(d));
+server.close();
+
+const mb = (bytes) => (bytes / 1e6).toFixed(2);
+console.log('| tileset | tileset.json | parsed (ms) | first content (ms) | initial view (ms) | fetched by then: json / subtrees / contents (MB) |');
+console.log('|---|---:|---:|---:|---:|---|');
+for (const [d, reports] of results) {
+  const json = (await readFile(path.join(d, 'tileset.json'))).length;
+  const bytes = reports[0].initialBytes;
+  console.log(`| ${path.basename(d)} | ${mb(json)} MB | ${median(reports.map((x) => x.parsed)).toFixed(0)} | ` +
+              `${median(reports.map((x) => x.firstContent)).toFixed(0)} | ${median(reports.map((x) => x.initial)).toFixed(0)} | ` +
+              `${mb(bytes.json)} / ${mb(bytes.subtree)} / ${mb(bytes.glb)} |`);
+}

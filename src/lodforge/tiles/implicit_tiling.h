@@ -1,0 +1,62 @@
+// 3D Tiles 1.1 implicit tiling of a mesh tileset: the octree written as an OCTREE subdivision
+// of the grid's cube (tileset.json then holds one root tile, however many tiles there are), its
+// tiles and contents given by availability bitstreams in subtree files, and each tile's own
+// geometric error and tight box kept as tile metadata (TILE_GEOMETRIC_ERROR, TILE_BOUNDING_BOX),
+// so viewers that read them (CesiumJS) see exactly what the explicit tileset declares.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lodforge/core/math.h"
+#include "lodforge/core/status.h"
+#include "lodforge/tiling/chunk_grid.h"
+#include "lodforge/tiling/octree.h"
+
+namespace lodforge {
+
+// Levels per subtree file (at most; fewer for a shallower tree): 8^5 child-subtree bits (4 KiB) at
+// most, so a file stays small while a billion-triangle tree (10 levels) needs two rows of them.
+inline constexpr int kSubtreeLevels = 5;
+
+// The position of (x, y, z) among the 8^level tiles of a level: bits interleaved x, y, z from
+// the lowest (the order of 3D Tiles' octree availability).
+std::uint64_t mortonIndex(std::uint32_t x, std::uint32_t y, std::uint32_t z);
+
+// Where level `level`'s bits start in a subtree's tile availability: (8^level - 1) / 7.
+std::uint64_t levelOffset(int level);
+
+// Whether the octree is one OCTREE subdivision: a single root at cell (0, 0, 0) over every level
+// (not a root added over a --levels cut).
+bool implicitTilingFits(const OctreeResult& octree);
+
+// A node's content in an implicit tileset: tiles/{level}/{x}/{y}/{z}.glb, the level counted from
+// the root.
+std::string implicitContentUri(const OctreeResult& octree, const OctreeNode& node);
+
+// One subtree file's bytes ("subt" header, JSON, binary of 8-byte aligned bitstreams and the
+// tile property table): its tiles (bit index into the subtree's tile availability, the node),
+// the set bits of its child subtrees. `errors` per node, as the explicit tileset declares them.
+struct SubtreeTile {
+  std::uint64_t bit = 0;
+  std::uint32_t node = 0;
+};
+std::vector<std::byte> subtreeFile(const OctreeResult& octree, std::span<const double> errors,
+                                   int subtreeLevels, std::vector<SubtreeTile> tiles,
+                                   std::span<const std::uint64_t> childSubtrees);
+
+// Writes `directory`/tileset.json with an implicit root over `grid`'s cube, the subtree files
+// under subtrees/, and moves each node's content from its explicit name (tileContentUri) to
+// implicitContentUri. Errors and boxes are those writeTilesetJson writes; the root's own
+// geometricError is the least one whose halving per level stays at or above every tile's error,
+// for viewers that ignore the metadata. Expects implicitTilingFits.
+Status writeImplicitTileset(const OctreeResult& octree, const ChunkGrid& grid,
+                            const std::string& directory, const std::optional<Mat4d>& rootTransform,
+                            bool quantized, const std::string& partsUri,
+                            int subtreeLevels = kSubtreeLevels);
+
+}  // namespace lodforge

@@ -504,6 +504,36 @@ TEST(PlySalvage, TruncatedFacesKeepTheCompleteOnes) {
   EXPECT_EQ(model->triangleCount(), 16u);  // 8 complete quads
 }
 
+// A vertex pass told to stop after the vertices does not read the faces at all (a face list has
+// no fixed size to seek over): it ends cleanly even where the faces are cut short, which a pass
+// that skips them reads into and reports.
+TEST(PlyRead, AVertexPassThatStopsAfterTheVerticesNeverReadsTheFaces) {
+  PlySpec spec =
+      gridSpec(PlyFormat::kBinaryLittleEndian, PlyType::kFloat32, PlyType::kUint8, PlyType::kInt32);
+  const std::string whole = encodePly(spec);
+  const std::string cut = whole.substr(0, whole.size() - 10);  // inside the last quad
+  const auto vertexPass = [&](bool stop) -> Result<std::uint64_t> {
+    PlyReadOptions options;
+    options.readFaces = false;
+    options.stopAfterDelivered = stop;
+    Result<PlyReader> reader = PlyReader::fromMemory(test::bytesOf(cut), "cut.ply", options);
+    if (!reader) return reader.status();
+    PlyBatch batch;
+    std::uint64_t vertices = 0;
+    while (true) {
+      Result<bool> more = reader->next(batch);
+      if (!more) return more.status();
+      if (!*more) return vertices;
+      EXPECT_EQ(batch.kind, PlyBatch::Kind::kVertices);
+      vertices += batch.count;
+    }
+  };
+  EXPECT_FALSE(vertexPass(false).ok());  // skipping the faces runs into the cut
+  Result<std::uint64_t> stopped = vertexPass(true);
+  ASSERT_TRUE(stopped.ok()) << stopped.error().message;
+  EXPECT_EQ(*stopped, 16u);
+}
+
 // --- triangle strips ------------------------------------------------------------------------
 
 // gridSpec's 4x4 quads as two triangle strips: quad rows 0 and 1 in one strip with a restart

@@ -253,10 +253,8 @@ Status writeImplicitTileset(const OctreeResult& octree, const ChunkGrid& grid,
   // For viewers that ignore the metadata: the root's error halves per level and stays at or
   // above every tile's own.
   double rootError = 0;
-  for (const OctreeNode& node : octree.nodes) {
-    const std::size_t i = static_cast<std::size_t>(&node - octree.nodes.data());
-    rootError = std::max(rootError, std::ldexp(errors[i], coordsOf(octree, node).level));
-  }
+  for (std::size_t i = 0; i < octree.nodes.size(); ++i)
+    rootError = std::max(rootError, std::ldexp(errors[i], coordsOf(octree, octree.nodes[i]).level));
   const double cube = grid.size * std::ldexp(1.0, levels - 1);
   nlohmann::json root = {
       {"boundingVolume",

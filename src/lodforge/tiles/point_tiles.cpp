@@ -481,7 +481,7 @@ Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
       {"geometricError", std::max(static_cast<double>(rootError),
                                   taus.empty() ? 0.0 : 2.0 * static_cast<double>(taus.front()))},
       {"root", root}};
-  return OutputFile::writeWhole(path, tileset.dump(1));
+  return OutputFile::writeWhole(path, tileset.dump() + '\n');  // compact, as for meshes
 }
 
 // The blocks of the partition, each ranked as the partition makes it, while its points are in

@@ -50,7 +50,8 @@ window.report = { error: null };
     const start = performance.now();
     const tileset = await Cesium.Cesium3DTileset.fromUrl('/tileset/tileset.json');
     window.report.parsed = performance.now() - start;
-    tileset.tileLoad.addEventListener(() => {
+    tileset.tileLoad.addEventListener((tile) => {
+      if (tile.hasImplicitContent) return;  // a subtree file, not a model
       if (window.report.firstContent === undefined) window.report.firstContent = performance.now() - start;
     });
     tileset.allTilesLoaded.addEventListener(() => {

@@ -79,6 +79,34 @@ struct TilesCommand {
   CadCommand cad;
 };
 
+// Textured meshes: the tile texture pages and their encoding.
+void addTextureOptions(CLI::App& sub, TilesCommand& options) {
+  sub.add_option("--texture-size", options.textureSize,
+                 "Textured meshes: a tile texture page's side at most, in texels (a tile whose "
+                 "texels need more gets several pages; default 4096)")
+      ->check(CLI::Range(64u, 16384u));
+  sub.add_option("--texture-format", options.textureFormat,
+                 "Textured meshes: jpeg (default; PNG where the source has alpha), png, or webp "
+                 "(EXT_texture_webp: viewers without it draw no texture)")
+      ->check(CLI::IsMember({"jpeg", "png", "webp"}));
+  sub.add_option("--texture-quality", options.textureQuality,
+                 "Textured meshes: JPEG or WebP quality, 1 to 100 (default 85)")
+      ->check(CLI::Range(1, 100));
+}
+
+// Point clouds: the block partition and the fields carried.
+void addPointCloudOptions(CLI::App& sub, TilesCommand& options) {
+  addCountOption(sub, "--block-size", options.blockSize,
+                 "Point clouds: most points per leaf tile (a block of the partition; default 50K)");
+  addCountOption(sub, "--tile-points", options.tilePoints,
+                 "Point clouds: about this many points in a tile above the blocks (default 50K)");
+  sub.add_option("--attributes", options.attributes,
+                 "Point clouds: the fields the tiles carry, comma-separated: classification, "
+                 "intensity, returns, flags, scan-angle, user-data, point-source, gps-time, nir, "
+                 "extras (LAS extra bytes, other PLY properties); or all (default: all the input "
+                 "has) or none");
+}
+
 void addTilesOptions(CLI::App& sub, TilesCommand& options) {
   sub.add_option("INPUT", options.input,
                  "A .ply .obj .stl .gltf or .glb mesh or assembly, a .step .iges .brep CAD file, "
@@ -127,26 +155,8 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
                  "glTF, FBX/DAE/IFC and .lfp inputs of several objects), on (any input of "
                  "several objects, which keeps objects from welding together), or off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
-  sub.add_option("--texture-size", options.textureSize,
-                 "Textured meshes: a tile texture page's side at most, in texels (a tile whose "
-                 "texels need more gets several pages; default 4096)")
-      ->check(CLI::Range(64u, 16384u));
-  sub.add_option("--texture-format", options.textureFormat,
-                 "Textured meshes: jpeg (default; PNG where the source has alpha), png, or webp "
-                 "(EXT_texture_webp: viewers without it draw no texture)")
-      ->check(CLI::IsMember({"jpeg", "png", "webp"}));
-  sub.add_option("--texture-quality", options.textureQuality,
-                 "Textured meshes: JPEG or WebP quality, 1 to 100 (default 85)")
-      ->check(CLI::Range(1, 100));
-  addCountOption(sub, "--block-size", options.blockSize,
-                 "Point clouds: most points per leaf tile (a block of the partition; default 50K)");
-  addCountOption(sub, "--tile-points", options.tilePoints,
-                 "Point clouds: about this many points in a tile above the blocks (default 50K)");
-  sub.add_option("--attributes", options.attributes,
-                 "Point clouds: the fields the tiles carry, comma-separated: classification, "
-                 "intensity, returns, flags, scan-angle, user-data, point-source, gps-time, nir, "
-                 "extras (LAS extra bytes, other PLY properties); or all (default: all the input "
-                 "has) or none");
+  addTextureOptions(sub, options);
+  addPointCloudOptions(sub, options);
   sub.add_flag("--surface", options.surface,
                "Point clouds: reconstruct a surface (as `lodforge reconstruct`), its chunks the "
                "leaves (--chunk-size: their edge, default 64 voxels); the options marked "

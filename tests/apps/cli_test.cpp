@@ -1261,6 +1261,37 @@ TEST(CliTiles, ASmallModelGetsLevelsAndLevelsAreHonouredOrRefused) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("b.work")));
 }
 
+// Implicit tiling where asked for, over an earlier explicit tileset of the same output (ours to
+// replace); refused, before any work, where it cannot describe the tree.
+TEST(CliTiles, ImplicitTilingIsWrittenOrRefusedBeforeAnyWork) {
+  test::TempDir dir;
+  const std::string horse = test::dataPath("meshes/horse.ply");
+  Outcome o = lodforge("tiles " + horse + " -o " + dir.file("h") + " --chunk-size 0.05", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  o = lodforge(
+      "tiles " + horse + " -o " + dir.file("h") + " --chunk-size 0.05 --implicit-tiling on", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_NE(o.out.find("implicit tiling"), std::string::npos) << o.out;
+  const nlohmann::json tileset = nlohmann::json::parse(test::readFile(dir.file("h/tileset.json")));
+  EXPECT_EQ(tileset["root"]["implicitTiling"]["subdivisionScheme"], "OCTREE");
+  EXPECT_TRUE(std::filesystem::exists(dir.file("h/subtrees/0/0/0/0.subtree")));
+  // And back: the implicit output is ours to replace too.
+  o = lodforge("tiles " + horse + " -o " + dir.file("h") + " --chunk-size 0.05", dir);
+  ASSERT_EQ(o.code, 0) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("h/subtrees")));
+
+  o = lodforge("tiles " + horse + " -o " + dir.file("l") + " --levels 1 --implicit-tiling on", dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("--implicit-tiling on and --levels"), std::string::npos) << o.err;
+  const std::string cloud = test::dataPath("points/autzen_trim.las");
+  o = lodforge("tiles " + cloud + " -o " + dir.file("p") + " --implicit-tiling on", dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_NE(o.err.find("--implicit-tiling is for meshes"), std::string::npos) << o.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("l")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("p")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("p.work")));
+}
+
 TEST(CliTiles, SaysWhenATilesetHasNoPlaceOnEarth) {
   test::TempDir dir;
   const std::string mesh = test::dataPath("meshes/horse.ply");

@@ -1,5 +1,6 @@
 #include "lodforge/tiles/implicit_tiling.h"
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/tiles/tileset.h"
+#include "lodforge/tiles/tileset_json.h"
 #include "lodforge/tiles/tileset_output.h"
 #include "test_support.h"
 
@@ -40,6 +42,41 @@ TEST(ImplicitTiling, MortonOrderAndLevelOffsetsFollowTheSpecification) {
   EXPECT_EQ(levelOffset(1), 1u);
   EXPECT_EQ(levelOffset(2), 9u);
   EXPECT_EQ(levelOffset(3), 73u);
+}
+
+// Contents move to their implicit names counted from the root's cube (here not at cell 0), again
+// without harm (a resumed run), and back to their explicit names with nothing of the implicit
+// layout left (a resumed run that writes the explicit one).
+TEST(ImplicitTiling, ContentsMoveBetweenTheLayoutsAsOftenAsARunIsResumed) {
+  const test::TempDir temp;
+  OctreeResult octree;
+  octree.levels = 1;
+  octree.nodes.resize(3);
+  for (int i = 0; i < 2; ++i) octree.nodes[static_cast<std::size_t>(i)].cell = {4 + i, 2, 0};
+  octree.nodes[2].level = 1;
+  octree.nodes[2].cell = {2, 1, 0};
+  octree.nodes[2].children = {0, 1};
+  octree.root = 2;
+  for (OctreeNode& node : octree.nodes) node.triangles = 1, node.meshPath = "mesh";
+  ASSERT_TRUE(implicitTilingFits(octree));
+  const fs::path dir = temp.path();
+  fs::create_directories(dir / "tiles");
+  for (const OctreeNode& node : octree.nodes)
+    std::ofstream(dir / tileContentUri(node)) << node.cell[0];
+  ASSERT_TRUE(placeContents(octree, dir.string(), true).ok());
+  ASSERT_TRUE(placeContents(octree, dir.string(), true).ok());
+  EXPECT_EQ(readBytes(dir / "tiles/0/0/0/0.glb"), "2");
+  EXPECT_EQ(readBytes(dir / "tiles/1/0/0/0.glb"), "4");
+  EXPECT_EQ(readBytes(dir / "tiles/1/1/0/0.glb"), "5");
+  fs::create_directories(dir / "subtrees/0/0/0");
+  std::ofstream(dir / "subtrees/0/0/0/0.subtree") << "left by an interrupted run";
+  ASSERT_TRUE(placeContents(octree, dir.string(), false).ok());
+  std::vector<std::string> left;
+  for (const auto& entry : fs::recursive_directory_iterator(dir))
+    left.push_back(fs::relative(entry.path(), dir).string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"tiles", "tiles/0-4-2-0.glb", "tiles/0-5-2-0.glb",
+                                            "tiles/1-2-1-0.glb"}));
 }
 
 // What the explicit tileset.json says of each tile, by its content's explicit name
@@ -235,6 +272,14 @@ TEST(ImplicitTiling, AnImplicitTilesetHoldsExactlyTheExplicitOnesTiles) {
     ++matched;
   }
   EXPECT_EQ(matched, named.size());
+  // Tiles without content have no name: the same errors and boxes, in any order.
+  std::vector<std::pair<double, std::vector<double>>> explicitEmpty, implicitEmpty;
+  for (const ExplicitTile& t : unnamed) explicitEmpty.emplace_back(t.error, t.box);
+  for (const ImplicitTile& t : tiles)
+    if (!t.content) implicitEmpty.emplace_back(t.error, t.box);
+  std::sort(explicitEmpty.begin(), explicitEmpty.end());
+  std::sort(implicitEmpty.begin(), implicitEmpty.end());
+  EXPECT_EQ(explicitEmpty, implicitEmpty);
   // The root: the explicit root's error and box in the metadata.
   ASSERT_FALSE(tiles.empty());
   EXPECT_EQ(tiles.front().level, 0);

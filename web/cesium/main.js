@@ -205,7 +205,8 @@ async function main() {
   });
   report.rootCorners = () => rootCorners(viewer, tileset);
   tileset.tileFailed.addEventListener((e) => report.failed.push(`${e.url}: ${e.message}`));
-  tileset.tileLoad.addEventListener(() => { report.tilesLoaded += 1; });
+  // Tiles with a model (an implicit tileset's subtree files are loaded as tiles too).
+  tileset.tileLoad.addEventListener((tile) => { if (!tile.hasImplicitContent) report.tilesLoaded += 1; });
   // Loaded: every tile the view needs, once the panels are set up too (the tiles may be in first).
   tileset.allTilesLoaded.addEventListener(() => { if (setUp && framed) report.loaded = true; });
   // What is drawn this frame: tiles, and their triangles or points.

@@ -47,6 +47,8 @@ function readSubtreeMetadata(buffer, tile, values) {
   const binary = buffer.slice(24 + jsonLength, 24 + jsonLength + binaryLength);
   if (json.tileMetadata === undefined) return;
   const table = json.propertyTables[json.tileMetadata];
+  // Another writer's subtree (lodforge serve takes any tileset): the plugin's defaults stand.
+  if (!table.properties.geometricError || !table.properties.boundingBox) return;
   const valuesOf = (name) => {
     const v = json.bufferViews[table.properties[name].values];
     return new Float64Array(binary.slice(v.byteOffset, v.byteOffset + v.byteLength));

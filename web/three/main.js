@@ -246,6 +246,15 @@ function addParts(parts, tiles, camera, controls, renderer, pivot) {
   };
 }
 
+// The tile whose volume frames the view: the root, or for an implicit tileset (its root volume
+// is the whole octree cube) the root's own content tile once the first subtree is in, whose
+// volume is the tight box of the subtree's metadata.
+function framingTile(tiles) {
+  const root = tiles.rootTileSet && tiles.rootTileSet.root;
+  const tile = root && root.implicitTiling ? root.children[0] : root;
+  return tile && tile.cached && tile.cached.boundingVolume ? tile : null;
+}
+
 function main() {
   const renderer = new THREE.WebGLRenderer({ antialias: true });
   renderer.setPixelRatio(window.devicePixelRatio);
@@ -276,14 +285,6 @@ function main() {
   // Framed once the root is in: its bounding sphere, in the tileset's local frame (the root
   // transform undone, z-up turned to y-up).
   let framed = false;
-  // The tile whose volume frames the view: the root, or for an implicit tileset (its root volume
-  // is the whole octree cube) the root's own content tile once the first subtree is in, whose
-  // volume is the tight box of the subtree's metadata.
-  const framingTile = () => {
-    const root = tiles.rootTileSet && tiles.rootTileSet.root;
-    const tile = root && root.implicitTiling ? root.children[0] : root;
-    return tile && tile.cached && tile.cached.boundingVolume ? tile : null;
-  };
   const frame = () => {
     const rootTransform = tiles.rootTileSet && tiles.rootTileSet.root && tiles.rootTileSet.root.transform;
     if (rootTransform) {
@@ -293,7 +294,7 @@ function main() {
     pivot.rotation.x = -Math.PI / 2;  // 3D Tiles are z-up, three.js is y-up
     pivot.updateMatrixWorld(true);
     const sphere = new THREE.Sphere();
-    const tile = framingTile();
+    const tile = framingTile(tiles);
     if (!tile) return false;
     tile.cached.boundingVolume.getSphere(sphere);
     sphere.applyMatrix4(tiles.group.matrixWorld);
@@ -310,7 +311,7 @@ function main() {
   // For tests: the framing tile's bounding box corners in CSS pixels (null: behind the camera).
   report.rootCorners = () => {
     const root = tiles.rootTileSet && tiles.rootTileSet.root;
-    const tile = framingTile();
+    const tile = framingTile(tiles);
     const box = tile && tile.boundingVolume && tile.boundingVolume.box;
     if (!box) return [];
     const toTiles = root.transform ? new THREE.Matrix4().fromArray(root.transform) : new THREE.Matrix4();

@@ -25,11 +25,15 @@ struct ImplicitCoords {
   std::array<std::uint32_t, 3> xyz{};
 };
 
+// The root's cell need not be (0, 0, 0) (the grid's corner comes from every input vertex, also
+// ones no triangle uses): coordinates count from the root's cube.
 ImplicitCoords coordsOf(const OctreeResult& octree, const OctreeNode& node) {
-  assert(node.level <= octree.nodes[octree.root].level);
-  return {octree.nodes[octree.root].level - node.level,
-          {static_cast<std::uint32_t>(node.cell[0]), static_cast<std::uint32_t>(node.cell[1]),
-           static_cast<std::uint32_t>(node.cell[2])}};
+  const OctreeNode& root = octree.nodes[octree.root];
+  assert(node.level <= root.level);
+  ImplicitCoords c{root.level - node.level, {}};
+  for (std::size_t a = 0; a < 3; ++a)
+    c.xyz[a] = static_cast<std::uint32_t>(node.cell[a] - (root.cell[a] << c.level));
+  return c;
 }
 
 // The subtree holding a tile: its root's level and coordinates (a multiple of the subtree
@@ -40,13 +44,14 @@ struct SubtreeKey {
   auto operator<=>(const SubtreeKey&) const = default;
 };
 
-SubtreeKey subtreeOf(const ImplicitCoords& c, int subtreeLevels, ImplicitCoords& local) {
+SubtreeKey subtreeOf(const ImplicitCoords& c, int subtreeLevels, ImplicitCoords* local = nullptr) {
   const int root = c.level / subtreeLevels * subtreeLevels;
-  local.level = c.level - root;
+  const int within = c.level - root;
   SubtreeKey key{root, {}};
-  for (std::size_t a = 0; a < 3; ++a) {
-    key.xyz[a] = c.xyz[a] >> local.level;
-    local.xyz[a] = c.xyz[a] & ((1u << local.level) - 1);
+  for (std::size_t a = 0; a < 3; ++a) key.xyz[a] = c.xyz[a] >> within;
+  if (local != nullptr) {
+    local->level = within;
+    for (std::size_t a = 0; a < 3; ++a) local->xyz[a] = c.xyz[a] & ((1u << within) - 1);
   }
   return key;
 }
@@ -54,6 +59,12 @@ SubtreeKey subtreeOf(const ImplicitCoords& c, int subtreeLevels, ImplicitCoords&
 std::string subtreeUri(const SubtreeKey& key) {
   return fmt::format("subtrees/{}/{}/{}/{}.subtree", key.level, key.xyz[0], key.xyz[1], key.xyz[2]);
 }
+
+// A tile of a subtree: its bit in the subtree's tile availability, and its node.
+struct SubtreeTile {
+  std::uint64_t bit = 0;
+  std::uint32_t node = 0;
+};
 
 // A subtree's binary chunk: buffer views of whole 8-byte units, appended in order.
 struct SubtreeBinary {
@@ -114,80 +125,8 @@ nlohmann::json tileSchema() {
       {"classes", {{"tile", {{"properties", {{"geometricError", error}, {"boundingBox", box}}}}}}}};
 }
 
-// Every subtree's tiles and child subtree bits.
-struct SubtreePlan {
-  std::map<SubtreeKey, std::vector<SubtreeTile>> tiles;
-  std::map<SubtreeKey, std::vector<std::uint64_t>> children;
-};
-
-SubtreePlan planSubtrees(const OctreeResult& octree, int subtreeLevels) {
-  SubtreePlan plan;
-  for (std::uint32_t i = 0; i < octree.nodes.size(); ++i) {
-    const ImplicitCoords c = coordsOf(octree, octree.nodes[i]);
-    ImplicitCoords local;
-    const SubtreeKey key = subtreeOf(c, subtreeLevels, local);
-    plan.tiles[key].push_back(
-        {levelOffset(local.level) + mortonIndex(local.xyz[0], local.xyz[1], local.xyz[2]), i});
-    if (local.level != 0 || c.level == 0) continue;
-    // A subtree's root: a bit in the subtree above, at its bottom row's next level.
-    ImplicitCoords above;
-    const SubtreeKey parent = subtreeOf(
-        {c.level - 1, {c.xyz[0] >> 1, c.xyz[1] >> 1, c.xyz[2] >> 1}}, subtreeLevels, above);
-    std::uint32_t xyz[3];
-    for (std::size_t a = 0; a < 3; ++a) xyz[a] = c.xyz[a] & ((1u << subtreeLevels) - 1);
-    plan.children[parent].push_back(mortonIndex(xyz[0], xyz[1], xyz[2]));
-  }
-  return plan;
-}
-
-// Each content from its explicit name to its implicit one.
-Status moveContents(const OctreeResult& octree, const std::string& directory) {
-  for (const OctreeNode& node : octree.nodes) {
-    if (node.triangles == 0 || node.meshPath.empty()) continue;
-    const fs::path to = fs::path(directory) / implicitContentUri(octree, node);
-    std::error_code error;
-    fs::create_directories(to.parent_path(), error);
-    if (!error) fs::rename(fs::path(directory) / tileContentUri(node), to, error);
-    if (error)
-      return ioError(to.string(), fmt::format("cannot move a tile there: {}", error.message()));
-  }
-  return {};
-}
-
-}  // namespace
-
-std::uint64_t mortonIndex(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-  std::uint64_t m = 0;
-  for (int b = 0; b < 21; ++b) {
-    m |= std::uint64_t{(x >> b) & 1u} << (3 * b);
-    m |= std::uint64_t{(y >> b) & 1u} << (3 * b + 1);
-    m |= std::uint64_t{(z >> b) & 1u} << (3 * b + 2);
-  }
-  return m;
-}
-
-std::uint64_t levelOffset(int level) {
-  return ((std::uint64_t{1} << (3 * level)) - 1) / 7;
-}
-
-bool implicitTilingFits(const OctreeResult& octree) {
-  const OctreeNode& root = octree.nodes[octree.root];
-  if (root.level != octree.levels || root.cell != ChunkCell{0, 0, 0}) return false;
-  for (const OctreeNode& node : octree.nodes)
-    for (std::uint32_t c : node.children) {
-      const OctreeNode& child = octree.nodes[c];
-      if (child.level != node.level - 1) return false;
-      for (std::size_t a = 0; a < 3; ++a)
-        if ((child.cell[a] >> 1) != node.cell[a]) return false;
-    }
-  return true;
-}
-
-std::string implicitContentUri(const OctreeResult& octree, const OctreeNode& node) {
-  const ImplicitCoords c = coordsOf(octree, node);
-  return fmt::format("tiles/{}/{}/{}/{}.glb", c.level, c.xyz[0], c.xyz[1], c.xyz[2]);
-}
-
+// One subtree file's bytes ("subt" header, JSON, binary of 8-byte aligned bitstreams and the
+// tile property table): its tiles and the set bits of its child subtrees. `errors` per node.
 std::vector<std::byte> subtreeFile(const OctreeResult& octree, std::span<const double> errors,
                                    int subtreeLevels, std::vector<SubtreeTile> tiles,
                                    std::span<const std::uint64_t> childSubtrees) {
@@ -227,6 +166,88 @@ std::vector<std::byte> subtreeFile(const OctreeResult& octree, std::span<const d
   return out;
 }
 
+// Every subtree's tiles and child subtree bits.
+struct SubtreePlan {
+  std::map<SubtreeKey, std::vector<SubtreeTile>> tiles;
+  std::map<SubtreeKey, std::vector<std::uint64_t>> children;
+};
+
+SubtreePlan planSubtrees(const OctreeResult& octree, int subtreeLevels) {
+  SubtreePlan plan;
+  for (std::uint32_t i = 0; i < octree.nodes.size(); ++i) {
+    const ImplicitCoords c = coordsOf(octree, octree.nodes[i]);
+    ImplicitCoords local;
+    const SubtreeKey key = subtreeOf(c, subtreeLevels, &local);
+    plan.tiles[key].push_back(
+        {levelOffset(local.level) + mortonIndex(local.xyz[0], local.xyz[1], local.xyz[2]), i});
+    if (local.level != 0 || c.level == 0) continue;
+    // A subtree's root: a bit in the subtree above, at its bottom row's next level.
+    const SubtreeKey parent =
+        subtreeOf({c.level - 1, {c.xyz[0] >> 1, c.xyz[1] >> 1, c.xyz[2] >> 1}}, subtreeLevels);
+    std::uint32_t xyz[3];
+    for (std::size_t a = 0; a < 3; ++a) xyz[a] = c.xyz[a] & ((1u << subtreeLevels) - 1);
+    plan.children[parent].push_back(mortonIndex(xyz[0], xyz[1], xyz[2]));
+  }
+  return plan;
+}
+
+}  // namespace
+
+std::uint64_t mortonIndex(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  std::uint64_t m = 0;
+  for (int b = 0; b < 21; ++b) {
+    m |= std::uint64_t{(x >> b) & 1u} << (3 * b);
+    m |= std::uint64_t{(y >> b) & 1u} << (3 * b + 1);
+    m |= std::uint64_t{(z >> b) & 1u} << (3 * b + 2);
+  }
+  return m;
+}
+
+std::uint64_t levelOffset(int level) {
+  return ((std::uint64_t{1} << (3 * level)) - 1) / 7;
+}
+
+bool implicitTilingFits(const OctreeResult& octree) {
+  const OctreeNode& root = octree.nodes[octree.root];
+  if (root.level != octree.levels) return false;  // a root added over a --levels cut
+  for (const OctreeNode& node : octree.nodes)
+    for (std::uint32_t c : node.children) {
+      const OctreeNode& child = octree.nodes[c];
+      if (child.level != node.level - 1) return false;
+      for (std::size_t a = 0; a < 3; ++a)
+        if ((child.cell[a] >> 1) != node.cell[a]) return false;
+    }
+  return true;
+}
+
+Status placeContents(const OctreeResult& octree, const std::string& directory, bool implicit) {
+  const fs::path dir(directory);
+  std::error_code error;
+  for (const OctreeNode& node : octree.nodes) {
+    if (node.triangles == 0 || node.meshPath.empty()) continue;
+    const std::string explicitUri = tileContentUri(node),
+                      implicitUri = implicitContentUri(octree, node);
+    const fs::path to = dir / (implicit ? implicitUri : explicitUri);
+    const fs::path from = dir / (implicit ? explicitUri : implicitUri);
+    if (fs::exists(to, error)) continue;  // where an interrupted attempt already put it
+    fs::create_directories(to.parent_path(), error);
+    if (!error) fs::rename(from, to, error);
+    if (error)
+      return ioError(to.string(), fmt::format("cannot move a tile there: {}", error.message()));
+  }
+  if (implicit) return {};
+  // What an interrupted implicit attempt left: its subtree files and emptied folders.
+  fs::remove_all(dir / "subtrees", error);
+  for (const auto& entry : fs::directory_iterator(dir / "tiles", error))
+    if (entry.is_directory()) fs::remove_all(entry.path(), error);
+  return {};
+}
+
+std::string implicitContentUri(const OctreeResult& octree, const OctreeNode& node) {
+  const ImplicitCoords c = coordsOf(octree, node);
+  return fmt::format("tiles/{}/{}/{}/{}.glb", c.level, c.xyz[0], c.xyz[1], c.xyz[2]);
+}
+
 Status writeImplicitTileset(const OctreeResult& octree, const ChunkGrid& grid,
                             const std::string& directory, const std::optional<Mat4d>& rootTransform,
                             bool quantized, const std::string& partsUri, int subtreeLevels) {
@@ -234,7 +255,6 @@ Status writeImplicitTileset(const OctreeResult& octree, const ChunkGrid& grid,
   const int levels = octree.nodes[octree.root].level + 1;
   subtreeLevels = std::min(subtreeLevels, levels);
   const std::vector<double> errors = declaredTileErrors(octree, quantized);
-  LODFORGE_TRY(moveContents(octree, directory));
   const SubtreePlan plan = planSubtrees(octree, subtreeLevels);
   for (const auto& [key, tiles] : plan.tiles) {
     const auto found = plan.children.find(key);
@@ -256,9 +276,10 @@ Status writeImplicitTileset(const OctreeResult& octree, const ChunkGrid& grid,
   for (std::size_t i = 0; i < octree.nodes.size(); ++i)
     rootError = std::max(rootError, std::ldexp(errors[i], coordsOf(octree, octree.nodes[i]).level));
   const double cube = grid.size * std::ldexp(1.0, levels - 1);
+  const ChunkCell& cell = octree.nodes[octree.root].cell;
+  const Vec3d corner = grid.origin + Vec3d{cell[0] * cube, cell[1] * cube, cell[2] * cube};
   nlohmann::json root = {
-      {"boundingVolume",
-       {{"box", tileBox(Aabbd{grid.origin, grid.origin + Vec3d{cube, cube, cube}})}}},
+      {"boundingVolume", {{"box", tileBox(Aabbd{corner, corner + Vec3d{cube, cube, cube}})}}},
       {"geometricError", rootError},
       {"refine", "REPLACE"},
       {"content", {{"uri", "tiles/{level}/{x}/{y}/{z}.glb"}}},

@@ -30,28 +30,23 @@ std::uint64_t mortonIndex(std::uint32_t x, std::uint32_t y, std::uint32_t z);
 // Where level `level`'s bits start in a subtree's tile availability: (8^level - 1) / 7.
 std::uint64_t levelOffset(int level);
 
-// Whether the octree is one OCTREE subdivision: a single root at cell (0, 0, 0) over every level
-// (not a root added over a --levels cut).
+// Whether the octree is one OCTREE subdivision: a single root over every level (not a root added
+// over a --levels cut).
 bool implicitTilingFits(const OctreeResult& octree);
 
 // A node's content in an implicit tileset: tiles/{level}/{x}/{y}/{z}.glb, the level counted from
 // the root.
 std::string implicitContentUri(const OctreeResult& octree, const OctreeNode& node);
 
-// One subtree file's bytes ("subt" header, JSON, binary of 8-byte aligned bitstreams and the
-// tile property table): its tiles (bit index into the subtree's tile availability, the node),
-// the set bits of its child subtrees. `errors` per node, as the explicit tileset declares them.
-struct SubtreeTile {
-  std::uint64_t bit = 0;
-  std::uint32_t node = 0;
-};
-std::vector<std::byte> subtreeFile(const OctreeResult& octree, std::span<const double> errors,
-                                   int subtreeLevels, std::vector<SubtreeTile> tiles,
-                                   std::span<const std::uint64_t> childSubtrees);
+// Moves each node's content to its name in the layout about to be written (tileContentUri or
+// implicitContentUri), from the other layout's name where an interrupted run that was writing
+// the other layout left it (--resume then writes either); for the explicit layout, also removes
+// what such a run's implicit layout left (subtree files, numbered folders).
+Status placeContents(const OctreeResult& octree, const std::string& directory, bool implicit);
 
-// Writes `directory`/tileset.json with an implicit root over `grid`'s cube, the subtree files
-// under subtrees/, and moves each node's content from its explicit name (tileContentUri) to
-// implicitContentUri. Errors and boxes are those writeTilesetJson writes; the root's own
+// Writes `directory`/tileset.json with an implicit root over the root node's cube of `grid` and
+// the subtree files under subtrees/ (the contents already placed by placeContents). Errors and
+// boxes are those writeTilesetJson writes; the root's own
 // geometricError is the least one whose halving per level stays at or above every tile's error,
 // for viewers that ignore the metadata. Expects implicitTilingFits.
 Status writeImplicitTileset(const OctreeResult& octree, const ChunkGrid& grid,

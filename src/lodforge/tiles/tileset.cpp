@@ -175,7 +175,9 @@ Result<bool> implicitTilingWanted(ImplicitTiling wanted, const OctreeResult& tre
                  "implicit tiling needs the octree up to a single root; --levels stopped it "
                  "below one"};
   if (wanted != ImplicitTiling::kAuto) return wanted == ImplicitTiling::kOn;
-  return fits && tree.nodes.size() > kImplicitTilingAboveTiles;
+  const auto tiles = std::count_if(tree.nodes.begin(), tree.nodes.end(),
+                                   [](const OctreeNode& node) { return node.triangles > 0; });
+  return fits && static_cast<std::uint64_t>(tiles) > kImplicitTilingAboveTiles;
 }
 
 // The octree over the chunks, each tile written into the staged tileset as soon as it is built.
@@ -310,6 +312,7 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   Result<bool> implicit = implicitTilingWanted(options.implicitTiling, *tree);
   if (!implicit) return implicit.status();
   stats.implicitTiling = *implicit;
+  LODFORGE_TRY(placeContents(*tree, place.staging.path, *implicit));
   if (*implicit)
     LODFORGE_TRY(writeImplicitTileset(*tree, chunked->chunks->grid(), place.staging.path,
                                       chunked->frame, options.quantize, partsUri,

@@ -7,10 +7,10 @@
 // (the first allTilesLoaded), with the bytes of tileset.json, subtree files and contents fetched
 // by then. Prints a markdown table of the medians.
 //   node bench/cesium_first_frame.mjs [--runs 3] TILESET_DIR...
-import http from 'node:http';
 import { readFile } from 'node:fs/promises';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { cesiumPageHelpers, serveCesiumPage } from '../tests/js/cesium-page.mjs';
 import { keepLocal, launchChromium } from '../tests/js/chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -30,23 +30,14 @@ const page = `<!doctype html>
 <script src="/cesium/Cesium.js"></script>
 <style>html, body, #view { margin: 0; width: 100%; height: 100%; overflow: hidden; }</style>
 </head><body><div id="view"></div><script>
+${cesiumPageHelpers}
 window.report = { error: null };
 (async () => {
   try {
-    const viewer = new Cesium.Viewer('view', {
-      baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false,
-      animation: false, homeButton: false, sceneModePicker: false, navigationHelpButton: false,
-      fullscreenButton: false, infoBox: false, selectionIndicator: false,
-      terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false, skyAtmosphere: false,
-    });
-    viewer.scene.globe.show = false;
-    // Every run looks from the camera of a first, untimed one that zoomed to the first tileset
-    // (an implicit root's volume is the whole octree cube: zooming to it frames differently).
-    const camera = await (await fetch('/camera.json')).json();
-    if (camera)
-      viewer.camera.setView({ destination: Cesium.Cartesian3.fromArray(camera.position),
-                              orientation: { direction: Cesium.Cartesian3.fromArray(camera.direction),
-                                             up: Cesium.Cartesian3.fromArray(camera.up) } });
+    const viewer = bareViewer();
+    // Every run looks from the camera of a first, untimed one on the first tileset's model (an
+    // implicit root's volume is the whole octree cube: zooming to it frames differently).
+    const camera = await servedView(viewer);
     const start = performance.now();
     const tileset = await Cesium.Cesium3DTileset.fromUrl('/tileset/tileset.json');
     window.report.parsed = performance.now() - start;
@@ -74,10 +65,7 @@ window.report = { error: null };
       }
       viewer.camera.viewBoundingSphere(sphere, new Cesium.HeadingPitchRange(0, -0.5, 0));
       viewer.camera.lookAtTransform(Cesium.Matrix4.IDENTITY);
-      const c = viewer.camera;
-      window.report.camera = { position: Cesium.Cartesian3.pack(c.position, []),
-                               direction: Cesium.Cartesian3.pack(c.direction, []),
-                               up: Cesium.Cartesian3.pack(c.up, []) };
+      window.report.camera = cameraOf(viewer);
     }
   } catch (e) {
     window.report.error = String(e && e.stack || e);
@@ -89,37 +77,12 @@ window.report = { error: null };
 let served = { json: 0, subtree: 0, glb: 0 };
 let tilesetDir = null;
 let camera = null;  // the view of every timed run
-const server = http.createServer(async (request, response) => {
-  const url = decodeURIComponent(new URL(request.url, 'http://localhost').pathname);
-  try {
-    if (url === '/') {
-      response.writeHead(200, { 'content-type': 'text/html' });
-      response.end(page);
-      return;
-    }
-    if (url === '/camera.json') {
-      response.writeHead(200, { 'content-type': 'application/json' });
-      response.end(JSON.stringify(camera));
-      return;
-    }
-    let file = null;
-    if (url.startsWith('/cesium/')) file = path.join(cesiumDir, url.slice('/cesium/'.length));
-    else if (url.startsWith('/tileset/')) file = path.join(tilesetDir, url.slice('/tileset/'.length));
-    if (!file || file.includes('..')) throw new Error('outside');
-    const body = await readFile(file);
-    if (url.startsWith('/tileset/')) {
-      const kind = url.endsWith('.json') ? 'json' : url.endsWith('.subtree') ? 'subtree' : 'glb';
-      served[kind] += body.length;
-    }
-    response.writeHead(200);
-    response.end(body);
-  } catch {
-    response.writeHead(404);
-    response.end();
-  }
+const { server, port } = await serveCesiumPage({
+  page, cesiumDir, tilesetDir: () => tilesetDir, camera: async () => camera,
+  onServed: (url, body) => {
+    served[url.endsWith('.json') ? 'json' : url.endsWith('.subtree') ? 'subtree' : 'glb'] += body.length;
+  },
 });
-await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-const port = server.address().port;
 
 async function measure(directory) {
   tilesetDir = directory;

@@ -5,10 +5,10 @@
 // (a run on the same model written another way: implicit tiling), seen from that run's camera,
 // the picture must match that one's and the same contents must have been fetched.
 //   node cesium-tiles.mjs TILESET_DIR SCREENSHOT.png [--min-coverage 0.02] [--same-as OTHER.png]
-import http from 'node:http';
 import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { cesiumPageHelpers, serveCesiumPage } from './cesium-page.mjs';
 import { coverageOf, differenceOf, keepLocal, launchChromium } from './chromium.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
@@ -30,16 +30,11 @@ const page = `<!doctype html>
 <link rel="stylesheet" href="/cesium/Widgets/widgets.css">
 <style>html, body, #view { margin: 0; width: 100%; height: 100%; overflow: hidden; }</style>
 </head><body><div id="view"></div><script>
+${cesiumPageHelpers}
 window.report = { failed: [], loaded: false, error: null };
 (async () => {
   try {
-    const viewer = new Cesium.Viewer('view', {
-      baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false,
-      animation: false, homeButton: false, sceneModePicker: false, navigationHelpButton: false,
-      fullscreenButton: false, infoBox: false, selectionIndicator: false,
-      terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false, skyAtmosphere: false,
-    });
-    viewer.scene.globe.show = false;
+    const viewer = bareViewer();
     viewer.scene.backgroundColor = Cesium.Color.BLACK;
     const tileset = await Cesium.Cesium3DTileset.fromUrl('/tileset/tileset.json',
                                                          { maximumScreenSpaceError: 4 });
@@ -47,18 +42,8 @@ window.report = { failed: [], loaded: false, error: null };
     viewer.scene.primitives.add(tileset);
     // The other run's camera (--same-as): an implicit tileset's root volume is the whole octree
     // cube, so zooming to it would frame the model differently.
-    const camera = await (await fetch('/camera.json')).json();
-    if (camera) {
-      viewer.camera.setView({ destination: Cesium.Cartesian3.fromArray(camera.position),
-                              orientation: { direction: Cesium.Cartesian3.fromArray(camera.direction),
-                                             up: Cesium.Cartesian3.fromArray(camera.up) } });
-    } else {
-      await viewer.zoomTo(tileset);
-    }
-    const c = viewer.camera;
-    window.report.camera = { position: Cesium.Cartesian3.pack(c.position, []),
-                             direction: Cesium.Cartesian3.pack(c.direction, []),
-                             up: Cesium.Cartesian3.pack(c.up, []) };
+    if (!(await servedView(viewer))) await viewer.zoomTo(tileset);
+    window.report.camera = cameraOf(viewer);
     tileset.allTilesLoaded.addEventListener(() => { window.report.loaded = true; });
   } catch (e) {
     window.report.error = String(e && e.stack || e);
@@ -66,45 +51,19 @@ window.report = { failed: [], loaded: false, error: null };
 })();
 </script></body></html>`;
 
-const types = { '.json': 'application/json', '.glb': 'model/gltf-binary', '.js': 'text/javascript',
-                '.css': 'text/css', '.png': 'image/png', '.wasm': 'application/wasm',
-                '.html': 'text/html', '.xml': 'application/xml', '.jpg': 'image/jpeg' };
 const failedRequests = [];
 const fetched = { contents: [], bytes: 0 };
-const server = http.createServer(async (request, response) => {
-  const url = decodeURIComponent(new URL(request.url, 'http://localhost').pathname);
-  let file = null;
-  if (url === '/') file = null;
-  else if (url.startsWith('/cesium/')) file = path.join(cesiumDir, url.slice('/cesium/'.length));
-  else if (url.startsWith('/tileset/')) file = path.join(tilesetDir, url.slice('/tileset/'.length));
-  try {
-    if (url === '/') {
-      response.writeHead(200, { 'content-type': 'text/html' });
-      response.end(page);
-      return;
-    }
-    if (url === '/camera.json') {
-      const other = sameAs ? JSON.parse(await readFile(sameAs.replace(/\.png$/, '.json'), 'utf8')) : null;
-      response.writeHead(200, { 'content-type': 'application/json' });
-      response.end(JSON.stringify(other ? other.camera : null));
-      return;
-    }
-    if (!file || file.includes('..')) throw new Error('outside');
-    const body = await readFile(file);
-    if (url.endsWith('.glb')) {
-      fetched.contents.push(path.relative(tilesetDir, file));
-      fetched.bytes += body.length;
-    }
-    response.writeHead(200, { 'content-type': types[path.extname(file)] ?? 'application/octet-stream' });
-    response.end(body);
-  } catch {
-    failedRequests.push(url);
-    response.writeHead(404);
-    response.end();
-  }
+const { server, port } = await serveCesiumPage({
+  page, cesiumDir, tilesetDir: () => tilesetDir,
+  // The other run's camera (--same-as), or none.
+  camera: async () => (sameAs ? JSON.parse(await readFile(sameAs.replace(/\.png$/, '.json'), 'utf8')).camera : null),
+  onServed: (url, body) => {
+    if (!url.endsWith('.glb')) return;
+    fetched.contents.push(url);
+    fetched.bytes += body.length;
+  },
+  onMissing: (url) => failedRequests.push(url),
 });
-await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
-const port = server.address().port;
 
 const { context, close: closeBrowser } = await launchChromium();
 const problems = [];

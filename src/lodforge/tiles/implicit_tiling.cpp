@@ -19,10 +19,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A node's place in the implicit tree: its level below the root and its coordinates there.
+// A place in the implicit tree: a level below the root and coordinates there (also a subtree's,
+// by its root's place).
 struct ImplicitCoords {
   int level = 0;
   std::array<std::uint32_t, 3> xyz{};
+  auto operator<=>(const ImplicitCoords&) const = default;
 };
 
 // The root's cell need not be (0, 0, 0) (the grid's corner comes from every input vertex, also
@@ -36,18 +38,13 @@ ImplicitCoords coordsOf(const OctreeResult& octree, const OctreeNode& node) {
   return c;
 }
 
-// The subtree holding a tile: its root's level and coordinates (a multiple of the subtree
-// levels), and the tile's level and coordinates within it.
-struct SubtreeKey {
-  int level = 0;
-  std::array<std::uint32_t, 3> xyz{};
-  auto operator<=>(const SubtreeKey&) const = default;
-};
-
-SubtreeKey subtreeOf(const ImplicitCoords& c, int subtreeLevels, ImplicitCoords* local = nullptr) {
+// The subtree holding a tile, by its root's place (at a multiple of the subtree levels), and
+// with `local` the tile's level and coordinates within it.
+ImplicitCoords subtreeOf(const ImplicitCoords& c, int subtreeLevels,
+                         ImplicitCoords* local = nullptr) {
   const int root = c.level / subtreeLevels * subtreeLevels;
   const int within = c.level - root;
-  SubtreeKey key{root, {}};
+  ImplicitCoords key{root, {}};
   for (std::size_t a = 0; a < 3; ++a) key.xyz[a] = c.xyz[a] >> within;
   if (local != nullptr) {
     local->level = within;
@@ -56,7 +53,7 @@ SubtreeKey subtreeOf(const ImplicitCoords& c, int subtreeLevels, ImplicitCoords*
   return key;
 }
 
-std::string subtreeUri(const SubtreeKey& key) {
+std::string subtreeUri(const ImplicitCoords& key) {
   return fmt::format("subtrees/{}/{}/{}/{}.subtree", key.level, key.xyz[0], key.xyz[1], key.xyz[2]);
 }
 
@@ -91,11 +88,6 @@ nlohmann::json availability(SubtreeBinary& binary, std::uint64_t bitCount,
   return {{"bitstream", binary.add(bits)}, {"availableCount", setBits.size()}};
 }
 
-template <class T>
-std::span<const std::byte> bytesOfValues(const std::vector<T>& values) {
-  return std::as_bytes(std::span(values));
-}
-
 // The tile property table: each available tile's error and tight box, in bit order.
 nlohmann::json tileTable(SubtreeBinary& binary, const OctreeResult& octree,
                          std::span<const double> errors, std::span<const SubtreeTile> tiles) {
@@ -108,8 +100,8 @@ nlohmann::json tileTable(SubtreeBinary& binary, const OctreeResult& octree,
   return {{"class", "tile"},
           {"count", tiles.size()},
           {"properties",
-           {{"geometricError", {{"values", binary.add(bytesOfValues(error))}}},
-            {"boundingBox", {{"values", binary.add(bytesOfValues(box))}}}}}};
+           {{"geometricError", {{"values", binary.add(std::as_bytes(std::span(error)))}}},
+            {"boundingBox", {{"values", binary.add(std::as_bytes(std::span(box)))}}}}}};
 }
 
 // The schema of that table: the semantics that make viewers take the values as the tile's own.
@@ -135,8 +127,7 @@ std::vector<std::byte> subtreeFile(const OctreeResult& octree, std::span<const d
   std::vector<std::uint64_t> tileBits, contentBits;
   for (const SubtreeTile& t : tiles) {
     tileBits.push_back(t.bit);
-    const OctreeNode& node = octree.nodes[t.node];
-    if (node.triangles > 0 && !node.meshPath.empty()) contentBits.push_back(t.bit);
+    if (hasTileContent(octree.nodes[t.node])) contentBits.push_back(t.bit);
   }
   std::vector<std::uint64_t> children(childSubtrees.begin(), childSubtrees.end());
   std::sort(children.begin(), children.end());
@@ -168,8 +159,8 @@ std::vector<std::byte> subtreeFile(const OctreeResult& octree, std::span<const d
 
 // Every subtree's tiles and child subtree bits.
 struct SubtreePlan {
-  std::map<SubtreeKey, std::vector<SubtreeTile>> tiles;
-  std::map<SubtreeKey, std::vector<std::uint64_t>> children;
+  std::map<ImplicitCoords, std::vector<SubtreeTile>> tiles;
+  std::map<ImplicitCoords, std::vector<std::uint64_t>> children;
 };
 
 SubtreePlan planSubtrees(const OctreeResult& octree, int subtreeLevels) {
@@ -177,12 +168,12 @@ SubtreePlan planSubtrees(const OctreeResult& octree, int subtreeLevels) {
   for (std::uint32_t i = 0; i < octree.nodes.size(); ++i) {
     const ImplicitCoords c = coordsOf(octree, octree.nodes[i]);
     ImplicitCoords local;
-    const SubtreeKey key = subtreeOf(c, subtreeLevels, &local);
+    const ImplicitCoords key = subtreeOf(c, subtreeLevels, &local);
     plan.tiles[key].push_back(
         {levelOffset(local.level) + mortonIndex(local.xyz[0], local.xyz[1], local.xyz[2]), i});
     if (local.level != 0 || c.level == 0) continue;
     // A subtree's root: a bit in the subtree above, at its bottom row's next level.
-    const SubtreeKey parent =
+    const ImplicitCoords parent =
         subtreeOf({c.level - 1, {c.xyz[0] >> 1, c.xyz[1] >> 1, c.xyz[2] >> 1}}, subtreeLevels);
     std::uint32_t xyz[3];
     for (std::size_t a = 0; a < 3; ++a) xyz[a] = c.xyz[a] & ((1u << subtreeLevels) - 1);
@@ -224,7 +215,7 @@ Status placeContents(const OctreeResult& octree, const std::string& directory, b
   const fs::path dir(directory);
   std::error_code error;
   for (const OctreeNode& node : octree.nodes) {
-    if (node.triangles == 0 || node.meshPath.empty()) continue;
+    if (!hasTileContent(node)) continue;
     const std::string explicitUri = tileContentUri(node),
                       implicitUri = implicitContentUri(octree, node);
     const fs::path to = dir / (implicit ? implicitUri : explicitUri);

@@ -175,8 +175,7 @@ Result<bool> implicitTilingWanted(ImplicitTiling wanted, const OctreeResult& tre
                  "implicit tiling needs the octree up to a single root; --levels stopped it "
                  "below one"};
   if (wanted != ImplicitTiling::kAuto) return wanted == ImplicitTiling::kOn;
-  const auto tiles = std::count_if(tree.nodes.begin(), tree.nodes.end(),
-                                   [](const OctreeNode& node) { return node.triangles > 0; });
+  const auto tiles = std::count_if(tree.nodes.begin(), tree.nodes.end(), hasTileContent);
   return fits && static_cast<std::uint64_t>(tiles) > kImplicitTilingAboveTiles;
 }
 
@@ -312,7 +311,9 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   Result<bool> implicit = implicitTilingWanted(options.implicitTiling, *tree);
   if (!implicit) return implicit.status();
   stats.implicitTiling = *implicit;
-  LODFORGE_TRY(placeContents(*tree, place.staging.path, *implicit));
+  // Contents are written under their explicit names: moved when implicit, or back where an
+  // interrupted implicit attempt moved them.
+  if (*implicit || stats.resumed) LODFORGE_TRY(placeContents(*tree, place.staging.path, *implicit));
   if (*implicit)
     LODFORGE_TRY(writeImplicitTileset(*tree, chunked->chunks->grid(), place.staging.path,
                                       chunked->frame, options.quantize, partsUri,

@@ -58,8 +58,7 @@ Status writeTilesetJson(const OctreeResult& octree, const std::string& path,
     nlohmann::json out = {{"boundingVolume", boxOf(node.bounds)},
                           {"geometricError", errors[index]},
                           {"refine", "REPLACE"}};
-    if (node.triangles > 0 && !node.meshPath.empty())
-      out["content"] = {{"uri", tileContentUri(node)}};
+    if (hasTileContent(node)) out["content"] = {{"uri", tileContentUri(node)}};
     if (!node.children.empty()) {
       out["children"] = nlohmann::json::array();
       for (std::uint32_t c : node.children) out["children"].push_back(tile(c));

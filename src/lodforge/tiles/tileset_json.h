@@ -33,6 +33,11 @@ double nothingShownError(const OctreeResult& octree, double rootError);
 // A tile's "box" bounding volume for axis-aligned bounds: centre, then three half-axes.
 std::array<double, 12> tileBox(const Aabbd& bounds);
 
+// Whether a node has a content file (triangles, written by the builder).
+inline bool hasTileContent(const OctreeNode& node) {
+  return node.triangles > 0 && !node.meshPath.empty();
+}
+
 // The relative URI of a node's content.
 std::string tileContentUri(const OctreeNode& node);
 

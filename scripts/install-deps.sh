@@ -21,6 +21,8 @@ packages=(
   libocct-data-exchange-dev libfontconfig1-dev occt-misc
   # interchange formats (OFF, FBX, Collada, 3DS, IFC, …) through assimp
   libassimp-dev
+  # builds across machines: OpenMPI (mpirun; Slurm's srun launches it as it is)
+  libopenmpi-dev openmpi-bin
   # rendering (headless EGL on Mesa's llvmpipe, GLFW window, Dear ImGui)
   libepoxy-dev libegl-dev libgl1-mesa-dri libglfw3-dev libimgui-dev xvfb
   # tests and benchmarks

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "lodforge/core/cluster.h"
 #include "lodforge/core/threads.h"
 #include "lodforge/core/units.h"
 #include "lodforge/io/points/point_reader.h"
@@ -64,6 +65,17 @@ Status checkThreads(Global& global) {
     fmt::print(stderr, "lodforge: note: --threads {}: this machine has {} cores; using {}\n",
                global.threads, cores, cores);
   global.threads = cores;
+  return {};
+}
+
+Status checkClusterCommand(const CLI::App& app) {
+  if (!clustered()) return {};
+  for (const CLI::App* command : app.get_subcommands())
+    if (command->get_name() != "tiles")
+      return Error{ErrorKind::kUsage,
+                   fmt::format("`{}` runs as one process; only `tiles` runs across the ranks of "
+                               "an mpirun or srun job (docs/distributed.md)",
+                               command->get_name())};
   return {};
 }
 

@@ -33,6 +33,9 @@ CLI::Option* addByteSizeOption(CLI::App& app, const std::string& name, std::uint
 CLI::Option* addThreadsOption(CLI::App& app, unsigned& target);
 // Lowers --threads above the machine's cores to them, with a note.
 Status checkThreads(Global& global);
+// Under mpirun or srun with several ranks: a subcommand that does not run across them is a
+// usage error (each rank would do the whole work again).
+Status checkClusterCommand(const CLI::App& app);
 // --memory-limit: refused when 0 (it would mean nothing) and for a subcommand that does not
 // honour it, before any work.
 Status checkMemoryLimit(const CLI::App& app, const CLI::Option& option, std::uint64_t limit);

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "lodforge/core/cluster.h"
 #include "lodforge/core/memory.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/threads.h"
@@ -53,15 +54,22 @@ int main(int argc, char** argv) {
   }
   Status status = cli::checkMemoryLimit(app, *memoryLimit, global.memoryLimit);
   if (status.ok()) status = cli::checkThreads(global);
+  if (status.ok()) status = joinCluster();
+  if (status.ok()) status = cli::checkClusterCommand(app);
   if (!status.ok()) {
-    fmt::print(stderr, "lodforge: {}\n", status.message());
+    if (clusterRank() == 0) fmt::print(stderr, "lodforge: {}\n", status.message());
+    leaveCluster();
     return exitCodeFor(status);
   }
+  // In a job of several ranks, rank 0 speaks for the job (docs/distributed.md).
+  if (clusterRank() != 0) global.verbosity = -1;
   if (global.verbosity < 0) setProgressMode(ProgressMode::kOff);
   installInterruptHandler();
   const ThreadLimit threads(global.threads);
 
   status = run ? cli::runGuarded(run) : Status(Error{ErrorKind::kUsage, "no subcommand"});
-  if (!status.ok()) fmt::print(stderr, "lodforge: {}\n", status.message());
+  if (!status.ok() && (clusterRank() == 0 || clusterAbandoned()))
+    fmt::print(stderr, "lodforge: {}\n", status.message());
+  leaveCluster();
   return exitCodeFor(status);
 }

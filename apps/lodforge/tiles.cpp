@@ -1,11 +1,13 @@
 // `lodforge tiles INPUT -o DIR`: a mesh of any size as a 3D Tiles 1.1 tileset (large-meshes
 // paper §3.2–3.4): chunk grid, octree of simplified super-chunks, one GLB per tile.
+#include <algorithm>
 #include <filesystem>
 
 #include <fmt/format.h>
 
 #include "cad_options.h"
 #include "cli.h"
+#include "lodforge/core/cluster.h"
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
@@ -217,6 +219,11 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
 }
 
 Status runPointTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
+  if (clustered())
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: a point cloud; point tilesets are built by one process for now "
+                             "(meshes and --surface run across ranks: docs/distributed.md)",
+                             options.input)};
   if (options.levels > 0 || options.chunkSize > 0 || options.resume)
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: a point cloud; --levels, --chunk-size and --resume are for "
@@ -299,13 +306,28 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
                          static_cast<double>(std::max<std::uint64_t>(1, stats.vertices)),
                      formatCount(stats.maxLockedVertices), formatCount(stats.droppedSegments),
                      formatBytes(peakRssBytes())));
+  if (stats.takenNodes > 0)
+    detail(global, fmt::format("octree: built {} nodes, took {} as the interrupted run left them",
+                               formatCount(stats.builtNodes), formatCount(stats.takenNodes)));
+  if (stats.ranks > 1) {
+    const auto [least, most] = std::minmax_element(stats.rankWork.begin(), stats.rankWork.end());
+    detail(global, fmt::format("{} ranks: subtrees under level {}, {} to {} leaf triangles a rank; "
+                               "subtrees {:.1f} s, then the levels above and the tileset on rank 0 "
+                               "{:.1f} s; peak memory of rank 0 {}",
+                               stats.ranks, stats.splitLevel, formatCount(*least),
+                               formatCount(*most), stats.subtreeSeconds,
+                               stats.seconds - stats.chunkSeconds - stats.subtreeSeconds,
+                               formatBytes(peakRssBytes())));
+  }
 }
 
 Status runMeshTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
   Result<TilesStats> stats = writeTiles(options.input, options.output, tiles);
   if (!stats) {
     const std::string work = tilesWorkDirectory(options.output);
-    if (tilesWorkKept(work))
+    // Not where another run holds the work (this one was refused), and once for a job.
+    if (clusterRank() == 0 && isWorkDirectory(work) && tilesWorkKept(work) &&
+        !workDirectoryLocked(work))
       fmt::print(stderr,
                  "lodforge: the finished work is kept in {}: run again with --resume to "
                  "continue, or delete it\n",

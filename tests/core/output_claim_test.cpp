@@ -61,5 +61,31 @@ TEST(OutputClaim, RemovesTheLeftoversOfADeadRunAtItsOutputOnly) {
   EXPECT_EQ(removeDeadLeftovers(dir.file("out.glb")), 0u);  // nothing left to remove
 }
 
+// One run at a time writes a work directory: a second lock is refused, naming the holder, until
+// the first is released (a second open of the lock file conflicts even within one process).
+TEST(OutputClaim, AWorkDirectoryIsWrittenByOneRunAtATime) {
+  const test::TempDir dir;
+  const std::string work = dir.file("t.work");
+  ASSERT_TRUE(claimWorkDirectory(work).ok());
+  {
+    Result<WorkLock> first = lockWorkDirectory(work);
+    ASSERT_TRUE(first.ok()) << first.status().message();
+    Result<WorkLock> second = lockWorkDirectory(work);
+    ASSERT_FALSE(second.ok());
+    EXPECT_EQ(second.status().kind(), ErrorKind::kUsage);
+    EXPECT_NE(
+        second.status().message().find(fmt::format("another lodforge run (pid {} on", ::getpid())),
+        std::string::npos)
+        << second.status().message();
+    WorkLock moved = std::move(*first);  // the lock goes with it
+    EXPECT_FALSE(lockWorkDirectory(work).ok());
+    EXPECT_TRUE(workDirectoryLocked(work));
+  }
+  EXPECT_FALSE(workDirectoryLocked(work)) << "released with the last holder";
+  EXPECT_TRUE(lockWorkDirectory(work).ok());
+  EXPECT_FALSE(workDirectoryLocked(dir.file("elsewhere"))) << "and creates nothing";
+  EXPECT_FALSE(std::filesystem::exists(dir.file("elsewhere")));
+}
+
 }  // namespace
 }  // namespace lodforge

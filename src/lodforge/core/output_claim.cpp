@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -19,6 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kWorkMarker = ".lodforge-work";
+constexpr const char* kWorkLock = ".lodforge-lock";
 
 // `inner` is `outer` itself or lies below it (both resolved through links and "..").
 bool isWithin(const std::string& inner, const std::string& outer) {
@@ -180,6 +182,49 @@ Status claimWorkDirectory(const std::string& path) {
   if (fd < 0) return ioErrorFromErrno(marker, "create");
   ::close(fd);
   return {};
+}
+
+WorkLock& WorkLock::operator=(WorkLock&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = std::exchange(other.fd_, -1);
+  }
+  return *this;
+}
+
+WorkLock::~WorkLock() {
+  if (fd_ >= 0) ::close(fd_);  // closing releases the lock
+}
+
+Result<WorkLock> lockWorkDirectory(const std::string& path) {
+  const std::string file = (fs::path(path) / kWorkLock).string();
+  const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return ioErrorFromErrno(file, "create");
+  WorkLock lock(fd);
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    std::string holder(256, '\0');
+    const ssize_t got = ::pread(fd, holder.data(), holder.size(), 0);
+    holder.resize(got > 0 ? static_cast<std::size_t>(got) : 0);
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: another lodforge run ({}) is writing this output; wait for it "
+                             "or choose another output",
+                             path, holder.empty() ? "unknown process" : holder)};
+  }
+  std::string host(256, '\0');
+  if (::gethostname(host.data(), host.size() - 1) != 0) host.clear();
+  const std::string holder = fmt::format("pid {} on {}", ::getpid(), host.c_str());
+  if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, holder.data(), holder.size(), 0) < 0)
+    return ioErrorFromErrno(file, "write");
+  return lock;
+}
+
+bool workDirectoryLocked(const std::string& path) {
+  const std::string file = (fs::path(path) / kWorkLock).string();
+  const int fd = ::open(file.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool locked = ::flock(fd, LOCK_EX | LOCK_NB) != 0;
+  ::close(fd);
+  return locked;
 }
 
 bool fileStartsWith(const std::string& path, std::string_view prefix) {

@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "lodforge/core/status.h"
 
@@ -48,6 +49,27 @@ std::optional<int> leftoverProcess(std::string_view name, std::string_view outpu
 // the user's and is refused. Creates the directory (with its marker) when it does not exist.
 Status claimWorkDirectory(const std::string& path);
 bool isWorkDirectory(const std::string& path);
+
+// Held while a run writes into its work directory (an advisory lock on a file in it), so that a
+// second run on the same output, another job or the same command started twice, is refused
+// instead of mixing its files with the first one's. Released when destroyed.
+class WorkLock {
+ public:
+  WorkLock() = default;
+  explicit WorkLock(int fd) : fd_(fd) {}
+  WorkLock(WorkLock&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+  WorkLock& operator=(WorkLock&& other) noexcept;
+  WorkLock(const WorkLock&) = delete;
+  WorkLock& operator=(const WorkLock&) = delete;
+  ~WorkLock();
+
+ private:
+  int fd_ = -1;
+};
+// Locks the work directory `path` (claimed first), or says which process holds it.
+Result<WorkLock> lockWorkDirectory(const std::string& path);
+// Whether a run holds the lock of work directory `path` now (creates nothing).
+bool workDirectoryLocked(const std::string& path);
 
 // Recognisers the kinds are made of.
 bool fileStartsWith(const std::string& path, std::string_view prefix);

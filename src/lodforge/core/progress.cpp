@@ -64,18 +64,24 @@ void checkpointReached(std::string_view kind) {
   struct Interrupt {
     std::string kind;
     long after = 0;
+    bool kill = false;
   };
   static const Interrupt interrupt = [] {
     const char* value = std::getenv("LODFORGE_INTERRUPT_AFTER");
     const std::string_view spec = value ? value : "";
     const std::size_t colon = spec.find(':');
     if (colon == std::string_view::npos) return Interrupt{};
-    return Interrupt{std::string(spec.substr(0, colon)),
-                     std::strtol(std::string(spec.substr(colon + 1)).c_str(), nullptr, 10)};
+    const std::string count(spec.substr(colon + 1));
+    char* end = nullptr;
+    const long after = std::strtol(count.c_str(), &end, 10);
+    return Interrupt{std::string(spec.substr(0, colon)), after, std::string_view(end) == ":kill"};
   }();
   static std::atomic<long> reached{0};
-  if (interrupt.after > 0 && kind == interrupt.kind && reached.fetch_add(1) + 1 == interrupt.after)
+  if (interrupt.after > 0 && kind == interrupt.kind &&
+      reached.fetch_add(1) + 1 == interrupt.after) {
+    if (interrupt.kill) ::raise(SIGKILL);  // a process that dies, not one that stops
     requestCancel();
+  }
 }
 
 void setProgressMode(ProgressMode mode) {

@@ -1,5 +1,7 @@
 #include "lodforge/core/threads.h"
 
+#include <sched.h>
+
 #include <thread>
 
 #include <tbb/global_control.h>
@@ -11,6 +13,12 @@ struct ThreadLimit::Control {
 };
 
 unsigned hardwareThreads() {
+  // The cores this process may run on: mpirun binds each rank to its own, and TBB will not
+  // start more workers than that.
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0 && CPU_COUNT(&set) > 0)
+    return static_cast<unsigned>(CPU_COUNT(&set));
   return std::max(1u, std::thread::hardware_concurrency());
 }
 

@@ -21,6 +21,7 @@ class ThreadLimit {
   unsigned threads_;
 };
 
+// The cores this process may run on (its affinity: all of the machine unless bound).
 unsigned hardwareThreads();
 
 }  // namespace lodforge

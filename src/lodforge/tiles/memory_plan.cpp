@@ -1,17 +1,17 @@
 #include "lodforge/tiles/memory_plan.h"
 
 #include <algorithm>
-#include <thread>
 
 #include <fmt/format.h>
 
+#include "lodforge/core/threads.h"
 #include "lodforge/core/units.h"
 
 namespace lodforge {
 
 Status planTilesMemory(TilesMemory mode, std::uint64_t memoryLimit, int threads,
                        ChunkInputOptions& input, OctreeOptions& octree) {
-  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  const int cores = static_cast<int>(hardwareThreads());
   switch (mode) {
     case TilesMemory::kMinimal:
       octree.threads = 1;

@@ -1,6 +1,7 @@
 #include "lodforge/tiles/tileset.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -9,8 +10,10 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/core/cluster.h"
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
+#include "lodforge/core/output_claim.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
 #include "lodforge/tiles/surface_input.h"
@@ -34,6 +37,8 @@ std::uint64_t fileBytes(const std::string& path) {
 // or Ctrl-C after the chunks are complete, it stays for --resume; otherwise (bad input, or
 // success) it goes.
 struct WorkPlace {
+  explicit WorkPlace(const std::string& workDirectory)
+      : work(workDirectory), staging(workDirectory + "/tileset") {}
   ScopedDirectory work;
   ScopedDirectory staging;
   bool done = false;
@@ -180,11 +185,18 @@ Result<bool> implicitTilingWanted(ImplicitTiling wanted, const OctreeResult& tre
 }
 
 // The octree over the chunks, each tile written into the staged tileset as soon as it is built.
+// In a job of several ranks, each node built counts towards the job's progress.
 Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& options,
                                 const OctreeOptions& octree, const std::string& tilesetDirectory,
-                                const TileTexturing* texturing) {
-  return buildOctree(
+                                const TileTexturing* texturing, std::uint64_t& builtNodes) {
+  std::atomic<std::uint64_t> built = 0;
+  const auto counted = [&](Result<OctreeResult> tree) {
+    builtNodes = built;
+    return tree;
+  };
+  return counted(buildOctree(
       *chunked.chunks, octree, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
+        reportProgress(++built);
         if (mesh.triangleCount() == 0) return {};
         return writeTileContent(mesh, node.bounds, tilesetDirectory + "/" + tileContentUri(node),
                                 {.colors = chunked.colors,
@@ -193,7 +205,7 @@ Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& o
                                  .parts = &chunked.parts,
                                  .texturing = texturing,
                                  .level = static_cast<std::uint32_t>(node.level)});
-      });
+      }));
 }
 
 // A textured input's images as pyramids in the work directory, for every tile to bake from.
@@ -220,6 +232,13 @@ Result<std::optional<TexturePyramid>> buildPyramids(const ChunkInput& chunked,
       TexturePyramid::build(chunked.textures.images, directory, plan.cacheBytes, resumed);
   if (!pyramid) return pyramid.status();
   return std::optional(std::move(*pyramid));
+}
+
+// The nodes the octree builds (not the empty root above the top level that --levels may leave).
+std::uint64_t plannedNodes(const OctreeResult& tree) {
+  return static_cast<std::uint64_t>(
+      std::count_if(tree.nodes.begin(), tree.nodes.end(),
+                    [&](const OctreeNode& node) { return node.level <= tree.levels; }));
 }
 
 void countChunks(const ChunkInput& chunked, TilesStats& stats) {
@@ -257,6 +276,201 @@ void countTiles(const OctreeResult& tree, TilesStats& stats) {
       static_cast<std::uint64_t>(std::unique(coarsest.begin(), coarsest.end()) - coarsest.begin());
 }
 
+// The chunk input's and the octree's options for this run, memory planned; a CRS attached.
+struct RunPlan {
+  ChunkInputOptions input;
+  OctreeOptions octree;
+  std::shared_ptr<const LazyCrs> crs;
+};
+Result<RunPlan> planRun(const TilesOptions& options, const std::string& workDirectory) {
+  RunPlan run{options.input, options.octree, nullptr};
+  run.input.levels = run.octree.levels;
+  run.input.workDirectory = workDirectory;
+  run.octree.workDirectory = workDirectory + "/nodes";
+  LODFORGE_TRY(
+      planTilesMemory(options.memory, options.memoryLimit, options.threads, run.input, run.octree));
+  if (clustered()) {
+    // Ranks hand chunks and node meshes over through the work directory.
+    run.input.keepInMemory = false;
+    run.octree.keepInMemory = false;
+  }
+  run.crs = attachCrs(options.crs, options.crsFrom, run.input);
+  return run;
+}
+
+// A textured input's pyramids and what its tiles bake from (no `tiles`: untextured).
+struct Texturing {
+  std::optional<TexturePyramid> pyramid;
+  std::optional<TileTexturing> tiles;
+};
+Status prepareTexturing(const ChunkInput& chunked, const TilesOptions& options,
+                        const OctreeOptions& octree, const std::string& workDirectory, bool resumed,
+                        Texturing& out) {
+  const TexturePlan plan = planTextureMemory(options.memoryLimit, octree.threads,
+                                             options.atlas.maxSize, options.textureCacheBytes);
+  Result<std::optional<TexturePyramid>> pyramid =
+      buildPyramids(chunked, workDirectory, plan, resumed);
+  if (!pyramid) return pyramid.status();
+  if (!*pyramid) return {};
+  out.pyramid = std::move(**pyramid);
+  AtlasOptions atlas = options.atlas;
+  atlas.maxSize = plan.pageSide;
+  out.tiles = TileTexturing{&chunked.textures, &*out.pyramid, atlas, options.textureEncoding};
+  return {};
+}
+
+// The listing (explicit or implicit) and parts.json beside the staged contents, the counts,
+// then the staged tileset replaces the output.
+Status finishTileset(const OctreeResult& tree, const ChunkInput& chunked,
+                     const TilesOptions& options, WorkPlace& place,
+                     const std::string& outputDirectory, TilesStats& stats) {
+  const std::string partsUri = chunked.parts.empty() ? "" : kPartsFileName;
+  Result<bool> implicit = implicitTilingWanted(options.implicitTiling, tree);
+  if (!implicit) return implicit.status();
+  stats.implicitTiling = *implicit;
+  // Contents are written under their explicit names: moved when implicit, or back where an
+  // interrupted implicit attempt moved them.
+  if (*implicit || stats.resumed) LODFORGE_TRY(placeContents(tree, place.staging.path, *implicit));
+  if (*implicit)
+    LODFORGE_TRY(writeImplicitTileset(tree, chunked.chunks->grid(), place.staging.path,
+                                      chunked.frame, options.quantize, partsUri,
+                                      options.subtreeLevels));
+  else
+    LODFORGE_TRY(writeTilesetJson(tree, place.staging.path + "/tileset.json", chunked.frame,
+                                  options.quantize, partsUri));
+  if (!partsUri.empty())
+    LODFORGE_TRY(writePartsJson(tree, chunked.parts, place.staging.path + "/" + partsUri));
+  countTiles(tree, stats);
+  stats.outputBytes = directoryBytes(place.staging.path);
+  place.done = true;
+  return replaceDirectory(place.staging, outputDirectory);
+}
+
+// The output and its work directory claimed and locked, the work place made ready.
+Status claimWorkPlace(const std::string& path, const std::string& outputDirectory,
+                      const TilesOptions& options, std::optional<WorkPlace>& place,
+                      WorkLock& lock) {
+  LODFORGE_TRY(claimTilesetOutput(path, outputDirectory));
+  const std::string workDirectory = tilesWorkDirectory(outputDirectory);
+  LODFORGE_TRY(claimWorkDirectory(workDirectory));  // before it is ours to remove
+  Result<WorkLock> locked = lockWorkDirectory(workDirectory);
+  if (!locked) return locked.status();
+  lock = std::move(*locked);
+  place.emplace(workDirectory);
+  return prepareWorkPlace(*place, options.resume);
+}
+
+// A job of several ranks (docs/distributed.md): rank 0 claims the output and chunks the input
+// while the others wait; every rank builds its share of the octree's subtrees; rank 0 builds
+// the levels above them and writes the tileset. Each step ends with every rank's outcome.
+class RankedTiles {
+ public:
+  RankedTiles(const std::string& path, const std::string& outputDirectory,
+              const TilesOptions& options)
+      : path_(path), output_(outputDirectory), options_(options), lead_(clusterRank() == 0) {}
+
+  Result<TilesStats> run() {
+    Result<RunPlan> run = planRun(options_, tilesWorkDirectory(output_));
+    LODFORGE_TRY(agreeAcrossRanks(lead_ && run ? chunkOnLead(*run) : run.status()));
+    stats_.chunkSeconds = secondsSince(start_);
+    setActivityDirectory(run->input.workDirectory + "/ranks");
+    LODFORGE_TRY(agreeAcrossRanks(lead_ ? Status{} : takeChunks(*run)));
+    countChunks(*chunked_, stats_);
+    stats_.threads = run->octree.threads;
+    stats_.ranks = clusterSize();
+    Result<std::uint64_t> taken = buildShare(run->octree);
+    if (!taken) return taken.status();
+    Result<std::uint64_t> built = sumAcrossRanks(builtNodes_);
+    if (!built) return built.status();
+    stats_.subtreeSeconds = secondsSince(start_) - stats_.chunkSeconds;
+    LODFORGE_TRY(agreeAcrossRanks(lead_ ? buildTop(run->octree) : Status{}));
+    stats_.builtNodes = *built + builtNodes_;  // the top: rank 0's since the sum
+    stats_.takenNodes = *taken;
+    stats_.seconds = secondsSince(start_);
+    return stats_;
+  }
+
+ private:
+  // Rank 0: the output and work directory claimed, the input chunked (or an interrupted run's
+  // chunks taken), a textured input's pyramids made.
+  Status chunkOnLead(const RunPlan& run) {
+    LODFORGE_TRY(claimWorkPlace(path_, output_, options_, place_, lock_));
+    Result<ChunkInput> chunks = chunkOrResume(path_, options_, run.input, run.octree, *place_,
+                                              *run.crs, stats_.resumed, stats_.surface);
+    if (!chunks) return chunks.status();
+    chunked_ = std::move(*chunks);
+    return prepareTexturing(*chunked_, options_, run.octree, place_->work.path, stats_.resumed,
+                            texturing_);
+  }
+
+  // The other ranks take rank 0's chunks and pyramids, as a resumed run would.
+  Status takeChunks(const RunPlan& run) {
+    const std::string& workDirectory = run.input.workDirectory;
+    std::optional<ChunkInput> chunks = resumeChunks(
+        workStatePath(workDirectory), runIdentity(path_, options_, run.input, run.octree),
+        workDirectory + "/chunks");
+    if (!chunks)
+      return Error{ErrorKind::kIo,
+                   fmt::format("{}: cannot read the chunks rank 0 made (is {} on a file system "
+                               "every rank shares, and the input the same file for each?)",
+                               describeRank(), workDirectory)};
+    chunked_ = std::move(*chunks);
+    return prepareTexturing(*chunked_, options_, run.octree, workDirectory, true, texturing_);
+  }
+
+  // Every rank its subtrees (what an interrupted job finished is taken); the job's progress on
+  // rank 0. Returns how many nodes all ranks took from an interrupted job.
+  Result<std::uint64_t> buildShare(const OctreeOptions& octree) {
+    OctreeOptions share = octree;
+    share.rank = clusterRank();
+    share.ranks = clusterSize();
+    share.resume = lead_ ? stats_.resumed : options_.resume;
+    share.quiet = true;
+    const ShareCounts counts = countShare(*chunked_->chunks, share);
+    reportActivity(fmt::format("building its {} nodes of the octree's subtrees", counts.mine));
+    Result<OctreeResult> subtrees = [&] {
+      const JobProgress progress(fmt::format("tiles: octree, {} ranks", share.ranks),
+                                 counts.subtrees);
+      Result<OctreeResult> tree =
+          buildTiles(*chunked_, options_, share, staging(), texturing(), builtNodes_);
+      reportProgress(counts.mine);  // with what was taken
+      return tree;
+    }();
+    reportActivity(subtrees ? "done with its subtrees" : "failed in its subtrees");
+    LODFORGE_TRY(agreeAcrossRanks(subtrees.status()));
+    stats_.splitLevel = subtrees->splitLevel;
+    stats_.rankWork = subtrees->rankWork;
+    return sumAcrossRanks(counts.mine - builtNodes_);
+  }
+
+  // Rank 0, once every subtree is done: the levels above them, then the tileset.
+  Status buildTop(const OctreeOptions& octree) {
+    reportActivity("building the levels above the subtrees and the tileset");
+    OctreeOptions top = octree;
+    top.resume = true;  // takes every subtree
+    builtNodes_ = 0;
+    Result<OctreeResult> tree =
+        buildTiles(*chunked_, options_, top, staging(), texturing(), builtNodes_);
+    if (!tree) return tree.status();
+    return finishTileset(*tree, *chunked_, options_, *place_, output_, stats_);
+  }
+
+  std::string staging() const { return tilesWorkDirectory(output_) + "/tileset"; }
+  const TileTexturing* texturing() const { return texturing_.tiles ? &*texturing_.tiles : nullptr; }
+
+  const std::string& path_;
+  const std::string& output_;
+  const TilesOptions& options_;
+  const bool lead_;
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  TilesStats stats_;
+  WorkLock lock_;  // rank 0's; released after the work place is cleaned up
+  std::optional<WorkPlace> place_;
+  std::optional<ChunkInput> chunked_;
+  Texturing texturing_;  // points into chunked_
+  std::uint64_t builtNodes_ = 0;
+};
+
 }  // namespace
 
 bool tilesWorkKept(const std::string& workDirectory) {
@@ -270,65 +484,32 @@ std::string tilesWorkDirectory(const std::string& outputDirectory) {
 
 Result<TilesStats> writeTiles(const std::string& path, const std::string& outputDirectory,
                               const TilesOptions& options) {
+  if (clustered()) return RankedTiles(path, outputDirectory, options).run();
   const auto start = std::chrono::steady_clock::now();
   TilesStats stats;
-  LODFORGE_TRY(claimTilesetOutput(path, outputDirectory));
-  const std::string workDirectory = tilesWorkDirectory(outputDirectory);
-  LODFORGE_TRY(claimWorkDirectory(workDirectory));  // before it is ours to remove
-  WorkPlace place{ScopedDirectory(workDirectory), ScopedDirectory(workDirectory + "/tileset")};
-  LODFORGE_TRY(prepareWorkPlace(place, options.resume));
+  WorkLock lock;  // released after the work place is cleaned up
+  std::optional<WorkPlace> place;
+  LODFORGE_TRY(claimWorkPlace(path, outputDirectory, options, place, lock));
+  Result<RunPlan> run = planRun(options, place->work.path);
+  if (!run) return run.status();
+  stats.threads = run->octree.threads;
 
-  ChunkInputOptions input = options.input;
-  OctreeOptions octree = options.octree;
-  input.levels = octree.levels;
-  input.workDirectory = workDirectory;
-  octree.workDirectory = workDirectory + "/nodes";
-  LODFORGE_TRY(
-      planTilesMemory(options.memory, options.memoryLimit, options.threads, input, octree));
-  stats.threads = octree.threads;
-  const std::shared_ptr<const LazyCrs> crs = attachCrs(options.crs, options.crsFrom, input);
-
-  Result<ChunkInput> chunked =
-      chunkOrResume(path, options, input, octree, place, *crs, stats.resumed, stats.surface);
+  Result<ChunkInput> chunked = chunkOrResume(path, options, run->input, run->octree, *place,
+                                             *run->crs, stats.resumed, stats.surface);
   if (!chunked) return chunked.status();
   countChunks(*chunked, stats);
   stats.chunkSeconds = secondsSince(start);
 
-  octree.resume = stats.resumed;
-  const TexturePlan plan = planTextureMemory(options.memoryLimit, octree.threads,
-                                             options.atlas.maxSize, options.textureCacheBytes);
-  Result<std::optional<TexturePyramid>> pyramid =
-      buildPyramids(*chunked, workDirectory, plan, stats.resumed);
-  if (!pyramid) return pyramid.status();
-  AtlasOptions atlas = options.atlas;
-  atlas.maxSize = plan.pageSide;
-  TileTexturing texturing{&chunked->textures, *pyramid ? &**pyramid : nullptr, atlas,
-                          options.textureEncoding};
+  run->octree.resume = stats.resumed;
+  Texturing texturing;
+  LODFORGE_TRY(
+      prepareTexturing(*chunked, options, run->octree, place->work.path, stats.resumed, texturing));
   Result<OctreeResult> tree =
-      buildTiles(*chunked, options, octree, place.staging.path, *pyramid ? &texturing : nullptr);
+      buildTiles(*chunked, options, run->octree, place->staging.path,
+                 texturing.tiles ? &*texturing.tiles : nullptr, stats.builtNodes);
   if (!tree) return tree.status();
-  const std::string partsUri = chunked->parts.empty() ? "" : kPartsFileName;
-  Result<bool> implicit = implicitTilingWanted(options.implicitTiling, *tree);
-  if (!implicit) return implicit.status();
-  stats.implicitTiling = *implicit;
-  // Contents are written under their explicit names: moved when implicit, or back where an
-  // interrupted implicit attempt moved them.
-  if (*implicit || stats.resumed) LODFORGE_TRY(placeContents(*tree, place.staging.path, *implicit));
-  if (*implicit)
-    LODFORGE_TRY(writeImplicitTileset(*tree, chunked->chunks->grid(), place.staging.path,
-                                      chunked->frame, options.quantize, partsUri,
-                                      options.subtreeLevels));
-  else
-    LODFORGE_TRY(writeTilesetJson(*tree, place.staging.path + "/tileset.json", chunked->frame,
-                                  options.quantize, partsUri));
-  if (!partsUri.empty())
-    LODFORGE_TRY(writePartsJson(*tree, chunked->parts, place.staging.path + "/" + partsUri));
-  countTiles(*tree, stats);
-  stats.outputBytes = directoryBytes(place.staging.path);
-
-  // Complete: replace the previous tileset, if any, by the new one.
-  place.done = true;
-  LODFORGE_TRY(replaceDirectory(place.staging, outputDirectory));
+  stats.takenNodes = plannedNodes(*tree) - stats.builtNodes;
+  LODFORGE_TRY(finishTileset(*tree, *chunked, options, *place, outputDirectory, stats));
   stats.seconds = secondsSince(start);
   return stats;
 }

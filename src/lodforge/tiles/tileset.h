@@ -77,6 +77,14 @@ struct TilesStats {
   std::optional<ReconstructStats> surface;  // --surface, when not resumed
   std::uint64_t parts = 0;                  // named parts (parts.json), 0: none
   std::uint64_t partsInRoot = 0;            // of them, those the coarsest tiles still hold
+  // A job of several ranks (docs/distributed.md): how many, the level whose subtrees they
+  // shared, each one's work (leaf triangles under its subtrees) and the subtrees' wall time.
+  int ranks = 1;
+  std::uint64_t builtNodes = 0;  // octree nodes this run built (all ranks)
+  std::uint64_t takenNodes = 0;  // and those it took as an earlier, interrupted run left them
+  int splitLevel = 0;
+  std::vector<std::uint64_t> rankWork;
+  double subtreeSeconds = 0;
 };
 
 // Where `lodforge tiles -o OUT` works: OUT.work holds the work files and the tileset being

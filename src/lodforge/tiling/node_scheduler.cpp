@@ -1,6 +1,7 @@
 #include "lodforge/tiling/node_scheduler.h"
 
 #include <mutex>
+#include <optional>
 #include <queue>
 
 #include <tbb/task_arena.h>
@@ -50,7 +51,8 @@ Status buildWhenReady(const std::vector<OctreeNode>& nodes, std::span<const std:
   std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, decltype(later)> ready(later);
   for (std::uint32_t i = 0; i < count; ++i)
     if (pending[i] == 0) ready.push(i);
-  Progress progress("tiles: octree", count);
+  std::optional<Progress> progress;
+  if (!schedule.quiet) progress.emplace("tiles: octree", count);
   std::mutex mutex;  // guards ready, pending, inFlight and failure
   Status failure;
   std::uint64_t inFlightBytes = 0;
@@ -65,7 +67,7 @@ Status buildWhenReady(const std::vector<OctreeNode>& nodes, std::span<const std:
     if (status.ok()) {
       tbb::this_task_arena::isolate([&] { status = build(index); });
     }
-    progress.advance(1);
+    if (progress) progress->advance(1);
     std::lock_guard lock(mutex);
     inFlightBytes -= bytes;
     --inFlight;
@@ -97,7 +99,7 @@ Status buildWhenReady(const std::vector<OctreeNode>& nodes, std::span<const std:
     }
     group.wait();
   });
-  progress.finish();
+  if (progress) progress->finish();
   return failure;
 }
 

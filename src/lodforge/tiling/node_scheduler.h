@@ -20,6 +20,7 @@ struct NodeSchedule {
   std::uint64_t memoryBudget = 0;  // bytes the nodes in progress may take (0: no limit)
   // A textured node also holds its texture coordinates, wedges and their texture quadrics.
   bool textured = false;
+  bool quiet = false;  // no progress shown
 };
 
 // Calls build(i) for every node i of `nodes` (children listed in each node), each once all its

@@ -9,6 +9,7 @@
 #include "lodforge/tiling/mesh_part.h"
 #include "lodforge/tiling/node_scheduler.h"
 #include "lodforge/tiling/node_store.h"
+#include "lodforge/tiling/octree_share.h"
 #include "lodforge/tiling/simplify_node.h"
 
 namespace lodforge {
@@ -95,11 +96,19 @@ class OctreeBuild {
       : chunks_(chunks), options_(options), sink_(sink), plan_(plan), store_(options) {}
 
   Status run() {
+    if (options_.ranks > 1) {
+      share_ = shareOctree(plan_.result.nodes, plan_.inputTriangles, options_.ranks);
+      plan_.result.splitLevel = share_.splitLevel;
+      plan_.result.rankWork = share_.work;
+    }
     return buildWhenReady(plan_.result.nodes, plan_.parentOf, plan_.inputTriangles,
                           {.threads = options_.threads,
                            .memoryBudget = options_.memoryBudget,
-                           .textured = chunks_.textured()},
-                          [this](std::uint32_t index) {
+                           .textured = chunks_.textured(),
+                           .quiet = options_.quiet},
+                          [this](std::uint32_t index) -> Status {
+                            if (!share_.owner.empty() && share_.owner[index] != options_.rank)
+                              return {};  // another rank's, or built after the subtrees
                             OctreeNode& node = plan_.result.nodes[index];
                             return node.level == 0 ? buildLeaf(index) : buildParent(index);
                           });
@@ -167,9 +176,22 @@ class OctreeBuild {
   const NodeSink& sink_;
   OctreePlan& plan_;
   NodeStore store_;
+  OctreeShare share_;  // empty in a job of one
 };
 
 }  // namespace
+
+ShareCounts countShare(const ChunkWriter& chunks, const OctreeOptions& options) {
+  if (chunks.triangleCounts().empty()) return {};
+  const OctreePlan plan = planOctree(chunks, options.levels);
+  const OctreeShare share = shareOctree(plan.result.nodes, plan.inputTriangles, options.ranks);
+  ShareCounts counts;
+  for (int owner : share.owner) {
+    counts.subtrees += owner != kBuiltAfterSubtrees ? 1 : 0;
+    counts.mine += owner == options.rank ? 1 : 0;
+  }
+  return counts;
+}
 
 Result<OctreeResult> buildOctree(const ChunkWriter& chunks, const OctreeOptions& options,
                                  const NodeSink& sink) {

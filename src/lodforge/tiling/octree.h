@@ -36,6 +36,11 @@ struct OctreeOptions {
   // are taken as they are: the sink is not called for them again.
   bool resume = false;
   std::string workDirectory;
+  // In a job of several ranks (docs/distributed.md): build only this rank's share of the
+  // subtrees (octree_share.h). Rank 0 then builds the levels above them in a second call with
+  // `ranks` 1 and `resume`, which takes every subtree as done.
+  int rank = 0, ranks = 1;
+  bool quiet = false;  // no progress of its own (a job's rank 0 shows the whole job's)
 };
 
 struct OctreeNode {
@@ -56,10 +61,20 @@ struct OctreeResult {
   std::vector<OctreeNode> nodes;  // leaves first, then level by level; the root last
   std::uint32_t root = 0;
   int levels = 0;  // levels above the leaves
+  // With ranks > 1: the subtrees' level and each rank's work (leaf triangles under its share).
+  int splitLevel = 0;
+  std::vector<std::uint64_t> rankWork;
 };
 
 // Called once per node, from any thread, with its finished mesh (before the parent is built).
 using NodeSink = std::function<Status(const OctreeNode&, const MeshPart&)>;
+
+// In a job of several ranks: the nodes of every rank's subtrees and of this rank's share (what
+// buildOctree with the same chunks and options builds), for the job's progress.
+struct ShareCounts {
+  std::uint64_t subtrees = 0, mine = 0;
+};
+ShareCounts countShare(const ChunkWriter& chunks, const OctreeOptions& options);
 
 Result<OctreeResult> buildOctree(const ChunkWriter& chunks, const OctreeOptions& options,
                                  const NodeSink& sink);

@@ -1,0 +1,239 @@
+#include "lodforge/core/cluster.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdlib>
+#include <thread>
+#include <vector>
+
+#include <filesystem>
+#include <mutex>
+
+#if LODFORGE_WITH_MPI
+#include <mpi.h>
+#endif
+
+#include "lodforge/core/file.h"
+#include "lodforge/core/progress.h"
+
+namespace lodforge {
+namespace {
+
+int rank = 0, size = 1;
+bool joined = false;
+bool abandoned = false;  // a wait was interrupted: the others may be gone, do not finalize
+std::string activityDirectory;
+
+std::string activityPath(int of) {
+  return fmt::format("{}/rank-{}", activityDirectory, of);
+}
+std::string progressPath(int of) {
+  return fmt::format("{}/done-{}", activityDirectory, of);
+}
+std::mutex progressMutex;  // reports come from the worker threads
+
+// The sum of every rank's last reported progress.
+std::uint64_t jobDone() {
+  std::uint64_t sum = 0;
+  for (int r = 0; r < size; ++r) {
+    Result<std::string> text = readFileToString(progressPath(r), 64);
+    if (text) sum += std::strtoull(text->c_str(), nullptr, 10);
+  }
+  return sum;
+}
+
+// Set by mpirun (OpenMPI's, PMIx) and srun (PMI-2, PMIx): the process belongs to a job.
+bool launchedAsJob() {
+  for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_SIZE"})
+    if (std::getenv(name) != nullptr) return true;
+  return false;
+}
+
+#if LODFORGE_WITH_MPI
+// Polls instead of blocking: OpenMPI's blocking waits spin a core, which ranks sharing a machine
+// need for their own work while one of them chunks alone.
+Status waitQuietly(MPI_Request& request) {
+  int done = 0;
+  while (MPI_Test(&request, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && done == 0) {
+    if (cancelRequested()) {
+      abandoned = true;
+      return Error{ErrorKind::kCancelled,
+                   fmt::format("{} stopped while waiting for the other ranks{}", describeRank(),
+                               otherRanksActivities())};
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return {};
+}
+
+Status mpiFailed(const char* what, int code) {
+  std::array<char, MPI_MAX_ERROR_STRING> text{};
+  int length = 0;
+  MPI_Error_string(code, text.data(), &length);
+  return Error{ErrorKind::kIo,
+               fmt::format("MPI: {}: {}", what,
+                           std::string_view(text.data(), static_cast<std::size_t>(length)))};
+}
+#endif
+
+}  // namespace
+
+bool clusterSupported() {
+  return LODFORGE_WITH_MPI != 0;
+}
+
+Status joinCluster() {
+  assert(!joined);
+  if (!launchedAsJob()) return {};
+#if LODFORGE_WITH_MPI
+  int provided = 0;
+  // Only the main thread talks to the other ranks; the pipelines' worker threads never do.
+  const int code = MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+  if (code != MPI_SUCCESS) return mpiFailed("cannot join the job", code);
+  joined = true;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  return {};
+#else
+  return Error{ErrorKind::kUsage,
+               "started by an MPI launcher, but this lodforge was built without MPI "
+               "(LODFORGE_MPI=OFF): it would run the whole job once per rank"};
+#endif
+}
+
+void leaveCluster() {
+#if LODFORGE_WITH_MPI
+  if (joined && !abandoned) MPI_Finalize();
+#endif
+  joined = false;
+  abandoned = false;
+  activityDirectory.clear();
+  rank = 0;
+  size = 1;
+}
+
+int clusterRank() {
+  return rank;
+}
+bool clusterAbandoned() {
+  return abandoned;
+}
+int clusterSize() {
+  return size;
+}
+
+std::string describeRank() {
+  std::array<char, 256> host{};
+  if (gethostname(host.data(), host.size() - 1) != 0) host[0] = '\0';
+  return fmt::format("rank {} of {} ({}, pid {})", rank, size, host.data(), getpid());
+}
+
+void setActivityDirectory(std::string directory) {
+  activityDirectory = std::move(directory);
+  std::error_code ignored;
+  if (clustered()) std::filesystem::create_directories(activityDirectory, ignored);
+}
+
+void reportActivity(std::string_view what) {
+  if (!clustered() || activityDirectory.empty()) return;
+  // Best effort: a report that cannot be written must not stop the work.
+  (void)OutputFile::writeWhole(activityPath(rank), fmt::format("{}: {}", describeRank(), what));
+}
+
+void reportProgress(std::uint64_t done) {
+  if (!clustered() || activityDirectory.empty()) return;
+  std::lock_guard lock(progressMutex);
+  (void)OutputFile::writeWhole(progressPath(rank), std::to_string(done));
+}
+
+JobProgress::JobProgress(std::string label, std::uint64_t total) {
+  if (!clustered() || rank != 0) return;
+  thread_ = std::thread([this, label = std::move(label), total] {
+    Progress progress(label, total);
+    std::uint64_t shown = 0;
+    while (!stop_.load()) {
+      const std::uint64_t done = jobDone();
+      if (done > shown) progress.advance(done - shown);
+      shown = std::max(shown, done);
+      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    }
+    const std::uint64_t done = jobDone();
+    if (done > shown) progress.advance(done - shown);
+  });
+}
+
+JobProgress::~JobProgress() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+std::string otherRanksActivities() {
+  std::string lines;
+  if (activityDirectory.empty()) return lines;
+  for (int r = 0; r < size; ++r) {
+    if (r == rank) continue;
+    Result<std::string> text = readFileToString(activityPath(r), 4096);
+    Result<std::string> done = readFileToString(progressPath(r), 64);
+    lines += fmt::format("\n  {}{}", text ? *text : fmt::format("rank {}: nothing reported", r),
+                         done ? fmt::format("; {} done", *done) : "");
+  }
+  return lines.empty() ? lines : "; their last steps:" + lines;
+}
+
+Result<std::uint64_t> sumAcrossRanks(std::uint64_t mine) {
+  if (!clustered()) return mine;
+#if LODFORGE_WITH_MPI
+  std::uint64_t sum = 0;
+  MPI_Request request;
+  const int code = MPI_Iallreduce(&mine, &sum, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD, &request);
+  if (code != MPI_SUCCESS) return mpiFailed("cannot add up the ranks' counts", code);
+  LODFORGE_TRY(waitQuietly(request));
+  return sum;
+#else
+  return mine;
+#endif
+}
+
+Status agreeAcrossRanks(const Status& mine) {
+  if (!clustered()) return mine;
+#if LODFORGE_WITH_MPI
+  // Each rank's kind (-1: ok) and message length, then the messages.
+  const std::string message = mine.ok() ? "" : mine.message();
+  const std::array<int, 2> own{mine.ok() ? -1 : static_cast<int>(mine.kind()),
+                               static_cast<int>(message.size())};
+  const auto ranks = static_cast<std::size_t>(size);
+  std::vector<int> all(2 * ranks);
+  MPI_Request request;
+  int code =
+      MPI_Iallgather(own.data(), 2, MPI_INT, all.data(), 2, MPI_INT, MPI_COMM_WORLD, &request);
+  if (code != MPI_SUCCESS) return mpiFailed("cannot exchange the ranks' outcomes", code);
+  LODFORGE_TRY(waitQuietly(request));
+  std::vector<int> lengths(ranks), offsets(ranks);
+  int total = 0;
+  for (std::size_t r = 0; r < ranks; ++r) {
+    lengths[r] = all[2 * r + 1];
+    offsets[r] = total;
+    total += lengths[r];
+  }
+  std::string messages(static_cast<std::size_t>(total), '\0');
+  code = MPI_Iallgatherv(message.data(), own[1], MPI_CHAR, messages.data(), lengths.data(),
+                         offsets.data(), MPI_CHAR, MPI_COMM_WORLD, &request);
+  if (code != MPI_SUCCESS) return mpiFailed("cannot exchange the ranks' outcomes", code);
+  LODFORGE_TRY(waitQuietly(request));
+  for (std::size_t r = 0; r < ranks; ++r) {
+    if (all[2 * r] < 0) continue;
+    if (static_cast<int>(r) == rank) return mine;  // our own, as a job of one would say it
+    const std::string text =
+        messages.substr(static_cast<std::size_t>(offsets[r]), static_cast<std::size_t>(lengths[r]));
+    return Error{static_cast<ErrorKind>(all[2 * r]), fmt::format("rank {}: {}", r, text)};
+  }
+  return {};
+#else
+  return mine;
+#endif
+}
+
+}  // namespace lodforge

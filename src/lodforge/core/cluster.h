@@ -1,0 +1,72 @@
+// The processes of one job that mpirun or Slurm's srun started (docs/distributed.md): which one
+// this is, how many there are, and the one collective step the pipelines take between their
+// stages, everyone's outcome. A process started any other way, or built without MPI
+// (LODFORGE_MPI=OFF), is a job of one and behaves exactly as a plain run.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <thread>
+
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+// Joins the job when an MPI launcher started this process (its environment says so) and the
+// build has MPI; otherwise this is a job of one. Call once, before any other thread starts.
+Status joinCluster();
+// Leaves the job (nothing for a job of one). Call once every rank is done with the others.
+void leaveCluster();
+
+int clusterRank();  // 0 for a job of one
+// Whether a wait for the other ranks was given up (agreeAcrossRanks): each survivor then says
+// what it knows, since the rank that speaks for the job may be the one that died.
+bool clusterAbandoned();
+int clusterSize();  // 1 for a job of one
+inline bool clustered() {
+  return clusterSize() > 1;
+}
+// Whether this build can join a job of several (built with MPI).
+bool clusterSupported();
+
+// Every rank's outcome of a step, known to all: ok when each succeeded, otherwise the failure
+// of the lowest failed rank with the rank named ("rank 2: …") and its kind. Waits without
+// spinning, so ranks that share a machine leave its cores to the ranks still working. Stopped
+// while waiting (mpirun's SIGTERM when another rank died, or Ctrl-C), it fails as cancelled with
+// the other ranks' last activities, and the job is left without waiting for them.
+Status agreeAcrossRanks(const Status& mine);
+
+// The sum of every rank's `mine`, known to all (as agreeAcrossRanks waits).
+Result<std::uint64_t> sumAcrossRanks(std::uint64_t mine);
+
+// What this rank is doing, kept from now on in `directory`/rank-<r> (a directory every rank sees),
+// so that when a rank dies the others can say what it was doing.
+void setActivityDirectory(std::string directory);
+void reportActivity(std::string_view what);
+// The other ranks' last reported activities, a line each ("rank 1 (host, pid 12): building …").
+std::string otherRanksActivities();
+
+// How much of its share this rank has done (in the job progress's unit), kept beside its
+// activity (a small file written whole: call it per unit of work that takes milliseconds).
+void reportProgress(std::uint64_t done);
+
+// Rank 0's progress bar for the whole job while it lives: the sum of every rank's
+// reportProgress, read from the activity directory twice a second. Nothing on other ranks.
+class JobProgress {
+ public:
+  JobProgress(std::string label, std::uint64_t total);
+  ~JobProgress();
+  JobProgress(const JobProgress&) = delete;
+  JobProgress& operator=(const JobProgress&) = delete;
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// A name for this rank in messages: "rank 2 of 4 (host, pid 1234)".
+std::string describeRank();
+
+}  // namespace lodforge

@@ -1,0 +1,69 @@
+#include "lodforge/tiling/octree_share.h"
+
+#include <algorithm>
+#include <cassert>
+#include <optional>
+
+namespace lodforge {
+namespace {
+
+// Leaf triangles under each node (children are listed before their parents).
+std::vector<std::uint64_t> subtreeWork(const std::vector<OctreeNode>& nodes,
+                                       std::span<const std::uint64_t> leafTriangles) {
+  std::vector<std::uint64_t> work(leafTriangles.begin(), leafTriangles.end());
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    for (std::uint32_t c : nodes[i].children) {
+      assert(c < i);
+      work[i] += work[c];
+    }
+  return work;
+}
+
+// The nodes of `level` dealt out largest first to the least loaded rank (longest processing
+// time first: within 4/3 of the best possible busiest rank); ties by node order, so every rank
+// computes the same share.
+OctreeShare dealLevel(const std::vector<OctreeNode>& nodes, std::span<const std::uint64_t> work,
+                      int level, int ranks) {
+  OctreeShare share{level, std::vector<int>(nodes.size(), kBuiltAfterSubtrees),
+                    std::vector<std::uint64_t>(static_cast<std::size_t>(ranks), 0)};
+  std::vector<std::uint32_t> roots;
+  for (std::uint32_t i = 0; i < nodes.size(); ++i)
+    if (nodes[i].level == level) roots.push_back(i);
+  std::stable_sort(roots.begin(), roots.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return work[a] > work[b]; });
+  for (std::uint32_t root : roots) {
+    const auto least = static_cast<std::size_t>(
+        std::min_element(share.work.begin(), share.work.end()) - share.work.begin());
+    share.owner[root] = static_cast<int>(least);
+    share.work[least] += work[root];
+  }
+  // A subtree's nodes go with its root (children before parents: walk down from the roots).
+  for (std::size_t i = nodes.size(); i-- > 0;)
+    if (share.owner[i] != kBuiltAfterSubtrees)
+      for (std::uint32_t c : nodes[i].children) share.owner[c] = share.owner[i];
+  return share;
+}
+
+}  // namespace
+
+double shareBalance(const OctreeShare& share) {
+  const auto [least, most] = std::minmax_element(share.work.begin(), share.work.end());
+  return *most == 0 ? 1.0 : static_cast<double>(*least) / static_cast<double>(*most);
+}
+
+OctreeShare shareOctree(const std::vector<OctreeNode>& nodes,
+                        std::span<const std::uint64_t> leafTriangles, int ranks, double tolerance) {
+  assert(ranks >= 1 && leafTriangles.size() == nodes.size());
+  const std::vector<std::uint64_t> work = subtreeWork(nodes, leafTriangles);
+  int top = 0;
+  for (const OctreeNode& node : nodes) top = std::max(top, node.level);
+  std::optional<OctreeShare> best;
+  for (int level = top; level >= std::min(top, 1); --level) {
+    OctreeShare share = dealLevel(nodes, work, level, ranks);
+    if (shareBalance(share) >= 1 - tolerance) return share;
+    if (!best || shareBalance(share) > shareBalance(*best)) best = std::move(share);
+  }
+  return std::move(*best);
+}
+
+}  // namespace lodforge

@@ -1,0 +1,40 @@
+#include "lodforge/core/cluster.h"
+
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "test_support.h"
+
+namespace lodforge {
+namespace {
+
+// A process not started by mpirun or srun is a job of one: every collective step is its own
+// outcome, and nothing is written for other ranks. (Several ranks: tests/mpi_tiles.sh.)
+TEST(Cluster, AProcessNotStartedAsAJobIsAJobOfOne) {
+  ASSERT_TRUE(joinCluster().ok());
+  EXPECT_EQ(clusterRank(), 0);
+  EXPECT_EQ(clusterSize(), 1);
+  EXPECT_FALSE(clustered());
+  EXPECT_TRUE(agreeAcrossRanks({}).ok());
+  const Status failed = agreeAcrossRanks(Error{ErrorKind::kBadInput, "x.ply: cut short"});
+  ASSERT_FALSE(failed.ok());
+  EXPECT_EQ(failed.kind(), ErrorKind::kBadInput);
+  EXPECT_EQ(failed.message(), "x.ply: cut short") << "no rank named in a job of one";
+  Result<std::uint64_t> sum = sumAcrossRanks(41);
+  ASSERT_TRUE(sum.ok());
+  EXPECT_EQ(*sum, 41u);
+  EXPECT_NE(describeRank().find("rank 0 of 1"), std::string::npos) << describeRank();
+
+  const test::TempDir dir;
+  setActivityDirectory(dir.file("ranks"));
+  reportActivity("chunking");
+  reportProgress(3);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("ranks"))) << "nothing to tell other ranks";
+  EXPECT_EQ(otherRanksActivities(), "");
+  EXPECT_FALSE(clusterAbandoned());
+  leaveCluster();
+}
+
+}  // namespace
+}  // namespace lodforge

@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# `lodforge tiles` across the ranks of an OpenMPI job (docs/distributed.md), run by OpenMPI's own
+# mpirun on this one machine (--oversubscribe: more ranks than cores): a scan, a 300-part
+# assembly and a reconstructed surface tiled by 1 to 4 ranks are byte for byte the tileset one
+# process writes; more ranks than chunks; a rank killed mid-octree stops the job with a message
+# naming it and what it was doing, and --resume finishes without rebuilding what was done; a
+# second run on an output being written is refused.
+set -euo pipefail
+lodforge=$1 out=$2
+command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/install-deps.sh" >&2; exit 1; }
+rm -rf "$out" && mkdir -p "$out"
+cd "$out"
+# --allow-run-as-root: CI runs as root, which OpenMPI otherwise refuses.
+mpi=(mpirun --allow-run-as-root --oversubscribe)
+failures=0
+fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+same() {  # same TILESET REFERENCE WHAT
+  if diff -r "$1" "$2" >/dev/null; then echo "ok: $3"; else fail "$3: $1 differs from $2"; diff -rq "$1" "$2" | head -5 >&2; fi
+}
+
+"$lodforge" -q generate scan --triangles 300K -o scan.ply
+"$lodforge" -q tiles scan.ply -o scan-1 --chunk-size 60
+for ranks in 1 2 3 4; do
+  "${mpi[@]}" -np $ranks "$lodforge" -q tiles scan.ply -o scan-np$ranks --chunk-size 60
+  same scan-np$ranks scan-1 "scan, $ranks ranks"
+done
+# The work was shared: -v says how, and each rank had its part within 20 % of the busiest.
+"${mpi[@]}" -np 3 "$lodforge" -v tiles scan.ply -o scan-v --chunk-size 60 2> scan-v.err
+grep -q "3 ranks: subtrees under level" scan-v.err || fail "no share in -v: $(cat scan-v.err)"
+
+"$lodforge" -q generate cad --objects 300 --seed 3 -o cad.glb
+"$lodforge" -q tiles cad.glb -o cad-1
+"${mpi[@]}" -np 3 "$lodforge" -q tiles cad.glb -o cad-np3
+same cad-np3 cad-1 "assembly (parts.json), 3 ranks"
+
+"$lodforge" -q generate points --points 20K -o points.ply
+"$lodforge" -q tiles points.ply --surface -o surface-1 --chunk-size 150
+"${mpi[@]}" -np 2 "$lodforge" -q tiles points.ply --surface -o surface-np2 --chunk-size 150
+same surface-np2 surface-1 "reconstructed surface, 2 ranks"
+
+# More ranks than chunks: the horse in two chunks, 4 ranks (two have nothing to build).
+"$lodforge" -q generate scan --triangles 20K -o small.ply
+"$lodforge" -q tiles small.ply -o small-1 --chunk-size 400
+"${mpi[@]}" -np 4 "$lodforge" -q tiles small.ply -o small-np4 --chunk-size 400
+same small-np4 small-1 "more ranks than chunks"
+
+# A rank killed (SIGKILL) after its third node: the job stops, naming the rank; the work stays.
+set +e
+"${mpi[@]}" -np 1 "$lodforge" tiles scan.ply -o killed --chunk-size 60 : \
+  -np 1 -x LODFORGE_INTERRUPT_AFTER=node:3:kill "$lodforge" tiles scan.ply -o killed --chunk-size 60 \
+  > killed.out 2> killed.err
+code=$?
+set -e
+[[ $code -ne 0 ]] || fail "a job with a killed rank exited 0"
+grep -q "rank 1" killed.err || fail "the stop does not name rank 1: $(cat killed.err)"
+grep -qE "building its [0-9]+ nodes of the octree's subtrees; [0-9]+ done" killed.err ||
+  fail "the stop does not say what rank 1 was doing: $(cat killed.err)"
+[[ -d killed.work ]] || fail "the work directory is gone after the kill"
+done_before=$(find killed.work/nodes -name '*.json' | wc -l)
+"${mpi[@]}" -np 2 "$lodforge" -v tiles scan.ply -o killed --chunk-size 60 --resume 2> resumed.err
+taken=$(sed -nE 's/.*took ([0-9,]+) as the interrupted run left them.*/\1/p' resumed.err | tr -d ,)
+[[ -n $taken && $taken -ge $done_before && $done_before -ge 3 ]] ||
+  fail "--resume took ${taken:-no} nodes of the $done_before finished: $(cat resumed.err)"
+same killed scan-1 "killed rank, then --resume"
+
+# Two runs on one output: the second is refused (exit 2) while the first writes, which finishes.
+"$lodforge" -q --threads 1 tiles scan.ply -o busy --chunk-size 60 --memory minimal &
+first=$!
+for _ in $(seq 200); do [[ -s busy.work/.lodforge-lock ]] && break; sleep 0.02; done
+set +e
+"${mpi[@]}" -np 2 "$lodforge" -q tiles scan.ply -o busy --chunk-size 60 2> busy.err
+code=$?
+set -e
+wait $first || fail "the first run failed"
+[[ $code -eq 2 ]] || fail "a second run on a busy output exited $code, not 2"
+grep -q "another lodforge run" busy.err || fail "no refusal message: $(cat busy.err)"
+same busy scan-1 "the first run, beside the refused one"
+
+# Subcommands that do not run across ranks are refused, not run once per rank.
+set +e
+"${mpi[@]}" -np 2 "$lodforge" -q generate scan --triangles 1K -o twice.ply 2> twice.err
+code=$?
+set -e
+[[ $code -eq 2 ]] && grep -q "only \`tiles\` runs across" twice.err ||
+  fail "generate under mpirun -np 2: exit $code, $(cat twice.err)"
+
+[[ $failures -eq 0 ]] || { echo "$failures failure(s)" >&2; exit 1; }
+echo "all distributed checks passed"

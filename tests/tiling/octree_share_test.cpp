@@ -1,0 +1,140 @@
+#include "lodforge/tiling/octree_share.h"
+
+#include <map>
+#include <numeric>
+
+#include <gtest/gtest.h>
+
+namespace lodforge {
+namespace {
+
+// An octree planned the way buildOctree plans it: the leaves, then 2x2x2 groups level by level
+// up to one root; `leafTriangles` per node (0 above the leaves).
+struct PlannedTree {
+  std::vector<OctreeNode> nodes;
+  std::vector<std::uint64_t> leafTriangles;
+};
+
+PlannedTree planTree(const std::map<ChunkCell, std::uint64_t>& leaves) {
+  PlannedTree tree;
+  std::vector<std::uint32_t> level;
+  for (const auto& [cell, triangles] : leaves) {
+    OctreeNode leaf;
+    leaf.cell = cell;
+    level.push_back(static_cast<std::uint32_t>(tree.nodes.size()));
+    tree.nodes.push_back(leaf);
+    tree.leafTriangles.push_back(triangles);
+  }
+  for (int depth = 1; level.size() > 1; ++depth) {
+    std::map<ChunkCell, std::vector<std::uint32_t>> groups;
+    for (std::uint32_t i : level) {
+      const ChunkCell& c = tree.nodes[i].cell;
+      groups[{c[0] >> 1, c[1] >> 1, c[2] >> 1}].push_back(i);
+    }
+    level.clear();
+    for (auto& [cell, children] : groups) {
+      OctreeNode parent;
+      parent.level = depth;
+      parent.cell = cell;
+      parent.children = children;
+      level.push_back(static_cast<std::uint32_t>(tree.nodes.size()));
+      tree.nodes.push_back(parent);
+      tree.leafTriangles.push_back(0);
+    }
+  }
+  return tree;
+}
+
+// A scan-like sheet of side x side leaves; those with x and y below `corner` hold `dense`
+// triangles, the others `sparse`.
+PlannedTree sheet(int side, int corner, std::uint64_t dense, std::uint64_t sparse) {
+  std::map<ChunkCell, std::uint64_t> leaves;
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) leaves[{x, y, 0}] = x < corner && y < corner ? dense : sparse;
+  return planTree(leaves);
+}
+
+// What every share must be: whole subtrees (a node's children have its owner), every node at or
+// below the split owned by a rank, every node above it built after, and the ranks' work adding
+// up to all leaf triangles.
+void expectWholeSubtrees(const PlannedTree& tree, const OctreeShare& share, int ranks) {
+  ASSERT_EQ(share.owner.size(), tree.nodes.size());
+  ASSERT_EQ(share.work.size(), static_cast<std::size_t>(ranks));
+  std::vector<std::uint64_t> work(static_cast<std::size_t>(ranks), 0);
+  for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+    const OctreeNode& node = tree.nodes[i];
+    if (node.level > share.splitLevel) {
+      EXPECT_EQ(share.owner[i], kBuiltAfterSubtrees) << "node " << i;
+      continue;
+    }
+    ASSERT_GE(share.owner[i], 0) << "node " << i;
+    ASSERT_LT(share.owner[i], ranks) << "node " << i;
+    for (std::uint32_t c : node.children) EXPECT_EQ(share.owner[c], share.owner[i]) << "node " << i;
+    if (node.level == 0) work[static_cast<std::size_t>(share.owner[i])] += tree.leafTriangles[i];
+  }
+  EXPECT_EQ(work, share.work);
+  EXPECT_EQ(
+      std::accumulate(work.begin(), work.end(), std::uint64_t{0}),
+      std::accumulate(tree.leafTriangles.begin(), tree.leafTriangles.end(), std::uint64_t{0}));
+}
+
+TEST(OctreeShare, AnEvenScanIsSharedHighUpAndEvenly) {
+  const PlannedTree tree = sheet(16, 0, 0, 50'000);
+  for (int ranks : {1, 2, 3, 4}) {
+    const OctreeShare share = shareOctree(tree.nodes, tree.leafTriangles, ranks);
+    expectWholeSubtrees(tree, share, ranks);
+    EXPECT_GE(shareBalance(share), 0.8) << ranks << " ranks";
+    // 16 x 16 leaves: 4 x 4 subtrees at level 2 balance 2 and 4 ranks exactly, 3 within 20 %.
+    EXPECT_GE(share.splitLevel, 2) << ranks << " ranks";
+  }
+  EXPECT_EQ(shareOctree(tree.nodes, tree.leafTriangles, 1).splitLevel, 4) << "one rank: the root";
+}
+
+TEST(OctreeShare, ADenseCornerIsBalancedWithinTwentyPercentOfTheBusiestRank) {
+  // A quarter of a sheet holds 20 times the triangles of the rest (73 % of all of them).
+  const PlannedTree tree = sheet(16, 8, 1'000'000, 50'000);
+  const PlannedTree even = sheet(16, 0, 0, 50'000);
+  for (int ranks : {2, 3, 4}) {
+    const OctreeShare share = shareOctree(tree.nodes, tree.leafTriangles, ranks);
+    expectWholeSubtrees(tree, share, ranks);
+    EXPECT_GE(shareBalance(share), 0.8) << ranks << " ranks, split at level " << share.splitLevel;
+    // At the even sheet's split the dense quarter's subtrees would be too big to balance: the
+    // share went lower.
+    const OctreeShare evenShare = shareOctree(even.nodes, even.leafTriangles, ranks);
+    EXPECT_LT(share.splitLevel, evenShare.splitLevel) << ranks << " ranks";
+  }
+}
+
+TEST(OctreeShare, TheBalanceMeasureSeesAnUnevenShare) {
+  // One subtree of four holding most of the work cannot be balanced at its level: a planted
+  // uneven share must read as one.
+  OctreeShare share;
+  share.work = {700, 100, 100};
+  EXPECT_NEAR(shareBalance(share), 100.0 / 700.0, 1e-12);
+  share.work = {0, 0};
+  EXPECT_EQ(shareBalance(share), 1.0) << "no work is even";
+}
+
+TEST(OctreeShare, MoreRanksThanChunksLeaveSomeRanksIdle) {
+  const PlannedTree tree = planTree({{{0, 0, 0}, 500}, {{1, 0, 0}, 700}});
+  const OctreeShare share = shareOctree(tree.nodes, tree.leafTriangles, 4);
+  expectWholeSubtrees(tree, share, 4);
+  EXPECT_EQ(share.splitLevel, 1) << "never the leaves while a level above exists";
+  EXPECT_EQ(std::count(share.work.begin(), share.work.end(), 0), 3);
+  // A single chunk: the leaf is the whole tree.
+  const PlannedTree one = planTree({{{3, 4, 5}, 10}});
+  const OctreeShare single = shareOctree(one.nodes, one.leafTriangles, 3);
+  expectWholeSubtrees(one, single, 3);
+  EXPECT_EQ(single.splitLevel, 0);
+}
+
+TEST(OctreeShare, EveryRankComputesTheSameShare) {
+  const PlannedTree tree = sheet(12, 5, 30'000, 30'000);  // equal work: ties everywhere
+  const OctreeShare a = shareOctree(tree.nodes, tree.leafTriangles, 3);
+  const OctreeShare b = shareOctree(tree.nodes, tree.leafTriangles, 3);
+  EXPECT_EQ(a.owner, b.owner);
+  EXPECT_EQ(a.work, b.work);
+}
+
+}  // namespace
+}  // namespace lodforge

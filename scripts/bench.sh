@@ -2,7 +2,7 @@
 # `make bench`: kernel benchmarks, then the generators at growing sizes with wall time and peak
 # memory from /usr/bin/time -v. BENCH_LARGE=1 adds the 1,000,000-object assembly and the
 # 100,000,000-triangle scan (several GB of disk, a few minutes). Results go to stdout and
-# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-closed, surface-tiles, cad, instances, textures, textured-obj, texture-formats, gltfpack, serve, tile-error, implicit or billion runs
+# build/bench/; docs/BENCHMARKS.md quotes them. BENCH_ONLY=simplify, runtime, render, tiles, points, laz, potree, surface, surface-closed, surface-tiles, cad, instances, textures, textured-obj, texture-formats, gltfpack, serve, tile-error, implicit, billion or distributed runs
 # only that part. BENCH_LARGE=1 also runs the runtime on the 718,000-part assembly of the CAD
 # paper's Table 1 (about 26 GB of disk and 8 minutes).
 set -euo pipefail
@@ -769,6 +769,35 @@ billion_section() {
   rm -rf "$work/scan1g.ply" "$work/tiles1g"
 }
 if [[ ${BENCH_ONLY:-} == billion ]]; then billion_section; exit 0; fi
+
+# Ranks against threads (issue 39): the same scan tiled by one process with 2 threads and by an
+# OpenMPI job of 2 ranks with 1 thread each (each rank bound to its core, mpirun's default),
+# alternately; wall time, each rank's peak memory (a /usr/bin/time per rank), outputs compared.
+distributed_section() {
+  echo
+  local n=${DISTRIBUTED_TRIANGLES:-10M} runs=${DISTRIBUTED_RUNS:-3}
+  echo "== ranks against threads: a $n-triangle scan, 1 process x 2 threads and 2 ranks x 1 thread"
+  "$lodforge" -q generate scan --triangles "$n" -o "$work/dist-scan.ply"
+  local mpi=(mpirun --allow-run-as-root -np 2)
+  printf '| run | 1 process x 2 threads | peak RSS | 2 ranks x 1 thread | peak RSS rank 0 / 1 | ranks / threads |\n|---|---:|---:|---:|---:|---:|\n'
+  for run in $(seq "$runs"); do
+    rm -rf "$work"/dist-one "$work"/dist-ranks
+    read -r one kib < <(timed "$lodforge" -q --threads 2 tiles "$work/dist-scan.ply" -o "$work/dist-one")
+    # Each rank under its own /usr/bin/time, the job's wall time from one around mpirun.
+    /usr/bin/time -f "%e" -o "$work/dist-time" "${mpi[@]}" \
+      sh -c '/usr/bin/time -f "%M" -o "$0-$OMPI_COMM_WORLD_RANK" "$@"' "$work/dist-rank" \
+      "$lodforge" -q --threads 1 tiles "$work/dist-scan.ply" -o "$work/dist-ranks"
+    local ranks
+    ranks=$(cat "$work/dist-time")
+    diff -rq "$work/dist-one" "$work/dist-ranks" > /dev/null || { echo "the two tilesets differ" >&2; exit 1; }
+    printf '| %d | %.2f s | %d MiB | %.2f s | %d / %d MiB | %.3f |\n' "$run" "$one" $((kib / 1024)) "$ranks" \
+      $(($(cat "$work/dist-rank-0") / 1024)) $(($(cat "$work/dist-rank-1") / 1024)) "$(echo "$ranks / $one" | bc -l)"
+  done
+  "${mpi[@]}" "$lodforge" -v --threads 1 tiles "$work/dist-scan.ply" -o "$work/dist-ranks" 2>&1 |
+    grep -E "^(rank|2 ranks|streamed)"
+  rm -rf "$work"/dist-*
+}
+if [[ ${BENCH_ONLY:-} == distributed ]]; then distributed_section; exit 0; fi
 
 if [[ -n ${skip_generators:-} ]]; then simplify_section; exit 0; fi
 

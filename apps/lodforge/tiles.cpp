@@ -311,13 +311,19 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
                                formatCount(stats.builtNodes), formatCount(stats.takenNodes)));
   if (stats.ranks > 1) {
     const auto [least, most] = std::minmax_element(stats.rankWork.begin(), stats.rankWork.end());
-    detail(global, fmt::format("{} ranks: subtrees under level {}, {} to {} leaf triangles a rank; "
-                               "subtrees {:.1f} s, then the levels above and the tileset on rank 0 "
-                               "{:.1f} s; peak memory of rank 0 {}",
-                               stats.ranks, stats.splitLevel, formatCount(*least),
-                               formatCount(*most), stats.subtreeSeconds,
-                               stats.seconds - stats.chunkSeconds - stats.subtreeSeconds,
-                               formatBytes(peakRssBytes())));
+    detail(
+        global,
+        fmt::format("{} ranks: {}; subtrees under level {}, {} to {} leaf triangles a rank, "
+                    "then the levels above shared level by level; octree {:.1f} s, then the "
+                    "tileset on rank 0 {:.1f} s; peak memory of rank 0 {}",
+                    stats.ranks,
+                    stats.resumed        ? "the chunks resumed"
+                    : stats.readInSlices ? "the input read in slices by every rank"
+                                         : "the input chunked by rank 0",
+                    stats.splitLevel, formatCount(*least), formatCount(*most), stats.octreeSeconds,
+                    stats.seconds - stats.chunkSeconds - stats.octreeSeconds,
+                    formatBytes(peakRssBytes())));
+    for (const std::string& line : stats.rankStages) detail(global, line);
   }
 }
 

@@ -1,5 +1,6 @@
 #include "lodforge/tiling/octree_share.h"
 
+#include <algorithm>
 #include <map>
 #include <numeric>
 
@@ -54,22 +55,25 @@ PlannedTree sheet(int side, int corner, std::uint64_t dense, std::uint64_t spars
   return planTree(leaves);
 }
 
-// What every share must be: whole subtrees (a node's children have its owner), every node at or
-// below the split owned by a rank, every node above it built after, and the ranks' work adding
-// up to all leaf triangles.
-void expectWholeSubtrees(const PlannedTree& tree, const OctreeShare& share, int ranks) {
+// What every share must be: whole subtrees under the split in round 0 (a node's children have
+// its owner), each level above in a round of its own, every owner a rank, and the ranks'
+// subtree work adding up to all leaf triangles.
+void expectRounds(const PlannedTree& tree, const OctreeShare& share, int ranks) {
   ASSERT_EQ(share.owner.size(), tree.nodes.size());
+  ASSERT_EQ(share.round.size(), tree.nodes.size());
   ASSERT_EQ(share.work.size(), static_cast<std::size_t>(ranks));
+  int top = 0;
+  for (const OctreeNode& node : tree.nodes) top = std::max(top, node.level);
+  EXPECT_EQ(share.rounds, top - share.splitLevel + 1);
   std::vector<std::uint64_t> work(static_cast<std::size_t>(ranks), 0);
   for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
     const OctreeNode& node = tree.nodes[i];
-    if (node.level > share.splitLevel) {
-      EXPECT_EQ(share.owner[i], kBuiltAfterSubtrees) << "node " << i;
-      continue;
-    }
     ASSERT_GE(share.owner[i], 0) << "node " << i;
     ASSERT_LT(share.owner[i], ranks) << "node " << i;
-    for (std::uint32_t c : node.children) EXPECT_EQ(share.owner[c], share.owner[i]) << "node " << i;
+    EXPECT_EQ(share.round[i], std::max(0, node.level - share.splitLevel)) << "node " << i;
+    if (node.level <= share.splitLevel) {
+      for (std::uint32_t c : node.children) EXPECT_EQ(share.owner[c], share.owner[i]) << i;
+    }
     if (node.level == 0) work[static_cast<std::size_t>(share.owner[i])] += tree.leafTriangles[i];
   }
   EXPECT_EQ(work, share.work);
@@ -78,16 +82,33 @@ void expectWholeSubtrees(const PlannedTree& tree, const OctreeShare& share, int 
       std::accumulate(tree.leafTriangles.begin(), tree.leafTriangles.end(), std::uint64_t{0}));
 }
 
-TEST(OctreeShare, AnEvenScanIsSharedHighUpAndEvenly) {
+// How many nodes of `level` each rank builds.
+std::vector<int> nodesOfLevel(const PlannedTree& tree, const OctreeShare& share, int level,
+                              int ranks) {
+  std::vector<int> count(static_cast<std::size_t>(ranks), 0);
+  for (std::size_t i = 0; i < tree.nodes.size(); ++i)
+    if (tree.nodes[i].level == level) ++count[static_cast<std::size_t>(share.owner[i])];
+  return count;
+}
+
+TEST(OctreeShare, AnEvenScanIsSharedEvenlyAndTheLevelsAboveToo) {
   const PlannedTree tree = sheet(16, 0, 0, 50'000);
   for (int ranks : {1, 2, 3, 4}) {
     const OctreeShare share = shareOctree(tree.nodes, tree.leafTriangles, ranks);
-    expectWholeSubtrees(tree, share, ranks);
-    EXPECT_GE(shareBalance(share), 0.8) << ranks << " ranks";
-    // 16 x 16 leaves: 4 x 4 subtrees at level 2 balance 2 and 4 ranks exactly, 3 within 20 %.
-    EXPECT_GE(share.splitLevel, 2) << ranks << " ranks";
+    expectRounds(tree, share, ranks);
+    EXPECT_GE(shareBalance(share), 0.95) << ranks << " ranks";
+    // The level above the subtrees has more nodes than ranks: none is left out of it.
+    const std::vector<int> above = nodesOfLevel(tree, share, share.splitLevel + 1, ranks);
+    if (ranks > 1 && share.splitLevel + 1 < 4) {
+      EXPECT_EQ(std::count(above.begin(), above.end(), 0), 0) << ranks << " ranks";
+    }
   }
+  // 16 x 16 leaves: 2 x 2 subtrees at level 3 balance 2 and 4 ranks exactly; 3 ranks go lower.
+  EXPECT_EQ(shareOctree(tree.nodes, tree.leafTriangles, 2).splitLevel, 3);
+  EXPECT_EQ(shareOctree(tree.nodes, tree.leafTriangles, 4).splitLevel, 3);
+  EXPECT_LT(shareOctree(tree.nodes, tree.leafTriangles, 3).splitLevel, 3);
   EXPECT_EQ(shareOctree(tree.nodes, tree.leafTriangles, 1).splitLevel, 4) << "one rank: the root";
+  EXPECT_EQ(shareOctree(tree.nodes, tree.leafTriangles, 1).rounds, 1);
 }
 
 TEST(OctreeShare, ADenseCornerIsBalancedWithinTwentyPercentOfTheBusiestRank) {
@@ -96,12 +117,16 @@ TEST(OctreeShare, ADenseCornerIsBalancedWithinTwentyPercentOfTheBusiestRank) {
   const PlannedTree even = sheet(16, 0, 0, 50'000);
   for (int ranks : {2, 3, 4}) {
     const OctreeShare share = shareOctree(tree.nodes, tree.leafTriangles, ranks);
-    expectWholeSubtrees(tree, share, ranks);
+    expectRounds(tree, share, ranks);
     EXPECT_GE(shareBalance(share), 0.8) << ranks << " ranks, split at level " << share.splitLevel;
     // At the even sheet's split the dense quarter's subtrees would be too big to balance: the
-    // share went lower.
+    // share went lower (3 ranks are at the lowest level already for the even sheet).
     const OctreeShare evenShare = shareOctree(even.nodes, even.leafTriangles, ranks);
-    EXPECT_LT(share.splitLevel, evenShare.splitLevel) << ranks << " ranks";
+    if (evenShare.splitLevel > 1) {
+      EXPECT_LT(share.splitLevel, evenShare.splitLevel) << ranks << " ranks";
+    } else {
+      EXPECT_EQ(share.splitLevel, 1) << ranks << " ranks";
+    }
   }
 }
 
@@ -118,13 +143,13 @@ TEST(OctreeShare, TheBalanceMeasureSeesAnUnevenShare) {
 TEST(OctreeShare, MoreRanksThanChunksLeaveSomeRanksIdle) {
   const PlannedTree tree = planTree({{{0, 0, 0}, 500}, {{1, 0, 0}, 700}});
   const OctreeShare share = shareOctree(tree.nodes, tree.leafTriangles, 4);
-  expectWholeSubtrees(tree, share, 4);
+  expectRounds(tree, share, 4);
   EXPECT_EQ(share.splitLevel, 1) << "never the leaves while a level above exists";
   EXPECT_EQ(std::count(share.work.begin(), share.work.end(), 0), 3);
   // A single chunk: the leaf is the whole tree.
   const PlannedTree one = planTree({{{3, 4, 5}, 10}});
   const OctreeShare single = shareOctree(one.nodes, one.leafTriangles, 3);
-  expectWholeSubtrees(one, single, 3);
+  expectRounds(one, single, 3);
   EXPECT_EQ(single.splitLevel, 0);
 }
 
@@ -133,6 +158,7 @@ TEST(OctreeShare, EveryRankComputesTheSameShare) {
   const OctreeShare a = shareOctree(tree.nodes, tree.leafTriangles, 3);
   const OctreeShare b = shareOctree(tree.nodes, tree.leafTriangles, 3);
   EXPECT_EQ(a.owner, b.owner);
+  EXPECT_EQ(a.round, b.round);
   EXPECT_EQ(a.work, b.work);
 }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 
 #if LODFORGE_WITH_MPI
@@ -17,7 +18,9 @@
 #endif
 
 #include "lodforge/core/file.h"
+#include "lodforge/core/memory.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/core/units.h"
 
 namespace lodforge {
 namespace {
@@ -26,6 +29,8 @@ int rank = 0, size = 1;
 bool joined = false;
 bool abandoned = false;  // a wait was interrupted: the others may be gone, do not finalize
 std::string activityDirectory;
+std::array<std::uint64_t, 2> ioAtLastStage{};  // recordStage's /proc/self/io at the last stage
+std::string stagesRecorded;
 
 std::string activityPath(int of) {
   return fmt::format("{}/rank-{}", activityDirectory, of);
@@ -111,6 +116,8 @@ void leaveCluster() {
   joined = false;
   abandoned = false;
   activityDirectory.clear();
+  stagesRecorded.clear();
+  ioAtLastStage = {};
   rank = 0;
   size = 1;
 }
@@ -170,6 +177,45 @@ JobProgress::~JobProgress() {
   if (thread_.joinable()) thread_.join();
 }
 
+namespace {
+
+// /proc/self/io's rchar and wchar (0 where the file is missing).
+std::array<std::uint64_t, 2> processIo() {
+  std::array<std::uint64_t, 2> io{};
+  std::ifstream in("/proc/self/io");  // a /proc file tells no size: read as a stream
+  std::string key;
+  std::uint64_t value = 0;
+  while (in >> key >> value) {
+    if (key == "rchar:") io[0] = value;
+    if (key == "wchar:") io[1] = value;
+  }
+  return io;
+}
+
+}  // namespace
+
+void recordStage(std::string_view stage) {
+  if (!clustered() || activityDirectory.empty()) return;
+  const std::array<std::uint64_t, 2> now = processIo();
+  stagesRecorded +=
+      fmt::format("{} read {}, wrote {}; ", stage, formatBytes(now[0] - ioAtLastStage[0]),
+                  formatBytes(now[1] - ioAtLastStage[1]));
+  ioAtLastStage = now;
+  (void)OutputFile::writeWhole(
+      fmt::format("{}/stages-{}", activityDirectory, rank),
+      fmt::format("rank {}: {}peak memory {}", rank, stagesRecorded, formatBytes(peakRssBytes())));
+}
+
+std::vector<std::string> rankStages() {
+  std::vector<std::string> lines;
+  for (int r = 0; r < size && !activityDirectory.empty(); ++r) {
+    Result<std::string> text =
+        readFileToString(fmt::format("{}/stages-{}", activityDirectory, r), 4096);
+    if (text) lines.push_back(*text);
+  }
+  return lines;
+}
+
 std::string otherRanksActivities() {
   std::string lines;
   if (activityDirectory.empty()) return lines;
@@ -194,6 +240,29 @@ Result<std::uint64_t> sumAcrossRanks(std::uint64_t mine) {
   return sum;
 #else
   return mine;
+#endif
+}
+
+Result<std::vector<std::uint64_t>> gatherAcrossRanks(std::span<const std::uint64_t> mine) {
+  if (!clustered()) return std::vector<std::uint64_t>(mine.begin(), mine.end());
+#if LODFORGE_WITH_MPI
+  const auto ranks = static_cast<std::size_t>(size);
+  const int own = static_cast<int>(mine.size());
+  std::vector<int> lengths(ranks), offsets(ranks);
+  MPI_Request request;
+  int code = MPI_Iallgather(&own, 1, MPI_INT, lengths.data(), 1, MPI_INT, MPI_COMM_WORLD, &request);
+  if (code != MPI_SUCCESS) return mpiFailed("cannot gather the ranks' counts", code);
+  LODFORGE_TRY(waitQuietly(request));
+  int total = 0;
+  for (std::size_t r = 0; r < ranks; ++r) offsets[r] = total, total += lengths[r];
+  std::vector<std::uint64_t> all(static_cast<std::size_t>(total));
+  code = MPI_Iallgatherv(mine.data(), own, MPI_UINT64_T, all.data(), lengths.data(), offsets.data(),
+                         MPI_UINT64_T, MPI_COMM_WORLD, &request);
+  if (code != MPI_SUCCESS) return mpiFailed("cannot gather the ranks' values", code);
+  LODFORGE_TRY(waitQuietly(request));
+  return all;
+#else
+  return std::vector<std::uint64_t>(mine.begin(), mine.end());
 #endif
 }
 

@@ -6,9 +6,11 @@
 
 #include <atomic>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <thread>
+#include <vector>
 
 #include "lodforge/core/status.h"
 
@@ -41,6 +43,9 @@ Status agreeAcrossRanks(const Status& mine);
 // The sum of every rank's `mine`, known to all (as agreeAcrossRanks waits).
 Result<std::uint64_t> sumAcrossRanks(std::uint64_t mine);
 
+// Every rank's `mine`, concatenated in rank order, known to all (lengths may differ).
+Result<std::vector<std::uint64_t>> gatherAcrossRanks(std::span<const std::uint64_t> mine);
+
 // What this rank is doing, kept from now on in `directory`/rank-<r> (a directory every rank sees),
 // so that when a rank dies the others can say what it was doing.
 void setActivityDirectory(std::string directory);
@@ -65,6 +70,13 @@ class JobProgress {
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };
+
+// What this rank read and wrote in a stage (/proc/self/io's rchar and wchar since the last
+// stage: what it asked of the file systems, from the page cache or not) and its peak memory,
+// kept beside its activity for rank 0's report.
+void recordStage(std::string_view stage);
+// Every rank's recorded stages, a line each ("rank 1: chunks read 1.2 GiB, wrote …").
+std::vector<std::string> rankStages();
 
 // A name for this rank in messages: "rank 2 of 4 (host, pid 1234)".
 std::string describeRank();

@@ -20,6 +20,7 @@
 #include "lodforge/tiles/tile_texture.h"
 #include "lodforge/tiles/tileset_output.h"
 #include "lodforge/tiles/tileset_parts.h"
+#include "lodforge/tiling/chunk_ply.h"
 #include "lodforge/tiling/resume.h"
 
 namespace lodforge {
@@ -110,8 +111,8 @@ nlohmann::json surfaceIdentity(const std::optional<ReconstructOptions>& surface)
 nlohmann::json runIdentity(const std::string& path, const TilesOptions& options,
                            const ChunkInputOptions& input, const OctreeOptions& octree) {
   std::error_code error;
-  // 3: textures in the state; work files of another format start over.
-  return {{"workFormat", 3},
+  // 4: chunks may be in pieces by rank; work files of another format start over.
+  return {{"workFormat", 4},
           {"input", fs::absolute(path, error).string()},
           {"bytes", fileBytes(path)},
           {"modified", modifiedTicks(path)},
@@ -146,31 +147,6 @@ ReconstructOptions resumableSurface(const TilesOptions& options, const ChunkInpu
   return surface;
 }
 
-// Streams the input into the chunk grid, or takes the chunks of an interrupted run.
-Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& options,
-                                 const ChunkInputOptions& input, const OctreeOptions& octree,
-                                 const WorkPlace& place, const LazyCrs& crs, bool& resumed,
-                                 std::optional<ReconstructStats>& surface) {
-  const std::string statePath = workStatePath(place.work.path);
-  const nlohmann::json identity = runIdentity(path, options, input, octree);
-  if (options.resume) {
-    std::optional<ChunkInput> earlier =
-        resumeChunks(statePath, identity, input.workDirectory + "/chunks");
-    resumed = earlier.has_value();
-    if (earlier) return std::move(*earlier);
-  }
-  LODFORGE_TRY(prepareWorkPlace(place, false));
-  Result<ChunkInput> fresh =
-      options.surface
-          ? surfaceChunkInput(path, input, resumableSurface(options, input), surface.emplace())
-          : chunkInput(path, input);
-  if (!fresh) return crs.error.ok() ? fresh.status() : crs.error;
-  if (options.origin) fresh->frame = eastNorthUpToEcef(*options.origin);
-  if (crs.transform) fresh->frame = crs.transform->localToEcef();
-  if (!input.keepInMemory) LODFORGE_TRY(saveChunkState(statePath, identity, *fresh));
-  return fresh;
-}
-
 // Whether the tileset goes out with implicit tiling: asked for (refused where the octree is no
 // single subdivision), or by its size.
 Result<bool> implicitTilingWanted(ImplicitTiling wanted, const OctreeResult& tree) {
@@ -188,15 +164,16 @@ Result<bool> implicitTilingWanted(ImplicitTiling wanted, const OctreeResult& tre
 // In a job of several ranks, each node built counts towards the job's progress.
 Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& options,
                                 const OctreeOptions& octree, const std::string& tilesetDirectory,
-                                const TileTexturing* texturing, std::uint64_t& builtNodes) {
+                                const TileTexturing* texturing, std::uint64_t& builtNodes,
+                                std::uint64_t doneBefore = 0) {
   std::atomic<std::uint64_t> built = 0;
   const auto counted = [&](Result<OctreeResult> tree) {
-    builtNodes = built;
+    builtNodes += built;
     return tree;
   };
   return counted(buildOctree(
       *chunked.chunks, octree, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
-        reportProgress(++built);
+        reportProgress(doneBefore + ++built);
         if (mesh.triangleCount() == 0) return {};
         return writeTileContent(mesh, node.bounds, tilesetDirectory + "/" + tileContentUri(node),
                                 {.colors = chunked.colors,
@@ -298,6 +275,50 @@ Result<RunPlan> planRun(const TilesOptions& options, const std::string& workDire
   return run;
 }
 
+// The chunks of an interrupted run, when resuming and they are intact and of the same input
+// and options.
+std::optional<ChunkInput> earlierChunks(const std::string& path, const TilesOptions& options,
+                                        const RunPlan& run) {
+  if (!options.resume) return std::nullopt;
+  const std::string& work = run.input.workDirectory;
+  return resumeChunks(workStatePath(work), runIdentity(path, options, run.input, run.octree),
+                      work + "/chunks");
+}
+
+// Chunks just made: placed on Earth, and recorded for --resume.
+Status recordChunks(const std::string& path, const TilesOptions& options, const RunPlan& run,
+                    ChunkInput& chunks) {
+  if (options.origin) chunks.frame = eastNorthUpToEcef(*options.origin);
+  if (run.crs->transform) chunks.frame = run.crs->transform->localToEcef();
+  if (run.input.keepInMemory) return {};
+  return saveChunkState(workStatePath(run.input.workDirectory),
+                        runIdentity(path, options, run.input, run.octree), chunks);
+}
+
+// Streams the input into the chunk grid (a fresh work place).
+Result<ChunkInput> chunkFresh(const std::string& path, const TilesOptions& options,
+                              const RunPlan& run, const WorkPlace& place,
+                              std::optional<ReconstructStats>& surface) {
+  LODFORGE_TRY(prepareWorkPlace(place, false));
+  Result<ChunkInput> fresh =
+      options.surface ? surfaceChunkInput(path, run.input, resumableSurface(options, run.input),
+                                          surface.emplace())
+                      : chunkInput(path, run.input);
+  if (!fresh) return run.crs->error.ok() ? fresh.status() : run.crs->error;
+  LODFORGE_TRY(recordChunks(path, options, run, *fresh));
+  return fresh;
+}
+
+// Streams the input into the chunk grid, or takes the chunks of an interrupted run.
+Result<ChunkInput> chunkOrResume(const std::string& path, const TilesOptions& options,
+                                 const RunPlan& run, const WorkPlace& place, bool& resumed,
+                                 std::optional<ReconstructStats>& surface) {
+  std::optional<ChunkInput> earlier = earlierChunks(path, options, run);
+  resumed = earlier.has_value();
+  if (earlier) return std::move(*earlier);
+  return chunkFresh(path, options, run, place, surface);
+}
+
 // A textured input's pyramids and what its tiles bake from (no `tiles`: untextured).
 struct Texturing {
   std::optional<TexturePyramid> pyramid;
@@ -371,10 +392,11 @@ class RankedTiles {
 
   Result<TilesStats> run() {
     Result<RunPlan> run = planRun(options_, tilesWorkDirectory(output_));
-    LODFORGE_TRY(agreeAcrossRanks(lead_ && run ? chunkOnLead(*run) : run.status()));
-    stats_.chunkSeconds = secondsSince(start_);
+    LODFORGE_TRY(agreeAcrossRanks(lead_ && run ? claimOnLead(*run) : run.status()));
     setActivityDirectory(run->input.workDirectory + "/ranks");
-    LODFORGE_TRY(agreeAcrossRanks(lead_ ? Status{} : takeChunks(*run)));
+    LODFORGE_TRY(chunkTogether(*run));
+    stats_.chunkSeconds = secondsSince(start_);
+    recordStage("chunks");
     countChunks(*chunked_, stats_);
     stats_.threads = run->octree.threads;
     stats_.ranks = clusterSize();
@@ -382,25 +404,70 @@ class RankedTiles {
     if (!taken) return taken.status();
     Result<std::uint64_t> built = sumAcrossRanks(builtNodes_);
     if (!built) return built.status();
-    stats_.subtreeSeconds = secondsSince(start_) - stats_.chunkSeconds;
-    LODFORGE_TRY(agreeAcrossRanks(lead_ ? buildTop(run->octree) : Status{}));
-    stats_.builtNodes = *built + builtNodes_;  // the top: rank 0's since the sum
+    builtNodes_ = 0;
+    stats_.octreeSeconds = secondsSince(start_) - stats_.chunkSeconds;
+    recordStage("octree");
+    LODFORGE_TRY(agreeAcrossRanks(lead_ ? writeTileset(run->octree) : Status{}));
+    stats_.rankStages = rankStages();
+    stats_.builtNodes = *built + builtNodes_;  // and rank 0's since the sum (none)
     stats_.takenNodes = *taken;
     stats_.seconds = secondsSince(start_);
     return stats_;
   }
 
  private:
-  // Rank 0: the output and work directory claimed, the input chunked (or an interrupted run's
-  // chunks taken), a textured input's pyramids made.
-  Status chunkOnLead(const RunPlan& run) {
+  // Rank 0 claims the output and its work directory, and takes an interrupted job's chunks
+  // when resuming (a fresh work place otherwise).
+  Status claimOnLead(const RunPlan& run) {
     LODFORGE_TRY(claimWorkPlace(path_, output_, options_, place_, lock_));
-    Result<ChunkInput> chunks = chunkOrResume(path_, options_, run.input, run.octree, *place_,
-                                              *run.crs, stats_.resumed, stats_.surface);
+    std::optional<ChunkInput> earlier = earlierChunks(path_, options_, run);
+    stats_.resumed = earlier.has_value();
+    if (!earlier) return prepareWorkPlace(*place_, false);
+    chunked_ = std::move(*earlier);
+    return prepareTexturing(*chunked_, options_, run.octree, place_->work.path, true, texturing_);
+  }
+
+  // The chunks on every rank: an interrupted job's; or the input read in slices by every rank
+  // where it allows that; or chunked by rank 0 while the others wait. The others then take
+  // rank 0's.
+  Status chunkTogether(const RunPlan& run) {
+    Result<std::uint64_t> resumed = sumAcrossRanks(stats_.resumed ? 1 : 0);
+    if (!resumed) return resumed.status();
+    if (*resumed == 0) {
+      Result<bool> sliced = readInSlices(run);
+      if (!sliced) return sliced.status();
+      if (!*sliced) {
+        reportActivity(lead_ ? "chunking the input" : "waiting for rank 0 to chunk the input");
+        LODFORGE_TRY(agreeAcrossRanks(lead_ ? chunkOnLead(run) : Status{}));
+      }
+    }
+    return agreeAcrossRanks(chunked_ ? Status{} : takeChunks(run));
+  }
+
+  // Every rank reads its slice of a PLY that allows it (chunk_ply.h). False where it does not,
+  // or where its faces turn out to be of different sizes: then rank 0 chunks it alone.
+  Result<bool> readInSlices(const RunPlan& run) {
+    if (options_.surface || fileExtension(path_) != "ply") return false;
+    Result<bool> sliceable = plyReadInSlices(path_, run.input);
+    LODFORGE_TRY(agreeAcrossRanks(sliceable.status()));
+    if (!*sliceable) return false;
+    reportActivity("reading its slice of the input into chunks");
+    Result<ChunkInput> chunks = chunkPlyInSlices(path_, run.input);
+    if (!chunks && chunks.status().kind() == ErrorKind::kUnsupported) return false;
     if (!chunks) return chunks.status();
     chunked_ = std::move(*chunks);
-    return prepareTexturing(*chunked_, options_, run.octree, place_->work.path, stats_.resumed,
-                            texturing_);
+    LODFORGE_TRY(
+        agreeAcrossRanks(lead_ ? recordChunks(path_, options_, run, *chunked_) : Status{}));
+    stats_.readInSlices = true;
+    return true;
+  }
+
+  // Rank 0 alone: the input chunked, a textured input's pyramids made.
+  Status chunkOnLead(const RunPlan& run) {
+    Result<ChunkInput> chunks = chunkFresh(path_, options_, run, *place_, stats_.surface);
+    if (!chunks) return chunks.status();
+    chunked_ = std::move(*chunks);
+    return prepareTexturing(*chunked_, options_, run.octree, place_->work.path, false, texturing_);
   }
 
   // The other ranks take rank 0's chunks and pyramids, as a resumed run would.
@@ -418,41 +485,49 @@ class RankedTiles {
     return prepareTexturing(*chunked_, options_, run.octree, workDirectory, true, texturing_);
   }
 
-  // Every rank its subtrees (what an interrupted job finished is taken); the job's progress on
-  // rank 0. Returns how many nodes all ranks took from an interrupted job.
+  // Every rank its nodes, round by round: its subtrees, then its nodes of each level above them
+  // (what an interrupted job finished is taken); the job's progress on rank 0. Returns how many
+  // nodes all ranks took from an interrupted job.
   Result<std::uint64_t> buildShare(const OctreeOptions& octree) {
     OctreeOptions share = octree;
     share.rank = clusterRank();
     share.ranks = clusterSize();
-    share.resume = lead_ ? stats_.resumed : options_.resume;
     share.quiet = true;
     const ShareCounts counts = countShare(*chunked_->chunks, share);
-    reportActivity(fmt::format("building its {} nodes of the octree's subtrees", counts.mine));
-    Result<OctreeResult> subtrees = [&] {
-      const JobProgress progress(fmt::format("tiles: octree, {} ranks", share.ranks),
-                                 counts.subtrees);
+    const JobProgress progress(fmt::format("tiles: octree, {} ranks", share.ranks), counts.nodes);
+    std::uint64_t done = 0, taken = 0;
+    for (int round = 0; round < counts.rounds; ++round) {
+      const std::uint64_t mine = counts.mine[static_cast<std::size_t>(round)];
+      share.round = round;
+      // Later rounds take the earlier ones' nodes; the first, an interrupted job's.
+      share.resume = round > 0 || (lead_ ? stats_.resumed : options_.resume);
+      reportActivity(fmt::format("building its {} nodes of round {} of {} of the octree", mine,
+                                 round + 1, counts.rounds));
+      const std::uint64_t before = builtNodes_;
       Result<OctreeResult> tree =
-          buildTiles(*chunked_, options_, share, staging(), texturing(), builtNodes_);
-      reportProgress(counts.mine);  // with what was taken
-      return tree;
-    }();
-    reportActivity(subtrees ? "done with its subtrees" : "failed in its subtrees");
-    LODFORGE_TRY(agreeAcrossRanks(subtrees.status()));
-    stats_.splitLevel = subtrees->splitLevel;
-    stats_.rankWork = subtrees->rankWork;
-    return sumAcrossRanks(counts.mine - builtNodes_);
+          buildTiles(*chunked_, options_, share, staging(), texturing(), builtNodes_, done);
+      done += mine;
+      taken += mine - (builtNodes_ - before);
+      reportProgress(done);
+      LODFORGE_TRY(agreeAcrossRanks(tree.status()));
+      if (round == 0) stats_.splitLevel = tree->splitLevel, stats_.rankWork = tree->rankWork;
+    }
+    reportActivity("done with its nodes");
+    return sumAcrossRanks(taken);
   }
 
-  // Rank 0, once every subtree is done: the levels above them, then the tileset.
-  Status buildTop(const OctreeOptions& octree) {
-    reportActivity("building the levels above the subtrees and the tileset");
-    OctreeOptions top = octree;
-    top.resume = true;  // takes every subtree
-    builtNodes_ = 0;
-    Result<OctreeResult> tree =
-        buildTiles(*chunked_, options_, top, staging(), texturing(), builtNodes_);
+  // Rank 0, once every node is built: the tree gathered from their summaries, the tileset.
+  Status writeTileset(const OctreeOptions& octree) {
+    reportActivity("writing the tileset");
+    OctreeOptions all = octree;
+    all.resume = true;        // takes every node
+    std::uint64_t built = 0;  // none (a root without content above --levels is no node)
+    Result<OctreeResult> tree = buildTiles(*chunked_, options_, all, staging(), texturing(), built);
     if (!tree) return tree.status();
-    return finishTileset(*tree, *chunked_, options_, *place_, output_, stats_);
+    builtNodes_ += built;
+    LODFORGE_TRY(finishTileset(*tree, *chunked_, options_, *place_, output_, stats_));
+    recordStage("tileset");
+    return {};
   }
 
   std::string staging() const { return tilesWorkDirectory(output_) + "/tileset"; }
@@ -494,8 +569,8 @@ Result<TilesStats> writeTiles(const std::string& path, const std::string& output
   if (!run) return run.status();
   stats.threads = run->octree.threads;
 
-  Result<ChunkInput> chunked = chunkOrResume(path, options, run->input, run->octree, *place,
-                                             *run->crs, stats.resumed, stats.surface);
+  Result<ChunkInput> chunked =
+      chunkOrResume(path, options, *run, *place, stats.resumed, stats.surface);
   if (!chunked) return chunked.status();
   countChunks(*chunked, stats);
   stats.chunkSeconds = secondsSince(start);

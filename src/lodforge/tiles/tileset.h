@@ -78,13 +78,15 @@ struct TilesStats {
   std::uint64_t parts = 0;                  // named parts (parts.json), 0: none
   std::uint64_t partsInRoot = 0;            // of them, those the coarsest tiles still hold
   // A job of several ranks (docs/distributed.md): how many, the level whose subtrees they
-  // shared, each one's work (leaf triangles under its subtrees) and the subtrees' wall time.
+  // shared, each one's work (leaf triangles under its subtrees) and the octree's wall time.
   int ranks = 1;
+  bool readInSlices = false;     // every rank read a slice of the input (chunk_ply.h)
   std::uint64_t builtNodes = 0;  // octree nodes this run built (all ranks)
   std::uint64_t takenNodes = 0;  // and those it took as an earlier, interrupted run left them
   int splitLevel = 0;
   std::vector<std::uint64_t> rankWork;
-  double subtreeSeconds = 0;
+  double octreeSeconds = 0;
+  std::vector<std::string> rankStages;  // per rank: bytes read and written by stage, peak memory
 };
 
 // Where `lodforge tiles -o OUT` works: OUT.work holds the work files and the tileset being

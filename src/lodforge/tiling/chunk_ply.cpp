@@ -4,10 +4,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <bit>
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -17,6 +20,7 @@
 
 #include <fmt/format.h>
 
+#include "lodforge/core/cluster.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/mesh/ply_reader.h"
@@ -65,10 +69,21 @@ struct FaceBatch {
   std::uint64_t faces = 0, triangles = 0;
 };
 
+// This rank's share of `count` elements (all of them in a job of one).
+PlySlice rankSlice(std::uint64_t count) {
+  const auto ranks = static_cast<std::uint64_t>(clusterSize());
+  const auto rank = static_cast<std::uint64_t>(clusterRank());
+  const std::uint64_t first = count * rank / ranks;
+  return {first, count * (rank + 1) / ranks - first};
+}
+
 class PlyChunking {
  public:
-  PlyChunking(const std::string& path, const ChunkInputOptions& options)
-      : path_(path), options_(options), vertexPath_(options.workDirectory + "/vertices.bin") {}
+  PlyChunking(const std::string& path, const ChunkInputOptions& options, bool sliced = false)
+      : path_(path),
+        options_(options),
+        vertexPath_(options.workDirectory + "/vertices.bin"),
+        sliced_(sliced) {}
   ~PlyChunking() {
     if (fd_ >= 0) ::close(fd_);
   }
@@ -77,9 +92,14 @@ class PlyChunking {
 
   Status openVertices();
   Status copyVertices();
+  Status openCache();
   Status scanFaces();
   Status cutFaces();
   ChunkInput finish();
+  // In slices: the ranks' bounds joined, then their chunk pieces and counts.
+  Status joinBounds();
+  Status joinChunks();
+  const PlyHeader& header() const { return header_; }
 
  private:
   std::shared_ptr<PlyBatch> readVertexBatch(tbb::flow_control& control);
@@ -95,6 +115,7 @@ class PlyChunking {
   const std::string& path_;
   const ChunkInputOptions& options_;
   const std::string vertexPath_;
+  const bool sliced_;    // this rank's slice of a job's (chunkPlyInSlices)
   VertexLayout layout_;  // of the vertex work file
   std::optional<PlyReader> vertices_, faces_;
   PlyHeader header_;
@@ -118,6 +139,10 @@ Status PlyChunking::openVertices() {
   read.stopAfterDelivered = true;  // the face pass reads the faces
   read.salvageTruncated = options_.salvageTruncated;
   Result<PlyReader> vertices = PlyReader::open(path_, read);
+  if (vertices && sliced_) {
+    read.vertexSlice = rankSlice(vertices->header().vertexCount);
+    vertices = PlyReader::open(path_, read);
+  }
   if (!vertices) return vertices.status();
   vertices_ = std::move(*vertices);
   header_ = vertices_->header();
@@ -139,7 +164,8 @@ Status PlyChunking::openVertices() {
   }
   // Float positions stay floats in the work file, unless a transform makes doubles of them.
   layout_.floatPositions = header_.floatPositions && !options_.transform;
-  fd_ = ::open(vertexPath_.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0644);
+  // Each rank writes its slice in place: none may truncate what the others wrote.
+  fd_ = ::open(vertexPath_.c_str(), O_RDWR | O_CREAT | (sliced_ ? 0 : O_TRUNC), 0644);
   if (fd_ < 0) return ioErrorFromErrno(vertexPath_, "create");
   return {};
 }
@@ -148,7 +174,8 @@ Status PlyChunking::openVertices() {
 // the next batch overlaps writing this one (the copy into the page cache is a large part of the
 // pass): read (the reader is sequential), then transform, bound and write in file order.
 Status PlyChunking::copyVertices() {
-  progress_.emplace("tiles: vertices", header_.vertexCount);
+  progress_.emplace("tiles: vertices",
+                    sliced_ ? rankSlice(header_.vertexCount).count : header_.vertexCount);
   std::vector<std::byte> buffer;  // one batch's records; freed after this pass
   const auto pipeline = [&] {
     using Work = std::shared_ptr<PlyBatch>;
@@ -164,7 +191,19 @@ Status PlyChunking::copyVertices() {
   runOn(options_.threads, pipeline);
   LODFORGE_TRY(failure_.status());
   progress_->finish();
+  return {};
+}
+
+// Corners are fetched from the vertex work file, complete (every rank's slice in it).
+Status PlyChunking::openCache() {
   if (input_.bounds.empty()) return badInput(path_, "no vertices");
+  if (sliced_) {
+    // Opened again after every rank closed it: what the others wrote is seen on a shared file
+    // system too (close-to-open consistency).
+    ::close(fd_);
+    fd_ = ::open(vertexPath_.c_str(), O_RDWR);
+    if (fd_ < 0) return ioErrorFromErrno(vertexPath_, "open");
+  }
   cache_.emplace(fd_, header_.vertexCount, options_.vertexCacheBytes, layout_);
   return {};
 }
@@ -209,7 +248,9 @@ void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>
     const Vec2f uv = batch.uvs.empty() ? Vec2f{} : batch.uvs[i];
     writeVertexRecord(buffer.data() + i * layout_.bytes(), layout_, p, color, n, uv);
   }
-  if (::write(fd_, buffer.data(), buffer.size()) != static_cast<ssize_t>(buffer.size())) {
+  // At the batch's place in the file: ranks write their slices side by side.
+  const auto offset = static_cast<off_t>(batch.first * layout_.bytes());
+  if (::pwrite(fd_, buffer.data(), buffer.size(), offset) != static_cast<ssize_t>(buffer.size())) {
     failure_.fail(batch.first, ioErrorFromErrno(vertexPath_, "write"));
     return;
   }
@@ -255,6 +296,7 @@ PlyReadOptions PlyChunking::faceReading() const {
   read.readFaces = true;
   read.readVertices = false;
   read.batchSize = 1 << 14;  // the batches in flight below stay a few MiB each
+  if (sliced_) read.faceSlice = rankSlice(header_.faceCount);
   return read;
 }
 
@@ -322,14 +364,18 @@ Status PlyChunking::cutFaces() {
   Result<ChunkGrid> grid = chunkGrid();
   if (!grid) return grid.status();
   grid_ = *grid;
-  input_.chunks = std::make_unique<ChunkWriter>(*grid_, options_.workDirectory + "/chunks",
-                                                options_.chunkBufferBytes, options_.keepInMemory);
+  const std::string chunks = options_.workDirectory + "/chunks";
+  input_.chunks = std::make_unique<ChunkWriter>(
+      *grid_,
+      sliced_ ? ChunkWriter::reopen(*grid_, chunks, {}).pieceDirectory(clusterRank()) : chunks,
+      options_.chunkBufferBytes, options_.keepInMemory);
   input_.chunks->setTextured(!input_.textures.empty());
   Result<PlyReader> faces = PlyReader::open(path_, faceReading());
   if (!faces) return faces.status();
   faces_ = std::move(*faces);
   read_ = 0;
-  progress_.emplace("tiles: chunks", header_.faceCount);
+  progress_.emplace("tiles: chunks",
+                    sliced_ ? rankSlice(header_.faceCount).count : header_.faceCount);
   // A few batches in flight: enough to keep every thread busy, little memory.
   const std::size_t tokens = static_cast<std::size_t>(std::max(2, options_.threads + 1));
   const auto pipeline = [&] {
@@ -405,10 +451,47 @@ void PlyChunking::addFaceBatch(const FaceBatch& work) {
   progress_->advance(work.faces);
 }
 
-// The vertex work file goes; the input says where a salvaged file was cut short.
+Status PlyChunking::joinBounds() {
+  const Aabbd& own = input_.bounds;
+  const std::array<std::uint64_t, 6> mine = {
+      std::bit_cast<std::uint64_t>(own.min.x), std::bit_cast<std::uint64_t>(own.min.y),
+      std::bit_cast<std::uint64_t>(own.min.z), std::bit_cast<std::uint64_t>(own.max.x),
+      std::bit_cast<std::uint64_t>(own.max.y), std::bit_cast<std::uint64_t>(own.max.z)};
+  Result<std::vector<std::uint64_t>> all = gatherAcrossRanks(mine);
+  if (!all) return all.status();
+  for (std::size_t at = 0; at + 6 <= all->size(); at += 6) {
+    const auto value = [&](std::size_t k) { return std::bit_cast<double>((*all)[at + k]); };
+    Aabbd bounds;
+    bounds.min = {value(0), value(1), value(2)};
+    bounds.max = {value(3), value(4), value(5)};
+    input_.bounds.add(bounds);  // min and max: the same whatever the order
+  }
+  return {};
+}
+
+// The ranks' chunk counts added up; the chunks are read back from every rank's pieces.
+Status PlyChunking::joinChunks() {
+  std::vector<std::uint64_t> mine;
+  for (const auto& [index, count] : input_.chunks->triangleCounts())
+    mine.insert(mine.end(), {index, count});
+  Result<std::vector<std::uint64_t>> all = gatherAcrossRanks(mine);
+  if (!all) return all.status();
+  std::map<std::uint64_t, std::uint64_t> counts;
+  for (std::size_t at = 0; at + 2 <= all->size(); at += 2) counts[(*all)[at]] += (*all)[at + 1];
+  Result<std::uint64_t> triangles = sumAcrossRanks(input_.inputTriangles);
+  if (!triangles) return triangles.status();
+  input_.inputTriangles = *triangles;
+  assert(!input_.chunks->textured());  // plyReadInSlices takes no textured file
+  input_.chunks = std::make_unique<ChunkWriter>(ChunkWriter::reopen(
+      *grid_, options_.workDirectory + "/chunks", std::move(counts), clusterSize()));
+  return {};
+}
+
+// The vertex work file goes (in slices, rank 0 removes it once every rank is done with it);
+// the input says where a salvaged file was cut short.
 ChunkInput PlyChunking::finish() {
   std::error_code ignored;
-  std::filesystem::remove(vertexPath_, ignored);
+  if (!sliced_) std::filesystem::remove(vertexPath_, ignored);
   input_.truncation = faces_->truncation() ? faces_->truncation() : vertices_->truncation();
   return std::move(input_);
 }
@@ -419,9 +502,39 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   PlyChunking chunking(path, options);
   LODFORGE_TRY(chunking.openVertices());
   LODFORGE_TRY(chunking.copyVertices());
+  LODFORGE_TRY(chunking.openCache());
   LODFORGE_TRY(chunking.scanFaces());
   LODFORGE_TRY(chunking.cutFaces());
   return chunking.finish();
+}
+
+Result<bool> plyReadInSlices(const std::string& path, const ChunkInputOptions& options) {
+  PlyReadOptions read;
+  read.readFaces = false;
+  Result<PlyReader> reader = PlyReader::open(path, read);
+  if (!reader) return reader.status();
+  const PlyHeader& header = reader->header();
+  return header.format != PlyFormat::kAscii && header.stripCount == 0 && header.hasNormals &&
+         !header.hasObjectIds && !header.hasUvs && !header.hasFaceUvs && !plyTextured(header) &&
+         !options.transform && !options.salvageTruncated && !options.keepInMemory;
+}
+
+Result<ChunkInput> chunkPlyInSlices(const std::string& path, const ChunkInputOptions& options) {
+  PlyChunking chunking(path, options, /*sliced=*/true);
+  Status step = chunking.openVertices();
+  if (step.ok()) step = chunking.copyVertices();
+  LODFORGE_TRY(agreeAcrossRanks(step));
+  LODFORGE_TRY(chunking.joinBounds());
+  step = chunking.openCache();
+  if (step.ok()) step = chunking.cutFaces();
+  LODFORGE_TRY(agreeAcrossRanks(step));
+  LODFORGE_TRY(chunking.joinChunks());
+  ChunkInput input = chunking.finish();
+  if (clusterRank() == 0) {
+    std::error_code ignored;
+    std::filesystem::remove(options.workDirectory + "/vertices.bin", ignored);
+  }
+  return input;
 }
 
 }  // namespace lodforge

@@ -13,4 +13,16 @@ namespace lodforge {
 
 Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& options);
 
+// In a job of several ranks (docs/distributed.md): whether the PLY can be read in slices, one
+// per rank: binary faces found by their index, the normals in the file (a normals pass sums
+// over the whole file), no object ids, texture coordinates, transform or salvage, chunks on
+// disk. Otherwise rank 0 chunks it alone.
+Result<bool> plyReadInSlices(const std::string& path, const ChunkInputOptions& options);
+
+// Every rank reads its slice of the vertices (into the shared vertex file) and then of the
+// faces (into chunk pieces of its own, ChunkWriter::pieceDirectory); each gets the same input,
+// its chunks the ranks' pieces. Collective: every rank calls it, and each step ends with every
+// rank's outcome (faces that cannot be found by index: kUnsupported on every rank).
+Result<ChunkInput> chunkPlyInSlices(const std::string& path, const ChunkInputOptions& options);
+
 }  // namespace lodforge

@@ -108,15 +108,28 @@ ChunkWriter::ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bu
 }
 
 ChunkWriter ChunkWriter::reopen(ChunkGrid grid, std::string directory,
-                                std::map<std::uint64_t, std::uint64_t> counts) {
+                                std::map<std::uint64_t, std::uint64_t> counts, int pieces) {
   ChunkWriter writer(grid, std::move(directory), 0);
   for (const auto& [index, count] : counts) writer.triangles_ += count;
   writer.counts_ = std::move(counts);
+  writer.pieces_ = pieces;
   return writer;
 }
 
 std::string ChunkWriter::chunkPath(const ChunkCell& cell) const {
   return fmt::format("{}/{}_{}_{}.tri", directory_, cell[0], cell[1], cell[2]);
+}
+
+std::string ChunkWriter::pieceDirectory(int r) const {
+  return fmt::format("{}/rank-{}", directory_, r);
+}
+
+std::vector<std::string> ChunkWriter::chunkFiles(const ChunkCell& cell) const {
+  if (pieces_ == 0) return {chunkPath(cell)};
+  std::vector<std::string> files;
+  const std::string name = std::filesystem::path(chunkPath(cell)).filename().string();
+  for (int r = 0; r < pieces_; ++r) files.push_back(pieceDirectory(r) + "/" + name);
+  return files;
 }
 
 Status ChunkWriter::add(const ChunkCell& cell, std::span<const CutCorner, 3> corners) {
@@ -282,6 +295,18 @@ Result<MeshPart> loadChunk(const std::string& path) {
 
 Result<MeshPart> ChunkWriter::load(const ChunkCell& cell) const {
   const auto it = buffers_.find(grid_.cellIndex(cell));
+  if (it == buffers_.end() && pieces_ > 0) {
+    // Blocks follow one another: the pieces in rank order are the chunk as one writer makes it.
+    std::vector<std::byte> bytes;
+    for (const std::string& piece : chunkFiles(cell)) {
+      std::error_code missing;
+      if (!std::filesystem::exists(piece, missing)) continue;  // a rank with none of it
+      Result<std::vector<std::byte>> read = readFileBytes(piece);
+      if (!read) return read.error();
+      bytes.insert(bytes.end(), read->begin(), read->end());
+    }
+    return parseChunk(bytes, chunkPath(cell));
+  }
   if (it == buffers_.end()) return loadChunk(chunkPath(cell));
   MeshPart mesh;
   appendRecords(it->second.vertices, mesh, textured_);

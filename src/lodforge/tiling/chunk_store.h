@@ -31,9 +31,11 @@ class ChunkWriter {
   ChunkWriter(ChunkGrid grid, std::string directory, std::uint64_t bufferBytes,
               bool keepInMemory = false);
 
-  // Chunk files written by an earlier, interrupted run (--resume): the grid and the counts.
+  // Chunk files written by an earlier, interrupted run (--resume) or by the ranks of a job: the
+  // grid and the counts. With `pieces` > 0 each chunk is in pieces, one per rank that read a
+  // slice of the input, at piecePath(cell, r): read back in rank order, as one file.
   static ChunkWriter reopen(ChunkGrid grid, std::string directory,
-                            std::map<std::uint64_t, std::uint64_t> counts);
+                            std::map<std::uint64_t, std::uint64_t> counts, int pieces = 0);
 
   // Records carry each corner's texture coordinate and material (a textured input): set before
   // the first triangle is added.
@@ -60,6 +62,11 @@ class ChunkWriter {
   const std::map<std::uint64_t, std::uint64_t>& triangleCounts() const { return counts_; }
   std::uint64_t triangleCount() const { return triangles_; }
   std::string chunkPath(const ChunkCell& cell) const;
+  // Where rank `r` wrote its piece of a chunk: a ChunkWriter of its own at pieceDirectory(r).
+  std::string pieceDirectory(int r) const;
+  int pieces() const { return pieces_; }
+  // The chunk's work files (its file, or its pieces), for removal once its leaf is built.
+  std::vector<std::string> chunkFiles(const ChunkCell& cell) const;
   // A chunk as a welded mesh, from its buffer or its file.
   Result<MeshPart> load(const ChunkCell& cell) const;
 
@@ -69,6 +76,7 @@ class ChunkWriter {
   std::uint64_t bufferBytes_ = 0, buffered_ = 0, triangles_ = 0;
   bool keepInMemory_ = false;
   bool textured_ = false;
+  int pieces_ = 0;
   // A chunk's pieces since the last flush: vertex records and triangles over them, and where
   // each input vertex's record is. Input vertices arrive in runs of nearby numbers (a scan's
   // rows, looked up again a row later), so the lookup is by runs of 64 numbers: an

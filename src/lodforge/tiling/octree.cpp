@@ -107,14 +107,31 @@ class OctreeBuild {
                            .textured = chunks_.textured(),
                            .quiet = options_.quiet},
                           [this](std::uint32_t index) -> Status {
-                            if (!share_.owner.empty() && share_.owner[index] != options_.rank)
-                              return {};  // another rank's, or built after the subtrees
+                            if (!share_.owner.empty() && !mine(index))
+                              return needed(index) ? takeDone(index) : Status{};
                             OctreeNode& node = plan_.result.nodes[index];
                             return node.level == 0 ? buildLeaf(index) : buildParent(index);
                           });
   }
 
  private:
+  // In a job of several ranks: a node this rank builds in this round; one of an earlier round
+  // that a node it builds needs (a child, built by some rank).
+  bool mine(std::uint32_t index) const {
+    return share_.round[index] == options_.round && share_.owner[index] == options_.rank;
+  }
+  bool needed(std::uint32_t index) const {
+    const std::uint32_t up = plan_.parentOf[index];
+    return share_.round[index] < options_.round && up != kNoParent && mine(up);
+  }
+  Status takeDone(std::uint32_t index) {
+    if (resumed(index)) return {};
+    return Error{ErrorKind::kIo, fmt::format("{}: the node is not done, though its round is "
+                                             "over (is the work directory on a file system "
+                                             "every rank shares?)",
+                                             store_.meshPath(plan_.result.nodes[index]))};
+  }
+
   // With --resume, a node a previous run finished is taken as it is.
   bool resumed(std::uint32_t index) {
     const std::uint32_t up = plan_.parentOf[index];
@@ -142,7 +159,7 @@ class OctreeBuild {
     LODFORGE_TRY(finish(node, std::move(*mesh)));
     // The chunk is no longer needed, even to resume: its work file goes now, while its pages
     // may still be unwritten, rather than in one long removal at the end.
-    store_.release(chunks_.chunkPath(node.cell));
+    for (const std::string& file : chunks_.chunkFiles(node.cell)) store_.release(file);
     return {};
   }
 
@@ -185,11 +202,10 @@ ShareCounts countShare(const ChunkWriter& chunks, const OctreeOptions& options) 
   if (chunks.triangleCounts().empty()) return {};
   const OctreePlan plan = planOctree(chunks, options.levels);
   const OctreeShare share = shareOctree(plan.result.nodes, plan.inputTriangles, options.ranks);
-  ShareCounts counts;
-  for (int owner : share.owner) {
-    counts.subtrees += owner != kBuiltAfterSubtrees ? 1 : 0;
-    counts.mine += owner == options.rank ? 1 : 0;
-  }
+  ShareCounts counts{share.rounds, plan.result.nodes.size(),
+                     std::vector<std::uint64_t>(static_cast<std::size_t>(share.rounds), 0)};
+  for (std::size_t i = 0; i < share.owner.size(); ++i)
+    if (share.owner[i] == options.rank) ++counts.mine[static_cast<std::size_t>(share.round[i])];
   return counts;
 }
 

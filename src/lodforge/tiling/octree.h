@@ -36,10 +36,10 @@ struct OctreeOptions {
   // are taken as they are: the sink is not called for them again.
   bool resume = false;
   std::string workDirectory;
-  // In a job of several ranks (docs/distributed.md): build only this rank's share of the
-  // subtrees (octree_share.h). Rank 0 then builds the levels above them in a second call with
-  // `ranks` 1 and `resume`, which takes every subtree as done.
-  int rank = 0, ranks = 1;
+  // In a job of several ranks (docs/distributed.md): build only this rank's nodes of `round`
+  // (octree_share.h), taking the children they need from the earlier rounds (with `resume`).
+  // Rank 0 then gathers the finished tree in a call with `ranks` 1 and `resume`.
+  int rank = 0, ranks = 1, round = 0;
   bool quiet = false;  // no progress of its own (a job's rank 0 shows the whole job's)
 };
 
@@ -61,7 +61,8 @@ struct OctreeResult {
   std::vector<OctreeNode> nodes;  // leaves first, then level by level; the root last
   std::uint32_t root = 0;
   int levels = 0;  // levels above the leaves
-  // With ranks > 1: the subtrees' level and each rank's work (leaf triangles under its share).
+  // With ranks > 1: the subtrees' level and each rank's work (leaf triangles under its
+  // subtrees).
   int splitLevel = 0;
   std::vector<std::uint64_t> rankWork;
 };
@@ -69,10 +70,13 @@ struct OctreeResult {
 // Called once per node, from any thread, with its finished mesh (before the parent is built).
 using NodeSink = std::function<Status(const OctreeNode&, const MeshPart&)>;
 
-// In a job of several ranks: the nodes of every rank's subtrees and of this rank's share (what
-// buildOctree with the same chunks and options builds), for the job's progress.
+// In a job of several ranks: the rounds, and the nodes of the whole tree and of this rank's
+// share in each round (what buildOctree with the same chunks and options builds), for the job's
+// progress.
 struct ShareCounts {
-  std::uint64_t subtrees = 0, mine = 0;
+  int rounds = 0;
+  std::uint64_t nodes = 0;
+  std::vector<std::uint64_t> mine;  // per round
 };
 ShareCounts countShare(const ChunkWriter& chunks, const OctreeOptions& options);
 

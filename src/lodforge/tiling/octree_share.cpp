@@ -21,26 +21,43 @@ std::vector<std::uint64_t> subtreeWork(const std::vector<OctreeNode>& nodes,
 
 // The nodes of `level` dealt out largest first to the least loaded rank (longest processing
 // time first: within 4/3 of the best possible busiest rank); ties by node order, so every rank
-// computes the same share.
-OctreeShare dealLevel(const std::vector<OctreeNode>& nodes, std::span<const std::uint64_t> work,
-                      int level, int ranks) {
-  OctreeShare share{level, std::vector<int>(nodes.size(), kBuiltAfterSubtrees),
-                    std::vector<std::uint64_t>(static_cast<std::size_t>(ranks), 0)};
+// computes the same share. Returns each rank's work.
+std::vector<std::uint64_t> dealLevel(const std::vector<OctreeNode>& nodes,
+                                     std::span<const std::uint64_t> work, int level, int ranks,
+                                     std::vector<int>& owner) {
+  std::vector<std::uint64_t> load(static_cast<std::size_t>(ranks), 0);
   std::vector<std::uint32_t> roots;
   for (std::uint32_t i = 0; i < nodes.size(); ++i)
     if (nodes[i].level == level) roots.push_back(i);
   std::stable_sort(roots.begin(), roots.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return work[a] > work[b]; });
   for (std::uint32_t root : roots) {
-    const auto least = static_cast<std::size_t>(
-        std::min_element(share.work.begin(), share.work.end()) - share.work.begin());
-    share.owner[root] = static_cast<int>(least);
-    share.work[least] += work[root];
+    const auto least =
+        static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    owner[root] = static_cast<int>(least);
+    load[least] += work[root];
   }
+  return load;
+}
+
+// Whole subtrees under `split` (round 0), then each level above it in a round of its own.
+OctreeShare shareAt(const std::vector<OctreeNode>& nodes, std::span<const std::uint64_t> work,
+                    int split, int top, int ranks) {
+  OctreeShare share{split,
+                    top - split + 1,
+                    std::vector<int>(nodes.size(), 0),
+                    std::vector<int>(nodes.size(), 0),
+                    {}};
+  share.work = dealLevel(nodes, work, split, ranks, share.owner);
   // A subtree's nodes go with its root (children before parents: walk down from the roots).
   for (std::size_t i = nodes.size(); i-- > 0;)
-    if (share.owner[i] != kBuiltAfterSubtrees)
+    if (nodes[i].level <= split)
       for (std::uint32_t c : nodes[i].children) share.owner[c] = share.owner[i];
+  for (int level = split + 1; level <= top; ++level) {
+    (void)dealLevel(nodes, work, level, ranks, share.owner);
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      if (nodes[i].level == level) share.round[i] = level - split;
+  }
   return share;
 }
 
@@ -59,7 +76,7 @@ OctreeShare shareOctree(const std::vector<OctreeNode>& nodes,
   for (const OctreeNode& node : nodes) top = std::max(top, node.level);
   std::optional<OctreeShare> best;
   for (int level = top; level >= std::min(top, 1); --level) {
-    OctreeShare share = dealLevel(nodes, work, level, ranks);
+    OctreeShare share = shareAt(nodes, work, level, top, ranks);
     if (shareBalance(share) >= 1 - tolerance) return share;
     if (!best || shareBalance(share) > shareBalance(*best)) best = std::move(share);
   }

@@ -1,7 +1,7 @@
-// Which rank builds which octree nodes in a job of several ranks (docs/distributed.md): whole
-// subtrees under one level, dealt out largest first to the least loaded rank (a subtree's work
-// is the leaf triangles under it), and the levels above them, which rank 0 builds once every
-// subtree is done.
+// Which rank builds which octree nodes in a job of several ranks (docs/distributed.md), in
+// rounds: first whole subtrees under one level, dealt out largest first to the least loaded rank
+// (a subtree's work is the leaf triangles under it); then each level above them, its nodes dealt
+// out the same way, once the level below is done. Every rank computes the same share.
 #pragma once
 
 #include <cstdint>
@@ -12,11 +12,11 @@
 
 namespace lodforge {
 
-inline constexpr int kBuiltAfterSubtrees = -1;
-
 struct OctreeShare {
   int splitLevel = 0;               // the subtrees' roots are the nodes of this level
-  std::vector<int> owner;           // per node: the rank that builds it, or kBuiltAfterSubtrees
+  int rounds = 1;                   // the subtrees, then one round per level above them
+  std::vector<int> owner;           // per node: the rank that builds it
+  std::vector<int> round;           // per node: when (0: in its subtree; k: level split + k)
   std::vector<std::uint64_t> work;  // per rank: the leaf triangles under its subtrees
 };
 
@@ -27,9 +27,9 @@ struct OctreeShare {
 // the simplification is above them).
 OctreeShare shareOctree(const std::vector<OctreeNode>& nodes,
                         std::span<const std::uint64_t> leafTriangles, int ranks,
-                        double tolerance = 0.2);
+                        double tolerance = 0.05);
 
-// The least loaded rank's work over the busiest one's (1: perfectly even).
+// The least loaded rank's subtree work over the busiest one's (1: perfectly even).
 double shareBalance(const OctreeShare& share);
 
 }  // namespace lodforge

@@ -83,6 +83,7 @@ Status saveChunkState(const std::string& path, const nlohmann::json& identity,
       {"streamed", input.streamed},
       {"frame", input.frame ? nlohmann::json(input.frame->m) : nlohmann::json()},
       {"counts", counts},
+      {"pieces", input.chunks->pieces()},
       {"parts",
        {{"source", input.parts.source},
         {"names", input.parts.names},
@@ -147,8 +148,8 @@ std::optional<ChunkInput> resumeChunks(const std::string& path, const nlohmann::
     std::optional<std::vector<std::string>> sideFiles = unchangedSideFiles(state.at("sideFiles"));
     if (!sideFiles) return std::nullopt;  // a material library changed: chunk again
     input.sideFiles = std::move(*sideFiles);
-    input.chunks =
-        std::make_unique<ChunkWriter>(ChunkWriter::reopen(grid, chunkDirectory, std::move(counts)));
+    input.chunks = std::make_unique<ChunkWriter>(ChunkWriter::reopen(
+        grid, chunkDirectory, std::move(counts), state.at("pieces").get<int>()));
     return input;
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;  // damaged: chunk again

@@ -23,6 +23,8 @@ struct PlyReader::State {
 
   explicit State(ByteSource s) : in(std::move(s)) {}
   bool next(PlyBatch& batch);
+  // The next batch of the current element, vertices or faces; false when a slice of it is done.
+  bool readElements(const PlyElement& e, bool isVertex, PlyBatch& batch);
 };
 
 namespace {
@@ -80,18 +82,8 @@ bool PlyReader::State::next(PlyBatch& batch) {
         if (batch.count > 0) return true;
         continue;  // the last strips were all degenerate
       }
-      batch.kind = isVertex ? PlyBatch::Kind::kVertices : PlyBatch::Kind::kFaces;
-      batch.first = in.elementDone;
-      const std::uint64_t end =
-          std::min<std::uint64_t>(e.count, in.elementDone + in.options.batchSize);
-      for (; in.elementDone < end; ++in.elementDone) {
-        if (isVertex)
-          in.readVertex(batch);
-        else
-          in.readFace(batch);
-      }
-      batch.count = end - batch.first;
-      return true;
+      if (readElements(e, isVertex, batch)) return true;
+      break;
     }
     return false;
   } catch (const PlyRecords::Truncated&) {
@@ -107,6 +99,31 @@ bool PlyReader::State::next(PlyBatch& batch) {
     batch.count = in.elementDone - batch.first;
     return batch.count > 0;
   }
+}
+
+bool PlyReader::State::readElements(const PlyElement& e, bool isVertex, PlyBatch& batch) {
+  const PlySlice& slice = isVertex ? in.options.vertexSlice : in.options.faceSlice;
+  const bool sliced = !slice.whole();
+  if (sliced && in.sliceElement != static_cast<int>(in.element)) in.enterSlice(e, slice, !isVertex);
+  if (sliced && in.elementDone == in.sliceEnd) {
+    in.element = in.header.elements.size();  // reading ends after a slice
+    return false;
+  }
+  batch.kind = isVertex ? PlyBatch::Kind::kVertices : PlyBatch::Kind::kFaces;
+  batch.first = in.elementDone;
+  const std::uint64_t end = std::min<std::uint64_t>(sliced ? in.sliceEnd : e.count,
+                                                    in.elementDone + in.options.batchSize);
+  for (; in.elementDone < end; ++in.elementDone) {
+    const std::uint64_t began = in.source.offset();
+    if (isVertex) {
+      in.readVertex(batch);
+    } else {
+      in.readFace(batch);
+      if (sliced) in.checkSliceFace(began);
+    }
+  }
+  batch.count = end - batch.first;
+  return true;
 }
 
 // --- PlyReader --------------------------------------------------------------------------------

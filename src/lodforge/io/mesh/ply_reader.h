@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -20,6 +21,13 @@
 
 namespace lodforge {
 
+// A run of elements by index: what one rank of a distributed job reads (docs/distributed.md).
+struct PlySlice {
+  std::uint64_t first = 0;
+  std::uint64_t count = std::numeric_limits<std::uint64_t>::max();
+  bool whole() const { return first == 0 && count == std::numeric_limits<std::uint64_t>::max(); }
+};
+
 struct PlyReadOptions {
   std::size_t batchSize = 1 << 16;  // elements per batch
   // A file that ends early is bad input. With this set, reading stops after the last complete
@@ -32,6 +40,11 @@ struct PlyReadOptions {
   // no fixed size to seek over: skipping a billion faces reads 13 GB). For a pass whose
   // partner pass reads, and checks, what follows.
   bool stopAfterDelivered = false;
+  // Binary files only: deliver just these vertices or these faces, found by seeking, and end
+  // after them. A face is found by its index as if every face before it had the first face's
+  // size (its lists as long); a face of another size inside the slice, an ascii file, strips or
+  // a vertex with a list fail as ErrorKind::kUnsupported (read the whole element then).
+  PlySlice vertexSlice = {}, faceSlice = {};
   bool readExtras = false;  // deliver the vertices' other scalar properties (PlyBatch::extras)
   std::vector<std::string>* warnings = nullptr;  // readPly adds what it salvaged, if anything
   // Face properties recognised as an object (part) id, first match wins.

@@ -349,4 +349,53 @@ void PlyRecords::skipElement(const PlyElement& e) {
   }
 }
 
+namespace {
+
+[[noreturn]] void unsliceable(const std::string& name, std::string_view why) {
+  throw ErrorException{
+      Error{ErrorKind::kUnsupported,
+            fmt::format("{}: cannot read a slice of its elements: {}", name, why)}};
+}
+
+}  // namespace
+
+void PlyRecords::enterSlice(const PlyElement& e, const PlySlice& slice, bool faces) {
+  if (header.format == PlyFormat::kAscii) unsliceable(source.name(), "an ascii file");
+  if (faces && roles.stripElement >= 0) unsliceable(source.name(), "triangle strips");
+  sliceElement = static_cast<int>(element);
+  const std::uint64_t first = std::min(slice.first, e.count);
+  sliceEnd = first + std::min(slice.count, e.count - first);
+  std::uint64_t bytes = 0;
+  if (!faces) {
+    planRecord(e);
+    if (recordOffsets.empty()) unsliceable(source.name(), "vertices with a list property");
+    bytes = record.size();
+  } else {
+    // The first face's size, read without consuming it: every face is taken to have it.
+    for (const PlyProperty& p : e.properties) {
+      if (source.ensure(bytes + 8) < bytes + plyTypeSize(p.isList ? p.countType : p.type))
+        fileEnds(fmt::format("file ends inside the first '{}' element", e.name));
+      if (!p.isList) {
+        bytes += plyTypeSize(p.type);
+        continue;
+      }
+      const auto count =
+          static_cast<std::uint64_t>(decodeNumber(source.data() + bytes, p.countType));
+      bytes += plyTypeSize(p.countType) + count * plyTypeSize(p.type);
+    }
+    sliceFaceBytes = bytes;
+  }
+  if (first > 0 && !source.skip(first * bytes))
+    fileEnds(fmt::format("file ends before '{}' element {}", e.name, first));
+  elementDone = first;
+}
+
+void PlyRecords::checkSliceFace(std::uint64_t began) const {
+  if (source.offset() - began != sliceFaceBytes)
+    unsliceable(source.name(),
+                fmt::format("face {} takes {} bytes, the first face {}: faces of different sizes "
+                            "are found only by reading every one before them",
+                            elementDone, source.offset() - began, sliceFaceBytes));
+}
+
 }  // namespace lodforge

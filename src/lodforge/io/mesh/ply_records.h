@@ -111,6 +111,16 @@ struct PlyRecords {
   void readFaceTexcoords(const PlyElement& e, const PlyProperty& p);
   void addCornerUvs(PlyBatch& batch, std::uint64_t corners, std::size_t triangles);
   void skipElement(const PlyElement& e);
+
+  // --- slices (PlyReadOptions::vertexSlice, faceSlice) ----------------------------------------
+
+  // Seeks to the slice's first element of `e`, the current element, and sets `sliceEnd`.
+  void enterSlice(const PlyElement& e, const PlySlice& slice, bool faces);
+  // A face of the slice: the size every face must have, checked after each one is read.
+  void checkSliceFace(std::uint64_t began) const;
+  int sliceElement = -1;       // the element the slice is in (-1: none entered)
+  std::uint64_t sliceEnd = 0;  // the element index where it ends
+  std::uint64_t sliceFaceBytes = 0;
 };
 
 }  // namespace lodforge

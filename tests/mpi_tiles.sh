@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `lodforge tiles` across the ranks of an OpenMPI job (docs/distributed.md), run by OpenMPI's own
-# mpirun on this one machine (--oversubscribe: more ranks than cores): a scan, a 300-part
-# assembly and a reconstructed surface tiled by 1 to 4 ranks are byte for byte the tileset one
-# process writes; more ranks than chunks; a rank killed mid-octree stops the job with a message
+# mpirun on this one machine (--oversubscribe: more ranks than cores): a scan by 2 to 4 ranks
+# (and mpirun -np 1, a job of one), a PLY with a quad, a textured scan, a 300-part assembly and a
+# reconstructed surface are byte for byte the tileset one process writes; more ranks than chunks; a rank killed mid-octree stops the job with a message
 # naming it and what it was doing, and --resume finishes without rebuilding what was done; a
 # second run on an output being written is refused.
 set -euo pipefail
@@ -49,6 +49,12 @@ perl -e '
 same quad-np3 quad-1 "faces of two sizes, 3 ranks"
 grep -q "3 ranks: the input chunked by rank 0" quad.err || fail "the quad file was not chunked by rank 0: $(cat quad.err)"
 
+# A textured scan (rank 0 chunks it and makes the texture pyramids; the others take them).
+"$lodforge" -q generate scan --triangles 50K --texture 512 -o textured.ply
+"$lodforge" -q tiles textured.ply -o textured-1 --chunk-size 120
+"${mpi[@]}" -np 3 "$lodforge" -q tiles textured.ply -o textured-np3 --chunk-size 120
+same textured-np3 textured-1 "textured scan, 3 ranks"
+
 "$lodforge" -q generate cad --objects 300 --seed 3 -o cad.glb
 "$lodforge" -q tiles cad.glb -o cad-1
 "${mpi[@]}" -np 3 "$lodforge" -q tiles cad.glb -o cad-np3
@@ -59,7 +65,8 @@ same cad-np3 cad-1 "assembly (parts.json), 3 ranks"
 "${mpi[@]}" -np 2 "$lodforge" -q tiles points.ply --surface -o surface-np2 --chunk-size 150
 same surface-np2 surface-1 "reconstructed surface, 2 ranks"
 
-# More ranks than chunks: the horse in two chunks, 4 ranks (two have nothing to build).
+# More ranks than chunks: a small scan in two chunks, 4 ranks (the split is their parent, the
+# root: three ranks have nothing to build).
 "$lodforge" -q generate scan --triangles 20K -o small.ply
 "$lodforge" -q tiles small.ply -o small-1 --chunk-size 400
 "${mpi[@]}" -np 4 "$lodforge" -q tiles small.ply -o small-np4 --chunk-size 400
@@ -73,11 +80,13 @@ set +e
 code=$?
 set -e
 [[ $code -ne 0 ]] || fail "a job with a killed rank exited 0"
-grep -q "rank 1" killed.err || fail "the stop does not name rank 1: $(cat killed.err)"
-grep -qE "building its [0-9]+ nodes of round 1 of [0-9]+ of the octree; [0-9]+ done" killed.err ||
+grep -q "^  rank 1 of 2 (" killed.err || fail "rank 0 does not say what rank 1 did: $(cat killed.err)"
+grep -qE "building its [0-9]+ nodes of round 1 of [0-9]+ of the octree; [0-9]+ nodes done" killed.err ||
   fail "the stop does not say what rank 1 was doing: $(cat killed.err)"
 [[ -d killed.work ]] || fail "the work directory is gone after the kill"
 done_before=$(find killed.work/nodes -name '*.json' | wc -l)
+# What a rank killed while writing a tile leaves: --resume must not ship it in the tileset.
+echo partial > killed.work/tileset/tiles/planted.glb.tmp-4242-7
 "${mpi[@]}" -np 2 "$lodforge" -v tiles scan.ply -o killed --chunk-size 60 --resume 2> resumed.err
 taken=$(sed -nE 's/.*took ([0-9,]+) as the interrupted run left them.*/\1/p' resumed.err | tr -d ,)
 [[ -n $taken && $taken -ge $done_before && $done_before -ge 3 ]] ||
@@ -85,17 +94,20 @@ taken=$(sed -nE 's/.*took ([0-9,]+) as the interrupted run left them.*/\1/p' res
 same killed scan-1 "killed rank, then --resume"
 
 # Two runs on one output: the second is refused (exit 2) while the first writes, which finishes.
-"$lodforge" -q --threads 1 tiles scan.ply -o busy --chunk-size 60 --memory minimal &
+# The first takes seconds (a larger scan on one thread); the refusal names it by its pid.
+"$lodforge" -q generate scan --triangles 1M -o busy.ply
+"$lodforge" -q tiles busy.ply -o busy-1 --chunk-size 60
+"$lodforge" -q --threads 1 tiles busy.ply -o busy --chunk-size 60 --memory minimal &
 first=$!
 for _ in $(seq 200); do [[ -s busy.work/.lodforge-lock ]] && break; sleep 0.02; done
 set +e
-"${mpi[@]}" -np 2 "$lodforge" -q tiles scan.ply -o busy --chunk-size 60 2> busy.err
+"${mpi[@]}" -np 2 "$lodforge" -q tiles busy.ply -o busy --chunk-size 60 2> busy.err
 code=$?
 set -e
 wait $first || fail "the first run failed"
 [[ $code -eq 2 ]] || fail "a second run on a busy output exited $code, not 2"
-grep -q "another lodforge run" busy.err || fail "no refusal message: $(cat busy.err)"
-same busy scan-1 "the first run, beside the refused one"
+grep -q "another lodforge run (pid $first on" busy.err || fail "no refusal naming the first run: $(cat busy.err)"
+same busy busy-1 "the first run, beside the refused one"
 
 # Subcommands that do not run across ranks are refused, not run once per rank.
 set +e

@@ -62,7 +62,9 @@ Status checkThreads(Global& global) {
   const unsigned cores = hardwareThreads();
   if (global.threads <= cores) return {};
   if (global.verbosity >= 0)
-    fmt::print(stderr, "lodforge: note: --threads {}: this machine has {} cores; using {}\n",
+    fmt::print(stderr,
+               "lodforge: note: --threads {}: this process may run on {} cores (its CPU "
+               "affinity); using {}\n",
                global.threads, cores, cores);
   global.threads = cores;
   return {};

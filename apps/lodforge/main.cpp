@@ -10,6 +10,23 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/core/threads.h"
 
+namespace {
+
+// Says a failure (in a job of several ranks: rank 0 what every rank knows, any rank what only
+// it knows) and leaves the job; the exit code.
+int finish(const lodforge::Status& status) {
+  using namespace lodforge;
+  const int code = exitCodeFor(status);
+  if (!status.ok() && (clusterRank() == 0 || clusterAbandoned() || !clusterFailureAgreed()))
+    fmt::print(stderr, "lodforge: {}{}\n",
+               clustered() && clusterRank() != 0 ? fmt::format("rank {}: ", clusterRank()) : "",
+               status.message());
+  leaveCluster(code);
+  return code;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace lodforge;
   keepFreedMemoryForReuse();
@@ -52,24 +69,20 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   }
-  Status status = cli::checkMemoryLimit(app, *memoryLimit, global.memoryLimit);
-  if (status.ok()) status = cli::checkThreads(global);
-  if (status.ok()) status = joinCluster();
-  if (status.ok()) status = cli::checkClusterCommand(app);
-  if (!status.ok()) {
-    if (clusterRank() == 0) fmt::print(stderr, "lodforge: {}\n", status.message());
-    leaveCluster();
-    return exitCodeFor(status);
-  }
-  // In a job of several ranks, rank 0 speaks for the job (docs/distributed.md).
+  // First, so that what follows is said once for a job of several ranks: rank 0 speaks for the
+  // job (docs/distributed.md), and the checks, the same on every rank, are agreed.
+  Status status = joinCluster();
+  if (!status.ok()) return finish(status);
   if (clusterRank() != 0) global.verbosity = -1;
+  status = cli::checkMemoryLimit(app, *memoryLimit, global.memoryLimit);
+  if (status.ok()) status = cli::checkThreads(global);
+  if (status.ok()) status = cli::checkClusterCommand(app);
+  status = agreeAcrossRanks(status);
+  if (!status.ok()) return finish(status);
   if (global.verbosity < 0) setProgressMode(ProgressMode::kOff);
   installInterruptHandler();
   const ThreadLimit threads(global.threads);
 
   status = run ? cli::runGuarded(run) : Status(Error{ErrorKind::kUsage, "no subcommand"});
-  if (!status.ok() && (clusterRank() == 0 || clusterAbandoned()))
-    fmt::print(stderr, "lodforge: {}\n", status.message());
-  leaveCluster();
-  return exitCodeFor(status);
+  return finish(status);
 }

@@ -219,11 +219,6 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
 }
 
 Status runPointTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
-  if (clustered())
-    return Error{ErrorKind::kUsage,
-                 fmt::format("{}: a point cloud; point tilesets are built by one process for now "
-                             "(meshes and --surface run across ranks: docs/distributed.md)",
-                             options.input)};
   if (options.levels > 0 || options.chunkSize > 0 || options.resume)
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: a point cloud; --levels, --chunk-size and --resume are for "
@@ -340,6 +335,7 @@ Status runMeshTiles(const Global& global, const TilesCommand& options, const Til
                  work);
     return stats.status();
   }
+  if (clusterRank() != 0) return {};  // rank 0 speaks for the job
   if (stats->truncation)
     fmt::print(stderr, "lodforge: warning: {}; built from what came before\n", *stats->truncation);
   for (const std::string& warning : stats->warnings)
@@ -380,18 +376,31 @@ Status runSurfaceTiles(const Global& global, const TilesCommand& options, TilesO
   return runMeshTiles(global, options, tiles);
 }
 
-Status runTiles(const Global& global, const TilesCommand& options) {
-  LODFORGE_TRY(checkTilesInput(options.input));
-  Result<TilesOptions> tiles = meshTilesOptions(global, options);
-  if (!tiles) return tiles.status();
-  const bool points = isPointInput(options.input);
+// Which pipeline the input and options go to, refused where they do not go together.
+Status checkTilesRoute(const TilesCommand& options, bool points) {
   if (options.surface && !points)
     return Error{ErrorKind::kUsage,
                  fmt::format("{}: --surface is for point clouds (this is a mesh)", options.input)};
-  if (options.surface) return runSurfaceTiles(global, options, *tiles);
-  if (usesSurfaceOptions(options.surfaceOptions))
+  if (!options.surface && usesSurfaceOptions(options.surfaceOptions))
     return Error{ErrorKind::kUsage,
                  "--voxel, --radius, --min-points, --orient and --min-triangles go with --surface"};
+  if (points && !options.surface && clustered())
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: a point cloud; point tilesets are built by one process for now "
+                             "(meshes and --surface run across ranks: docs/distributed.md)",
+                             options.input)};
+  return {};
+}
+
+Status runTiles(const Global& global, const TilesCommand& options) {
+  Status checked = checkTilesInput(options.input);
+  Result<TilesOptions> tiles =
+      checked.ok() ? meshTilesOptions(global, options) : Result<TilesOptions>(checked);
+  const bool points = tiles && isPointInput(options.input);
+  checked = tiles ? checkTilesRoute(options, points) : tiles.status();
+  // Every rank of a job checks the same: agreed, a refusal is said once (by rank 0).
+  LODFORGE_TRY(agreeAcrossRanks(checked));
+  if (options.surface) return runSurfaceTiles(global, options, *tiles);
   if (points) return runPointTiles(global, options, *tiles);
   return runMeshTiles(global, options, *tiles);
 }

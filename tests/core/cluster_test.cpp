@@ -24,16 +24,21 @@ TEST(Cluster, AProcessNotStartedAsAJobIsAJobOfOne) {
   Result<std::uint64_t> sum = sumAcrossRanks(41);
   ASSERT_TRUE(sum.ok());
   EXPECT_EQ(*sum, 41u);
+  const std::vector<std::uint64_t> mine = {7, 0, 9};
+  Result<std::vector<std::uint64_t>> gathered = gatherAcrossRanks(mine);
+  ASSERT_TRUE(gathered.ok());
+  EXPECT_EQ(*gathered, mine);
+  EXPECT_FALSE(clusterFailureAgreed());
   EXPECT_NE(describeRank().find("rank 0 of 1"), std::string::npos) << describeRank();
 
   const test::TempDir dir;
   setActivityDirectory(dir.file("ranks"));
   reportActivity("chunking");
-  reportProgress(3);
+  reportProgress("nodes", 3);
   EXPECT_FALSE(std::filesystem::exists(dir.file("ranks"))) << "nothing to tell other ranks";
   EXPECT_EQ(otherRanksActivities(), "");
   EXPECT_FALSE(clusterAbandoned());
-  leaveCluster();
+  leaveCluster(1);  // a failure in a job of one aborts nothing
 }
 
 }  // namespace

@@ -153,14 +153,5 @@ TEST(OctreeShare, MoreRanksThanChunksLeaveSomeRanksIdle) {
   EXPECT_EQ(single.splitLevel, 0);
 }
 
-TEST(OctreeShare, EveryRankComputesTheSameShare) {
-  const PlannedTree tree = sheet(12, 5, 30'000, 30'000);  // equal work: ties everywhere
-  const OctreeShare a = shareOctree(tree.nodes, tree.leafTriangles, 3);
-  const OctreeShare b = shareOctree(tree.nodes, tree.leafTriangles, 3);
-  EXPECT_EQ(a.owner, b.owner);
-  EXPECT_EQ(a.round, b.round);
-  EXPECT_EQ(a.work, b.work);
-}
-
 }  // namespace
 }  // namespace lodforge

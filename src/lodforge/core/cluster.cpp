@@ -27,7 +27,8 @@ namespace {
 
 int rank = 0, size = 1;
 bool joined = false;
-bool abandoned = false;  // a wait was interrupted: the others may be gone, do not finalize
+bool abandoned = false;      // a wait was interrupted: the others may be gone, do not finalize
+bool failureAgreed = false;  // every rank knows of the failure agreeAcrossRanks returned
 std::string activityDirectory;
 std::array<std::uint64_t, 2> ioAtLastStage{};  // recordStage's /proc/self/io at the last stage
 std::string stagesRecorded;
@@ -40,12 +41,21 @@ std::string progressPath(int of) {
 }
 std::mutex progressMutex;  // reports come from the worker threads
 
-// The sum of every rank's last reported progress.
-std::uint64_t jobDone() {
+// A rank's last reported progress: how many of what ("12 nodes"; empty: none).
+std::pair<std::uint64_t, std::string> lastProgress(int of) {
+  Result<std::string> text = readFileToString(progressPath(of), 128);
+  if (!text) return {0, ""};
+  char* end = nullptr;
+  const std::uint64_t done = std::strtoull(text->c_str(), &end, 10);
+  return {done, std::string(end + (*end == ' ' ? 1 : 0))};
+}
+
+// The sum of every rank's last reported progress in `units` (a rank still at another stage: 0).
+std::uint64_t jobDone(std::string_view units) {
   std::uint64_t sum = 0;
   for (int r = 0; r < size; ++r) {
-    Result<std::string> text = readFileToString(progressPath(r), 64);
-    if (text) sum += std::strtoull(text->c_str(), nullptr, 10);
+    const auto [done, of] = lastProgress(r);
+    if (of == units) sum += done;
   }
   return sum;
 }
@@ -58,11 +68,25 @@ bool launchedAsJob() {
 }
 
 #if LODFORGE_WITH_MPI
+Status mpiFailed(const char* what, int code) {
+  std::array<char, MPI_MAX_ERROR_STRING> text{};
+  int length = 0;
+  MPI_Error_string(code, text.data(), &length);
+  return Error{ErrorKind::kIo,
+               fmt::format("MPI: {}: {}", what,
+                           std::string_view(text.data(), static_cast<std::size_t>(length)))};
+}
+
 // Polls instead of blocking: OpenMPI's blocking waits spin a core, which ranks sharing a machine
 // need for their own work while one of them chunks alone.
 Status waitQuietly(MPI_Request& request) {
   int done = 0;
-  while (MPI_Test(&request, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && done == 0) {
+  while (done == 0) {
+    if (const int code = MPI_Test(&request, &done, MPI_STATUS_IGNORE); code != MPI_SUCCESS) {
+      abandoned = true;
+      return mpiFailed("waiting for the other ranks", code);
+    }
+    if (done != 0) break;
     if (cancelRequested()) {
       abandoned = true;
       return Error{ErrorKind::kCancelled,
@@ -74,14 +98,6 @@ Status waitQuietly(MPI_Request& request) {
   return {};
 }
 
-Status mpiFailed(const char* what, int code) {
-  std::array<char, MPI_MAX_ERROR_STRING> text{};
-  int length = 0;
-  MPI_Error_string(code, text.data(), &length);
-  return Error{ErrorKind::kIo,
-               fmt::format("MPI: {}: {}", what,
-                           std::string_view(text.data(), static_cast<std::size_t>(length)))};
-}
 #endif
 
 }  // namespace
@@ -109,12 +125,17 @@ Status joinCluster() {
 #endif
 }
 
-void leaveCluster() {
+void leaveCluster(int exitCode) {
 #if LODFORGE_WITH_MPI
+  // A failure the other ranks do not know of: they would wait for this one forever (and
+  // MPI_Finalize for them), so the job ends here.
+  if (joined && exitCode != 0 && !failureAgreed && !abandoned && size > 1)
+    MPI_Abort(MPI_COMM_WORLD, exitCode);
   if (joined && !abandoned) MPI_Finalize();
 #endif
   joined = false;
   abandoned = false;
+  failureAgreed = false;
   activityDirectory.clear();
   stagesRecorded.clear();
   ioAtLastStage = {};
@@ -127,6 +148,10 @@ int clusterRank() {
 }
 bool clusterAbandoned() {
   return abandoned;
+}
+
+bool clusterFailureAgreed() {
+  return failureAgreed;
 }
 int clusterSize() {
   return size;
@@ -141,7 +166,12 @@ std::string describeRank() {
 void setActivityDirectory(std::string directory) {
   activityDirectory = std::move(directory);
   std::error_code ignored;
-  if (clustered()) std::filesystem::create_directories(activityDirectory, ignored);
+  if (!clustered()) return;
+  std::filesystem::create_directories(activityDirectory, ignored);
+  // What this rank of an interrupted job said is not what this one does.
+  for (const std::string& path : {activityPath(rank), progressPath(rank),
+                                  fmt::format("{}/stages-{}", activityDirectory, rank)})
+    std::filesystem::remove(path, ignored);
 }
 
 void reportActivity(std::string_view what) {
@@ -150,24 +180,24 @@ void reportActivity(std::string_view what) {
   (void)OutputFile::writeWhole(activityPath(rank), fmt::format("{}: {}", describeRank(), what));
 }
 
-void reportProgress(std::uint64_t done) {
+void reportProgress(std::string_view units, std::uint64_t done) {
   if (!clustered() || activityDirectory.empty()) return;
   std::lock_guard lock(progressMutex);
-  (void)OutputFile::writeWhole(progressPath(rank), std::to_string(done));
+  (void)OutputFile::writeWhole(progressPath(rank), fmt::format("{} {}", done, units));
 }
 
-JobProgress::JobProgress(std::string label, std::uint64_t total) {
+JobProgress::JobProgress(std::string label, std::string units, std::uint64_t total) {
   if (!clustered() || rank != 0) return;
-  thread_ = std::thread([this, label = std::move(label), total] {
+  thread_ = std::thread([this, label = std::move(label), units = std::move(units), total] {
     Progress progress(label, total);
     std::uint64_t shown = 0;
     while (!stop_.load()) {
-      const std::uint64_t done = jobDone();
+      const std::uint64_t done = jobDone(units);
       if (done > shown) progress.advance(done - shown);
       shown = std::max(shown, done);
       std::this_thread::sleep_for(std::chrono::milliseconds(500));
     }
-    const std::uint64_t done = jobDone();
+    const std::uint64_t done = jobDone(units);
     if (done > shown) progress.advance(done - shown);
   });
 }
@@ -222,9 +252,9 @@ std::string otherRanksActivities() {
   for (int r = 0; r < size; ++r) {
     if (r == rank) continue;
     Result<std::string> text = readFileToString(activityPath(r), 4096);
-    Result<std::string> done = readFileToString(progressPath(r), 64);
+    const auto [done, units] = lastProgress(r);
     lines += fmt::format("\n  {}{}", text ? *text : fmt::format("rank {}: nothing reported", r),
-                         done ? fmt::format("; {} done", *done) : "");
+                         units.empty() ? "" : fmt::format("; {} {} done", done, units));
   }
   return lines.empty() ? lines : "; their last steps:" + lines;
 }
@@ -294,6 +324,7 @@ Status agreeAcrossRanks(const Status& mine) {
   LODFORGE_TRY(waitQuietly(request));
   for (std::size_t r = 0; r < ranks; ++r) {
     if (all[2 * r] < 0) continue;
+    failureAgreed = true;
     if (static_cast<int>(r) == rank) return mine;  // our own, as a job of one would say it
     const std::string text =
         messages.substr(static_cast<std::size_t>(offsets[r]), static_cast<std::size_t>(lengths[r]));

@@ -19,13 +19,17 @@ namespace lodforge {
 // Joins the job when an MPI launcher started this process (its environment says so) and the
 // build has MPI; otherwise this is a job of one. Call once, before any other thread starts.
 Status joinCluster();
-// Leaves the job (nothing for a job of one). Call once every rank is done with the others.
-void leaveCluster();
+// Leaves the job (nothing for a job of one). Call once, last: with a failure (`exitCode` not 0)
+// that the other ranks do not know of (not one agreeAcrossRanks returned), the whole job is
+// aborted, since they would wait for this rank forever.
+void leaveCluster(int exitCode = 0);
 
 int clusterRank();  // 0 for a job of one
 // Whether a wait for the other ranks was given up (agreeAcrossRanks): each survivor then says
 // what it knows, since the rank that speaks for the job may be the one that died.
 bool clusterAbandoned();
+// Whether agreeAcrossRanks returned a failure: every rank knows of it, rank 0 says it.
+bool clusterFailureAgreed();
 int clusterSize();  // 1 for a job of one
 inline bool clustered() {
   return clusterSize() > 1;
@@ -53,15 +57,16 @@ void reportActivity(std::string_view what);
 // The other ranks' last reported activities, a line each ("rank 1 (host, pid 12): building …").
 std::string otherRanksActivities();
 
-// How much of its share this rank has done (in the job progress's unit), kept beside its
-// activity (a small file written whole: call it per unit of work that takes milliseconds).
-void reportProgress(std::uint64_t done);
+// How many `units` ("faces", "nodes") of its share this rank has done, kept beside its activity
+// (a small file written whole: call it per piece of work that takes milliseconds).
+void reportProgress(std::string_view units, std::uint64_t done);
 
-// Rank 0's progress bar for the whole job while it lives: the sum of every rank's
-// reportProgress, read from the activity directory twice a second. Nothing on other ranks.
+// Rank 0's progress bar for the whole job while it lives: the sum of every rank's last
+// reportProgress in `units`, read from the activity directory twice a second. Nothing on other
+// ranks.
 class JobProgress {
  public:
-  JobProgress(std::string label, std::uint64_t total);
+  JobProgress(std::string label, std::string units, std::uint64_t total);
   ~JobProgress();
   JobProgress(const JobProgress&) = delete;
   JobProgress& operator=(const JobProgress&) = delete;

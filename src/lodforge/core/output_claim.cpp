@@ -202,6 +202,10 @@ Result<WorkLock> lockWorkDirectory(const std::string& path) {
   if (fd < 0) return ioErrorFromErrno(file, "create");
   WorkLock lock(fd);
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    // A file system without locks (NFS without lockd, Lustre mounted noflock): nothing to
+    // guard with, the run goes on as runs did before they locked.
+    if (errno == ENOLCK || errno == ENOSYS || errno == EOPNOTSUPP || errno == EINVAL) return lock;
+    if (errno != EWOULDBLOCK) return ioErrorFromErrno(file, "lock");
     std::string holder(256, '\0');
     const ssize_t got = ::pread(fd, holder.data(), holder.size(), 0);
     holder.resize(got > 0 ? static_cast<std::size_t>(got) : 0);

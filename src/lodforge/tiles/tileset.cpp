@@ -49,9 +49,32 @@ struct WorkPlace {
   }
 };
 
-// Empties what a run makes again (all of it unless resuming) and creates the folders.
+// Whether `name` is a temporary an OutputFile makes ("<name>.tmp-<pid>-<n>").
+bool outputTemporary(std::string_view name) {
+  const std::size_t at = name.rfind(".tmp-");
+  if (at == std::string_view::npos) return false;
+  const std::string_view rest = name.substr(at + 5);
+  const std::size_t dash = rest.find('-');
+  const auto digits = [](std::string_view text) {
+    return !text.empty() &&
+           std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  return dash != std::string_view::npos && digits(rest.substr(0, dash)) &&
+         digits(rest.substr(dash + 1));
+}
+
+// Empties what a run makes again (all of it unless resuming) and creates the folders. A resumed
+// run removes the temporaries a killed one left in the staged tileset (they would be renamed
+// into the output with it); the work directory is locked, so no other run is writing them.
 Status prepareWorkPlace(const WorkPlace& place, bool keepEarlierWork) {
   std::error_code error;
+  if (keepEarlierWork && fs::exists(place.staging.path, error)) {
+    std::vector<fs::path> temporaries;
+    for (const auto& entry : fs::recursive_directory_iterator(place.staging.path, error))
+      if (entry.is_regular_file(error) && outputTemporary(entry.path().filename().string()))
+        temporaries.push_back(entry.path());
+    for (const fs::path& path : temporaries) fs::remove(path, error);
+  }
   if (!keepEarlierWork) {
     fs::remove_all(place.staging.path, error);
     fs::remove_all(place.work.path + "/nodes", error);
@@ -173,7 +196,7 @@ Result<OctreeResult> buildTiles(const ChunkInput& chunked, const TilesOptions& o
   };
   return counted(buildOctree(
       *chunked.chunks, octree, [&](const OctreeNode& node, const MeshPart& mesh) -> Status {
-        reportProgress(doneBefore + ++built);
+        reportProgress("nodes", doneBefore + ++built);
         if (mesh.triangleCount() == 0) return {};
         return writeTileContent(mesh, node.bounds, tilesetDirectory + "/" + tileContentUri(node),
                                 {.colors = chunked.colors,
@@ -433,7 +456,8 @@ class RankedTiles {
   Status chunkTogether(const RunPlan& run) {
     Result<std::uint64_t> resumed = sumAcrossRanks(stats_.resumed ? 1 : 0);
     if (!resumed) return resumed.status();
-    if (*resumed == 0) {
+    jobResumed_ = *resumed > 0;  // rank 0's decision, for every rank
+    if (!jobResumed_) {
       Result<bool> sliced = readInSlices(run);
       if (!sliced) return sliced.status();
       if (!*sliced) {
@@ -448,11 +472,15 @@ class RankedTiles {
   // or where its faces turn out to be of different sizes: then rank 0 chunks it alone.
   Result<bool> readInSlices(const RunPlan& run) {
     if (options_.surface || fileExtension(path_) != "ply") return false;
-    Result<bool> sliceable = plyReadInSlices(path_, run.input);
-    LODFORGE_TRY(agreeAcrossRanks(sliceable.status()));
-    if (!*sliceable) return false;
+    Result<std::uint64_t> faces = plyFacesInSlices(path_, run.input);
+    LODFORGE_TRY(agreeAcrossRanks(faces.status()));
+    if (*faces == 0) return false;
     reportActivity("reading its slice of the input into chunks");
-    Result<ChunkInput> chunks = chunkPlyInSlices(path_, run.input);
+    Result<ChunkInput> chunks = [&] {
+      const JobProgress progress(fmt::format("tiles: chunks, {} ranks", clusterSize()), "faces",
+                                 *faces);
+      return chunkPlyInSlices(path_, run.input);
+    }();
     if (!chunks && chunks.status().kind() == ErrorKind::kUnsupported) return false;
     if (!chunks) return chunks.status();
     chunked_ = std::move(*chunks);
@@ -494,13 +522,14 @@ class RankedTiles {
     share.ranks = clusterSize();
     share.quiet = true;
     const ShareCounts counts = countShare(*chunked_->chunks, share);
-    const JobProgress progress(fmt::format("tiles: octree, {} ranks", share.ranks), counts.nodes);
+    const JobProgress progress(fmt::format("tiles: octree, {} ranks", share.ranks), "nodes",
+                               counts.nodes);
     std::uint64_t done = 0, taken = 0;
     for (int round = 0; round < counts.rounds; ++round) {
       const std::uint64_t mine = counts.mine[static_cast<std::size_t>(round)];
       share.round = round;
       // Later rounds take the earlier ones' nodes; the first, an interrupted job's.
-      share.resume = round > 0 || (lead_ ? stats_.resumed : options_.resume);
+      share.resume = round > 0 || jobResumed_;
       reportActivity(fmt::format("building its {} nodes of round {} of {} of the octree", mine,
                                  round + 1, counts.rounds));
       const std::uint64_t before = builtNodes_;
@@ -508,7 +537,7 @@ class RankedTiles {
           buildTiles(*chunked_, options_, share, staging(), texturing(), builtNodes_, done);
       done += mine;
       taken += mine - (builtNodes_ - before);
-      reportProgress(done);
+      reportProgress("nodes", done);
       LODFORGE_TRY(agreeAcrossRanks(tree.status()));
       if (round == 0) stats_.splitLevel = tree->splitLevel, stats_.rankWork = tree->rankWork;
     }
@@ -544,6 +573,7 @@ class RankedTiles {
   std::optional<ChunkInput> chunked_;
   Texturing texturing_;  // points into chunked_
   std::uint64_t builtNodes_ = 0;
+  bool jobResumed_ = false;  // rank 0 took an interrupted job's chunks
 };
 
 }  // namespace

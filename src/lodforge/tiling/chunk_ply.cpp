@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 #include <tbb/parallel_pipeline.h>
 
@@ -127,6 +128,7 @@ class PlyChunking {
   // The pipelines' state: the failure, the faces or vertices read so far, a reader's batch.
   PipelineFailure failure_;
   std::uint64_t read_ = 0;
+  std::uint64_t facesDone_ = 0;  // cut into chunks
   PlyBatch batch_;
   std::optional<Progress> progress_;
 };
@@ -174,8 +176,7 @@ Status PlyChunking::openVertices() {
 // the next batch overlaps writing this one (the copy into the page cache is a large part of the
 // pass): read (the reader is sequential), then transform, bound and write in file order.
 Status PlyChunking::copyVertices() {
-  progress_.emplace("tiles: vertices",
-                    sliced_ ? rankSlice(header_.vertexCount).count : header_.vertexCount);
+  if (!sliced_) progress_.emplace("tiles: vertices", header_.vertexCount);
   std::vector<std::byte> buffer;  // one batch's records; freed after this pass
   const auto pipeline = [&] {
     using Work = std::shared_ptr<PlyBatch>;
@@ -190,7 +191,13 @@ Status PlyChunking::copyVertices() {
   };
   runOn(options_.threads, pipeline);
   LODFORGE_TRY(failure_.status());
-  progress_->finish();
+  if (progress_) progress_->finish();
+  if (sliced_) {
+    // Closed before the ranks agree that the file is complete: on a shared file system what a
+    // rank wrote is seen by the others once it closed the file (close-to-open consistency).
+    const int fd = std::exchange(fd_, -1);
+    if (::close(fd) != 0) return ioErrorFromErrno(vertexPath_, "write");
+  }
   return {};
 }
 
@@ -198,9 +205,7 @@ Status PlyChunking::copyVertices() {
 Status PlyChunking::openCache() {
   if (input_.bounds.empty()) return badInput(path_, "no vertices");
   if (sliced_) {
-    // Opened again after every rank closed it: what the others wrote is seen on a shared file
-    // system too (close-to-open consistency).
-    ::close(fd_);
+    // Opened again once every rank closed it (copyVertices): with what every rank wrote.
     fd_ = ::open(vertexPath_.c_str(), O_RDWR);
     if (fd_ < 0) return ioErrorFromErrno(vertexPath_, "open");
   }
@@ -254,7 +259,7 @@ void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>
     failure_.fail(batch.first, ioErrorFromErrno(vertexPath_, "write"));
     return;
   }
-  progress_->advance(batch.positions.size());
+  if (progress_) progress_->advance(batch.positions.size());
 }
 
 Status PlyChunking::fetch(const PlyBatch& batch, std::size_t t,
@@ -374,8 +379,9 @@ Status PlyChunking::cutFaces() {
   if (!faces) return faces.status();
   faces_ = std::move(*faces);
   read_ = 0;
-  progress_.emplace("tiles: chunks",
-                    sliced_ ? rankSlice(header_.faceCount).count : header_.faceCount);
+  progress_.reset();
+  // In slices, rank 0 shows the whole job's faces (JobProgress) instead of its own.
+  if (!sliced_) progress_.emplace("tiles: chunks", header_.faceCount);
   // A few batches in flight: enough to keep every thread busy, little memory.
   const std::size_t tokens = static_cast<std::size_t>(std::max(2, options_.threads + 1));
   const auto pipeline = [&] {
@@ -395,7 +401,7 @@ Status PlyChunking::cutFaces() {
   runOn(options_.threads, pipeline);
   LODFORGE_TRY(failure_.status());
   LODFORGE_TRY(input_.chunks->flush());
-  progress_->finish();
+  if (progress_) progress_->finish();
   return {};
 }
 
@@ -448,7 +454,9 @@ void PlyChunking::addFaceBatch(const FaceBatch& work) {
   if (Status status = input_.chunks->addPieces(work.cells, work.pieces); !status.ok())
     return failure_.fail(work.first, std::move(status));
   input_.inputTriangles += work.triangles;
-  progress_->advance(work.faces);
+  facesDone_ += work.faces;
+  if (progress_) progress_->advance(work.faces);
+  if (sliced_) reportProgress("faces", facesDone_);
 }
 
 Status PlyChunking::joinBounds() {
@@ -481,7 +489,7 @@ Status PlyChunking::joinChunks() {
   Result<std::uint64_t> triangles = sumAcrossRanks(input_.inputTriangles);
   if (!triangles) return triangles.status();
   input_.inputTriangles = *triangles;
-  assert(!input_.chunks->textured());  // plyReadInSlices takes no textured file
+  assert(!input_.chunks->textured());  // plyFacesInSlices takes no textured file
   input_.chunks = std::make_unique<ChunkWriter>(ChunkWriter::reopen(
       *grid_, options_.workDirectory + "/chunks", std::move(counts), clusterSize()));
   return {};
@@ -508,15 +516,17 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
   return chunking.finish();
 }
 
-Result<bool> plyReadInSlices(const std::string& path, const ChunkInputOptions& options) {
+Result<std::uint64_t> plyFacesInSlices(const std::string& path, const ChunkInputOptions& options) {
   PlyReadOptions read;
   read.readFaces = false;
   Result<PlyReader> reader = PlyReader::open(path, read);
   if (!reader) return reader.status();
   const PlyHeader& header = reader->header();
-  return header.format != PlyFormat::kAscii && header.stripCount == 0 && header.hasNormals &&
-         !header.hasObjectIds && !header.hasUvs && !header.hasFaceUvs && !plyTextured(header) &&
-         !options.transform && !options.salvageTruncated && !options.keepInMemory;
+  const bool sliceable = header.format != PlyFormat::kAscii && header.stripCount == 0 &&
+                         header.hasNormals && !header.hasObjectIds && !header.hasUvs &&
+                         !header.hasFaceUvs && !plyTextured(header) && !options.transform &&
+                         !options.salvageTruncated && !options.keepInMemory;
+  return sliceable ? header.faceCount : 0;
 }
 
 Result<ChunkInput> chunkPlyInSlices(const std::string& path, const ChunkInputOptions& options) {

@@ -13,11 +13,11 @@ namespace lodforge {
 
 Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& options);
 
-// In a job of several ranks (docs/distributed.md): whether the PLY can be read in slices, one
-// per rank: binary faces found by their index, the normals in the file (a normals pass sums
-// over the whole file), no object ids, texture coordinates, transform or salvage, chunks on
-// disk. Otherwise rank 0 chunks it alone.
-Result<bool> plyReadInSlices(const std::string& path, const ChunkInputOptions& options);
+// In a job of several ranks (docs/distributed.md): the faces of a PLY that can be read in
+// slices, one per rank (binary, faces found by their index, the normals in the file: a normals
+// pass sums over the whole file; no object ids, texture coordinates, transform or salvage;
+// chunks on disk), or 0: then rank 0 chunks it alone.
+Result<std::uint64_t> plyFacesInSlices(const std::string& path, const ChunkInputOptions& options);
 
 // Every rank reads its slice of the vertices (into the shared vertex file) and then of the
 // faces (into chunk pieces of its own, ChunkWriter::pieceDirectory); each gets the same input,

@@ -295,24 +295,45 @@ Result<MeshPart> loadChunk(const std::string& path) {
 
 Result<MeshPart> ChunkWriter::load(const ChunkCell& cell) const {
   const auto it = buffers_.find(grid_.cellIndex(cell));
-  if (it == buffers_.end() && pieces_ > 0) {
-    // Blocks follow one another: the pieces in rank order are the chunk as one writer makes it.
-    std::vector<std::byte> bytes;
-    for (const std::string& piece : chunkFiles(cell)) {
-      std::error_code missing;
-      if (!std::filesystem::exists(piece, missing)) continue;  // a rank with none of it
-      Result<std::vector<std::byte>> read = readFileBytes(piece);
-      if (!read) return read.error();
-      bytes.insert(bytes.end(), read->begin(), read->end());
-    }
-    return parseChunk(bytes, chunkPath(cell));
-  }
+  if (it == buffers_.end() && pieces_ > 0) return loadPieces(cell);
   if (it == buffers_.end()) return loadChunk(chunkPath(cell));
   MeshPart mesh;
   appendRecords(it->second.vertices, mesh, textured_);
   mesh.indices = it->second.indices;
   weldExact(mesh);
   return mesh;
+}
+
+// Blocks follow one another: the pieces in rank order are the chunk as one writer makes it. A
+// piece a rank wrote and this one cannot see (a shared file system out of step, a piece gone)
+// shows in the triangle count, which must be the chunk's.
+Result<MeshPart> ChunkWriter::loadPieces(const ChunkCell& cell) const {
+  std::vector<std::byte> bytes;
+  for (const std::string& piece : chunkFiles(cell)) {
+    std::error_code missing;
+    if (!std::filesystem::exists(piece, missing)) continue;  // a rank with none of it
+    Result<std::vector<std::byte>> read = readFileBytes(piece);
+    if (!read) return read.error();
+    bytes.insert(bytes.end(), read->begin(), read->end());
+  }
+  const std::string name = chunkPath(cell);
+  std::uint64_t triangles = 0;
+  for (std::size_t at = 0; at + kBlockHeaderBytes <= bytes.size();) {
+    const bool textured =
+        std::memcmp(bytes.data() + at, kTexturedBlockMagic, sizeof kBlockMagic) == 0;
+    std::uint32_t counts[2];
+    std::memcpy(counts, bytes.data() + at + sizeof kBlockMagic, sizeof counts);
+    triangles += counts[1];
+    at += kBlockHeaderBytes + std::uint64_t{counts[0]} * cornerBytes(textured) +
+          std::uint64_t{counts[1]} * 12;
+  }
+  const auto expected = counts_.find(grid_.cellIndex(cell));
+  if (expected == counts_.end() || expected->second != triangles)
+    return Error{ErrorKind::kIo,
+                 fmt::format("{}: its pieces hold {} triangles, the ranks wrote {} (a piece "
+                             "missing from the shared work directory?)",
+                             name, triangles, expected == counts_.end() ? 0 : expected->second)};
+  return parseChunk(bytes, name);
 }
 
 ChunkCell cellOfIndex(const ChunkGrid& grid, std::uint64_t index) {

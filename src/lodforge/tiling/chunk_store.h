@@ -90,6 +90,7 @@ class ChunkWriter {
     std::vector<std::uint32_t> blocks;
     std::uint32_t runCount = 0;
   };
+  Result<MeshPart> loadPieces(const ChunkCell& cell) const;
   // The record of `corner` in `buffer` (added if new); the bytes it took go to buffered_.
   std::uint32_t vertexOf(Buffer& buffer, const CutCorner& corner);
   std::map<std::uint64_t, Buffer> buffers_;  // by cell index

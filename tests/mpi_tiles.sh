@@ -6,7 +6,7 @@
 # naming it and what it was doing, and --resume finishes without rebuilding what was done; a
 # second run on an output being written is refused.
 set -euo pipefail
-lodforge=$1 out=$2
+lodforge=$1 out=$2 sanitized=${3:-0}
 command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/install-deps.sh" >&2; exit 1; }
 rm -rf "$out" && mkdir -p "$out"
 cd "$out"
@@ -54,6 +54,29 @@ grep -q "3 ranks: the input chunked by rank 0" quad.err || fail "the quad file w
 "$lodforge" -q tiles textured.ply -o textured-1 --chunk-size 120
 "${mpi[@]}" -np 3 "$lodforge" -q tiles textured.ply -o textured-np3 --chunk-size 120
 same textured-np3 textured-1 "textured scan, 3 ranks"
+
+# An uneven input: a coarse sheet with a patch 25 times denser in one corner (two surfaces, as
+# perl writes them). Each rank's share of the leaf triangles is within 20 % of the busiest's.
+perl -e '
+  my (@v, @f);
+  sub sheet { my ($n, $size, $z) = @_; my $base = @v;
+    for my $y (0..$n) { for my $x (0..$n) {
+      push @v, pack("f<6", $x * $size / $n, $y * $size / $n, $z + sin($x * $size / $n / 3), 0, 0, 1) } }
+    for my $y (0..$n-1) { for my $x (0..$n-1) {
+      my ($a, $b, $c, $d) = map { $base + $_ } ($y*($n+1)+$x, $y*($n+1)+$x+1, ($y+1)*($n+1)+$x+1, ($y+1)*($n+1)+$x);
+      push @f, pack("C l<3", 3, $a, $b, $c), pack("C l<3", 3, $a, $c, $d) } } }
+  sheet(120, 100, 0); sheet(120, 20, 5);
+  print "ply\nformat binary_little_endian 1.0\nelement vertex ", scalar(@v), "\n",
+    (map { "property float $_\n" } qw(x y z nx ny nz)), "element face ", scalar(@f),
+    "\nproperty list uchar int vertex_indices\nend_header\n", @v, @f;' > uneven.ply
+"$lodforge" -q tiles uneven.ply -o uneven-1 --chunk-size 6
+for ranks in 2 3; do
+  "${mpi[@]}" -np $ranks "$lodforge" -v tiles uneven.ply -o uneven-np$ranks --chunk-size 6 2> uneven.err
+  same uneven-np$ranks uneven-1 "uneven input, $ranks ranks"
+  read -r least most < <(sed -nE 's/.*subtrees under level [0-9]+, ([0-9,]+) to ([0-9,]+) leaf triangles a rank.*/\1 \2/p' uneven.err | tr -d ,)
+  [[ -n $most ]] && awk -v l="$least" -v m="$most" 'BEGIN { exit !(l >= 0.8 * m) }' ||
+    fail "uneven input, $ranks ranks: ${least:-?} to ${most:-?} leaf triangles a rank: $(cat uneven.err)"
+done
 
 "$lodforge" -q generate cad --objects 300 --seed 3 -o cad.glb
 "$lodforge" -q tiles cad.glb -o cad-1
@@ -108,6 +131,19 @@ wait $first || fail "the first run failed"
 [[ $code -eq 2 ]] || fail "a second run on a busy output exited $code, not 2"
 grep -q "another lodforge run (pid $first on" busy.err || fail "no refusal naming the first run: $(cat busy.err)"
 same busy busy-1 "the first run, beside the refused one"
+
+# --memory-limit holds per rank: each rank's peak (the -v lines rank 0 gathers) stays under it
+# (not in the sanitizer tree, whose shadow memory the limit does not count: said, not hidden).
+"${mpi[@]}" -np 2 "$lodforge" -v --memory-limit 96M tiles busy.ply -o limited --chunk-size 60 \
+  2> limited.err
+[[ $sanitized == 1 ]] && echo "not checked in the sanitizer tree: each rank's peak memory"
+for r in 0 1; do
+  [[ $sanitized == 1 ]] && break
+  peak=$(sed -nE "s/^rank $r: .*peak memory ([0-9.]+) MiB$/\1/p" limited.err)
+  [[ -n $peak ]] && awk -v p="$peak" 'BEGIN { exit !(p < 96) }' ||
+    fail "rank $r's peak memory ${peak:-unknown} MiB is not under --memory-limit 96M: $(cat limited.err)"
+done
+same limited busy-1 "2 ranks under --memory-limit 96M"
 
 # Subcommands that do not run across ranks are refused, not run once per rank.
 set +e

@@ -473,7 +473,17 @@ class RankedTiles {
   Result<bool> readInSlices(const RunPlan& run) {
     if (options_.surface || fileExtension(path_) != "ply") return false;
     Result<std::uint64_t> faces = plyFacesInSlices(path_, run.input);
-    LODFORGE_TRY(agreeAcrossRanks(faces.status()));
+    // Every rank must decide the same: each sees what the others count.
+    Result<std::uint64_t> total = sumAcrossRanks(faces ? *faces : 0);
+    if (!total) return total.status();
+    const auto ranks = static_cast<std::uint64_t>(clusterSize());
+    LODFORGE_TRY(agreeAcrossRanks(!faces ? faces.status()
+                                  : *total != *faces * ranks
+                                      ? Status(badInput(path_,
+                                                        "the ranks read different files "
+                                                        "by this name (is it on a file "
+                                                        "system every rank shares?)"))
+                                      : Status()));
     if (*faces == 0) return false;
     reportActivity("reading its slice of the input into chunks");
     Result<ChunkInput> chunks = [&] {

@@ -191,19 +191,24 @@ JobProgress::JobProgress(std::string label, std::string units, std::uint64_t tot
   thread_ = std::thread([this, label = std::move(label), units = std::move(units), total] {
     Progress progress(label, total);
     std::uint64_t shown = 0;
-    while (!stop_.load()) {
+    std::unique_lock lock(mutex_);
+    while (true) {
+      const bool stopping = stop_;
       const std::uint64_t done = jobDone(units);
       if (done > shown) progress.advance(done - shown);
       shown = std::max(shown, done);
-      std::this_thread::sleep_for(std::chrono::milliseconds(500));
+      if (stopping) break;
+      wake_.wait_for(lock, std::chrono::milliseconds(500), [this] { return stop_; });
     }
-    const std::uint64_t done = jobDone(units);
-    if (done > shown) progress.advance(done - shown);
   });
 }
 
 JobProgress::~JobProgress() {
-  stop_ = true;
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_one();
   if (thread_.joinable()) thread_.join();
 }
 

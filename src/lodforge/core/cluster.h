@@ -4,8 +4,9 @@
 // (LODFORGE_MPI=OFF), is a job of one and behaves exactly as a plain run.
 #pragma once
 
-#include <atomic>
+#include <condition_variable>
 #include <cstdint>
+#include <mutex>
 #include <span>
 #include <string>
 #include <string_view>
@@ -72,7 +73,9 @@ class JobProgress {
   JobProgress& operator=(const JobProgress&) = delete;
 
  private:
-  std::atomic<bool> stop_{false};
+  std::mutex mutex_;
+  std::condition_variable wake_;  // the destructor's: stop at once, not at the next poll
+  bool stop_ = false;
   std::thread thread_;
 };
 

@@ -19,7 +19,9 @@ int finish(const lodforge::Status& status) {
   const int code = exitCodeFor(status);
   if (!status.ok() && (clusterRank() == 0 || clusterAbandoned() || !clusterFailureAgreed()))
     fmt::print(stderr, "lodforge: {}{}\n",
-               clustered() && clusterRank() != 0 ? fmt::format("rank {}: ", clusterRank()) : "",
+               clustered() && clusterRank() != 0 && !clusterAbandoned()
+                   ? fmt::format("rank {}: ", clusterRank())
+                   : "",
                status.message());
   leaveCluster(code);
   return code;

@@ -115,6 +115,8 @@ Status joinCluster() {
   const int code = MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
   if (code != MPI_SUCCESS) return mpiFailed("cannot join the job", code);
   joined = true;
+  // Errors come back as codes (mpiFailed), not as the job ended by MPI itself.
+  MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   return {};
@@ -303,6 +305,7 @@ Result<std::vector<std::uint64_t>> gatherAcrossRanks(std::span<const std::uint64
 
 Status agreeAcrossRanks(const Status& mine) {
   if (!clustered()) return mine;
+  failureAgreed = false;  // only the last step's: a job may go on after an agreed fallback
 #if LODFORGE_WITH_MPI
   // Each rank's kind (-1: ok) and message length, then the messages.
   const std::string message = mine.ok() ? "" : mine.message();

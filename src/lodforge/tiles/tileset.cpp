@@ -52,15 +52,7 @@ struct WorkPlace {
 // Whether `name` is a temporary an OutputFile makes ("<name>.tmp-<pid>-<n>").
 bool outputTemporary(std::string_view name) {
   const std::size_t at = name.rfind(".tmp-");
-  if (at == std::string_view::npos) return false;
-  const std::string_view rest = name.substr(at + 5);
-  const std::size_t dash = rest.find('-');
-  const auto digits = [](std::string_view text) {
-    return !text.empty() &&
-           std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
-  };
-  return dash != std::string_view::npos && digits(rest.substr(0, dash)) &&
-         digits(rest.substr(dash + 1));
+  return at != std::string_view::npos && leftoverProcess(name, name.substr(0, at)).has_value();
 }
 
 // Empties what a run makes again (all of it unless resuming) and creates the folders. A resumed
@@ -298,14 +290,20 @@ Result<RunPlan> planRun(const TilesOptions& options, const std::string& workDire
   return run;
 }
 
-// The chunks of an interrupted run, when resuming and they are intact and of the same input
-// and options.
-std::optional<ChunkInput> earlierChunks(const std::string& path, const TilesOptions& options,
-                                        const RunPlan& run) {
-  if (!options.resume) return std::nullopt;
+// The chunks in the work directory, when they are complete, intact and of the same input and
+// options (an interrupted run's, or rank 0's for the other ranks of a job).
+std::optional<ChunkInput> chunksInWork(const std::string& path, const TilesOptions& options,
+                                       const RunPlan& run) {
   const std::string& work = run.input.workDirectory;
   return resumeChunks(workStatePath(work), runIdentity(path, options, run.input, run.octree),
                       work + "/chunks");
+}
+
+// The chunks of an interrupted run, when resuming.
+std::optional<ChunkInput> earlierChunks(const std::string& path, const TilesOptions& options,
+                                        const RunPlan& run) {
+  if (!options.resume) return std::nullopt;
+  return chunksInWork(path, options, run);
 }
 
 // Chunks just made: placed on Earth, and recorded for --resume.
@@ -511,9 +509,7 @@ class RankedTiles {
   // The other ranks take rank 0's chunks and pyramids, as a resumed run would.
   Status takeChunks(const RunPlan& run) {
     const std::string& workDirectory = run.input.workDirectory;
-    std::optional<ChunkInput> chunks = resumeChunks(
-        workStatePath(workDirectory), runIdentity(path_, options_, run.input, run.octree),
-        workDirectory + "/chunks");
+    std::optional<ChunkInput> chunks = chunksInWork(path_, options_, run);
     if (!chunks)
       return Error{ErrorKind::kIo,
                    fmt::format("{}: cannot read the chunks rank 0 made (is {} on a file system "

@@ -371,8 +371,7 @@ Status PlyChunking::cutFaces() {
   grid_ = *grid;
   const std::string chunks = options_.workDirectory + "/chunks";
   input_.chunks = std::make_unique<ChunkWriter>(
-      *grid_,
-      sliced_ ? ChunkWriter::reopen(*grid_, chunks, {}).pieceDirectory(clusterRank()) : chunks,
+      *grid_, sliced_ ? chunkPieceDirectory(chunks, clusterRank()) : chunks,
       options_.chunkBufferBytes, options_.keepInMemory);
   input_.chunks->setTextured(!input_.textures.empty());
   Result<PlyReader> faces = PlyReader::open(path_, faceReading());

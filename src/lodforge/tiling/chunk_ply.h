@@ -20,7 +20,7 @@ Result<ChunkInput> chunkPly(const std::string& path, const ChunkInputOptions& op
 Result<std::uint64_t> plyFacesInSlices(const std::string& path, const ChunkInputOptions& options);
 
 // Every rank reads its slice of the vertices (into the shared vertex file) and then of the
-// faces (into chunk pieces of its own, ChunkWriter::pieceDirectory); each gets the same input,
+// faces (into chunk pieces of its own, chunkPieceDirectory); each gets the same input,
 // its chunks the ranks' pieces. Collective: every rank calls it, and each step ends with every
 // rank's outcome (faces that cannot be found by index: kUnsupported on every rank).
 Result<ChunkInput> chunkPlyInSlices(const std::string& path, const ChunkInputOptions& options);

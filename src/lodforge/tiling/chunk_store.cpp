@@ -120,15 +120,16 @@ std::string ChunkWriter::chunkPath(const ChunkCell& cell) const {
   return fmt::format("{}/{}_{}_{}.tri", directory_, cell[0], cell[1], cell[2]);
 }
 
-std::string ChunkWriter::pieceDirectory(int r) const {
-  return fmt::format("{}/rank-{}", directory_, r);
+std::string chunkPieceDirectory(const std::string& chunkDirectory, int r) {
+  return fmt::format("{}/rank-{}", chunkDirectory, r);
 }
 
 std::vector<std::string> ChunkWriter::chunkFiles(const ChunkCell& cell) const {
   if (pieces_ == 0) return {chunkPath(cell)};
   std::vector<std::string> files;
   const std::string name = std::filesystem::path(chunkPath(cell)).filename().string();
-  for (int r = 0; r < pieces_; ++r) files.push_back(pieceDirectory(r) + "/" + name);
+  for (int r = 0; r < pieces_; ++r)
+    files.push_back(chunkPieceDirectory(directory_, r) + "/" + name);
   return files;
 }
 

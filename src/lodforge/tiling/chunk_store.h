@@ -62,8 +62,6 @@ class ChunkWriter {
   const std::map<std::uint64_t, std::uint64_t>& triangleCounts() const { return counts_; }
   std::uint64_t triangleCount() const { return triangles_; }
   std::string chunkPath(const ChunkCell& cell) const;
-  // Where rank `r` wrote its piece of a chunk: a ChunkWriter of its own at pieceDirectory(r).
-  std::string pieceDirectory(int r) const;
   int pieces() const { return pieces_; }
   // The chunk's work files (its file, or its pieces), for removal once its leaf is built.
   std::vector<std::string> chunkFiles(const ChunkCell& cell) const;
@@ -103,6 +101,10 @@ class ChunkWriter {
   std::vector<ChunkCell> pieceCells_;  // addTriangle's scratch
   std::vector<CutCorner> pieceCorners_;
 };
+
+// Where rank `r` of a job writes its pieces of the chunks in `chunkDirectory` (a ChunkWriter of
+// its own there; ChunkWriter::reopen with pieces reads them back).
+std::string chunkPieceDirectory(const std::string& chunkDirectory, int r);
 
 // The pieces addSegmentTriangle adds (`segment` null: a triangle of no segment, cut), appended
 // to `cells` and `corners`, so that cutting can run apart from adding.

@@ -770,32 +770,49 @@ billion_section() {
 }
 if [[ ${BENCH_ONLY:-} == billion ]]; then billion_section; exit 0; fi
 
-# Ranks against threads (issue 39): the same scan tiled by one process with 2 threads and by an
+# Ranks against threads (issue 39): the same input tiled by one process with 2 threads and by an
 # OpenMPI job of 2 ranks with 1 thread each (each rank bound to its core, mpirun's default),
 # alternately; wall time, each rank's peak memory (a /usr/bin/time per rank), outputs compared.
-distributed_section() {
-  echo
-  local n=${DISTRIBUTED_TRIANGLES:-10M} runs=${DISTRIBUTED_RUNS:-3}
-  echo "== ranks against threads: a $n-triangle scan, 1 process x 2 threads and 2 ranks x 1 thread"
-  "$lodforge" -q generate scan --triangles "$n" -o "$work/dist-scan.ply"
+# A scan (DISTRIBUTED_TRIANGLES) and an airborne LAS (DISTRIBUTED_POINTS); DISTRIBUTED_ONLY=scan
+# or points runs one.
+ranks_against_threads() {  # the input; prints the table and rank 0's -v lines for the ranks
+  local input=$1 runs=${DISTRIBUTED_RUNS:-3}
   local mpi=(mpirun --allow-run-as-root -np 2)
   printf '| run | 1 process x 2 threads | peak RSS | 2 ranks x 1 thread | peak RSS rank 0 / 1 | ranks / threads |\n|---|---:|---:|---:|---:|---:|\n'
   for run in $(seq "$runs"); do
     rm -rf "$work"/dist-one "$work"/dist-ranks
-    read -r one kib < <(timed "$lodforge" -q --threads 2 tiles "$work/dist-scan.ply" -o "$work/dist-one")
+    read -r one kib < <(timed "$lodforge" -q --threads 2 tiles "$input" -o "$work/dist-one")
     # Each rank under its own /usr/bin/time, the job's wall time from one around mpirun.
     /usr/bin/time -f "%e" -o "$work/dist-time" "${mpi[@]}" \
       sh -c '/usr/bin/time -f "%M" -o "$0-$OMPI_COMM_WORLD_RANK" "$@"' "$work/dist-rank" \
-      "$lodforge" -q --threads 1 tiles "$work/dist-scan.ply" -o "$work/dist-ranks"
+      "$lodforge" -q --threads 1 tiles "$input" -o "$work/dist-ranks"
     local ranks
     ranks=$(cat "$work/dist-time")
     diff -rq "$work/dist-one" "$work/dist-ranks" > /dev/null || { echo "the two tilesets differ" >&2; exit 1; }
     printf '| %d | %.2f s | %d MiB | %.2f s | %d / %d MiB | %.3f |\n' "$run" "$one" $((kib / 1024)) "$ranks" \
       $(($(cat "$work/dist-rank-0") / 1024)) $(($(cat "$work/dist-rank-1") / 1024)) "$(echo "$ranks / $one" | bc -l)"
   done
-  "${mpi[@]}" "$lodforge" -v --threads 1 tiles "$work/dist-scan.ply" -o "$work/dist-ranks" 2>&1 |
+  rm -rf "$work"/dist-ranks
+  "${mpi[@]}" "$lodforge" -v --threads 1 tiles "$input" -o "$work/dist-ranks" 2>&1 |
     grep -E "^(rank|2 ranks|streamed)"
-  rm -rf "$work"/dist-*
+  rm -rf "$work"/dist-one "$work"/dist-ranks "$work"/dist-rank-* "$work/dist-time"
+}
+distributed_section() {
+  local n=${DISTRIBUTED_TRIANGLES:-10M} points=${DISTRIBUTED_POINTS:-20M}
+  if [[ ${DISTRIBUTED_ONLY:-scan} == scan ]]; then
+    echo
+    echo "== ranks against threads: a $n-triangle scan, 1 process x 2 threads and 2 ranks x 1 thread"
+    "$lodforge" -q generate scan --triangles "$n" -o "$work/dist-scan.ply"
+    ranks_against_threads "$work/dist-scan.ply"
+    rm -f "$work/dist-scan.ply"
+  fi
+  if [[ ${DISTRIBUTED_ONLY:-points} == points ]]; then
+    echo
+    echo "== ranks against threads: a $points-point LAS, 1 process x 2 threads and 2 ranks x 1 thread"
+    "$lodforge" -q generate points --points "$points" -o "$work/dist-points.las"
+    ranks_against_threads "$work/dist-points.las"
+    rm -f "$work/dist-points.las"
+  fi
 }
 if [[ ${BENCH_ONLY:-} == distributed ]]; then distributed_section; exit 0; fi
 

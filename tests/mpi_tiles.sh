@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # `lodforge tiles` across the ranks of an OpenMPI job (docs/distributed.md), run by OpenMPI's own
 # mpirun on this one machine (--oversubscribe: more ranks than cores): a scan by 2 to 4 ranks
-# (and mpirun -np 1, a job of one), a PLY with a quad, a textured scan, a 300-part assembly and a
-# reconstructed surface are byte for byte the tileset one process writes; more ranks than chunks; a rank killed mid-octree stops the job with a message
-# naming it and what it was doing, and --resume finishes without rebuilding what was done; a
-# second run on an output being written is refused.
+# (and mpirun -np 1, a job of one), a PLY with a quad, a textured scan, a 300-part assembly, a
+# reconstructed surface and point clouds (LAS with extra bytes, PLY) are byte for byte the
+# tileset one process writes; more ranks than chunks or blocks; a rank killed mid-octree or
+# mid-ranking stops the job with a message naming it and what it was doing, and --resume
+# finishes a mesh without rebuilding what was done; a second run on an output being written is
+# refused, a mesh's or a point cloud's.
 set -euo pipefail
 lodforge=$1 out=$2 sanitized=${3:-0}
 command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/install-deps.sh" >&2; exit 1; }
@@ -88,6 +90,40 @@ same cad-np3 cad-1 "assembly (parts.json), 3 ranks"
 "${mpi[@]}" -np 2 "$lodforge" -q tiles points.ply --surface -o surface-np2 --chunk-size 150
 same surface-np2 surface-1 "reconstructed surface, 2 ranks"
 
+# Point clouds: rank 0 partitions, every rank ranks blocks from the queue and writes its share of
+# the tiles. A LAS with extra bytes (their own work file, reordered with the points) and a PLY.
+"$lodforge" -q generate points --points 120K --extra-bytes -o cloud.las
+"$lodforge" -q tiles cloud.las -o cloud-1 --block-size 8000
+for ranks in 1 2 3 4; do
+  "${mpi[@]}" -np $ranks "$lodforge" -q tiles cloud.las -o cloud-np$ranks --block-size 8000
+  same cloud-np$ranks cloud-1 "point cloud (LAS, extra bytes), $ranks ranks"
+done
+"${mpi[@]}" -np 2 "$lodforge" -v tiles cloud.las -o cloud-v --block-size 8000 2> cloud-v.err
+read -r first second < <(sed -nE 's/.*rank 0 ranked ([0-9,]+) points.*rank 1 ranked ([0-9,]+) points.*/\1 \2/p' cloud-v.err | tr -d ,) || true
+[[ -n $second && $first -gt 0 && $second -gt 0 && $((first + second)) -eq 120000 ]] ||
+  fail "the ranking was not shared by both ranks: $(cat cloud-v.err)"
+"$lodforge" -q tiles points.ply -o points-1 --block-size 3000
+"${mpi[@]}" -np 3 "$lodforge" -q tiles points.ply -o points-np3 --block-size 3000
+same points-np3 points-1 "point cloud (PLY with normals), 3 ranks"
+# More ranks than blocks: one block, 4 ranks.
+"${mpi[@]}" -np 4 "$lodforge" -q tiles points.ply -o points-np4 --block-size 50000
+"$lodforge" -q tiles points.ply -o points-one --block-size 50000
+same points-np4 points-one "more ranks than blocks"
+# A rank killed while ranking: the job stops, rank 0 says what rank 1 was doing, and nothing is
+# left behind (a point tileset has no --resume: the same command builds it again).
+set +e
+"${mpi[@]}" -np 1 "$lodforge" tiles cloud.las -o cloud-killed --block-size 8000 : \
+  -np 1 -x LODFORGE_INTERRUPT_AFTER=block:2:kill "$lodforge" tiles cloud.las -o cloud-killed \
+  --block-size 8000 > cloud-killed.out 2> cloud-killed.err
+code=$?
+set -e
+[[ $code -ne 0 ]] || fail "a point job with a killed rank exited 0"
+grep -qE "^  rank 1 of 2 \(.*\): ranking blocks from the queue; [0-9]+ points done" cloud-killed.err ||
+  fail "the stop does not say what rank 1 was doing: $(cat cloud-killed.err)"
+[[ ! -e cloud-killed && ! -e cloud-killed.work ]] || fail "the killed point job left files behind"
+"${mpi[@]}" -np 2 "$lodforge" -q tiles cloud.las -o cloud-killed --block-size 8000
+same cloud-killed cloud-1 "point cloud, killed rank, then the same command"
+
 # More ranks than chunks: a small scan in two chunks, 4 ranks (the split is their parent, the
 # root: three ranks have nothing to build).
 "$lodforge" -q generate scan --triangles 20K -o small.ply
@@ -131,6 +167,20 @@ wait $first || fail "the first run failed"
 [[ $code -eq 2 ]] || fail "a second run on a busy output exited $code, not 2"
 grep -q "another lodforge run (pid $first on" busy.err || fail "no refusal naming the first run: $(cat busy.err)"
 same busy busy-1 "the first run, beside the refused one"
+
+# The same for a point cloud: a one-process run holds the output, a job of 2 is refused.
+"$lodforge" -q generate points --points 3M -o busy.las
+"$lodforge" -q --threads 1 tiles busy.las -o busy-points &
+first=$!
+for _ in $(seq 200); do [[ -s busy-points.work/.lodforge-lock ]] && break; sleep 0.02; done
+set +e
+"${mpi[@]}" -np 2 "$lodforge" -q tiles busy.las -o busy-points 2> busy-points.err
+code=$?
+set -e
+wait $first || fail "the first point run failed"
+[[ $code -eq 2 ]] && grep -q "another lodforge run (pid $first on" busy-points.err ||
+  fail "a point job on a busy output: exit $code, $(cat busy-points.err)"
+[[ -f busy-points/tileset.json && ! -e busy-points.work ]] || fail "the first point run did not finish cleanly"
 
 # --memory-limit holds per rank: each rank's peak (the -v lines rank 0 gathers) stays under it
 # (not in the sanitizer tree, whose shadow memory the limit does not count: said, not hidden).

@@ -218,6 +218,19 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
   return tiles;
 }
 
+// -v for a job of several ranks: each rank's share of the ranking and of the tiles, its stages.
+void reportPointRanks(const Global& global, const PointTilesStats& stats) {
+  std::string shares;
+  for (std::size_t r = 0; r < stats.rankPoints.size(); ++r)
+    shares += fmt::format("{}rank {} ranked {} points, wrote {} tiles", r == 0 ? "" : "; ", r,
+                          formatCount(stats.rankPoints[r]),
+                          formatCount(r < stats.rankTiles.size() ? stats.rankTiles[r] : 0));
+  detail(global, fmt::format("{} ranks: the input partitioned by rank 0, blocks ranked from a "
+                             "queue (partition done at {:.1f} s, ranking at {:.1f} s); {}",
+                             stats.ranks, stats.partitionSeconds, stats.rankingSeconds, shares));
+  for (const std::string& line : stats.rankStages) detail(global, line);
+}
+
 Status runPointTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
   if (options.levels > 0 || options.chunkSize > 0 || options.resume)
     return Error{ErrorKind::kUsage,
@@ -258,6 +271,7 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
                   stats->crs.empty() ? "" : "; placed on Earth from its coordinate system"));
   if (stats->attributes != 0)
     detail(global, fmt::format("point attributes: {}", pointAttributeNames(stats->attributes)));
+  if (stats->ranks > 1) reportPointRanks(global, *stats);
   return {};
 }
 
@@ -384,11 +398,6 @@ Status checkTilesRoute(const TilesCommand& options, bool points) {
   if (!options.surface && usesSurfaceOptions(options.surfaceOptions))
     return Error{ErrorKind::kUsage,
                  "--voxel, --radius, --min-points, --orient and --min-triangles go with --surface"};
-  if (points && !options.surface && clustered())
-    return Error{ErrorKind::kUsage,
-                 fmt::format("{}: a point cloud; point tilesets are built by one process for now "
-                             "(meshes and --surface run across ranks: docs/distributed.md)",
-                             options.input)};
   return {};
 }
 

@@ -324,11 +324,14 @@ Status finishBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids, P
   std::vector<std::byte> scratch;
   LODFORGE_TRY(shared.files.writePoints(block.first, points, scratch));
   const std::size_t stride = shared.files.stride;
-  if (stride == 0) return {};
   std::vector<std::byte> extras(points.size() * stride);
-  for (std::size_t i = 0; i < ids.size(); ++i)
-    std::memcpy(extras.data() + i * stride, shared.extras.data() + ids[i] * stride, stride);
-  return shared.files.extras->writeAt(block.first * stride, extras.data(), extras.size());
+  if (stride != 0) {
+    for (std::size_t i = 0; i < ids.size(); ++i)
+      std::memcpy(extras.data() + i * stride, shared.extras.data() + ids[i] * stride, stride);
+    LODFORGE_TRY(shared.files.extras->writeAt(block.first * stride, extras.data(), extras.size()));
+  }
+  if (!shared.options.blockWritten) return {};
+  return shared.options.blockWritten(block, points, extras);
 }
 
 // A node in memory (its records from `first` on in the work file), split recursively into

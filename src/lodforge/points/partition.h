@@ -53,6 +53,10 @@ struct PartitionOptions {
   // With extra fields it gets one id per point and must reorder them with the points (so the
   // extras can follow); without, the ids are empty.
   std::function<Status(std::span<CloudPoint>, std::span<std::uint32_t> ids, PointBlock&)> blockSink;
+  // Called with each block once it is in the work files (after the sink), from several threads
+  // at once: its points as written and, with extra fields, their bytes as written.
+  std::function<Status(const PointBlock&, std::span<const CloudPoint>, std::span<const std::byte>)>
+      blockWritten;
 };
 
 struct Partition {

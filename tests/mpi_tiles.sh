@@ -2,8 +2,8 @@
 # `lodforge tiles` across the ranks of an OpenMPI job (docs/distributed.md), run by OpenMPI's own
 # mpirun on this one machine (--oversubscribe: more ranks than cores): a scan by 2 to 4 ranks
 # (and mpirun -np 1, a job of one), a PLY with a quad, a textured scan, a 300-part assembly, a
-# reconstructed surface and point clouds (LAS with extra bytes, PLY) are byte for byte the
-# tileset one process writes; more ranks than chunks or blocks; a rank killed mid-octree or
+# reconstructed surface and point clouds (LAS with extra bytes, PLY, one node or two) are byte
+# for byte the tileset one process writes; more ranks than chunks; a rank killed mid-octree or
 # mid-ranking stops the job with a message naming it and what it was doing, and --resume
 # finishes a mesh without rebuilding what was done; a second run on an output being written is
 # refused, a mesh's or a point cloud's.
@@ -90,39 +90,51 @@ same cad-np3 cad-1 "assembly (parts.json), 3 ranks"
 "${mpi[@]}" -np 2 "$lodforge" -q tiles points.ply --surface -o surface-np2 --chunk-size 150
 same surface-np2 surface-1 "reconstructed surface, 2 ranks"
 
-# Point clouds: rank 0 partitions, every rank ranks blocks from the queue and writes its share of
-# the tiles. A LAS with extra bytes (their own work file, reordered with the points) and a PLY.
+# Point clouds: every rank reads a slice of the input; rank 0 splits the nodes too big for memory,
+# every rank splits and ranks its share of the rest and writes its share of the tiles. A LAS
+# with extra bytes (their own work file, reordered with the points) and a PLY, each one node in
+# memory (the other ranks read and write tiles); a LAS of 16 nodes shared by 2 and 3 ranks.
 "$lodforge" -q generate points --points 120K --extra-bytes -o cloud.las
 "$lodforge" -q tiles cloud.las -o cloud-1 --block-size 8000
 for ranks in 1 2 3 4; do
   "${mpi[@]}" -np $ranks "$lodforge" -q tiles cloud.las -o cloud-np$ranks --block-size 8000
   same cloud-np$ranks cloud-1 "point cloud (LAS, extra bytes), $ranks ranks"
 done
-"${mpi[@]}" -np 2 "$lodforge" -v tiles cloud.las -o cloud-v --block-size 8000 2> cloud-v.err
-read -r first second < <(sed -nE 's/.*rank 0 ranked ([0-9,]+) points.*rank 1 ranked ([0-9,]+) points.*/\1 \2/p' cloud-v.err | tr -d ,) || true
-[[ -n $second && $first -gt 0 && $second -gt 0 && $((first + second)) -eq 120000 ]] ||
-  fail "the ranking was not shared by both ranks: $(cat cloud-v.err)"
 "$lodforge" -q tiles points.ply -o points-1 --block-size 3000
 "${mpi[@]}" -np 3 "$lodforge" -q tiles points.ply -o points-np3 --block-size 3000
 same points-np3 points-1 "point cloud (PLY with normals), 3 ranks"
-# More ranks than blocks: one block, 4 ranks.
-"${mpi[@]}" -np 4 "$lodforge" -q tiles points.ply -o points-np4 --block-size 50000
-"$lodforge" -q tiles points.ply -o points-one --block-size 50000
-same points-np4 points-one "more ranks than blocks"
+# Several nodes: the partition holds 4 MB of points at once (LODFORGE_PARTITION_BYTES, the
+# tests' knob), about 48 K points of this LAS (84 bytes each in memory): 16 nodes of 25 K.
+export LODFORGE_PARTITION_BYTES=4000000
+"$lodforge" -q generate points --points 400K --extra-bytes -o large.las
+"$lodforge" -q tiles large.las -o large-1 --block-size 10000
+for ranks in 2 3; do
+  "${mpi[@]}" -np $ranks "$lodforge" -v tiles large.las -o large-np$ranks --block-size 10000 \
+    2> large.err
+  same large-np$ranks large-1 "point cloud of 16 nodes, $ranks ranks"
+done
+grep -q "3 ranks: the input read in slices by every rank;" large.err ||
+  fail "the LAS was not read in slices: $(cat large.err)"
+# Each rank's share of the points within 20 % of the busiest's (whole nodes, largest first).
+shares=$(grep -oE "rank [0-9] split and ranked [0-9,]+ points" large.err |
+  sed -E 's/.* ranked ([0-9,]+) points/\1/' | tr -d , | tr '\n' ' ')
+awk -v s="$shares" 'BEGIN { n = split(s, a, " "); if (n != 3) exit 1; lo = a[1]; hi = a[1]; t = 0
+  for (i = 1; i <= n; ++i) { t += a[i]; if (a[i] < lo) lo = a[i]; if (a[i] > hi) hi = a[i] }
+  exit !(t == 400000 && lo >= 0.8 * hi) }' ||
+  fail "the partition was not shared among the ranks: $(cat large.err)"
 # A rank killed while ranking: the job stops, rank 0 says what rank 1 was doing, and nothing is
 # left behind (a point tileset has no --resume: the same command builds it again).
 set +e
-"${mpi[@]}" -np 1 "$lodforge" tiles cloud.las -o cloud-killed --block-size 8000 : \
-  -np 1 -x LODFORGE_INTERRUPT_AFTER=block:2:kill "$lodforge" tiles cloud.las -o cloud-killed \
-  --block-size 8000 > cloud-killed.out 2> cloud-killed.err
+"${mpi[@]}" -np 1 "$lodforge" tiles large.las -o large-killed --block-size 10000 : \
+  -np 1 -x LODFORGE_INTERRUPT_AFTER=block:2:kill "$lodforge" tiles large.las -o large-killed \
+  --block-size 10000 > large-killed.out 2> large-killed.err
 code=$?
 set -e
 [[ $code -ne 0 ]] || fail "a point job with a killed rank exited 0"
-grep -qE "^  rank 1 of 2 \(.*\): ranking blocks from the queue; [0-9]+ points done" cloud-killed.err ||
-  fail "the stop does not say what rank 1 was doing: $(cat cloud-killed.err)"
-[[ ! -e cloud-killed && ! -e cloud-killed.work ]] || fail "the killed point job left files behind"
-"${mpi[@]}" -np 2 "$lodforge" -q tiles cloud.las -o cloud-killed --block-size 8000
-same cloud-killed cloud-1 "point cloud, killed rank, then the same command"
+grep -qE "^  rank 1 of 2 \(.*\): splitting and ranking [0-9]+ of the partition's [0-9]+ nodes" \
+  large-killed.err || fail "the stop does not say what rank 1 was doing: $(cat large-killed.err)"
+[[ ! -e large-killed && ! -e large-killed.work ]] || fail "the killed point job left files behind"
+unset LODFORGE_PARTITION_BYTES
 
 # More ranks than chunks: a small scan in two chunks, 4 ranks (the split is their parent, the
 # root: three ranks have nothing to build).

@@ -222,12 +222,15 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
 void reportPointRanks(const Global& global, const PointTilesStats& stats) {
   std::string shares;
   for (std::size_t r = 0; r < stats.rankPoints.size(); ++r)
-    shares += fmt::format("{}rank {} ranked {} points, wrote {} tiles", r == 0 ? "" : "; ", r,
-                          formatCount(stats.rankPoints[r]),
+    shares += fmt::format("{}rank {} split and ranked {} points, wrote {} tiles",
+                          r == 0 ? "" : "; ", r, formatCount(stats.rankPoints[r]),
                           formatCount(r < stats.rankTiles.size() ? stats.rankTiles[r] : 0));
-  detail(global, fmt::format("{} ranks: the input partitioned by rank 0, blocks ranked from a "
-                             "queue (partition done at {:.1f} s, ranking at {:.1f} s); {}",
-                             stats.ranks, stats.partitionSeconds, stats.rankingSeconds, shares));
+  detail(global,
+         fmt::format("{} ranks: the input read {}; the partition's large nodes split by "
+                     "rank 0 ({:.1f} s), the rest split and ranked by every rank ({:.1f} "
+                     "s); {}",
+                     stats.ranks, stats.readInSlices ? "in slices by every rank" : "by rank 0",
+                     stats.partitionSeconds, stats.rankingSeconds, shares));
   for (const std::string& line : stats.rankStages) detail(global, line);
 }
 

@@ -1,5 +1,8 @@
 #include "lodforge/points/partition.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
 #include <cassert>
@@ -22,15 +25,7 @@ namespace lodforge {
 
 namespace {
 
-// A node of the partition while it is being split: records [first, first + count) of the work
-// file (every node's, split in place).
-struct PartNode {
-  std::string name;  // path in the split tree: "b", "b0", "b01", ... (depth-first order)
-  std::uint64_t first = 0;
-  std::uint64_t count = 0;
-  Aabbd bounds;
-  Vec3d sum;  // of positions, for the centroid
-};
+using PartNode = PartitionNode;
 
 struct Stats {
   std::uint64_t count = 0;
@@ -148,7 +143,8 @@ struct RawRecords {
 
 // Converts a batch into work records, checking every position (and placing it, with a transform).
 Status convertBatch(const std::string& input, const PartitionOptions& options, PointBatch& batch,
-                    std::size_t stride, Records& out, Stats& stats) {
+                    std::size_t stride, Records& out, Stats& total, Vec3d& batchSum) {
+  Stats stats;  // this batch's: its sum is added to the total whole (InputRead::sum)
   out.resize(batch.size());
   for (std::size_t i = 0; i < batch.size(); ++i) {
     CloudPoint& p = out.points[i];
@@ -169,16 +165,24 @@ Status convertBatch(const std::string& input, const PartitionOptions& options, P
     assert(batch.extras.size() == batch.size() * stride);
     std::swap(out.extras, batch.extras);
   }
+  total.count += stats.count;
+  total.bounds.add(stats.bounds);
+  total.sum = total.sum + stats.sum;
+  batchSum = stats.sum;
   return {};
 }
 
 // Pass 0: the input into the work files, with its bounds and centroid.
-Result<PartNode> readInput(const std::string& input, const std::string& path,
-                           const std::string& extrasPath, const PartitionOptions& options,
-                           Partition& partition, PointRecordLayout& layout) {
-  PointCloudInfo& info = partition.info;
-  Result<PointReader> reader = PointReader::open(
-      input, {.salvageTruncated = options.salvageTruncated, .readExtras = options.carryExtras});
+Result<InputRead> readInput(const std::string& input, const std::string& path,
+                            const std::string& extrasPath, const PartitionOptions& options) {
+  InputRead read;
+  read.input = input;
+  PointCloudInfo& info = read.info;
+  PointRecordLayout& layout = read.layout;
+  Result<PointReader> reader =
+      PointReader::open(input, {.batchPoints = kInputBatchPoints,
+                                .salvageTruncated = options.salvageTruncated,
+                                .readExtras = options.carryExtras});
   if (!reader) return reader.status();
   info = reader->info();
   layout = PointRecordLayout::of(info, static_cast<bool>(options.transform), options.normals);
@@ -208,7 +212,8 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
     if (!more) return more.status();
     if (!*more) break;
     Records& mine = records[turn];
-    LODFORGE_TRY(convertBatch(input, options, batch, stride, mine, stats));
+    Vec3d batchSum;
+    LODFORGE_TRY(convertBatch(input, options, batch, stride, mine, stats, batchSum));
     writing.wait();
     LODFORGE_TRY(written);
     writing.run([&out, &extrasOut, &written, &mine, &layout] {
@@ -228,11 +233,28 @@ Result<PartNode> readInput(const std::string& input, const std::string& path,
   writing.wait();
   LODFORGE_TRY(written);
   progress.finish();
-  partition.truncation = reader->truncation();
+  read.truncation = reader->truncation();
   LODFORGE_TRY(out->commit());
   if (extrasOut) LODFORGE_TRY(extrasOut->commit());
   if (stats.count == 0) return badInput(input, "the file has no points");
-  return PartNode{"b", 0, stats.count, stats.bounds, stats.sum};
+  read.count = stats.count;
+  read.bounds = stats.bounds;
+  read.sum = stats.sum;
+  return read;
+}
+
+// A new file of `bytes` bytes (zeros) that several processes then write parts of.
+Status createSizedFile(const std::string& path, std::uint64_t bytes) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return ioErrorFromErrno(path, "create");
+  const int sized = ::ftruncate(fd, static_cast<off_t>(bytes));
+  const int error = errno;
+  ::close(fd);
+  if (sized != 0) {
+    errno = error;
+    return ioErrorFromErrno(path, "size");
+  }
+  return {};
 }
 
 // One streamed split of a node's range of the work file, in place: a two-ended external
@@ -324,14 +346,11 @@ Status finishBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids, P
   std::vector<std::byte> scratch;
   LODFORGE_TRY(shared.files.writePoints(block.first, points, scratch));
   const std::size_t stride = shared.files.stride;
+  if (stride == 0) return {};
   std::vector<std::byte> extras(points.size() * stride);
-  if (stride != 0) {
-    for (std::size_t i = 0; i < ids.size(); ++i)
-      std::memcpy(extras.data() + i * stride, shared.extras.data() + ids[i] * stride, stride);
-    LODFORGE_TRY(shared.files.extras->writeAt(block.first * stride, extras.data(), extras.size()));
-  }
-  if (!shared.options.blockWritten) return {};
-  return shared.options.blockWritten(block, points, extras);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    std::memcpy(extras.data() + i * stride, shared.extras.data() + ids[i] * stride, stride);
+  return shared.files.extras->writeAt(block.first * stride, extras.data(), extras.size());
 }
 
 // A node in memory (its records from `first` on in the work file), split recursively into
@@ -444,67 +463,219 @@ Result<std::vector<std::byte>> readExtraRecords(const std::string& path, std::ui
   return extras;
 }
 
-Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options) {
+Result<InputRead> readWholeInput(const std::string& input, const PartitionOptions& options) {
   assert(options.blockSize > 0 && !options.workDirectory.empty());
-  Partition partition;
-  const std::string path = options.workDirectory + "/b.points";
-  const std::string extrasPath = options.workDirectory + "/b.extras";
-  PointRecordLayout layout;
-  Result<PartNode> root = readInput(input, path, extrasPath, options, partition, layout);
-  if (!root) return root.status();
-  partition.pointCount = root->count;
-  partition.bounds = root->bounds;
-  const std::size_t stride = partition.info.extras.stride;
-  if (stride != 0) partition.extrasPath = extrasPath;
-  Result<WorkFile> file = WorkFile::open(path);
-  if (!file) return file.status();
-  std::optional<WorkFile> extrasFile;
+  return readInput(input, options.workDirectory + "/b.points", options.workDirectory + "/b.extras",
+                   options);
+}
+
+Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options) {
+  Result<InputRead> read = readWholeInput(input, options);
+  if (!read) return read.status();
+  return partitionRead(*read, options);
+}
+
+Result<InputRead> createInputFiles(const std::string& input, const PartitionOptions& options) {
+  if (options.salvageTruncated)
+    return Error{ErrorKind::kUnsupported,
+                 fmt::format("{}: a file to salvage is read whole", input)};
+  // A reader of one point's slice says whether the input can be read in slices.
+  Result<PointReader> probe = PointReader::open(
+      input, {.batchPoints = 1, .readExtras = options.carryExtras, .first = 0, .count = 1});
+  if (!probe) return probe.status();
+  PointBatch first;
+  Result<bool> some = probe->next(first);
+  if (!some) return some.status();
+  InputRead read;
+  read.input = input;
+  read.info = probe->info();
+  if (!*some || !read.info.count)
+    return Error{ErrorKind::kUnsupported, fmt::format("{}: no point count to share", input)};
+  read.layout =
+      PointRecordLayout::of(read.info, static_cast<bool>(options.transform), options.normals);
+  read.count = *read.info.count;
+  LODFORGE_TRY(
+      createSizedFile(options.workDirectory + "/b.points", read.count * read.layout.bytes()));
+  const std::size_t stride = read.info.extras.stride;
+  if (stride != 0)
+    LODFORGE_TRY(createSizedFile(options.workDirectory + "/b.extras", read.count * stride));
+  return read;
+}
+
+PointRange inputSlice(std::uint64_t points, int part, int parts) {
+  assert(parts > 0 && part >= 0 && part < parts);
+  const std::uint64_t batches = (points + kInputBatchPoints - 1) / kInputBatchPoints;
+  const auto at = [&](int p) {
+    return std::min(points, batches * static_cast<std::uint64_t>(p) /
+                                static_cast<std::uint64_t>(parts) * kInputBatchPoints);
+  };
+  return {at(part), at(part + 1) - at(part)};
+}
+
+Result<SliceRead> readInputSlice(const std::string& input, const PartitionOptions& options,
+                                 PointRange slice,
+                                 const std::function<void(std::uint64_t)>& advanced) {
+  SliceRead out;
+  if (slice.count == 0) return out;
+  Result<PointReader> reader = PointReader::open(input, {.batchPoints = kInputBatchPoints,
+                                                         .readExtras = options.carryExtras,
+                                                         .first = slice.first,
+                                                         .count = slice.count});
+  if (!reader) return reader.status();
+  const PointCloudInfo& info = reader->info();
+  const PointRecordLayout layout =
+      PointRecordLayout::of(info, static_cast<bool>(options.transform), options.normals);
+  const std::size_t stride = info.extras.stride;
+  Result<WorkFile> points = WorkFile::open(options.workDirectory + "/b.points");
+  if (!points) return points.status();
+  std::optional<WorkFile> extras;
   if (stride != 0) {
-    Result<WorkFile> opened = WorkFile::open(extrasPath);
+    Result<WorkFile> opened = WorkFile::open(options.workDirectory + "/b.extras");
     if (!opened) return opened.status();
-    extrasFile.emplace(std::move(*opened));
+    extras.emplace(std::move(*opened));
   }
-  const WorkFiles files{*file, layout, extrasFile ? &*extrasFile : nullptr, stride};
+  PointBatch batch;
+  Records records{stride, {}, {}, {}};
+  Stats stats;
+  for (;;) {
+    Result<bool> more = reader->next(batch);
+    if (!more) return more.status();
+    if (!*more) break;
+    const std::uint64_t at = batch.first;
+    LODFORGE_TRY(
+        convertBatch(input, options, batch, stride, records, stats, out.batchSums.emplace_back()));
+    records.scratch.resize(records.size() * layout.bytes());
+    LODFORGE_TRY(layout.encode(records.points, records.scratch.data()));
+    LODFORGE_TRY(
+        points->writeAt(at * layout.bytes(), records.scratch.data(), records.scratch.size()));
+    if (extras)
+      LODFORGE_TRY(extras->writeAt(at * stride, records.extras.data(), records.extras.size()));
+    if (advanced) advanced(stats.count);
+    LODFORGE_TRY(checkCancelled());
+  }
+  if (stats.count != slice.count)
+    return badInput(input,
+                    fmt::format("points {} to {}: {} read, the header counts {}", slice.first,
+                                slice.first + slice.count, stats.count, slice.count));
+  out.count = stats.count;
+  out.bounds = stats.bounds;
+  return out;
+}
+
+void addSlices(std::span<const SliceRead> slices, InputRead& read) {
+  Stats stats;
+  for (const SliceRead& slice : slices) {
+    stats.count += slice.count;
+    stats.bounds.add(slice.bounds);
+    for (const Vec3d& sum : slice.batchSums) stats.sum = stats.sum + sum;
+  }
+  read.count = stats.count;
+  read.bounds = stats.bounds;
+  read.sum = stats.sum;
+}
+
+namespace {
+
+// The work files of a read input, open.
+struct OpenFiles {
+  WorkFile points;
+  std::optional<WorkFile> extras;
+  WorkFiles view(const PointRecordLayout& layout, std::size_t stride) const {
+    return WorkFiles{points, layout, extras ? &*extras : nullptr, stride};
+  }
+};
+
+Result<OpenFiles> openWorkFiles(const PartitionOptions& options, std::size_t stride) {
+  Result<WorkFile> points = WorkFile::open(options.workDirectory + "/b.points");
+  if (!points) return points.status();
+  OpenFiles files{std::move(*points), {}};
+  if (stride == 0) return files;
+  Result<WorkFile> extras = WorkFile::open(options.workDirectory + "/b.extras");
+  if (!extras) return extras.status();
+  files.extras.emplace(std::move(*extras));
+  return files;
+}
+
+// The most points a node split in memory may have.
+std::uint64_t inMemoryPoints(const PartitionOptions& options, std::size_t stride) {
   // A point in memory: its record, and with extras their bytes twice (read, gathered) and an id.
   const std::uint64_t pointBytes = sizeof(CloudPoint) + (stride == 0 ? 0 : 2 * stride + 4);
   // Ids are 32-bit: no node is split in memory with more points than they count.
-  const std::uint64_t inMemory = std::min<std::uint64_t>(
+  return std::min<std::uint64_t>(
       std::max<std::uint64_t>(options.blockSize, options.memoryBytes / pointBytes),
       stride == 0 ? ~std::uint64_t{0} : std::numeric_limits<std::uint32_t>::max());
-  Result<std::vector<PartNode>> nodes =
-      splitStreamedLevels(std::move(*root), inMemory, files, partition);
-  if (!nodes) return nodes.status();
-  // Then one node at a time in memory (so that only one is held), its halves in parallel.
+}
+
+}  // namespace
+
+Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
+                                                   const PartitionOptions& options,
+                                                   Partition& partition) {
+  partition.info = read.info;
+  partition.truncation = read.truncation;
+  partition.pointCount = read.count;
+  partition.bounds = read.bounds;
+  const std::size_t stride = partition.info.extras.stride;
+  if (stride != 0) partition.extrasPath = options.workDirectory + "/b.extras";
+  Result<OpenFiles> files = openWorkFiles(options, stride);
+  if (!files) return files.status();
+  return splitStreamedLevels(PartNode{"b", 0, read.count, read.bounds, read.sum},
+                             inMemoryPoints(options, stride), files->view(read.layout, stride),
+                             partition);
+}
+
+Result<std::vector<PointBlock>> splitNodesInMemory(
+    const InputRead& read, std::span<const PartitionNode> nodes, const PartitionOptions& options,
+    const std::function<void(std::uint64_t)>& advanced) {
+  const std::size_t stride = read.info.extras.stride;
+  Result<OpenFiles> opened = openWorkFiles(options, stride);
+  if (!opened) return opened.status();
+  const WorkFiles files = opened->view(read.layout, stride);
   Blocks blocks;
-  Progress progress("points: partition", partition.pointCount);
+  std::uint64_t total = 0, done = 0;
+  for (const PartNode& node : nodes) total += node.count;
+  std::optional<Progress> progress;
+  if (!advanced) progress.emplace("points: partition", total);
   // One buffer for the biggest node (growing it node by node would hold two at once).
   Records records{stride, {}, {}, {}};
   std::vector<std::uint32_t> ids;
   std::uint64_t biggest = 0;
-  for (const PartNode& node : *nodes) biggest = std::max(biggest, node.count);
+  for (const PartNode& node : nodes) biggest = std::max(biggest, node.count);
   records.points.reserve(static_cast<std::size_t>(biggest));
   records.extras.reserve(static_cast<std::size_t>(biggest) * stride);
-  for (const PartNode& node : *nodes) {
+  for (const PartNode& node : nodes) {
     if (stride != 0 && node.count > std::numeric_limits<std::uint32_t>::max())
       return Error{ErrorKind::kLimit,
                    fmt::format("{}: {} points share one position, more than the 2^32 that can "
                                "carry extra fields; leave them out with --attributes",
-                               input, node.count)};
+                               read.input, node.count)};
     LODFORGE_TRY(records.read(files, node.first, static_cast<std::size_t>(node.count)));
     ids.resize(stride == 0 ? 0 : records.size());
     std::iota(ids.begin(), ids.end(), 0u);
     splitInMemory(records.points, ids, node.first, node.name,
                   InMemory{options, files, records.extras, blocks});
     if (!blocks.status.ok()) return blocks.status;
-    progress.advance(node.count);
+    done += node.count;
+    if (progress) progress->advance(node.count);
+    if (advanced) advanced(done);
     LODFORGE_TRY(checkCancelled());
   }
-  progress.finish();
+  if (progress) progress->finish();
   std::sort(blocks.named.begin(), blocks.named.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (auto& [name, block] : blocks.named) {
-    partition.blocks.push_back(std::move(block));
-  }
+  std::vector<PointBlock> out;
+  for (auto& [name, block] : blocks.named) out.push_back(std::move(block));
+  return out;
+}
+
+// Then one node at a time in memory (so that only one is held), its halves in parallel.
+Result<Partition> partitionRead(const InputRead& read, const PartitionOptions& options) {
+  Partition partition;
+  Result<std::vector<PartitionNode>> nodes = splitLargeNodes(read, options, partition);
+  if (!nodes) return nodes.status();
+  Result<std::vector<PointBlock>> blocks = splitNodesInMemory(read, *nodes, options);
+  if (!blocks) return blocks.status();
+  partition.blocks = std::move(*blocks);
   return partition;
 }
 

@@ -53,10 +53,6 @@ struct PartitionOptions {
   // With extra fields it gets one id per point and must reorder them with the points (so the
   // extras can follow); without, the ids are empty.
   std::function<Status(std::span<CloudPoint>, std::span<std::uint32_t> ids, PointBlock&)> blockSink;
-  // Called with each block once it is in the work files (after the sink), from several threads
-  // at once: its points as written and, with extra fields, their bytes as written.
-  std::function<Status(const PointBlock&, std::span<const CloudPoint>, std::span<const std::byte>)>
-      blockWritten;
 };
 
 struct Partition {
@@ -150,5 +146,65 @@ Result<std::vector<std::byte>> readExtraRecords(const std::string& path, std::ui
                                                 std::uint64_t first, std::uint64_t count);
 
 Result<Partition> partitionPoints(const std::string& input, const PartitionOptions& options);
+
+// The input in the work files after the first pass (read by one process, or in slices by the
+// processes of a job): what partitionRead goes on from.
+struct InputRead {
+  std::string input;  // its path, for messages
+  PointCloudInfo info;
+  PointRecordLayout layout;
+  std::uint64_t count = 0;
+  Aabbd bounds;
+  // Of the positions: each batch's sum (batchPoints points from the first) added in batch order,
+  // the same sum however the batches were shared out.
+  Vec3d sum;
+  std::optional<std::string> truncation;
+};
+
+// A job's first pass (point_ranks.h): process 0 makes the work files at their full size
+// (createInputFiles: kUnsupported for an input not read in slices: LAZ, text, ascii PLY, a file
+// to salvage); each process reads its slice of whole batches into them (inputSlice,
+// readInputSlice); process 0 adds the slices up in order (addSlices) and partitions them
+// (partitionRead).
+constexpr std::size_t kInputBatchPoints = std::size_t{1} << 16;
+struct SliceRead {
+  std::uint64_t count = 0;
+  Aabbd bounds;
+  std::vector<Vec3d> batchSums;  // a batch's sum of positions each, in order
+};
+Result<InputRead> createInputFiles(const std::string& input, const PartitionOptions& options);
+struct PointRange {
+  std::uint64_t first = 0, count = 0;
+};
+PointRange inputSlice(std::uint64_t points, int part, int parts);
+// `advanced` (if any) is told the points read so far after each batch.
+Result<SliceRead> readInputSlice(const std::string& input, const PartitionOptions& options,
+                                 PointRange slice,
+                                 const std::function<void(std::uint64_t)>& advanced = {});
+// `read` (from createInputFiles) with every slice's count, bounds and sum, in slice order.
+void addSlices(std::span<const SliceRead> slices, InputRead& read);
+Result<Partition> partitionRead(const InputRead& read, const PartitionOptions& options);
+// The input read by one process (partitionPoints' first pass).
+Result<InputRead> readWholeInput(const std::string& input, const PartitionOptions& options);
+
+// partitionRead in two steps, for a job: process 0 splits the nodes too big for memory by
+// streamed passes (splitLargeNodes: the nodes left, each split in memory next, in name order;
+// `partition` gets all but the blocks); each process then splits its share of those nodes in
+// memory, one at a time, each block handed to the sink and written back in place
+// (splitNodesInMemory: its blocks in name order; `advanced`, if any, told the points done after
+// each node instead of a progress bar).
+struct PartitionNode {
+  std::string name;         // path in the split tree: "b", "b0", "b01", ... (depth-first order)
+  std::uint64_t first = 0;  // records [first, first + count) of the work files
+  std::uint64_t count = 0;
+  Aabbd bounds;
+  Vec3d sum;  // of positions, for the centroid
+};
+Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
+                                                   const PartitionOptions& options,
+                                                   Partition& partition);
+Result<std::vector<PointBlock>> splitNodesInMemory(
+    const InputRead& read, std::span<const PartitionNode> nodes, const PartitionOptions& options,
+    const std::function<void(std::uint64_t)>& advanced = {});
 
 }  // namespace lodforge

@@ -16,11 +16,9 @@
 #include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
-#include "lodforge/core/checksum.h"
 #include "lodforge/core/cluster.h"
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
-#include "lodforge/core/file_queue.h"
 #include "lodforge/core/output_claim.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/tiles/point_steps.h"
@@ -33,19 +31,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A block's positions and extra bytes as rank 0 wrote them: the rank that ranks it checks what
-// it reads against this, so a shared file system that shows another host stale pages is an
-// error, never a different tileset.
-std::uint64_t recordsChecksum(std::span<const CloudPoint> points,
-                              std::span<const std::byte> extras) {
-  std::vector<Vec3d> positions(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) positions[i] = points[i].position;
-  Checksum64 sum;
-  sum.update(positions.data(), positions.size() * sizeof(Vec3d));
-  sum.update(extras);
-  return sum.digest();
-}
-
 nlohmann::json boxJson(const Aabbd& box) {
   return {box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z};
 }
@@ -57,37 +42,104 @@ Aabbd boxOf(const nlohmann::json& j) {
   return box;
 }
 
-// A queued block: where its records are in the partition's files, and their checksum.
-std::string queueItem(std::uint64_t number, const PointBlock& block, std::uint64_t checksum) {
-  return nlohmann::json{{"number", number},
-                        {"name", block.name},
-                        {"first", block.first},
-                        {"count", block.count},
-                        {"bounds", boxJson(block.bounds)},
-                        {"centroid", {block.centroid.x, block.centroid.y, block.centroid.z}},
-                        {"checksum", checksum}}
-      .dump();
+nlohmann::json vecJson(const Vec3d& v) {
+  return {v.x, v.y, v.z};
 }
 
-struct Queued {
-  std::uint64_t number = 0;  // in the queue
-  PointBlock block;
-  std::uint64_t checksum = 0;
-};
+Vec3d vecOf(const nlohmann::json& j) {
+  return Vec3d{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
 
-Result<Queued> parseQueueItem(const std::string& item, const std::string& queue) {
-  const nlohmann::json j = nlohmann::json::parse(item, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return ioError(queue, "a queued block is not JSON");
-  Queued q;
-  q.number = j.at("number").get<std::uint64_t>();
-  q.block.name = j.at("name").get<std::string>();
-  q.block.first = j.at("first").get<std::uint64_t>();
-  q.block.count = j.at("count").get<std::uint64_t>();
-  q.block.bounds = boxOf(j.at("bounds"));
-  const nlohmann::json& c = j.at("centroid");
-  q.block.centroid = Vec3d{c[0].get<double>(), c[1].get<double>(), c[2].get<double>()};
-  q.checksum = j.at("checksum").get<std::uint64_t>();
-  return q;
+// Rank 0's nodes to split in memory, for the other ranks (JSON keeps doubles exactly).
+std::string nodesJson(std::span<const PartitionNode> nodes) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const PartitionNode& n : nodes)
+    out.push_back({{"name", n.name},
+                   {"first", n.first},
+                   {"count", n.count},
+                   {"bounds", boxJson(n.bounds)},
+                   {"sum", vecJson(n.sum)}});
+  return out.dump();
+}
+
+std::vector<PartitionNode> nodesOf(const nlohmann::json& j) {
+  std::vector<PartitionNode> nodes;
+  for (const nlohmann::json& n : j)
+    nodes.push_back({n.at("name").get<std::string>(), n.at("first").get<std::uint64_t>(),
+                     n.at("count").get<std::uint64_t>(), boxOf(n.at("bounds")),
+                     vecOf(n.at("sum"))});
+  return nodes;
+}
+
+// A rank's share of the nodes: the largest first, each to the rank with the fewest points so
+// far (ties: the lower rank), the same on every rank.
+std::vector<PartitionNode> nodeShare(std::span<const PartitionNode> nodes, int rank, int ranks) {
+  std::vector<std::size_t> order(nodes.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return nodes[a].count > nodes[b].count; });
+  std::vector<std::uint64_t> load(static_cast<std::size_t>(ranks), 0);
+  std::vector<std::uint8_t> mine(nodes.size(), 0);
+  for (const std::size_t i : order) {
+    const auto least =
+        static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[least] += nodes[i].count + 1;
+    mine[i] = least == static_cast<std::size_t>(rank) ? 1 : 0;
+  }
+  std::vector<PartitionNode> out;
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (mine[i] != 0) out.push_back(nodes[i]);
+  return out;  // in name order, as given
+}
+
+// A rank's ranked blocks for rank 0: where each lies and its errors.
+std::string blocksJson(std::span<const PointBlock> blocks,
+                       const std::map<std::string, BlockTiles>& tiles) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const PointBlock& b : blocks) {
+    const BlockTiles& t = tiles.at(b.name);
+    out.push_back({{"name", b.name},
+                   {"first", b.first},
+                   {"count", b.count},
+                   {"bounds", boxJson(b.bounds)},
+                   {"centroid", vecJson(b.centroid)},
+                   {"rootError", t.rootError},
+                   {"leastError", t.leastError}});
+  }
+  return out.dump();
+}
+
+// A slice's count, bounds and batch sums as numbers for gatherAcrossRanks, and back.
+std::vector<std::uint64_t> encodeSlice(const SliceRead& slice) {
+  std::vector<std::uint64_t> out = {slice.count};
+  for (const Vec3d& corner : {slice.bounds.min, slice.bounds.max})
+    for (int k = 0; k < 3; ++k) out.push_back(std::bit_cast<std::uint64_t>(corner[k]));
+  out.push_back(slice.batchSums.size());
+  for (const Vec3d& sum : slice.batchSums)
+    for (int k = 0; k < 3; ++k) out.push_back(std::bit_cast<std::uint64_t>(sum[k]));
+  return out;
+}
+
+Result<std::vector<SliceRead>> decodeSlices(std::span<const std::uint64_t> numbers) {
+  std::vector<SliceRead> slices;
+  std::size_t at = 0;
+  const auto number = [&]() -> double { return std::bit_cast<double>(numbers[at++]); };
+  while (at < numbers.size()) {
+    if (numbers.size() - at < 8) break;
+    SliceRead& slice = slices.emplace_back();
+    slice.count = numbers[at++];
+    for (Vec3d* corner : {&slice.bounds.min, &slice.bounds.max})
+      for (int k = 0; k < 3; ++k) (*corner)[k] = number();
+    const std::uint64_t sums = numbers[at++];
+    if (numbers.size() - at < 3 * sums) break;
+    for (std::uint64_t i = 0; i < sums; ++i) {
+      Vec3d& sum = slice.batchSums.emplace_back();
+      for (int k = 0; k < 3; ++k) sum[k] = number();
+    }
+  }
+  if (at != numbers.size() || slices.size() != static_cast<std::size_t>(clusterSize()))
+    return Error{ErrorKind::kInternal, "the ranks' slices of the input do not add up"};
+  return slices;
 }
 
 class RankedPoints {
@@ -98,8 +150,7 @@ class RankedPoints {
         output_(output),
         options_(options),
         lead_(clusterRank() == 0),
-        work_(pointWorkDirectory(output)),
-        queue_(work_ + "/queue") {}
+        work_(pointWorkDirectory(output)) {}
 
   Result<PointTilesStats> run() {
     Result<PointMemoryPlan> plan = planPointMemory(options_.memoryLimit, options_.blockSize);
@@ -108,6 +159,13 @@ class RankedPoints {
     LODFORGE_TRY(agreeAcrossRanks(lead_ ? claimOnLead() : Status{}));
     setActivityDirectory(work_ + "/ranks");
     LODFORGE_TRY(agreeAcrossRanks(readHeader()));
+    Result<bool> sliced = readTogether();
+    if (!sliced) return sliced.status();
+    stats_.readInSlices = *sliced;
+    recordStage("input");
+    LODFORGE_TRY(agreeAcrossRanks(lead_ ? splitOnLead() : Status{}));
+    LODFORGE_TRY(agreeAcrossRanks(lead_ ? Status{} : readNodes()));
+    stats_.partitionSeconds = secondsSince(start_);
     LODFORGE_TRY(rankTogether());
     stats_.rankingSeconds = secondsSince(start_);
     recordStage("partition and ranking");
@@ -138,11 +196,8 @@ class RankedPoints {
   }
   std::string stagingPath() const { return work_ + "/tileset"; }
 
-  // Rank 0 claims the output and the work place, and makes the queue.
-  Status claimOnLead() {
-    LODFORGE_TRY(claimPointWorkPlace(input_, output_, lock_, scope_));
-    return queue_.create();
-  }
+  // Rank 0 claims the output and the work place.
+  Status claimOnLead() { return claimPointWorkPlace(input_, output_, lock_, scope_); }
 
   // Every rank reads the header: the frame and the records' layout the partition will use.
   Status readHeader() {
@@ -160,162 +215,156 @@ class RankedPoints {
     return {};
   }
 
-  // Rank 0 partitions, queueing every block as it is written, then joins the others in ranking
-  // from the queue; the others rank from the start.
-  Status rankTogether() {
-    Status partitioned;
-    if (lead_) {
-      reportActivity("reading and partitioning the input");
-      partitioned = partitionOnLead();
-      // Closed whatever happened, so that no rank waits for blocks that will not come.
-      const Status closed = queue_.close(published_, !partitioned.ok());
-      if (partitioned.ok()) partitioned = closed;
+  // The input into the work files: read by every rank, a slice of whole batches each, where its
+  // format allows (an uncompressed LAS, a binary PLY), else by rank 0 alone; true when sliced.
+  Result<bool> readTogether() {
+    const PartitionOptions options = pointPartitionOptions(options_, plan_, frame_, work_);
+    Result<InputRead> files = lead_ ? createInputFiles(input_, options) : InputRead{};
+    const bool alone = !files && files.status().kind() == ErrorKind::kUnsupported;
+    LODFORGE_TRY(agreeAcrossRanks(files || alone ? Status{} : files.status()));
+    // Rank 0's count to all (+ 1: 0 says the input is read by rank 0 alone).
+    Result<std::uint64_t> count = sumAcrossRanks(lead_ && files ? files->count + 1 : 0);
+    if (!count) return count.status();
+    if (*count == 0) {
+      reportActivity(lead_ ? "reading the input" : "waiting for rank 0 to read the input");
+      LODFORGE_TRY(agreeAcrossRanks(lead_ ? readOnLead(options) : Status{}));
+      return false;
     }
-    const std::optional<JobProgress> progress =
-        lead_ && partitioned.ok()
-            ? std::optional<JobProgress>(std::in_place,
-                                         fmt::format("points: ranking, {} ranks", clusterSize()),
-                                         "points", partition_.pointCount)
-            : std::nullopt;
-    reportActivity("ranking blocks from the queue");
-    const Status ranked = partitioned.ok() ? drainQueue() : Status{};
-    LODFORGE_TRY(agreeAcrossRanks(partitioned.ok() ? ranked : partitioned));
-    const std::uint64_t mine = rankedPoints_;
-    Result<std::vector<std::uint64_t>> points = gatherAcrossRanks(std::span(&mine, 1));
+    if (lead_) read_ = std::move(*files);
+    reportActivity("reading its slice of the input");
+    Result<SliceRead> mine = [&] {
+      const JobProgress progress(fmt::format("points: reading, {} ranks", clusterSize()), "read",
+                                 *count - 1);
+      return readInputSlice(input_, options, inputSlice(*count - 1, clusterRank(), clusterSize()),
+                            [](std::uint64_t done) { reportProgress("read", done); });
+    }();
+    LODFORGE_TRY(agreeAcrossRanks(mine.status()));
+    Result<std::vector<std::uint64_t>> slices = gatherAcrossRanks(encodeSlice(*mine));
+    if (!slices) return slices.status();
+    if (!lead_) return true;
+    Result<std::vector<SliceRead>> decoded = decodeSlices(*slices);
+    if (!decoded) return decoded.status();
+    addSlices(*decoded, read_);
+    return true;
+  }
+
+  Status readOnLead(const PartitionOptions& options) {
+    Result<InputRead> read = readWholeInput(input_, options);
+    if (!read) return read.status();
+    read_ = std::move(*read);
+    return {};
+  }
+
+  // Rank 0 splits the nodes too big for memory (streamed passes over the work files) and lists
+  // the rest for every rank.
+  Status splitOnLead() {
+    reportActivity("splitting the partition's large nodes");
+    const PartitionOptions options = pointPartitionOptions(options_, plan_, frame_, work_);
+    Result<std::vector<PartitionNode>> nodes = [&] {
+      tbb::task_arena arena(plan_.threads);
+      return arena.execute([&] { return splitLargeNodes(read_, options, partition_); });
+    }();
+    if (!nodes) return nodes.status();
+    memoryNodes_ = std::move(*nodes);
+    return OutputFile::writeWhole(work_ + "/nodes.json", nodesJson(memoryNodes_));
+  }
+
+  Status readNodes() {
+    const std::string path = work_ + "/nodes.json";
+    Result<std::string> text = readFileToString(path, std::uint64_t{1} << 34);
+    if (!text) return text.status();
+    const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+    if (j.is_discarded()) return ioError(path, "is not JSON");
+    memoryNodes_ = nodesOf(j);
+    return {};
+  }
+
+  // Every rank splits its share of the nodes in memory and ranks each block as it comes out (as
+  // one process does), then lists its blocks for rank 0.
+  Status rankTogether() {
+    const std::vector<PartitionNode>& all = memoryNodes_;
+    const std::vector<PartitionNode> mine = nodeShare(all, clusterRank(), clusterSize());
+    std::uint64_t total = 0, share = 0;
+    for (const PartitionNode& n : all) total += n.count;
+    for (const PartitionNode& n : mine) share += n.count;
+    reportActivity(fmt::format("splitting and ranking {} of the partition's {} nodes ({} points)",
+                               mine.size(), all.size(), share));
+    std::map<std::string, BlockTiles> ranked;
+    Result<std::vector<PointBlock>> blocks = [&] {
+      const JobProgress progress(fmt::format("points: partition, {} ranks", clusterSize()),
+                                 "points", total);
+      return splitMine(mine, ranked);
+    }();
+    Status listed = blocks.status();
+    if (blocks)
+      listed = OutputFile::writeWhole(fmt::format("{}/blocks-{}.json", work_, clusterRank()),
+                                      blocksJson(*blocks, ranked));
+    LODFORGE_TRY(agreeAcrossRanks(listed));
+    Result<std::vector<std::uint64_t>> points = gatherAcrossRanks(std::span(&share, 1));
     if (!points) return points.status();
     stats_.rankPoints = std::move(*points);
-    // Each ranked block's errors to every rank: (queue number, root error, least error).
-    Result<std::vector<std::uint64_t>> errors = gatherAcrossRanks(rankedErrors_);
-    if (!errors) return errors.status();
-    rankedErrors_ = std::move(*errors);
     return {};
   }
 
-  Status partitionOnLead() {
+  Result<std::vector<PointBlock>> splitMine(std::span<const PartitionNode> mine,
+                                            std::map<std::string, BlockTiles>& ranked) {
     PartitionOptions options = pointPartitionOptions(options_, plan_, frame_, work_);
-    options.blockWritten = [this](const PointBlock& block, std::span<const CloudPoint> points,
-                                  std::span<const std::byte> extras) {
-      const std::uint64_t number = published_++;
-      {
-        const std::lock_guard lock(queuedMutex_);
-        queuedNames_.resize(std::max<std::size_t>(queuedNames_.size(), number + 1));
-        queuedNames_[number] = block.name;
-      }
-      return queue_.publish(number, queueItem(number, block, recordsChecksum(points, extras)));
+    std::mutex mutex;
+    options.blockSink = [&](std::span<CloudPoint> points, std::span<std::uint32_t> ids,
+                            PointBlock& block) {
+      BlockTiles tiles;
+      LODFORGE_TRY(rankBlock(points, ids, block, hasNormals_, options_, work_, tiles));
+      checkpointReached("block");
+      const std::lock_guard lock(mutex);
+      ranked[block.name] = std::move(tiles);
+      return Status{};
     };
+    InputRead read = read_;  // rank 0's; the others know the input, its fields and layout
+    if (!lead_) {
+      read.input = input_;
+      read.info = info_;
+      read.layout = layout_;
+    }
     tbb::task_arena arena(plan_.threads);
-    Result<Partition> partition = arena.execute([&] { return partitionPoints(input_, options); });
-    if (!partition) return partition.status();
-    partition_ = std::move(*partition);
-    stats_.partitionSeconds = secondsSince(start_);
-    return {};
-  }
-
-  // This rank's threads claim blocks until the queue is empty and closed.
-  Status drainQueue() {
-    std::vector<Status> outcomes(static_cast<std::size_t>(plan_.threads));
-    tbb::task_arena arena(plan_.threads);
-    arena.execute([&] {
-      tbb::parallel_for(0, plan_.threads, [&](int worker) {
-        std::uint64_t cursor = 0;
-        for (;;) {
-          Result<std::optional<std::string>> item = queue_.claim(cursor);
-          if (!item || !*item) {
-            outcomes[static_cast<std::size_t>(worker)] = item.status();
-            return;
-          }
-          const Status ranked = rankQueued(**item);
-          if (!ranked.ok()) {
-            outcomes[static_cast<std::size_t>(worker)] = ranked;
-            return;
-          }
-        }
-      });
+    return arena.execute([&] {
+      return splitNodesInMemory(read, mine, options,
+                                [](std::uint64_t done) { reportProgress("points", done); });
     });
-    for (const Status& outcome : outcomes) LODFORGE_TRY(outcome);
-    return {};
   }
 
-  // One queued block: read from the partition's files, checked, ranked, written to files of
-  // its own with its errors beside.
-  Status rankQueued(const std::string& item) {
-    Result<Queued> queued = parseQueueItem(item, queue_.directory());
-    if (!queued) return queued.status();
-    PointBlock& block = queued->block;
-    block.path = pointsPath();
-    block.layout = layout_;
-    Result<std::vector<CloudPoint>> points =
-        readPointRecords(block.path, layout_, block.first, block.count);
-    if (!points) return points.status();
-    const std::size_t stride = info_.extras.stride;
-    std::vector<std::byte> extras;
-    if (stride != 0) {
-      Result<std::vector<std::byte>> read = readExtraRecords(
-          extrasPath(), static_cast<std::uint32_t>(stride), block.first, block.count);
-      if (!read) return read.status();
-      extras = std::move(*read);
-    }
-    if (recordsChecksum(*points, extras) != queued->checksum)
-      return ioError(block.path,
-                     fmt::format("block {} (records {} to {}) reads differently from what rank 0 "
-                                 "wrote: the work directory must be on a file system every rank "
-                                 "sees alike (docs/distributed.md)",
-                                 block.name, block.first, block.first + block.count));
-    std::vector<std::uint32_t> ids(stride == 0 ? 0 : points->size());
-    std::iota(ids.begin(), ids.end(), 0u);
-    BlockTiles tiles;
-    LODFORGE_TRY(rankBlock(*points, ids, block, hasNormals_, options_, work_, tiles));
-    LODFORGE_TRY(writeBack(block, *points, ids, extras));
-    {
-      const std::lock_guard lock(queuedMutex_);
-      rankedErrors_.insert(rankedErrors_.end(),
-                           {queued->number, std::bit_cast<std::uint32_t>(tiles.rootError),
-                            std::bit_cast<std::uint32_t>(tiles.leastError)});
-    }
-    const std::uint64_t done = rankedPoints_.fetch_add(block.count) + block.count;
-    reportProgress("points", done);
-    checkpointReached("block");
-    return {};
-  }
-
-  // The ranked block in place in the partition's files, as one process would leave it (pages
-  // the kernel already has: new files cost it more).
-  Status writeBack(const PointBlock& block, std::span<const CloudPoint> points,
-                   std::span<const std::uint32_t> ids, std::span<const std::byte> extras) {
-    Result<WorkFile> file = WorkFile::open(pointsPath());
-    if (!file) return file.status();
-    std::vector<std::byte> records(points.size() * layout_.bytes());
-    LODFORGE_TRY(layout_.encode(points, records.data()));
-    LODFORGE_TRY(file->writeAt(block.first * layout_.bytes(), records.data(), records.size()));
-    if (extras.empty()) return {};
-    const std::size_t stride = info_.extras.stride;
-    std::vector<std::byte> gathered(extras.size());
-    for (std::size_t i = 0; i < ids.size(); ++i)
-      std::copy_n(extras.data() + std::size_t{ids[i]} * stride, stride,
-                  gathered.data() + i * stride);
-    Result<WorkFile> extrasFile = WorkFile::open(extrasPath());
-    if (!extrasFile) return extrasFile.status();
-    return extrasFile->writeAt(block.first * stride, gathered.data(), gathered.size());
-  }
-
-  // Rank 0: every block's ranked files and errors, the tolerances, each block's points per
-  // depth; written for the other ranks.
+  // Rank 0: every rank's blocks in name order, the tolerances, each block's points per depth;
+  // written for the other ranks.
   Status planContents() {
     reportActivity("choosing the tolerances");
-    std::map<std::string, std::array<float, 2>> errors;  // root, least
-    for (std::size_t i = 0; i + 2 < rankedErrors_.size(); i += 3)
-      errors[queuedNames_.at(rankedErrors_[i])] = {
-          std::bit_cast<float>(static_cast<std::uint32_t>(rankedErrors_[i + 1])),
-          std::bit_cast<float>(static_cast<std::uint32_t>(rankedErrors_[i + 2]))};
-    for (const PointBlock& block : partition_.blocks) {
+    std::vector<std::pair<PointBlock, std::array<float, 2>>> listed;
+    for (int r = 0; r < clusterSize(); ++r) {
+      const std::string path = fmt::format("{}/blocks-{}.json", work_, r);
+      Result<std::string> text = readFileToString(path, std::uint64_t{1} << 34);
+      if (!text) return text.status();
+      const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
+      if (j.is_discarded()) return ioError(path, "is not JSON");
+      for (const nlohmann::json& b : j) {
+        PointBlock block;
+        block.name = b.at("name").get<std::string>();
+        block.path = pointsPath();
+        block.layout = layout_;
+        block.first = b.at("first").get<std::uint64_t>();
+        block.count = b.at("count").get<std::uint64_t>();
+        block.bounds = boxOf(b.at("bounds"));
+        block.centroid = vecOf(b.at("centroid"));
+        listed.push_back(
+            {std::move(block), {b.at("rootError").get<float>(), b.at("leastError").get<float>()}});
+      }
+    }
+    std::sort(listed.begin(), listed.end(),
+              [](const auto& a, const auto& b) { return a.first.name < b.first.name; });
+    for (auto& [block, errors] : listed) {
       BlockTiles tiles = blockTiles(block.name, block.bounds);
       tiles.first = block.first;
-      const auto found = errors.find(block.name);
-      if (found == errors.end())
-        return Error{ErrorKind::kInternal, fmt::format("block {} was not ranked", block.name)};
-      tiles.rootError = found->second[0];
-      tiles.leastError = found->second[1];
+      tiles.rootError = errors[0];
+      tiles.leastError = errors[1];
       blocks_.push_back(std::move(tiles));
+      partition_.blocks.push_back(std::move(block));
     }
     noteStats(partition_, options_, stats_);
     Result<std::vector<float>> taus =
@@ -385,7 +434,6 @@ class RankedPoints {
   const PointTilesOptions& options_;
   bool lead_;
   std::string work_;
-  FileQueue queue_;
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   PointMemoryPlan plan_;
   WorkLock lock_;
@@ -394,12 +442,10 @@ class RankedPoints {
   bool hasNormals_ = false;
   PointCloudInfo info_;
   PointRecordLayout layout_;
+  InputRead read_;       // rank 0's: the input in the work files, when read in slices
   Partition partition_;  // rank 0's
-  std::atomic<std::uint64_t> published_{0};
-  std::atomic<std::uint64_t> rankedPoints_{0};
-  std::mutex queuedMutex_;
-  std::vector<std::string> queuedNames_;     // rank 0's: each queue number's block
-  std::vector<std::uint64_t> rankedErrors_;  // (number, root error bits, least error bits)
+  // The nodes split in memory: rank 0's from its streamed splits, the others' from its list.
+  std::vector<PartitionNode> memoryNodes_;
   std::vector<BlockTiles> blocks_;
   std::vector<float> taus_;
   std::map<std::string, TileNode> nodes_;

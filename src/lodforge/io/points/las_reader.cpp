@@ -1,6 +1,7 @@
 #include "lodforge/io/points/las_reader.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -106,6 +107,7 @@ struct LasReader::State {
   LasHeader header;
   std::size_t batchSize = 1 << 16;
   std::uint64_t nextPoint = 0;
+  std::uint64_t endPoint = ~std::uint64_t{0};  // restrictTo's end (clipped to pointCount)
   std::size_t rgb = 0;
   std::vector<std::byte> records;
   std::uint8_t formatByte = 0;   // as stored (LASzip sets its top bits)
@@ -470,13 +472,29 @@ Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
   return e.error;
 }
 
+Status LasReader::restrictTo(std::uint64_t first, std::uint64_t count) {
+  State& s = *state_;
+  const LasHeader& h = s.header;
+  assert(s.nextPoint == 0);
+  if (h.compressed)
+    return Error{ErrorKind::kUnsupported,
+                 fmt::format("{}: a LAZ file is not read in slices", s.source->name())};
+  first = std::min(first, h.pointCount);
+  if (!s.source->skip(first * h.recordLength))
+    return s.fail(s.source->offset(), fmt::format("the file ends before point {}", first));
+  s.nextPoint = first;
+  s.endPoint = first + std::min(count, h.pointCount - first);
+  return {};
+}
+
 Result<bool> LasReader::nextRecords(std::vector<std::byte>& records) try {
   State& s = *state_;
   const LasHeader& h = s.header;
   records.clear();
-  if (s.nextPoint >= h.pointCount) return false;
+  const std::uint64_t end = std::min(h.pointCount, s.endPoint);
+  if (s.nextPoint >= end) return false;
   const std::size_t count =
-      static_cast<std::size_t>(std::min<std::uint64_t>(s.batchSize, h.pointCount - s.nextPoint));
+      static_cast<std::size_t>(std::min<std::uint64_t>(s.batchSize, end - s.nextPoint));
   records.resize(count * h.recordLength);
   if (s.lazPoints) {
     LODFORGE_TRY(s.lazPoints->read(records.data(), count));

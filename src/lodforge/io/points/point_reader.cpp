@@ -38,11 +38,20 @@ std::optional<std::string> PointReader::truncation() const {
   return std::nullopt;
 }
 
+namespace {
+
+bool sliced(const PointReadOptions& options) {
+  return options.first != 0 || options.count != ~std::uint64_t{0};
+}
+
+}  // namespace
+
 Result<PointReader> PointReader::open(const std::string& path, const PointReadOptions& options) {
   const std::string ext = fileExtension(path);
   if (ext == "las" || ext == "laz") {
     Result<LasReader> las = LasReader::open(path, options.batchPoints);
     if (las && !options.readExtras) las->skipExtraBytes();
+    if (las && sliced(options)) LODFORGE_TRY(las->restrictTo(options.first, options.count));
     if (!las) return las.status();
     const LasHeader& h = las->header();
     PointCloudInfo info;
@@ -67,6 +76,7 @@ Result<PointReader> PointReader::open(const std::string& path, const PointReadOp
     Result<PlyReader> ply = PlyReader::open(path, {.batchSize = options.batchPoints,
                                                    .salvageTruncated = options.salvageTruncated,
                                                    .readFaces = false,
+                                                   .vertexSlice = {options.first, options.count},
                                                    .readExtras = options.readExtras});
     if (!ply) return ply.status();
     const PlyHeader& h = ply->header();
@@ -82,6 +92,9 @@ Result<PointReader> PointReader::open(const std::string& path, const PointReadOp
     return PointReader(std::make_unique<State>(State{std::move(*ply), std::move(info), {}}));
   }
   if (isPointCloudPath(path)) {
+    if (sliced(options))
+      return Error{ErrorKind::kUnsupported,
+                   fmt::format("{}: a text point file is not read in slices", path)};
     Result<XyzReader> xyz = XyzReader::open(path, options.batchPoints);
     if (!xyz) return xyz.status();
     const XyzLayout& layout = xyz->layout();

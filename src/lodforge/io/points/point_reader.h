@@ -44,6 +44,9 @@ struct PointReadOptions {
   // Extra fields (LAS extra bytes, other PLY vertex properties) in the batches and in
   // info().extras; without, both are empty.
   bool readExtras = true;
+  // Only points [first, first + count): a slice of an uncompressed LAS or a binary PLY, reached
+  // by seeking; other inputs (LAZ, text, ascii PLY) refuse a slice (kUnsupported).
+  std::uint64_t first = 0, count = ~std::uint64_t{0};
 };
 
 class PointReader {

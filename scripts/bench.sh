@@ -780,8 +780,12 @@ ranks_against_threads() {  # the input; prints the table and rank 0's -v lines f
   local mpi=(mpirun --allow-run-as-root -np 2)
   printf '| run | 1 process x 2 threads | peak RSS | 2 ranks x 1 thread | peak RSS rank 0 / 1 | ranks / threads |\n|---|---:|---:|---:|---:|---:|\n'
   for run in $(seq "$runs"); do
+    # Each run starts with the page cache's dirty pages written out (sync): a 1 GB tileset
+    # still being flushed slows whichever run comes next.
     rm -rf "$work"/dist-one "$work"/dist-ranks
+    sync
     read -r one kib < <(timed "$lodforge" -q --threads 2 tiles "$input" -o "$work/dist-one")
+    sync
     # Each rank under its own /usr/bin/time, the job's wall time from one around mpirun.
     /usr/bin/time -f "%e" -o "$work/dist-time" "${mpi[@]}" \
       sh -c '/usr/bin/time -f "%M" -o "$0-$OMPI_COMM_WORLD_RANK" "$@"' "$work/dist-rank" \

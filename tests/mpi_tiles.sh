@@ -8,7 +8,9 @@
 # finishes a mesh without rebuilding what was done; a second run on an output being written is
 # refused, a mesh's or a point cloud's.
 set -euo pipefail
-lodforge=$1 out=$2 sanitized=${3:-0}
+lodforge=$1 out=$2 sanitized=${3:-0} data=${4:-}
+[[ -d $data/points ]] || { echo "usage: mpi_tiles.sh LODFORGE OUT SANITIZED DATA (the shared data folder)" >&2; exit 1; }
+data=$(cd "$data" && pwd)
 command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/install-deps.sh" >&2; exit 1; }
 rm -rf "$out" && mkdir -p "$out"
 cd "$out"
@@ -113,7 +115,7 @@ for ranks in 2 3; do
     2> large.err
   same large-np$ranks large-1 "point cloud of 16 nodes, $ranks ranks"
 done
-grep -q "3 ranks: the input read in slices by every rank;" large.err ||
+grep -q "3 ranks: the input read in slices by every rank (done at" large.err ||
   fail "the LAS was not read in slices: $(cat large.err)"
 # Each rank's share of the points within 20 % of the busiest's (whole nodes, largest first).
 shares=$(grep -oE "rank [0-9] split and ranked [0-9,]+ points" large.err |
@@ -122,6 +124,12 @@ awk -v s="$shares" 'BEGIN { n = split(s, a, " "); if (n != 3) exit 1; lo = a[1];
   for (i = 1; i <= n; ++i) { t += a[i]; if (a[i] < lo) lo = a[i]; if (a[i] > hi) hi = a[i] }
   exit !(t == 400000 && lo >= 0.8 * hi) }' ||
   fail "the partition was not shared among the ranks: $(cat large.err)"
+# A LAZ file is read by rank 0 alone (its records are not at fixed places); the rest is shared.
+"$lodforge" -q tiles "$data/points/autzen_trim.laz" -o laz-1 --block-size 5000
+"${mpi[@]}" -np 2 "$lodforge" -v tiles "$data/points/autzen_trim.laz" -o laz-np2 --block-size 5000 \
+  2> laz.err
+same laz-np2 laz-1 "LAZ, read by rank 0, 2 ranks"
+grep -q "2 ranks: the input read by rank 0 (done at" laz.err || fail "the LAZ was read in slices: $(cat laz.err)"
 # A rank killed while ranking: the job stops, rank 0 says what rank 1 was doing, and nothing is
 # left behind (a point tileset has no --resume: the same command builds it again).
 set +e

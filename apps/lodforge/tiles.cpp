@@ -226,11 +226,11 @@ void reportPointRanks(const Global& global, const PointTilesStats& stats) {
                           r == 0 ? "" : "; ", r, formatCount(stats.rankPoints[r]),
                           formatCount(r < stats.rankTiles.size() ? stats.rankTiles[r] : 0));
   detail(global,
-         fmt::format("{} ranks: the input read {}; the partition's large nodes split by "
-                     "rank 0 ({:.1f} s), the rest split and ranked by every rank ({:.1f} "
-                     "s); {}",
+         fmt::format("{} ranks: the input read {} (done at {:.1f} s); the partition's large "
+                     "nodes split level by level by the ranks ({:.1f} s), the rest split and "
+                     "ranked by each rank ({:.1f} s); {}",
                      stats.ranks, stats.readInSlices ? "in slices by every rank" : "by rank 0",
-                     stats.partitionSeconds, stats.rankingSeconds, shares));
+                     stats.readSeconds, stats.partitionSeconds, stats.rankingSeconds, shares));
   for (const std::string& line : stats.rankStages) detail(global, line);
 }
 

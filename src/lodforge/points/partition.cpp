@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -390,8 +391,70 @@ void splitInMemory(std::span<CloudPoint> points, std::span<std::uint32_t> ids, s
 // Nodes too big for memory split by streamed passes, a level of the tree at a time with that
 // level's nodes in parallel (each pass streams its own range); what is left, in split-tree
 // order, fits in memory (or could not be split by streaming: every point on one side).
+// What the processes of a job found splitting their share of a level: one record per node
+// they split (its index in the level, whether it split, and its halves), for every process.
+std::vector<std::uint64_t> encodeHalves(
+    std::span<const std::optional<Result<std::array<PartNode, 2>>>> halves) {
+  std::vector<std::uint64_t> out;
+  for (std::size_t i = 0; i < halves.size(); ++i) {
+    if (!halves[i]) continue;
+    out.push_back(i);
+    out.push_back(*halves[i] ? 1 : 0);
+    if (!*halves[i]) continue;
+    for (const PartNode& half : **halves[i]) {
+      out.insert(out.end(), {half.first, half.count});
+      for (const Vec3d& v : {half.bounds.min, half.bounds.max, half.sum})
+        for (int k = 0; k < 3; ++k) out.push_back(std::bit_cast<std::uint64_t>(v[k]));
+    }
+  }
+  return out;
+}
+
+Status decodeHalves(std::span<const std::uint64_t> numbers, std::span<const PartNode> level,
+                    std::span<std::optional<Result<std::array<PartNode, 2>>>> halves) {
+  const auto bad = [] { return Error{ErrorKind::kInternal, "the ranks' splits do not add up"}; };
+  for (std::size_t at = 0; at < numbers.size();) {
+    if (numbers.size() - at < 2 || numbers[at] >= level.size()) return bad();
+    const std::size_t i = numbers[at];
+    const bool split = numbers[at + 1] != 0;
+    at += 2;
+    if (!split) {
+      halves[i] = Result<std::array<PartNode, 2>>(Error{ErrorKind::kUnsupported, "not split"});
+      continue;
+    }
+    if (numbers.size() - at < 22) return bad();
+    std::array<PartNode, 2> both;
+    for (int side = 0; side < 2; ++side) {
+      PartNode& half = both[static_cast<std::size_t>(side)];
+      half.name = level[i].name + static_cast<char>('0' + side);
+      half.first = numbers[at++];
+      half.count = numbers[at++];
+      for (Vec3d* v : {&half.bounds.min, &half.bounds.max, &half.sum})
+        for (int k = 0; k < 3; ++k) (*v)[k] = std::bit_cast<double>(numbers[at++]);
+    }
+    halves[i] = std::move(both);
+  }
+  return {};
+}
+
+// A job's level: each process split its share (the level's nodes to split, dealt in turn); their
+// outcomes agreed and their halves exchanged, so every process has the whole level's.
+Status shareLevel(std::span<const PartNode> level,
+                  std::span<std::optional<Result<std::array<PartNode, 2>>>> halves,
+                  const LevelShare& share) {
+  Status mine = checkCancelled();
+  for (const auto& half : halves)
+    if (mine.ok() && half && !*half && half->error().kind != ErrorKind::kUnsupported)
+      mine = half->status();
+  LODFORGE_TRY(share.agree(mine));
+  Result<std::vector<std::uint64_t>> all = share.gather(encodeHalves(halves));
+  if (!all) return all.status();
+  return decodeHalves(*all, level, halves);
+}
+
 Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t inMemory,
-                                                  const WorkFiles& files, Partition& partition) {
+                                                  const WorkFiles& files, Partition& partition,
+                                                  const LevelShare& share) {
   // About one pass over every point per level: levels halve the nodes until they fit.
   int levels = 0;
   for (std::uint64_t n = root.count; n > inMemory; n = (n + 1) / 2) ++levels;
@@ -400,11 +463,18 @@ Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t i
   level.push_back(std::move(root));
   while (!level.empty()) {
     std::vector<std::optional<Result<std::array<PartNode, 2>>>> halves(level.size());
+    std::vector<std::uint8_t> mine(level.size(), 0);
+    for (std::size_t i = 0, turn = 0; i < level.size(); ++i)
+      if (level[i].count > inMemory)
+        mine[i] = static_cast<int>(turn++ % static_cast<std::size_t>(share.parts)) == share.part;
     tbb::parallel_for(std::size_t{0}, level.size(), [&](std::size_t i) {
-      if (level[i].count > inMemory && !cancelRequested())
-        halves[i] = splitInPlace(level[i], files, progress);
+      if (mine[i] != 0 && !cancelRequested()) halves[i] = splitInPlace(level[i], files, progress);
     });
-    LODFORGE_TRY(checkCancelled());
+    if (share.parts > 1) {
+      LODFORGE_TRY(shareLevel(level, halves, share));
+    } else {
+      LODFORGE_TRY(checkCancelled());
+    }
     std::vector<PartNode> next;
     for (std::size_t i = 0; i < level.size(); ++i) {
       if (halves[i] && *halves[i]) {
@@ -610,7 +680,7 @@ std::uint64_t inMemoryPoints(const PartitionOptions& options, std::size_t stride
 
 Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
                                                    const PartitionOptions& options,
-                                                   Partition& partition) {
+                                                   Partition& partition, const LevelShare& share) {
   partition.info = read.info;
   partition.truncation = read.truncation;
   partition.pointCount = read.count;
@@ -621,7 +691,7 @@ Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
   if (!files) return files.status();
   return splitStreamedLevels(PartNode{"b", 0, read.count, read.bounds, read.sum},
                              inMemoryPoints(options, stride), files->view(read.layout, stride),
-                             partition);
+                             partition, share);
 }
 
 Result<std::vector<PointBlock>> splitNodesInMemory(

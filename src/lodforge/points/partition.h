@@ -187,7 +187,7 @@ Result<Partition> partitionRead(const InputRead& read, const PartitionOptions& o
 // The input read by one process (partitionPoints' first pass).
 Result<InputRead> readWholeInput(const std::string& input, const PartitionOptions& options);
 
-// partitionRead in two steps, for a job: process 0 splits the nodes too big for memory by
+// partitionRead in two steps, for a job: the processes split the nodes too big for memory by
 // streamed passes (splitLargeNodes: the nodes left, each split in memory next, in name order;
 // `partition` gets all but the blocks); each process then splits its share of those nodes in
 // memory, one at a time, each block handed to the sink and written back in place
@@ -200,9 +200,18 @@ struct PartitionNode {
   Aabbd bounds;
   Vec3d sum;  // of positions, for the centroid
 };
+// In a job every process splits its share of each level (the nodes to split, dealt in turn),
+// and `agree` (every process's outcome) and `gather` (every process's numbers, in process order)
+// give each the whole level: the same nodes come out on every process.
+struct LevelShare {
+  int part = 0, parts = 1;
+  std::function<Status(const Status&)> agree;
+  std::function<Result<std::vector<std::uint64_t>>(std::span<const std::uint64_t>)> gather;
+};
 Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
                                                    const PartitionOptions& options,
-                                                   Partition& partition);
+                                                   Partition& partition,
+                                                   const LevelShare& share = {});
 Result<std::vector<PointBlock>> splitNodesInMemory(
     const InputRead& read, std::span<const PartitionNode> nodes, const PartitionOptions& options,
     const std::function<void(std::uint64_t)>& advanced = {});

@@ -50,27 +50,6 @@ Vec3d vecOf(const nlohmann::json& j) {
   return Vec3d{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
 }
 
-// Rank 0's nodes to split in memory, for the other ranks (JSON keeps doubles exactly).
-std::string nodesJson(std::span<const PartitionNode> nodes) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const PartitionNode& n : nodes)
-    out.push_back({{"name", n.name},
-                   {"first", n.first},
-                   {"count", n.count},
-                   {"bounds", boxJson(n.bounds)},
-                   {"sum", vecJson(n.sum)}});
-  return out.dump();
-}
-
-std::vector<PartitionNode> nodesOf(const nlohmann::json& j) {
-  std::vector<PartitionNode> nodes;
-  for (const nlohmann::json& n : j)
-    nodes.push_back({n.at("name").get<std::string>(), n.at("first").get<std::uint64_t>(),
-                     n.at("count").get<std::uint64_t>(), boxOf(n.at("bounds")),
-                     vecOf(n.at("sum"))});
-  return nodes;
-}
-
 // A rank's share of the nodes: the largest first, each to the rank with the fewest points so
 // far (ties: the lower rank), the same on every rank.
 std::vector<PartitionNode> nodeShare(std::span<const PartitionNode> nodes, int rank, int ranks) {
@@ -120,7 +99,7 @@ std::vector<std::uint64_t> encodeSlice(const SliceRead& slice) {
   return out;
 }
 
-Result<std::vector<SliceRead>> decodeSlices(std::span<const std::uint64_t> numbers) {
+Result<std::vector<SliceRead>> decodeSlices(std::span<const std::uint64_t> numbers, int expected) {
   std::vector<SliceRead> slices;
   std::size_t at = 0;
   const auto number = [&]() -> double { return std::bit_cast<double>(numbers[at++]); };
@@ -137,7 +116,7 @@ Result<std::vector<SliceRead>> decodeSlices(std::span<const std::uint64_t> numbe
       for (int k = 0; k < 3; ++k) sum[k] = number();
     }
   }
-  if (at != numbers.size() || slices.size() != static_cast<std::size_t>(clusterSize()))
+  if (at != numbers.size() || slices.size() != static_cast<std::size_t>(expected))
     return Error{ErrorKind::kInternal, "the ranks' slices of the input do not add up"};
   return slices;
 }
@@ -162,9 +141,9 @@ class RankedPoints {
     Result<bool> sliced = readTogether();
     if (!sliced) return sliced.status();
     stats_.readInSlices = *sliced;
+    stats_.readSeconds = secondsSince(start_);
     recordStage("input");
-    LODFORGE_TRY(agreeAcrossRanks(lead_ ? splitOnLead() : Status{}));
-    LODFORGE_TRY(agreeAcrossRanks(lead_ ? Status{} : readNodes()));
+    LODFORGE_TRY(splitTogether());
     stats_.partitionSeconds = secondsSince(start_);
     LODFORGE_TRY(rankTogether());
     stats_.rankingSeconds = secondsSince(start_);
@@ -228,24 +207,39 @@ class RankedPoints {
     if (*count == 0) {
       reportActivity(lead_ ? "reading the input" : "waiting for rank 0 to read the input");
       LODFORGE_TRY(agreeAcrossRanks(lead_ ? readOnLead(options) : Status{}));
+      // Rank 0's totals to every rank, as one slice.
+      Result<std::vector<std::uint64_t>> totals =
+          gatherAcrossRanks(lead_ ? encodeSlice(SliceRead{read_.count, read_.bounds, {read_.sum}})
+                                  : std::vector<std::uint64_t>{});
+      if (!totals) return totals.status();
+      LODFORGE_TRY(addSlicesFrom(*totals, 1));
       return false;
     }
     if (lead_) read_ = std::move(*files);
     reportActivity("reading its slice of the input");
-    Result<SliceRead> mine = [&] {
+    Result<SliceRead> mine = SliceRead{};
+    {
       const JobProgress progress(fmt::format("points: reading, {} ranks", clusterSize()), "read",
                                  *count - 1);
-      return readInputSlice(input_, options, inputSlice(*count - 1, clusterRank(), clusterSize()),
+      mine = readInputSlice(input_, options, inputSlice(*count - 1, clusterRank(), clusterSize()),
                             [](std::uint64_t done) { reportProgress("read", done); });
-    }();
-    LODFORGE_TRY(agreeAcrossRanks(mine.status()));
+      LODFORGE_TRY(agreeAcrossRanks(mine.status()));
+    }
     Result<std::vector<std::uint64_t>> slices = gatherAcrossRanks(encodeSlice(*mine));
     if (!slices) return slices.status();
-    if (!lead_) return true;
-    Result<std::vector<SliceRead>> decoded = decodeSlices(*slices);
+    LODFORGE_TRY(addSlicesFrom(*slices, clusterSize()));
+    return true;
+  }
+
+  // Every rank: the input's totals from the slices gathered, and what it knows of the input.
+  Status addSlicesFrom(std::span<const std::uint64_t> numbers, int slices) {
+    Result<std::vector<SliceRead>> decoded = decodeSlices(numbers, slices);
     if (!decoded) return decoded.status();
     addSlices(*decoded, read_);
-    return true;
+    read_.input = input_;
+    read_.info = info_;
+    read_.layout = layout_;
+    return {};
   }
 
   Status readOnLead(const PartitionOptions& options) {
@@ -255,27 +249,20 @@ class RankedPoints {
     return {};
   }
 
-  // Rank 0 splits the nodes too big for memory (streamed passes over the work files) and lists
-  // the rest for every rank.
-  Status splitOnLead() {
-    reportActivity("splitting the partition's large nodes");
+  // The nodes too big for memory split by streamed passes over the work files, each level's
+  // nodes shared out among the ranks: every rank ends with the list of the nodes left.
+  Status splitTogether() {
+    reportActivity("splitting its share of the partition's large nodes");
     const PartitionOptions options = pointPartitionOptions(options_, plan_, frame_, work_);
+    const LevelShare share{clusterRank(), clusterSize(), agreeAcrossRanks, gatherAcrossRanks};
+    Partition mine;  // rank 0's is the job's
     Result<std::vector<PartitionNode>> nodes = [&] {
       tbb::task_arena arena(plan_.threads);
-      return arena.execute([&] { return splitLargeNodes(read_, options, partition_); });
+      return arena.execute([&] { return splitLargeNodes(read_, options, mine, share); });
     }();
     if (!nodes) return nodes.status();
     memoryNodes_ = std::move(*nodes);
-    return OutputFile::writeWhole(work_ + "/nodes.json", nodesJson(memoryNodes_));
-  }
-
-  Status readNodes() {
-    const std::string path = work_ + "/nodes.json";
-    Result<std::string> text = readFileToString(path, std::uint64_t{1} << 34);
-    if (!text) return text.status();
-    const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
-    if (j.is_discarded()) return ioError(path, "is not JSON");
-    memoryNodes_ = nodesOf(j);
+    if (lead_) partition_ = std::move(mine);
     return {};
   }
 
@@ -289,17 +276,18 @@ class RankedPoints {
     for (const PartitionNode& n : mine) share += n.count;
     reportActivity(fmt::format("splitting and ranking {} of the partition's {} nodes ({} points)",
                                mine.size(), all.size(), share));
-    std::map<std::string, BlockTiles> ranked;
-    Result<std::vector<PointBlock>> blocks = [&] {
+    {
+      // Shown until every rank is done, so that the bar ends at the job's total.
       const JobProgress progress(fmt::format("points: partition, {} ranks", clusterSize()),
                                  "points", total);
-      return splitMine(mine, ranked);
-    }();
-    Status listed = blocks.status();
-    if (blocks)
-      listed = OutputFile::writeWhole(fmt::format("{}/blocks-{}.json", work_, clusterRank()),
-                                      blocksJson(*blocks, ranked));
-    LODFORGE_TRY(agreeAcrossRanks(listed));
+      std::map<std::string, BlockTiles> ranked;
+      Result<std::vector<PointBlock>> blocks = splitMine(mine, ranked);
+      Status listed = blocks.status();
+      if (blocks)
+        listed = OutputFile::writeWhole(fmt::format("{}/blocks-{}.json", work_, clusterRank()),
+                                        blocksJson(*blocks, ranked));
+      LODFORGE_TRY(agreeAcrossRanks(listed));
+    }
     Result<std::vector<std::uint64_t>> points = gatherAcrossRanks(std::span(&share, 1));
     if (!points) return points.status();
     stats_.rankPoints = std::move(*points);
@@ -319,12 +307,7 @@ class RankedPoints {
       ranked[block.name] = std::move(tiles);
       return Status{};
     };
-    InputRead read = read_;  // rank 0's; the others know the input, its fields and layout
-    if (!lead_) {
-      read.input = input_;
-      read.info = info_;
-      read.layout = layout_;
-    }
+    const InputRead& read = read_;
     tbb::task_arena arena(plan_.threads);
     return arena.execute([&] {
       return splitNodesInMemory(read, mine, options,
@@ -406,15 +389,18 @@ class RankedPoints {
     std::uint64_t withContent = 0;
     for (const auto& [name, node] : nodes_) withContent += node.uri.empty() ? 0u : 1u;
     reportActivity("writing its share of the tiles");
-    Result<std::uint64_t> written = [&]() -> Result<std::uint64_t> {
+    std::uint64_t mine = 0;
+    {
       const JobProgress progress(fmt::format("tiles: contents, {} ranks", clusterSize()), "tiles",
                                  withContent);
-      return writeContents(nodes_, blocks_, options_,
-                           {info_.hasColors, info_.attributes & options_.attributes, &info_.extras},
-                           stagingPath(), {.rank = clusterRank(), .ranks = clusterSize()});
-    }();
-    LODFORGE_TRY(agreeAcrossRanks(written.status()));
-    Result<std::vector<std::uint64_t>> tiles = gatherAcrossRanks(std::span(&*written, 1));
+      Result<std::uint64_t> written =
+          writeContents(nodes_, blocks_, options_,
+                        {info_.hasColors, info_.attributes & options_.attributes, &info_.extras},
+                        stagingPath(), {.rank = clusterRank(), .ranks = clusterSize()});
+      LODFORGE_TRY(agreeAcrossRanks(written.status()));
+      mine = *written;
+    }
+    Result<std::vector<std::uint64_t>> tiles = gatherAcrossRanks(std::span(&mine, 1));
     if (!tiles) return tiles.status();
     stats_.rankTiles = std::move(*tiles);
     stats_.tiles = withContent;
@@ -444,7 +430,7 @@ class RankedPoints {
   PointRecordLayout layout_;
   InputRead read_;       // rank 0's: the input in the work files, when read in slices
   Partition partition_;  // rank 0's
-  // The nodes split in memory: rank 0's from its streamed splits, the others' from its list.
+  // The nodes split in memory, the same on every rank.
   std::vector<PartitionNode> memoryNodes_;
   std::vector<BlockTiles> blocks_;
   std::vector<float> taus_;

@@ -44,11 +44,11 @@ struct PointTilesStats {
   double seconds = 0;
   // A job of several ranks (point_ranks.h): how many, whether the input was read in slices,
   // each rank's split and ranked points and written tiles (rank order), the seconds to the end
-  // of rank 0's streamed splits and to the end of the ranking, and each rank's stages.
+  // of the reading, of the streamed splits and of the ranking, and each rank's stages.
   int ranks = 1;
   bool readInSlices = false;
   std::vector<std::uint64_t> rankPoints, rankTiles;
-  double partitionSeconds = 0, rankingSeconds = 0;
+  double readSeconds = 0, partitionSeconds = 0, rankingSeconds = 0;
   std::vector<std::string> rankStages;
 };
 

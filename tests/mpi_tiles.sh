@@ -92,8 +92,9 @@ same cad-np3 cad-1 "assembly (parts.json), 3 ranks"
 "${mpi[@]}" -np 2 "$lodforge" -q tiles points.ply --surface -o surface-np2 --chunk-size 150
 same surface-np2 surface-1 "reconstructed surface, 2 ranks"
 
-# Point clouds: every rank reads a slice of the input; rank 0 splits the nodes too big for memory,
-# every rank splits and ranks its share of the rest and writes its share of the tiles. A LAS
+# Point clouds: every rank reads a slice of the input; the ranks split the nodes too big for
+# memory level by level, then each splits and ranks its share of the rest and writes its share
+# of the tiles. A LAS
 # with extra bytes (their own work file, reordered with the points) and a PLY, each one node in
 # memory (the other ranks read and write tiles); a LAS of 16 nodes shared by 2 and 3 ranks.
 "$lodforge" -q generate points --points 120K --extra-bytes -o cloud.las
@@ -178,7 +179,7 @@ same killed scan-1 "killed rank, then --resume"
 "$lodforge" -q tiles busy.ply -o busy-1 --chunk-size 60
 "$lodforge" -q --threads 1 tiles busy.ply -o busy --chunk-size 60 --memory minimal &
 first=$!
-for _ in $(seq 200); do [[ -s busy.work/.lodforge-lock ]] && break; sleep 0.02; done
+for _ in $(seq 1000); do [[ -s busy.work/.lodforge-lock ]] && break; sleep 0.02; done
 set +e
 "${mpi[@]}" -np 2 "$lodforge" -q tiles busy.ply -o busy --chunk-size 60 2> busy.err
 code=$?
@@ -192,7 +193,7 @@ same busy busy-1 "the first run, beside the refused one"
 "$lodforge" -q generate points --points 3M -o busy.las
 "$lodforge" -q --threads 1 tiles busy.las -o busy-points &
 first=$!
-for _ in $(seq 200); do [[ -s busy-points.work/.lodforge-lock ]] && break; sleep 0.02; done
+for _ in $(seq 1000); do [[ -s busy-points.work/.lodforge-lock ]] && break; sleep 0.02; done
 set +e
 "${mpi[@]}" -np 2 "$lodforge" -q tiles busy.las -o busy-points 2> busy-points.err
 code=$?

@@ -164,8 +164,8 @@ struct InputRead {
 // A job's first pass (point_ranks.h): process 0 makes the work files at their full size
 // (createInputFiles: kUnsupported for an input not read in slices: LAZ, text, ascii PLY, a file
 // to salvage); each process reads its slice of whole batches into them (inputSlice,
-// readInputSlice); process 0 adds the slices up in order (addSlices) and partitions them
-// (partitionRead).
+// readInputSlice); every process adds up all the slices in order (addSlices) before the
+// partition's job steps below.
 constexpr std::size_t kInputBatchPoints = std::size_t{1} << 16;
 struct SliceRead {
   std::uint64_t count = 0;
@@ -203,10 +203,14 @@ struct PartitionNode {
 // In a job every process splits its share of each level (the nodes to split, dealt in turn),
 // and `agree` (every process's outcome) and `gather` (every process's numbers, in process order)
 // give each the whole level: the same nodes come out on every process.
+// Every process must give the same PartitionOptions::memoryBytes: the nodes to split and their
+// turns follow from it. `levelDone`, if any, is told the points this process has split so far
+// after each level (for the job's progress).
 struct LevelShare {
   int part = 0, parts = 1;
   std::function<Status(const Status&)> agree;
   std::function<Result<std::vector<std::uint64_t>>(std::span<const std::uint64_t>)> gather;
+  std::function<void(std::uint64_t)> levelDone;
 };
 Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
                                                    const PartitionOptions& options,

@@ -36,9 +36,9 @@ nlohmann::json boxJson(const Aabbd& box) {
 }
 
 Aabbd boxOf(const nlohmann::json& j) {
-  Aabbd box;
-  box.add(Vec3d{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()});
-  box.add(Vec3d{j[3].get<double>(), j[4].get<double>(), j[5].get<double>()});
+  Aabbd box;  // the corners as written (adding them would turn a max of +0 into -0 beside -0)
+  box.min = Vec3d{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+  box.max = Vec3d{j[3].get<double>(), j[4].get<double>(), j[5].get<double>()};
   return box;
 }
 
@@ -135,6 +135,7 @@ class RankedPoints {
     Result<PointMemoryPlan> plan = planPointMemory(options_.memoryLimit, options_.blockSize);
     LODFORGE_TRY(agreeAcrossRanks(plan.status()));
     plan_ = *plan;
+    LODFORGE_TRY(agreeOnPartitionMemory());
     LODFORGE_TRY(agreeAcrossRanks(lead_ ? claimOnLead() : Status{}));
     setActivityDirectory(work_ + "/ranks");
     LODFORGE_TRY(agreeAcrossRanks(readHeader()));
@@ -174,6 +175,16 @@ class RankedPoints {
     return tiles;
   }
   std::string stagingPath() const { return work_ + "/tileset"; }
+
+  // Every rank splits with the least allowance of all (each rank's plan counts its own
+  // footprint): the nodes to split, and whose turn each is, follow from it.
+  Status agreeOnPartitionMemory() {
+    Result<std::vector<std::uint64_t>> all =
+        gatherAcrossRanks(std::span<const std::uint64_t>(&plan_.partitionBytes, 1));
+    if (!all) return all.status();
+    plan_.partitionBytes = *std::min_element(all->begin(), all->end());
+    return {};
+  }
 
   // Rank 0 claims the output and the work place.
   Status claimOnLead() { return claimPointWorkPlace(input_, output_, lock_, scope_); }
@@ -242,6 +253,17 @@ class RankedPoints {
     return {};
   }
 
+  // The points the streamed levels go over: the input once per level above the allowance.
+  std::uint64_t streamedPoints(const PartitionOptions& options) const {
+    const std::uint64_t pointBytes =
+        sizeof(CloudPoint) + (info_.extras.stride == 0 ? 0 : 2 * info_.extras.stride + 4);
+    const std::uint64_t inMemory =
+        std::max<std::uint64_t>(options.blockSize, options.memoryBytes / pointBytes);
+    std::uint64_t total = 0;
+    for (std::uint64_t n = read_.count; n > inMemory; n = (n + 1) / 2) total += read_.count;
+    return total;
+  }
+
   Status readOnLead(const PartitionOptions& options) {
     Result<InputRead> read = readWholeInput(input_, options);
     if (!read) return read.status();
@@ -254,9 +276,13 @@ class RankedPoints {
   Status splitTogether() {
     reportActivity("splitting its share of the partition's large nodes");
     const PartitionOptions options = pointPartitionOptions(options_, plan_, frame_, work_);
-    const LevelShare share{clusterRank(), clusterSize(), agreeAcrossRanks, gatherAcrossRanks};
+    const LevelShare share{clusterRank(), clusterSize(), agreeAcrossRanks, gatherAcrossRanks,
+                           [](std::uint64_t done) { reportProgress("split", done); }};
     Partition mine;  // rank 0's is the job's
     Result<std::vector<PartitionNode>> nodes = [&] {
+      // Counted by level: about one pass over every point a level.
+      const JobProgress progress(fmt::format("points: streamed splits, {} ranks", clusterSize()),
+                                 "split", streamedPoints(options));
       tbb::task_arena arena(plan_.threads);
       return arena.execute([&] { return splitLargeNodes(read_, options, mine, share); });
     }();

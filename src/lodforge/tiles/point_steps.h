@@ -90,7 +90,7 @@ std::string pointWorkDirectory(const std::string& outputDirectory);
 // Claims the output and the tiles work directory, locked (WorkLock) so that a second run on the
 // same output is refused, and makes the point work directory afresh (a point tileset has nothing
 // to resume) with its staging folder (`/tileset/tiles`). `scope` gets what to remove when the
-// run ends: the whole work directory if this run made it, else its own folder.
+// run ends: the whole work directory, unless another run's work is kept there (then its folder).
 Status claimPointWorkPlace(const std::string& input, const std::string& outputDirectory,
                            WorkLock& lock, ScopedDirectory& scope);
 

@@ -472,7 +472,7 @@ Result<LasReader> LasReader::start(std::unique_ptr<State> state) try {
   return e.error;
 }
 
-Status LasReader::restrictTo(std::uint64_t first, std::uint64_t count) {
+Status LasReader::restrictTo(std::uint64_t first, std::uint64_t count) try {
   State& s = *state_;
   const LasHeader& h = s.header;
   assert(s.nextPoint == 0);
@@ -485,6 +485,8 @@ Status LasReader::restrictTo(std::uint64_t first, std::uint64_t count) {
   s.nextPoint = first;
   s.endPoint = first + std::min(count, h.pointCount - first);
   return {};
+} catch (const ErrorException& e) {
+  return e.error;
 }
 
 Result<bool> LasReader::nextRecords(std::vector<std::byte>& records) try {

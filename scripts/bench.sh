@@ -801,22 +801,20 @@ ranks_against_threads() {  # the input; prints the table and rank 0's -v lines f
     grep -E "^(rank|2 ranks|streamed)"
   rm -rf "$work"/dist-one "$work"/dist-ranks "$work"/dist-rank-* "$work/dist-time"
 }
+distributed_input() {  # kind (scan or points), what it is, its file, then `generate` arguments
+  local kind=$1 label=$2 file=$3
+  shift 3
+  [[ ${DISTRIBUTED_ONLY:-$kind} == "$kind" ]] || return 0
+  echo
+  echo "== ranks against threads: $label, 1 process x 2 threads and 2 ranks x 1 thread"
+  "$lodforge" -q generate "$@" -o "$file"
+  ranks_against_threads "$file"
+  rm -f "$file"
+}
 distributed_section() {
   local n=${DISTRIBUTED_TRIANGLES:-10M} points=${DISTRIBUTED_POINTS:-20M}
-  if [[ ${DISTRIBUTED_ONLY:-scan} == scan ]]; then
-    echo
-    echo "== ranks against threads: a $n-triangle scan, 1 process x 2 threads and 2 ranks x 1 thread"
-    "$lodforge" -q generate scan --triangles "$n" -o "$work/dist-scan.ply"
-    ranks_against_threads "$work/dist-scan.ply"
-    rm -f "$work/dist-scan.ply"
-  fi
-  if [[ ${DISTRIBUTED_ONLY:-points} == points ]]; then
-    echo
-    echo "== ranks against threads: a $points-point LAS, 1 process x 2 threads and 2 ranks x 1 thread"
-    "$lodforge" -q generate points --points "$points" -o "$work/dist-points.las"
-    ranks_against_threads "$work/dist-points.las"
-    rm -f "$work/dist-points.las"
-  fi
+  distributed_input scan "a $n-triangle scan" "$work/dist-scan.ply" scan --triangles "$n"
+  distributed_input points "a $points-point LAS" "$work/dist-points.las" points --points "$points"
 }
 if [[ ${BENCH_ONLY:-} == distributed ]]; then distributed_section; exit 0; fi
 

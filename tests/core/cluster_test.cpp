@@ -41,5 +41,20 @@ TEST(Cluster, AProcessNotStartedAsAJobIsAJobOfOne) {
   leaveCluster(1);  // a failure in a job of one aborts nothing
 }
 
+// Largest first to the least loaded rank, ties by order: the same deal on every rank, within
+// 4/3 of the best busiest rank.
+TEST(Cluster, WorkIsDealtLargestFirstToTheLeastLoadedRank) {
+  const std::vector<std::uint64_t> work = {5, 9, 2, 9, 7, 1};
+  const std::vector<int> owner = dealLargestFirst(work, 2);
+  // 9→0, 9→1, 7→0 (a tie: the lower rank), 5→1, 2→1, 1→0 (a tie again).
+  EXPECT_EQ(owner, (std::vector<int>{1, 0, 1, 1, 0, 0}));
+  std::vector<std::uint64_t> load(2, 0);
+  for (std::size_t i = 0; i < work.size(); ++i) load[static_cast<std::size_t>(owner[i])] += work[i];
+  EXPECT_EQ(load[0], 17u);
+  EXPECT_EQ(load[1], 16u);
+  EXPECT_EQ(dealLargestFirst(work, 1), std::vector<int>(work.size(), 0));
+  EXPECT_TRUE(dealLargestFirst({}, 3).empty());
+}
+
 }  // namespace
 }  // namespace lodforge

@@ -1,5 +1,7 @@
 #include "lodforge/core/cluster.h"
 
+#include <numeric>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -342,6 +344,22 @@ Status agreeAcrossRanks(const Status& mine) {
 #else
   return mine;
 #endif
+}
+
+std::vector<int> dealLargestFirst(std::span<const std::uint64_t> work, int ranks) {
+  std::vector<std::size_t> order(work.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return work[a] > work[b]; });
+  std::vector<std::uint64_t> load(static_cast<std::size_t>(ranks), 0);
+  std::vector<int> owner(work.size(), 0);
+  for (const std::size_t i : order) {
+    const auto least =
+        static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    owner[i] = static_cast<int>(least);
+    load[least] += work[i];
+  }
+  return owner;
 }
 
 }  // namespace lodforge

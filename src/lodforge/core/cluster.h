@@ -86,6 +86,11 @@ void recordStage(std::string_view stage);
 // Every rank's recorded stages, a line each ("rank 1: chunks read 1.2 GiB, wrote …").
 std::vector<std::string> rankStages();
 
+// Items dealt out to `ranks` by their `work`, largest first, each to the least loaded rank so far
+// (longest processing time first: within 4/3 of the best busiest rank); ties by item order, so
+// every rank computes the same deal. The rank of each item.
+std::vector<int> dealLargestFirst(std::span<const std::uint64_t> work, int ranks);
+
 // A name for this rank in messages: "rank 2 of 4 (host, pid 1234)".
 std::string describeRank();
 

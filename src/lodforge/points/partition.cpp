@@ -388,9 +388,6 @@ void splitInMemory(std::span<CloudPoint> points, std::span<std::uint32_t> ids, s
   group.wait();
 }
 
-// Nodes too big for memory split by streamed passes, a level of the tree at a time with that
-// level's nodes in parallel (each pass streams its own range); what is left, in split-tree
-// order, fits in memory (or could not be split by streaming: every point on one side).
 // What the processes of a job found splitting their share of a level: one record per node
 // they split (its index in the level, whether it split, and its halves), for every process.
 std::vector<std::uint64_t> encodeHalves(
@@ -418,6 +415,7 @@ Status decodeHalves(std::span<const std::uint64_t> numbers, std::span<const Part
     const std::size_t i = numbers[at];
     const bool split = numbers[at + 1] != 0;
     at += 2;
+    if (halves[i]) return bad();  // two processes split the same node
     if (!split) {
       halves[i] = Result<std::array<PartNode, 2>>(Error{ErrorKind::kUnsupported, "not split"});
       continue;
@@ -449,16 +447,23 @@ Status shareLevel(std::span<const PartNode> level,
   LODFORGE_TRY(share.agree(mine));
   Result<std::vector<std::uint64_t>> all = share.gather(encodeHalves(halves));
   if (!all) return all.status();
+  for (auto& half : halves) half.reset();  // every process's, this one's too, come from `all`
   return decodeHalves(*all, level, halves);
 }
 
+// Nodes too big for memory split by streamed passes, a level of the tree at a time with that
+// level's nodes in parallel (each pass streams its own range); what is left, in split-tree
+// order, fits in memory (or could not be split by streaming: every point on one side).
 Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t inMemory,
                                                   const WorkFiles& files, Partition& partition,
                                                   const LevelShare& share) {
   // About one pass over every point per level: levels halve the nodes until they fit.
   int levels = 0;
   for (std::uint64_t n = root.count; n > inMemory; n = (n + 1) / 2) ++levels;
-  Progress progress("points: streamed splits", root.count * static_cast<std::uint64_t>(levels));
+  // A job shows its own progress (LevelShare::levelDone): this bar would see one process's part.
+  Progress progress("points: streamed splits",
+                    share.parts > 1 ? 0 : root.count * static_cast<std::uint64_t>(levels));
+  std::uint64_t splitHere = 0;
   std::vector<PartNode> level, small;
   level.push_back(std::move(root));
   while (!level.empty()) {
@@ -471,6 +476,8 @@ Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t i
       if (mine[i] != 0 && !cancelRequested()) halves[i] = splitInPlace(level[i], files, progress);
     });
     if (share.parts > 1) {
+      for (std::size_t i = 0; i < level.size(); ++i) splitHere += mine[i] != 0 ? level[i].count : 0;
+      if (share.levelDone) share.levelDone(splitHere);
       LODFORGE_TRY(shareLevel(level, halves, share));
     } else {
       LODFORGE_TRY(checkCancelled());
@@ -489,7 +496,7 @@ Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t i
     }
     level = std::move(next);
   }
-  if (levels > 0) progress.finish();
+  if (levels > 0 && share.parts <= 1) progress.finish();
   std::sort(small.begin(), small.end(),
             [](const PartNode& a, const PartNode& b) { return a.name < b.name; });
   return small;
@@ -625,8 +632,10 @@ Result<SliceRead> readInputSlice(const std::string& input, const PartitionOption
   }
   if (stats.count != slice.count)
     return badInput(input,
-                    fmt::format("points {} to {}: {} read, the header counts {}", slice.first,
-                                slice.first + slice.count, stats.count, slice.count));
+                    fmt::format("points {} to {}: only {} read (the header counts {} points in "
+                                "all)",
+                                slice.first, slice.first + slice.count, stats.count,
+                                reader->info().count.value_or(0)));
   out.count = stats.count;
   out.bounds = stats.bounds;
   return out;
@@ -642,6 +651,15 @@ void addSlices(std::span<const SliceRead> slices, InputRead& read) {
   read.count = stats.count;
   read.bounds = stats.bounds;
   read.sum = stats.sum;
+}
+
+std::uint64_t inMemoryPoints(const PartitionOptions& options, std::size_t stride) {
+  // A point in memory: its record, and with extras their bytes twice (read, gathered) and an id.
+  const std::uint64_t pointBytes = sizeof(CloudPoint) + (stride == 0 ? 0 : 2 * stride + 4);
+  // Ids are 32-bit: no node is split in memory with more points than they count.
+  return std::min<std::uint64_t>(
+      std::max<std::uint64_t>(options.blockSize, options.memoryBytes / pointBytes),
+      stride == 0 ? ~std::uint64_t{0} : std::numeric_limits<std::uint32_t>::max());
 }
 
 namespace {
@@ -666,16 +684,6 @@ Result<OpenFiles> openWorkFiles(const PartitionOptions& options, std::size_t str
   return files;
 }
 
-// The most points a node split in memory may have.
-std::uint64_t inMemoryPoints(const PartitionOptions& options, std::size_t stride) {
-  // A point in memory: its record, and with extras their bytes twice (read, gathered) and an id.
-  const std::uint64_t pointBytes = sizeof(CloudPoint) + (stride == 0 ? 0 : 2 * stride + 4);
-  // Ids are 32-bit: no node is split in memory with more points than they count.
-  return std::min<std::uint64_t>(
-      std::max<std::uint64_t>(options.blockSize, options.memoryBytes / pointBytes),
-      stride == 0 ? ~std::uint64_t{0} : std::numeric_limits<std::uint32_t>::max());
-}
-
 }  // namespace
 
 Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
@@ -688,6 +696,8 @@ Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
   const std::size_t stride = partition.info.extras.stride;
   if (stride != 0) partition.extrasPath = options.workDirectory + "/b.extras";
   Result<OpenFiles> files = openWorkFiles(options, stride);
+  // In a job the others are at the first level's agreement: they learn of it there.
+  if (!files && share.parts > 1) LODFORGE_TRY(share.agree(files.status()));
   if (!files) return files.status();
   return splitStreamedLevels(PartNode{"b", 0, read.count, read.bounds, read.sum},
                              inMemoryPoints(options, stride), files->view(read.layout, stride),

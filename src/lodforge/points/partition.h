@@ -212,6 +212,9 @@ struct LevelShare {
   std::function<Result<std::vector<std::uint64_t>>(std::span<const std::uint64_t>)> gather;
   std::function<void(std::uint64_t)> levelDone;
 };
+// The most points a node split in memory may have (`stride`: extra bytes a point): larger ones
+// are split by streamed passes.
+std::uint64_t inMemoryPoints(const PartitionOptions& options, std::size_t stride);
 Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
                                                    const PartitionOptions& options,
                                                    Partition& partition,

@@ -2,32 +2,24 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <chrono>
-#include <filesystem>
 #include <map>
 #include <mutex>
 #include <numeric>
 #include <optional>
-#include <type_traits>
 
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/cluster.h"
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
-#include "lodforge/core/output_claim.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/tiles/point_steps.h"
 #include "lodforge/tiles/tileset.h"
-#include "lodforge/tiles/tileset_output.h"
 
 namespace lodforge {
-
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -50,25 +42,15 @@ Vec3d vecOf(const nlohmann::json& j) {
   return Vec3d{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
 }
 
-// A rank's share of the nodes: the largest first, each to the rank with the fewest points so
-// far (ties: the lower rank), the same on every rank.
+// A rank's share of the nodes (dealLargestFirst by their points), in name order as given.
 std::vector<PartitionNode> nodeShare(std::span<const PartitionNode> nodes, int rank, int ranks) {
-  std::vector<std::size_t> order(nodes.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return nodes[a].count > nodes[b].count; });
-  std::vector<std::uint64_t> load(static_cast<std::size_t>(ranks), 0);
-  std::vector<std::uint8_t> mine(nodes.size(), 0);
-  for (const std::size_t i : order) {
-    const auto least =
-        static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
-    load[least] += nodes[i].count + 1;
-    mine[i] = least == static_cast<std::size_t>(rank) ? 1 : 0;
-  }
+  std::vector<std::uint64_t> work;
+  for (const PartitionNode& node : nodes) work.push_back(node.count + 1);
+  const std::vector<int> owner = dealLargestFirst(work, ranks);
   std::vector<PartitionNode> out;
   for (std::size_t i = 0; i < nodes.size(); ++i)
-    if (mine[i] != 0) out.push_back(nodes[i]);
-  return out;  // in name order, as given
+    if (owner[i] == rank) out.push_back(nodes[i]);
+  return out;
 }
 
 // A rank's ranked blocks for rank 0: where each lies and its errors.
@@ -255,10 +237,7 @@ class RankedPoints {
 
   // The points the streamed levels go over: the input once per level above the allowance.
   std::uint64_t streamedPoints(const PartitionOptions& options) const {
-    const std::uint64_t pointBytes =
-        sizeof(CloudPoint) + (info_.extras.stride == 0 ? 0 : 2 * info_.extras.stride + 4);
-    const std::uint64_t inMemory =
-        std::max<std::uint64_t>(options.blockSize, options.memoryBytes / pointBytes);
+    const std::uint64_t inMemory = inMemoryPoints(options, info_.extras.stride);
     std::uint64_t total = 0;
     for (std::uint64_t n = read_.count; n > inMemory; n = (n + 1) / 2) total += read_.count;
     return total;

@@ -316,15 +316,11 @@ std::vector<const TileNode*> contentShare(const std::map<std::string, TileNode>&
   for (const auto& [name, node] : nodes)
     if (!node.uri.empty()) withContent.push_back(&node);
   if (share.ranks <= 1) return withContent;
-  std::vector<const TileNode*> largestFirst = withContent;
-  std::stable_sort(largestFirst.begin(), largestFirst.end(),
-                   [](const TileNode* a, const TileNode* b) { return a->points > b->points; });
-  std::vector<std::uint64_t> load(static_cast<std::size_t>(share.ranks), 0);
-  for (const TileNode* node : largestFirst) {
-    const auto least = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
-    load[static_cast<std::size_t>(least)] += node->points + 1;
-    if (least == share.rank) mine.push_back(node);
-  }
+  std::vector<std::uint64_t> work;  // + 1: tiles of few points are spread too
+  for (const TileNode* node : withContent) work.push_back(node->points + 1);
+  const std::vector<int> owner = dealLargestFirst(work, share.ranks);
+  for (std::size_t i = 0; i < withContent.size(); ++i)
+    if (owner[i] == share.rank) mine.push_back(withContent[i]);
   return mine;
 }
 

@@ -4,6 +4,8 @@
 #include <cassert>
 #include <optional>
 
+#include "lodforge/core/cluster.h"
+
 namespace lodforge {
 namespace {
 
@@ -19,23 +21,23 @@ std::vector<std::uint64_t> subtreeWork(const std::vector<OctreeNode>& nodes,
   return work;
 }
 
-// The nodes of `level` dealt out largest first to the least loaded rank (longest processing
-// time first: within 4/3 of the best possible busiest rank); ties by node order, so every rank
-// computes the same share. Returns each rank's work.
+// The nodes of `level` dealt out largest first to the least loaded rank (dealLargestFirst).
+// Returns each rank's work.
 std::vector<std::uint64_t> dealLevel(const std::vector<OctreeNode>& nodes,
                                      std::span<const std::uint64_t> work, int level, int ranks,
                                      std::vector<int>& owner) {
-  std::vector<std::uint64_t> load(static_cast<std::size_t>(ranks), 0);
   std::vector<std::uint32_t> roots;
+  std::vector<std::uint64_t> rootWork;
   for (std::uint32_t i = 0; i < nodes.size(); ++i)
-    if (nodes[i].level == level) roots.push_back(i);
-  std::stable_sort(roots.begin(), roots.end(),
-                   [&](std::uint32_t a, std::uint32_t b) { return work[a] > work[b]; });
-  for (std::uint32_t root : roots) {
-    const auto least =
-        static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
-    owner[root] = static_cast<int>(least);
-    load[least] += work[root];
+    if (nodes[i].level == level) {
+      roots.push_back(i);
+      rootWork.push_back(work[i]);
+    }
+  const std::vector<int> dealt = dealLargestFirst(rootWork, ranks);
+  std::vector<std::uint64_t> load(static_cast<std::size_t>(ranks), 0);
+  for (std::size_t k = 0; k < roots.size(); ++k) {
+    owner[roots[k]] = dealt[k];
+    load[static_cast<std::size_t>(dealt[k])] += rootWork[k];
   }
   return load;
 }

@@ -770,51 +770,56 @@ billion_section() {
 }
 if [[ ${BENCH_ONLY:-} == billion ]]; then billion_section; exit 0; fi
 
-# Ranks against threads (issue 39): the same input tiled by one process with 2 threads and by an
-# OpenMPI job of 2 ranks with 1 thread each (each rank bound to its core, mpirun's default),
-# alternately; wall time, each rank's peak memory (a /usr/bin/time per rank), outputs compared.
-# A scan (DISTRIBUTED_TRIANGLES) and an airborne LAS (DISTRIBUTED_POINTS); DISTRIBUTED_ONLY=scan
-# or points runs one.
-ranks_against_threads() {  # the input; prints the table and rank 0's -v lines for the ranks
-  local input=$1 runs=${DISTRIBUTED_RUNS:-3}
-  local mpi=(mpirun --allow-run-as-root -np 2)
+# Ranks against threads (issue 39): the same input tiled (or reconstructed) by one process with
+# 2 threads and by an OpenMPI job of 2 ranks with 1 thread each (each rank bound to its core,
+# mpirun's default), alternately; wall time, each rank's peak memory (a /usr/bin/time per rank),
+# outputs compared. A scan (DISTRIBUTED_TRIANGLES), an airborne LAS (DISTRIBUTED_POINTS) and a
+# cloud's surface (`reconstruct`, DISTRIBUTED_SURFACE_POINTS); DISTRIBUTED_ONLY=scan, points or
+# surface runs one.
+ranks_against_threads() {  # the input, the subcommand, the output's suffix; the table, -v lines
+  local input=$1 command=$2 suffix=$3 runs=${DISTRIBUTED_RUNS:-3}
+  local mpi=(mpirun --allow-run-as-root -np 2) one_out="$work/dist-one$suffix" ranks_out="$work/dist-ranks$suffix"
   printf '| run | 1 process x 2 threads | peak RSS | 2 ranks x 1 thread | peak RSS rank 0 / 1 | ranks / threads |\n|---|---:|---:|---:|---:|---:|\n'
   for run in $(seq "$runs"); do
     # Each run starts with the page cache's dirty pages written out (sync): a 1 GB tileset
     # still being flushed slows whichever run comes next.
-    rm -rf "$work"/dist-one "$work"/dist-ranks
+    rm -rf "$one_out" "$ranks_out"
     sync
-    read -r one kib < <(timed "$lodforge" -q --threads 2 tiles "$input" -o "$work/dist-one")
+    read -r one kib < <(timed "$lodforge" -q --threads 2 "$command" "$input" -o "$one_out")
     sync
     # Each rank under its own /usr/bin/time, the job's wall time from one around mpirun.
     /usr/bin/time -f "%e" -o "$work/dist-time" "${mpi[@]}" \
       sh -c '/usr/bin/time -f "%M" -o "$0-$OMPI_COMM_WORLD_RANK" "$@"' "$work/dist-rank" \
-      "$lodforge" -q --threads 1 tiles "$input" -o "$work/dist-ranks"
+      "$lodforge" -q --threads 1 "$command" "$input" -o "$ranks_out"
     local ranks
     ranks=$(cat "$work/dist-time")
-    diff -rq "$work/dist-one" "$work/dist-ranks" > /dev/null || { echo "the two tilesets differ" >&2; exit 1; }
+    diff -rq "$one_out" "$ranks_out" > /dev/null || { echo "the two outputs differ" >&2; exit 1; }
     printf '| %d | %.2f s | %d MiB | %.2f s | %d / %d MiB | %.3f |\n' "$run" "$one" $((kib / 1024)) "$ranks" \
       $(($(cat "$work/dist-rank-0") / 1024)) $(($(cat "$work/dist-rank-1") / 1024)) "$(echo "$ranks / $one" | bc -l)"
   done
-  rm -rf "$work"/dist-ranks
-  "${mpi[@]}" "$lodforge" -v --threads 1 tiles "$input" -o "$work/dist-ranks" 2>&1 |
+  rm -rf "$ranks_out"
+  "${mpi[@]}" "$lodforge" -v --threads 1 "$command" "$input" -o "$ranks_out" 2>&1 |
     grep -E "^(rank|2 ranks|streamed)"
-  rm -rf "$work"/dist-one "$work"/dist-ranks "$work"/dist-rank-* "$work/dist-time"
+  rm -rf "$one_out" "$ranks_out" "$work"/dist-rank-* "$work/dist-time"
 }
-distributed_input() {  # kind (scan or points), what it is, its file, then `generate` arguments
-  local kind=$1 label=$2 file=$3
-  shift 3
+distributed_input() {  # kind (scan, points or surface), what it is, its file, the subcommand,
+  # the output's suffix, then `generate` arguments
+  local kind=$1 label=$2 file=$3 command=$4 suffix=$5
+  shift 5
   [[ ${DISTRIBUTED_ONLY:-$kind} == "$kind" ]] || return 0
   echo
-  echo "== ranks against threads: $label, 1 process x 2 threads and 2 ranks x 1 thread"
+  echo "== ranks against threads: $command $label, 1 process x 2 threads and 2 ranks x 1 thread"
   "$lodforge" -q generate "$@" -o "$file"
-  ranks_against_threads "$file"
+  ranks_against_threads "$file" "$command" "$suffix"
   rm -f "$file"
 }
 distributed_section() {
   local n=${DISTRIBUTED_TRIANGLES:-10M} points=${DISTRIBUTED_POINTS:-20M}
-  distributed_input scan "a $n-triangle scan" "$work/dist-scan.ply" scan --triangles "$n"
-  distributed_input points "a $points-point LAS" "$work/dist-points.las" points --points "$points"
+  local surface=${DISTRIBUTED_SURFACE_POINTS:-2M}
+  distributed_input scan "a $n-triangle scan" "$work/dist-scan.ply" tiles "" scan --triangles "$n"
+  distributed_input points "a $points-point LAS" "$work/dist-points.las" tiles "" points --points "$points"
+  distributed_input surface "a $surface-point LAS (no normals)" "$work/dist-surface.las" reconstruct .ply \
+    points --points "$surface"
 }
 if [[ ${BENCH_ONLY:-} == distributed ]]; then distributed_section; exit 0; fi
 

@@ -73,10 +73,10 @@ Status checkThreads(Global& global) {
 Status checkClusterCommand(const CLI::App& app) {
   if (!clustered()) return {};
   for (const CLI::App* command : app.get_subcommands())
-    if (command->get_name() != "tiles")
+    if (command->get_name() != "tiles" && command->get_name() != "reconstruct")
       return Error{ErrorKind::kUsage,
-                   fmt::format("`{}` runs as one process; only `tiles` runs across the ranks of "
-                               "an mpirun or srun job (docs/distributed.md)",
+                   fmt::format("`{}` runs as one process; only `tiles` and `reconstruct` run "
+                               "across the ranks of an mpirun or srun job (docs/distributed.md)",
                                command->get_name())};
   return {};
 }

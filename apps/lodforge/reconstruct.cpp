@@ -1,11 +1,13 @@
 // `lodforge reconstruct CLOUD -o mesh.ply`: a surface from a point cloud, chunk by chunk
 // (large-meshes paper §3.1, §3.3; docs/surface.md).
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 
 #include <fmt/format.h>
 
 #include "cli.h"
+#include "lodforge/core/cluster.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
 #include "lodforge/core/units.h"
@@ -16,6 +18,23 @@
 #include "surface_options.h"
 
 namespace lodforge::cli {
+
+namespace {
+
+// -v for a job of several ranks: the chunks each made, and when each step was done.
+void reportRanks(const Global& global, const ReconstructStats& stats) {
+  const auto [least, most] = std::minmax_element(stats.rankChunks.begin(), stats.rankChunks.end());
+  const auto [first, last] =
+      std::minmax_element(stats.rankMadeSeconds.begin(), stats.rankMadeSeconds.end());
+  detail(global, fmt::format("{} ranks: the points sorted into runs by rank 0 (done at {:.1f} s); "
+                             "the runs made by the ranks, {} to {} chunks a rank (each done at "
+                             "{:.1f} to {:.1f} s); joined by rank 0 (done at {:.1f} s)",
+                             stats.rankChunks.size(), stats.sortedSeconds, formatCount(*least),
+                             formatCount(*most), *first, *last, stats.joinedSeconds));
+  for (const std::string& line : stats.rankStages) detail(global, line);
+}
+
+}  // namespace
 
 void addReconstruct(CLI::App& app, const Global& global, Run& run) {
   struct Options {
@@ -53,18 +72,22 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
                                  options->input)};
       Result<ReconstructOptions> reconstruct = surfaceOptions(options->surface, options->input);
       if (!reconstruct) return reconstruct.status();
-      LODFORGE_TRY(claimOutput(options->output, modelFileOutput(options->output),
-                               std::vector<std::string>{options->input}));
+      // In a job, rank 0 claims the output for all (docs/distributed.md).
+      LODFORGE_TRY(agreeAcrossRanks(
+          clusterRank() != 0 ? Status{}
+                             : claimOutput(options->output, modelFileOutput(options->output),
+                                           std::vector<std::string>{options->input})));
       reconstruct->memoryLimit = global.memoryLimit;
       reconstruct->salvageTruncated = options->salvage;
       reconstruct->resumable = true;
       reconstruct->resume = options->resume;
+      reconstruct->acrossRanks = clustered();
       Result<ReconstructStats> mesh =
           reconstructToFile(options->input, options->output, *reconstruct);
       if (!mesh) {
         std::error_code ignored;
         const std::string work = reconstructWorkDirectory(options->output);
-        if (std::filesystem::exists(reconstructStatePath(work), ignored))
+        if (clusterRank() == 0 && std::filesystem::exists(reconstructStatePath(work), ignored))
           fmt::print(stderr,
                      "lodforge: the finished runs of chunks are kept in {}: run again with "
                      "--resume to continue, or delete it\n",
@@ -77,15 +100,16 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       say(global,
           fmt::format("wrote {}: {} triangles, {} vertices from {} points in {:.2f} s "
-                      "(voxel {:g}, {} chunks in {} runs{}{}{})",
+                      "(voxel {:g}, {} chunks in {} run{}{}{}{})",
                       options->output, formatCount(mesh->triangles), formatCount(mesh->vertices),
                       formatCount(mesh->points), seconds, mesh->grid.voxel,
-                      formatCount(mesh->chunks), mesh->runs,
+                      formatCount(mesh->chunks), mesh->runs, mesh->runs == 1 ? "" : "s",
                       mesh->resumedRuns > 0 ? fmt::format(", {} resumed", mesh->resumedRuns) : "",
                       mesh->estimatedNormals ? ", normals estimated" : "",
                       mesh->droppedPieces > 0
                           ? fmt::format(", {} small pieces dropped", mesh->droppedPieces)
                           : ""));
+      if (!mesh->rankChunks.empty()) reportRanks(global, *mesh);
       detail(global, fmt::format("peak memory {}", formatBytes(peakRssBytes())));
       return Status{};
     };

@@ -278,14 +278,28 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
   return {};
 }
 
+// How a job of several ranks came by its chunks, for -v.
+std::string chunkedBy(const TilesStats& stats) {
+  if (stats.resumed) return "the chunks resumed";
+  if (stats.readInSlices) return "the input read in slices by every rank";
+  if (!stats.surface || stats.surface->rankChunks.empty()) return "the input chunked by rank 0";
+  const std::vector<std::uint64_t>& chunks = stats.surface->rankChunks;
+  const auto [least, most] = std::minmax_element(chunks.begin(), chunks.end());
+  return fmt::format(
+      "the surface's runs made by the ranks, {} to {} chunks a rank, and joined "
+      "by rank 0",
+      formatCount(*least), formatCount(*most));
+}
+
 void reportMeshTiles(const Global& global, const TilesCommand& options, const TilesStats& stats) {
   if (stats.surface) {
     const ReconstructStats& surface = *stats.surface;
     say(global,
         fmt::format("reconstructed {} triangles from {} points (voxel {:g}, chunks of {} voxels, "
-                    "{} runs{}{}{})",
+                    "{} run{}{}{}{})",
                     formatCount(surface.triangles), formatCount(surface.points),
                     surface.grid.voxel / surface.unitScale, surface.chunkVoxels, surface.runs,
+                    surface.runs == 1 ? "" : "s",
                     surface.resumedRuns > 0 ? fmt::format(", {} resumed", surface.resumedRuns) : "",
                     surface.estimatedNormals ? ", normals estimated" : "",
                     surface.droppedPieces > 0
@@ -323,18 +337,14 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
                                formatCount(stats.builtNodes), formatCount(stats.takenNodes)));
   if (stats.ranks > 1) {
     const auto [least, most] = std::minmax_element(stats.rankWork.begin(), stats.rankWork.end());
-    detail(
-        global,
-        fmt::format("{} ranks: {}; subtrees under level {}, {} to {} leaf triangles a rank, "
-                    "then the levels above shared level by level; octree {:.1f} s, then the "
-                    "tileset on rank 0 {:.1f} s; peak memory of rank 0 {}",
-                    stats.ranks,
-                    stats.resumed        ? "the chunks resumed"
-                    : stats.readInSlices ? "the input read in slices by every rank"
-                                         : "the input chunked by rank 0",
-                    stats.splitLevel, formatCount(*least), formatCount(*most), stats.octreeSeconds,
-                    stats.seconds - stats.chunkSeconds - stats.octreeSeconds,
-                    formatBytes(peakRssBytes())));
+    detail(global,
+           fmt::format("{} ranks: {}; subtrees under level {}, {} to {} leaf triangles a rank, "
+                       "then the levels above shared level by level; octree {:.1f} s, then the "
+                       "tileset on rank 0 {:.1f} s; peak memory of rank 0 {}",
+                       stats.ranks, chunkedBy(stats), stats.splitLevel, formatCount(*least),
+                       formatCount(*most), stats.octreeSeconds,
+                       stats.seconds - stats.chunkSeconds - stats.octreeSeconds,
+                       formatBytes(peakRssBytes())));
     for (const std::string& line : stats.rankStages) detail(global, line);
   }
 }

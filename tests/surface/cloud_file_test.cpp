@@ -85,6 +85,29 @@ TEST(MergeNormals, AFileCutShortIsAnErrorNamingIt) {
   }
 }
 
+// Counts taken from the files' sizes (a job's ranks wrote them): a file that lost whole records
+// leaves a point without a normal, and one with a record too many a normal without a point;
+// both are I/O errors naming what is missing.
+TEST(MergeNormals, CountsFromSizesStillFindAShortOrALongFile) {
+  for (const bool shorter : {true, false}) {
+    test::TempDir dir;
+    writeCloud(dir.file("cloud.points"), shorter ? 1'000 : 999);
+    std::vector<OwnedNormalFile> files = writeNormals(dir, 1'000, 2);
+    if (shorter) std::filesystem::resize_file(files[1].path, 400 * sizeof(OwnedNormal));
+    for (OwnedNormalFile& file : files)
+      file.records = std::filesystem::file_size(file.path) / sizeof(OwnedNormal);
+    const Status merged = mergeNormals(dir.file("cloud.points"), files);
+    ASSERT_FALSE(merged.ok()) << shorter;
+    EXPECT_EQ(merged.error().kind, ErrorKind::kIo) << merged.error().message;
+    EXPECT_EQ(merged.error().message,
+              shorter ? dir.file("cloud.points") +
+                            ": point 801 has no normal (is a normals file of the work directory "
+                            "cut short?)"
+                      : files[1].path + ": a normal for point 999, which " +
+                            dir.file("cloud.points") + " does not have");
+  }
+}
+
 // A file that cannot be read (a directory in its place) is an I/O error naming it.
 TEST(MergeNormals, AFileThatCannotBeReadIsAnErrorNamingIt) {
   test::TempDir dir;

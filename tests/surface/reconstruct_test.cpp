@@ -7,9 +7,11 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
+#include <unistd.h>
 
 #include "lodforge/core/distance.h"
 #include "lodforge/core/mesh.h"
+#include "lodforge/core/output_claim.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/terrain.h"
 #include "lodforge/io/mesh/ply_reader.h"
@@ -299,6 +301,57 @@ TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
     EXPECT_EQ(back->positions[v], toFloat(memory->positions[v] - back->origin)) << v;
   EXPECT_EQ(back->indices, memory->indices);
   EXPECT_EQ(test::listFolder(dir.path()).size(), 3u);  // the cloud and two meshes
+}
+
+// The path a job's ranks take (acrossRanks), as a job of one: the normals estimated run by run
+// into files merged from the runs' list (chunks denser than a run in parts), every run made into
+// its pieces file, then all replayed in chunk order into the join, the same bytes as the plain
+// path, and the work gone when done. A run on an output whose work another run holds is refused,
+// naming that run, and leaves its work alone.
+TEST(Reconstruct, TheRanksPathAsAJobOfOneWritesTheSameMesh) {
+  test::TempDir dir;
+  const std::string cloud = writeCloud(dir, "cloud.ply", terrainSamples(12'000, 95), false, true);
+  ReconstructOptions options;
+  options.voxel = 1.1;
+  options.chunkVoxels = 9;
+  options.normals.orientation = NormalOrientation::kUp;
+  options.resumable = true;
+  options.runPoints = 800;  // 137 runs, 38 of them a chunk denser than a run may hold
+  Result<ReconstructStats> plain = reconstructToFile(cloud, dir.file("plain.ply"), options);
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  ASSERT_GT(plain->runs, 10u);
+  EXPECT_TRUE(plain->estimatedNormals);
+  EXPECT_TRUE(plain->rankChunks.empty());
+  options.acrossRanks = true;
+  Result<ReconstructStats> job = reconstructToFile(cloud, dir.file("job.ply"), options);
+  ASSERT_TRUE(job.ok()) << job.error().message;
+  EXPECT_EQ(test::readFile(dir.file("job.ply")), test::readFile(dir.file("plain.ply")));
+  ASSERT_EQ(job->rankChunks.size(), 1u);
+  EXPECT_GT(job->rankChunks[0], job->runs);
+  EXPECT_LE(job->rankChunks[0], job->chunks);
+  EXPECT_EQ(job->triangles, plain->triangles);
+  EXPECT_GT(job->streamedChunks, 10u);  // dense chunks: their normals in parts
+  EXPECT_EQ(job->streamedChunks, plain->streamedChunks);
+  EXPECT_LE(job->sortedSeconds, job->madeSeconds);
+  EXPECT_LE(job->madeSeconds, job->joinedSeconds);
+  EXPECT_FALSE(std::filesystem::exists(reconstructWorkDirectory(dir.file("job.ply"))));
+
+  const std::string held = reconstructWorkDirectory(dir.file("held.ply"));
+  ASSERT_TRUE(claimWorkDirectory(held).ok());
+  Result<WorkLock> lock = lockWorkDirectory(held);
+  ASSERT_TRUE(lock.ok());
+  for (const bool ranks : {false, true}) {
+    options.acrossRanks = ranks;
+    Result<ReconstructStats> refused = reconstructToFile(cloud, dir.file("held.ply"), options);
+    ASSERT_FALSE(refused.ok());
+    EXPECT_EQ(refused.error().kind, ErrorKind::kUsage);
+    EXPECT_NE(
+        refused.error().message.find(fmt::format("another lodforge run (pid {} on", ::getpid())),
+        std::string::npos)
+        << refused.error().message;
+    EXPECT_TRUE(std::filesystem::exists(held + "/.lodforge-lock"));
+    EXPECT_FALSE(std::filesystem::exists(dir.file("held.ply")));
+  }
 }
 
 // Stops a reconstruction at its n-th piece, as Ctrl-C would; counts the pieces until then.

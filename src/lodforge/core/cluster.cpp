@@ -2,6 +2,7 @@
 
 #include <numeric>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -159,6 +160,17 @@ bool clusterFailureAgreed() {
 }
 int clusterSize() {
   return size;
+}
+
+Result<bool> claimInJob(const std::string& path) {
+  if (!clustered()) return true;  // a job of one has no one to share with
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd >= 0) {
+    ::close(fd);
+    return true;
+  }
+  if (errno == EEXIST) return false;
+  return ioErrorFromErrno(path, "claim");
 }
 
 std::string describeRank() {

@@ -91,6 +91,12 @@ std::vector<std::string> rankStages();
 // every rank computes the same deal. The rank of each item.
 std::vector<int> dealLargestFirst(std::span<const std::uint64_t> work, int ranks);
 
+// Whether this rank is the first of the job to claim `path`, a file created exclusively on the
+// file system every rank shares (work the ranks take in turn, whoever is free first); always, and
+// no file, in a job of one. Claims are the caller's to remove before a job claims the same work
+// again.
+Result<bool> claimInJob(const std::string& path);
+
 // A name for this rank in messages: "rank 2 of 4 (host, pid 1234)".
 std::string describeRank();
 

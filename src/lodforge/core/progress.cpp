@@ -92,7 +92,7 @@ Progress::Progress(std::string label, std::uint64_t total, Unit unit)
     : label_(std::move(label)),
       total_(total),
       unit_(unit),
-      mode_(gMode.load()),
+      mode_(label_.empty() ? ProgressMode::kOff : gMode.load()),
       start_(std::chrono::steady_clock::now()) {
   if (mode_ == ProgressMode::kAuto) mode_ = ::isatty(2) ? ProgressMode::kBar : ProgressMode::kLines;
   nextDrawMs_ = kQuietMs;

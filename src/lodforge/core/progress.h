@@ -37,6 +37,7 @@ enum class ProgressMode : std::uint8_t { kAuto, kBar, kLines, kOff };
 // Process-wide choice (the CLI sets kOff for -q); kAuto picks a bar when stderr is a terminal.
 void setProgressMode(ProgressMode mode);
 
+// One with no label shows nothing: a share of work that another bar shows (a job's, JobProgress).
 class Progress {
  public:
   enum class Unit : std::uint8_t { kCount, kBytes };

@@ -461,8 +461,8 @@ Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t i
   int levels = 0;
   for (std::uint64_t n = root.count; n > inMemory; n = (n + 1) / 2) ++levels;
   // A job shows its own progress (LevelShare::levelDone): this bar would see one process's part.
-  Progress progress("points: streamed splits",
-                    share.parts > 1 ? 0 : root.count * static_cast<std::uint64_t>(levels));
+  Progress progress(share.parts > 1 ? "" : "points: streamed splits",
+                    root.count * static_cast<std::uint64_t>(levels));
   std::uint64_t splitHere = 0;
   std::vector<PartNode> level, small;
   level.push_back(std::move(root));

@@ -189,9 +189,11 @@ Status mergeNormals(const std::string& cloudPath, const std::vector<OwnedNormalF
     if (!streams[s]->done()) heads.emplace(streams[s]->head().id, s);
   LODFORGE_TRY(rewriteNormals(cloudPath, [&](std::span<CloudRecord> block) -> Status {
     for (CloudRecord& record : block) {
+      // (Counts taken from the files' sizes, a job's ranks', make a file cut short land here.)
       if (heads.empty() || heads.top().first != record.id)
-        return Error{ErrorKind::kInternal,
-                     fmt::format("{}: point {} has no normal", cloudPath, record.id)};
+        return Error{ErrorKind::kIo, fmt::format("{}: point {} has no normal (is a normals file "
+                                                 "of the work directory cut short?)",
+                                                 cloudPath, record.id)};
       const std::size_t from = heads.top().second;
       heads.pop();
       NormalStream& s = *streams[from];
@@ -201,6 +203,10 @@ Status mergeNormals(const std::string& cloudPath, const std::vector<OwnedNormalF
     }
     return Status{};
   }));
+  if (!heads.empty())
+    return Error{ErrorKind::kIo,
+                 fmt::format("{}: a normal for point {}, which {} does not have",
+                             files[heads.top().second].path, heads.top().first, cloudPath)};
   std::error_code ignored;
   for (const OwnedNormalFile& file : files) std::filesystem::remove(file.path, ignored);
   return {};

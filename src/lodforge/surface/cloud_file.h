@@ -82,7 +82,8 @@ struct OwnedNormalFile {
 
 // Sets every record's normal in the record file from `files` (together one normal per record),
 // then removes them. A file that cannot be read, or holds fewer normals than were written to
-// it, is an I/O error naming it and where it ends.
+// it, is an I/O error naming it and where it ends; so is a record left without a normal (files
+// whose counts were taken from their sizes) or a normal left without a record.
 Status mergeNormals(const std::string& cloudPath, const std::vector<OwnedNormalFile>& files);
 
 // The median distance from a point to its nearest other point, over up to `samples` points

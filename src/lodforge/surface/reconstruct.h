@@ -49,6 +49,13 @@ struct ReconstructOptions {
   bool resume = false;
   // Names what `transform` does (a CRS), for the resume identity.
   std::string placement;
+  // Every rank of an MPI job (core/cluster) calls with the same input, work directory and options,
+  // and they share the runs (docs/distributed.md): rank 0 sorts the points into runs and saves
+  // the state; each rank makes the runs dealt to it (largest first by their points) into their
+  // pieces files; rank 0 replays every run's pieces in chunk order into its sink, which so sees
+  // what one process would give it (the other ranks' sinks see nothing). Each step's outcome is
+  // agreed between the ranks.
+  bool acrossRanks = false;
   // Applied to every input point before anything else (a CRS to a local frame, in metres);
   // false: the point cannot be placed, which is bad input. Given normals turn with it.
   std::function<bool(Vec3d, Vec3d&)> transform;
@@ -66,8 +73,14 @@ struct ReconstructStats {
   std::uint64_t streamedChunks = 0;  // chunks denser than a run, streamed from their run file
   std::uint64_t resumedRuns = 0;     // runs whose pieces an interrupted reconstruction kept
   bool estimatedNormals = false;
-  bool hasColors = false;             // the points had colours, and so do the vertices
-  std::vector<std::string> warnings;  // the input's reading (CloudSummary::warnings)
+  bool hasColors = false;  // the points had colours, and so do the vertices
+  // A job's (acrossRanks): the chunks each rank made, and the seconds from the start at which
+  // rank 0 had sorted the points, the ranks had made their runs and rank 0 had joined them.
+  std::vector<std::uint64_t> rankChunks;
+  std::vector<double> rankMadeSeconds;  // when each rank was done with its runs
+  double sortedSeconds = 0, madeSeconds = 0, joinedSeconds = 0;
+  std::vector<std::string> rankStages;  // rank 0's: what each rank read and wrote by stage
+  std::vector<std::string> warnings;    // the input's reading (CloudSummary::warnings)
 };
 
 // The mesh in memory (tests, small clouds): pieces joined by vertex name.
@@ -80,7 +93,8 @@ struct ReconstructedMesh : ReconstructStats {
 
 // Reads `input` (any point format) and hands every chunk's piece to `sink` in chunk order, out
 // of core, with its work files in `workDirectory` (which must exist; they are removed as they
-// are used). Fills the layout's figures; the sink counts what it keeps.
+// are used). Fills the layout's figures; the sink counts what it keeps. With
+// options.acrossRanks, every rank calls it (rank 0's sink gets the pieces).
 Result<ReconstructStats> reconstructPieces(const std::string& input,
                                            const std::string& workDirectory,
                                            const ReconstructOptions& options, PieceSink& sink);
@@ -94,7 +108,9 @@ std::string reconstructWorkDirectory(const std::string& output);
 // Reads `input` (any point format) and writes the surface to `output` as binary PLY, out of
 // core: the pieces joined by vertex name. No surface at all is bad input (nothing written).
 // With options.resumable, an interruption after the points are sorted keeps the work directory
-// (reconstructWorkDirectory) for options.resume.
+// (reconstructWorkDirectory) for options.resume; it is locked while in use, so a second run on
+// the same output is refused. With options.acrossRanks (which needs options.resumable: the ranks
+// share that directory), every rank calls it and rank 0 writes the mesh.
 Result<ReconstructStats> reconstructToFile(const std::string& input, const std::string& output,
                                            const ReconstructOptions& options);
 

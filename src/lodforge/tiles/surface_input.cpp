@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "lodforge/core/cluster.h"
 #include "lodforge/core/directory.h"
 #include "lodforge/surface/layout.h"
 #include "lodforge/surface/resume_state.h"
@@ -113,17 +114,21 @@ Result<ChunkInput> surfaceChunkInput(const std::string& path, const ChunkInputOp
   // The chunk store's buffer is held beside the reconstruction.
   if (reconstruct.memoryLimit > 0)
     reconstruct.memoryLimit -= std::min(reconstruct.memoryLimit / 2, options.chunkBufferBytes);
-  ScopedDirectory work(surfaceWorkDirectory(options.workDirectory));
+  // In a job, rank 0's: the directory it removes when done.
+  const bool lead = !reconstruct.acrossRanks || clusterRank() == 0;
+  const std::string workPath = surfaceWorkDirectory(options.workDirectory);
+  ScopedDirectory work(lead ? workPath : std::string());
   std::error_code error;
-  std::filesystem::create_directories(work.path, error);
-  if (error) return ioError(work.path, fmt::format("cannot create: {}", error.message()));
+  if (lead) std::filesystem::create_directories(workPath, error);
+  if (error) return ioError(workPath, fmt::format("cannot create: {}", error.message()));
   LeafChunkSink sink(options, reconstruct.minTriangles);
-  Result<ReconstructStats> made = reconstructPieces(path, work.path, reconstruct, sink);
+  Result<ReconstructStats> made = reconstructPieces(path, workPath, reconstruct, sink);
   if (!made) {
     if (surfaceWorkKept(options.workDirectory)) work.path.clear();
     return made.status();
   }
   stats = *made;
+  if (!lead) return ChunkInput{};
   stats.triangles = sink.triangles();
   stats.droppedPieces = sink.droppedPieces();
   if (sink.triangles() == 0) return noSurface(path, stats.grid.voxel / stats.unitScale);

@@ -21,7 +21,9 @@ bool surfaceWorkKept(const std::string& tilesWorkDirectory);
 
 // The chunks of `path`'s surface (work files under options.workDirectory). options.transform
 // places the points; options.chunkBufferBytes and keepInMemory are the chunk store's.
-// `stats` receives the reconstruction's figures. No surface at all is bad input.
+// `stats` receives the reconstruction's figures. No surface at all is bad input. With
+// reconstruct.acrossRanks every rank of the job calls it; rank 0 gets the chunks, the others an
+// empty ChunkInput (they take rank 0's chunks after).
 Result<ChunkInput> surfaceChunkInput(const std::string& path, const ChunkInputOptions& options,
                                      ReconstructOptions reconstruct, ReconstructStats& stats);
 

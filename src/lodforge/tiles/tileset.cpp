@@ -458,7 +458,8 @@ class RankedTiles {
     if (!jobResumed_) {
       Result<bool> sliced = readInSlices(run);
       if (!sliced) return sliced.status();
-      if (!*sliced) {
+      if (!*sliced && options_.surface) LODFORGE_TRY(surfaceTogether(run));
+      if (!*sliced && !options_.surface) {
         reportActivity(lead_ ? "chunking the input" : "waiting for rank 0 to chunk the input");
         LODFORGE_TRY(agreeAcrossRanks(lead_ ? chunkOnLead(run) : Status{}));
       }
@@ -496,6 +497,24 @@ class RankedTiles {
         agreeAcrossRanks(lead_ ? recordChunks(path_, options_, run, *chunked_) : Status{}));
     stats_.readInSlices = true;
     return true;
+  }
+
+  // A surface: every rank makes its share of the reconstruction's runs and rank 0 joins them into
+  // the chunks (surface_input.h).
+  Status surfaceTogether(const RunPlan& run) {
+    ReconstructOptions surface = resumableSurface(options_, run.input);
+    surface.acrossRanks = true;
+    Result<ChunkInput> chunks =
+        surfaceChunkInput(path_, run.input, surface, stats_.surface.emplace());
+    Status finished = chunks ? Status{} : run.crs->error.ok() ? chunks.status() : run.crs->error;
+    if (lead_ && chunks) {
+      chunked_ = std::move(*chunks);
+      finished = recordChunks(path_, options_, run, *chunked_);
+      if (finished.ok())
+        finished =
+            prepareTexturing(*chunked_, options_, run.octree, place_->work.path, false, texturing_);
+    }
+    return agreeAcrossRanks(finished);
   }
 
   // Rank 0 alone: the input chunked, a textured input's pyramids made.

@@ -774,11 +774,13 @@ if [[ ${BENCH_ONLY:-} == billion ]]; then billion_section; exit 0; fi
 # 2 threads and by an OpenMPI job of 2 ranks with 1 thread each (each rank bound to its core,
 # mpirun's default), alternately; wall time, each rank's peak memory (a /usr/bin/time per rank),
 # outputs compared. A scan (DISTRIBUTED_TRIANGLES), an airborne LAS (DISTRIBUTED_POINTS) and a
-# cloud's surface (`reconstruct`, DISTRIBUTED_SURFACE_POINTS); DISTRIBUTED_ONLY=scan, points or
-# surface runs one.
+# cloud's surface (`reconstruct`, DISTRIBUTED_SURFACE_POINTS), and the LAS as LAZ when
+# LAZ_COMPRESS is set; DISTRIBUTED_ONLY=scan, points, laz or surface runs one. DISTRIBUTED_MPIRUN_ARGS goes to mpirun ("--mca pml ob1": OpenMPI's
+# shared-memory transport without UCX's start-up, docs/distributed.md).
 ranks_against_threads() {  # the input, the subcommand, the output's suffix; the table, -v lines
-  local input=$1 command=$2 suffix=$3 runs=${DISTRIBUTED_RUNS:-3}
-  local mpi=(mpirun --allow-run-as-root -np 2) one_out="$work/dist-one$suffix" ranks_out="$work/dist-ranks$suffix"
+  local input=$1 command=$2 suffix=$3 runs=${DISTRIBUTED_RUNS:-3} extra
+  read -ra extra <<< "${DISTRIBUTED_MPIRUN_ARGS:-}"
+  local mpi=(mpirun --allow-run-as-root -np 2 "${extra[@]}") one_out="$work/dist-one$suffix" ranks_out="$work/dist-ranks$suffix"
   printf '| run | 1 process x 2 threads | peak RSS | 2 ranks x 1 thread | peak RSS rank 0 / 1 | ranks / threads |\n|---|---:|---:|---:|---:|---:|\n'
   for run in $(seq "$runs"); do
     # Each run starts with the page cache's dirty pages written out (sync): a 1 GB tileset
@@ -809,7 +811,13 @@ distributed_input() {  # kind (scan, points or surface), what it is, its file, t
   [[ ${DISTRIBUTED_ONLY:-$kind} == "$kind" ]] || return 0
   echo
   echo "== ranks against threads: $command $label, 1 process x 2 threads and 2 ranks x 1 thread"
-  "$lodforge" -q generate "$@" -o "$file"
+  if [[ $file == *.laz ]]; then  # lodforge writes no LAZ: LAZ_COMPRESS makes it from a LAS
+    "$lodforge" -q generate "$@" -o "${file%.laz}.las"
+    "$LAZ_COMPRESS" "${file%.laz}.las" "$file" > /dev/null
+    rm -f "${file%.laz}.las"
+  else
+    "$lodforge" -q generate "$@" -o "$file"
+  fi
   ranks_against_threads "$file" "$command" "$suffix"
   rm -f "$file"
 }
@@ -818,6 +826,9 @@ distributed_section() {
   local surface=${DISTRIBUTED_SURFACE_POINTS:-2M}
   distributed_input scan "a $n-triangle scan" "$work/dist-scan.ply" tiles "" scan --triangles "$n"
   distributed_input points "a $points-point LAS" "$work/dist-points.las" tiles "" points --points "$points"
+  # The same points as LAZ when LAZ_COMPRESS names a compressor (the potree section's).
+  [[ -z ${LAZ_COMPRESS:-} ]] ||
+    distributed_input laz "a $points-point LAZ" "$work/dist-points.laz" tiles "" points --points "$points"
   distributed_input surface "a $surface-point LAS (no normals)" "$work/dist-surface.las" reconstruct .ply \
     points --points "$surface"
 }

@@ -122,12 +122,21 @@ awk -v s="$shares" 'BEGIN { n = split(s, a, " "); if (n != 3) exit 1; lo = a[1];
   for (i = 1; i <= n; ++i) { t += a[i]; if (a[i] < lo) lo = a[i]; if (a[i] > hi) hi = a[i] }
   exit !(t == 400000 && lo >= 0.8 * hi) }' ||
   fail "the partition was not shared among the ranks: $(cat large.err)"
-# A LAZ file is read by rank 0 alone (its records are not at fixed places); the rest is shared.
+# A LAZ file is read in slices too, each rank decoding from the chunk that holds its first point
+# (autzen_trim.laz: chunks of 50,000, 50,000 and 10,000 points; slices of 65,536).
 "$lodforge" -q tiles "$data/points/autzen_trim.laz" -o laz-1 --block-size 5000
 "${mpi[@]}" -np 2 "$lodforge" -v tiles "$data/points/autzen_trim.laz" -o laz-np2 --block-size 5000 \
   2> laz.err
-same laz-np2 laz-1 "LAZ, read by rank 0, 2 ranks"
-grep -q "2 ranks: the input read by rank 0 (done at" laz.err || fail "the LAZ was read in slices: $(cat laz.err)"
+same laz-np2 laz-1 "LAZ, read in slices, 2 ranks"
+grep -q "2 ranks: the input read in slices by every rank (done at" laz.err ||
+  fail "the LAZ was not read in slices: $(cat laz.err)"
+# A text cloud has no records at known places: rank 0 reads it alone, the rest is shared.
+awk 'BEGIN { for (i = 0; i < 4000; ++i) printf "%.3f %.3f %.3f\n", i % 80, int(i / 80), sin(i / 50) }' > text.xyz
+"$lodforge" -q tiles text.xyz -o text-1 --block-size 500
+"${mpi[@]}" -np 2 "$lodforge" -v tiles text.xyz -o text-np2 --block-size 500 2> text.err
+same text-np2 text-1 "text cloud, read by rank 0, 2 ranks"
+grep -q "2 ranks: the input read by rank 0 (done at" text.err ||
+  fail "the text cloud was not read by rank 0: $(cat text.err)"
 # A rank killed while ranking: the job stops, rank 0 says what rank 1 was doing, and nothing is
 # left behind (a point tileset has no --resume: the same command builds it again).
 set +e

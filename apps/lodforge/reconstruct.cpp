@@ -10,6 +10,7 @@
 #include "lodforge/core/cluster.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/memory.h"
+#include "lodforge/core/output_claim.h"
 #include "lodforge/core/units.h"
 #include "lodforge/io/points/point_reader.h"
 #include "lodforge/surface/reconstruct.h"
@@ -87,7 +88,9 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
       if (!mesh) {
         std::error_code ignored;
         const std::string work = reconstructWorkDirectory(options->output);
-        if (clusterRank() == 0 && std::filesystem::exists(reconstructStatePath(work), ignored))
+        // Not where another run holds the work (this one was refused), and once for a job.
+        if (clusterRank() == 0 && std::filesystem::exists(reconstructStatePath(work), ignored) &&
+            !workDirectoryLocked(work))
           fmt::print(stderr,
                      "lodforge: the finished runs of chunks are kept in {}: run again with "
                      "--resume to continue, or delete it\n",

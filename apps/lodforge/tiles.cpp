@@ -221,10 +221,12 @@ Result<TilesOptions> meshTilesOptions(const Global& global, const TilesCommand& 
 // -v for a job of several ranks: each rank's share of the ranking and of the tiles, its stages.
 void reportPointRanks(const Global& global, const PointTilesStats& stats) {
   std::string shares;
-  for (std::size_t r = 0; r < stats.rankPoints.size(); ++r)
-    shares += fmt::format("{}rank {} split and ranked {} points, wrote {} tiles",
-                          r == 0 ? "" : "; ", r, formatCount(stats.rankPoints[r]),
-                          formatCount(r < stats.rankTiles.size() ? stats.rankTiles[r] : 0));
+  for (std::size_t r = 0; r < stats.rankPoints.size(); ++r) {
+    const std::uint64_t tiles = r < stats.rankTiles.size() ? stats.rankTiles[r] : 0;
+    shares +=
+        fmt::format("{}rank {} split and ranked {} points, wrote {} tile{}", r == 0 ? "" : "; ", r,
+                    formatCount(stats.rankPoints[r]), formatCount(tiles), tiles == 1 ? "" : "s");
+  }
   detail(global,
          fmt::format("{} ranks: the input read {} (done at {:.1f} s); the partition's large "
                      "nodes split level by level by the ranks ({:.1f} s), the rest split and "
@@ -264,11 +266,11 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
     fmt::print(stderr, "lodforge: warning: {}\n", warning);
   warnIfNotPlaced(global, !stats->crs.empty() || points.origin.has_value());
   say(global,
-      fmt::format("wrote {}: a point tileset of {} points in {} tiles ({} blocks, depth {}), "
+      fmt::format("wrote {}: a point tileset of {} points in {} tile{} ({} blocks, depth {}), "
                   "{} in {:.1f} s ({} points/s){}",
                   options.output, formatCount(stats->points), formatCount(stats->tiles),
-                  formatCount(stats->blocks), stats->depth, formatBytes(stats->outputBytes),
-                  stats->seconds,
+                  stats->tiles == 1 ? "" : "s", formatCount(stats->blocks), stats->depth,
+                  formatBytes(stats->outputBytes), stats->seconds,
                   formatCount(static_cast<std::uint64_t>(static_cast<double>(stats->points) /
                                                          std::max(stats->seconds, 1e-9))),
                   stats->crs.empty() ? "" : "; placed on Earth from its coordinate system"));

@@ -87,6 +87,7 @@ TEST(ResumeState, TheStateComesBackOnlyForTheSameIdentity) {
   state.runs.chunks = {1, 4, 9, 100};
   state.runs.points = {10, 20, 30, 40};
   state.runs.firstChunk = {0, 2, 4};
+  state.runBudget = 25;
   state.points = 12345;
   state.hasColors = true;
   const nlohmann::json identity = {{"input", "/a/b.laz"}, {"voxel", 0.7}};
@@ -101,12 +102,17 @@ TEST(ResumeState, TheStateComesBackOnlyForTheSameIdentity) {
   EXPECT_EQ(back->runs.chunks, state.runs.chunks);
   EXPECT_EQ(back->runs.points, state.runs.points);
   EXPECT_EQ(back->runs.firstChunk, state.runs.firstChunk);
+  EXPECT_EQ(back->runBudget, 25u);
   EXPECT_EQ(back->points, 12345u);
   EXPECT_TRUE(back->hasColors);
   EXPECT_FALSE(back->estimatedNormals);
   EXPECT_FALSE(loadReconstructState(path, {{"input", "/a/b.laz"}, {"voxel", 0.8}}).has_value());
   ReconstructState odd = state;  // runs that do not start at the first chunk
   odd.runs.firstChunk = {1, 2, 4};
+  ASSERT_TRUE(saveReconstructState(path, identity, odd).ok());
+  EXPECT_FALSE(loadReconstructState(path, identity).has_value());
+  odd = state;  // no budget to find the dense chunks by
+  odd.runBudget = 0;
   ASSERT_TRUE(saveReconstructState(path, identity, odd).ok());
   EXPECT_FALSE(loadReconstructState(path, identity).has_value());
   odd = state;  // a chunk outside the lattice

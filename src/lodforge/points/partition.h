@@ -162,10 +162,10 @@ struct InputRead {
 };
 
 // A job's first pass (point_ranks.h): process 0 makes the work files at their full size
-// (createInputFiles: kUnsupported for an input not read in slices: LAZ, text, ascii PLY, a file
-// to salvage); each process reads its slice of whole batches into them (inputSlice,
-// readInputSlice); every process adds up all the slices in order (addSlices) before the
-// partition's job steps below.
+// (createInputFiles: kUnsupported for an input not read in slices: text, ascii PLY, a LAZ file
+// without a chunk table, a file to salvage); each process reads its slice of whole batches into
+// them (inputSlice, readInputSlice); every process adds up all the slices in order (addSlices)
+// before the partition's job steps below.
 constexpr std::size_t kInputBatchPoints = std::size_t{1} << 16;
 struct SliceRead {
   std::uint64_t count = 0;

@@ -50,11 +50,13 @@ struct ReconstructOptions {
   // Names what `transform` does (a CRS), for the resume identity.
   std::string placement;
   // Every rank of an MPI job (core/cluster) calls with the same input, work directory and options,
-  // and they share the runs (docs/distributed.md): rank 0 sorts the points into runs and saves
-  // the state; each rank makes the runs dealt to it (largest first by their points) into their
-  // pieces files; rank 0 replays every run's pieces in chunk order into its sink, which so sees
-  // what one process would give it (the other ranks' sinks see nothing). Each step's outcome is
-  // agreed between the ranks.
+  // and they share the runs (docs/distributed.md, surface/reconstruct_ranks.h): rank 0 sorts the
+  // points into runs and saves the state, the ranks estimating missing normals run by run; the
+  // ranks make the runs, each taken by the first rank free, into their pieces files; rank 0
+  // replays every run's pieces in chunk order into its sink, which so sees what one process
+  // would give it (the other ranks' sinks see nothing). Each step's outcome is agreed between
+  // the ranks. With a memory limit the runs' size follows rank 0's threads (the grids in
+  // flight), so one process writes the same bytes when it has as many threads as rank 0.
   bool acrossRanks = false;
   // Applied to every input point before anything else (a CRS to a local frame, in metres);
   // false: the point cannot be placed, which is bad input. Given normals turn with it.

@@ -36,18 +36,19 @@ Status forgetClaims(const std::string& workDirectory) {
 }
 
 // A job's runs: the state, and which runs an interrupted job finished (their pieces kept, taken
-// when resuming), the same on every rank.
+// when resuming), as rank 0 found them.
 struct JobRuns {
   ReconstructState state;
   std::vector<char> kept;
 };
 
-std::vector<char> keptRuns(const ChunkRuns& runs, const std::string& workDirectory,
-                           const ReconstructOptions& options) {
-  std::vector<char> kept(runs.runCount(), 0);
+// Rank 0: the runs whose pieces an interrupted job kept, when resuming.
+std::vector<std::uint64_t> keptRuns(const ChunkRuns& runs, const std::string& workDirectory,
+                                    const ReconstructOptions& options) {
+  std::vector<std::uint64_t> kept;
   std::error_code error;
-  for (std::size_t r = 0; r < kept.size() && options.resume; ++r)
-    kept[r] = std::filesystem::exists(piecesPath(workDirectory, r), error) ? 1 : 0;
+  for (std::size_t r = 0; r < runs.runCount() && options.resume; ++r)
+    if (std::filesystem::exists(piecesPath(workDirectory, r), error)) kept.push_back(r);
   return kept;
 }
 
@@ -102,19 +103,18 @@ Status normalsShare(const ReconstructState& plan, const ReconstructOptions& opti
     if (!claimed) return claimed.status();
     if (!*claimed) continue;
     std::vector<OwnedNormalFile> files;
-    LODFORGE_TRY(runNormals(plan.layout, runs, r, options, workDirectory, files));
+    LODFORGE_TRY(runNormals(plan.layout, runs, r, plan.runBudget, options, workDirectory, files));
     reportProgress("runs", ++made);
   }
   return {};
 }
 
 // Rank 0, once the ranks' normals are written: every run's merged into the record file.
-Status mergeRunNormals(const Sorting& sorting, const ReconstructOptions& options,
-                       const std::string& workDirectory) {
+Status mergeRunNormals(const Sorting& sorting, const std::string& workDirectory) {
   std::vector<OwnedNormalFile> files;
   for (std::size_t r = 0; r < sorting.runs.runCount(); ++r) {
     Result<std::vector<OwnedNormalFile>> run =
-        runNormalFiles(sorting.layout, sorting.runs, r, options, workDirectory);
+        runNormalFiles(sorting.layout, sorting.runs, r, sorting.budget, workDirectory);
     if (!run) return run.status();
     files.insert(files.end(), run->begin(), run->end());
   }
@@ -137,7 +137,7 @@ Status normalsTogether(const std::string& input, const std::string& workDirector
                                plan->runs.runCount());
     LODFORGE_TRY(agreeAcrossRanks(normalsShare(*plan, options, workDirectory)));
   }
-  return agreeAcrossRanks(lead ? mergeRunNormals(*sorting, options, workDirectory) : Status{});
+  return agreeAcrossRanks(lead ? mergeRunNormals(*sorting, workDirectory) : Status{});
 }
 
 // Rank 0's last part: the runs' files written and the state saved for the others (or an
@@ -157,8 +157,8 @@ Result<ReconstructState> finishOnLead(const std::string& input, const std::strin
 }
 
 // Sorted by rank 0 (the normals estimated by the ranks), or an interrupted job's state taken,
-// then read by the other ranks. Every rank looks for kept runs before the last agreement, after
-// which runs are made.
+// then read by the other ranks, each checking that its chunks in flight fit its memory limit;
+// rank 0's list of the kept runs given to all before any run is made.
 Result<JobRuns> stateOnEveryRank(const std::string& input, const std::string& workDirectory,
                                  const ReconstructOptions& options) {
   const bool lead = clusterRank() == 0;
@@ -177,10 +177,17 @@ Result<JobRuns> stateOnEveryRank(const std::string& input, const std::string& wo
   LODFORGE_TRY(agreeAcrossRanks(lead ? state.status() : Status{}));
   if (!lead)
     state = savedByLead(reconstructStatePath(workDirectory), input, workDirectory, options);
-  std::vector<char> kept;
-  if (state) kept = keptRuns(state->runs, workDirectory, options);
+  if (!lead && state) {
+    const Status fits = checkChunkFits(state->layout, options, input);
+    if (!fits.ok()) state = fits.error();
+  }
   LODFORGE_TRY(agreeAcrossRanks(state.status()));
-  return JobRuns{std::move(*state), std::move(kept)};
+  Result<std::vector<std::uint64_t>> kept = gatherAcrossRanks(
+      lead ? keptRuns(state->runs, workDirectory, options) : std::vector<std::uint64_t>{});
+  if (!kept) return kept.status();
+  std::vector<char> flags(state->runs.runCount(), 0);
+  for (const std::uint64_t r : *kept) flags.at(static_cast<std::size_t>(r)) = 1;
+  return JobRuns{std::move(*state), std::move(flags)};
 }
 
 // A job's runs, claimed by the ranks one at a time, the largest (by points, overlaps included)

@@ -311,10 +311,9 @@ Status denseChunkNormals(const std::string& runFile, const ChunkLayout& layout, 
 }  // namespace
 
 Status runNormals(const ChunkLayout& layout, const ChunkRuns& runs, std::size_t r,
-                  const ReconstructOptions& options, const std::string& directory,
-                  std::vector<OwnedNormalFile>& files) {
+                  std::uint64_t budget, const ReconstructOptions& options,
+                  const std::string& directory, std::vector<OwnedNormalFile>& files) {
   const std::string runFile = runPath(directory, r);
-  const std::uint64_t budget = runBudget(layout, options);
   if (isDenseRun(runs, r, budget)) {
     LODFORGE_TRY(denseChunkNormals(runFile, layout, runs.chunks[runs.firstChunk[r]],
                                    runs.points[runs.firstChunk[r]], budget, options,
@@ -334,10 +333,9 @@ Status runNormals(const ChunkLayout& layout, const ChunkRuns& runs, std::size_t 
 
 Result<std::vector<OwnedNormalFile>> runNormalFiles(const ChunkLayout& layout,
                                                     const ChunkRuns& runs, std::size_t r,
-                                                    const ReconstructOptions& options,
+                                                    std::uint64_t budget,
                                                     const std::string& directory) {
   std::vector<std::string> paths;
-  const std::uint64_t budget = runBudget(layout, options);
   if (isDenseRun(runs, r, budget)) {
     const std::array<std::uint64_t, 2> cuts =
         denseCuts(layout, runs.points[runs.firstChunk[r]], budget);
@@ -420,7 +418,8 @@ Result<Sorting> planSorting(const std::string& input, const std::string& workDir
   if (!layout) return layout.status();
   LODFORGE_TRY(checkChunkFits(*layout, options, input));
   const double reach = options.distance.radius + 1;
-  Result<ChunkRuns> runs = planRuns(sorting.cloudPath, *layout, reach, runBudget(*layout, options));
+  sorting.budget = runBudget(*layout, options);
+  Result<ChunkRuns> runs = planRuns(sorting.cloudPath, *layout, reach, sorting.budget);
   if (!runs) return runs.status();
   sorting.cloud = std::move(*cloud);
   sorting.layout = *layout;
@@ -438,8 +437,8 @@ Result<Sorting> planSorting(const std::string& input, const std::string& workDir
 
 ReconstructState stateOf(const Sorting& sorting) {
   const CloudSummary& cloud = sorting.cloud;
-  return ReconstructState{sorting.layout,    sorting.runs,    cloud.count,   cloud.hasColors,
-                          !cloud.hasNormals, cloud.unitScale, cloud.warnings};
+  return ReconstructState{sorting.layout,  sorting.runs,      sorting.budget,  cloud.count,
+                          cloud.hasColors, !cloud.hasNormals, cloud.unitScale, cloud.warnings};
 }
 
 Result<ReconstructState> finishSorting(const Sorting& sorting, const std::string& workDirectory,
@@ -463,7 +462,7 @@ Status estimateNormalsByRun(const Sorting& sorting, const ReconstructOptions& op
   std::vector<OwnedNormalFile> files;
   Progress progress("reconstruct: normals", runs.runCount());
   for (std::size_t r = 0; r < runs.runCount(); ++r) {
-    LODFORGE_TRY(runNormals(layout, runs, r, options, directory, files));
+    LODFORGE_TRY(runNormals(layout, runs, r, sorting.budget, options, directory, files));
     progress.advance(1);
   }
   progress.finish();

@@ -48,16 +48,17 @@ Status makeChunks(const ChunkLayout& layout, std::span<const CloudRecord> record
                   std::vector<SurfacePiece>* pieces);
 
 // Run r's normals: each owned point's from its neighbours in the run (a run of one chunk denser
-// than a run may hold in parts); the files of owned normals appended to `files`.
+// than `budget`, the one the runs were cut with, in parts); the files of owned normals appended
+// to `files`.
 Status runNormals(const ChunkLayout& layout, const ChunkRuns& runs, std::size_t r,
-                  const ReconstructOptions& options, const std::string& directory,
-                  std::vector<OwnedNormalFile>& files);
+                  std::uint64_t budget, const ReconstructOptions& options,
+                  const std::string& directory, std::vector<OwnedNormalFile>& files);
 
 // The files runNormals wrote for run r, their counts from their sizes (what a rank of a job wrote:
 // mergeNormals then finds a normal missing from a file cut short).
 Result<std::vector<OwnedNormalFile>> runNormalFiles(const ChunkLayout& layout,
                                                     const ChunkRuns& runs, std::size_t r,
-                                                    const ReconstructOptions& options,
+                                                    std::uint64_t budget,
                                                     const std::string& directory);
 
 // What the runs depend on: a resumed reconstruction takes earlier work only when this is
@@ -76,6 +77,7 @@ struct Sorting {
   CloudSummary cloud;
   ChunkLayout layout;
   ChunkRuns runs;
+  std::uint64_t budget = 0;  // runBudget: what the runs were cut with, and dense chunks found by
   bool normalsByRun = false;
 };
 

@@ -13,7 +13,8 @@ namespace lodforge {
 
 namespace {
 
-constexpr int kStateFormat = 2;  // 2: the unit scale (lengths in the cloud's units)
+// 2: the unit scale (lengths in the cloud's units); 3: the run budget the runs were cut with.
+constexpr int kStateFormat = 3;
 
 struct PieceHeader {
   std::uint64_t chunk = 0, vertices = 0, indices = 0, colors = 0;
@@ -29,8 +30,9 @@ bool readArray(std::FILE* file, std::vector<T>& values, std::uint64_t count) {
 // taken).
 bool wellFormed(const ReconstructState& state) {
   const ChunkRuns& runs = state.runs;
-  bool ok = state.layout.n > 0 && state.layout.grid.voxel > 0 && !runs.firstChunk.empty() &&
-            runs.firstChunk.front() == 0 && runs.firstChunk.back() == runs.chunks.size() &&
+  bool ok = state.layout.n > 0 && state.layout.grid.voxel > 0 && state.runBudget > 0 &&
+            !runs.firstChunk.empty() && runs.firstChunk.front() == 0 &&
+            runs.firstChunk.back() == runs.chunks.size() &&
             runs.points.size() == runs.chunks.size();
   for (std::size_t a = 0; a < 3; ++a)
     ok = ok && state.layout.chunks[a] > 0 && state.layout.grid.corners[a] > 0;
@@ -61,6 +63,7 @@ Status saveReconstructState(const std::string& path, const nlohmann::json& ident
                                {"runChunks", state.runs.chunks},
                                {"runPoints", state.runs.points},
                                {"firstChunk", state.runs.firstChunk},
+                               {"runBudget", state.runBudget},
                                {"points", state.points},
                                {"hasColors", state.hasColors},
                                {"estimatedNormals", state.estimatedNormals},
@@ -88,6 +91,7 @@ std::optional<ReconstructState> loadReconstructState(const std::string& path,
     state.runs.chunks = json.at("runChunks").get<std::vector<std::uint64_t>>();
     state.runs.points = json.at("runPoints").get<std::vector<std::uint64_t>>();
     state.runs.firstChunk = json.at("firstChunk").get<std::vector<std::size_t>>();
+    state.runBudget = json.at("runBudget").get<std::uint64_t>();
     state.points = json.at("points").get<std::uint64_t>();
     state.hasColors = json.at("hasColors").get<bool>();
     state.estimatedNormals = json.at("estimatedNormals").get<bool>();

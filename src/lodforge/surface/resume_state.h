@@ -23,6 +23,9 @@ namespace lodforge {
 struct ReconstructState {
   ChunkLayout layout;
   ChunkRuns runs;
+  // The points a run held when the runs were cut: which chunks are dense, and so in how many
+  // parts their normals were estimated (every rank of a job must take the same).
+  std::uint64_t runBudget = 0;
   std::uint64_t points = 0;
   bool hasColors = false, estimatedNormals = false;
   double unitScale = 1;  // the frame's length of one of the cloud's units (CloudSummary)

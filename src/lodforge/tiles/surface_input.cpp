@@ -120,11 +120,17 @@ Result<ChunkInput> surfaceChunkInput(const std::string& path, const ChunkInputOp
   ScopedDirectory work(lead ? workPath : std::string());
   std::error_code error;
   if (lead) std::filesystem::create_directories(workPath, error);
-  if (error) return ioError(workPath, fmt::format("cannot create: {}", error.message()));
+  Status created =
+      error ? Status(ioError(workPath, fmt::format("cannot create: {}", error.message())))
+            : Status();
+  // (In a job the others wait in the reconstruction's steps: rank 0's failure is agreed first.)
+  if (reconstruct.acrossRanks) created = agreeAcrossRanks(created);
+  LODFORGE_TRY(created);
   LeafChunkSink sink(options, reconstruct.minTriangles);
   Result<ReconstructStats> made = reconstructPieces(path, workPath, reconstruct, sink);
   if (!made) {
-    if (surfaceWorkKept(options.workDirectory)) work.path.clear();
+    // (A job saves its state for the ranks whether or not it can be resumed.)
+    if (reconstruct.resumable && surfaceWorkKept(options.workDirectory)) work.path.clear();
     return made.status();
   }
   stats = *made;

@@ -1,10 +1,12 @@
 // LAZ decoding: the real LAZ and COPC files in ../shared/data decode to exactly the records of
 // their LAS twins.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstring>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "lodforge/io/points/las_reader.h"
@@ -38,6 +40,54 @@ TEST(Laz, PointwiseChunkedVersion2DecodesToTheLasRecords) {
   ASSERT_EQ(las.size(), 110000u * 34);
   ASSERT_EQ(laz.size(), las.size());
   EXPECT_EQ(firstDifference(laz, las), las.size()) << "record " << firstDifference(laz, las) / 34;
+}
+
+// The records of points [first, first + count) read through restrictTo (the batches read by one
+// rank of a job): a slice of `path`.
+std::vector<std::byte> sliceRecords(const std::string& path, std::uint64_t first,
+                                    std::uint64_t count, std::size_t batch) {
+  Result<LasReader> reader = LasReader::open(path, batch);
+  EXPECT_TRUE(reader.ok()) << reader.status().message();
+  std::vector<std::byte> all, records;
+  if (!reader.ok()) return all;
+  const Status restricted = reader->restrictTo(first, count);
+  EXPECT_TRUE(restricted.ok()) << restricted.message();
+  while (true) {
+    Result<bool> more = reader->nextRecords(records);
+    EXPECT_TRUE(more.ok()) << more.status().message();
+    if (!more.ok() || !*more) break;
+    all.insert(all.end(), records.begin(), records.end());
+  }
+  return all;
+}
+
+// A slice of a LAZ file is decoded from the chunk that holds its first point (autzen_trim.laz:
+// chunks of 50,000, 50,000 and 10,000 points; the COPC file: layered chunks) and is the whole
+// file's records there: at a chunk's start, inside one, across two, in the last, at the end.
+TEST(Laz, ASliceIsTheWholeFilesRecordsThere) {
+  for (const char* name : {"points/autzen_trim.laz", "points/1.2-with-color.copc.laz"}) {
+    const std::string path = test::dataPath(name);
+    const std::vector<std::byte> whole = allRecords(path);
+    Result<LasReader> probe = LasReader::open(path, 1);
+    ASSERT_TRUE(probe.ok());
+    const std::uint64_t points = probe->header().pointCount;
+    const std::size_t length = probe->header().recordLength;
+    ASSERT_EQ(whole.size(), points * length);
+    for (const auto& [first, count] :
+         std::vector<std::pair<std::uint64_t, std::uint64_t>>{{0, 1},
+                                                              {points / 2, 7},
+                                                              {49'990, 30},
+                                                              {12'345, 70'000},
+                                                              {points - 5, 100},
+                                                              {points, 3}}) {
+      SCOPED_TRACE(fmt::format("{} [{}, +{})", name, first, count));
+      const std::uint64_t end = std::min(points, first + count);
+      const std::vector<std::byte> slice = sliceRecords(path, first, count, 1000);
+      ASSERT_EQ(slice.size(), (end - std::min(first, end)) * length);
+      EXPECT_TRUE(std::equal(slice.begin(), slice.end(),
+                             whole.begin() + static_cast<std::ptrdiff_t>(first * length)));
+    }
+  }
 }
 
 TEST(Laz, PointwiseVersion1DecodesToTheLasRecords) {
@@ -192,6 +242,15 @@ TEST(Laz, AMissingChunkTableIsToleratedAsLaszipDoes) {
     all.insert(all.end(), records.begin(), records.end());
   }
   EXPECT_TRUE(all == allRecords(test::dataPath("points/autzen_trim.las")));
+  // Without a table a slice would decode every chunk before it: refused, so that a job's rank 0
+  // reads the file alone.
+  Result<LasReader> sliced = LasReader::fromMemory(span, "untabled.laz");
+  ASSERT_TRUE(sliced.ok());
+  const Status restricted = sliced->restrictTo(60'000, 10);
+  ASSERT_FALSE(restricted.ok());
+  EXPECT_EQ(restricted.kind(), ErrorKind::kUnsupported);
+  EXPECT_EQ(restricted.message(),
+            "untabled.laz: a LAZ file without a chunk table is not read from a point on");
 }
 
 TEST(Laz, DamagedLayersAreBadInputNamingChunkAndByte) {

@@ -476,12 +476,15 @@ Status LasReader::restrictTo(std::uint64_t first, std::uint64_t count) try {
   State& s = *state_;
   const LasHeader& h = s.header;
   assert(s.nextPoint == 0);
-  if (h.compressed)
-    return Error{ErrorKind::kUnsupported,
-                 fmt::format("{}: a LAZ file is not read in slices", s.source->name())};
   first = std::min(first, h.pointCount);
-  if (!s.source->skip(first * h.recordLength))
+  if (h.compressed && !s.lazPoints)
+    return Error{ErrorKind::kUnsupported,
+                 fmt::format("{}: the header alone was read", s.source->name())};
+  if (h.compressed) {
+    LODFORGE_TRY(s.lazPoints->skipTo(first));
+  } else if (!s.source->skip(first * h.recordLength)) {
     return s.fail(s.source->offset(), fmt::format("the file ends before point {}", first));
+  }
   s.nextPoint = first;
   s.endPoint = first + std::min(count, h.pointCount - first);
   return {};

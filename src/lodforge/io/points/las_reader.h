@@ -71,9 +71,9 @@ class LasReader {
   // The next batch of points (positions, the lidar attributes, colours when the format has
   // them, and the extra bytes the header describes); false at the end of the point records.
   Result<bool> next(PointBatch& batch);
-  // From now on, only points [first, first + count) (clipped to the file's): a slice of an
-  // uncompressed file, reached by seeking (kUnsupported for LAZ, whose records are not at fixed
-  // places). Call before the first batch.
+  // From now on, only points [first, first + count) (clipped to the file's): a slice, reached by
+  // seeking in an uncompressed file and by decoding from the chunk that holds `first` in a LAZ
+  // file (kUnsupported for one without a chunk table). Call before the first batch.
   Status restrictTo(std::uint64_t first, std::uint64_t count);
   // Or the next batch as the point records themselves (record length bytes each, decoded when
   // the file is LAZ); false at the end.

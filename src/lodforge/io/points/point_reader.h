@@ -45,7 +45,8 @@ struct PointReadOptions {
   // info().extras; without, both are empty.
   bool readExtras = true;
   // Only points [first, first + count): a slice of an uncompressed LAS or a binary PLY, reached
-  // by seeking; other inputs (LAZ, text, ascii PLY) refuse a slice (kUnsupported).
+  // by seeking, or of a LAZ file from the chunk that holds `first`; other inputs (text, ascii
+  // PLY, a LAZ file without a chunk table) refuse a slice (kUnsupported).
   std::uint64_t first = 0, count = ~std::uint64_t{0};
 };
 

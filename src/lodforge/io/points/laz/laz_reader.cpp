@@ -134,6 +134,26 @@ Status LazPointStream::State::decodeBatch() {
   return {};
 }
 
+Status LazPointStream::skipTo(std::uint64_t point) {
+  State& s = *state_;
+  if (point == 0) return {};
+  if (!s.table.complete)
+    return Error{ErrorKind::kUnsupported,
+                 fmt::format("{}: a LAZ file without a chunk table is not read from a point on",
+                             s.layout.file)};
+  std::uint64_t start = 0;  // the first point of chunk k
+  std::size_t k = 0;
+  while (k < s.table.chunks.size() && start + s.table.chunks[k].points <= point)
+    start += s.table.chunks[k++].points;
+  s.nextChunk = k;
+  s.decoded.clear();
+  s.handedOut = 0;
+  if (k == s.table.chunks.size()) return {};  // past the last point: nothing left to read
+  LODFORGE_TRY(s.decodeBatch());
+  s.handedOut = static_cast<std::size_t>((point - start) * s.layout.recordLength);
+  return {};
+}
+
 Result<std::span<const std::byte>> LazPointStream::peek() {
   State& s = *state_;
   if (s.handedOut == s.decoded.size() && s.nextChunk < s.table.chunks.size())

@@ -22,6 +22,10 @@ class LazPointStream {
   LazPointStream& operator=(LazPointStream&&) noexcept;
   ~LazPointStream();
 
+  // From record `point` on (call before the first read; a peek may come before): the chunk that
+  // holds it decoded, the records before it dropped. kUnsupported without a chunk table (its
+  // chunks are found only by decoding them in turn).
+  Status skipTo(std::uint64_t point);
   // The next `count` records into `out` (count × record length bytes).
   Status read(std::byte* out, std::uint64_t count);
   // The records decoded ahead and not read yet (a batch is decoded when none are): a look at the

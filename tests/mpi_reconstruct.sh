@@ -8,16 +8,9 @@
 # runs that were done; a job on an output a run is writing is refused.
 set -euo pipefail
 lodforge=$1 out=$2
-command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/install-deps.sh" >&2; exit 1; }
+source "$(dirname "$0")/mpi_common.sh"
 rm -rf "$out" && mkdir -p "$out"
 cd "$out"
-# --allow-run-as-root: CI runs as root. Without LeakSanitizer in the ranks (mpi_tiles.sh says why).
-mpi=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" mpirun --allow-run-as-root --oversubscribe)
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
-same() {  # same FILE REFERENCE WHAT
-  if cmp -s "$1" "$2"; then echo "ok: $3"; else fail "$3: $1 differs from $2"; fi
-}
 
 # 100 K points in 17 runs of chunks (--memory-limit 64M holds about 6 K points a run).
 "$lodforge" -q generate points --points 100K -o cloud.ply
@@ -73,8 +66,7 @@ same killed.ply one.ply "killed rank, then --resume"
 "$lodforge" -q "${limit[@]}" tiles cloud.ply --surface -o surface-1 --chunk-size 100
 "${mpi[@]}" -np 3 "$lodforge" -v "${limit[@]}" tiles cloud.ply --surface -o surface-np3 \
   --chunk-size 100 2> surface.err
-if diff -r surface-np3 surface-1 >/dev/null; then echo "ok: tiles --surface, 3 ranks"; else
-  fail "tiles --surface, 3 ranks: differs from one process"; fi
+same surface-np3 surface-1 "tiles --surface, 3 ranks"
 grep -q "3 ranks: the surface's runs made by the ranks, " surface.err ||
   fail "the surface was not made by the ranks: $(cat surface.err)"
 
@@ -94,5 +86,4 @@ wait $first || fail "the first run failed"
   fail "a job on a busy output: exit $code, $(cat busy.err)"
 same busy.ply one.ply "the first run, beside the refused job"
 
-[[ $failures -eq 0 ]] || { echo "$failures failure(s)" >&2; exit 1; }
-echo "all distributed reconstruction checks passed"
+finish "distributed reconstruction"

@@ -11,19 +11,9 @@ set -euo pipefail
 lodforge=$1 out=$2 sanitized=${3:-0} data=${4:-}
 [[ -d $data/points ]] || { echo "usage: mpi_tiles.sh LODFORGE OUT SANITIZED DATA (the shared data folder)" >&2; exit 1; }
 data=$(cd "$data" && pwd)
-command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/install-deps.sh" >&2; exit 1; }
+source "$(dirname "$0")/mpi_common.sh"
 rm -rf "$out" && mkdir -p "$out"
 cd "$out"
-# --allow-run-as-root: CI runs as root, which OpenMPI otherwise refuses. In the sanitizer tree
-# the ranks run without LeakSanitizer: OpenMPI's components are loaded and unloaded at run time
-# and leave allocations it can only attribute to "<unknown module>" (ours are checked by every
-# other test, which runs the same code in one process).
-mpi=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" mpirun --allow-run-as-root --oversubscribe)
-failures=0
-fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
-same() {  # same TILESET REFERENCE WHAT
-  if diff -r "$1" "$2" >/dev/null; then echo "ok: $3"; else fail "$3: $1 differs from $2"; diff -rq "$1" "$2" | head -5 >&2; fi
-}
 
 "$lodforge" -q generate scan --triangles 300K -o scan.ply
 "$lodforge" -q tiles scan.ply -o scan-1 --chunk-size 60
@@ -230,5 +220,4 @@ set -e
 [[ $code -eq 2 ]] && grep -q "only \`tiles\` and \`reconstruct\` run across" twice.err ||
   fail "generate under mpirun -np 2: exit $code, $(cat twice.err)"
 
-[[ $failures -eq 0 ]] || { echo "$failures failure(s)" >&2; exit 1; }
-echo "all distributed checks passed"
+finish distributed

@@ -303,6 +303,17 @@ TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
   EXPECT_EQ(test::listFolder(dir.path()).size(), 3u);  // the cloud and two meshes
 }
 
+// A terrain of 12,000 points in runs of at most 800 (normals estimated up, kept for --resume).
+ReconstructOptions manyRunsOptions() {
+  ReconstructOptions options;
+  options.voxel = 1.1;
+  options.chunkVoxels = 9;
+  options.runPoints = 800;
+  options.normals.orientation = NormalOrientation::kUp;
+  options.resumable = true;
+  return options;
+}
+
 // The path a job's ranks take (acrossRanks), as a job of one: the normals estimated run by run
 // into files merged from the runs' list (chunks denser than a run in parts), every run made into
 // its pieces file, then all replayed in chunk order into the join, the same bytes as the plain
@@ -311,12 +322,7 @@ TEST(Reconstruct, RunsOfChunksGiveTheSameMeshAsOneRun) {
 TEST(Reconstruct, TheRanksPathAsAJobOfOneWritesTheSameMesh) {
   test::TempDir dir;
   const std::string cloud = writeCloud(dir, "cloud.ply", terrainSamples(12'000, 95), false, true);
-  ReconstructOptions options;
-  options.voxel = 1.1;
-  options.chunkVoxels = 9;
-  options.normals.orientation = NormalOrientation::kUp;
-  options.resumable = true;
-  options.runPoints = 800;  // 137 runs, 38 of them a chunk denser than a run may hold
+  ReconstructOptions options = manyRunsOptions();  // 137 runs, 38 a chunk denser than a run
   Result<ReconstructStats> plain = reconstructToFile(cloud, dir.file("plain.ply"), options);
   ASSERT_TRUE(plain.ok()) << plain.error().message;
   ASSERT_GT(plain->runs, 10u);
@@ -379,12 +385,7 @@ class StoppingSink : public PieceSink {
 TEST(Reconstruct, AnInterruptedReconstructionResumesToTheSameMesh) {
   test::TempDir dir;
   const std::string cloud = writeCloud(dir, "cloud.ply", terrainSamples(12'000, 95), false, true);
-  ReconstructOptions options;
-  options.voxel = 1.1;
-  options.chunkVoxels = 9;
-  options.runPoints = 800;
-  options.normals.orientation = NormalOrientation::kUp;
-  options.resumable = true;
+  ReconstructOptions options = manyRunsOptions();
   const auto reconstruct = [&](const std::string& work, MemoryMeshOutput& out, std::size_t stopAt) {
     std::filesystem::create_directories(work);
     PieceJoiner joiner(0, out);

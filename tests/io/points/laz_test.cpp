@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -15,11 +16,19 @@
 namespace lodforge {
 namespace {
 
-std::vector<std::byte> allRecords(const std::string& path, std::size_t batch = 1 << 16) {
+// The records of `path` in batches of `batch`; only points [first, first + count) when given (a
+// slice through restrictTo, what one rank of a job reads).
+std::vector<std::byte> allRecords(
+    const std::string& path, std::size_t batch = 1 << 16,
+    std::optional<std::pair<std::uint64_t, std::uint64_t>> slice = std::nullopt) {
   Result<LasReader> reader = LasReader::open(path, batch);
   EXPECT_TRUE(reader.ok()) << reader.status().message();
   std::vector<std::byte> all, records;
   if (!reader.ok()) return all;
+  if (slice) {
+    const Status restricted = reader->restrictTo(slice->first, slice->second);
+    EXPECT_TRUE(restricted.ok()) << restricted.message();
+  }
   while (true) {
     Result<bool> more = reader->nextRecords(records);
     EXPECT_TRUE(more.ok()) << more.status().message();
@@ -40,25 +49,6 @@ TEST(Laz, PointwiseChunkedVersion2DecodesToTheLasRecords) {
   ASSERT_EQ(las.size(), 110000u * 34);
   ASSERT_EQ(laz.size(), las.size());
   EXPECT_EQ(firstDifference(laz, las), las.size()) << "record " << firstDifference(laz, las) / 34;
-}
-
-// The records of points [first, first + count) read through restrictTo (the batches read by one
-// rank of a job): a slice of `path`.
-std::vector<std::byte> sliceRecords(const std::string& path, std::uint64_t first,
-                                    std::uint64_t count, std::size_t batch) {
-  Result<LasReader> reader = LasReader::open(path, batch);
-  EXPECT_TRUE(reader.ok()) << reader.status().message();
-  std::vector<std::byte> all, records;
-  if (!reader.ok()) return all;
-  const Status restricted = reader->restrictTo(first, count);
-  EXPECT_TRUE(restricted.ok()) << restricted.message();
-  while (true) {
-    Result<bool> more = reader->nextRecords(records);
-    EXPECT_TRUE(more.ok()) << more.status().message();
-    if (!more.ok() || !*more) break;
-    all.insert(all.end(), records.begin(), records.end());
-  }
-  return all;
 }
 
 // A slice of a LAZ file is decoded from the chunk that holds its first point (autzen_trim.laz:
@@ -82,7 +72,7 @@ TEST(Laz, ASliceIsTheWholeFilesRecordsThere) {
                                                               {points, 3}}) {
       SCOPED_TRACE(fmt::format("{} [{}, +{})", name, first, count));
       const std::uint64_t end = std::min(points, first + count);
-      const std::vector<std::byte> slice = sliceRecords(path, first, count, 1000);
+      const std::vector<std::byte> slice = allRecords(path, 1000, std::pair{first, count});
       ASSERT_EQ(slice.size(), (end - std::min(first, end)) * length);
       EXPECT_TRUE(std::equal(slice.begin(), slice.end(),
                              whole.begin() + static_cast<std::ptrdiff_t>(first * length)));

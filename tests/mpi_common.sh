@@ -1,0 +1,18 @@
+# What the MPI test scripts share (sourced by mpi_tiles.sh and mpi_reconstruct.sh): OpenMPI's
+# mpirun as the tests run it, and the failures counted.
+command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/install-deps.sh" >&2; exit 1; }
+# --allow-run-as-root: CI runs as root, which OpenMPI otherwise refuses. --oversubscribe: more
+# ranks than this machine's cores. In the sanitizer tree the ranks run without LeakSanitizer:
+# OpenMPI's components are loaded and unloaded at run time and leave allocations it can only
+# attribute to "<unknown module>" (ours are checked by every other test, which runs the same
+# code in one process).
+mpi=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" mpirun --allow-run-as-root --oversubscribe)
+failures=0
+fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
+same() {  # same OUTPUT REFERENCE WHAT: a tileset (folder) or a mesh (file), byte for byte
+  if diff -r "$1" "$2" >/dev/null; then echo "ok: $3"; else fail "$3: $1 differs from $2"; diff -rq "$1" "$2" | head -5 >&2; fi
+}
+finish() {  # the verdict, last
+  [[ $failures -eq 0 ]] || { echo "$failures failure(s)" >&2; exit 1; }
+  echo "all $1 checks passed"
+}

@@ -35,16 +35,72 @@ void reportRanks(const Global& global, const ReconstructStats& stats) {
   for (const std::string& line : stats.rankStages) detail(global, line);
 }
 
+struct ReconstructCommand {
+  std::string input, output;
+  SurfaceCommand surface;
+  bool salvage = false;
+  bool resume = false;
+};
+
+// The command once parsed: the surface written, or why not.
+Status runReconstruct(const Global& global, const ReconstructCommand& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (fileExtension(options.output) != "ply")
+    return Error{ErrorKind::kUsage,
+                 fmt::format("{}: reconstruct writes a .ply mesh", options.output)};
+  if (!isPointCloudPath(options.input) && fileExtension(options.input) != "ply")
+    return Error{
+        ErrorKind::kUsage,
+        fmt::format("{}: not a point cloud (.las .laz .ply .xyz .txt .csv .pts)", options.input)};
+  Result<ReconstructOptions> reconstruct = surfaceOptions(options.surface, options.input);
+  if (!reconstruct) return reconstruct.status();
+  // In a job, rank 0 claims the output for all (docs/distributed.md).
+  LODFORGE_TRY(agreeAcrossRanks(clusterRank() != 0
+                                    ? Status{}
+                                    : claimOutput(options.output, modelFileOutput(options.output),
+                                                  std::vector<std::string>{options.input})));
+  reconstruct->memoryLimit = global.memoryLimit;
+  reconstruct->salvageTruncated = options.salvage;
+  reconstruct->resumable = true;
+  reconstruct->resume = options.resume;
+  reconstruct->acrossRanks = clustered();
+  Result<ReconstructStats> mesh = reconstructToFile(options.input, options.output, *reconstruct);
+  if (!mesh) {
+    std::error_code ignored;
+    const std::string work = reconstructWorkDirectory(options.output);
+    // Not where another run holds the work (this one was refused), and once for a job.
+    if (clusterRank() == 0 && std::filesystem::exists(reconstructStatePath(work), ignored) &&
+        !workDirectoryLocked(work))
+      fmt::print(stderr,
+                 "lodforge: the finished runs of chunks are kept in {}: run again with "
+                 "--resume to continue, or delete it\n",
+                 work);
+    return mesh.status();
+  }
+  for (const std::string& warning : mesh->warnings)
+    fmt::print(stderr, "lodforge: warning: {}\n", warning);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  say(global,
+      fmt::format("wrote {}: {} triangles, {} vertices from {} points in {:.2f} s "
+                  "(voxel {:g}, {} chunks in {} run{}{}{}{})",
+                  options.output, formatCount(mesh->triangles), formatCount(mesh->vertices),
+                  formatCount(mesh->points), seconds, mesh->grid.voxel, formatCount(mesh->chunks),
+                  mesh->runs, mesh->runs == 1 ? "" : "s",
+                  mesh->resumedRuns > 0 ? fmt::format(", {} resumed", mesh->resumedRuns) : "",
+                  mesh->estimatedNormals ? ", normals estimated" : "",
+                  mesh->droppedPieces > 0
+                      ? fmt::format(", {} small pieces dropped", mesh->droppedPieces)
+                      : ""));
+  if (!mesh->rankChunks.empty()) reportRanks(global, *mesh);
+  detail(global, fmt::format("peak memory {}", formatBytes(peakRssBytes())));
+  return Status{};
+}
+
 }  // namespace
 
 void addReconstruct(CLI::App& app, const Global& global, Run& run) {
-  struct Options {
-    std::string input, output;
-    SurfaceCommand surface;
-    bool salvage = false;
-    bool resume = false;
-  };
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<ReconstructCommand>();
   // A mesh for use, not for tiling (tiles simplify anyway): thinned unless asked not to.
   options->surface.reconstruct.decimateVoxels = kReconstructDecimateVoxels;
   CLI::App* sub = app.add_subcommand(
@@ -62,60 +118,7 @@ void addReconstruct(CLI::App& app, const Global& global, Run& run) {
                 "Go on from an interrupted run with the same input and options: the runs of "
                 "chunks it finished are kept in OUTPUT.work");
   sub->callback([&global, &run, options] {
-    run = [&global, options]() -> Status {
-      const auto start = std::chrono::steady_clock::now();
-      if (fileExtension(options->output) != "ply")
-        return Error{ErrorKind::kUsage,
-                     fmt::format("{}: reconstruct writes a .ply mesh", options->output)};
-      if (!isPointCloudPath(options->input) && fileExtension(options->input) != "ply")
-        return Error{ErrorKind::kUsage,
-                     fmt::format("{}: not a point cloud (.las .laz .ply .xyz .txt .csv .pts)",
-                                 options->input)};
-      Result<ReconstructOptions> reconstruct = surfaceOptions(options->surface, options->input);
-      if (!reconstruct) return reconstruct.status();
-      // In a job, rank 0 claims the output for all (docs/distributed.md).
-      LODFORGE_TRY(agreeAcrossRanks(
-          clusterRank() != 0 ? Status{}
-                             : claimOutput(options->output, modelFileOutput(options->output),
-                                           std::vector<std::string>{options->input})));
-      reconstruct->memoryLimit = global.memoryLimit;
-      reconstruct->salvageTruncated = options->salvage;
-      reconstruct->resumable = true;
-      reconstruct->resume = options->resume;
-      reconstruct->acrossRanks = clustered();
-      Result<ReconstructStats> mesh =
-          reconstructToFile(options->input, options->output, *reconstruct);
-      if (!mesh) {
-        std::error_code ignored;
-        const std::string work = reconstructWorkDirectory(options->output);
-        // Not where another run holds the work (this one was refused), and once for a job.
-        if (clusterRank() == 0 && std::filesystem::exists(reconstructStatePath(work), ignored) &&
-            !workDirectoryLocked(work))
-          fmt::print(stderr,
-                     "lodforge: the finished runs of chunks are kept in {}: run again with "
-                     "--resume to continue, or delete it\n",
-                     work);
-        return mesh.status();
-      }
-      for (const std::string& warning : mesh->warnings)
-        fmt::print(stderr, "lodforge: warning: {}\n", warning);
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      say(global,
-          fmt::format("wrote {}: {} triangles, {} vertices from {} points in {:.2f} s "
-                      "(voxel {:g}, {} chunks in {} run{}{}{}{})",
-                      options->output, formatCount(mesh->triangles), formatCount(mesh->vertices),
-                      formatCount(mesh->points), seconds, mesh->grid.voxel,
-                      formatCount(mesh->chunks), mesh->runs, mesh->runs == 1 ? "" : "s",
-                      mesh->resumedRuns > 0 ? fmt::format(", {} resumed", mesh->resumedRuns) : "",
-                      mesh->estimatedNormals ? ", normals estimated" : "",
-                      mesh->droppedPieces > 0
-                          ? fmt::format(", {} small pieces dropped", mesh->droppedPieces)
-                          : ""));
-      if (!mesh->rankChunks.empty()) reportRanks(global, *mesh);
-      detail(global, fmt::format("peak memory {}", formatBytes(peakRssBytes())));
-      return Status{};
-    };
+    run = [&global, options]() -> Status { return runReconstruct(global, *options); };
   });
 }
 

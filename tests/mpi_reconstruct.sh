@@ -3,9 +3,9 @@
 # (docs/distributed.md), run by OpenMPI's own mpirun on this one machine (--oversubscribe): rank 0
 # sorts the points into runs, every rank makes its share of the runs, rank 0 joins them. The mesh
 # is byte for byte the one process's with 1 to 3 ranks, also with the normals estimated by the
-# ranks and with more ranks than runs; a rank
-# killed mid-share stops the job naming what it did, and --resume finishes without remaking the
-# runs that were done; a job on an output a run is writing is refused.
+# ranks and with more ranks than runs; a rank killed mid-share stops the job naming what it did,
+# and --resume finishes without remaking the runs that were done (`reconstruct` and `tiles
+# --surface`); a job on an output a run is writing is refused.
 set -euo pipefail
 lodforge=$1 out=$2
 source "$(dirname "$0")/mpi_common.sh"
@@ -69,6 +69,19 @@ same killed.ply one.ply "killed rank, then --resume"
 same surface-np3 surface-1 "tiles --surface, 3 ranks"
 grep -q "3 ranks: the surface's runs made by the ranks, " surface.err ||
   fail "the surface was not made by the ranks: $(cat surface.err)"
+# Its reconstruction stopped by a killed rank resumes too: the kept runs taken, the same tileset.
+set +e
+"${mpi[@]}" -np 1 "$lodforge" "${limit[@]}" tiles cloud.ply --surface -o surface-killed \
+  --chunk-size 100 : -np 1 -x LODFORGE_INTERRUPT_AFTER=run:2:kill "$lodforge" "${limit[@]}" \
+  tiles cloud.ply --surface -o surface-killed --chunk-size 100 > surface-killed.out 2>&1
+code=$?
+set -e
+[[ $code -ne 0 ]] || fail "a surface job with a killed rank exited 0"
+"${mpi[@]}" -np 2 "$lodforge" "${limit[@]}" tiles cloud.ply --surface -o surface-killed \
+  --chunk-size 100 --resume > surface-resumed.out 2>&1
+grep -qE "runs, [1-9][0-9]* resumed" surface-resumed.out ||
+  fail "the surface's kept runs were not taken: $(cat surface-resumed.out)"
+same surface-killed surface-np3 "tiles --surface: killed rank, then --resume"
 
 # A job on an output that a one-process run is writing is refused (exit 2), naming that run,
 # which finishes (held stopped by SIGSTOP while the job tries).

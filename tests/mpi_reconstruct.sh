@@ -7,7 +7,7 @@
 # and --resume finishes without remaking the runs that were done (`reconstruct` and `tiles
 # --surface`); a job on an output a run is writing is refused.
 set -euo pipefail
-lodforge=$1 out=$2
+lodforge=$1 out=$2 sanitized=${3:-0}
 source "$(dirname "$0")/mpi_common.sh"
 rm -rf "$out" && mkdir -p "$out"
 cd "$out"
@@ -17,7 +17,7 @@ cd "$out"
 limit=(--memory-limit 64M)
 "$lodforge" -v "${limit[@]}" reconstruct cloud.ply -o one.ply > one.err 2>&1
 grep -q "35 chunks in 17 runs" one.err || fail "not 17 runs of chunks: $(cat one.err)"
-for ranks in 1 2 3; do
+for ranks in $(rank_counts 1 2 3); do
   "${mpi[@]}" -np $ranks "$lodforge" -v "${limit[@]}" reconstruct cloud.ply -o np$ranks.ply \
     2> np$ranks.err
   same np$ranks.ply one.ply "reconstruct, $ranks ranks"

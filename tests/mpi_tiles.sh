@@ -17,7 +17,7 @@ cd "$out"
 
 "$lodforge" -q generate scan --triangles 300K -o scan.ply
 "$lodforge" -q tiles scan.ply -o scan-1 --chunk-size 60
-for ranks in 1 2 3 4; do
+for ranks in $(rank_counts 1 2 3 4); do
   "${mpi[@]}" -np $ranks "$lodforge" -q tiles scan.ply -o scan-np$ranks --chunk-size 60
   same scan-np$ranks scan-1 "scan, $ranks ranks"
 done
@@ -86,7 +86,7 @@ same cad-np3 cad-1 "assembly (parts.json), 3 ranks"
 # memory (the other ranks read and write tiles); a LAS of 16 nodes shared by 2 and 3 ranks.
 "$lodforge" -q generate points --points 120K --extra-bytes -o cloud.las
 "$lodforge" -q tiles cloud.las -o cloud-1 --block-size 8000
-for ranks in 1 2 3 4; do
+for ranks in $(rank_counts 1 2 3 4); do
   "${mpi[@]}" -np $ranks "$lodforge" -q tiles cloud.las -o cloud-np$ranks --block-size 8000
   same cloud-np$ranks cloud-1 "point cloud (LAS, extra bytes), $ranks ranks"
 done

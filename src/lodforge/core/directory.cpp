@@ -1,6 +1,9 @@
 #include "lodforge/core/directory.h"
 
 #include <filesystem>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "lodforge/core/file.h"
 
@@ -41,6 +44,18 @@ std::uint64_t directoryBytes(const std::string& path) {
     if (!failed) bytes += size;
   }
   return bytes;
+}
+
+Status removeFilesIn(const std::string& directory,
+                     const std::function<bool(const std::string& name)>& which) {
+  std::error_code error;
+  std::vector<fs::path> matched;  // listed first: removing while iterating skips entries
+  for (fs::directory_iterator at(directory, error), end; !error && at != end; at.increment(error))
+    if (which(at->path().filename().string())) matched.push_back(at->path());
+  for (const fs::path& path : matched)
+    if (!error) fs::remove(path, error);
+  if (error) return ioError(directory, fmt::format("cannot clear: {}", error.message()));
+  return {};
 }
 
 }  // namespace lodforge

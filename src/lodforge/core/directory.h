@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "lodforge/core/status.h"
@@ -25,5 +26,10 @@ Status replaceDirectory(ScopedDirectory& staging, const std::string& output);
 
 // Bytes in the regular files below `path` (what could not be read counts 0).
 std::uint64_t directoryBytes(const std::string& path);
+
+// Removes the entries directly in `directory` whose names `which` accepts (a run's leftovers of a
+// kind); an I/O error naming the directory when one cannot be listed or removed.
+Status removeFilesIn(const std::string& directory,
+                     const std::function<bool(const std::string& name)>& which);
 
 }  // namespace lodforge

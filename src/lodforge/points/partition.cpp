@@ -496,7 +496,7 @@ Result<std::vector<PartNode>> splitStreamedLevels(PartNode root, std::uint64_t i
     }
     level = std::move(next);
   }
-  if (levels > 0 && share.parts <= 1) progress.finish();
+  if (levels > 0) progress.finish();  // (a job's bar has no label: it shows nothing)
   std::sort(small.begin(), small.end(),
             [](const PartNode& a, const PartNode& b) { return a.name < b.name; });
   return small;

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/cluster.h"
+#include "lodforge/core/directory.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/surface/reconstruct_steps.h"
 #include "lodforge/surface/resume_state.h"
@@ -24,15 +25,8 @@ namespace {
 // The claims of an earlier job's ranks on its runs (claimInJob), removed before a job's ranks
 // claim them again.
 Status forgetClaims(const std::string& workDirectory) {
-  std::error_code error;
-  std::vector<std::filesystem::path> claims;
-  for (std::filesystem::directory_iterator at(workDirectory, error), end; !error && at != end;
-       at.increment(error))
-    if (at->path().extension() == ".claim") claims.push_back(at->path());
-  for (const std::filesystem::path& path : claims)
-    if (!error) std::filesystem::remove(path, error);
-  if (error) return ioError(workDirectory, fmt::format("cannot clear: {}", error.message()));
-  return {};
+  return removeFilesIn(workDirectory,
+                       [](const std::string& name) { return name.ends_with(".claim"); });
 }
 
 // A job's runs: the state, and which runs an interrupted job finished (their pieces kept, taken

@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/units.h"
 #include "lodforge/surface/chunk_piece.h"
@@ -380,19 +381,12 @@ nlohmann::json reconstructIdentity(const std::string& input, const ReconstructOp
 }
 
 Status forgetEarlierRuns(const std::string& workDirectory) {
-  std::error_code error;
-  std::filesystem::remove(reconstructStatePath(workDirectory), error);
-  std::vector<std::filesystem::path> pieces;  // run-R.pieces and their temporaries
-  for (std::filesystem::directory_iterator at(workDirectory, error), end; !error && at != end;
-       at.increment(error)) {
-    const std::string name = at->path().filename().string();
-    if (name.starts_with("run-") && name.find(".pieces") != std::string::npos)
-      pieces.push_back(at->path());
-  }
-  for (const std::filesystem::path& path : pieces)
-    if (!error) std::filesystem::remove(path, error);
-  if (error) return ioError(workDirectory, fmt::format("cannot clear: {}", error.message()));
-  return {};
+  std::error_code ignored;
+  std::filesystem::remove(reconstructStatePath(workDirectory), ignored);
+  // run-R.pieces and their temporaries
+  return removeFilesIn(workDirectory, [](const std::string& name) {
+    return name.starts_with("run-") && name.find(".pieces") != std::string::npos;
+  });
 }
 
 Result<Sorting> planSorting(const std::string& input, const std::string& workDirectory,

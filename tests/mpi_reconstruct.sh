@@ -12,8 +12,11 @@ source "$(dirname "$0")/mpi_common.sh"
 rm -rf "$out" && mkdir -p "$out"
 cd "$out"
 
-# 100 K points in 17 runs of chunks (--memory-limit 64M holds about 6 K points a run).
+# 100 K points in 17 runs of chunks (--memory-limit 64M holds about 6 K points a run); 60 K in
+# 8 runs for a surface's tiles; 30 K in 12 chunks for what one run holds.
 "$lodforge" -q generate points --points 100K -o cloud.ply
+"$lodforge" -q generate points --points 60K -o mid.ply
+"$lodforge" -q generate points --points 30K -o small.ply
 limit=(--memory-limit 64M)
 "$lodforge" -v "${limit[@]}" reconstruct cloud.ply -o one.ply > one.err 2>&1
 grep -q "35 chunks in 17 runs" one.err || fail "not 17 runs of chunks: $(cat one.err)"
@@ -27,18 +30,18 @@ grep -qE "^3 ranks: the points sorted into runs by rank 0 .*; the runs made by t
   fail "the runs were not shared by 3 ranks: $(cat np3.err)"
 [[ ! -e np3.ply.work ]] || fail "the job left its work directory"
 
-# A LAS has no normals: the ranks estimate them run by run, rank 0 merges them.
-"$lodforge" -q generate points --points 100K -o cloud.las
+# A LAS has no normals: the ranks estimate them run by run (7 runs), rank 0 merges them.
+"$lodforge" -q generate points --points 40K -o cloud.las
 "$lodforge" -q "${limit[@]}" reconstruct cloud.las -o las-1.ply
 "${mpi[@]}" -np 2 "$lodforge" -v "${limit[@]}" reconstruct cloud.las -o las-np2.ply > las.err 2>&1
 same las-np2.ply las-1.ply "normals estimated by the ranks, 2 ranks"
 grep -q "normals estimated" las.err || fail "the LAS's normals were not estimated: $(cat las.err)"
 
 # More ranks than runs: the default budget holds the cloud in one run; 3 ranks, two idle.
-"$lodforge" -q reconstruct cloud.ply -o whole.ply
-"${mpi[@]}" -np 3 "$lodforge" -v reconstruct cloud.ply -o whole-np3.ply 2> whole.err
+"$lodforge" -q reconstruct small.ply -o whole.ply
+"${mpi[@]}" -np 3 "$lodforge" -v reconstruct small.ply -o whole-np3.ply 2> whole.err
 same whole-np3.ply whole.ply "more ranks than runs"
-grep -q "the runs made by the ranks, 0 to 35 chunks a rank" whole.err ||
+grep -q "the runs made by the ranks, 0 to 12 chunks a rank" whole.err ||
   fail "one rank did not make the one run: $(cat whole.err)"
 
 # A rank killed (SIGKILL) after its second run: the job stops naming it and its step; the
@@ -63,21 +66,21 @@ resumed=$(sed -nE 's/.* in 17 runs, ([0-9]+) resumed.*/\1/p' resumed.err)
 same killed.ply one.ply "killed rank, then --resume"
 
 # A surface's tiles: the ranks make the reconstruction's runs, then build the octree.
-"$lodforge" -q "${limit[@]}" tiles cloud.ply --surface -o surface-1 --chunk-size 100
-"${mpi[@]}" -np 3 "$lodforge" -v "${limit[@]}" tiles cloud.ply --surface -o surface-np3 \
+"$lodforge" -q "${limit[@]}" tiles mid.ply --surface -o surface-1 --chunk-size 100
+"${mpi[@]}" -np 3 "$lodforge" -v "${limit[@]}" tiles mid.ply --surface -o surface-np3 \
   --chunk-size 100 2> surface.err
 same surface-np3 surface-1 "tiles --surface, 3 ranks"
 grep -q "3 ranks: the surface's runs made by the ranks, " surface.err ||
   fail "the surface was not made by the ranks: $(cat surface.err)"
 # Its reconstruction stopped by a killed rank resumes too: the kept runs taken, the same tileset.
 set +e
-"${mpi[@]}" -np 1 "$lodforge" "${limit[@]}" tiles cloud.ply --surface -o surface-killed \
+"${mpi[@]}" -np 1 "$lodforge" "${limit[@]}" tiles mid.ply --surface -o surface-killed \
   --chunk-size 100 : -np 1 -x LODFORGE_INTERRUPT_AFTER=run:2:kill "$lodforge" "${limit[@]}" \
-  tiles cloud.ply --surface -o surface-killed --chunk-size 100 > surface-killed.out 2>&1
+  tiles mid.ply --surface -o surface-killed --chunk-size 100 > surface-killed.out 2>&1
 code=$?
 set -e
 [[ $code -ne 0 ]] || fail "a surface job with a killed rank exited 0"
-"${mpi[@]}" -np 2 "$lodforge" "${limit[@]}" tiles cloud.ply --surface -o surface-killed \
+"${mpi[@]}" -np 2 "$lodforge" "${limit[@]}" tiles mid.ply --surface -o surface-killed \
   --chunk-size 100 --resume > surface-resumed.out 2>&1
 grep -qE "runs, [1-9][0-9]* resumed" surface-resumed.out ||
   fail "the surface's kept runs were not taken: $(cat surface-resumed.out)"
@@ -85,18 +88,18 @@ same surface-killed surface-np3 "tiles --surface: killed rank, then --resume"
 
 # A job on an output that a one-process run is writing is refused (exit 2), naming that run,
 # which finishes (held stopped by SIGSTOP while the job tries).
-"$lodforge" -q --threads 1 "${limit[@]}" reconstruct cloud.ply -o busy.ply &
+"$lodforge" -q --threads 1 reconstruct small.ply -o busy.ply &
 first=$!
 for _ in $(seq 1000); do [[ -s busy.ply.work/.lodforge-lock ]] && break; sleep 0.02; done
-kill -STOP $first
+kill -STOP $first || fail "the first run ended before it was held"
 set +e
-"${mpi[@]}" -np 2 "$lodforge" -q reconstruct cloud.ply -o busy.ply 2> busy.err
+"${mpi[@]}" -np 2 "$lodforge" -q reconstruct small.ply -o busy.ply 2> busy.err
 code=$?
 set -e
-kill -CONT $first
+kill -CONT $first 2>/dev/null || true
 wait $first || fail "the first run failed"
 [[ $code -eq 2 ]] && grep -q "another lodforge run (pid $first on" busy.err ||
   fail "a job on a busy output: exit $code, $(cat busy.err)"
-same busy.ply one.ply "the first run, beside the refused job"
+same busy.ply whole.ply "the first run, beside the refused job"
 
 finish "distributed reconstruction"

@@ -7,12 +7,15 @@ import { readFile } from 'node:fs/promises';
 import path from 'node:path';
 
 export const cesiumPageHelpers = `
-function bareViewer() {
+// onDemand: draw only when something changed (a tile loaded, the camera moved), not every
+// animation frame; a test's software WebGL then spends no CPU on frames that show nothing new.
+function bareViewer({ onDemand = false } = {}) {
   const viewer = new Cesium.Viewer('view', {
     baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false,
     animation: false, homeButton: false, sceneModePicker: false, navigationHelpButton: false,
     fullscreenButton: false, infoBox: false, selectionIndicator: false,
     terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false, skyAtmosphere: false,
+    requestRenderMode: onDemand, maximumRenderTimeChange: Infinity,
   });
   viewer.scene.globe.show = false;
   return viewer;

@@ -34,7 +34,7 @@ ${cesiumPageHelpers}
 window.report = { failed: [], loaded: false, error: null };
 (async () => {
   try {
-    const viewer = bareViewer();
+    const viewer = bareViewer({ onDemand: true });
     viewer.scene.backgroundColor = Cesium.Color.BLACK;
     const tileset = await Cesium.Cesium3DTileset.fromUrl('/tileset/tileset.json',
                                                          { maximumScreenSpaceError: 4 });

@@ -14,6 +14,14 @@ import { classColor, colorModes, colorPanel, intensityGrey, ramp } from '../poin
 
 const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0, frames: 0 });
 
+// The view is drawn on demand, as the CesiumJS page is: a frame when something changed (the
+// camera, a tile loaded, a colour or a part's state) and every frame while tiles load; an idle
+// view costs no GPU time.
+let frameWanted = true;
+function requestFrame() {
+  frameWanted = true;
+}
+
 // Point tiles coloured by a LAS field: each loaded Points object keeps its own colours and is
 // recoloured on the CPU (RGBA; a hidden class gets alpha 0, which alphaTest discards).
 const RETURN_COLORS = [[0.9, 0.2, 0.15], [0.95, 0.6, 0.1], [0.95, 0.9, 0.2], [0.3, 0.8, 0.3], [0.2, 0.5, 0.95]];
@@ -48,6 +56,7 @@ function recolour(points) {
     out[4 * i + 3] = hidden ? 0 : 255;
   }
   color.needsUpdate = true;
+  requestFrame();
 }
 
 function recolourAll() {
@@ -153,6 +162,7 @@ function recolourParts(mesh) {
     color.array.set([c[0], c[1], c[2], alpha], 4 * i);
   }
   color.needsUpdate = true;
+  requestFrame();
 }
 
 // A tile's meshes, as they load: RGBA colours to write into (the original kept), its part ids.
@@ -188,7 +198,10 @@ function prepareParts(scene) {
 
 function addParts(parts, tiles, camera, controls, renderer, pivot) {
   partState.parts = parts;
-  const restyle = () => { for (const mesh of partState.meshes) recolourParts(mesh); };
+  const restyle = () => {
+    for (const mesh of partState.meshes) recolourParts(mesh);
+    requestFrame();
+  };
   const raycaster = new THREE.Raycaster();
   // The part drawn at a pixel (CSS pixels of the canvas): the nearest hit of a part not hidden.
   const partAt = (x, y) => {
@@ -217,6 +230,7 @@ function addParts(parts, tiles, camera, controls, renderer, pivot) {
       camera.near = radius / 1000;
       camera.updateProjectionMatrix();
       controls.update();
+      requestFrame();
     },
   });
   let down = null;
@@ -268,6 +282,7 @@ function main() {
   scene.add(sun);
   const camera = new THREE.PerspectiveCamera(60, window.innerWidth / window.innerHeight, 0.01, 1e7);
   const controls = new OrbitControls(camera, renderer.domElement);
+  controls.addEventListener('change', requestFrame);
 
   const tiles = new TilesRenderer('/tiles/tileset.json');
   // EXT_meshopt_compression contents (lodforge tiles --compress meshopt).
@@ -340,8 +355,11 @@ function main() {
     // A hair off vertical: the orbit controls need a view direction apart from their up.
     camera.position.copy(hit.point).add(new THREE.Vector3(0, distance, distance * 1e-3));
     controls.update();
+    requestFrame();
     return true;
   };
+  for (const event of ['load-tile-set', 'load-model', 'dispose-model', 'tiles-load-start', 'tiles-load-end'])
+    tiles.addEventListener(event, requestFrame);
   tiles.addEventListener('load-model', (e) => {
     report.tilesLoaded += 1;
     e.scene.traverse((o) => { if (o.isPoints) preparePoints(o); });
@@ -359,15 +377,19 @@ function main() {
     addParts(parts, tiles, camera, controls, renderer, pivot);
   }).catch((error) => { report.error = String(error); });
 
-  onScreenSpaceError((pixels) => { tiles.errorTarget = pixels; });
+  onScreenSpaceError((pixels) => { tiles.errorTarget = pixels; requestFrame(); });
   window.addEventListener('resize', () => {
     camera.aspect = window.innerWidth / window.innerHeight;
     camera.updateProjectionMatrix();
     renderer.setSize(window.innerWidth, window.innerHeight);
     tiles.setResolutionFromRenderer(camera, renderer);
+    requestFrame();
   });
   const stats = document.getElementById('stats');
   renderer.setAnimationLoop(() => {
+    const loading = tiles.stats.downloading > 0 || tiles.stats.parsing > 0;
+    if (!frameWanted && !loading && framed) return;
+    frameWanted = false;
     if (!framed) framed = frame();
     controls.update();
     camera.updateMatrixWorld();

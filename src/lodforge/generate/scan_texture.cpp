@@ -107,6 +107,16 @@ Image drawScanAtlas(std::uint64_t seed, const ScanAtlasLayout& layout, std::uint
     for (std::uint32_t i = 0; i < grid; ++i)
       coarse[std::size_t{j} * grid + i] = patches(u0 + i * kStep * du, v0 + j * kStep * dv, seed);
   });
+  // The clumps' noise, a few texels across, repeats every 1,024 texels (stb's noise every 256
+  // units, four texels a unit): drawn once for a tile of that size, not once a texel.
+  const std::uint32_t period = std::min<std::uint32_t>(size, 1024);
+  std::vector<float> clumps(std::size_t{period} * period);
+  tbb::parallel_for(std::uint32_t{0}, period, [&](std::uint32_t y) {
+    for (std::uint32_t x = 0; x < period; ++x) {
+      const double wx = u0 + (x + 0.5) * du, wy = v0 + (y + 0.5) * dv;
+      clumps[std::size_t{y} * period + x] = noise(wx / (4 * du), wy / (4 * dv), 9, seed);
+    }
+  });
   Image image(size, size);
   tbb::parallel_for(std::uint32_t{0}, size, [&](std::uint32_t y) {
     const std::uint32_t j = y / kStep;
@@ -118,16 +128,16 @@ Image drawScanAtlas(std::uint64_t seed, const ScanAtlasLayout& layout, std::uint
       const auto& b = coarse[std::size_t{j} * grid + i + 1];
       const auto& c = coarse[std::size_t{j + 1} * grid + i];
       const auto& d = coarse[std::size_t{j + 1} * grid + i + 1];
-      const double wx = u0 + (x + 0.5) * du, wy = v0 + (y + 0.5) * dv;
       // Detail: clumps a few texels across, then grain at the texel.
-      const float detail = 0.35f * noise(wx / (4 * du), wy / (4 * dv), 9, seed) +
+      const float detail = 0.35f * clumps[std::size_t{y % period} * period + x % period] +
                            0.25f * grain(cells[0] * size + x, cells[2] * size + y, seed);
       std::uint8_t* p = &image.rgba[4 * (std::size_t{y} * size + x)];
       for (std::size_t k = 0; k < 3; ++k) {
         const float base =
             (a[k] * (1 - fx) + b[k] * fx) * (1 - fy) + (c[k] * (1 - fx) + d[k] * fx) * fy;
-        p[k] = static_cast<std::uint8_t>(
-            std::lround(std::clamp(base * (1.0f + detail), 0.0f, 1.0f) * 255));
+        // Rounded half up (the value is not negative): what lround gives, without its call.
+        p[k] =
+            static_cast<std::uint8_t>(std::clamp(base * (1.0f + detail), 0.0f, 1.0f) * 255 + 0.5f);
       }
       p[3] = 255;
     }

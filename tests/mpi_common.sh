@@ -6,9 +6,10 @@ command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/ins
 # OpenMPI's components are loaded and unloaded at run time and leave allocations it can only
 # attribute to "<unknown module>" (ours are checked by every other test, which runs the same
 # code in one process).
-# --mca pml ob1: OpenMPI's shared-memory transport, what a job on one machine uses; its default
-# first probes UCX, 0.25 s of every mpirun here (in a release and a sanitizer run alike), and the
-# scripts start about fifty jobs. mpi_default keeps OpenMPI's own choice for one check.
+# --mca pml ob1: OpenMPI's own point-to-point layer, which between the ranks of one machine sends
+# through shared memory; OpenMPI's default first probes UCX, 0.25 s of every mpirun here (in a
+# release and a sanitizer run alike), and the scripts start about fifty jobs. mpi_default keeps
+# OpenMPI's own choice for one check.
 mpi_default=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" mpirun --allow-run-as-root --oversubscribe)
 mpi=("${mpi_default[@]}" --mca pml ob1)
 # The rank counts each output is compared at: every one from 1 (a job of one) to 4 in the release
@@ -16,6 +17,17 @@ mpi=("${mpi_default[@]}" --mca pml ob1)
 # any count; what differs between counts is checked in the release tree).
 rank_counts() { if [[ ${sanitized:-0} == 1 ]]; then echo 2 3; else echo "$@"; fi; }
 failures=0
+# hold PID LOCK: once the run PID holds its output (its lock file LOCK is written), stops it
+# (SIGSTOP) until `release PID`, so that a second run meets it whatever its speed; the script
+# never leaves it stopped.
+hold() {
+  local _
+  for _ in $(seq 3000); do [[ -s $2 ]] && break; sleep 0.02; done
+  [[ -s $2 ]] || { fail "no lock $2 after 60 s"; return; }
+  kill -STOP "$1" || fail "the run $1 ended before it was held"
+  trap "kill -CONT $1 2>/dev/null || true" EXIT
+}
+release() { kill -CONT "$1" 2>/dev/null || true; trap - EXIT; }
 fail() { echo "FAIL: $*" >&2; failures=$((failures + 1)); }
 same() {  # same OUTPUT REFERENCE WHAT: a tileset (folder) or a mesh (file), byte for byte
   if diff -r "$1" "$2" >/dev/null; then echo "ok: $3"; else fail "$3: $1 differs from $2"; diff -rq "$1" "$2" | head -5 >&2; fi

@@ -90,13 +90,12 @@ same surface-killed surface-np3 "tiles --surface: killed rank, then --resume"
 # which finishes (held stopped by SIGSTOP while the job tries).
 "$lodforge" -q --threads 1 reconstruct small.ply -o busy.ply &
 first=$!
-for _ in $(seq 1000); do [[ -s busy.ply.work/.lodforge-lock ]] && break; sleep 0.02; done
-kill -STOP $first || fail "the first run ended before it was held"
+hold $first busy.ply.work/.lodforge-lock
 set +e
 "${mpi[@]}" -np 2 "$lodforge" -q reconstruct small.ply -o busy.ply 2> busy.err
 code=$?
 set -e
-kill -CONT $first 2>/dev/null || true
+release $first
 wait $first || fail "the first run failed"
 [[ $code -eq 2 ]] && grep -q "another lodforge run (pid $first on" busy.err ||
   fail "a job on a busy output: exit $code, $(cat busy.err)"

@@ -175,13 +175,12 @@ same killed scan-1 "killed rank, then --resume"
 # names it by its pid.
 "$lodforge" -q tiles scan.ply -o busy --chunk-size 60 &
 first=$!
-for _ in $(seq 1000); do [[ -s busy.work/.lodforge-lock ]] && break; sleep 0.02; done
-kill -STOP $first || fail "the first run ended before it was held"
+hold $first busy.work/.lodforge-lock
 set +e
 "${mpi[@]}" -np 2 "$lodforge" -q tiles scan.ply -o busy --chunk-size 60 2> busy.err
 code=$?
 set -e
-kill -CONT $first 2>/dev/null || true
+release $first
 wait $first || fail "the first run failed"
 [[ $code -eq 2 ]] || fail "a second run on a busy output exited $code, not 2"
 grep -q "another lodforge run (pid $first on" busy.err || fail "no refusal naming the first run: $(cat busy.err)"
@@ -190,13 +189,12 @@ same busy scan-1 "the first run, beside the refused one"
 # The same for a point cloud: a one-process run holds the output, a job of 2 is refused.
 "$lodforge" -q tiles cloud.las -o busy-points --block-size 8000 &
 first=$!
-for _ in $(seq 1000); do [[ -s busy-points.work/.lodforge-lock ]] && break; sleep 0.02; done
-kill -STOP $first || fail "the first run ended before it was held"
+hold $first busy-points.work/.lodforge-lock
 set +e
 "${mpi[@]}" -np 2 "$lodforge" -q tiles cloud.las -o busy-points --block-size 8000 2> busy-points.err
 code=$?
 set -e
-kill -CONT $first 2>/dev/null || true
+release $first
 wait $first || fail "the first point run failed"
 [[ $code -eq 2 ]] && grep -q "another lodforge run (pid $first on" busy-points.err ||
   fail "a point job on a busy output: exit $code, $(cat busy-points.err)"

@@ -45,8 +45,8 @@ const port = await new Promise((resolve, reject) => {
 });
 
 // Runs fn(arg) in the page, a change made through window.lodforge, and waits until the viewer
-// has drawn a frame after it (its own frame counter), not a fixed time. The CesiumJS page draws
-// only when something changed, so this also checks that each change asks for a frame.
+// has drawn a frame after it (its own frame counter), not a fixed time. Both pages draw only
+// when something changed, so this also checks that each change asks for a frame.
 async function change(tab, fn, arg) {
   const from = await tab.evaluate(() => window.lodforge.frames);
   await tab.evaluate(fn, arg);
@@ -203,6 +203,16 @@ try {
     // Loaded means drawn (CesiumJS says so in the frame that draws the last tile); two more
     // animation frames give a viewer time to ask for a tile twice.
     await browserFrames(tab);
+    // Loaded and left alone, a viewer draws nothing (both draw on demand): its frame counter
+    // stands still over ten of the browser's animation frames.
+    const idleFrom = await tab.evaluate(() => window.lodforge.frames);
+    await tab.evaluate(() => new Promise((done) => {
+      let n = 0;
+      const next = () => (++n < 10 ? requestAnimationFrame(next) : done());
+      requestAnimationFrame(next);
+    }));
+    const idleTo = await tab.evaluate(() => window.lodforge.frames);
+    if (idleTo !== idleFrom) mine(`left alone after loading, the view drew ${idleTo - idleFrom} frames`);
     const twice = [...tileGets].filter(([, n]) => n > 1);
     if (viewer === 'three' && twice.length > 0) mine(`${twice.length} tile(s) downloaded more than once, e.g. ${twice[0][0]}`);
     const stats = await tab.evaluate(() => document.getElementById('stats').textContent);

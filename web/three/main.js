@@ -386,10 +386,16 @@ function main() {
     requestFrame();
   });
   const stats = document.getElementById('stats');
+  let cached = 0;  // tiles.stats.inCache at the last frame
   renderer.setAnimationLoop(() => {
-    const loading = tiles.stats.downloading > 0 || tiles.stats.parsing > 0;
-    if (!frameWanted && !loading && framed) return;
+    // Loading, or tiles left the cache (a full cache holds back the tiles waiting for it until
+    // the next update, and dropping a tile without a model fires no event).
+    const loading = tiles.stats.downloading > 0 || tiles.stats.parsing > 0 ||
+                    tiles.stats.inCache !== cached;
+    // A tileset that failed to load has nothing to frame: it waits like an idle view.
+    if (!frameWanted && !loading && (framed || report.failed.length > 0)) return;
     frameWanted = false;
+    cached = tiles.stats.inCache;
     if (!framed) framed = frame();
     controls.update();
     camera.updateMatrixWorld();

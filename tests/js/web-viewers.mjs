@@ -57,9 +57,12 @@ async function drawnSince(tab, from) {
   await tab.waitForFunction((n) => window.lodforge.frames > n, from, { timeout: 60000 });
 }
 
-// Two of the browser's animation frames: a viewer draws what it has pending in the next one.
-async function browserFrames(tab) {
-  await tab.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
+// `count` of the browser's animation frames (two: a viewer draws what it has pending in the next).
+async function browserFrames(tab, count = 2) {
+  await tab.evaluate((n) => new Promise((done) => {
+    const next = () => (--n > 0 ? requestAnimationFrame(next) : done());
+    requestAnimationFrame(next);
+  }), count);
 }
 
 // Each colour mode draws (covers the view) and draws differently from the mode before; hiding
@@ -207,11 +210,7 @@ try {
     // frames it draws at most a trailing frame or two (CesiumJS may ask for one after the last
     // tile), where a viewer drawing all the time draws one in each.
     const idleFrom = await tab.evaluate(() => window.lodforge.frames);
-    await tab.evaluate(() => new Promise((done) => {
-      let n = 0;
-      const next = () => (++n < 10 ? requestAnimationFrame(next) : done());
-      requestAnimationFrame(next);
-    }));
+    await browserFrames(tab, 10);
     const idleTo = await tab.evaluate(() => window.lodforge.frames);
     if (idleTo - idleFrom > 2) mine(`left alone after loading, the view drew ${idleTo - idleFrom} frames in 10`);
     const twice = [...tileGets].filter(([, n]) => n > 1);

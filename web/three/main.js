@@ -56,11 +56,12 @@ function recolour(points) {
     out[4 * i + 3] = hidden ? 0 : 255;
   }
   color.needsUpdate = true;
-  requestFrame();
 }
 
+// A colour setting changed (a tile's first colouring is drawn with its load's frame).
 function recolourAll() {
   for (const points of colouring.points) recolour(points);
+  requestFrame();
 }
 
 // A tile's Points, as they load: RGBA colours to write into, the original RGB kept, the
@@ -162,7 +163,6 @@ function recolourParts(mesh) {
     color.array.set([c[0], c[1], c[2], alpha], 4 * i);
   }
   color.needsUpdate = true;
-  requestFrame();
 }
 
 // A tile's meshes, as they load: RGBA colours to write into (the original kept), its part ids.

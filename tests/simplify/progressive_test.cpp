@@ -6,6 +6,7 @@
 #include <set>
 #include <vector>
 
+#include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
 #include "lodforge/core/mesh.h"
@@ -30,6 +31,26 @@ struct ExactnessReport {
   std::size_t levelsChecked = 0;
 };
 
+// An order-free fingerprint of a multiset of triangles (corners in their order): the count and
+// two sums of independent 64-bit mixes, kept as triangles come and go, so each level is compared
+// without sorting both sides; two different multisets agree by chance about once in 2^128.
+struct TriangleMultiset {
+  std::uint64_t count = 0, first = 0, second = 0;
+  static std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+  }
+  void add(const Triangle& t, std::uint64_t sign) {
+    const std::uint64_t h = mix(mix((std::uint64_t{t[0]} << 32) | t[1]) ^ t[2]);
+    count += sign;
+    first += sign * h;
+    second += sign * mix(h ^ 0x9e3779b97f4a7c15ull);
+  }
+  bool operator==(const TriangleMultiset&) const = default;
+};
+constexpr std::uint64_t kAdd = 1, kRemove = ~std::uint64_t{0};  // +1 and −1 modulo 2^64
+
 ExactnessReport expectExact(const ProgressiveMesh& mesh, const std::vector<std::uint32_t>& levels,
                             const std::string& what) {
   ExactnessReport report;
@@ -44,7 +65,8 @@ ExactnessReport expectExact(const ProgressiveMesh& mesh, const std::vector<std::
       incident[current[t][k]].push_back(t);
     }
   }
-  std::uint32_t aliveCount = T;
+  TriangleMultiset expected;
+  for (const Triangle& t : current) expected.add(t, kAdd);
   std::set<std::uint32_t> wanted(levels.begin(), levels.end());
   std::vector<std::uint32_t> reformed;
   for (std::uint32_t n = p;; --n) {
@@ -53,28 +75,20 @@ ExactnessReport expectExact(const ProgressiveMesh& mesh, const std::vector<std::
       // map(n) is the surviving count, and the first map(n) re-formed triangles are exactly the
       // surviving ones (as a multiset), none degenerate.
       const std::uint32_t count = mesh.trianglesAt(n);
-      EXPECT_EQ(count, aliveCount) << what << " n=" << n;
+      EXPECT_EQ(count, expected.count) << what << " n=" << n;
       reformed.resize(3 * std::size_t{count});
       reformObject(std::span(mesh.triangles).first(3 * std::size_t{count}), mesh.ecol, n, 0,
                    reformed);
-      // Multisets as sorted vectors.
-      std::vector<Triangle> expected, actual;
-      expected.reserve(aliveCount);
-      actual.reserve(count);
-      for (std::uint32_t t = 0; t < T; ++t) {
-        if (alive[t]) expected.push_back(current[t]);
-      }
+      TriangleMultiset actual;
       bool degenerate = false, outOfRange = false;
       for (std::size_t t = 0; t < count; ++t) {
         const Triangle tri{reformed[3 * t], reformed[3 * t + 1], reformed[3 * t + 2]};
         degenerate = degenerate || tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
         outOfRange = outOfRange || std::max({tri[0], tri[1], tri[2]}) >= n;
-        actual.push_back(tri);
+        actual.add(tri, kAdd);
       }
       EXPECT_FALSE(degenerate) << what << " degenerate triangle at n=" << n;
       EXPECT_FALSE(outOfRange) << what << " corner beyond n=" << n;
-      std::sort(expected.begin(), expected.end());
-      std::sort(actual.begin(), actual.end());
       EXPECT_TRUE(actual == expected) << what << " n=" << n;
       if (::testing::Test::HasFailure()) return report;
     }
@@ -84,14 +98,15 @@ ExactnessReport expectExact(const ProgressiveMesh& mesh, const std::vector<std::
     EXPECT_LT(to, from) << what << ": ECol chains must strictly decrease";
     for (std::uint32_t t : incident[from]) {
       if (!alive[t]) continue;
+      expected.add(current[t], kRemove);
       for (std::uint32_t& c : current[t]) {
         if (c == from) c = to;
       }
       if (current[t][0] == current[t][1] || current[t][1] == current[t][2] ||
           current[t][0] == current[t][2]) {
         alive[t] = false;
-        --aliveCount;
       } else {
+        expected.add(current[t], kAdd);
         incident[to].push_back(t);
       }
     }
@@ -156,6 +171,43 @@ TEST(Progressive, ExactOnRandomSurfacesAtEveryLevel) {
       }
     }
   }
+}
+
+// The reference check can fail: a mesh whose first and last triangles trade places re-forms
+// the wrong triangles at the counts where only one of them survives (the same number of them,
+// so only the multisets tell), and the check reports those counts.
+TEST(Progressive, TheExactnessCheckCatchesWrongTrianglesAtARightCount) {
+  std::vector<Vec3f> positions;
+  std::vector<std::uint32_t> indices;
+  randomSurface(3, positions, indices);
+  ProgressiveMesh mesh = buildPrepared(positions, indices);
+  const std::size_t last = mesh.triangles.size() - 3;
+  ASSERT_LT(mesh.trianglesAt(mesh.q), mesh.triangleCount());
+  for (std::size_t k = 0; k < 3; ++k) std::swap(mesh.triangles[k], mesh.triangles[last + k]);
+  ::testing::TestPartResultArray failures;
+  {
+    const ::testing::ScopedFakeTestPartResultReporter intercept(
+        ::testing::ScopedFakeTestPartResultReporter::INTERCEPT_ONLY_CURRENT_THREAD, &failures);
+    expectExact(mesh, levelsOf(mesh, 100000), "swapped");
+  }
+  bool multisets = false;
+  for (int i = 0; i < failures.size(); ++i)
+    multisets =
+        multisets || std::string(failures.GetTestPartResult(i).message()).find("swapped n=") !=
+                         std::string::npos;
+  EXPECT_TRUE(multisets) << failures.size() << " failures, none of the multisets";
+  // The fingerprint itself: blind to the triangles' order, not to their corners' or their count.
+  const auto of = [](std::initializer_list<Triangle> triangles) {
+    TriangleMultiset set;
+    for (const Triangle& t : triangles) set.add(t, kAdd);
+    return set;
+  };
+  EXPECT_TRUE(of({{1, 2, 3}, {4, 5, 6}}) == of({{4, 5, 6}, {1, 2, 3}}));
+  EXPECT_FALSE(of({{1, 2, 3}, {4, 5, 6}}) == of({{1, 2, 3}, {4, 6, 5}}));
+  EXPECT_FALSE(of({{1, 2, 3}, {1, 2, 3}}) == of({{1, 2, 3}, {4, 5, 6}}));
+  TriangleMultiset back = of({{1, 2, 3}, {4, 5, 6}});
+  back.add({4, 5, 6}, kRemove);
+  EXPECT_TRUE(back == of({{1, 2, 3}}));
 }
 
 TEST(Progressive, RealMeshesAreExact) {
@@ -285,14 +337,17 @@ TEST(Progressive, ClosedSurfacesStayManifoldDownToTheirMinimum) {
     reformObject(std::span(mesh.triangles).first(reformed.size()), mesh.ecol, n, 0, reformed);
     EXPECT_EQ(countBoundaryEdges(reformed), 0u)
         << "n=" << n;  // the horse is closed: it stays closed
-    std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+    // No undirected edge used by three triangles or more: sorted, no key three times in a row.
+    std::vector<std::uint64_t> edges;
     for (std::size_t t = 0; t < reformed.size(); t += 3) {
       for (std::size_t k = 0; k < 3; ++k) {
-        const std::uint32_t a = reformed[t + k], b = reformed[t + (k + 1) % 3];
-        const auto edge = std::make_pair(std::min(a, b), std::max(a, b));
-        ASSERT_LE(++uses[edge], 2) << "non-manifold edge at n=" << n;
+        const std::uint64_t a = reformed[t + k], b = reformed[t + (k + 1) % 3];
+        edges.push_back(std::min(a, b) << 32 | std::max(a, b));
       }
     }
+    std::sort(edges.begin(), edges.end());
+    for (std::size_t i = 2; i < edges.size(); ++i)
+      ASSERT_FALSE(edges[i] == edges[i - 2]) << "non-manifold edge at n=" << n;
   }
   EXPECT_LE(mesh.q, 8u);  // a closed genus-0 surface ends near a tetrahedron
 }

@@ -244,7 +244,7 @@ TEST(TileFeatures, CadLayersReachEveryTileAndPartsJson) {
   fs::remove_all(root);
   fs::create_directories(root);
   const std::string input = (root / "cad.step").string();
-  ASSERT_TRUE(generateCad({.objects = 150, .seed = 4}, input).ok());
+  ASSERT_TRUE(generateCad({.objects = 40, .seed = 4}, input).ok());
   Result<Model> model = readCad(input);
   ASSERT_TRUE(model.ok()) << model.error().message;
   ASSERT_GT(model->layers.size(), 3u);

@@ -173,8 +173,10 @@ TEST(CadRead, TrianglesAreOcctsAtTheSameDeflection) {
   }
 }
 
+// (OCCT's larger IGES sample, bearing.iges, takes 8 s to mesh: the glTF validator's run converts
+// it once, in the release tree.)
 TEST(CadRead, IgesAndBrepSamplesRead) {
-  for (const std::string name : {"iges/bearing.iges", "iges/hammer.iges", "occ/Ball.brep"}) {
+  for (const std::string name : {"iges/hammer.iges", "occ/Ball.brep"}) {
     Result<Model> model = readModel(kSamples + "/" + name);
     ASSERT_TRUE(model.ok()) << model.error().message;
     EXPECT_GT(model->triangleCount(), 500u) << name;

@@ -1,6 +1,11 @@
 #include "lodforge/core/file.h"
 
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -159,6 +164,63 @@ TEST(OutputFile, FailsCleanlyWhereItCannotWrite) {
   ASSERT_FALSE(out.ok());
   EXPECT_EQ(out.error().kind, ErrorKind::kIo);
   EXPECT_NE(out.error().message.find("/nonexistent-dir/out.glb"), std::string::npos);
+}
+
+// The I/O buffer keeps its bytes when it grows and when it shrinks and grows back; a move takes
+// them and leaves the source empty.
+TEST(IoBuffer, KeepsItsBytesThroughResizesAndMoves) {
+  IoBuffer buffer;
+  EXPECT_EQ(buffer.size(), 0u);
+  buffer.resize(3);
+  std::memcpy(buffer.data(), "abc", 3);
+  buffer.resize(1 << 20);
+  EXPECT_EQ(std::memcmp(buffer.data(), "abc", 3), 0);
+  buffer.resize(2);
+  EXPECT_EQ(buffer.size(), 2u);
+  buffer.resize(3);
+  EXPECT_EQ(std::memcmp(buffer.data(), "abc", 3), 0);
+  IoBuffer taken(std::move(buffer));
+  EXPECT_EQ(taken.size(), 3u);
+  EXPECT_EQ(std::memcmp(taken.data(), "abc", 3), 0);
+  EXPECT_EQ(buffer.size(), 0u);  // NOLINT(bugprone-use-after-move): what a move leaves
+  buffer = std::move(taken);
+  EXPECT_EQ(std::memcmp(buffer.data(), "abc", 3), 0);
+}
+
+// A file of records read back block by block: every record once, in order, whatever the block;
+// a file smaller than the block is read in one block of its own size (at least one record).
+TEST(FileBlocks, EveryRecordOnceInOrderAndNoBlockBiggerThanTheFile) {
+  test::TempDir dir;
+  std::vector<std::uint32_t> records(1000);
+  for (std::uint32_t i = 0; i < records.size(); ++i) records[i] = i * 7 + 1;
+  {
+    std::ofstream out(dir.file("r.bin"), std::ios::binary);
+    out.write(reinterpret_cast<const char*>(records.data()), 4 * records.size());
+    std::ofstream(dir.file("empty.bin"), std::ios::binary);
+  }
+  for (const std::size_t block : {1, 7, 1000, 1 << 20}) {
+    std::vector<std::uint32_t> back;
+    std::size_t largest = 0;
+    ASSERT_TRUE(forEachFileBlock<std::uint32_t>(dir.file("r.bin"), block,
+                                                [&](std::span<const std::uint32_t> some) {
+                                                  largest = std::max(largest, some.size());
+                                                  back.insert(back.end(), some.begin(), some.end());
+                                                  return Status{};
+                                                })
+                    .ok());
+    EXPECT_EQ(back, records) << block;
+    EXPECT_EQ(largest, std::min<std::size_t>(block, records.size())) << block;
+  }
+  std::FILE* file = std::fopen(dir.file("r.bin").c_str(), "rb");
+  ASSERT_NE(file, nullptr);
+  EXPECT_EQ(blockForFile(file, 1 << 20, 4), 1000u);
+  EXPECT_EQ(blockForFile(file, 10, 4), 10u);
+  EXPECT_EQ(blockForFile(file, 1 << 20, 3000), 1u);  // one record's room, even past the end
+  std::fclose(file);
+  file = std::fopen(dir.file("empty.bin").c_str(), "rb");
+  ASSERT_NE(file, nullptr);
+  EXPECT_EQ(blockForFile(file, 1 << 20, 4), 1u);
+  std::fclose(file);
 }
 
 TEST(MappedFile, SeesTheFileContents) {

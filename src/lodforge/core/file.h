@@ -5,15 +5,52 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "lodforge/core/progress.h"
 #include "lodforge/core/status.h"
 
 namespace lodforge {
+
+// An I/O buffer of bytes left unset when it grows: it is written before it is read, and zeroing
+// megabytes for each small file (touching every page of them) cost more than the file's bytes.
+// Growing keeps what it held; shrinking keeps the memory.
+class IoBuffer {
+ public:
+  IoBuffer() = default;
+  IoBuffer(IoBuffer&& other) noexcept
+      : bytes_(std::move(other.bytes_)),
+        size_(std::exchange(other.size_, 0)),
+        capacity_(std::exchange(other.capacity_, 0)) {}
+  IoBuffer& operator=(IoBuffer&& other) noexcept {
+    bytes_ = std::move(other.bytes_);
+    size_ = std::exchange(other.size_, 0);
+    capacity_ = std::exchange(other.capacity_, 0);
+    return *this;
+  }
+  std::byte* data() { return bytes_.get(); }
+  const std::byte* data() const { return bytes_.get(); }
+  std::size_t size() const { return size_; }
+  void resize(std::size_t n) {
+    if (n > capacity_) {
+      std::unique_ptr<std::byte[]> grown = std::make_unique_for_overwrite<std::byte[]>(n);
+      if (size_ != 0) std::memcpy(grown.get(), bytes_.get(), size_);
+      bytes_ = std::move(grown);
+      capacity_ = n;
+    }
+    size_ = n;
+  }
+
+ private:
+  std::unique_ptr<std::byte[]> bytes_;
+  std::size_t size_ = 0, capacity_ = 0;
+};
 
 // Sequential reader over a file or a memory block. Streaming parsers pull from it a little at a
 // time, so a file larger than RAM is read with a fixed buffer.
@@ -53,7 +90,7 @@ class ByteSource {
   std::string name_;
   int fd_ = -1;
   std::uint64_t size_ = 0;
-  std::vector<std::byte> buffer_;
+  IoBuffer buffer_;
   const std::byte* begin_ = nullptr;  // start of buffered bytes (buffer_ or the memory block)
   std::size_t available_ = 0;         // bytes valid at begin_
   std::size_t position_ = 0;          // next byte, relative to begin_
@@ -99,7 +136,7 @@ class OutputFile {
   std::string path_;
   std::string tempPath_;
   int fd_ = -1;
-  std::vector<std::byte> buffer_;
+  IoBuffer buffer_;
   std::size_t buffered_ = 0;
   std::uint64_t written_ = 0;
 };
@@ -161,13 +198,17 @@ std::string fileStem(const std::string& path);
 // rename-on-complete pattern.
 std::string temporaryPathFor(const std::string& path);
 
+// `block` records, or fewer when the open file holds fewer (at least one): a small file read
+// often should not zero a large block each time.
+std::size_t blockForFile(std::FILE* file, std::size_t block, std::size_t recordBytes);
+
 // Calls `each` with the file's records of type T, `block` at a time in file order, and checks
 // for cancellation between blocks (work files of fixed records read back).
 template <class T, class F>
 Status forEachFileBlock(const std::string& path, std::size_t block, F&& each) {
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) return ioErrorFromErrno(path, "open");
-  std::vector<T> values(block);
+  std::vector<T> values(blockForFile(file, block, sizeof(T)));
   Status status;
   while (status.ok()) {
     const std::size_t got = std::fread(values.data(), sizeof(T), values.size(), file);

@@ -32,8 +32,8 @@ struct ExactnessReport {
 };
 
 // An order-free fingerprint of a multiset of triangles (corners in their order): the count and
-// two sums of independent 64-bit mixes, kept as triangles come and go, so each level is compared
-// without sorting both sides; two different multisets agree by chance about once in 2^128.
+// the sums of two 64-bit hashes of each triangle, from its corners taken in two different
+// orders, kept as triangles come and go, so each level is compared without sorting both sides.
 struct TriangleMultiset {
   std::uint64_t count = 0, first = 0, second = 0;
   static std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
@@ -42,10 +42,9 @@ struct TriangleMultiset {
     return x ^ (x >> 31);
   }
   void add(const Triangle& t, std::uint64_t sign) {
-    const std::uint64_t h = mix(mix((std::uint64_t{t[0]} << 32) | t[1]) ^ t[2]);
     count += sign;
-    first += sign * h;
-    second += sign * mix(h ^ 0x9e3779b97f4a7c15ull);
+    first += sign * mix(mix((std::uint64_t{t[0]} << 32) | t[1]) ^ t[2]);
+    second += sign * mix(mix((std::uint64_t{t[2]} << 32) | t[0]) ^ (t[1] + 0x9e3779b97f4a7c15ull));
   }
   bool operator==(const TriangleMultiset&) const = default;
 };
@@ -89,7 +88,7 @@ ExactnessReport expectExact(const ProgressiveMesh& mesh, const std::vector<std::
       }
       EXPECT_FALSE(degenerate) << what << " degenerate triangle at n=" << n;
       EXPECT_FALSE(outOfRange) << what << " corner beyond n=" << n;
-      EXPECT_TRUE(actual == expected) << what << " n=" << n;
+      EXPECT_TRUE(actual == expected) << what << ": other triangles at n=" << n;
       if (::testing::Test::HasFailure()) return report;
     }
     if (n == q) break;
@@ -174,8 +173,8 @@ TEST(Progressive, ExactOnRandomSurfacesAtEveryLevel) {
 }
 
 // The reference check can fail: a mesh whose first and last triangles trade places re-forms
-// the wrong triangles at the counts where only one of them survives (the same number of them,
-// so only the multisets tell), and the check reports those counts.
+// the wrong triangles at the counts where only one of them survives: the same number of them, so
+// the count check passes, and the multisets (one re-formed triangle is degenerate) tell.
 TEST(Progressive, TheExactnessCheckCatchesWrongTrianglesAtARightCount) {
   std::vector<Vec3f> positions;
   std::vector<std::uint32_t> indices;
@@ -190,11 +189,14 @@ TEST(Progressive, TheExactnessCheckCatchesWrongTrianglesAtARightCount) {
         ::testing::ScopedFakeTestPartResultReporter::INTERCEPT_ONLY_CURRENT_THREAD, &failures);
     expectExact(mesh, levelsOf(mesh, 100000), "swapped");
   }
-  bool multisets = false;
-  for (int i = 0; i < failures.size(); ++i)
-    multisets =
-        multisets || std::string(failures.GetTestPartResult(i).message()).find("swapped n=") !=
-                         std::string::npos;
+  bool multisets = false, counts = false;
+  for (int i = 0; i < failures.size(); ++i) {
+    counts = counts || std::string(failures.GetTestPartResult(i).message()).find("swapped n=") !=
+                           std::string::npos;
+    multisets = multisets || std::string(failures.GetTestPartResult(i).message())
+                                     .find("swapped: other triangles at n=") != std::string::npos;
+  }
+  EXPECT_FALSE(counts) << "the swap changed a count";
   EXPECT_TRUE(multisets) << failures.size() << " failures, none of the multisets";
   // The fingerprint itself: blind to the triangles' order, not to their corners' or their count.
   const auto of = [](std::initializer_list<Triangle> triangles) {

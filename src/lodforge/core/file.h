@@ -20,7 +20,7 @@ namespace lodforge {
 
 // An I/O buffer of bytes left unset when it grows: it is written before it is read, and zeroing
 // megabytes for each small file (touching every page of them) cost more than the file's bytes.
-// Growing keeps what it held; shrinking keeps the memory.
+// Growing keeps the bytes below the old size (those above are unset); shrinking keeps the memory.
 class IoBuffer {
  public:
   IoBuffer() = default;

@@ -165,9 +165,10 @@ Result<Model> readSource(ByteSource& source) {
     }
     if (binary) return readBinary(source);
     // Not a consistent binary file: ascii if it says "solid", otherwise a broken binary one.
-    source.ensure(512);
+    // What it holds now (a file cut short since its size was read holds less than `size`).
+    const std::size_t held = source.ensure(512);
     const std::string_view start(reinterpret_cast<const char*>(source.data()),
-                                 std::min<std::uint64_t>(size, 512));
+                                 std::min<std::uint64_t>(size, held));
     const auto first = start.find_first_not_of(" \t\r\n");
     if (first != std::string_view::npos && start.substr(first).starts_with("solid")) {
       AsciiStl ascii(source);

@@ -191,10 +191,9 @@ TEST(Progressive, TheExactnessCheckCatchesWrongTrianglesAtARightCount) {
   }
   bool multisets = false, counts = false;
   for (int i = 0; i < failures.size(); ++i) {
-    counts = counts || std::string(failures.GetTestPartResult(i).message()).find("swapped n=") !=
-                           std::string::npos;
-    multisets = multisets || std::string(failures.GetTestPartResult(i).message())
-                                     .find("swapped: other triangles at n=") != std::string::npos;
+    const std::string message = failures.GetTestPartResult(i).message();
+    counts = counts || message.find("swapped n=") != std::string::npos;
+    multisets = multisets || message.find("swapped: other triangles at n=") != std::string::npos;
   }
   EXPECT_FALSE(counts) << "the swap changed a count";
   EXPECT_TRUE(multisets) << failures.size() << " failures, none of the multisets";

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Tilesets lodforge writes, loaded by CesiumJS in Debian's headless chromium from a local HTTP
-# server (tests/js/cesium-tiles.mjs): the horse georeferenced with --origin, and a generated scan
-# with meshopt-compressed contents, both with KHR_mesh_quantization (the default), and a
-# generated 2,000-part assembly (tiled by part, colours per part), a LAS point cloud placed from
-# its own coordinate system, and the scan again with implicit tiling. Fails on any tile failure,
-# failed request or console error, or if the screenshot does not show the model.
+# server (tests/js/cesium-tiles.mjs): a generated scan, georeferenced with --origin, its contents
+# meshopt-compressed and with KHR_mesh_quantization (the default), the same scan with implicit
+# tiling, and a generated 2,000-part assembly (tiled by part, colours per part). Fails on any tile
+# failure, failed request or console error, or if the screenshot does not show the model. The
+# horse (quantised, not compressed) and a LAS point cloud placed from its own coordinate system
+# go through the same CesiumJS in tests/web_viewers.sh, with the same commands.
 set -euo pipefail
-lodforge=$1 data=$2 out=$3
+lodforge=$1 out=$2
 here=$(cd "$(dirname "$0")" && pwd)
 for package in cesium playwright-core; do
   [[ -d $here/js/node_modules/$package ]] ||
@@ -14,9 +15,6 @@ for package in cesium playwright-core; do
 done
 [[ -x /usr/bin/chromium ]] || { echo "chromium is not installed: run scripts/install-deps.sh" >&2; exit 1; }
 rm -rf "$out" && mkdir -p "$out"
-"$lodforge" -q tiles "$data/meshes/horse.ply" -o "$out/horse" --chunk-size 0.05 \
-  --origin 8.5417,47.3769,408
-node "$here/js/cesium-tiles.mjs" "$out/horse" "$out/horse.png" --min-coverage 0.05
 "$lodforge" -q generate scan --triangles 200K -o "$out/scan.ply"
 "$lodforge" -q tiles "$out/scan.ply" -o "$out/scan" --chunk-size 150 --compress meshopt \
   --origin -122.4,37.8,10
@@ -30,6 +28,3 @@ node "$here/js/cesium-tiles.mjs" "$out/scan-implicit" "$out/scan-implicit.png" -
 "$lodforge" -q generate cad --objects 2000 --seed 5 -o "$out/cad.glb"
 "$lodforge" -q tiles "$out/cad.glb" -o "$out/cad" --origin 2.35,48.85,35
 node "$here/js/cesium-tiles.mjs" "$out/cad" "$out/cad.png" --min-coverage 0.05
-# A point cloud (refine ADD, glTF POINTS), placed on Earth from its LAS coordinate system.
-"$lodforge" -q tiles "$data/points/autzen_trim.las" -o "$out/autzen" --block-size 20K --tile-points 10K
-node "$here/js/cesium-tiles.mjs" "$out/autzen" "$out/autzen.png" --min-coverage 0.05

@@ -14,10 +14,9 @@ function bareViewer({ onDemand = false } = {}) {
     baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false,
     animation: false, homeButton: false, sceneModePicker: false, navigationHelpButton: false,
     fullscreenButton: false, infoBox: false, selectionIndicator: false,
-    terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false, skyAtmosphere: false,
+    globe: false, skyBox: false, skyAtmosphere: false,
     requestRenderMode: onDemand, maximumRenderTimeChange: Infinity,
   });
-  viewer.scene.globe.show = false;
   return viewer;
 }
 async function servedView(viewer) {

@@ -183,12 +183,12 @@ async function main() {
     baseLayer: false, baseLayerPicker: false, geocoder: false, timeline: false, animation: false,
     homeButton: false, sceneModePicker: false, navigationHelpButton: false, fullscreenButton: false,
     infoBox: false, selectionIndicator: false,
-    terrainProvider: new Cesium.EllipsoidTerrainProvider(), skyBox: false, skyAtmosphere: false,
+    // No imagery and no terrain: a globe would be a blank ball; the model alone is shown (and
+    // no globe's shaders and tiles are made at all).
+    globe: false, skyBox: false, skyAtmosphere: false,
     // Draw only when something changed (the camera, a tile, a setting): an idle view costs no CPU.
     requestRenderMode: true, maximumRenderTimeChange: Infinity,
   });
-  // No imagery and no terrain: the globe would be a blank ball; the model alone is shown.
-  viewer.scene.globe.show = false;
   viewer.scene.backgroundColor = Cesium.Color.fromCssColorString('#12151a');
   const tileset = await Cesium.Cesium3DTileset.fromUrl('/tiles/tileset.json', {
     maximumScreenSpaceError: 16,

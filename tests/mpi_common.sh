@@ -8,8 +8,9 @@ command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/ins
 # code in one process).
 # --mca pml ob1: OpenMPI's own point-to-point layer, which between the ranks of one machine sends
 # through shared memory; OpenMPI's default first probes UCX, 0.25 s of every mpirun here (in a
-# release and a sanitizer run alike), and the scripts start about fifty jobs. mpi_default keeps
-# OpenMPI's own choice for one check.
+# release and a sanitizer run alike), and the scripts start about fifty jobs. lodforge asks for
+# ob1 itself when every rank is on one machine and no layer was chosen (src/lodforge/core/
+# cluster.cpp): mpi_default leaves that choice to it for one check.
 mpi_default=(env "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" mpirun --allow-run-as-root --oversubscribe)
 mpi=("${mpi_default[@]}" --mca pml ob1)
 # The rank counts each output is compared at: every one given in the release tree (1, a job of

@@ -24,8 +24,8 @@ cd "$out"
   "${mpi[@]}" -np $ranks "$lodforge" -q tiles scan.ply -o scan-np$ranks --chunk-size 60
   same scan-np$ranks scan-1 "scan, $ranks ranks"
 done
-# The work was shared: -v says how (the scan read in slices by every rank). OpenMPI's own choice
-# of transport here (the other jobs use the shared-memory one, mpi_common.sh).
+# The work was shared: -v says how (the scan read in slices by every rank). No transport given
+# here (the other jobs ask for the shared-memory one, mpi_common.sh).
 "${mpi_default[@]}" -np 3 "$lodforge" -v tiles scan.ply -o scan-np3 --chunk-size 60 2> scan-v.err
 same scan-np3 scan-1 "scan, 3 ranks"
 grep -q "3 ranks: the input read in slices by every rank; subtrees under level" scan-v.err ||

@@ -59,7 +59,9 @@ void reportActivity(std::string_view what);
 std::string otherRanksActivities();
 
 // How many `units` ("faces", "nodes") of its share this rank has done, kept beside its activity
-// (a small file written whole: call it per piece of work that takes milliseconds).
+// (a small file written whole, at most ten times a second and at the first report of a stage;
+// the last report is written before the ranks next meet: agreeAcrossRanks, sumAcrossRanks,
+// gatherAcrossRanks). Call it per piece of work, however small.
 void reportProgress(std::string_view units, std::uint64_t done);
 
 // Rank 0's progress bar for the whole job while it lives: the sum of every rank's last

@@ -4,8 +4,9 @@
 # meshopt-compressed and with KHR_mesh_quantization (the default), the same scan with implicit
 # tiling, and a generated 2,000-part assembly (tiled by part, colours per part). Fails on any tile
 # failure, failed request or console error, or if the screenshot does not show the model. The
-# horse (quantised, not compressed) and a LAS point cloud placed from its own coordinate system
-# go through the same CesiumJS in tests/web_viewers.sh, with the same commands.
+# horse (meshopt-compressed, and uncompressed with implicit tiling) and a LAS point cloud placed
+# from its own coordinate system (the same command) go through the same CesiumJS in
+# tests/web_viewers.sh, at that viewer's screen-space error (16, not 4).
 set -euo pipefail
 lodforge=$1 out=$2
 here=$(cd "$(dirname "$0")" && pwd)

@@ -7,7 +7,7 @@ command -v mpirun >/dev/null || { echo "mpirun is not installed: run scripts/ins
 # attribute to "<unknown module>" (ours are checked by every other test, which runs the same
 # code in one process).
 # --mca pml ob1: OpenMPI's own point-to-point layer, which between the ranks of one machine sends
-# through shared memory; OpenMPI's default first probes UCX, 0.25 s of every mpirun here (in a
+# through shared memory; OpenMPI's own choice of a layer took 0.25 s of every mpirun here (in a
 # release and a sanitizer run alike), and the scripts start about fifty jobs. lodforge asks for
 # ob1 itself when every rank is on one machine and no layer was chosen (src/lodforge/core/
 # cluster.cpp): mpi_default leaves that choice to it for one check.

@@ -41,6 +41,34 @@ TEST(Cluster, AProcessNotStartedAsAJobIsAJobOfOne) {
   leaveCluster(1);  // a failure in a job of one aborts nothing
 }
 
+// A job's ranks ask for OpenMPI's shared-memory layer only when mpirun put them all on this
+// machine and nothing chose a layer: --mca pml (or -x), a parameter file named, or one of the
+// standard files.
+TEST(Cluster, OnlyAJobOnOneMachineWithNoLayerChosenAsksForSharedMemory) {
+  EXPECT_TRUE(ob1SharedMemoryWanted({"4", "4", nullptr, nullptr, false}));
+  EXPECT_FALSE(ob1SharedMemoryWanted({"8", "4", nullptr, nullptr, false})) << "two machines";
+  EXPECT_FALSE(ob1SharedMemoryWanted({nullptr, nullptr, nullptr, nullptr, false})) << "srun";
+  EXPECT_FALSE(ob1SharedMemoryWanted({"4", nullptr, nullptr, nullptr, false}));
+  EXPECT_FALSE(ob1SharedMemoryWanted({"4", "4", "ucx", nullptr, false})) << "--mca pml ucx";
+  EXPECT_FALSE(ob1SharedMemoryWanted({"4", "4", nullptr, "/site/mca.conf", false}));
+  EXPECT_FALSE(ob1SharedMemoryWanted({"4", "4", nullptr, nullptr, true})) << "pml = in a file";
+}
+
+// A parameter file chooses a layer with `pml = NAME`, not with a list of layers ruled out
+// (Debian's own file), a comment, another parameter or no file at all.
+TEST(Cluster, AParameterFileChoosesALayerOnlyByNamingIt) {
+  const test::TempDir dir;
+  const auto chooses = [&](const std::string& text) {
+    test::writeFile(dir.file("mca-params.conf"), text);
+    return paramFileChoosesPml(dir.file("mca-params.conf"));
+  };
+  EXPECT_TRUE(chooses("btl = ^openib\npml = ucx\n"));
+  EXPECT_TRUE(chooses("  pml=ob1"));
+  EXPECT_FALSE(chooses("mtl = ^ofi\npml = ^ucx\n"));
+  EXPECT_FALSE(chooses("# pml = ucx\npml_ucx_verbose = 1\n"));
+  EXPECT_FALSE(paramFileChoosesPml(dir.file("none.conf")));
+}
+
 // Largest first to the least loaded rank, ties by order: the same deal on every rank, within
 // 4/3 of the best busiest rank.
 TEST(Cluster, WorkIsDealtLargestFirstToTheLeastLoadedRank) {

@@ -133,18 +133,42 @@ bool clusterSupported() {
   return LODFORGE_WITH_MPI != 0;
 }
 
-#if LODFORGE_WITH_MPI
-// A job whose ranks all run on this machine talks through shared memory whatever the transport,
-// but OpenMPI 4.1's default first sets up UCX (0.27 s of MPI_Init here, against 0.06 s): unless
-// the user chose a layer (--mca pml …, which mpirun hands over as OMPI_MCA_pml), the ranks ask
-// for the shared-memory one, ob1. mpirun says where the ranks are before they start; every rank
-// of one machine sees the same, so they all choose alike.
-void preferSharedMemoryOnOneMachine() {
-  const char* ranks = std::getenv("OMPI_COMM_WORLD_SIZE");
-  const char* here = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
-  if (ranks == nullptr || here == nullptr || std::string_view(ranks) != here) return;
-  if (std::getenv("OMPI_MCA_pml") == nullptr) ::setenv("OMPI_MCA_pml", "ob1", 0);
+bool ob1SharedMemoryWanted(const LaunchEnvironment& launch) {
+  if (launch.worldSize == nullptr || launch.localSize == nullptr) return false;
+  if (std::string_view(launch.worldSize) != launch.localSize) return false;
+  return launch.pml == nullptr && launch.paramFiles == nullptr && !launch.pmlInParamFile;
 }
+
+bool paramFileChoosesPml(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t at = line.find_first_not_of(" \t");
+    if (at == std::string::npos || line.compare(at, 3, "pml") != 0) continue;
+    const std::size_t equals = line.find_first_not_of(" \t", at + 3);
+    if (equals == std::string::npos || line[equals] != '=') continue;
+    const std::size_t value = line.find_first_not_of(" \t", equals + 1);
+    if (value != std::string::npos && line[value] != '^') return true;
+  }
+  return false;
+}
+
+#if LODFORGE_WITH_MPI
+namespace {
+
+// Asks OpenMPI for its shared-memory layer where ob1SharedMemoryWanted says so.
+void preferSharedMemoryOnOneMachine() {
+  const char* home = std::getenv("HOME");
+  const bool inFile =
+      paramFileChoosesPml("/etc/openmpi/openmpi-mca-params.conf") ||
+      (home != nullptr && paramFileChoosesPml(std::string(home) + "/.openmpi/mca-params.conf"));
+  const LaunchEnvironment launch{
+      std::getenv("OMPI_COMM_WORLD_SIZE"), std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE"),
+      std::getenv("OMPI_MCA_pml"), std::getenv("OMPI_MCA_mca_base_param_files"), inFile};
+  if (ob1SharedMemoryWanted(launch)) ::setenv("OMPI_MCA_pml", "ob1", 0);
+}
+
+}  // namespace
 #endif
 
 Status joinCluster() {
@@ -242,7 +266,8 @@ void reportProgress(std::string_view units, std::uint64_t done) {
   const std::lock_guard lock(progressMutex);
   const bool newStage = units != progressReport.units;
   progressReport.units = units;
-  progressReport.done = done;
+  // Worker threads count in turn but may take the lock out of turn: a count never goes back.
+  progressReport.done = newStage ? done : std::max(progressReport.done, done);
   progressReport.written = false;
   // A report replaces the file by a rename, which ext4 makes write the new file out at once: one
   // per tile cost a 20 M-point job a second. Rank 0 reads twice a second; ten a second are plenty.

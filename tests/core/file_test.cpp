@@ -1,7 +1,6 @@
 #include "lodforge/core/file.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -213,16 +212,11 @@ TEST(FileBlocks, EveryRecordOnceInOrderAndNoBlockBiggerThanTheFile) {
     EXPECT_EQ(back, records) << block;
     EXPECT_EQ(largest, std::min<std::size_t>(block, records.size())) << block;
   }
-  std::FILE* file = std::fopen(dir.file("r.bin").c_str(), "rb");
-  ASSERT_NE(file, nullptr);
-  EXPECT_EQ(blockForFile(file, 1 << 20, 4), 1000u);
-  EXPECT_EQ(blockForFile(file, 10, 4), 10u);
-  EXPECT_EQ(blockForFile(file, 1 << 20, 3000), 1u);  // one record's room, even past the end
-  std::fclose(file);
-  file = std::fopen(dir.file("empty.bin").c_str(), "rb");
-  ASSERT_NE(file, nullptr);
-  EXPECT_EQ(blockForFile(file, 1 << 20, 4), 1u);
-  std::fclose(file);
+  const std::string r = dir.file("r.bin");
+  EXPECT_EQ(blockForFile(r, 1 << 20, 4), 1000u);
+  EXPECT_EQ(blockForFile(r, 10, 4), 10u);
+  EXPECT_EQ(blockForFile(r, 1 << 20, 3000), 1u);  // one record's room, even past the end
+  EXPECT_EQ(blockForFile(dir.file("empty.bin"), 1 << 20, 4), 1u);
 }
 
 TEST(MappedFile, SeesTheFileContents) {

@@ -279,10 +279,10 @@ Status OutputFile::write(const void* data, std::size_t size) {
   return {};
 }
 
-std::size_t blockForFile(std::FILE* file, std::size_t block, std::size_t recordBytes) {
-  struct stat info {};
-  if (::fstat(::fileno(file), &info) != 0 || info.st_size < 0) return block;
-  const std::uint64_t records = static_cast<std::uint64_t>(info.st_size) / recordBytes;
+std::size_t blockForFile(const std::string& path, std::size_t block, std::size_t recordBytes) {
+  const Result<std::uint64_t> bytes = fileSize(path);
+  if (!bytes) return block;  // the read that follows says what is wrong with the file
+  const std::uint64_t records = *bytes / recordBytes;
   return std::max<std::size_t>(1,
                                static_cast<std::size_t>(std::min<std::uint64_t>(block, records)));
 }

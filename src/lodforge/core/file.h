@@ -198,9 +198,9 @@ std::string fileStem(const std::string& path);
 // rename-on-complete pattern.
 std::string temporaryPathFor(const std::string& path);
 
-// `block` records, or fewer when the open file holds fewer (at least one): a small file read
-// often should not zero a large block each time.
-std::size_t blockForFile(std::FILE* file, std::size_t block, std::size_t recordBytes);
+// `block` records, or fewer when the file holds fewer (at least one): a small file read often
+// should not zero a large block each time.
+std::size_t blockForFile(const std::string& path, std::size_t block, std::size_t recordBytes);
 
 // Calls `each` with the file's records of type T, `block` at a time in file order, and checks
 // for cancellation between blocks (work files of fixed records read back).
@@ -208,7 +208,7 @@ template <class T, class F>
 Status forEachFileBlock(const std::string& path, std::size_t block, F&& each) {
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) return ioErrorFromErrno(path, "open");
-  std::vector<T> values(blockForFile(file, block, sizeof(T)));
+  std::vector<T> values(blockForFile(path, block, sizeof(T)));
   Status status;
   while (status.ok()) {
     const std::size_t got = std::fread(values.data(), sizeof(T), values.size(), file);

@@ -132,18 +132,30 @@ awk 'BEGIN { for (i = 0; i < 4000; ++i) printf "%.3f %.3f %.3f\n", i % 80, int(i
 same text-np2 text-1 "text cloud, read by rank 0, 2 ranks"
 grep -q "2 ranks: the input read by rank 0 (done at" text.err ||
   fail "the text cloud was not read by rank 0: $(cat text.err)"
-# A rank killed while ranking: the job stops, rank 0 says what rank 1 was doing, and nothing is
-# left behind (a point tileset has no --resume: the same command builds it again).
+# A rank killed after ranking its second node of the partition: the job stops, rank 0 says what
+# rank 1 was doing, and the work stays; --resume by 3 ranks takes the split input and every node
+# whose summary was written, and writes the same tileset.
 set +e
 "${mpi[@]}" -np 1 "$lodforge" tiles large.las -o large-killed --block-size 10000 : \
-  -np 1 -x LODFORGE_INTERRUPT_AFTER=block:2:kill "$lodforge" tiles large.las -o large-killed \
+  -np 1 -x LODFORGE_INTERRUPT_AFTER=pointnode:2:kill "$lodforge" tiles large.las -o large-killed \
   --block-size 10000 > large-killed.out 2> large-killed.err
 code=$?
 set -e
 [[ $code -ne 0 ]] || fail "a point job with a killed rank exited 0"
 grep -qE "^  rank 1 of 2 \(.*\): splitting and ranking [0-9]+ of the partition's [0-9]+ nodes" \
   large-killed.err || fail "the stop does not say what rank 1 was doing: $(cat large-killed.err)"
-[[ ! -e large-killed && ! -e large-killed.work ]] || fail "the killed point job left files behind"
+grep -q "the finished work is kept in large-killed.work" large-killed.err ||
+  fail "the killed point job does not say its work is kept: $(cat large-killed.err)"
+[[ ! -e large-killed ]] || fail "the killed point job left a tileset"
+done_before=$(find large-killed.work/points/nodes -name '*.json' | wc -l)
+"${mpi[@]}" -np 3 "$lodforge" -v tiles large.las -o large-killed --block-size 10000 --resume \
+  2> large-resumed.err
+taken=$(sed -nE "s/.*resumed: the input as the interrupted run split it, ([0-9]+) of the partition's 16 nodes.*/\1/p" \
+  large-resumed.err)
+[[ -n $taken && $taken -ge $done_before && $done_before -ge 2 ]] ||
+  fail "--resume took ${taken:-no} nodes of the $done_before ranked: $(cat large-resumed.err)"
+same large-killed large-1 "point job: killed rank, then --resume by 3 ranks"
+[[ ! -e large-killed.work ]] || fail "the resumed point job left its work behind"
 unset LODFORGE_PARTITION_BYTES
 
 # More ranks than chunks: a small scan in two chunks, 4 ranks (the split is their parent, the

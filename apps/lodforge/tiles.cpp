@@ -168,8 +168,7 @@ void addTilesOptions(CLI::App& sub, TilesCommand& options) {
   sub.add_flag("--salvage", options.salvage,
                "Read a PLY, STEP or IFC cut short up to the cut (with a warning)");
   sub.add_flag("--resume", options.resume,
-               "Meshes and --surface: continue an interrupted run from OUTPUT.work (same input "
-               "and options)");
+               "Continue an interrupted run from OUTPUT.work (same input and options)");
 }
 
 // The command line as the mesh pipeline's options.
@@ -227,20 +226,35 @@ void reportPointRanks(const Global& global, const PointTilesStats& stats) {
         fmt::format("{}rank {} split and ranked {} points, wrote {} tile{}", r == 0 ? "" : "; ", r,
                     formatCount(stats.rankPoints[r]), formatCount(tiles), tiles == 1 ? "" : "s");
   }
-  detail(global,
-         fmt::format("{} ranks: the input read {} (done at {:.1f} s); the partition's large "
-                     "nodes split level by level by the ranks ({:.1f} s), the rest split and "
-                     "ranked by each rank ({:.1f} s); {}",
-                     stats.ranks, stats.readInSlices ? "in slices by every rank" : "by rank 0",
-                     stats.readSeconds, stats.partitionSeconds, stats.rankingSeconds, shares));
+  const std::string split =
+      stats.resumed ? "the input as the interrupted job split it"
+                    : fmt::format(
+                          "the input read {} (done at {:.1f} s); the partition's large nodes split "
+                          "level by level by the ranks ({:.1f} s)",
+                          stats.readInSlices ? "in slices by every rank" : "by rank 0",
+                          stats.readSeconds, stats.partitionSeconds);
+  detail(global, fmt::format("{} ranks: {}, the rest split and ranked by each rank ({:.1f} s); {}",
+                             stats.ranks, split, stats.rankingSeconds, shares));
   for (const std::string& line : stats.rankStages) detail(global, line);
 }
 
+// After a failed run: where its finished work stays for --resume, if it does.
+void sayWorkKept(const std::string& output) {
+  const std::string work = tilesWorkDirectory(output);
+  // Not where another run holds the work (this one was refused), and once for a job.
+  if (clusterRank() == 0 && isWorkDirectory(work) && tilesWorkKept(work) &&
+      !workDirectoryLocked(work))
+    fmt::print(stderr,
+               "lodforge: the finished work is kept in {}: run again with --resume to continue, "
+               "or delete it\n",
+               work);
+}
+
 Status runPointTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
-  if (options.levels > 0 || options.chunkSize > 0 || options.resume)
+  if (options.levels > 0 || options.chunkSize > 0)
     return Error{ErrorKind::kUsage,
-                 fmt::format("{}: a point cloud; --levels, --chunk-size and --resume are for "
-                             "meshes (a point tileset's depth follows --block-size)",
+                 fmt::format("{}: a point cloud; --levels and --chunk-size are for meshes (a "
+                             "point tileset's depth follows --block-size)",
                              options.input)};
   if (options.implicitTiling == "on")
     return Error{ErrorKind::kUsage,
@@ -260,8 +274,12 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
   Result<std::uint32_t> attributes = parsePointAttributes(options.attributes);
   if (!attributes) return attributes.status();
   points.attributes = *attributes;
+  points.resume = options.resume;
   Result<PointTilesStats> stats = writePointTiles(options.input, options.output, points);
-  if (!stats) return stats.status();
+  if (!stats) {
+    sayWorkKept(options.output);
+    return stats.status();
+  }
   for (const std::string& warning : stats->warnings)
     fmt::print(stderr, "lodforge: warning: {}\n", warning);
   warnIfNotPlaced(global, !stats->crs.empty() || points.origin.has_value());
@@ -276,6 +294,13 @@ Status runPointTiles(const Global& global, const TilesCommand& options, const Ti
                   stats->crs.empty() ? "" : "; placed on Earth from its coordinate system"));
   if (stats->attributes != 0)
     detail(global, fmt::format("point attributes: {}", pointAttributeNames(stats->attributes)));
+  if (stats->resumed)
+    detail(global,
+           fmt::format("resumed: the input as the interrupted run split it, {} of the "
+                       "partition's {} nodes as it ranked them, {} tile{} as it wrote "
+                       "them",
+                       formatCount(stats->nodesResumed), formatCount(stats->nodes),
+                       formatCount(stats->tilesResumed), stats->tilesResumed == 1 ? "" : "s"));
   if (stats->ranks > 1) reportPointRanks(global, *stats);
   return {};
 }
@@ -354,14 +379,7 @@ void reportMeshTiles(const Global& global, const TilesCommand& options, const Ti
 Status runMeshTiles(const Global& global, const TilesCommand& options, const TilesOptions& tiles) {
   Result<TilesStats> stats = writeTiles(options.input, options.output, tiles);
   if (!stats) {
-    const std::string work = tilesWorkDirectory(options.output);
-    // Not where another run holds the work (this one was refused), and once for a job.
-    if (clusterRank() == 0 && isWorkDirectory(work) && tilesWorkKept(work) &&
-        !workDirectoryLocked(work))
-      fmt::print(stderr,
-                 "lodforge: the finished work is kept in {}: run again with --resume to "
-                 "continue, or delete it\n",
-                 work);
+    sayWorkKept(options.output);
     return stats.status();
   }
   if (clusterRank() != 0) return {};  // rank 0 speaks for the job

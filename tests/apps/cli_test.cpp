@@ -1684,6 +1684,105 @@ TEST(CliTiles, AReconstructionStoppedHalfwayResumesToTheSameTileset) {
                                 " resumed)");
 }
 
+// An environment variable set for a test's runs of lodforge, unset after.
+struct ScopedVariable {
+  std::string name;
+  ScopedVariable(std::string n, const std::string& value) : name(std::move(n)) {
+    ::setenv(name.c_str(), value.c_str(), 1);
+  }
+  ~ScopedVariable() { ::unsetenv(name.c_str()); }
+};
+
+// A point tileset of p.las into `out`, stopped as by Ctrl-C at the durable step `stopAt`
+// ("pointnode:3": the third node of the partition ranked; "tile:4": the fourth tile written;
+// with ":kill", killed there), then, after `damage`, resumed: the tileset is byte for byte the
+// uninterrupted one in `a`, nothing is left beside it, and what `-v` says of the resumed work is
+// returned.
+std::string resumePointTiles(const test::TempDir& dir, const std::string& out,
+                             const std::string& stopAt, const std::function<void()>& damage) {
+  std::vector<std::string> args = {"-q",          "--threads",       "1",
+                                   "tiles",       dir.file("p.las"), "-o",
+                                   dir.file(out), "--block-size",    "1000"};
+  if (stopAt.ends_with(":kill")) {
+    ::setenv("LODFORGE_INTERRUPT_AFTER", stopAt.c_str(), 1);
+    const pid_t pid = spawnLodforge(args, dir.file(".stderr"));
+    ::unsetenv("LODFORGE_INTERRUPT_AFTER");
+    EXPECT_EQ(waitFor(pid).code, -1) << "the run was not killed at " << stopAt;
+    std::remove(dir.file(".stderr").c_str());
+  } else {
+    interruptAfter(dir, args, stopAt);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file(out)));
+  // What a run killed while writing a tile leaves: --resume must not ship it.
+  test::writeFile(dir.file(out + ".work/points/tileset/tiles/planted.glb.tmp-4242-7"), "partial");
+  damage();
+  args.front() = "-v";
+  args.push_back("--resume");
+  std::string line;
+  for (const std::string& a : args) line += a + " ";
+  const Outcome o = lodforge(line, dir);
+  EXPECT_EQ(o.code, 0) << o.err;
+  const std::vector<std::string> files = test::listFolder(dir.file("a/tiles"));
+  EXPECT_EQ(test::listFolder(dir.file(out + "/tiles")), files);
+  for (const std::string& f : files)
+    EXPECT_EQ(test::readFile(dir.file("a/tiles/" + f)),
+              test::readFile(dir.file(out + "/tiles/" + f)))
+        << f;
+  EXPECT_EQ(test::readFile(dir.file("a/tileset.json")),
+            test::readFile(dir.file(out + "/tileset.json")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file(out + ".work")));
+  const std::size_t at = o.err.find("resumed: ");
+  return at == std::string::npos ? "" : o.err.substr(at, o.err.find('\n', at) - at);
+}
+
+// A point tileset resumes from the split input, each node of the partition ranked and each tile
+// written (16 nodes of ~3,750 points here, LODFORGE_PARTITION_BYTES); a changed input starts
+// over.
+TEST(CliTiles, AnInterruptedPointRunResumesToTheSameTileset) {
+  test::TempDir dir;
+  const ScopedVariable nodes("LODFORGE_PARTITION_BYTES", "500000");
+  ASSERT_EQ(
+      lodforge("-q generate points --points 60K --extra-bytes -o " + dir.file("p.las"), dir).code,
+      0);
+  ASSERT_EQ(lodforge("-q --threads 1 tiles " + dir.file("p.las") + " -o " + dir.file("a") +
+                         " --block-size 1000",
+                     dir)
+                .code,
+            0);
+  const auto none = [] {};
+  EXPECT_EQ(resumePointTiles(dir, "b", "pointnode:3", none),
+            "resumed: the input as the interrupted run split it, 3 of the partition's 16 nodes "
+            "as it ranked them, 0 tiles as it wrote them");
+  // (A tile another thread was writing when the fourth was done may be done too.)
+  const std::string tiles = resumePointTiles(dir, "c", "tile:4", none);
+  std::smatch kept;
+  ASSERT_TRUE(std::regex_match(tiles, kept,
+                               std::regex("resumed: the input as the interrupted run split it, 16 "
+                                          "of the partition's 16 nodes as it ranked them, "
+                                          "([0-9]+) tiles as it wrote them")))
+      << tiles;
+  EXPECT_GE(std::stoi(kept[1]), 4);
+  // Stopped in the middle of its second node: the blocks after the stop are not ranked, so
+  // that node is split again.
+  EXPECT_EQ(resumePointTiles(dir, "f", "pointblock:6", none),
+            "resumed: the input as the interrupted run split it, 1 of the partition's 16 nodes "
+            "as it ranked them, 0 tiles as it wrote them");
+  // Killed with its third node staged but not yet in place: --resume puts it there.
+  EXPECT_EQ(resumePointTiles(dir, "d", "pointstaged:3:kill", none),
+            "resumed: the input as the interrupted run split it, 3 of the partition's 16 nodes "
+            "as it ranked them, 0 tiles as it wrote them");
+  EXPECT_EQ(resumePointTiles(dir, "e", "pointnode:3",
+                             [&] {
+                               const auto file = dir.file("p.las");
+                               std::filesystem::last_write_time(
+                                   file, std::filesystem::last_write_time(file) +
+                                             std::chrono::seconds(10));
+                             }),
+            "");
+  EXPECT_EQ(test::listFolder(dir.path()),
+            (std::vector<std::string>{"a", "b", "c", "d", "e", "f", "p.las"}));
+}
+
 // reconstruct: Ctrl-C after some runs of chunks keeps OUTPUT.work and says so; --resume takes
 // the finished runs and writes the bytes of an unbroken run, leaving nothing else behind.
 TEST(CliReconstruct, AnInterruptedReconstructionResumesToTheSameMesh) {

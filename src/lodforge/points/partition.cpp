@@ -244,9 +244,10 @@ Result<InputRead> readInput(const std::string& input, const std::string& path,
   return read;
 }
 
-// A new file of `bytes` bytes (zeros) that several processes then write parts of.
-Status createSizedFile(const std::string& path, std::uint64_t bytes) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+// A file of `bytes` bytes (zeros where not yet written) that several processes then write parts
+// of; `fresh`: emptied first.
+Status createSizedFile(const std::string& path, std::uint64_t bytes, bool fresh = true) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | (fresh ? O_TRUNC : 0) | O_CLOEXEC, 0644);
   if (fd < 0) return ioErrorFromErrno(path, "create");
   const int sized = ::ftruncate(fd, static_cast<off_t>(bytes));
   const int error = errno;
@@ -333,25 +334,27 @@ struct Blocks {
 // What every in-memory split shares: the node's extra bytes by id (its records' order as read).
 struct InMemory {
   const PartitionOptions& options;
-  const WorkFiles& files;
+  const WorkFiles& files;  // where finished blocks go: in place, or staged from `offset` on
   std::span<const std::byte> extras;
   Blocks& blocks;
+  std::uint64_t offset = 0;  // the node's first record, when staged
 };
 
-// A finished block: handed to the sink, if any, then written back in place (its extra bytes
-// gathered by the ids the splits and the sink moved with the points).
+// A finished block: handed to the sink, if any, then written back (its extra bytes gathered by
+// the ids the splits and the sink moved with the points).
 Status finishBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids, PointBlock& block,
                    const InMemory& shared) {
   if (shared.options.blockSink && !cancelRequested())
     LODFORGE_TRY(shared.options.blockSink(points, ids, block));
   std::vector<std::byte> scratch;
-  LODFORGE_TRY(shared.files.writePoints(block.first, points, scratch));
+  const std::uint64_t at = block.first - shared.offset;
+  LODFORGE_TRY(shared.files.writePoints(at, points, scratch));
   const std::size_t stride = shared.files.stride;
   if (stride == 0) return {};
   std::vector<std::byte> extras(points.size() * stride);
   for (std::size_t i = 0; i < ids.size(); ++i)
     std::memcpy(extras.data() + i * stride, shared.extras.data() + ids[i] * stride, stride);
-  return shared.files.extras->writeAt(block.first * stride, extras.data(), extras.size());
+  return shared.files.extras->writeAt(at * stride, extras.data(), extras.size());
 }
 
 // A node in memory (its records from `first` on in the work file), split recursively into
@@ -673,18 +676,107 @@ struct OpenFiles {
   }
 };
 
-Result<OpenFiles> openWorkFiles(const PartitionOptions& options, std::size_t stride) {
-  Result<WorkFile> points = WorkFile::open(options.workDirectory + "/b.points");
+Result<OpenFiles> openWorkFiles(const PartitionOptions& options, std::size_t stride,
+                                const std::string& stem = "b") {
+  const std::string at = options.workDirectory + "/" + stem;
+  Result<WorkFile> points = WorkFile::open(at + ".points");
   if (!points) return points.status();
   OpenFiles files{std::move(*points), {}};
   if (stride == 0) return files;
-  Result<WorkFile> extras = WorkFile::open(options.workDirectory + "/b.extras");
+  Result<WorkFile> extras = WorkFile::open(at + ".extras");
   if (!extras) return extras.status();
   files.extras.emplace(std::move(*extras));
   return files;
 }
 
+// The blocks a node's split added to `blocks` (from `from` on), in name order.
+std::vector<PointBlock> nodeBlocks(Blocks& blocks, std::size_t from) {
+  const auto begin = blocks.named.begin() + static_cast<std::ptrdiff_t>(from);
+  std::sort(begin, blocks.named.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<PointBlock> out;
+  for (auto it = begin; it != blocks.named.end(); ++it) out.push_back(it->second);
+  return out;
+}
+
+// The scratch files a process stages its nodes in: at least `records` records, what they hold
+// kept (a resumed run places an interrupted one's staged node before it stages any).
+Result<OpenFiles> scratchFiles(const InputRead& read, const PartitionOptions& options,
+                               const std::string& stem, std::uint64_t records) {
+  const std::string at = options.workDirectory + "/" + stem;
+  LODFORGE_TRY(createSizedFile(at + ".points", records * read.layout.bytes(), false));
+  const std::size_t stride = read.info.extras.stride;
+  if (stride != 0) LODFORGE_TRY(createSizedFile(at + ".extras", records * stride, false));
+  return openWorkFiles(options, stride, stem);
+}
+
+// Bytes [from, from + bytes) of one file to `to` of another, pieces in parallel, each copied by
+// the kernel from page cache to page cache (copy_file_range: a user-space buffer took two copies;
+// the copy sits between nodes, with the other threads idle).
+Status copyBytes(const std::string& sourcePath, std::uint64_t from, const std::string& targetPath,
+                 std::uint64_t to, std::uint64_t bytes) {
+  const int in = ::open(sourcePath.c_str(), O_RDONLY | O_CLOEXEC);
+  if (in < 0) return ioErrorFromErrno(sourcePath, "open");
+  const int out = ::open(targetPath.c_str(), O_WRONLY | O_CLOEXEC);
+  if (out < 0) {
+    const Status error = ioErrorFromErrno(targetPath, "open");
+    ::close(in);
+    return error;
+  }
+  constexpr std::uint64_t kPiece = std::uint64_t{8} << 20;
+  std::vector<Status> copied((bytes + kPiece - 1) / kPiece);
+  tbb::parallel_for(std::size_t{0}, copied.size(), [&](std::size_t piece) {
+    auto inAt = static_cast<off_t>(from + piece * kPiece);
+    auto outAt = static_cast<off_t>(to + piece * kPiece);
+    std::uint64_t left = std::min(kPiece, bytes - piece * kPiece);
+    while (left > 0) {
+      const ssize_t n = ::copy_file_range(in, &inAt, out, &outAt, left, 0);
+      if (n <= 0) {
+        copied[piece] = n == 0 ? ioError(sourcePath, "ends before the node's records")
+                               : ioErrorFromErrno(targetPath, "copy into");
+        return;
+      }
+      left -= static_cast<std::uint64_t>(n);
+    }
+  });
+  ::close(in);
+  ::close(out);
+  for (const Status& status : copied) LODFORGE_TRY(status);
+  return {};
+}
+
+// Records [from, from + count) of one pair of work files to `to` of another.
+Status copyRecords(const WorkFiles& source, std::uint64_t from, const WorkFiles& target,
+                   std::uint64_t to, std::uint64_t count) {
+  const std::uint64_t bytes = source.layout.bytes();
+  LODFORGE_TRY(copyBytes(source.points.path(), from * bytes, target.points.path(), to * bytes,
+                         count * bytes));
+  if (source.stride == 0) return {};
+  return copyBytes(source.extras->path(), from * source.stride, target.extras->path(),
+                   to * source.stride, count * source.stride);
+}
+
+// A node whose blocks are all in the scratch files: told, copied into place, told.
+Status placeStaged(const NodeStaging& staging, const PartNode& node,
+                   std::span<const PointBlock> blocks, const WorkFiles& scratch,
+                   const WorkFiles& files) {
+  LODFORGE_TRY(staging.staged(node, blocks));
+  LODFORGE_TRY(copyRecords(scratch, 0, files, node.first, node.count));
+  return staging.placed(node);
+}
+
 }  // namespace
+
+Status placeScratchNode(const InputRead& read, const PartitionOptions& options,
+                        const std::string& scratchStem, const PartitionNode& node) {
+  const std::size_t stride = read.info.extras.stride;
+  Result<OpenFiles> scratch = openWorkFiles(options, stride, scratchStem);
+  if (!scratch) return scratch.status();
+  Result<OpenFiles> files = openWorkFiles(options, stride);
+  if (!files) return files.status();
+  return copyRecords(scratch->view(read.layout, stride), 0, files->view(read.layout, stride),
+                     node.first, node.count);
+}
 
 Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
                                                    const PartitionOptions& options,
@@ -706,11 +798,20 @@ Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
 
 Result<std::vector<PointBlock>> splitNodesInMemory(
     const InputRead& read, std::span<const PartitionNode> nodes, const PartitionOptions& options,
-    const std::function<void(std::uint64_t)>& advanced) {
+    const std::function<void(std::uint64_t)>& advanced, const NodeStaging* staging) {
   const std::size_t stride = read.info.extras.stride;
   Result<OpenFiles> opened = openWorkFiles(options, stride);
   if (!opened) return opened.status();
   const WorkFiles files = opened->view(read.layout, stride);
+  std::uint64_t biggest = 0;
+  for (const PartNode& node : nodes) biggest = std::max(biggest, node.count);
+  std::optional<OpenFiles> scratch;
+  if (staging) {
+    Result<OpenFiles> made = scratchFiles(read, options, staging->scratchStem, biggest);
+    if (!made) return made.status();
+    scratch.emplace(std::move(*made));
+  }
+  const WorkFiles finished = scratch ? scratch->view(read.layout, stride) : files;
   Blocks blocks;
   std::uint64_t total = 0, done = 0;
   for (const PartNode& node : nodes) total += node.count;
@@ -719,8 +820,6 @@ Result<std::vector<PointBlock>> splitNodesInMemory(
   // One buffer for the biggest node (growing it node by node would hold two at once).
   Records records{stride, {}, {}, {}};
   std::vector<std::uint32_t> ids;
-  std::uint64_t biggest = 0;
-  for (const PartNode& node : nodes) biggest = std::max(biggest, node.count);
   records.points.reserve(static_cast<std::size_t>(biggest));
   records.extras.reserve(static_cast<std::size_t>(biggest) * stride);
   for (const PartNode& node : nodes) {
@@ -732,9 +831,14 @@ Result<std::vector<PointBlock>> splitNodesInMemory(
     LODFORGE_TRY(records.read(files, node.first, static_cast<std::size_t>(node.count)));
     ids.resize(stride == 0 ? 0 : records.size());
     std::iota(ids.begin(), ids.end(), 0u);
+    const std::size_t before = blocks.named.size();
     splitInMemory(records.points, ids, node.first, node.name,
-                  InMemory{options, files, records.extras, blocks});
+                  InMemory{options, finished, records.extras, blocks, scratch ? node.first : 0});
     if (!blocks.status.ok()) return blocks.status;
+    // A block finished after a cancellation skipped the sink: such a node is never staged.
+    LODFORGE_TRY(checkCancelled());
+    if (staging)
+      LODFORGE_TRY(placeStaged(*staging, node, nodeBlocks(blocks, before), finished, files));
     done += node.count;
     if (progress) progress->advance(node.count);
     if (advanced) advanced(done);

@@ -219,8 +219,21 @@ Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
                                                    const PartitionOptions& options,
                                                    Partition& partition,
                                                    const LevelShare& share = {});
+// With `staging`, each node's finished blocks go first to scratch files in the work directory
+// (`scratchStem` + ".points" and ".extras", from record 0); `staged` is told the node and its
+// blocks once they are all there, then they are copied into the node's place and `placed` is
+// told. So the node of an interrupted run is either untouched in place (split it again) or whole
+// in the scratch files (placeScratchNode), never half overwritten.
+struct NodeStaging {
+  std::string scratchStem;
+  std::function<Status(const PartitionNode&, std::span<const PointBlock>)> staged;
+  std::function<Status(const PartitionNode&)> placed;
+};
 Result<std::vector<PointBlock>> splitNodesInMemory(
     const InputRead& read, std::span<const PartitionNode> nodes, const PartitionOptions& options,
-    const std::function<void(std::uint64_t)>& advanced = {});
+    const std::function<void(std::uint64_t)>& advanced = {}, const NodeStaging* staging = nullptr);
+// A staged node's records, from the scratch files of `scratchStem`, into its place.
+Status placeScratchNode(const InputRead& read, const PartitionOptions& options,
+                        const std::string& scratchStem, const PartitionNode& node);
 
 }  // namespace lodforge

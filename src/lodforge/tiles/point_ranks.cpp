@@ -16,31 +16,13 @@
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
+#include "lodforge/tiles/point_resume.h"
 #include "lodforge/tiles/point_steps.h"
 #include "lodforge/tiles/tileset.h"
 
 namespace lodforge {
 
 namespace {
-
-nlohmann::json boxJson(const Aabbd& box) {
-  return {box.min.x, box.min.y, box.min.z, box.max.x, box.max.y, box.max.z};
-}
-
-Aabbd boxOf(const nlohmann::json& j) {
-  Aabbd box;  // the corners as written (adding them would turn a max of +0 into -0 beside -0)
-  box.min = Vec3d{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
-  box.max = Vec3d{j[3].get<double>(), j[4].get<double>(), j[5].get<double>()};
-  return box;
-}
-
-nlohmann::json vecJson(const Vec3d& v) {
-  return {v.x, v.y, v.z};
-}
-
-Vec3d vecOf(const nlohmann::json& j) {
-  return Vec3d{j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
-}
 
 // A rank's share of the nodes (dealLargestFirst by their points), in name order as given.
 std::vector<PartitionNode> nodeShare(std::span<const PartitionNode> nodes, int rank, int ranks) {
@@ -51,23 +33,6 @@ std::vector<PartitionNode> nodeShare(std::span<const PartitionNode> nodes, int r
   for (std::size_t i = 0; i < nodes.size(); ++i)
     if (owner[i] == rank) out.push_back(nodes[i]);
   return out;
-}
-
-// A rank's ranked blocks for rank 0: where each lies and its errors.
-std::string blocksJson(std::span<const PointBlock> blocks,
-                       const std::map<std::string, BlockTiles>& tiles) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const PointBlock& b : blocks) {
-    const BlockTiles& t = tiles.at(b.name);
-    out.push_back({{"name", b.name},
-                   {"first", b.first},
-                   {"count", b.count},
-                   {"bounds", boxJson(b.bounds)},
-                   {"centroid", vecJson(b.centroid)},
-                   {"rootError", t.rootError},
-                   {"leastError", t.leastError}});
-  }
-  return out.dump();
 }
 
 // A slice's count, bounds and batch sums as numbers for gatherAcrossRanks, and back.
@@ -119,20 +84,19 @@ class RankedPoints {
     plan_ = *plan;
     LODFORGE_TRY(agreeOnPartitionMemory());
     LODFORGE_TRY(agreeAcrossRanks(lead_ ? claimOnLead() : Status{}));
+    Result<std::uint64_t> resumed = sumAcrossRanks(state_ ? 1 : 0);  // rank 0's decision
+    if (!resumed) return resumed.status();
+    stats_.resumed = *resumed > 0;
     setActivityDirectory(work_ + "/ranks");
     LODFORGE_TRY(agreeAcrossRanks(readHeader()));
-    Result<bool> sliced = readTogether();
-    if (!sliced) return sliced.status();
-    stats_.readInSlices = *sliced;
-    stats_.readSeconds = secondsSince(start_);
-    recordStage("input");
-    LODFORGE_TRY(splitTogether());
-    stats_.partitionSeconds = secondsSince(start_);
-    LODFORGE_TRY(rankTogether());
+    if (stats_.resumed) {
+      LODFORGE_TRY(agreeAcrossRanks(takeSplitState()));
+    } else {
+      LODFORGE_TRY(readAndSplit());
+    }
+    LODFORGE_TRY(rankOrResume());
     stats_.rankingSeconds = secondsSince(start_);
     recordStage("partition and ranking");
-    LODFORGE_TRY(agreeAcrossRanks(lead_ ? planContents() : Status{}));
-    LODFORGE_TRY(agreeAcrossRanks(lead_ ? Status{} : readPlan()));
     LODFORGE_TRY(writeShare());
     recordStage("contents");
     LODFORGE_TRY(agreeAcrossRanks(lead_ ? finishOnLead() : Status{}));
@@ -143,19 +107,6 @@ class RankedPoints {
   }
 
  private:
-  std::string pointsPath() const { return work_ + "/b.points"; }
-  std::string extrasPath() const { return work_ + "/b.extras"; }
-  // A block's tiles as ranked in place (its first record and errors still to fill in).
-  BlockTiles blockTiles(const std::string& name, const Aabbd& bounds) const {
-    BlockTiles tiles;
-    tiles.name = name;
-    tiles.path = pointsPath();
-    tiles.keysPath = work_ + "/" + name + ".keys";
-    if (info_.extras.stride != 0) tiles.extrasPath = extrasPath();
-    tiles.layout = layout_;
-    tiles.bounds = bounds;
-    return tiles;
-  }
   std::string stagingPath() const { return work_ + "/tileset"; }
 
   // Every rank splits with the least allowance of all (each rank's plan counts its own
@@ -168,8 +119,91 @@ class RankedPoints {
     return {};
   }
 
-  // Rank 0 claims the output and the work place.
-  Status claimOnLead() { return claimPointWorkPlace(input_, output_, lock_, scope_); }
+  // Rank 0 claims the output and the work place, and takes an interrupted job's split input
+  // when resuming (its work goes otherwise).
+  Status claimOnLead() {
+    LODFORGE_TRY(claimPointWorkPlace(input_, output_, options_.resume, lock_, scope_));
+    if (!options_.resume) return {};
+    state_ = loadSplitState(work_, pointRunIdentity(input_, options_));
+    return state_ ? Status{} : resetPointWork(work_);
+  }
+
+  // The input read into the work files and its large nodes split, then recorded (rank 0).
+  Status readAndSplit() {
+    Result<bool> sliced = readTogether();
+    if (!sliced) return sliced.status();
+    stats_.readInSlices = *sliced;
+    stats_.readSeconds = secondsSince(start_);
+    recordStage("input");
+    LODFORGE_TRY(splitTogether());
+    stats_.partitionSeconds = secondsSince(start_);
+    return agreeAcrossRanks(
+        lead_ ? saveSplitState(work_, pointRunIdentity(input_, options_), splitStateOf(split_))
+              : Status{});
+  }
+
+  // Every rank: the split input as the interrupted job left it (rank 0 has checked it).
+  Status takeSplitState() {
+    if (!lead_) state_ = loadSplitState(work_, pointRunIdentity(input_, options_));
+    if (!state_) return ioError(work_, "the interrupted job's state cannot be read");
+    Result<PointSplit> split =
+        resumedSplit(*state_, input_, pointPartitionOptions(options_, plan_, frame_, work_));
+    if (!split) return split.status();
+    split_ = std::move(*split);
+    return {};
+  }
+
+  // Every node not yet ranked split and ranked by the ranks, then rank 0's plan; or the plan
+  // as an interrupted job left it. Every rank ends with the plan.
+  Status rankOrResume() {
+    stats_.nodes = split_.nodes.size();
+    Result<std::optional<PointPlan>> earlier =
+        lead_ && stats_.resumed ? resumedPlan(work_, split_.read) : std::optional<PointPlan>();
+    LODFORGE_TRY(agreeAcrossRanks(earlier.status()));
+    Result<std::uint64_t> planned = sumAcrossRanks(lead_ && *earlier ? 1 : 0);
+    if (!planned) return planned.status();
+    if (*planned == 0) {
+      LODFORGE_TRY(agreeAcrossRanks(lead_ && stats_.resumed ? placeStagedOnLead() : Status{}));
+      std::vector<std::uint64_t> done;  // rank 0's view
+      if (lead_)
+        for (const bool d : rankedNodesDone(work_, split_.nodes, split_.read))
+          done.push_back(d ? 1 : 0);
+      Result<std::vector<PartitionNode>> todo = nodesToRankOnLead(done);
+      if (!todo) return todo.status();
+      stats_.nodesResumed = split_.nodes.size() - todo->size();
+      LODFORGE_TRY(rankTogether(*todo));
+      LODFORGE_TRY(agreeAcrossRanks(lead_ ? planOnLead() : Status{}));
+    } else {
+      stats_.nodesResumed = split_.nodes.size();
+      stats_.rankPoints.assign(static_cast<std::size_t>(clusterSize()), 0);
+      if (lead_) {
+        contents_ = std::move(**earlier);
+        split_.partition.blocks = contents_.partition;
+        noteStats(split_.partition, options_, stats_);
+      }
+    }
+    return agreeAcrossRanks(lead_ ? Status{} : readPlan());
+  }
+
+  // Rank 0: the nodes the interrupted job had staged but not placed, in place.
+  Status placeStagedOnLead() {
+    return placeStagedNodes(work_, split_.nodes, split_.read,
+                            pointPartitionOptions(options_, plan_, frame_, work_))
+        .status();
+  }
+
+  // The nodes still to rank as rank 0 sees them (`done`, one flag a node, empty on the other
+  // ranks), for every rank.
+  Result<std::vector<PartitionNode>> nodesToRankOnLead(std::span<const std::uint64_t> done) {
+    Result<std::vector<std::uint64_t>> all = gatherAcrossRanks(done);  // rank 0's alone
+    if (!all) return all.status();
+    if (all->size() != split_.nodes.size())
+      return Error{ErrorKind::kInternal, "the ranks do not agree on the partition's nodes"};
+    std::vector<PartitionNode> todo;
+    for (std::size_t i = 0; i < all->size(); ++i)
+      if ((*all)[i] == 0) todo.push_back(split_.nodes[i]);
+    return todo;
+  }
 
   // Every rank reads the header: the frame and the records' layout the partition will use.
   Status readHeader() {
@@ -201,14 +235,14 @@ class RankedPoints {
       reportActivity(lead_ ? "reading the input" : "waiting for rank 0 to read the input");
       LODFORGE_TRY(agreeAcrossRanks(lead_ ? readOnLead(options) : Status{}));
       // Rank 0's totals to every rank, as one slice.
-      Result<std::vector<std::uint64_t>> totals =
-          gatherAcrossRanks(lead_ ? encodeSlice(SliceRead{read_.count, read_.bounds, {read_.sum}})
-                                  : std::vector<std::uint64_t>{});
+      Result<std::vector<std::uint64_t>> totals = gatherAcrossRanks(
+          lead_ ? encodeSlice(SliceRead{split_.read.count, split_.read.bounds, {split_.read.sum}})
+                : std::vector<std::uint64_t>{});
       if (!totals) return totals.status();
       LODFORGE_TRY(addSlicesFrom(*totals, 1));
       return false;
     }
-    if (lead_) read_ = std::move(*files);
+    if (lead_) split_.read = std::move(*files);
     reportActivity("reading its slice of the input");
     Result<SliceRead> mine = SliceRead{};
     {
@@ -228,10 +262,10 @@ class RankedPoints {
   Status addSlicesFrom(std::span<const std::uint64_t> numbers, int slices) {
     Result<std::vector<SliceRead>> decoded = decodeSlices(numbers, slices);
     if (!decoded) return decoded.status();
-    addSlices(*decoded, read_);
-    read_.input = input_;
-    read_.info = info_;
-    read_.layout = layout_;
+    addSlices(*decoded, split_.read);
+    split_.read.input = input_;
+    split_.read.info = info_;
+    split_.read.layout = layout_;
     return {};
   }
 
@@ -239,14 +273,15 @@ class RankedPoints {
   std::uint64_t streamedPoints(const PartitionOptions& options) const {
     const std::uint64_t inMemory = inMemoryPoints(options, info_.extras.stride);
     std::uint64_t total = 0;
-    for (std::uint64_t n = read_.count; n > inMemory; n = (n + 1) / 2) total += read_.count;
+    for (std::uint64_t n = split_.read.count; n > inMemory; n = (n + 1) / 2)
+      total += split_.read.count;
     return total;
   }
 
   Status readOnLead(const PartitionOptions& options) {
     Result<InputRead> read = readWholeInput(input_, options);
     if (!read) return read.status();
-    read_ = std::move(*read);
+    split_.read = std::move(*read);
     return {};
   }
 
@@ -263,18 +298,17 @@ class RankedPoints {
       const JobProgress progress(fmt::format("points: streamed splits, {} ranks", clusterSize()),
                                  "split", streamedPoints(options));
       tbb::task_arena arena(plan_.threads);
-      return arena.execute([&] { return splitLargeNodes(read_, options, mine, share); });
+      return arena.execute([&] { return splitLargeNodes(split_.read, options, mine, share); });
     }();
     if (!nodes) return nodes.status();
-    memoryNodes_ = std::move(*nodes);
-    if (lead_) partition_ = std::move(mine);
+    split_.nodes = std::move(*nodes);
+    if (lead_) split_.partition = std::move(mine);
     return {};
   }
 
-  // Every rank splits its share of the nodes in memory and ranks each block as it comes out (as
-  // one process does), then lists its blocks for rank 0.
-  Status rankTogether() {
-    const std::vector<PartitionNode>& all = memoryNodes_;
+  // Every rank splits its share of the nodes to rank in memory and ranks each block as it comes
+  // out (as one process does); each node's summary says it is done.
+  Status rankTogether(std::span<const PartitionNode> all) {
     const std::vector<PartitionNode> mine = nodeShare(all, clusterRank(), clusterSize());
     std::uint64_t total = 0, share = 0;
     for (const PartitionNode& n : all) total += n.count;
@@ -285,13 +319,7 @@ class RankedPoints {
       // Shown until every rank is done, so that the bar ends at the job's total.
       const JobProgress progress(fmt::format("points: partition, {} ranks", clusterSize()),
                                  "points", total);
-      std::map<std::string, BlockTiles> ranked;
-      Result<std::vector<PointBlock>> blocks = splitMine(mine, ranked);
-      Status listed = blocks.status();
-      if (blocks)
-        listed = OutputFile::writeWhole(fmt::format("{}/blocks-{}.json", work_, clusterRank()),
-                                        blocksJson(*blocks, ranked));
-      LODFORGE_TRY(agreeAcrossRanks(listed));
+      LODFORGE_TRY(agreeAcrossRanks(splitMine(mine)));
     }
     Result<std::vector<std::uint64_t>> points = gatherAcrossRanks(std::span(&share, 1));
     if (!points) return points.status();
@@ -299,126 +327,79 @@ class RankedPoints {
     return {};
   }
 
-  Result<std::vector<PointBlock>> splitMine(std::span<const PartitionNode> mine,
-                                            std::map<std::string, BlockTiles>& ranked) {
+  Status splitMine(std::span<const PartitionNode> mine) {
     PartitionOptions options = pointPartitionOptions(options_, plan_, frame_, work_);
-    std::mutex mutex;
-    options.blockSink = [&](std::span<CloudPoint> points, std::span<std::uint32_t> ids,
-                            PointBlock& block) {
-      BlockTiles tiles;
-      LODFORGE_TRY(rankBlock(points, ids, block, hasNormals_, options_, work_, tiles));
-      checkpointReached("block");
-      const std::lock_guard lock(mutex);
-      ranked[block.name] = std::move(tiles);
-      return Status{};
-    };
-    const InputRead& read = read_;
+    NodeRanking ranking(work_, hasNormals_, options_);
+    ranking.attach(options);
+    const NodeStaging staging = ranking.staging(clusterRank());
+    const InputRead& read = split_.read;
     tbb::task_arena arena(plan_.threads);
-    return arena.execute([&] {
-      return splitNodesInMemory(read, mine, options,
-                                [](std::uint64_t done) { reportProgress("points", done); });
-    });
+    return arena
+        .execute([&] {
+          return splitNodesInMemory(
+              read, mine, options, [](std::uint64_t done) { reportProgress("points", done); },
+              &staging);
+        })
+        .status();
   }
 
-  // Rank 0: every rank's blocks in name order, the tolerances, each block's points per depth;
+  // Rank 0: every node's blocks in name order, the tolerances, each block's points per depth;
   // written for the other ranks.
-  Status planContents() {
+  Status planOnLead() {
     reportActivity("choosing the tolerances");
-    std::vector<std::pair<PointBlock, std::array<float, 2>>> listed;
-    for (int r = 0; r < clusterSize(); ++r) {
-      const std::string path = fmt::format("{}/blocks-{}.json", work_, r);
-      Result<std::string> text = readFileToString(path, std::uint64_t{1} << 34);
-      if (!text) return text.status();
-      const nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
-      if (j.is_discarded()) return ioError(path, "is not JSON");
-      for (const nlohmann::json& b : j) {
-        PointBlock block;
-        block.name = b.at("name").get<std::string>();
-        block.path = pointsPath();
-        block.layout = layout_;
-        block.first = b.at("first").get<std::uint64_t>();
-        block.count = b.at("count").get<std::uint64_t>();
-        block.bounds = boxOf(b.at("bounds"));
-        block.centroid = vecOf(b.at("centroid"));
-        listed.push_back(
-            {std::move(block), {b.at("rootError").get<float>(), b.at("leastError").get<float>()}});
-      }
-    }
-    std::sort(listed.begin(), listed.end(),
-              [](const auto& a, const auto& b) { return a.first.name < b.first.name; });
-    for (auto& [block, errors] : listed) {
-      BlockTiles tiles = blockTiles(block.name, block.bounds);
-      tiles.first = block.first;
-      tiles.rootError = errors[0];
-      tiles.leastError = errors[1];
-      blocks_.push_back(std::move(tiles));
-      partition_.blocks.push_back(std::move(block));
-    }
-    noteStats(partition_, options_, stats_);
-    Result<std::vector<float>> taus =
-        toleranceSchedule(partition_, blocks_, options_, stats_.depth);
-    if (!taus) return taus.status();
-    taus_ = std::move(*taus);
-    LODFORGE_TRY(countLevels(partition_, taus_, blocks_));
-    nlohmann::json plan = {{"taus", taus_}, {"blocks", nlohmann::json::array()}};
-    for (const BlockTiles& b : blocks_)
-      plan["blocks"].push_back({{"name", b.name},
-                                {"first", b.first},
-                                {"bounds", boxJson(b.bounds)},
-                                {"counts", b.counts},
-                                {"rootError", b.rootError}});
-    return OutputFile::writeWhole(work_ + "/plan.json", plan.dump());
+    Result<PointPlan> plan =
+        planContents(work_, split_.read, split_.nodes, options_, split_.partition, stats_);
+    if (!plan) return plan.status();
+    contents_ = std::move(*plan);
+    return {};
   }
 
   // The other ranks: rank 0's plan.
   Status readPlan() {
-    const std::string path = work_ + "/plan.json";
-    Result<std::string> text = readFileToString(path, std::uint64_t{1} << 34);
-    if (!text) return text.status();
-    const nlohmann::json plan = nlohmann::json::parse(*text, nullptr, false);
-    if (plan.is_discarded()) return ioError(path, "is not JSON");
-    taus_ = plan.at("taus").get<std::vector<float>>();
-    for (const nlohmann::json& b : plan.at("blocks")) {
-      BlockTiles tiles = blockTiles(b.at("name").get<std::string>(), boxOf(b.at("bounds")));
-      tiles.first = b.at("first").get<std::uint64_t>();
-      tiles.counts = b.at("counts").get<std::vector<std::uint64_t>>();
-      tiles.rootError = b.at("rootError").get<float>();
-      blocks_.push_back(std::move(tiles));
-    }
+    Result<std::optional<PointPlan>> plan = resumedPlan(work_, split_.read);
+    if (!plan) return plan.status();
+    if (!*plan) return ioError(work_ + "/plan.json", "is missing");
+    contents_ = std::move(**plan);
     return {};
   }
 
   // Every rank writes its share of the tiles into the staging folder.
   Status writeShare() {
-    nodes_ = tileTree(blocks_);
+    nodes_ = tileTree(contents_.blocks);
     std::uint64_t withContent = 0;
     for (const auto& [name, node] : nodes_) withContent += node.uri.empty() ? 0u : 1u;
     reportActivity("writing its share of the tiles");
-    std::uint64_t mine = 0;
+    ContentsWritten mine;
     {
       const JobProgress progress(fmt::format("tiles: contents, {} ranks", clusterSize()), "tiles",
                                  withContent);
-      Result<std::uint64_t> written =
-          writeContents(nodes_, blocks_, options_,
-                        {info_.hasColors, info_.attributes & options_.attributes, &info_.extras},
-                        stagingPath(), {.rank = clusterRank(), .ranks = clusterSize()});
+      Result<ContentsWritten> written = writeContents(
+          nodes_, contents_.blocks, options_,
+          {info_.hasColors, info_.attributes & options_.attributes, &info_.extras}, stagingPath(),
+          {.rank = clusterRank(), .ranks = clusterSize(), .resumed = stats_.resumed});
       LODFORGE_TRY(agreeAcrossRanks(written.status()));
       mine = *written;
     }
-    Result<std::vector<std::uint64_t>> tiles = gatherAcrossRanks(std::span(&mine, 1));
+    Result<std::vector<std::uint64_t>> tiles = gatherAcrossRanks(std::span(&mine.tiles, 1));
     if (!tiles) return tiles.status();
     stats_.rankTiles = std::move(*tiles);
     stats_.tiles = withContent;
+    Result<std::uint64_t> kept = sumAcrossRanks(mine.kept);
+    if (!kept) return kept.status();
+    stats_.tilesResumed = *kept;
     return {};
   }
 
   Status finishOnLead() {
     reportActivity("writing the tileset");
-    LODFORGE_TRY(writePointTilesetJson(nodes_, blocks_, taus_, rootTransformOf(frame_, options_),
-                                       options_.quantize, stagingPath() + "/tileset.json"));
+    LODFORGE_TRY(writePointTilesetJson(nodes_, contents_.blocks, contents_.taus,
+                                       rootTransformOf(frame_, options_), options_.quantize,
+                                       stagingPath() + "/tileset.json"));
     stats_.outputBytes = directoryBytes(stagingPath());
     ScopedDirectory staging(stagingPath());
-    return replaceDirectory(staging, output_);  // scope_ removes the rest when the job ends
+    LODFORGE_TRY(replaceDirectory(staging, output_));
+    scope_.finished = true;  // scope_ removes the rest when the job ends
+    return {};
   }
 
   std::string input_, output_;
@@ -428,17 +409,16 @@ class RankedPoints {
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   PointMemoryPlan plan_;
   WorkLock lock_;
-  ScopedDirectory scope_;  // rank 0's: what it removes at the end
+  PointWorkScope scope_;             // rank 0's: what it removes at the end
+  std::optional<SplitState> state_;  // an interrupted job's, when resuming
   std::optional<CrsToLocal> frame_;
   bool hasNormals_ = false;
   PointCloudInfo info_;
   PointRecordLayout layout_;
-  InputRead read_;       // rank 0's: the input in the work files, when read in slices
-  Partition partition_;  // rank 0's
-  // The nodes split in memory, the same on every rank.
-  std::vector<PartitionNode> memoryNodes_;
-  std::vector<BlockTiles> blocks_;
-  std::vector<float> taus_;
+  // The input read and split: its nodes to split in memory the same on every rank, the
+  // partition (all but the blocks, then with them) rank 0's.
+  PointSplit split_;
+  PointPlan contents_;  // every rank's
   std::map<std::string, TileNode> nodes_;
   PointTilesStats stats_;
 };

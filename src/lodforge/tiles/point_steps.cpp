@@ -25,6 +25,7 @@
 #include "lodforge/points/build.h"
 #include "lodforge/points/partition.h"
 #include "lodforge/tiles/point_attributes.h"
+#include "lodforge/tiles/point_resume.h"
 #include "lodforge/tiles/tileset.h"
 #include "lodforge/tiles/tileset_output.h"
 
@@ -254,11 +255,14 @@ Status countLevels(const Partition& partition, std::span<const float> taus,
       while (d < static_cast<std::size_t>(depth) && !(taus[d] < key)) ++d;
       ++counts[d];
     }
-    std::error_code ignored;
-    fs::remove(blocks[b].keysPath, ignored);
   });
   for (const Status& f : failures) LODFORGE_TRY(f);
   return Status{};
+}
+
+void removeKeys(std::span<const BlockTiles> blocks) {
+  std::error_code ignored;
+  for (const BlockTiles& b : blocks) fs::remove(b.keysPath, ignored);
 }
 
 // Georeferencing: a CRS (given, or the input's) sets up the local east-north-up frame at the
@@ -324,20 +328,27 @@ std::vector<const TileNode*> contentShare(const std::map<std::string, TileNode>&
   return mine;
 }
 
-Result<std::uint64_t> writeContents(const std::map<std::string, TileNode>& nodes,
-                                    std::span<const BlockTiles> blocks,
-                                    const PointTilesOptions& options, const ContentFields& fields,
-                                    const std::string& tilesetDirectory, ContentShare share) {
+Result<ContentsWritten> writeContents(const std::map<std::string, TileNode>& nodes,
+                                      std::span<const BlockTiles> blocks,
+                                      const PointTilesOptions& options, const ContentFields& fields,
+                                      const std::string& tilesetDirectory, ContentShare share) {
   const std::vector<const TileNode*> mine = contentShare(nodes, share);
   std::vector<Status> written(mine.size());
+  std::atomic<std::uint64_t> kept{0};
   // A job's progress is rank 0's JobProgress, from every rank's reports.
   std::optional<Progress> writing;
   if (share.ranks <= 1) writing.emplace("tiles: contents", mine.size());
   std::atomic<std::uint64_t> done{0};
   tbb::parallel_for(std::size_t{0}, mine.size(), [&](std::size_t i) {
     if (cancelRequested()) return;
-    written[i] =
-        writeContent(*mine[i], blocks, options, fields, tilesetDirectory + "/" + mine[i]->uri);
+    const std::string path = tilesetDirectory + "/" + mine[i]->uri;
+    std::error_code ignored;
+    if (share.resumed && fs::exists(path, ignored)) {
+      ++kept;
+    } else {
+      written[i] = writeContent(*mine[i], blocks, options, fields, path);
+      checkpointReached("tile");
+    }
     if (writing) {
       writing->advance(1);
     } else {
@@ -347,7 +358,7 @@ Result<std::uint64_t> writeContents(const std::map<std::string, TileNode>& nodes
   for (const Status& f : written) LODFORGE_TRY(f);
   LODFORGE_TRY(checkCancelled());
   if (writing) writing->finish();
-  return mine.size();
+  return ContentsWritten{mine.size(), kept.load()};
 }
 
 // tileset.json: ADD refinement; a tile at depth d stands for the cut at τ_d, a block's tile for
@@ -439,13 +450,26 @@ std::string pointWorkDirectory(const std::string& outputDirectory) {
   return tilesWorkDirectory(outputDirectory) + "/points";
 }
 
+PointWorkScope::~PointWorkScope() {
+  if (!finished && !work.empty() && pointWorkKept(work)) directory.path.clear();
+}
+
+Status resetPointWork(const std::string& workDirectory) {
+  std::error_code error;
+  fs::remove_all(workDirectory, error);
+  if (!error) fs::create_directories(workDirectory + "/tileset/tiles", error);
+  if (!error) fs::create_directories(workDirectory + "/nodes", error);
+  if (error) return ioError(workDirectory, fmt::format("cannot create: {}", error.message()));
+  return {};
+}
+
 Status claimPointWorkPlace(const std::string& input, const std::string& outputDirectory,
-                           WorkLock& lock, ScopedDirectory& scope) {
+                           bool resume, WorkLock& lock, PointWorkScope& scope) {
   LODFORGE_TRY(claimTilesetOutput(input, outputDirectory));
   const std::string workDirectory = tilesWorkDirectory(outputDirectory);
   const std::string work = pointWorkDirectory(outputDirectory);
   // Another run's work kept there (an interrupted mesh run's, for --resume) stays; our own
-  // folder, and an earlier point run's, go.
+  // folder, and an earlier point run's unless resuming, go.
   std::error_code error;
   bool othersWork = false;
   for (fs::directory_iterator entry(workDirectory, error), end; !error && entry != end;
@@ -453,15 +477,14 @@ Status claimPointWorkPlace(const std::string& input, const std::string& outputDi
     const std::string name = entry->path().filename().string();
     othersWork = othersWork || (name != "points" && !name.starts_with(".lodforge-"));
   }
-  error.clear();
   LODFORGE_TRY(claimWorkDirectory(workDirectory));
   Result<WorkLock> locked = lockWorkDirectory(workDirectory);
   if (!locked) return locked.status();
   lock = std::move(*locked);
-  scope.path = othersWork ? work : workDirectory;
-  fs::remove_all(work, error);
-  if (!error) fs::create_directories(work + "/tileset/tiles", error);
-  if (error) return ioError(work, fmt::format("cannot create: {}", error.message()));
+  scope.directory.path = othersWork ? work : workDirectory;
+  scope.work = work;
+  if (!resume) return resetPointWork(work);
+  removeOutputTemporaries(work + "/tileset");
   return {};
 }
 

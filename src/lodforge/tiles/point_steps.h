@@ -46,9 +46,11 @@ Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
 Result<std::vector<float>> toleranceSchedule(const Partition& partition,
                                              std::span<const BlockTiles> blocks,
                                              const PointTilesOptions& options, int maxDepth);
-// Each block's points per depth once the τ are known (its keys file is removed).
+// Each block's points per depth once the τ are known.
 Status countLevels(const Partition& partition, std::span<const float> taus,
                    std::span<BlockTiles> blocks);
+// The blocks' keys files, once their counts are in the plan.
+void removeKeys(std::span<const BlockTiles> blocks);
 
 struct TileNode {
   std::string name;
@@ -73,12 +75,17 @@ struct ContentFields {
 // the rank with the fewest points so far); all of them for a job of one.
 struct ContentShare {
   int rank = 0, ranks = 1;
+  bool resumed = false;  // tiles already in the folder (whole: written by rename) stay
 };
-// The GLB of every tile with points in this rank's share, in parallel; how many were written.
-Result<std::uint64_t> writeContents(const std::map<std::string, TileNode>& nodes,
-                                    std::span<const BlockTiles> blocks,
-                                    const PointTilesOptions& options, const ContentFields& fields,
-                                    const std::string& tilesetDirectory, ContentShare share = {});
+struct ContentsWritten {
+  std::uint64_t tiles = 0;  // of the share
+  std::uint64_t kept = 0;   // of those, already there
+};
+// The GLB of every tile with points in this rank's share, in parallel.
+Result<ContentsWritten> writeContents(const std::map<std::string, TileNode>& nodes,
+                                      std::span<const BlockTiles> blocks,
+                                      const PointTilesOptions& options, const ContentFields& fields,
+                                      const std::string& tilesetDirectory, ContentShare share = {});
 
 Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
                              std::span<const BlockTiles> blocks, const std::vector<float>& taus,
@@ -87,12 +94,27 @@ Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
 
 // Where a point tileset is built: `pointWorkDirectory(output)`, below the tiles work directory.
 std::string pointWorkDirectory(const std::string& outputDirectory);
+// What a point run removes when it ends: on success the whole work directory, unless another
+// run's work is kept there (then the point folder); on failure nothing once the input is split
+// (pointWorkKept), so that --resume can go on.
+struct PointWorkScope {
+  ScopedDirectory directory;
+  std::string work;  // the point work directory
+  bool finished = false;
+  PointWorkScope() = default;
+  PointWorkScope(const PointWorkScope&) = delete;
+  PointWorkScope& operator=(const PointWorkScope&) = delete;
+  ~PointWorkScope();
+};
 // Claims the output and the tiles work directory, locked (WorkLock) so that a second run on the
-// same output is refused, and makes the point work directory afresh (a point tileset has nothing
-// to resume) with its staging folder (`/tileset/tiles`). `scope` gets what to remove when the
-// run ends: the whole work directory, unless another run's work is kept there (then its folder).
+// same output is refused. Without `resume`, makes the point work directory afresh with its
+// folders (resetPointWork); with it, keeps an earlier run's work (the caller resets it when that
+// is not what it can go on from) but removes the temporaries a killed run left in the staged
+// tileset (they would be renamed into the output with it).
 Status claimPointWorkPlace(const std::string& input, const std::string& outputDirectory,
-                           WorkLock& lock, ScopedDirectory& scope);
+                           bool resume, WorkLock& lock, PointWorkScope& scope);
+// The point work directory emptied, with its staging folder (`/tileset/tiles`) and `/nodes`.
+Status resetPointWork(const std::string& workDirectory);
 
 // The local east-north-up frame of the CRS (given, or the input's), if any; `hasNormals` and
 // the stats' CRS from the input.

@@ -1,6 +1,7 @@
 #include "lodforge/tiles/point_tiles.h"
 
 #include "lodforge/tiles/point_ranks.h"
+#include "lodforge/tiles/point_resume.h"
 #include "lodforge/tiles/point_steps.h"
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/core/cluster.h"
 #include "lodforge/core/directory.h"
 #include "lodforge/core/file.h"
 #include "lodforge/core/progress.h"
@@ -115,39 +117,119 @@ std::vector<float> pointKeys(std::span<const ClusterNode> tree,
 
 namespace {
 
-// The blocks of the partition, each ranked as the partition makes it, while its points are in
-// memory (no block files written and read back), as many at once as the memory plan allows.
-struct RankedPartition {
-  Partition partition;
-  std::vector<BlockTiles> blocks;  // in the partition's block order
-};
+// One process's point run, as named steps; each step's work is kept for --resume (point_resume.h).
+class PointRun {
+ public:
+  PointRun(const std::string& input, const std::string& output, const PointTilesOptions& options)
+      : input_(input), output_(output), options_(options), work_(pointWorkDirectory(output)) {}
 
-Result<RankedPartition> partitionAndRank(const std::string& input, const PointTilesOptions& options,
-                                         const PointMemoryPlan& plan,
-                                         const std::optional<CrsToLocal>& frame, bool hasNormals,
-                                         const std::string& workDirectory) {
-  PartitionOptions partitionOptions = pointPartitionOptions(options, plan, frame, workDirectory);
-  std::mutex ranked;
-  std::map<std::string, BlockTiles> byName;
-  partitionOptions.blockSink = [&](std::span<CloudPoint> points, std::span<std::uint32_t> ids,
-                                   PointBlock& block) {
-    BlockTiles tiles;
-    LODFORGE_TRY(rankBlock(points, ids, block, hasNormals, options, workDirectory, tiles));
-    std::lock_guard lock(ranked);
-    byName[block.name] = std::move(tiles);
-    return Status{};
-  };
-  tbb::task_arena arena(plan.threads);
-  Result<Partition> partition =
-      arena.execute([&] { return partitionPoints(input, partitionOptions); });
-  if (!partition) return partition.status();
-  RankedPartition out{std::move(*partition), {}};
-  for (const PointBlock& b : out.partition.blocks) {
-    out.blocks.push_back(std::move(byName.at(b.name)));
-    out.blocks.back().extrasPath = out.partition.extrasPath;
+  Result<PointTilesStats> run() {
+    LODFORGE_TRY(claimPointWorkPlace(input_, output_, options_.resume, lock_, scope_));
+    Result<PointMemoryPlan> plan = planPointMemory(options_.memoryLimit, options_.blockSize);
+    if (!plan) return plan.status();
+    Result<std::optional<CrsToLocal>> frame = localFrame(input_, options_, stats_, hasNormals_);
+    if (!frame) return frame.status();
+    frame_ = std::move(*frame);
+    partitionOptions_ = pointPartitionOptions(options_, *plan, frame_, work_);
+    tbb::task_arena arena(plan->threads);
+    LODFORGE_TRY(arena.execute([&] { return splitOrResume(); }));
+    LODFORGE_TRY(arena.execute([&] { return rankOrResume(); }));
+    const std::map<std::string, TileNode> nodes = tileTree(plan_.blocks);
+    LODFORGE_TRY(writeTiles(nodes));
+    stats_.seconds = secondsSince(start_);
+    return stats_;
   }
-  return out;
-}
+
+ private:
+  // The input read and split by streamed passes, or as an interrupted run left it.
+  Status splitOrResume() {
+    const nlohmann::json identity = pointRunIdentity(input_, options_);
+    if (std::optional<SplitState> state =
+            options_.resume ? loadSplitState(work_, identity) : std::nullopt) {
+      Result<PointSplit> split = resumedSplit(*state, input_, partitionOptions_);
+      if (!split) return split.status();
+      split_ = std::move(*split);
+      stats_.resumed = true;
+      return {};
+    }
+    if (options_.resume) LODFORGE_TRY(resetPointWork(work_));  // nothing to go on from
+    Result<InputRead> read = readWholeInput(input_, partitionOptions_);
+    if (!read) return read.status();
+    split_.read = std::move(*read);
+    Result<std::vector<PartitionNode>> nodes =
+        splitLargeNodes(split_.read, partitionOptions_, split_.partition);
+    if (!nodes) return nodes.status();
+    split_.nodes = std::move(*nodes);
+    return saveSplitState(work_, identity, splitStateOf(split_));
+  }
+
+  // Every node not yet ranked split in memory and ranked, then the plan; or the plan as an
+  // interrupted run left it.
+  Status rankOrResume() {
+    Partition& partition = split_.partition;
+    stats_.nodes = split_.nodes.size();
+    Result<std::optional<PointPlan>> earlier =
+        stats_.resumed ? resumedPlan(work_, split_.read) : std::optional<PointPlan>();
+    if (!earlier) return earlier.status();
+    if (*earlier) {
+      plan_ = std::move(**earlier);
+      partition.blocks = plan_.partition;
+      noteStats(partition, options_, stats_);
+      stats_.nodesResumed = split_.nodes.size();
+      return {};
+    }
+    if (stats_.resumed)
+      LODFORGE_TRY(placeStagedNodes(work_, split_.nodes, split_.read, partitionOptions_).status());
+    const std::vector<PartitionNode> todo = nodesToRank(work_, split_.nodes, split_.read);
+    stats_.nodesResumed = split_.nodes.size() - todo.size();
+    PartitionOptions options = partitionOptions_;
+    NodeRanking ranking(work_, hasNormals_, options_);
+    ranking.attach(options);
+    const NodeStaging staging = ranking.staging(0);
+    Result<std::vector<PointBlock>> blocks =
+        splitNodesInMemory(split_.read, todo, options, {}, &staging);
+    if (!blocks) return blocks.status();
+    Result<PointPlan> plan =
+        planContents(work_, split_.read, split_.nodes, options_, partition, stats_);
+    if (!plan) return plan.status();
+    plan_ = std::move(*plan);
+    return {};
+  }
+
+  Status writeTiles(const std::map<std::string, TileNode>& nodes) {
+    const PointCloudInfo& info = split_.partition.info;
+    const std::string staged = work_ + "/tileset";  // kept with the work (scope_)
+    Result<ContentsWritten> tiles =
+        writeContents(nodes, plan_.blocks, options_,
+                      {info.hasColors, info.attributes & options_.attributes, &info.extras}, staged,
+                      {.resumed = stats_.resumed});
+    if (!tiles) return tiles.status();
+    stats_.tiles = tiles->tiles;
+    stats_.tilesResumed = tiles->kept;
+    LODFORGE_TRY(writePointTilesetJson(nodes, plan_.blocks, plan_.taus,
+                                       rootTransformOf(frame_, options_), options_.quantize,
+                                       staged + "/tileset.json"));
+    stats_.outputBytes = directoryBytes(staged);
+    // Complete: replace the previous tileset, if any, by the new one.
+    ScopedDirectory staging(staged);
+    LODFORGE_TRY(replaceDirectory(staging, output_));
+    scope_.finished = true;
+    return {};
+  }
+
+  std::string input_, output_;
+  const PointTilesOptions& options_;
+  std::string work_;
+  const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  WorkLock lock_;
+  PointWorkScope scope_;
+  PointTilesStats stats_;
+  bool hasNormals_ = false;
+  std::optional<CrsToLocal> frame_;
+  PartitionOptions partitionOptions_;
+  PointSplit split_;
+  PointPlan plan_;
+};
 
 }  // namespace
 
@@ -155,45 +237,7 @@ Result<PointTilesStats> writePointTiles(const std::string& input,
                                         const std::string& outputDirectory,
                                         const PointTilesOptions& options) {
   if (clustered()) return writePointTilesAcrossRanks(input, outputDirectory, options);
-  const auto start = std::chrono::steady_clock::now();
-  PointTilesStats stats;
-  WorkLock lock;
-  ScopedDirectory scope;
-  LODFORGE_TRY(claimPointWorkPlace(input, outputDirectory, lock, scope));
-  Result<PointMemoryPlan> plan = planPointMemory(options.memoryLimit, options.blockSize);
-  if (!plan) return plan.status();
-  const std::string work = pointWorkDirectory(outputDirectory);
-  ScopedDirectory staging(work + "/tileset");
-
-  bool hasNormals = false;
-  Result<std::optional<CrsToLocal>> frame = localFrame(input, options, stats, hasNormals);
-  if (!frame) return frame.status();
-  Result<RankedPartition> ranked =
-      partitionAndRank(input, options, *plan, *frame, hasNormals, work);
-  if (!ranked) return ranked.status();
-  const Partition& partition = ranked->partition;
-  std::vector<BlockTiles>& blocks = ranked->blocks;
-  noteStats(partition, options, stats);
-  Result<std::vector<float>> taus = toleranceSchedule(partition, blocks, options, stats.depth);
-  if (!taus) return taus.status();
-  LODFORGE_TRY(countLevels(partition, *taus, blocks));
-
-  const std::map<std::string, TileNode> nodes = tileTree(blocks);
-  Result<std::uint64_t> tiles =
-      writeContents(nodes, blocks, options,
-                    {partition.info.hasColors, partition.info.attributes & options.attributes,
-                     &partition.info.extras},
-                    staging.path);
-  if (!tiles) return tiles.status();
-  stats.tiles = *tiles;
-  LODFORGE_TRY(writePointTilesetJson(nodes, blocks, *taus, rootTransformOf(*frame, options),
-                                     options.quantize, staging.path + "/tileset.json"));
-  stats.outputBytes = directoryBytes(staging.path);
-
-  // Complete: replace the previous tileset, if any, by the new one.
-  LODFORGE_TRY(replaceDirectory(staging, outputDirectory));
-  stats.seconds = secondsSince(start);
-  return stats;
+  return PointRun(input, outputDirectory, options).run();
 }
 
 }  // namespace lodforge

@@ -30,6 +30,8 @@ struct PointTilesOptions {
   bool quantize = true;  // KHR_mesh_quantization positions (16-bit over the tile's box)
   bool meshoptCompression = false;
   bool salvageTruncated = false;
+  // Go on from an interrupted run's work (the same input and options), as far as it got.
+  bool resume = false;
   // The lidar fields to carry (PointAttributeBit), of those the input has: all by default.
   std::uint32_t attributes = ~std::uint32_t{0};
 };
@@ -42,6 +44,11 @@ struct PointTilesStats {
   std::vector<std::string> warnings;  // what was read past, what viewers may not manage
   std::uint64_t outputBytes = 0;
   double seconds = 0;
+  // --resume: whether the split input was taken as an interrupted run left it, and how many of
+  // the partition's nodes (ranked) and tiles (written) were.
+  bool resumed = false;
+  std::uint64_t nodes = 0;  // the partition's nodes split in memory
+  std::uint64_t nodesResumed = 0, tilesResumed = 0;
   // A job of several ranks (point_ranks.h): how many, whether the input was read in slices,
   // each rank's split and ranked points and written tiles (rank order), the seconds to the end
   // of the reading, of the streamed splits and of the ranking, and each rank's stages.

@@ -16,6 +16,7 @@
 #include "lodforge/core/output_claim.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/core/units.h"
+#include "lodforge/tiles/point_resume.h"
 #include "lodforge/tiles/surface_input.h"
 #include "lodforge/tiles/tile_texture.h"
 #include "lodforge/tiles/tileset_output.h"
@@ -49,24 +50,11 @@ struct WorkPlace {
   }
 };
 
-// Whether `name` is a temporary an OutputFile makes ("<name>.tmp-<pid>-<n>").
-bool outputTemporary(std::string_view name) {
-  const std::size_t at = name.rfind(".tmp-");
-  return at != std::string_view::npos && leftoverProcess(name, name.substr(0, at)).has_value();
-}
-
 // Empties what a run makes again (all of it unless resuming) and creates the folders. A resumed
-// run removes the temporaries a killed one left in the staged tileset (they would be renamed
-// into the output with it); the work directory is locked, so no other run is writing them.
+// run removes the temporaries a killed one left in the staged tileset.
 Status prepareWorkPlace(const WorkPlace& place, bool keepEarlierWork) {
   std::error_code error;
-  if (keepEarlierWork && fs::exists(place.staging.path, error)) {
-    std::vector<fs::path> temporaries;
-    for (const auto& entry : fs::recursive_directory_iterator(place.staging.path, error))
-      if (entry.is_regular_file(error) && outputTemporary(entry.path().filename().string()))
-        temporaries.push_back(entry.path());
-    for (const fs::path& path : temporaries) fs::remove(path, error);
-  }
+  if (keepEarlierWork) removeOutputTemporaries(place.staging.path);
   if (!keepEarlierWork) {
     fs::remove_all(place.staging.path, error);
     fs::remove_all(place.work.path + "/nodes", error);
@@ -605,7 +593,8 @@ class RankedTiles {
 
 bool tilesWorkKept(const std::string& workDirectory) {
   std::error_code ignored;
-  return fs::exists(workStatePath(workDirectory), ignored) || surfaceWorkKept(workDirectory);
+  return fs::exists(workStatePath(workDirectory), ignored) || surfaceWorkKept(workDirectory) ||
+         pointWorkKept(workDirectory + "/points");  // pointWorkDirectory
 }
 
 std::string tilesWorkDirectory(const std::string& outputDirectory) {

@@ -1,6 +1,8 @@
 #include "lodforge/tiles/tileset_output.h"
 
+#include <filesystem>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -67,6 +69,27 @@ OutputKind tilesetOutput() {
 Status claimTilesetOutput(const std::string& input, const std::string& outputDirectory) {
   const std::string inputs[] = {input};
   return claimOutput(outputDirectory, tilesetOutput(), inputs);
+}
+
+namespace {
+
+// Whether `name` is a temporary an OutputFile makes ("<name>.tmp-<pid>-<n>").
+bool outputTemporary(std::string_view name) {
+  const std::size_t at = name.rfind(".tmp-");
+  return at != std::string_view::npos && leftoverProcess(name, name.substr(0, at)).has_value();
+}
+
+}  // namespace
+
+void removeOutputTemporaries(const std::string& stagingDirectory) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::exists(stagingDirectory, error)) return;
+  std::vector<fs::path> temporaries;
+  for (const auto& entry : fs::recursive_directory_iterator(stagingDirectory, error))
+    if (entry.is_regular_file(error) && outputTemporary(entry.path().filename().string()))
+      temporaries.push_back(entry.path());
+  for (const fs::path& path : temporaries) fs::remove(path, error);
 }
 
 }  // namespace lodforge

@@ -17,4 +17,9 @@ OutputKind tilesetOutput();
 // Claims `outputDirectory` for a tileset of `input` (nothing is written yet).
 Status claimTilesetOutput(const std::string& input, const std::string& outputDirectory);
 
+// Removes, under a staged tileset of a resumed run, the temporaries a killed run left (files
+// that an OutputFile was writing: they would be renamed into the output with it). The work
+// directory is locked, so no other run is writing them.
+void removeOutputTemporaries(const std::string& stagingDirectory);
+
 }  // namespace lodforge

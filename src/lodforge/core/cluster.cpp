@@ -171,9 +171,18 @@ void preferSharedMemoryOnOneMachine() {
 }  // namespace
 #endif
 
+Status checkTasksJoined(const char* stepTasks) {
+  if (stepTasks == nullptr || std::strtoll(stepTasks, nullptr, 10) <= 1) return {};
+  return Error{ErrorKind::kUsage,
+               fmt::format("started by srun as one of {} tasks, but without an MPI plugin to "
+                           "join them each would do the whole work: start them with `srun "
+                           "--mpi=pmix` (docs/distributed.md), or start one",
+                           stepTasks)};
+}
+
 Status joinCluster() {
   assert(!joined);
-  if (!launchedAsJob()) return {};
+  if (!launchedAsJob()) return checkTasksJoined(std::getenv("SLURM_STEP_NUM_TASKS"));
 #if LODFORGE_WITH_MPI
   preferSharedMemoryOnOneMachine();
   int provided = 0;

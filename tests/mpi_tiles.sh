@@ -132,12 +132,13 @@ awk 'BEGIN { for (i = 0; i < 4000; ++i) printf "%.3f %.3f %.3f\n", i % 80, int(i
 same text-np2 text-1 "text cloud, read by rank 0, 2 ranks"
 grep -q "2 ranks: the input read by rank 0 (done at" text.err ||
   fail "the text cloud was not read by rank 0: $(cat text.err)"
-# A rank killed after ranking its second node of the partition: the job stops, rank 0 says what
-# rank 1 was doing, and the work stays; --resume by 3 ranks takes the split input and every node
-# whose summary was written, and writes the same tileset.
+# A rank killed with its second node of the partition staged in its scratch files, not yet in
+# place: the job stops, rank 0 says what rank 1 was doing, and the work stays; --resume by 3 ranks
+# takes the split input and every node done or staged (rank 0 puts rank 1's in place), and
+# writes the same tileset.
 set +e
 "${mpi[@]}" -np 1 "$lodforge" tiles large.las -o large-killed --block-size 10000 : \
-  -np 1 -x LODFORGE_INTERRUPT_AFTER=pointnode:2:kill "$lodforge" tiles large.las -o large-killed \
+  -np 1 -x LODFORGE_INTERRUPT_AFTER=pointstaged:2:kill "$lodforge" tiles large.las -o large-killed \
   --block-size 10000 > large-killed.out 2> large-killed.err
 code=$?
 set -e
@@ -147,7 +148,9 @@ grep -qE "^  rank 1 of 2 \(.*\): splitting and ranking [0-9]+ of the partition's
 grep -q "the finished work is kept in large-killed.work" large-killed.err ||
   fail "the killed point job does not say its work is kept: $(cat large-killed.err)"
 [[ ! -e large-killed ]] || fail "the killed point job left a tileset"
-done_before=$(find large-killed.work/points/nodes -name '*.json' | wc -l)
+done_before=$(find large-killed.work/points/nodes -name '*.json' | wc -l)  # done or staged
+[[ -n $(find large-killed.work/points/nodes -name '*.staged.json') ]] ||
+  fail "rank 1 left no node staged: $(ls large-killed.work/points/nodes)"
 "${mpi[@]}" -np 3 "$lodforge" -v tiles large.las -o large-killed --block-size 10000 --resume \
   2> large-resumed.err
 taken=$(sed -nE "s/.*resumed: the input as the interrupted run split it, ([0-9]+) of the partition's 16 nodes.*/\1/p" \

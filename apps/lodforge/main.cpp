@@ -1,6 +1,7 @@
 // The `lodforge` command: one subcommand per file in this folder.
 // Exit codes: 0 ok, 1 failure (I/O, limits, cancelled), 2 bad input or usage.
 #include <cstdio>
+#include <cstdlib>
 
 #include <fmt/format.h>
 
@@ -75,6 +76,8 @@ int main(int argc, char** argv) {
   // job (docs/distributed.md), and the checks, the same on every rank, are agreed.
   Status status = joinCluster();
   if (!status.ok()) return finish(status);
+  if (const auto alone = tasksNotJoined(std::getenv("SLURM_STEP_NUM_TASKS")); alone)
+    fmt::print(stderr, "lodforge: warning: {}\n", *alone);
   if (clusterRank() != 0) global.verbosity = -1;
   status = cli::checkMemoryLimit(app, *memoryLimit, global.memoryLimit);
   if (status.ok()) status = cli::checkThreads(global);

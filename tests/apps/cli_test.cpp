@@ -1767,8 +1767,21 @@ TEST(CliTiles, AnInterruptedPointRunResumesToTheSameTileset) {
   EXPECT_EQ(resumePointTiles(dir, "f", "pointblock:6", none),
             "resumed: the input as the interrupted run split it, 1 of the partition's 16 nodes "
             "as it ranked them, 0 tiles as it wrote them");
-  // Killed with its third node staged but not yet in place: --resume puts it there.
-  EXPECT_EQ(resumePointTiles(dir, "d", "pointstaged:3:kill", none),
+  // Killed with its third node staged but not yet in place: --resume puts it there, whatever
+  // its place holds (here garbage, as a copy cut short may leave).
+  const auto scribble = [&] {
+    const nlohmann::json state =
+        nlohmann::json::parse(test::readFile(dir.file("d.work/points/state.json")));
+    const std::string path = dir.file("d.work/points/b.points");
+    const std::uint64_t recordBytes =
+        std::filesystem::file_size(path) / state["count"].get<std::uint64_t>();
+    const nlohmann::json& third = state["nodes"][2];
+    std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(static_cast<std::streamoff>(third["first"].get<std::uint64_t>() * recordBytes));
+    const std::string garbage(third["count"].get<std::uint64_t>() * recordBytes, '\x5a');
+    file.write(garbage.data(), static_cast<std::streamsize>(garbage.size()));
+  };
+  EXPECT_EQ(resumePointTiles(dir, "d", "pointstaged:3:kill", scribble),
             "resumed: the input as the interrupted run split it, 3 of the partition's 16 nodes "
             "as it ranked them, 0 tiles as it wrote them");
   EXPECT_EQ(resumePointTiles(dir, "e", "pointnode:3",

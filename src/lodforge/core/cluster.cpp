@@ -29,6 +29,8 @@
 namespace lodforge {
 namespace {
 
+constexpr bool kWithMpi = LODFORGE_WITH_MPI != 0;
+
 int rank = 0, size = 1;
 bool joined = false;
 bool abandoned = false;      // a wait was interrupted: the others may be gone, do not finalize
@@ -171,18 +173,20 @@ void preferSharedMemoryOnOneMachine() {
 }  // namespace
 #endif
 
-Status checkTasksJoined(const char* stepTasks) {
-  if (stepTasks == nullptr || std::strtoll(stepTasks, nullptr, 10) <= 1) return {};
-  return Error{ErrorKind::kUsage,
-               fmt::format("started by srun as one of {} tasks, but without an MPI plugin to "
-                           "join them each would do the whole work: start them with `srun "
-                           "--mpi=pmix` (docs/distributed.md), or start one",
-                           stepTasks)};
+std::optional<std::string> tasksNotJoined(const char* stepTasks) {
+  if (joined || stepTasks == nullptr || std::strtoll(stepTasks, nullptr, 10) <= 1)
+    return std::nullopt;
+  return fmt::format(
+      "started by srun as one of {} tasks with no MPI plugin to join them: each "
+      "task works alone{}",
+      stepTasks,
+      kWithMpi ? " (`srun --mpi=pmix` makes them one job, docs/distributed.md)"
+               : " (this lodforge was built without MPI)");
 }
 
 Status joinCluster() {
   assert(!joined);
-  if (!launchedAsJob()) return checkTasksJoined(std::getenv("SLURM_STEP_NUM_TASKS"));
+  if (!launchedAsJob()) return {};
 #if LODFORGE_WITH_MPI
   preferSharedMemoryOnOneMachine();
   int provided = 0;

@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -58,10 +59,12 @@ void reportActivity(std::string_view what);
 // The other ranks' last reported activities, a line each ("rank 1 (host, pid 12): building …").
 std::string otherRanksActivities();
 
-// Refuses (kUsage) a process that srun started as one of several tasks without an MPI plugin to
-// join them (`srun --mpi=none`, or a site's default without PMIx): each task would do the whole
-// work on its own. `stepTasks`: SLURM_STEP_NUM_TASKS (null: not set, as in a batch script).
-Status checkTasksJoined(const char* stepTasks);
+// A warning for a process that srun started as one of several tasks with no MPI plugin to join
+// them (`srun --mpi=none`, or a site's default without PMIx): each task works alone, as tasks
+// started on purpose for separate inputs do, but tasks meant as one job would each do the whole
+// work. `stepTasks`: SLURM_STEP_NUM_TASKS (null: not set, as in a batch script). Nothing for a
+// step of one task, or a process that joined a job.
+std::optional<std::string> tasksNotJoined(const char* stepTasks);
 
 // What mpirun tells a rank before MPI starts (null: not set), and whether OpenMPI's parameter
 // files (the system's, the user's) choose a point-to-point layer.

@@ -21,11 +21,11 @@ void clearCancel();
 bool cancelRequested();
 // An ErrorKind::kCancelled status when cancellation was requested, ok otherwise.
 Status checkCancelled();
-// Marks one durable step of resumable work done: `kind` is "node" (a tile node's summary), "run"
-// (reconstructed chunks), "pointnode" (a ranked partition node) or "tile" (a point tile). With
-// LODFORGE_INTERRUPT_AFTER=KIND:N the N-th step of that kind requests cancellation as Ctrl-C
-// would: the resume tests stop a run at a known point instead of racing it. With KIND:N:kill the
-// process dies there instead (SIGKILL), as a rank of a distributed job may.
+// Marks a step of resumable work done: `kind` is "node" (a tile node's summary), "run" (chunks
+// reconstructed), "pointblock", "pointstaged", "pointnode" (a point block ranked, a node staged,
+// placed) or "tile" (a point tile). LODFORGE_INTERRUPT_AFTER=KIND:N makes the N-th step of that
+// kind request cancellation as Ctrl-C would (the resume tests stop a run at a known point); with
+// KIND:N:kill the process dies there instead (SIGKILL), as a rank of a distributed job may.
 void checkpointReached(std::string_view kind);
 
 // Wall time since `start`, for the figures long work reports.

@@ -7,6 +7,7 @@
 #include <array>
 #include <bit>
 #include <cassert>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -338,6 +339,7 @@ struct InMemory {
   std::span<const std::byte> extras;
   Blocks& blocks;
   std::uint64_t offset = 0;  // the node's first record, when staged
+  std::string_view place;    // the work file the blocks end in (PointBlock::path)
 };
 
 // A finished block: handed to the sink, if any, then written back (its extra bytes gathered by
@@ -366,7 +368,7 @@ void splitInMemory(std::span<CloudPoint> points, std::span<std::uint32_t> ids, s
   if (points.size() <= shared.options.blockSize) {
     PointBlock block;
     block.name = name;
-    block.path = shared.files.points.path();
+    block.path = shared.place;
     block.layout = shared.files.layout;
     block.first = first;
     block.count = points.size();
@@ -729,8 +731,16 @@ Status copyBytes(const std::string& sourcePath, std::uint64_t from, const std::s
     auto inAt = static_cast<off_t>(from + piece * kPiece);
     auto outAt = static_cast<off_t>(to + piece * kPiece);
     std::uint64_t left = std::min(kPiece, bytes - piece * kPiece);
+    std::vector<std::byte> buffer;  // where the kernel cannot copy between the two files
     while (left > 0) {
-      const ssize_t n = ::copy_file_range(in, &inAt, out, &outAt, left, 0);
+      ssize_t n = buffer.empty() ? ::copy_file_range(in, &inAt, out, &outAt, left, 0) : -1;
+      if (n < 0 && (buffer.size() > 0 || errno == ENOSYS || errno == EXDEV || errno == EOPNOTSUPP ||
+                    errno == EINVAL)) {
+        buffer.resize(static_cast<std::size_t>(std::min<std::uint64_t>(left, kPiece)));
+        n = ::pread(in, buffer.data(), buffer.size(), inAt);
+        if (n > 0 && ::pwrite(out, buffer.data(), static_cast<std::size_t>(n), outAt) != n) n = -1;
+        if (n > 0) inAt += n, outAt += n;
+      }
       if (n <= 0) {
         copied[piece] = n == 0 ? ioError(sourcePath, "ends before the node's records")
                                : ioErrorFromErrno(targetPath, "copy into");
@@ -833,7 +843,8 @@ Result<std::vector<PointBlock>> splitNodesInMemory(
     std::iota(ids.begin(), ids.end(), 0u);
     const std::size_t before = blocks.named.size();
     splitInMemory(records.points, ids, node.first, node.name,
-                  InMemory{options, finished, records.extras, blocks, scratch ? node.first : 0});
+                  InMemory{options, finished, records.extras, blocks, scratch ? node.first : 0,
+                           files.points.path()});
     if (!blocks.status.ok()) return blocks.status;
     // A block finished after a cancellation skipped the sink: such a node is never staged.
     LODFORGE_TRY(checkCancelled());

@@ -223,7 +223,8 @@ Result<std::vector<PartitionNode>> splitLargeNodes(const InputRead& read,
 // (`scratchStem` + ".points" and ".extras", from record 0); `staged` is told the node and its
 // blocks once they are all there, then they are copied into the node's place and `placed` is
 // told. So the node of an interrupted run is either untouched in place (split it again) or whole
-// in the scratch files (placeScratchNode), never half overwritten.
+// in the scratch files with its summary staged (placeScratchNode copies it again), never half
+// overwritten with nothing whole to mend it from.
 struct NodeStaging {
   std::string scratchStem;
   std::function<Status(const PartitionNode&, std::span<const PointBlock>)> staged;

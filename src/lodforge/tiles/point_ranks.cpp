@@ -166,8 +166,7 @@ class RankedPoints {
       LODFORGE_TRY(agreeAcrossRanks(lead_ && stats_.resumed ? placeStagedOnLead() : Status{}));
       std::vector<std::uint64_t> done;  // rank 0's view
       if (lead_)
-        for (const bool d : rankedNodesDone(work_, split_.nodes, split_.read))
-          done.push_back(d ? 1 : 0);
+        for (const bool d : rankedNodesDone(work_, split_.nodes)) done.push_back(d ? 1 : 0);
       Result<std::vector<PartitionNode>> todo = nodesToRankOnLead(done);
       if (!todo) return todo.status();
       stats_.nodesResumed = split_.nodes.size() - todo->size();

@@ -48,6 +48,15 @@ std::optional<nlohmann::json> readJson(const std::string& path) {
   return j;
 }
 
+// The split's work files' sizes (0: missing), as a state records them.
+nlohmann::json workFileSizes(const std::string& workDirectory) {
+  const auto bytes = [&](const char* name) {
+    const Result<std::uint64_t> size = fileSize(workDirectory + "/" + name);
+    return size ? *size : 0;
+  };
+  return {bytes("b.points"), bytes("b.extras")};
+}
+
 }  // namespace
 
 nlohmann::json pointRunIdentity(const std::string& input, const PointTilesOptions& options) {
@@ -84,6 +93,7 @@ Status saveSplitState(const std::string& workDirectory, const nlohmann::json& id
                      {"sum", vecToJson(n.sum)}});
   const nlohmann::json j = {
       {"identity", identity},
+      {"workFiles", workFileSizes(workDirectory)},
       {"count", state.count},
       {"bounds", boundsToJson(state.bounds)},
       {"sum", vecToJson(state.sum)},
@@ -99,6 +109,8 @@ std::optional<SplitState> loadSplitState(const std::string& workDirectory,
   if (!j) return std::nullopt;
   try {
     if (j->at("identity") != identity) return std::nullopt;  // other input or options
+    // Work files not as the state left them (cut short, removed): start over, not go on.
+    if (j->at("workFiles") != workFileSizes(workDirectory)) return std::nullopt;
     SplitState state;
     state.count = j->at("count").get<std::uint64_t>();
     state.bounds = boundsFromJson(j->at("bounds"));
@@ -142,18 +154,11 @@ Status markNodeDone(const std::string& workDirectory, const std::string& nodeNam
 }
 
 std::vector<bool> rankedNodesDone(const std::string& workDirectory,
-                                  std::span<const PartitionNode> nodes, const InputRead& read) {
-  const auto whole = [&](const char* extension, std::uint64_t bytes) {
-    const Result<std::uint64_t> size = fileSize(fmt::format("{}/b.{}", workDirectory, extension));
-    return size && *size == bytes;
-  };
-  const std::size_t stride = read.info.extras.stride;
-  const bool records = whole("points", read.count * read.layout.bytes()) &&
-                       (stride == 0 || whole("extras", read.count * stride));
+                                  std::span<const PartitionNode> nodes) {
   std::vector<bool> done;
   std::error_code ignored;
   for (const PartitionNode& n : nodes)
-    done.push_back(records && fs::exists(nodePath(workDirectory, n.name), ignored));
+    done.push_back(fs::exists(nodePath(workDirectory, n.name), ignored));
   return done;
 }
 
@@ -165,7 +170,7 @@ Result<std::vector<RankedBlock>> readRankedNodes(const std::string& workDirector
   for (const PartitionNode& node : nodes) {
     const std::string file = nodePath(workDirectory, node.name);
     const std::optional<nlohmann::json> j = readJson(file);
-    if (!j) return ioError(file, "is missing or not JSON");
+    if (!j) return ioError(file, "is missing or not JSON: run without --resume to start over");
     try {
       for (const nlohmann::json& b : j->at("blocks")) {
         RankedBlock& r = out.emplace_back();
@@ -180,7 +185,8 @@ Result<std::vector<RankedBlock>> readRankedNodes(const std::string& workDirector
         r.leastError = b.at("leastError").get<float>();
       }
     } catch (const nlohmann::json::exception& e) {
-      return ioError(file, fmt::format("is damaged: {}", e.what()));
+      return ioError(file,
+                     fmt::format("is damaged ({}): run without --resume to start over", e.what()));
     }
   }
   // Nodes are in name order and a node's blocks all start with its name.
@@ -208,7 +214,7 @@ Result<std::optional<PointPlan>> readPointPlan(const std::string& workDirectory)
   std::error_code ignored;
   if (!fs::exists(path, ignored)) return std::optional<PointPlan>();
   const std::optional<nlohmann::json> j = readJson(path);
-  if (!j) return ioError(path, "is not JSON");
+  if (!j) return ioError(path, "is not JSON: run without --resume to start over");
   try {
     PointPlan plan;
     plan.taus = j->at("taus").get<std::vector<float>>();
@@ -227,7 +233,8 @@ Result<std::optional<PointPlan>> readPointPlan(const std::string& workDirectory)
     }
     return std::optional<PointPlan>(std::move(plan));
   } catch (const nlohmann::json::exception& e) {
-    return ioError(path, fmt::format("is damaged: {}", e.what()));
+    return ioError(path,
+                   fmt::format("is damaged ({}): run without --resume to start over", e.what()));
   }
 }
 
@@ -314,7 +321,7 @@ Result<std::uint64_t> placeStagedNodes(const std::string& workDirectory,
       continue;
     const std::optional<nlohmann::json> j = readJson(staged);
     if (!j || !j->contains("scratch") || !j->at("scratch").is_string())
-      return ioError(staged, "is damaged");
+      return ioError(staged, "is damaged: run without --resume to start over");
     LODFORGE_TRY(placeScratchNode(read, options, j->at("scratch").get<std::string>(), node));
     LODFORGE_TRY(markNodeDone(workDirectory, node.name));
     ++placed;
@@ -323,9 +330,8 @@ Result<std::uint64_t> placeStagedNodes(const std::string& workDirectory,
 }
 
 std::vector<PartitionNode> nodesToRank(const std::string& workDirectory,
-                                       std::span<const PartitionNode> nodes,
-                                       const InputRead& read) {
-  const std::vector<bool> done = rankedNodesDone(workDirectory, nodes, read);
+                                       std::span<const PartitionNode> nodes) {
+  const std::vector<bool> done = rankedNodesDone(workDirectory, nodes);
   std::vector<PartitionNode> out;
   for (std::size_t i = 0; i < nodes.size(); ++i)
     if (!done[i]) out.push_back(nodes[i]);

@@ -47,10 +47,12 @@ SplitState splitStateOf(const PointSplit& split);
 // partition's, for the records' layout).
 Result<PointSplit> resumedSplit(const SplitState& state, const std::string& input,
                                 const PartitionOptions& options);
-// Written once the streamed splits are done; from then on the work is kept for --resume.
+// Written once the streamed splits are done, with the work files' sizes; from then on the work
+// is kept for --resume.
 Status saveSplitState(const std::string& workDirectory, const nlohmann::json& identity,
                       const SplitState& state);
-// An earlier run's state, when intact and made with `identity`.
+// An earlier run's state, when intact, made with `identity` and its work files still of the
+// sizes it recorded (else the run starts over).
 std::optional<SplitState> loadSplitState(const std::string& workDirectory,
                                          const nlohmann::json& identity);
 // Whether `workDirectory` holds a split state (the work is worth keeping).
@@ -66,10 +68,9 @@ struct RankedBlock {
 Status writeRankedNode(const std::string& workDirectory, const std::string& nodeName,
                        const std::string& scratchStem, std::span<const RankedBlock> blocks);
 Status markNodeDone(const std::string& workDirectory, const std::string& nodeName);
-// Per node, whether it is done; none is when the work files are not there at their full size
-// (`read`'s records), so that a summary never stands for records lost.
+// Per node, whether it is done (its records in place).
 std::vector<bool> rankedNodesDone(const std::string& workDirectory,
-                                  std::span<const PartitionNode> nodes, const InputRead& read);
+                                  std::span<const PartitionNode> nodes);
 // Every node's blocks, in name order; `path` and `layout` are the ranked records'.
 Result<std::vector<RankedBlock>> readRankedNodes(const std::string& workDirectory,
                                                  std::span<const PartitionNode> nodes,
@@ -104,7 +105,7 @@ Result<std::uint64_t> placeStagedNodes(const std::string& workDirectory,
                                        const PartitionOptions& options);
 // The nodes not done yet (rankedNodesDone; a fresh run's: all), in name order.
 std::vector<PartitionNode> nodesToRank(const std::string& workDirectory,
-                                       std::span<const PartitionNode> nodes, const InputRead& read);
+                                       std::span<const PartitionNode> nodes);
 
 // A block's tiles as ranked into the work directory (`layout` of its records; `extras`: they
 // carry extra bytes).

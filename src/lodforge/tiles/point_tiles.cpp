@@ -180,7 +180,7 @@ class PointRun {
     }
     if (stats_.resumed)
       LODFORGE_TRY(placeStagedNodes(work_, split_.nodes, split_.read, partitionOptions_).status());
-    const std::vector<PartitionNode> todo = nodesToRank(work_, split_.nodes, split_.read);
+    const std::vector<PartitionNode> todo = nodesToRank(work_, split_.nodes);
     stats_.nodesResumed = split_.nodes.size() - todo.size();
     PartitionOptions options = partitionOptions_;
     NodeRanking ranking(work_, hasNormals_, options_);

@@ -736,8 +736,8 @@ Status copyBytes(const std::string& sourcePath, std::uint64_t from, const std::s
       ssize_t n = buffer.empty() ? ::copy_file_range(in, &inAt, out, &outAt, left, 0) : -1;
       if (n < 0 && (buffer.size() > 0 || errno == ENOSYS || errno == EXDEV || errno == EOPNOTSUPP ||
                     errno == EINVAL)) {
-        buffer.resize(static_cast<std::size_t>(std::min<std::uint64_t>(left, kPiece)));
-        n = ::pread(in, buffer.data(), buffer.size(), inAt);
+        if (buffer.empty()) buffer.resize(static_cast<std::size_t>(left));
+        n = ::pread(in, buffer.data(), static_cast<std::size_t>(left), inAt);  // never past it
         if (n > 0 && ::pwrite(out, buffer.data(), static_cast<std::size_t>(n), outAt) != n) n = -1;
         if (n > 0) inAt += n, outAt += n;
       }

@@ -17,6 +17,7 @@
 #include "lodforge/core/progress.h"
 #include "lodforge/io/image/image_codec.h"
 #include "lodforge/io/mesh/gltf_constants.h"
+#include "lodforge/io/mesh/vertex_codec.h"
 
 namespace lodforge {
 
@@ -88,7 +89,9 @@ struct GlbWriter::State {
   std::string spillPath;
   std::uint64_t binaryBytes = 0;    // total, memory + spilled
   std::uint64_t fallbackBytes = 0;  // meshopt: the uncompressed layout the views describe
-  std::vector<std::byte> scratch, encoded;
+  std::vector<std::byte> scratch;
+  std::unique_ptr<std::byte[]> encodeBuffer;  // EXT_meshopt_compression: a view's encoding
+  std::size_t encodeCapacity = 0;
 
   // Room for a mesh's views at once (a tile's binary grew by doubling, copying its bytes about
   // twice), growing geometrically still for writers of many meshes; at most what stays in
@@ -127,6 +130,28 @@ struct GlbWriter::State {
     return {};
   }
 
+  // Room for a view's encoding, left uninitialised (a vector would zero its whole bound first).
+  std::span<std::byte> encodeRoom(std::size_t bound) {
+    if (bound > encodeCapacity) {
+      encodeBuffer.reset(new std::byte[bound]);
+      encodeCapacity = bound;
+    }
+    return {encodeBuffer.get(), bound};
+  }
+  std::span<const std::byte> encodeIndices(std::span<const std::uint32_t> indices,
+                                           std::size_t vertices) {
+    const std::span<std::byte> room =
+        encodeRoom(meshopt_encodeIndexBufferBound(indices.size(), vertices));
+    return room.first(meshopt_encodeIndexBuffer(reinterpret_cast<unsigned char*>(room.data()),
+                                                room.size(), indices.data(), indices.size()));
+  }
+  // Our encoder: the same bytes as meshopt_encodeVertexBuffer, 3 to 7 times as fast.
+  std::span<const std::byte> encodeVertices(const void* data, std::size_t count,
+                                            std::size_t stride) {
+    const std::span<std::byte> room = encodeRoom(vertexAttributesBound(count, stride));
+    return room.first(encodeVertexAttributes(room, data, count, stride));
+  }
+
   // Writes one view + accessor; returns the accessor index. `stride` is one element's size.
   // Indices (`target` kElementArrayBuffer) come as `wideIndices`, the 32-bit values the index
   // codec reads whatever size they decode to, with `vertices` bounding them; `data` then holds
@@ -140,15 +165,9 @@ struct GlbWriter::State {
     nlohmann::json view;
     if (options.meshoptCompression) {
       const bool triangles = target == kElementArrayBuffer;
-      if (triangles) {
-        encoded.resize(meshopt_encodeIndexBufferBound(count, vertices));
-        encoded.resize(meshopt_encodeIndexBuffer(reinterpret_cast<unsigned char*>(encoded.data()),
-                                                 encoded.size(), wideIndices.data(), count));
-      } else {
-        encoded.resize(meshopt_encodeVertexBufferBound(count, stride));
-        encoded.resize(meshopt_encodeVertexBuffer(reinterpret_cast<unsigned char*>(encoded.data()),
-                                                  encoded.size(), data, count, stride));
-      }
+      const std::span<const std::byte> encoded =
+          triangles ? encodeIndices(wideIndices.first(count), vertices)
+                    : encodeVertices(data, count, stride);
       const std::uint64_t offset = binaryBytes;
       LODFORGE_TRY(appendBinary(encoded.data(), encoded.size()));
       view = {{"buffer", 1},

@@ -14,6 +14,7 @@
 
 #include "lodforge/core/file.h"
 #include "lodforge/io/mesh/gltf_constants.h"
+#include "lodforge/io/mesh/gltf_meshopt.h"
 #include "lodforge/io/mesh/gltf_textures.h"
 
 namespace lodforge {
@@ -838,12 +839,22 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
     if (bytes.size() >= 4) std::memcpy(&magic, bytes.data(), 4);
     if (magic == kGlbMagic) {
       LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset, binLength));
-      Result<std::optional<std::string>> rewritten = withoutDracoIndices(bytes, name, true);
+      Result<std::optional<std::string>> decoded =
+          withMeshoptDecoded(bytes, name, binOffset, binLength);
+      if (!decoded) return decoded.status();
+      // Decoded views follow the original BIN chunk, whose bytes stay where they were.
+      std::span<const std::byte> glb = bytes;
+      if (*decoded) {
+        glb = std::as_bytes(std::span<const char>(**decoded));
+        std::uint64_t decodedBinOffset = 0;
+        LODFORGE_TRY(checkGlbContainer(glb, name, decodedBinOffset, binLength));
+      }
+      Result<std::optional<std::string>> rewritten = withoutDracoIndices(glb, name, true);
       if (!rewritten) return rewritten.status();
       // Same BIN chunk, maybe a new JSON length: byte offsets reported are the original file's.
       std::string copy = *rewritten
                              ? std::move(**rewritten)
-                             : std::string(reinterpret_cast<const char*>(data), bytes.size());
+                             : std::string(reinterpret_cast<const char*>(glb.data()), glb.size());
       const std::size_t size = copy.size();
       copy.append(kTinygltfOverread, '\0');
       ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings,

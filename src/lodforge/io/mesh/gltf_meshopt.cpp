@@ -1,0 +1,225 @@
+#include "lodforge/io/mesh/gltf_meshopt.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+#include <meshoptimizer.h>
+#include <nlohmann/json.hpp>
+
+#include "lodforge/io/mesh/gltf_constants.h"
+
+namespace lodforge {
+namespace {
+
+using Json = nlohmann::json;
+constexpr const char* kExtension = "EXT_meshopt_compression";
+
+// A non-negative integer member, or nothing.
+std::optional<std::uint64_t> unsignedMember(const Json& object, const char* key) {
+  if (!object.contains(key) || !object[key].is_number_unsigned()) return std::nullopt;
+  return object[key].get<std::uint64_t>();
+}
+
+// One compressed view, as its extension object describes it.
+struct CompressedView {
+  std::uint64_t byteOffset = 0;  // in the BIN chunk
+  std::uint64_t byteLength = 0;
+  std::uint64_t byteStride = 0;
+  std::uint64_t count = 0;
+  std::string mode;
+  std::string filter = "NONE";
+};
+
+Result<CompressedView> describe(const Json& extension, std::size_t view, const std::string& name) {
+  const auto fail = [&](std::string_view what) {
+    return badInput(name, fmt::format("bufferViews[{}].extensions.{}: {}", view, kExtension, what));
+  };
+  if (!extension.is_object()) return fail("not an object");
+  CompressedView c;
+  const std::optional<std::uint64_t> buffer = unsignedMember(extension, "buffer");
+  const std::optional<std::uint64_t> offset = unsignedMember(extension, "byteOffset");
+  const std::optional<std::uint64_t> length = unsignedMember(extension, "byteLength");
+  const std::optional<std::uint64_t> stride = unsignedMember(extension, "byteStride");
+  const std::optional<std::uint64_t> elements = unsignedMember(extension, "count");
+  if (!buffer || !length || !stride || !elements || !extension.contains("mode") ||
+      !extension["mode"].is_string())
+    return fail("buffer, byteLength, byteStride, count and mode are required");
+  if (*buffer != 0) return fail("compressed data outside the GLB's BIN chunk is not read");
+  if (*length > std::numeric_limits<std::uint32_t>::max())
+    return fail(fmt::format("byteLength {} is more than a GLB holds", *length));
+  c.byteOffset = offset.value_or(0);
+  c.byteLength = *length;
+  c.byteStride = *stride;
+  c.count = *elements;
+  c.mode = extension["mode"].get<std::string>();
+  if (extension.contains("filter")) {
+    if (!extension["filter"].is_string()) return fail("filter is not a string");
+    c.filter = extension["filter"].get<std::string>();
+  }
+  const bool attributes = c.mode == "ATTRIBUTES";
+  if (!attributes && c.mode != "TRIANGLES" && c.mode != "INDICES")
+    return fail(fmt::format("unknown mode \"{}\"", c.mode));
+  if (attributes ? (c.byteStride == 0 || c.byteStride > 256 || c.byteStride % 4 != 0)
+                 : (c.byteStride != 2 && c.byteStride != 4))
+    return fail(fmt::format("byteStride {} for mode {}", c.byteStride, c.mode));
+  if (c.mode == "TRIANGLES" && c.count % 3 != 0)
+    return fail(fmt::format("{} indices are not whole triangles", c.count));
+  const bool filterFits = c.filter == "NONE" ||
+                          (c.filter == "OCTAHEDRAL" && (c.byteStride == 4 || c.byteStride == 8)) ||
+                          (c.filter == "QUATERNION" && c.byteStride == 8) ||
+                          (c.filter == "EXPONENTIAL" && c.byteStride % 4 == 0);
+  if (!filterFits || (c.filter != "NONE" && !attributes))
+    return fail(
+        fmt::format("filter {} with mode {} and byteStride {}", c.filter, c.mode, c.byteStride));
+  // Every codec spends at least a byte on 64 decoded ones (an all-zero group of 16 elements
+  // still costs its 2 header bits per byte), so a larger count is a lie, not a big file.
+  if (c.count > 64 * c.byteLength / c.byteStride)
+    return fail(fmt::format("{} elements cannot come from {} bytes", c.count, c.byteLength));
+  return c;
+}
+
+// Decodes one view into `out` (count × byteStride bytes).
+Status decode(const CompressedView& c, std::span<const std::byte> bin, std::uint64_t binOffset,
+              const std::string& name, std::vector<std::byte>& out) {
+  if (c.byteOffset > bin.size() || c.byteLength > bin.size() - c.byteOffset)
+    return badInputAtByte(
+        name, binOffset + c.byteOffset,
+        fmt::format("a compressed view of {} bytes runs past the BIN chunk", c.byteLength));
+  const auto* source = reinterpret_cast<const unsigned char*>(bin.data() + c.byteOffset);
+  out.assign(c.count * c.byteStride, std::byte{0});
+  int rc = 0;
+  if (c.mode == "ATTRIBUTES")
+    rc = meshopt_decodeVertexBuffer(out.data(), c.count, c.byteStride, source, c.byteLength);
+  else if (c.mode == "TRIANGLES")
+    rc = meshopt_decodeIndexBuffer(out.data(), c.count, c.byteStride, source, c.byteLength);
+  else
+    rc = meshopt_decodeIndexSequence(out.data(), c.count, c.byteStride, source, c.byteLength);
+  if (rc != 0)
+    return badInputAtByte(name, binOffset + c.byteOffset,
+                          fmt::format("{} stream of {} elements does not decode (meshoptimizer: "
+                                      "{})",
+                                      c.mode, c.count, rc));
+  if (c.filter == "OCTAHEDRAL") meshopt_decodeFilterOct(out.data(), c.count, c.byteStride);
+  if (c.filter == "QUATERNION") meshopt_decodeFilterQuat(out.data(), c.count, c.byteStride);
+  if (c.filter == "EXPONENTIAL") meshopt_decodeFilterExp(out.data(), c.count, c.byteStride);
+  return {};
+}
+
+// Decodes every compressed view to the end of `bin` and points the view there (buffer 0).
+Status decodeViews(Json& document, std::string& bin, std::span<const std::byte> original,
+                   std::uint64_t binOffset, const std::string& name) {
+  std::vector<std::byte> decoded;
+  // Views may share compressed bytes; all of them together still decode to at most 64 times the
+  // chunk (a stream's bound), so a file cannot make the reader allocate without end.
+  std::uint64_t decodedBytes = 0;
+  for (std::size_t v = 0; v < document["bufferViews"].size(); ++v) {
+    Json& view = document["bufferViews"][v];
+    if (!view.is_object() || !view.contains("extensions") || !view["extensions"].is_object() ||
+        !view["extensions"].contains(kExtension))
+      continue;
+    Result<CompressedView> c = describe(view["extensions"][kExtension], v, name);
+    if (!c) return c.status();
+    decodedBytes += c->count * c->byteStride;
+    if (decodedBytes > 64 * original.size())
+      return badInput(name, fmt::format("bufferViews[{}]: the compressed views decode to more than "
+                                        "64 times the BIN chunk's {} bytes",
+                                        v, original.size()));
+    LODFORGE_TRY(decode(*c, original, binOffset, name, decoded));
+    while (bin.size() % 4 != 0) bin.push_back('\0');
+    view["buffer"] = 0;
+    view["byteOffset"] = bin.size();
+    view["byteLength"] = decoded.size();
+    view["extensions"].erase(kExtension);
+    if (view["extensions"].empty()) view.erase("extensions");
+    bin.append(reinterpret_cast<const char*>(decoded.data()), decoded.size());
+  }
+  return {};
+}
+
+// Buffers no view uses any more (the fallbacks) go; the views' numbers follow. Buffer 0, the BIN
+// chunk, stays.
+void dropUnusedBuffers(Json& document, std::uint64_t binBytes) {
+  Json& buffers = document["buffers"];
+  std::vector<bool> used(buffers.size(), false);
+  if (!used.empty()) used[0] = true;
+  for (const Json& view : document["bufferViews"])
+    if (std::optional<std::uint64_t> b = unsignedMember(view, "buffer"); b && *b < used.size())
+      used[*b] = true;
+  std::map<std::uint64_t, std::uint64_t> renumbered;
+  Json kept = Json::array();
+  for (std::size_t b = 0; b < buffers.size(); ++b) {
+    if (!used[b]) continue;
+    renumbered[b] = kept.size();
+    kept.push_back(buffers[b]);
+  }
+  kept[0]["byteLength"] = binBytes;
+  buffers = std::move(kept);
+  for (Json& view : document["bufferViews"])
+    if (std::optional<std::uint64_t> b = unsignedMember(view, "buffer"); b && renumbered.count(*b))
+      view["buffer"] = renumbered[*b];
+}
+
+// The extension leaves the used and required lists once nothing is compressed.
+void forgetExtension(Json& document) {
+  for (const char* list : {"extensionsUsed", "extensionsRequired"}) {
+    if (!document.contains(list) || !document[list].is_array()) continue;
+    Json& names = document[list];
+    names.erase(std::remove(names.begin(), names.end(), Json(kExtension)), names.end());
+    if (names.empty()) document.erase(list);
+  }
+}
+
+std::string glbOf(const Json& document, const std::string& bin) {
+  std::string text = document.dump();
+  while (text.size() % 4 != 0) text += ' ';
+  const std::uint32_t binChunk = static_cast<std::uint32_t>((bin.size() + 3) / 4 * 4);
+  const std::uint32_t header[5] = {gltf::kGlbMagic, 2,
+                                   static_cast<std::uint32_t>(20 + text.size() + 8 + binChunk),
+                                   static_cast<std::uint32_t>(text.size()), gltf::kChunkJson};
+  std::string out(reinterpret_cast<const char*>(header), sizeof header);
+  out += text;
+  const std::uint32_t binHeader[2] = {binChunk, gltf::kChunkBin};
+  out.append(reinterpret_cast<const char*>(binHeader), sizeof binHeader);
+  out += bin;
+  out.append(binChunk - bin.size(), '\0');
+  return out;
+}
+
+}  // namespace
+
+Result<std::optional<std::string>> withMeshoptDecoded(std::span<const std::byte> glb,
+                                                      const std::string& name,
+                                                      std::uint64_t binOffset,
+                                                      std::uint64_t binLength) {
+  std::uint32_t jsonLength = 0;
+  std::memcpy(&jsonLength, glb.data() + 12, 4);
+  const std::string_view text(reinterpret_cast<const char*>(glb.data()) + 20, jsonLength);
+  if (text.find(kExtension) == std::string_view::npos) return std::optional<std::string>();
+  Json document = Json::parse(text, nullptr, false);
+  if (document.is_discarded()) return badInputAtByte(name, 20, "the glTF JSON does not parse");
+  if (!document.is_object() || !document.contains("bufferViews") ||
+      !document["bufferViews"].is_array() || !document.contains("buffers") ||
+      !document["buffers"].is_array() || document["buffers"].empty() ||
+      !document["buffers"][0].is_object())
+    return std::optional<std::string>();
+  if (document["buffers"][0].contains("uri"))
+    return badInput(
+        name, fmt::format("{} in a GLB whose buffer 0 is not its BIN chunk: not read", kExtension));
+  const std::span<const std::byte> original =
+      binLength == 0 ? std::span<const std::byte>() : glb.subspan(binOffset, binLength);
+  std::string bin(reinterpret_cast<const char*>(original.data()), original.size());
+  LODFORGE_TRY(decodeViews(document, bin, original, binOffset, name));
+  if (bin.size() > std::numeric_limits<std::uint32_t>::max() - text.size() - 64)
+    return Error{ErrorKind::kLimit,
+                 fmt::format("{}: decoded, the GLB would pass 4 GiB, which GLB cannot hold", name)};
+  dropUnusedBuffers(document, bin.size());
+  forgetExtension(document);
+  return std::optional<std::string>(glbOf(document, bin));
+}
+
+}  // namespace lodforge

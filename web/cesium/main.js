@@ -4,6 +4,7 @@
 import { drawnSummary, formatBytes, onScreenSpaceError } from '../format.js';
 import { boundsOf, loadParts, partsPanel } from '../parts_panel.js';
 import { CLASSES, classColor, colorModes, colorPanel, hexToRgb } from '../point_colors.js';
+import { MeshoptDecoder } from 'meshoptimizer/decoder';
 
 const Cesium = window.Cesium;
 const report = (window.lodforge = { loaded: false, failed: [], error: null, tilesLoaded: 0, frames: 0 });
@@ -22,17 +23,28 @@ async function rootContent(tileset) {
   const jsonLength = view.getUint32(12, true);
   const gltf = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, 20, jsonLength)));
   const attributes = gltf.meshes[0].primitives[0].attributes;
-  // A scalar attribute's values (4 bytes apart), unless meshopt-compressed.
-  const values = (name, read) => {
+  const bin = 20 + jsonLength + 8;
+  // A scalar attribute's values (4 bytes apart), decoded first where meshopt-compressed (point
+  // tiles are, by default).
+  const values = async (name, read) => {
     if (!(name in attributes)) return [];
     const accessor = gltf.accessors[attributes[name]];
     const bufferView = gltf.bufferViews[accessor.bufferView];
-    if (bufferView.extensions) return [];
-    const at = 20 + jsonLength + 8 + (bufferView.byteOffset ?? 0);
-    return Array.from({ length: accessor.count }, (_, i) => read(at + 4 * i));
+    const packed = bufferView.extensions && bufferView.extensions.EXT_meshopt_compression;
+    let data = view;
+    let at = bin + (bufferView.byteOffset ?? 0);
+    if (packed) {
+      await MeshoptDecoder.ready;
+      const decoded = new Uint8Array(packed.count * packed.byteStride);
+      MeshoptDecoder.decodeGltfBuffer(decoded, packed.count, packed.byteStride,
+        new Uint8Array(bytes, bin + (packed.byteOffset ?? 0), packed.byteLength), packed.mode, packed.filter);
+      data = new DataView(decoded.buffer);
+      at = 0;
+    }
+    return Array.from({ length: accessor.count }, (_, i) => read(data, at + 4 * i));
   };
-  const classes = new Set(values('_CLASSIFICATION', (at) => view.getUint8(at)));
-  const wide = values('_INTENSITY', (at) => view.getUint16(at, true)).some((v) => v > 255);
+  const classes = new Set(await values('_CLASSIFICATION', (data, at) => data.getUint8(at)));
+  const wide = (await values('_INTENSITY', (data, at) => data.getUint16(at, true))).some((v) => v > 255);
   return { names: Object.keys(attributes), classes, intensityMax: wide ? 65535 : 255,
            hasMetadata: !!(gltf.extensions && gltf.extensions.EXT_structural_metadata &&
                            gltf.extensions.EXT_structural_metadata.propertyAttributes) };

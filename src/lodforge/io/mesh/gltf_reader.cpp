@@ -818,6 +818,33 @@ Result<std::optional<std::string>> withoutDracoIndices(std::span<const std::byte
   return std::optional<std::string>(std::move(out));
 }
 
+// The GLB as tinygltf is given it: its container checked (`binOffset`: where the BIN chunk's
+// data starts in the original file; `binLength`: its length once meshopt views are decoded),
+// EXT_meshopt_compression views decoded, Draco primitives' indices dropped, and
+// kTinygltfOverread zero bytes after the end.
+Result<std::string> glbForTinygltf(std::span<const std::byte> bytes, const std::string& name,
+                                   std::uint64_t& binOffset, std::uint64_t& binLength) {
+  LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset, binLength));
+  Result<std::optional<std::string>> decoded =
+      withMeshoptDecoded(bytes, name, binOffset, binLength);
+  if (!decoded) return decoded.status();
+  // Decoded views follow the original BIN chunk, whose bytes stay where they were.
+  std::span<const std::byte> glb = bytes;
+  if (*decoded) {
+    glb = std::as_bytes(std::span<const char>(**decoded));
+    std::uint64_t decodedBinOffset = 0;
+    LODFORGE_TRY(checkGlbContainer(glb, name, decodedBinOffset, binLength));
+  }
+  Result<std::optional<std::string>> rewritten = withoutDracoIndices(glb, name, true);
+  if (!rewritten) return rewritten.status();
+  // Same BIN chunk, maybe a new JSON length: byte offsets reported are the original file's.
+  std::string copy = *rewritten
+                         ? std::move(**rewritten)
+                         : std::string(reinterpret_cast<const char*>(glb.data()), glb.size());
+  copy.append(kTinygltfOverread, '\0');
+  return copy;
+}
+
 Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
                     const std::string& baseDir, const GltfReadOptions& options) {
   if (bytes.size() > std::numeric_limits<unsigned>::max())
@@ -838,27 +865,11 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
     std::uint32_t magic = 0;
     if (bytes.size() >= 4) std::memcpy(&magic, bytes.data(), 4);
     if (magic == kGlbMagic) {
-      LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset, binLength));
-      Result<std::optional<std::string>> decoded =
-          withMeshoptDecoded(bytes, name, binOffset, binLength);
-      if (!decoded) return decoded.status();
-      // Decoded views follow the original BIN chunk, whose bytes stay where they were.
-      std::span<const std::byte> glb = bytes;
-      if (*decoded) {
-        glb = std::as_bytes(std::span<const char>(**decoded));
-        std::uint64_t decodedBinOffset = 0;
-        LODFORGE_TRY(checkGlbContainer(glb, name, decodedBinOffset, binLength));
-      }
-      Result<std::optional<std::string>> rewritten = withoutDracoIndices(glb, name, true);
-      if (!rewritten) return rewritten.status();
-      // Same BIN chunk, maybe a new JSON length: byte offsets reported are the original file's.
-      std::string copy = *rewritten
-                             ? std::move(**rewritten)
-                             : std::string(reinterpret_cast<const char*>(glb.data()), glb.size());
-      const std::size_t size = copy.size();
-      copy.append(kTinygltfOverread, '\0');
+      Result<std::string> copy = glbForTinygltf(bytes, name, binOffset, binLength);
+      if (!copy) return copy.status();
+      const std::size_t size = copy->size() - kTinygltfOverread;
       ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings,
-                                       reinterpret_cast<const unsigned char*>(copy.data()),
+                                       reinterpret_cast<const unsigned char*>(copy->data()),
                                        static_cast<unsigned>(size), baseDir);
       if (ok && !gltf.buffers.empty() && gltf.buffers[0].uri.empty() &&
           gltf.buffers[0].data.size() > binLength)

@@ -217,6 +217,21 @@ TEST(GlbRead, MeshoptCompressedFilesReadAsTheUncompressedOnes) {
               rotatedTriangles(plain->objectIndices(o)));
 }
 
+TEST(GlbRead, AFileThatOnlyNamesTheExtensionIsReadAsItIs) {
+  // Nothing compressed, the name in extensionsUsed: not rewritten, read as before.
+  test::TempDir dir;
+  ASSERT_TRUE(writeGlb(randomModel(6, 1, 50), dir.file("plain.glb")).ok());
+  const std::string bytes = test::readFile(dir.file("plain.glb"));
+  nlohmann::json document = parseGlb(bytes).document;
+  document["extensionsUsed"].push_back("EXT_meshopt_compression");
+  Result<Model> plain = readGltfFromMemory(test::bytesOf(bytes), "p.glb");
+  Result<Model> named = readGltfFromMemory(test::bytesOf(withDocument(bytes, document)), "n.glb");
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  ASSERT_TRUE(named.ok()) << named.error().message;
+  EXPECT_EQ(named->positions, plain->positions);
+  EXPECT_EQ(named->indices, plain->indices);
+}
+
 TEST(GlbRead, DamagedMeshoptViewsAreBadInputNamingTheView) {
   test::TempDir dir;
   ASSERT_TRUE(
@@ -245,7 +260,7 @@ TEST(GlbRead, DamagedMeshoptViewsAreBadInputNamingTheView) {
   message = damaged([](nlohmann::json& e) { e["byteStride"] = 6; });
   EXPECT_NE(message.find("byteStride 6"), std::string::npos) << message;
   message = damaged([](nlohmann::json& e) { e["byteOffset"] = 1u << 30; });
-  EXPECT_NE(message.find("runs past the BIN chunk"), std::string::npos) << message;
+  EXPECT_NE(message.find("of the BIN chunk runs past its end"), std::string::npos) << message;
   // Views sharing one stream could decode without end: together they may not pass 64 times
   // the BIN chunk, which no real file does.
   nlohmann::json document = glb.document;
@@ -256,6 +271,33 @@ TEST(GlbRead, DamagedMeshoptViewsAreBadInputNamingTheView) {
   ASSERT_FALSE(shared.ok());
   EXPECT_NE(shared.error().message.find("more than 64 times the BIN chunk"), std::string::npos)
       << shared.error().message;
+  message = damaged([](nlohmann::json& e) { e["byteOffset"] = -8; });
+  EXPECT_NE(message.find("byteOffset is not an offset"), std::string::npos) << message;
+  // The view around a stream must describe what it decodes to (the extension's MUSTs), and no
+  // plain view may read the fallback buffer, which holds no data.
+  const auto refused = [&](const std::function<void(nlohmann::json&)>& change) {
+    nlohmann::json changed = glb.document;
+    change(changed);
+    Result<Model> model = readGltfFromMemory(test::bytesOf(withDocument(bytes, changed)), "d.glb");
+    EXPECT_FALSE(model.ok());
+    return model.ok() ? std::string() : model.error().message;
+  };
+  message = refused([](nlohmann::json& d) {
+    d["bufferViews"][0]["byteStride"] = 16;  // the stream's is 12 or 8
+  });
+  EXPECT_NE(message.find("bufferViews[0]: byteStride 16 but its"), std::string::npos) << message;
+  message = refused([](nlohmann::json& d) { d["bufferViews"][0]["byteLength"] = 4; });
+  EXPECT_NE(message.find("bufferViews[0]: byteLength 4 but its"), std::string::npos) << message;
+  message = refused([](nlohmann::json& d) {
+    nlohmann::json plain = d["bufferViews"][0];
+    plain.erase("extensions");
+    d["bufferViews"].push_back(plain);
+  });
+  EXPECT_NE(message.find("which holds no data"), std::string::npos) << message;
+  message = refused([](nlohmann::json& d) { d["buffers"][0]["byteLength"] = 1u << 30; });
+  EXPECT_NE(message.find("buffer 0 declares 1073741824 bytes but the BIN chunk holds"),
+            std::string::npos)
+      << message;
   message = damaged([](nlohmann::json& e) { e["filter"] = "OCTAHEDRAL"; });
   EXPECT_NE(message.find("filter OCTAHEDRAL"), std::string::npos) << message;
 }
@@ -305,6 +347,9 @@ TEST(GlbWrite, QuantizedMeshesReadBackWithinHalfAGridStep) {
     Result<Model> back = readGltf(path);
     ASSERT_TRUE(back.ok()) << back.error().message;
     ASSERT_EQ(back->objectCount(), 2u);
+    if (!meshopt) {
+      EXPECT_EQ(back->indices, model.indices);
+    }
     for (std::size_t o = 0; o < 2; ++o) {  // the index codec may rotate a triangle's corners
       EXPECT_EQ(rotatedTriangles(back->objectIndices(o)), rotatedTriangles(model.objectIndices(o)));
       const Aabb box = computeBounds(model.objectPositions(o));

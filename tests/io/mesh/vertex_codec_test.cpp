@@ -37,7 +37,8 @@ std::vector<unsigned char> elements(std::size_t count, std::size_t stride, int k
 
 std::vector<unsigned char> encode(const std::vector<unsigned char>& bytes, std::size_t count,
                                   std::size_t stride) {
-  std::vector<std::byte> out(vertexAttributesBound(count, stride));
+  // Not zeros: the writer's buffer is uninitialised, so every byte must be written.
+  std::vector<std::byte> out(vertexAttributesBound(count, stride), std::byte{0xcd});
   out.resize(encodeVertexAttributes(out, bytes.data(), count, stride));
   std::vector<unsigned char> stream(out.size());
   std::memcpy(stream.data(), out.data(), out.size());

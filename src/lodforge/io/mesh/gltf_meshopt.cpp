@@ -18,6 +18,8 @@ namespace {
 
 using Json = nlohmann::json;
 constexpr const char* kExtension = "EXT_meshopt_compression";
+// The most a GLB's BIN chunk can hold, less room for the JSON chunk (a 32-bit file length).
+constexpr std::uint64_t kGlbBytes = std::uint64_t{0xffffffff} - (std::uint64_t{64} << 20);
 
 // A non-negative integer member, or nothing.
 std::optional<std::uint64_t> unsignedMember(const Json& object, const char* key) {
@@ -50,6 +52,7 @@ Result<CompressedView> describe(const Json& extension, std::size_t view, const s
       !extension["mode"].is_string())
     return fail("buffer, byteLength, byteStride, count and mode are required");
   if (*buffer != 0) return fail("compressed data outside the GLB's BIN chunk is not read");
+  if (extension.contains("byteOffset") && !offset) return fail("byteOffset is not an offset");
   if (*length > std::numeric_limits<std::uint32_t>::max())
     return fail(fmt::format("byteLength {} is more than a GLB holds", *length));
   c.byteOffset = offset.value_or(0);
@@ -83,13 +86,33 @@ Result<CompressedView> describe(const Json& extension, std::size_t view, const s
   return c;
 }
 
+// The view around the extension describes the decoded data (the extension's MUSTs): its stride,
+// where it has one, is the stream's, and its length is count × byteStride.
+Status checkParent(const Json& view, const CompressedView& c, std::size_t v,
+                   const std::string& name) {
+  const std::optional<std::uint64_t> stride = unsignedMember(view, "byteStride");
+  const std::optional<std::uint64_t> length = unsignedMember(view, "byteLength");
+  if (view.contains("byteStride") && stride != c.byteStride)
+    return badInput(name, fmt::format("bufferViews[{}]: byteStride {} but its {} stream's is {}", v,
+                                      view["byteStride"].dump(), kExtension, c.byteStride));
+  if (length != c.count * c.byteStride)
+    return badInput(name, fmt::format("bufferViews[{}]: byteLength {} but its {} stream decodes "
+                                      "to {} elements of {} bytes",
+                                      v,
+                                      view.contains("byteLength") ? view["byteLength"].dump()
+                                                                  : std::string("missing"),
+                                      kExtension, c.count, c.byteStride));
+  return {};
+}
+
 // Decodes one view into `out` (count × byteStride bytes).
 Status decode(const CompressedView& c, std::span<const std::byte> bin, std::uint64_t binOffset,
               const std::string& name, std::vector<std::byte>& out) {
   if (c.byteOffset > bin.size() || c.byteLength > bin.size() - c.byteOffset)
-    return badInputAtByte(
-        name, binOffset + c.byteOffset,
-        fmt::format("a compressed view of {} bytes runs past the BIN chunk", c.byteLength));
+    return badInputAtByte(name, binOffset + std::min<std::uint64_t>(c.byteOffset, bin.size()),
+                          fmt::format("a compressed view of {} bytes at byte {} of the BIN chunk "
+                                      "runs past its end",
+                                      c.byteLength, c.byteOffset));
   const auto* source = reinterpret_cast<const unsigned char*>(bin.data() + c.byteOffset);
   out.assign(c.count * c.byteStride, std::byte{0});
   int rc = 0;
@@ -124,11 +147,17 @@ Status decodeViews(Json& document, std::string& bin, std::span<const std::byte> 
       continue;
     Result<CompressedView> c = describe(view["extensions"][kExtension], v, name);
     if (!c) return c.status();
+    LODFORGE_TRY(checkParent(view, *c, v, name));
     decodedBytes += c->count * c->byteStride;
     if (decodedBytes > 64 * original.size())
       return badInput(name, fmt::format("bufferViews[{}]: the compressed views decode to more than "
                                         "64 times the BIN chunk's {} bytes",
                                         v, original.size()));
+    if (bin.size() + c->count * c->byteStride > kGlbBytes)
+      return Error{
+          ErrorKind::kLimit,
+          fmt::format("{}: bufferViews[{}]: decoded, the GLB would pass the 4 GiB GLB holds", name,
+                      v)};
     LODFORGE_TRY(decode(*c, original, binOffset, name, decoded));
     while (bin.size() % 4 != 0) bin.push_back('\0');
     view["buffer"] = 0;
@@ -142,14 +171,21 @@ Status decodeViews(Json& document, std::string& bin, std::span<const std::byte> 
 }
 
 // Buffers no view uses any more (the fallbacks) go; the views' numbers follow. Buffer 0, the BIN
-// chunk, stays.
-void dropUnusedBuffers(Json& document, std::uint64_t binBytes) {
+// chunk, stays. A view left on a buffer without data (a fallback, which only compressed views
+// may name) is bad input: tinygltf would fill it from the BIN chunk, compressed bytes and all.
+Status dropUnusedBuffers(Json& document, std::uint64_t binBytes, const std::string& name) {
   Json& buffers = document["buffers"];
   std::vector<bool> used(buffers.size(), false);
   if (!used.empty()) used[0] = true;
-  for (const Json& view : document["bufferViews"])
-    if (std::optional<std::uint64_t> b = unsignedMember(view, "buffer"); b && *b < used.size())
-      used[*b] = true;
+  for (std::size_t v = 0; v < document["bufferViews"].size(); ++v) {
+    const std::optional<std::uint64_t> b = unsignedMember(document["bufferViews"][v], "buffer");
+    if (!b || *b >= used.size()) continue;
+    if (*b != 0 && !(buffers[*b].is_object() && buffers[*b].contains("uri")))
+      return badInput(name, fmt::format("bufferViews[{}] reads buffer {}, which holds no data (a "
+                                        "fallback for {} views)",
+                                        v, *b, kExtension));
+    used[*b] = true;
+  }
   std::map<std::uint64_t, std::uint64_t> renumbered;
   Json kept = Json::array();
   for (std::size_t b = 0; b < buffers.size(); ++b) {
@@ -162,6 +198,7 @@ void dropUnusedBuffers(Json& document, std::uint64_t binBytes) {
   for (Json& view : document["bufferViews"])
     if (std::optional<std::uint64_t> b = unsignedMember(view, "buffer"); b && renumbered.count(*b))
       view["buffer"] = renumbered[*b];
+  return {};
 }
 
 // The extension leaves the used and required lists once nothing is compressed.
@@ -174,9 +211,12 @@ void forgetExtension(Json& document) {
   }
 }
 
-std::string glbOf(const Json& document, const std::string& bin) {
+Result<std::string> glbOf(const Json& document, const std::string& bin, const std::string& name) {
   std::string text = document.dump();
   while (text.size() % 4 != 0) text += ' ';
+  if (20 + text.size() + 8 + bin.size() + 3 > std::numeric_limits<std::uint32_t>::max())
+    return Error{ErrorKind::kLimit,
+                 fmt::format("{}: decoded, the GLB would pass the 4 GiB GLB holds", name)};
   const std::uint32_t binChunk = static_cast<std::uint32_t>((bin.size() + 3) / 4 * 4);
   const std::uint32_t header[5] = {gltf::kGlbMagic, 2,
                                    static_cast<std::uint32_t>(20 + text.size() + 8 + binChunk),
@@ -207,19 +247,31 @@ Result<std::optional<std::string>> withMeshoptDecoded(std::span<const std::byte>
       !document["buffers"].is_array() || document["buffers"].empty() ||
       !document["buffers"][0].is_object())
     return std::optional<std::string>();
-  if (document["buffers"][0].contains("uri"))
+  const Json& views = document["bufferViews"];
+  const bool compressed = std::any_of(views.begin(), views.end(), [](const Json& view) {
+    return view.is_object() && view.contains("extensions") && view["extensions"].is_object() &&
+           view["extensions"].contains(kExtension);
+  });
+  if (!compressed) return std::optional<std::string>();
+  const Json& buffer0 = document["buffers"][0];
+  if (buffer0.contains("uri"))
     return badInput(
         name, fmt::format("{} in a GLB whose buffer 0 is not its BIN chunk: not read", kExtension));
+  // The reader's own check, made here before buffer 0 is given the decoded chunk's length.
+  if (const std::optional<std::uint64_t> declared = unsignedMember(buffer0, "byteLength");
+      declared && *declared > binLength)
+    return badInputAtByte(
+        name, binOffset - 8,
+        fmt::format("buffer 0 declares {} bytes but the BIN chunk holds {}", *declared, binLength));
   const std::span<const std::byte> original =
       binLength == 0 ? std::span<const std::byte>() : glb.subspan(binOffset, binLength);
   std::string bin(reinterpret_cast<const char*>(original.data()), original.size());
   LODFORGE_TRY(decodeViews(document, bin, original, binOffset, name));
-  if (bin.size() > std::numeric_limits<std::uint32_t>::max() - text.size() - 64)
-    return Error{ErrorKind::kLimit,
-                 fmt::format("{}: decoded, the GLB would pass 4 GiB, which GLB cannot hold", name)};
-  dropUnusedBuffers(document, bin.size());
+  LODFORGE_TRY(dropUnusedBuffers(document, bin.size(), name));
   forgetExtension(document);
-  return std::optional<std::string>(glbOf(document, bin));
+  Result<std::string> out = glbOf(document, bin, name);
+  if (!out) return out.status();
+  return std::optional<std::string>(std::move(*out));
 }
 
 }  // namespace lodforge

@@ -108,9 +108,16 @@ bool refuseWrite(std::string*, const std::string&, const std::vector<unsigned ch
 }
 class Loader {
  public:
+  // `binOffset`, `fileBinBytes`: where the BIN chunk's data is in the file and how much of it
+  // the file holds (decoded meshopt views come after it, in no byte of the file).
   Loader(const tinygltf::Model& gltf, const std::string& name, std::uint64_t binOffset,
-         const std::string& baseDir, std::vector<std::string>* warnings)
-      : gltf_(gltf), name_(name), binOffset_(binOffset), baseDir_(baseDir), warnings_(warnings) {}
+         std::uint64_t fileBinBytes, const std::string& baseDir, std::vector<std::string>* warnings)
+      : gltf_(gltf),
+        name_(name),
+        binOffset_(binOffset),
+        fileBinBytes_(fileBinBytes),
+        baseDir_(baseDir),
+        warnings_(warnings) {}
 
   Model load() {
     readMaterials();
@@ -173,10 +180,11 @@ class Loader {
            elementSize <= view.byteLength - accessor.byteOffset &&
            accessor.count - 1 <= (view.byteLength - accessor.byteOffset - elementSize) / stride);
       if (!fits) {
-        // GLB only: buffer 0 is the BIN chunk, so the file position is known.
-        const std::uint64_t at = binOffset_ != 0 && view.buffer == 0
-                                     ? binOffset_ + view.byteOffset + accessor.byteOffset
-                                     : 0;
+        // GLB only: buffer 0 is the BIN chunk, so the file position is known (not for a
+        // decoded meshopt view's data, which no byte of the file holds).
+        const std::uint64_t inBin = view.byteOffset + accessor.byteOffset;
+        const std::uint64_t at =
+            binOffset_ != 0 && view.buffer == 0 && inBin < fileBinBytes_ ? binOffset_ + inBin : 0;
         fail(fmt::format(
             "{}: {} elements of {} bytes (stride {}) starting at byte {} do not fit in "
             "bufferView {} ({} bytes){}",
@@ -719,6 +727,7 @@ class Loader {
   const tinygltf::Model& gltf_;
   const std::string& name_;
   std::uint64_t binOffset_;
+  std::uint64_t fileBinBytes_;
   std::string baseDir_;  // where external images lie; empty: none may be read
   std::vector<std::string>* warnings_;
   struct Skipped {
@@ -819,12 +828,14 @@ Result<std::optional<std::string>> withoutDracoIndices(std::span<const std::byte
 }
 
 // The GLB as tinygltf is given it: its container checked (`binOffset`: where the BIN chunk's
-// data starts in the original file; `binLength`: its length once meshopt views are decoded),
-// EXT_meshopt_compression views decoded, Draco primitives' indices dropped, and
-// kTinygltfOverread zero bytes after the end.
+// data starts in the original file, `fileBinLength` bytes; `binLength`: its length once meshopt
+// views are decoded after them), EXT_meshopt_compression views decoded, Draco primitives'
+// indices dropped, and kTinygltfOverread zero bytes after the end.
 Result<std::string> glbForTinygltf(std::span<const std::byte> bytes, const std::string& name,
-                                   std::uint64_t& binOffset, std::uint64_t& binLength) {
+                                   std::uint64_t& binOffset, std::uint64_t& binLength,
+                                   std::uint64_t& fileBinLength) {
   LODFORGE_TRY(checkGlbContainer(bytes, name, binOffset, binLength));
+  fileBinLength = binLength;
   Result<std::optional<std::string>> decoded =
       withMeshoptDecoded(bytes, name, binOffset, binLength);
   if (!decoded) return decoded.status();
@@ -837,7 +848,7 @@ Result<std::string> glbForTinygltf(std::span<const std::byte> bytes, const std::
   }
   Result<std::optional<std::string>> rewritten = withoutDracoIndices(glb, name, true);
   if (!rewritten) return rewritten.status();
-  // Same BIN chunk, maybe a new JSON length: byte offsets reported are the original file's.
+  // A new JSON length changes no offset reported: they count from the original BIN chunk.
   std::string copy = *rewritten
                          ? std::move(**rewritten)
                          : std::string(reinterpret_cast<const char*>(glb.data()), glb.size());
@@ -857,7 +868,7 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
   }
   tinygltf::Model gltf;
   std::string errors, warnings;
-  std::uint64_t binOffset = 0, binLength = 0;
+  std::uint64_t binOffset = 0, binLength = 0, fileBinLength = 0;
   bool ok = false;
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   // tinygltf throws (nlohmann::json conversions of out-of-range numbers) on some bad files.
@@ -865,7 +876,7 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
     std::uint32_t magic = 0;
     if (bytes.size() >= 4) std::memcpy(&magic, bytes.data(), 4);
     if (magic == kGlbMagic) {
-      Result<std::string> copy = glbForTinygltf(bytes, name, binOffset, binLength);
+      Result<std::string> copy = glbForTinygltf(bytes, name, binOffset, binLength, fileBinLength);
       if (!copy) return copy.status();
       const std::size_t size = copy->size() - kTinygltfOverread;
       ok = loader.LoadBinaryFromMemory(&gltf, &errors, &warnings,
@@ -901,8 +912,8 @@ Result<Model> parse(std::span<const std::byte> bytes, const std::string& name,
     return badInput(name, errors.empty() ? std::string("tinygltf cannot parse the file") : errors);
   }
   try {
-    Loader builder(gltf, name, binOffset, options.allowExternalFiles ? baseDir : std::string(),
-                   options.warnings);
+    Loader builder(gltf, name, binOffset, fileBinLength,
+                   options.allowExternalFiles ? baseDir : std::string(), options.warnings);
     return builder.load();
   } catch (const ErrorException& e) {
     return e.error;

@@ -106,12 +106,14 @@ void blockDeltas(const unsigned char* block, std::size_t bytes, std::size_t stri
     deltas[j] = static_cast<unsigned char>((d * 2) ^ (d >> 7));
   }
   for (; j + kGroup <= bytes; j += kGroup) {
-    Signed16 now;
-    Signed16 before;
+    Bytes16 now;
+    Bytes16 before;
     std::memcpy(&now, block + j, kGroup);
     std::memcpy(&before, block + j - stride, kGroup);
-    const Signed16 d = now - before;
-    const Signed16 zigzag = (d + d) ^ reinterpret_cast<Signed16>(d < 0);
+    // Unsigned arithmetic wraps; the signed view only says which deltas are negative.
+    const Bytes16 d = now - before;
+    const Bytes16 negative = reinterpret_cast<Bytes16>(reinterpret_cast<Signed16>(d) < 0);
+    const Bytes16 zigzag = (d + d) ^ negative;
     std::memcpy(deltas + j, &zigzag, kGroup);
   }
   for (; j < bytes; ++j) {

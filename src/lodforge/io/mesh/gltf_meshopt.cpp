@@ -27,6 +27,11 @@ std::optional<std::uint64_t> unsignedMember(const Json& object, const char* key)
   return object[key].get<std::uint64_t>();
 }
 
+bool isCompressed(const Json& view) {
+  return view.is_object() && view.contains("extensions") && view["extensions"].is_object() &&
+         view["extensions"].contains(kExtension);
+}
+
 // One compressed view, as its extension object describes it.
 struct CompressedView {
   std::uint64_t byteOffset = 0;  // in the BIN chunk
@@ -107,14 +112,13 @@ Status checkParent(const Json& view, const CompressedView& c, std::size_t v,
 
 // Decodes one view into `out` (count × byteStride bytes).
 Status decode(const CompressedView& c, std::span<const std::byte> bin, std::uint64_t binOffset,
-              const std::string& name, std::vector<std::byte>& out) {
+              const std::string& name, std::span<char> out) {
   if (c.byteOffset > bin.size() || c.byteLength > bin.size() - c.byteOffset)
     return badInputAtByte(name, binOffset + std::min<std::uint64_t>(c.byteOffset, bin.size()),
                           fmt::format("a compressed view of {} bytes at byte {} of the BIN chunk "
                                       "runs past its end",
                                       c.byteLength, c.byteOffset));
   const auto* source = reinterpret_cast<const unsigned char*>(bin.data() + c.byteOffset);
-  out.assign(c.count * c.byteStride, std::byte{0});
   int rc = 0;
   if (c.mode == "ATTRIBUTES")
     rc = meshopt_decodeVertexBuffer(out.data(), c.count, c.byteStride, source, c.byteLength);
@@ -136,15 +140,12 @@ Status decode(const CompressedView& c, std::span<const std::byte> bin, std::uint
 // Decodes every compressed view to the end of `bin` and points the view there (buffer 0).
 Status decodeViews(Json& document, std::string& bin, std::span<const std::byte> original,
                    std::uint64_t binOffset, const std::string& name) {
-  std::vector<std::byte> decoded;
   // Views may share compressed bytes; all of them together still decode to at most 64 times the
   // chunk (a stream's bound), so a file cannot make the reader allocate without end.
   std::uint64_t decodedBytes = 0;
   for (std::size_t v = 0; v < document["bufferViews"].size(); ++v) {
     Json& view = document["bufferViews"][v];
-    if (!view.is_object() || !view.contains("extensions") || !view["extensions"].is_object() ||
-        !view["extensions"].contains(kExtension))
-      continue;
+    if (!isCompressed(view)) continue;
     Result<CompressedView> c = describe(view["extensions"][kExtension], v, name);
     if (!c) return c.status();
     LODFORGE_TRY(checkParent(view, *c, v, name));
@@ -158,14 +159,15 @@ Status decodeViews(Json& document, std::string& bin, std::span<const std::byte> 
           ErrorKind::kLimit,
           fmt::format("{}: bufferViews[{}]: decoded, the GLB would pass the 4 GiB GLB holds", name,
                       v)};
-    LODFORGE_TRY(decode(*c, original, binOffset, name, decoded));
-    while (bin.size() % 4 != 0) bin.push_back('\0');
+    // Straight into the chunk's tail: the decoders write every byte of it.
+    const std::size_t at = (bin.size() + 3) / 4 * 4, bytes = c->count * c->byteStride;
+    bin.resize(at + bytes);
+    LODFORGE_TRY(decode(*c, original, binOffset, name, std::span(bin).subspan(at)));
     view["buffer"] = 0;
-    view["byteOffset"] = bin.size();
-    view["byteLength"] = decoded.size();
+    view["byteOffset"] = at;
+    view["byteLength"] = bytes;
     view["extensions"].erase(kExtension);
     if (view["extensions"].empty()) view.erase("extensions");
-    bin.append(reinterpret_cast<const char*>(decoded.data()), decoded.size());
   }
   return {};
 }
@@ -248,11 +250,7 @@ Result<std::optional<std::string>> withMeshoptDecoded(std::span<const std::byte>
       !document["buffers"][0].is_object())
     return std::optional<std::string>();
   const Json& views = document["bufferViews"];
-  const bool compressed = std::any_of(views.begin(), views.end(), [](const Json& view) {
-    return view.is_object() && view.contains("extensions") && view["extensions"].is_object() &&
-           view["extensions"].contains(kExtension);
-  });
-  if (!compressed) return std::optional<std::string>();
+  if (std::none_of(views.begin(), views.end(), isCompressed)) return std::optional<std::string>();
   const Json& buffer0 = document["buffers"][0];
   if (buffer0.contains("uri"))
     return badInput(

@@ -849,8 +849,9 @@ Result<std::string> glbForTinygltf(std::span<const std::byte> bytes, const std::
   Result<std::optional<std::string>> rewritten = withoutDracoIndices(glb, name, true);
   if (!rewritten) return rewritten.status();
   // A new JSON length changes no offset reported: they count from the original BIN chunk.
-  std::string copy = *rewritten
-                         ? std::move(**rewritten)
+  std::string copy = *rewritten ? std::move(**rewritten)
+                     : *decoded
+                         ? std::move(**decoded)
                          : std::string(reinterpret_cast<const char*>(glb.data()), glb.size());
   copy.append(kTinygltfOverread, '\0');
   return copy;

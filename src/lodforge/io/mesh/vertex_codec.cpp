@@ -96,15 +96,18 @@ unsigned char* encodeGroup(const unsigned char* deltas, unsigned char* out, unsi
   return out + kGroup;
 }
 
+unsigned char zigzag(unsigned char delta) {
+  const auto d = static_cast<signed char>(delta);
+  return static_cast<unsigned char>((d * 2) ^ (d >> 7));
+}
+
 // Zigzag-coded byte deltas of a block against the element before each (the first against
 // `last`), in element order: bytes[j] - bytes[j - stride], contiguous, so whole vectors at once.
 void blockDeltas(const unsigned char* block, std::size_t bytes, std::size_t stride,
                  const unsigned char* last, unsigned char* deltas) {
   std::size_t j = 0;
-  for (; j < std::min(stride, bytes); ++j) {
-    const auto d = static_cast<signed char>(block[j] - last[j]);
-    deltas[j] = static_cast<unsigned char>((d * 2) ^ (d >> 7));
-  }
+  for (; j < std::min(stride, bytes); ++j)
+    deltas[j] = zigzag(static_cast<unsigned char>(block[j] - last[j]));
   for (; j + kGroup <= bytes; j += kGroup) {
     Bytes16 now;
     Bytes16 before;
@@ -116,10 +119,8 @@ void blockDeltas(const unsigned char* block, std::size_t bytes, std::size_t stri
     const Bytes16 zigzag = (d + d) ^ negative;
     std::memcpy(deltas + j, &zigzag, kGroup);
   }
-  for (; j < bytes; ++j) {
-    const auto d = static_cast<signed char>(block[j] - block[j - stride]);
-    deltas[j] = static_cast<unsigned char>((d * 2) ^ (d >> 7));
-  }
+  for (; j < bytes; ++j)
+    deltas[j] = zigzag(static_cast<unsigned char>(block[j] - block[j - stride]));
 }
 
 // Sixteen elements' bytes regrouped by byte: word `w` of each element (4 of its bytes) to lanes

@@ -10,6 +10,7 @@
 
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
+#include "lodforge/io/mesh/glb_container.h"
 #include "lodforge/io/mesh/glb_writer.h"
 #include "lodforge/io/mesh/gltf_reader.h"
 #include "lodforge/io/mesh/ply_reader.h"
@@ -79,6 +80,34 @@ TEST(GlbWrite, ModelRoundTripsThroughOurReader) {
     ASSERT_NEAR(a.y, b.y, 1e-6);
     ASSERT_NEAR(a.z, b.z, 1e-6);
     ASSERT_NEAR(dot(back->normals[v], model.normals[v]), 1.0f, 1e-6f);
+  }
+}
+
+// The container as the reader's rewrites put it together: the JSON padded with spaces, the
+// lengths in the header, the chunks after it as given; and what the check refuses, at its byte.
+TEST(GlbContainer, AssembledFilesPassTheCheckAndDamagedOnesAreRefusedAtTheirByte) {
+  const std::string bin = "abcdefgh";  // 8 bytes: a BIN chunk needs no padding
+  const std::array<std::uint32_t, 2> binHead = binChunkHead(bin.size());
+  const std::string chunks = std::string(reinterpret_cast<const char*>(binHead.data()), 8) + bin;
+  for (const std::string json : {"{}", R"({"asset":{"version":"2.0"}})", "{\"a\":1}"}) {
+    const std::string glb = glbWithJson(json, chunks);
+    const auto bytes = std::as_bytes(std::span<const char>(glb));
+    std::uint64_t binOffset = 0, binLength = 0;
+    ASSERT_TRUE(checkGlbContainer(bytes, "t.glb", binOffset, binLength).ok()) << json;
+    const Glb parsed = parseGlb(glb);
+    EXPECT_EQ(parsed.totalLength, glb.size());
+    EXPECT_EQ(parsed.jsonLength % 4, 0u);
+    EXPECT_EQ(parsed.jsonLength, (json.size() + 3) / 4 * 4);
+    EXPECT_EQ(glb.substr(20 + json.size(), parsed.jsonLength - json.size()),
+              std::string(parsed.jsonLength - json.size(), ' '));
+    EXPECT_EQ(binLength, bin.size());
+    EXPECT_EQ(glb.substr(binOffset, binLength), bin);
+    // A file cut inside its BIN chunk, and one whose header claims another length.
+    const auto cut = bytes.first(bytes.size() - 1);
+    const Status shortened = checkGlbContainer(cut, "t.glb", binOffset, binLength);
+    EXPECT_EQ(shortened.error().kind, ErrorKind::kBadInput);
+    EXPECT_NE(shortened.error().message.find("byte 8"), std::string::npos)
+        << shortened.error().message;
   }
 }
 

@@ -16,6 +16,7 @@
 #include "lodforge/core/instances.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/image/image_codec.h"
+#include "lodforge/io/mesh/glb_container.h"
 #include "lodforge/io/mesh/gltf_constants.h"
 #include "lodforge/io/mesh/vertex_codec.h"
 
@@ -624,14 +625,12 @@ Status GlbWriter::State::writeFile(const std::string& json) {
   // is (a 4 MB buffer zeroed for every tile was 4 % of the point tiles' contents).
   Result<OutputFile> out = OutputFile::create(path, std::size_t{64} << 10);
   if (!out) return out.status();
-  const std::uint32_t header[3] = {kGlbMagic, 2, static_cast<std::uint32_t>(total)};
-  const std::uint32_t jsonChunk[2] = {static_cast<std::uint32_t>(json.size()), kChunkJson};
-  LODFORGE_TRY(out->write(header, sizeof header));
-  LODFORGE_TRY(out->write(jsonChunk, sizeof jsonChunk));
+  const std::array<std::uint32_t, 5> head = glbHead(json.size(), hasBinary ? 8 + binaryBytes : 0);
+  LODFORGE_TRY(out->write(head.data(), sizeof head));
   LODFORGE_TRY(out->write(json.data(), json.size()));
   if (hasBinary) {
-    const std::uint32_t binChunk[2] = {static_cast<std::uint32_t>(binaryBytes), kChunkBin};
-    LODFORGE_TRY(out->write(binChunk, sizeof binChunk));
+    const std::array<std::uint32_t, 2> binChunk = binChunkHead(binaryBytes);
+    LODFORGE_TRY(out->write(binChunk.data(), sizeof binChunk));
     if (spill) {
       // The spilled part is committed to a side file, copied in, then removed.
       const std::uint64_t spilled = spill->bytesWritten();
@@ -653,7 +652,7 @@ Status GlbWriter::finish() {
   s.addAppearance(document);
   // (Names come from inputs and may not be UTF-8: replaced rather than thrown on.)
   std::string json = document.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-  while (json.size() % 4 != 0) json += ' ';
+  padGlbJson(json);
   return s.writeFile(json);
 }
 

@@ -11,6 +11,7 @@
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
 
+#include "lodforge/io/mesh/glb_container.h"
 #include "lodforge/io/mesh/gltf_constants.h"
 
 namespace lodforge {
@@ -215,21 +216,17 @@ void forgetExtension(Json& document) {
 
 Result<std::string> glbOf(const Json& document, const std::string& bin, const std::string& name) {
   std::string text = document.dump();
-  while (text.size() % 4 != 0) text += ' ';
-  if (20 + text.size() + 8 + bin.size() + 3 > std::numeric_limits<std::uint32_t>::max())
+  padGlbJson(text);
+  const std::uint64_t binChunk = (bin.size() + 3) / 4 * 4;
+  if (20 + text.size() + 8 + binChunk > std::numeric_limits<std::uint32_t>::max())
     return Error{ErrorKind::kLimit,
                  fmt::format("{}: decoded, the GLB would pass the 4 GiB GLB holds", name)};
-  const std::uint32_t binChunk = static_cast<std::uint32_t>((bin.size() + 3) / 4 * 4);
-  const std::uint32_t header[5] = {gltf::kGlbMagic, 2,
-                                   static_cast<std::uint32_t>(20 + text.size() + 8 + binChunk),
-                                   static_cast<std::uint32_t>(text.size()), gltf::kChunkJson};
-  std::string out(reinterpret_cast<const char*>(header), sizeof header);
-  out += text;
-  const std::uint32_t binHeader[2] = {binChunk, gltf::kChunkBin};
-  out.append(reinterpret_cast<const char*>(binHeader), sizeof binHeader);
-  out += bin;
-  out.append(binChunk - bin.size(), '\0');
-  return out;
+  const std::array<std::uint32_t, 2> head = binChunkHead(binChunk);
+  std::string chunks(reinterpret_cast<const char*>(head.data()), sizeof head);
+  chunks.reserve(sizeof head + binChunk);
+  chunks += bin;
+  chunks.append(binChunk - bin.size(), '\0');
+  return glbWithJson(std::move(text), chunks);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lodforge/core/file.h"
+#include "lodforge/io/mesh/glb_container.h"
 #include "lodforge/io/mesh/gltf_constants.h"
 #include "lodforge/io/mesh/gltf_meshopt.h"
 #include "lodforge/io/mesh/gltf_textures.h"
@@ -746,41 +747,6 @@ class Loader {
   bool pointsOnly_ = false;  // drawsPointsOnly()
 };
 
-// Checks the GLB container before tinygltf does, so errors carry byte offsets.
-Status checkGlbContainer(std::span<const std::byte> bytes, const std::string& name,
-                         std::uint64_t& binOffset, std::uint64_t& binLength) {
-  auto u32 = [&](std::size_t at) {
-    std::uint32_t v;
-    std::memcpy(&v, bytes.data() + at, 4);
-    return v;
-  };
-  if (bytes.size() < 20)
-    return badInputAtByte(name, bytes.size(), "GLB ends inside its 20-byte header");
-  if (u32(4) != 2)
-    return badInputAtByte(name, 4, fmt::format("GLB version {} (expected 2)", u32(4)));
-  if (u32(8) != bytes.size())
-    return badInputAtByte(
-        name, 8, fmt::format("GLB header says {} bytes but the file has {}", u32(8), bytes.size()));
-  const std::uint64_t jsonLength = u32(12);
-  if (u32(16) != kChunkJson) return badInputAtByte(name, 16, "first GLB chunk is not JSON");
-  if (20 + jsonLength > bytes.size())
-    return badInputAtByte(
-        name, 12, fmt::format("JSON chunk of {} bytes runs past the end of the file", jsonLength));
-  binOffset = 20 + jsonLength + 8;
-  binLength = 0;
-  if (20 + jsonLength < bytes.size()) {
-    if (bytes.size() - (20 + jsonLength) < 8)
-      return badInputAtByte(name, 20 + jsonLength, "GLB ends inside a chunk header");
-    const std::uint64_t length = u32(20 + jsonLength);
-    if (length > bytes.size() - binOffset)
-      return badInputAtByte(
-          name, 20 + jsonLength,
-          fmt::format("BIN chunk of {} bytes runs past the end of the file", length));
-    if (u32(24 + jsonLength) == kChunkBin) binLength = length;
-  }
-  return {};
-}
-
 // Draco primitives name an indices accessor without a bufferView (the data is in the Draco
 // stream), which Debian's tinygltf, built without Draco, rejects. The reader takes indices from
 // the Draco stream anyway, so drop the reference before tinygltf sees it. Returns the rewritten
@@ -815,16 +781,8 @@ Result<std::optional<std::string>> withoutDracoIndices(std::span<const std::byte
   if (!changed) return std::optional<std::string>();
   std::string json = document.dump();
   if (!glb) return std::optional<std::string>(std::move(json));
-  while (json.size() % 4) json += ' ';
-  const std::string_view rest = all.substr(20 + jsonLength);
-  std::string out(20, '\0');
-  const std::uint32_t header[5] = {kGlbMagic, 2,
-                                   static_cast<std::uint32_t>(20 + json.size() + rest.size()),
-                                   static_cast<std::uint32_t>(json.size()), kChunkJson};
-  std::memcpy(out.data(), header, 20);
-  out += json;
-  out += rest;
-  return std::optional<std::string>(std::move(out));
+  // Dropping members only shortens the JSON: the file stays under the 4 GiB it was under.
+  return std::optional<std::string>(glbWithJson(std::move(json), all.substr(20 + jsonLength)));
 }
 
 // The GLB as tinygltf is given it: its container checked (`binOffset`: where the BIN chunk's

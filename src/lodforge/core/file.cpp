@@ -287,10 +287,10 @@ std::size_t blockForFile(const std::string& path, std::size_t block, std::size_t
                                static_cast<std::size_t>(std::min<std::uint64_t>(block, records)));
 }
 
-Result<WorkFile> WorkFile::open(const std::string& path) {
+Result<WorkFile> WorkFile::open(const std::string& path, bool create) {
   WorkFile file;
   file.path_ = path;
-  file.fd_ = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+  file.fd_ = ::open(path.c_str(), O_RDWR | O_CLOEXEC | (create ? O_CREAT : 0), 0644);
   if (file.fd_ < 0) return ioErrorFromErrno(path, "open");
   return file;
 }

@@ -64,7 +64,7 @@ nlohmann::json pointRunIdentity(const std::string& input, const PointTilesOption
   const Result<std::uint64_t> bytes = fileSize(input);
   const ClusterOptions& cluster = options.cluster;
   return {
-      {"workFormat", 1},
+      {"workFormat", 2},  // 2: one keys file for every block
       {"input", fs::absolute(input, error).string()},
       {"bytes", bytes ? *bytes : 0},
       {"modified", modifiedTicks(input)},
@@ -343,7 +343,7 @@ BlockTiles rankedBlockTiles(const std::string& workDirectory, const std::string&
   BlockTiles tiles;
   tiles.name = name;
   tiles.path = workDirectory + "/b.points";
-  tiles.keysPath = workDirectory + "/" + name + ".keys";
+  tiles.keysPath = pointKeysPath(workDirectory);
   if (extras) tiles.extrasPath = workDirectory + "/b.extras";
   tiles.layout = layout;
   return tiles;

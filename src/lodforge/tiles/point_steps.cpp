@@ -88,11 +88,10 @@ std::vector<std::array<std::int8_t, 4>> tileNormalBytes(std::span<const CloudPoi
 }
 
 Result<std::vector<float>> readKeys(const BlockTiles& block, std::uint64_t count) {
-  Result<ByteSource> in = ByteSource::openFile(block.keysPath);
+  Result<WorkFile> in = WorkFile::open(block.keysPath);
   if (!in) return in.status();
   std::vector<float> keys(count);
-  if (!in->read(keys.data(), keys.size() * sizeof(float)))
-    return ioError(block.keysPath, "work file is shorter than expected");
+  LODFORGE_TRY(in->readAt(block.first * sizeof(float), keys.data(), keys.size() * sizeof(float)));
   return keys;
 }
 
@@ -168,6 +167,10 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
 
 // Sorts the block's points by key (the partition writes them back in that order) and writes
 // the keys beside.
+std::string pointKeysPath(const std::string& workDirectory) {
+  return workDirectory + "/b.keys";
+}
+
 Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
                  const PointBlock& block, bool hasNormals, const PointTilesOptions& options,
                  const std::string& workDirectory, BlockTiles& out) {
@@ -191,13 +194,14 @@ Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
   out.path = block.path;
   out.layout = block.layout;
   out.first = block.first;
-  out.keysPath = workDirectory + "/" + block.name + ".keys";
+  out.keysPath = pointKeysPath(workDirectory);
   out.bounds = block.bounds;
   out.rootError = tree.front().error;
-  Result<OutputFile> keys = OutputFile::create(out.keysPath, std::size_t{1} << 20);
+  // One file for every block's keys, each at its records' place: a file per block cost a
+  // creation each (1.4 ms apiece on ext4 when a previous run's files were removed minutes before).
+  Result<WorkFile> keys = WorkFile::open(out.keysPath, true);
   if (!keys) return keys.status();
-  LODFORGE_TRY(keys->writeSpan(std::span<const float>(key)));
-  return keys->commit();
+  return keys->writeAt(block.first * sizeof(float), key.data(), key.size() * sizeof(float));
 }
 
 // τ_d per depth of the partition tree: a tile at depth d should hold about `tilePoints`, so the
@@ -262,7 +266,10 @@ Status countLevels(const Partition& partition, std::span<const float> taus,
 
 void removeKeys(std::span<const BlockTiles> blocks) {
   std::error_code ignored;
-  for (const BlockTiles& b : blocks) fs::remove(b.keysPath, ignored);
+  if (blocks.empty()) return;
+  assert(std::all_of(blocks.begin(), blocks.end(),
+                     [&](const BlockTiles& b) { return b.keysPath == blocks.front().keysPath; }));
+  fs::remove(blocks.front().keysPath, ignored);
 }
 
 // Georeferencing: a CRS (given, or the input's) sets up the local east-north-up frame at the

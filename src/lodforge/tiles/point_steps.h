@@ -20,13 +20,13 @@
 namespace lodforge {
 
 // One block, ranked: its points sorted by their key, highest first, in `path` from `first` on
-// and the keys in `keysPath`. A point's key is the tile error of the parent of the highest node
-// it represents (+∞ for the root's): the cut at τ holds the point exactly when τ < key, so a
-// tile at depth d (tolerance τ_d, non-increasing with d) holds a prefix of the sorted block
-// whatever the τ turn out to be.
+// and the keys in `keysPath` (from `first` on too). A point's key is the tile error of the parent
+// of the highest node it represents (+∞ for the root's): the cut at τ holds the point exactly when
+// τ < key, so a tile at depth d (tolerance τ_d, non-increasing with d) holds a prefix of the sorted
+// block whatever the τ turn out to be.
 struct BlockTiles {
   std::string name;            // the partition's block name ("b0110")
-  std::string path, keysPath;  // the ranked records (from `first` on), the keys
+  std::string path, keysPath;  // the ranked records and their keys (each from `first` on)
   std::string extrasPath;      // their extra bytes in step (from `first` on), if any
   PointRecordLayout layout;    // of the records
   std::uint64_t first = 0;
@@ -36,8 +36,12 @@ struct BlockTiles {
   float leastError = 0;  // the least tile error in the block's tree
 };
 
+// The work file of every block's keys (`BlockTiles::keysPath`): a block's keys at its records'
+// place, record i's key at float i.
+std::string pointKeysPath(const std::string& workDirectory);
+
 // Sorts the block's points by key (the caller writes them back in that order, with the ids'
-// extra bytes) and writes the keys into `workDirectory`.
+// extra bytes) and writes the keys into the keys file of `workDirectory`.
 Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
                  const PointBlock& block, bool hasNormals, const PointTilesOptions& options,
                  const std::string& workDirectory, BlockTiles& out);
@@ -49,7 +53,7 @@ Result<std::vector<float>> toleranceSchedule(const Partition& partition,
 // Each block's points per depth once the τ are known.
 Status countLevels(const Partition& partition, std::span<const float> taus,
                    std::span<BlockTiles> blocks);
-// The blocks' keys files, once their counts are in the plan.
+// The blocks' keys file (they share it), once their counts are in the plan.
 void removeKeys(std::span<const BlockTiles> blocks);
 
 struct TileNode {

@@ -165,12 +165,12 @@ Status writeContent(const TileNode& node, std::span<const BlockTiles> blocks,
 
 }  // namespace
 
-// Sorts the block's points by key (the partition writes them back in that order) and writes
-// the keys beside.
 std::string pointKeysPath(const std::string& workDirectory) {
   return workDirectory + "/b.keys";
 }
 
+// Sorts the block's points by key (the partition writes them back in that order) and writes
+// the keys at their records' place in the keys file.
 Status rankBlock(std::span<CloudPoint> points, std::span<std::uint32_t> ids,
                  const PointBlock& block, bool hasNormals, const PointTilesOptions& options,
                  const std::string& workDirectory, BlockTiles& out) {

@@ -387,7 +387,7 @@ Result<PointPlan> planContents(const std::string& workDirectory, const InputRead
   plan.taus = std::move(*taus);
   LODFORGE_TRY(countLevels(partition, plan.taus, plan.blocks));
   LODFORGE_TRY(writePointPlan(workDirectory, plan.taus, plan.blocks, partition.blocks));
-  removeKeys(plan.blocks);
+  removeKeys(workDirectory);
   removeScratchFiles(workDirectory);
   plan.partition = partition.blocks;
   return plan;

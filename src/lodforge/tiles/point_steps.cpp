@@ -264,12 +264,9 @@ Status countLevels(const Partition& partition, std::span<const float> taus,
   return Status{};
 }
 
-void removeKeys(std::span<const BlockTiles> blocks) {
+void removeKeys(const std::string& workDirectory) {
   std::error_code ignored;
-  if (blocks.empty()) return;
-  assert(std::all_of(blocks.begin(), blocks.end(),
-                     [&](const BlockTiles& b) { return b.keysPath == blocks.front().keysPath; }));
-  fs::remove(blocks.front().keysPath, ignored);
+  fs::remove(pointKeysPath(workDirectory), ignored);
 }
 
 // Georeferencing: a CRS (given, or the input's) sets up the local east-north-up frame at the

@@ -53,8 +53,8 @@ Result<std::vector<float>> toleranceSchedule(const Partition& partition,
 // Each block's points per depth once the τ are known.
 Status countLevels(const Partition& partition, std::span<const float> taus,
                    std::span<BlockTiles> blocks);
-// The blocks' keys file (they share it), once their counts are in the plan.
-void removeKeys(std::span<const BlockTiles> blocks);
+// The keys file of `workDirectory`, once the blocks' counts are in the plan.
+void removeKeys(const std::string& workDirectory);
 
 struct TileNode {
   std::string name;

@@ -90,7 +90,7 @@ TEST(GlbContainer, AssembledFilesPassTheCheckAndDamagedOnesAreRefusedAtTheirByte
   const std::array<std::uint32_t, 2> binHead = binChunkHead(bin.size());
   const std::string chunks = std::string(reinterpret_cast<const char*>(binHead.data()), 8) + bin;
   for (const std::string json : {"{}", R"({"asset":{"version":"2.0"}})", "{\"a\":1}"}) {
-    const std::string glb = glbWithJson(json, chunks);
+    const std::string glb = glbWithJson(json, chunks, "t.glb").value();
     const auto bytes = std::as_bytes(std::span<const char>(glb));
     std::uint64_t binOffset = 0, binLength = 0;
     ASSERT_TRUE(checkGlbContainer(bytes, "t.glb", binOffset, binLength).ok()) << json;
@@ -102,13 +102,30 @@ TEST(GlbContainer, AssembledFilesPassTheCheckAndDamagedOnesAreRefusedAtTheirByte
               std::string(parsed.jsonLength - json.size(), ' '));
     EXPECT_EQ(binLength, bin.size());
     EXPECT_EQ(glb.substr(binOffset, binLength), bin);
-    // A file cut inside its BIN chunk, and one whose header claims another length.
+    // A file cut short, whose header still gives the whole length: refused at that length.
     const auto cut = bytes.first(bytes.size() - 1);
     const Status shortened = checkGlbContainer(cut, "t.glb", binOffset, binLength);
     EXPECT_EQ(shortened.error().kind, ErrorKind::kBadInput);
     EXPECT_NE(shortened.error().message.find("byte 8"), std::string::npos)
         << shortened.error().message;
+    // The same with the header mended: the BIN chunk runs past the end, at its header's byte.
+    std::string mended = glb.substr(0, glb.size() - 1);
+    const std::uint32_t length = static_cast<std::uint32_t>(mended.size());
+    std::memcpy(mended.data() + 8, &length, 4);
+    const Status binCut = checkGlbContainer(std::as_bytes(std::span<const char>(mended)), "t.glb",
+                                            binOffset, binLength);
+    EXPECT_EQ(binCut.error().kind, ErrorKind::kBadInput);
+    EXPECT_NE(
+        binCut.error().message.find(fmt::format("byte {}: BIN chunk", 20 + parsed.jsonLength)),
+        std::string::npos)
+        << binCut.error().message;
   }
+  // A rewrite past the 4 GiB a GLB's lengths can say is refused, not wrapped (the chunks' view
+  // is never read: its length is refused first).
+  const Result<std::string> tooLong =
+      glbWithJson("{}", std::string_view(bin.data(), std::size_t{0xFFFFFFFF}), "t.glb");
+  ASSERT_FALSE(tooLong.ok());
+  EXPECT_EQ(tooLong.error().kind, ErrorKind::kLimit);
 }
 
 TEST(GlbWrite, LayoutIsAlignedWithBoundsAndTheRightIndexWidth) {

@@ -60,8 +60,13 @@ std::array<std::uint32_t, 2> binChunkHead(std::uint64_t bytes) {
   return {static_cast<std::uint32_t>(bytes), gltf::kChunkBin};
 }
 
-std::string glbWithJson(std::string json, std::string_view chunks) {
+Result<std::string> glbWithJson(std::string json, std::string_view chunks,
+                                const std::string& name) {
   padGlbJson(json);
+  // A rewrite may lengthen the JSON: nlohmann writes numbers its own way (1e2 as 100.0).
+  if (20 + json.size() + chunks.size() > std::numeric_limits<std::uint32_t>::max())
+    return Error{ErrorKind::kLimit,
+                 fmt::format("{}: rewritten, the GLB would pass the 4 GiB GLB holds", name)};
   const std::array<std::uint32_t, 5> head = glbHead(json.size(), chunks.size());
   std::string out(reinterpret_cast<const char*>(head.data()), sizeof head);
   out.reserve(sizeof head + json.size() + chunks.size());

@@ -31,7 +31,8 @@ std::array<std::uint32_t, 5> glbHead(std::uint64_t jsonBytes, std::uint64_t afte
 // A BIN chunk's 8-byte header for `bytes` of data (padded to a multiple of 4).
 std::array<std::uint32_t, 2> binChunkHead(std::uint64_t bytes);
 
-// A whole GLB in memory: `json` (padded here) and then `chunks` as they are.
-std::string glbWithJson(std::string json, std::string_view chunks);
+// A whole GLB in memory: `json` (padded here) and then `chunks` as they are; kLimit (naming
+// `name`) when it would pass the 4 GiB a GLB's lengths can say.
+Result<std::string> glbWithJson(std::string json, std::string_view chunks, const std::string& name);
 
 }  // namespace lodforge

@@ -218,7 +218,7 @@ Result<std::string> glbOf(const Json& document, const std::string& bin, const st
   std::string text = document.dump();
   padGlbJson(text);
   const std::uint64_t binChunk = (bin.size() + 3) / 4 * 4;
-  if (20 + text.size() + 8 + binChunk > std::numeric_limits<std::uint32_t>::max())
+  if (8 + binChunk > std::numeric_limits<std::uint32_t>::max())
     return Error{ErrorKind::kLimit,
                  fmt::format("{}: decoded, the GLB would pass the 4 GiB GLB holds", name)};
   const std::array<std::uint32_t, 2> head = binChunkHead(binChunk);
@@ -226,7 +226,7 @@ Result<std::string> glbOf(const Json& document, const std::string& bin, const st
   chunks.reserve(sizeof head + binChunk);
   chunks += bin;
   chunks.append(binChunk - bin.size(), '\0');
-  return glbWithJson(std::move(text), chunks);
+  return glbWithJson(std::move(text), chunks, name);
 }
 
 }  // namespace

@@ -781,8 +781,9 @@ Result<std::optional<std::string>> withoutDracoIndices(std::span<const std::byte
   if (!changed) return std::optional<std::string>();
   std::string json = document.dump();
   if (!glb) return std::optional<std::string>(std::move(json));
-  // Dropping members only shortens the JSON: the file stays under the 4 GiB it was under.
-  return std::optional<std::string>(glbWithJson(std::move(json), all.substr(20 + jsonLength)));
+  Result<std::string> out = glbWithJson(std::move(json), all.substr(20 + jsonLength), name);
+  if (!out) return out.status();
+  return std::optional<std::string>(std::move(*out));
 }
 
 // The GLB as tinygltf is given it: its container checked (`binOffset`: where the BIN chunk's

@@ -90,7 +90,7 @@ TEST(GlbContainer, AssembledFilesPassTheCheckAndDamagedOnesAreRefusedAtTheirByte
   const std::array<std::uint32_t, 2> binHead = binChunkHead(bin.size());
   const std::string chunks = std::string(reinterpret_cast<const char*>(binHead.data()), 8) + bin;
   for (const std::string json : {"{}", R"({"asset":{"version":"2.0"}})", "{\"a\":1}"}) {
-    const std::string glb = glbWithJson(json, chunks, "t.glb").value();
+    const std::string glb = glbWithJson(json, {chunks}, "t.glb").value();
     const auto bytes = std::as_bytes(std::span<const char>(glb));
     std::uint64_t binOffset = 0, binLength = 0;
     ASSERT_TRUE(checkGlbContainer(bytes, "t.glb", binOffset, binLength).ok()) << json;
@@ -123,7 +123,7 @@ TEST(GlbContainer, AssembledFilesPassTheCheckAndDamagedOnesAreRefusedAtTheirByte
   // A rewrite past the 4 GiB a GLB's lengths can say is refused, not wrapped (the chunks' view
   // is never read: its length is refused first).
   const Result<std::string> tooLong =
-      glbWithJson("{}", std::string_view(bin.data(), std::size_t{0xFFFFFFFF}), "t.glb");
+      glbWithJson("{}", {std::string_view(bin.data(), std::size_t{0xFFFFFFFF})}, "t.glb");
   ASSERT_FALSE(tooLong.ok());
   EXPECT_EQ(tooLong.error().kind, ErrorKind::kLimit);
 }

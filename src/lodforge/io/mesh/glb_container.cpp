@@ -60,18 +60,20 @@ std::array<std::uint32_t, 2> binChunkHead(std::uint64_t bytes) {
   return {static_cast<std::uint32_t>(bytes), gltf::kChunkBin};
 }
 
-Result<std::string> glbWithJson(std::string json, std::string_view chunks,
+Result<std::string> glbWithJson(std::string json, std::initializer_list<std::string_view> chunks,
                                 const std::string& name) {
   padGlbJson(json);
+  std::uint64_t after = 0;
+  for (const std::string_view piece : chunks) after += piece.size();
   // A rewrite may lengthen the JSON: nlohmann writes numbers its own way (1e2 as 100.0).
-  if (20 + json.size() + chunks.size() > std::numeric_limits<std::uint32_t>::max())
+  if (20 + json.size() + after > std::numeric_limits<std::uint32_t>::max())
     return Error{ErrorKind::kLimit,
                  fmt::format("{}: rewritten, the GLB would pass the 4 GiB GLB holds", name)};
-  const std::array<std::uint32_t, 5> head = glbHead(json.size(), chunks.size());
+  const std::array<std::uint32_t, 5> head = glbHead(json.size(), after);
   std::string out(reinterpret_cast<const char*>(head.data()), sizeof head);
-  out.reserve(sizeof head + json.size() + chunks.size());
+  out.reserve(sizeof head + json.size() + after);
   out += json;
-  out += chunks;
+  for (const std::string_view piece : chunks) out += piece;
   return out;
 }
 

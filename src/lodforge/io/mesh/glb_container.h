@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <span>
 #include <string>
 #include <string_view>
@@ -31,8 +32,10 @@ std::array<std::uint32_t, 5> glbHead(std::uint64_t jsonBytes, std::uint64_t afte
 // A BIN chunk's 8-byte header for `bytes` of data (padded to a multiple of 4).
 std::array<std::uint32_t, 2> binChunkHead(std::uint64_t bytes);
 
-// A whole GLB in memory: `json` (padded here) and then `chunks` as they are; kLimit (naming
-// `name`) when it would pass the 4 GiB a GLB's lengths can say.
-Result<std::string> glbWithJson(std::string json, std::string_view chunks, const std::string& name);
+// A whole GLB in memory: `json` (padded here) and then the pieces of the further chunks, each
+// copied once, as they are; kLimit (naming `name`) when it would pass the 4 GiB a GLB's
+// lengths can say.
+Result<std::string> glbWithJson(std::string json, std::initializer_list<std::string_view> chunks,
+                                const std::string& name);
 
 }  // namespace lodforge

@@ -215,18 +215,13 @@ void forgetExtension(Json& document) {
 }
 
 Result<std::string> glbOf(const Json& document, const std::string& bin, const std::string& name) {
-  std::string text = document.dump();
-  padGlbJson(text);
+  // decodeViews kept the chunk under kGlbBytes; glbWithJson checks the whole.
   const std::uint64_t binChunk = (bin.size() + 3) / 4 * 4;
-  if (8 + binChunk > std::numeric_limits<std::uint32_t>::max())
-    return Error{ErrorKind::kLimit,
-                 fmt::format("{}: decoded, the GLB would pass the 4 GiB GLB holds", name)};
   const std::array<std::uint32_t, 2> head = binChunkHead(binChunk);
-  std::string chunks(reinterpret_cast<const char*>(head.data()), sizeof head);
-  chunks.reserve(sizeof head + binChunk);
-  chunks += bin;
-  chunks.append(binChunk - bin.size(), '\0');
-  return glbWithJson(std::move(text), chunks, name);
+  return glbWithJson(document.dump(),
+                     {std::string_view(reinterpret_cast<const char*>(head.data()), sizeof head),
+                      bin, std::string_view("\0\0\0", binChunk - bin.size())},
+                     name);
 }
 
 }  // namespace

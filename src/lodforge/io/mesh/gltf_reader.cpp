@@ -781,7 +781,7 @@ Result<std::optional<std::string>> withoutDracoIndices(std::span<const std::byte
   if (!changed) return std::optional<std::string>();
   std::string json = document.dump();
   if (!glb) return std::optional<std::string>(std::move(json));
-  Result<std::string> out = glbWithJson(std::move(json), all.substr(20 + jsonLength), name);
+  Result<std::string> out = glbWithJson(std::move(json), {all.substr(20 + jsonLength)}, name);
   if (!out) return out.status();
   return std::optional<std::string>(std::move(*out));
 }

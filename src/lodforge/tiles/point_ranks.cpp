@@ -346,8 +346,8 @@ class RankedPoints {
   // written for the other ranks.
   Status planOnLead() {
     reportActivity("choosing the tolerances");
-    Result<PointPlan> plan =
-        planContents(work_, split_.read, split_.nodes, options_, split_.partition, stats_);
+    Result<PointPlan> plan = planContents(work_, split_.read, split_.nodes, options_,
+                                          split_.partition, stats_, release_);
     if (!plan) return plan.status();
     contents_ = std::move(*plan);
     return {};
@@ -409,6 +409,7 @@ class RankedPoints {
   PointMemoryPlan plan_;
   WorkLock lock_;
   PointWorkScope scope_;             // rank 0's: what it removes at the end
+  SpaceRelease release_;             // the keys and scratch files, once planned (before scope_)
   std::optional<SplitState> state_;  // an interrupted job's, when resuming
   std::optional<CrsToLocal> frame_;
   bool hasNormals_ = false;

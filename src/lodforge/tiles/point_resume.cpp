@@ -352,13 +352,13 @@ BlockTiles rankedBlockTiles(const std::string& workDirectory, const std::string&
 namespace {
 
 // The scratch files of every process: once the plan is written no node is staged again.
-void removeScratchFiles(const std::string& workDirectory) {
+void removeScratchFiles(const std::string& workDirectory, SpaceRelease& release) {
   std::error_code error;
   std::vector<fs::path> scratch;
   for (fs::directory_iterator entry(workDirectory, error), end; !error && entry != end;
        entry.increment(error))
     if (entry->path().filename().string().starts_with("scratch-")) scratch.push_back(*entry);
-  for (const fs::path& path : scratch) fs::remove(path, error);
+  for (const fs::path& path : scratch) release.remove(path.string());
 }
 
 }  // namespace
@@ -366,7 +366,7 @@ void removeScratchFiles(const std::string& workDirectory) {
 Result<PointPlan> planContents(const std::string& workDirectory, const InputRead& read,
                                std::span<const PartitionNode> nodes,
                                const PointTilesOptions& options, Partition& partition,
-                               PointTilesStats& stats) {
+                               PointTilesStats& stats, SpaceRelease& release) {
   const bool extras = read.info.extras.stride != 0;
   Result<std::vector<RankedBlock>> ranked =
       readRankedNodes(workDirectory, nodes, workDirectory + "/b.points", read.layout);
@@ -387,8 +387,8 @@ Result<PointPlan> planContents(const std::string& workDirectory, const InputRead
   plan.taus = std::move(*taus);
   LODFORGE_TRY(countLevels(partition, plan.taus, plan.blocks));
   LODFORGE_TRY(writePointPlan(workDirectory, plan.taus, plan.blocks, partition.blocks));
-  removeKeys(workDirectory);
-  removeScratchFiles(workDirectory);
+  release.remove(pointKeysPath(workDirectory));
+  removeScratchFiles(workDirectory, release);
   plan.partition = partition.blocks;
   return plan;
 }

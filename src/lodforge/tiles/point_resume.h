@@ -16,6 +16,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "lodforge/core/space_release.h"
 #include "lodforge/core/status.h"
 #include "lodforge/points/partition.h"
 #include "lodforge/tiles/point_steps.h"
@@ -125,12 +126,12 @@ struct PointPlan {
 Result<std::optional<PointPlan>> readPointPlan(const std::string& workDirectory);
 // Once every node is ranked (one process, or rank 0 of a job): the blocks from the node
 // summaries, the tolerances and each block's points per depth, written as the plan; then the
-// keys and the scratch files, which nothing needs any more, are removed. The partition's
-// blocks and the stats are filled in.
+// keys and the scratch files, which nothing needs any more, are given to `release` to remove.
+// The partition's blocks and the stats are filled in.
 Result<PointPlan> planContents(const std::string& workDirectory, const InputRead& read,
                                std::span<const PartitionNode> nodes,
                                const PointTilesOptions& options, Partition& partition,
-                               PointTilesStats& stats);
+                               PointTilesStats& stats, SpaceRelease& release);
 // The plan of an earlier run (then its blocks' paths as rankedBlockTiles'), if there is one.
 Result<std::optional<PointPlan>> resumedPlan(const std::string& workDirectory,
                                              const InputRead& read);

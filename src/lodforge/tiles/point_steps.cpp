@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -264,11 +265,6 @@ Status countLevels(const Partition& partition, std::span<const float> taus,
   return Status{};
 }
 
-void removeKeys(const std::string& workDirectory) {
-  std::error_code ignored;
-  fs::remove(pointKeysPath(workDirectory), ignored);
-}
-
 // Georeferencing: a CRS (given, or the input's) sets up the local east-north-up frame at the
 // first point; the partition applies it while the input is read (one thread).
 Result<std::optional<CrsToLocal>> localFrame(const std::string& input,
@@ -317,6 +313,8 @@ std::map<std::string, TileNode> tileTree(std::span<const BlockTiles> blocks) {
   return nodes;
 }
 
+namespace {
+
 // Of the tiles with content (in name order), those of `share.rank`.
 std::vector<const TileNode*> contentShare(const std::map<std::string, TileNode>& nodes,
                                           ContentShare share) {
@@ -332,18 +330,53 @@ std::vector<const TileNode*> contentShare(const std::map<std::string, TileNode>&
   return mine;
 }
 
+// body(i) for i in [0, n), each thread taking the next i: tiles in name order (a parent before
+// its children) with blocks' last readers done throughout. (parallel_for's halves left the first
+// tiles of the second half, the ancestors of half the blocks, to the end.)
+void inNameOrder(std::size_t n, const std::function<void(std::size_t)>& body) {
+  std::atomic<std::size_t> next{0};
+  tbb::parallel_for(0, tbb::this_task_arena::max_concurrency(), [&](int) {
+    for (std::size_t i = next++; i < n; i = next++) body(i);
+  });
+}
+
+// How many of `tiles` read each block's records.
+std::vector<std::atomic<std::uint32_t>> blockReaders(std::span<const TileNode* const> tiles,
+                                                     std::size_t blocks) {
+  std::vector<std::atomic<std::uint32_t>> readers(blocks);
+  for (const TileNode* tile : tiles)
+    for (std::size_t b : tile->blocks) readers[b].fetch_add(1, std::memory_order_relaxed);
+  return readers;
+}
+
+// A block's records (and extra bytes) once the last tile reading them is written.
+void releaseBlock(const BlockTiles& block, std::size_t extrasStride, SpaceRelease& release) {
+  std::uint64_t count = 0;
+  for (std::uint64_t c : block.counts) count += c;
+  release.punch(block.path, block.first * block.layout.bytes(), count * block.layout.bytes());
+  if (extrasStride != 0 && !block.extrasPath.empty())
+    release.punch(block.extrasPath, block.first * extrasStride, count * extrasStride);
+}
+
+}  // namespace
+
 Result<ContentsWritten> writeContents(const std::map<std::string, TileNode>& nodes,
                                       std::span<const BlockTiles> blocks,
                                       const PointTilesOptions& options, const ContentFields& fields,
-                                      const std::string& tilesetDirectory, ContentShare share) {
+                                      const std::string& tilesetDirectory, ContentShare share,
+                                      SpaceRelease* release) {
   const std::vector<const TileNode*> mine = contentShare(nodes, share);
+  assert(release == nullptr || share.ranks <= 1);  // a job's ranks share the blocks
+  std::vector<std::atomic<std::uint32_t>> readers =
+      blockReaders(release ? mine : std::span<const TileNode* const>{}, blocks.size());
+  const std::size_t extrasStride = fields.extras ? fields.extras->stride : 0;
   std::vector<Status> written(mine.size());
   std::atomic<std::uint64_t> kept{0};
   // A job's progress is rank 0's JobProgress, from every rank's reports.
   std::optional<Progress> writing;
   if (share.ranks <= 1) writing.emplace("tiles: contents", mine.size());
   std::atomic<std::uint64_t> done{0};
-  tbb::parallel_for(std::size_t{0}, mine.size(), [&](std::size_t i) {
+  inNameOrder(mine.size(), [&](std::size_t i) {
     if (cancelRequested()) return;
     const std::string path = tilesetDirectory + "/" + mine[i]->uri;
     std::error_code ignored;
@@ -353,6 +386,9 @@ Result<ContentsWritten> writeContents(const std::map<std::string, TileNode>& nod
       written[i] = writeContent(*mine[i], blocks, options, fields, path);
       checkpointReached("tile");
     }
+    if (release && written[i].ok())
+      for (std::size_t b : mine[i]->blocks)
+        if (readers[b].fetch_sub(1) == 1) releaseBlock(blocks[b], extrasStride, *release);
     if (writing) {
       writing->advance(1);
     } else {

@@ -12,6 +12,7 @@
 
 #include "lodforge/core/directory.h"
 #include "lodforge/core/output_claim.h"
+#include "lodforge/core/space_release.h"
 #include "lodforge/core/status.h"
 #include "lodforge/points/build.h"
 #include "lodforge/points/partition.h"
@@ -53,8 +54,6 @@ Result<std::vector<float>> toleranceSchedule(const Partition& partition,
 // Each block's points per depth once the τ are known.
 Status countLevels(const Partition& partition, std::span<const float> taus,
                    std::span<BlockTiles> blocks);
-// The keys file of `workDirectory`, once the blocks' counts are in the plan.
-void removeKeys(const std::string& workDirectory);
 
 struct TileNode {
   std::string name;
@@ -85,11 +84,15 @@ struct ContentsWritten {
   std::uint64_t tiles = 0;  // of the share
   std::uint64_t kept = 0;   // of those, already there
 };
-// The GLB of every tile with points in this rank's share, in parallel.
+// The GLB of every tile with points in this rank's share, in parallel. With `release` (one
+// process only: a job's ranks read each other's blocks), each block's records are given to it
+// once the last tile reading them is written: a resumed run reads only the blocks of tiles not
+// yet written, and those are whole.
 Result<ContentsWritten> writeContents(const std::map<std::string, TileNode>& nodes,
                                       std::span<const BlockTiles> blocks,
                                       const PointTilesOptions& options, const ContentFields& fields,
-                                      const std::string& tilesetDirectory, ContentShare share = {});
+                                      const std::string& tilesetDirectory, ContentShare share = {},
+                                      SpaceRelease* release = nullptr);
 
 Status writePointTilesetJson(const std::map<std::string, TileNode>& nodes,
                              std::span<const BlockTiles> blocks, const std::vector<float>& taus,

@@ -190,7 +190,7 @@ class PointRun {
         splitNodesInMemory(split_.read, todo, options, {}, &staging);
     if (!blocks) return blocks.status();
     Result<PointPlan> plan =
-        planContents(work_, split_.read, split_.nodes, options_, partition, stats_);
+        planContents(work_, split_.read, split_.nodes, options_, partition, stats_, release_);
     if (!plan) return plan.status();
     plan_ = std::move(*plan);
     return {};
@@ -202,7 +202,7 @@ class PointRun {
     Result<ContentsWritten> tiles =
         writeContents(nodes, plan_.blocks, options_,
                       {info.hasColors, info.attributes & options_.attributes, &info.extras}, staged,
-                      {.resumed = stats_.resumed});
+                      {.resumed = stats_.resumed}, &release_);
     if (!tiles) return tiles.status();
     stats_.tiles = tiles->tiles;
     stats_.tilesResumed = tiles->kept;
@@ -223,6 +223,8 @@ class PointRun {
   const std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   WorkLock lock_;
   PointWorkScope scope_;
+  // Destroyed before scope_ removes the work: what it was given is done first.
+  SpaceRelease release_;
   PointTilesStats stats_;
   bool hasNormals_ = false;
   std::optional<CrsToLocal> frame_;

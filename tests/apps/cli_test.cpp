@@ -1754,9 +1754,10 @@ TEST(CliTiles, AnInterruptedPointRunResumesToTheSameTileset) {
   EXPECT_EQ(resumePointTiles(dir, "b", "pointnode:3", none),
             "resumed: the input as the interrupted run split it, 3 of the partition's 16 nodes "
             "as it ranked them, 0 tiles as it wrote them");
-  // (A tile another thread was writing when the fourth was done may be done too.) Blocks whose
-  // tiles are all written were given back (holes in the work file): the resumed run reads only
-  // whole blocks.
+  // (A tile another thread was writing when the fourth was done may be done too.) By then the
+  // blocks read by those tiles alone (about half here: `b` and `b0` hold most of the 60K points)
+  // were given back as holes in the work file; the resumed tileset, byte for byte the
+  // uninterrupted one, shows that no hole was read.
   const auto holes = [&] {
     const std::string path = dir.file("c.work/points/b.points");
     struct stat info {};

@@ -16,11 +16,11 @@
 
 namespace lodforge {
 
-// The whole blocks of `blockSize` bytes inside [offset, offset + length): {first byte, length},
-// length 0 when none.
 struct ByteRange {
   std::uint64_t offset = 0, length = 0;
 };
+// The whole blocks of `blockSize` bytes inside [offset, offset + length): {first byte, length},
+// length 0 when none.
 ByteRange wholeBlocksInside(std::uint64_t offset, std::uint64_t length, std::uint64_t blockSize);
 
 class SpaceRelease {
@@ -38,10 +38,12 @@ class SpaceRelease {
   // `path` will not be read again: removed.
   void remove(const std::string& path);
   // Does everything asked so far, then stops the thread (a later request is done at once, on the
-  // caller's thread). What could not be freed (a file system without holes) is freed with the
-  // file: a missed release costs disk space until then, never a byte of a range still to read.
+  // caller's thread). What could not be freed (a file system without holes, a failed allocation)
+  // is freed with the file: a missed release costs disk space until then, never a byte of a range
+  // still to read. Called by the owner alone (not from two threads at once).
   void finish();
-  // What was freed so far: holes' bytes and removed files' sizes (for -v and the tests).
+  // Bytes of the holes punched (a range punched again counts again) and of the files removed
+  // (their sizes): what the tests check.
   std::uint64_t bytesReleased() const;
 
  private:
@@ -62,7 +64,7 @@ class SpaceRelease {
   std::deque<Request> queue_;
   bool stopping_ = false;
   std::uint64_t released_ = 0;
-  // Per path, the ranges given so far, merged: [first byte, end) (the serving thread's alone).
+  // Per path, the ranges given so far, merged: [first byte, end) (under releasing_).
   std::map<std::string, std::map<std::uint64_t, std::uint64_t>> given_;
   std::thread thread_;
 };

@@ -379,8 +379,13 @@ Result<ContentsWritten> writeContents(const std::map<std::string, TileNode>& nod
   inNameOrder(mine.size(), [&](std::size_t i) {
     if (cancelRequested()) return;
     const std::string path = tilesetDirectory + "/" + mine[i]->uri;
-    std::error_code ignored;
-    if (share.resumed && fs::exists(path, ignored)) {
+    std::error_code error;  // (a missing tile is no error)
+    const bool there = share.resumed && fs::exists(path, error);
+    if (error) {
+      // Not rewritten: its blocks may have been given back once it was written.
+      written[i] =
+          ioError(path, fmt::format("cannot tell whether it is written: {}", error.message()));
+    } else if (there) {
       ++kept;
     } else {
       written[i] = writeContent(*mine[i], blocks, options, fields, path);

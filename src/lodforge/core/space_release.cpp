@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cassert>
 #include <filesystem>
+#include <iterator>
 
 namespace lodforge {
 
@@ -66,8 +67,9 @@ void SpaceRelease::serve() {
   for (;;) {
     wake_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
     if (queue_.empty()) return;  // stopping, and everything asked is done
-    std::vector<Request> batch;
-    batch.swap(queue_);
+    std::vector<Request> batch(std::make_move_iterator(queue_.begin()),
+                               std::make_move_iterator(queue_.end()));
+    queue_.clear();
     lock.unlock();
     try {
       release(std::move(batch));

@@ -7,6 +7,7 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <string>
@@ -60,7 +61,7 @@ class SpaceRelease {
   std::mutex releasing_;  // one release at a time (the thread's, or a caller's after finish())
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  std::vector<Request> queue_;
+  std::deque<Request> queue_;
   bool stopping_ = false;
   std::uint64_t released_ = 0;
   // Per path, the ranges given so far, merged: [first byte, end) (under releasing_).

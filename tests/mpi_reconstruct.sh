@@ -47,7 +47,7 @@ grep -q "the runs made by the ranks, 0 to 12 chunks a rank" whole.err ||
 # A rank killed (SIGKILL) after its second run: the job stops naming it and its step; the
 # finished runs stay, and --resume (by 2 ranks) takes them and writes the same mesh.
 set +e
-"${mpi[@]}" -np 1 "$lodforge" "${limit[@]}" reconstruct cloud.ply -o killed.ply : \
+"${mpi_killed[@]}" -np 1 "$lodforge" "${limit[@]}" reconstruct cloud.ply -o killed.ply : \
   -np 1 -x LODFORGE_INTERRUPT_AFTER=run:2:kill "$lodforge" "${limit[@]}" reconstruct cloud.ply \
   -o killed.ply > killed.out 2> killed.err
 code=$?
@@ -74,7 +74,7 @@ grep -q "3 ranks: the surface's runs made by the ranks, " surface.err ||
   fail "the surface was not made by the ranks: $(cat surface.err)"
 # Its reconstruction stopped by a killed rank resumes too: the kept runs taken, the same tileset.
 set +e
-"${mpi[@]}" -np 1 "$lodforge" "${limit[@]}" tiles mid.ply --surface -o surface-killed \
+"${mpi_killed[@]}" -np 1 "$lodforge" "${limit[@]}" tiles mid.ply --surface -o surface-killed \
   --chunk-size 100 : -np 1 -x LODFORGE_INTERRUPT_AFTER=run:2:kill "$lodforge" "${limit[@]}" \
   tiles mid.ply --surface -o surface-killed --chunk-size 100 > surface-killed.out 2>&1
 code=$?

@@ -137,7 +137,7 @@ grep -q "2 ranks: the input read by rank 0 (done at" text.err ||
 # takes the split input and every node done or staged (rank 0 puts rank 1's in place), and
 # writes the same tileset.
 set +e
-"${mpi[@]}" -np 1 "$lodforge" tiles large.las -o large-killed --block-size 10000 : \
+"${mpi_killed[@]}" -np 1 "$lodforge" tiles large.las -o large-killed --block-size 10000 : \
   -np 1 -x LODFORGE_INTERRUPT_AFTER=pointstaged:2:kill "$lodforge" tiles large.las -o large-killed \
   --block-size 10000 > large-killed.out 2> large-killed.err
 code=$?
@@ -170,7 +170,7 @@ same small-np4 small-1 "more ranks than chunks"
 
 # A rank killed (SIGKILL) after its third node: the job stops, naming the rank; the work stays.
 set +e
-"${mpi[@]}" -np 1 "$lodforge" tiles scan.ply -o killed --chunk-size 60 : \
+"${mpi_killed[@]}" -np 1 "$lodforge" tiles scan.ply -o killed --chunk-size 60 : \
   -np 1 -x LODFORGE_INTERRUPT_AFTER=node:3:kill "$lodforge" tiles scan.ply -o killed --chunk-size 60 \
   > killed.out 2> killed.err
 code=$?

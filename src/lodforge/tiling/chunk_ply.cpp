@@ -23,6 +23,7 @@
 
 #include "lodforge/core/cluster.h"
 #include "lodforge/core/file.h"
+#include "lodforge/core/pipeline_failure.h"
 #include "lodforge/core/progress.h"
 #include "lodforge/io/mesh/ply_reader.h"
 #include "lodforge/io/mesh/ply_textures.h"
@@ -32,26 +33,6 @@
 
 namespace lodforge {
 namespace {
-
-// The failure of a pipeline over batches, from any of its stages: the one nearest the start of
-// the file is kept (the same message whatever the timing), and every stage stops once one is.
-class PipelineFailure {
- public:
-  void fail(std::uint64_t position, Status status, tbb::flow_control* control = nullptr) {
-    std::lock_guard lock(mutex_);
-    if (status_.ok() || position < position_) status_ = std::move(status), position_ = position;
-    failed_ = true;
-    if (control) control->stop();
-  }
-  bool failed() const { return failed_; }
-  const Status& status() const { return status_; }
-
- private:
-  std::mutex mutex_;
-  Status status_;
-  std::uint64_t position_ = std::numeric_limits<std::uint64_t>::max();
-  std::atomic<bool> failed_ = false;
-};
 
 // Where a PLY's objects are, for the chunk size and for segments (§3.3): small objects go into
 // the chunk of their centre whole.

@@ -1,0 +1,38 @@
+// The failure of a tbb::parallel_pipeline over the batches of a file, from any of its stages:
+// the one nearest the start of the file is kept (the same message whatever the timing), and
+// every stage stops once one is.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <limits>
+#include <mutex>
+#include <utility>
+
+#include <tbb/parallel_pipeline.h>
+
+#include "lodforge/core/status.h"
+
+namespace lodforge {
+
+class PipelineFailure {
+ public:
+  // `position`: where in the file (a record, a byte); `control`, from the first stage, stops it.
+  void fail(std::uint64_t position, Status status, tbb::flow_control* control = nullptr) {
+    std::lock_guard lock(mutex_);
+    if (status_.ok() || position < position_) status_ = std::move(status), position_ = position;
+    failed_ = true;
+    if (control) control->stop();
+  }
+  bool failed() const { return failed_; }
+  // Read once the pipeline is over.
+  const Status& status() const { return status_; }
+
+ private:
+  std::mutex mutex_;
+  Status status_;
+  std::uint64_t position_ = std::numeric_limits<std::uint64_t>::max();
+  std::atomic<bool> failed_ = false;
+};
+
+}  // namespace lodforge

@@ -206,7 +206,7 @@ struct ReadSlot {
 // 1.4–1.7 of this machine's 2 cores busy.
 Status readBatches(const std::string& input, const PartitionOptions& options, PointReader& reader,
                    const PointRecordLayout& layout, OutputFile& out, OutputFile* extrasOut,
-                   Stats& stats, Progress& progress) {
+                   [[maybe_unused]] std::size_t stride, Stats& stats, Progress& progress) {
   constexpr std::size_t kSlots = 3;  // batches in flight (a slot is free again once written)
   std::array<ReadSlot, kSlots> slots;
   std::size_t started = 0;
@@ -230,6 +230,7 @@ Status readBatches(const std::string& input, const PartitionOptions& options, Po
   };
   const auto write = [&](ReadSlot* slot) {
     if (failure.failed()) return;
+    assert(!extrasOut || slot->batch.extras.size() == slot->batch.size() * stride);
     addBatch(stats, slot->stats);
     Status status = out.writeSpan(std::span<const std::byte>(slot->records));
     if (status.ok() && extrasOut)
@@ -271,7 +272,7 @@ Result<InputRead> readInput(const std::string& input, const std::string& path,
   Progress progress("points: reading", info.count.value_or(0));
   Stats stats;
   LODFORGE_TRY(readBatches(input, options, *reader, layout, *out, extrasOut ? &*extrasOut : nullptr,
-                           stats, progress));
+                           stride, stats, progress));
   progress.finish();
   read.truncation = reader->truncation();
   LODFORGE_TRY(out->commit());

@@ -1,8 +1,10 @@
 #include "lodforge/core/pipeline_failure.h"
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -24,12 +26,27 @@ TEST(PipelineFailure, KeepsTheFailureNearestTheStart) {
   EXPECT_EQ(failure.status().error().message, "at 200");
 }
 
-// A failure in a later stage stops the first: no batch is read after the failure is seen, and
-// the kept failure is the earliest batch's even when a later batch failed first.
-TEST(PipelineFailure, StopsThePipelineAndKeepsTheEarliestBatch) {
+// Only failures before a position count for it: a stage that skips its batch when an earlier
+// one failed still reports its own when only a later one did.
+TEST(PipelineFailure, FailedBeforeCountsOnlyEarlierPositions) {
+  PipelineFailure failure;
+  EXPECT_FALSE(failure.failedBefore(~std::uint64_t{0}));
+  failure.fail(300, Error{ErrorKind::kIo, "at 300"});
+  EXPECT_FALSE(failure.failedBefore(300));
+  EXPECT_TRUE(failure.failedBefore(301));
+  failure.fail(100, Error{ErrorKind::kIo, "at 100"});
+  EXPECT_TRUE(failure.failedBefore(101));
+  EXPECT_FALSE(failure.failedBefore(100));
+}
+
+// A pipeline whose parallel stage skips a batch only after an earlier failure, as the points'
+// reading pass does: batch 41 fails first (batch 40 waits for it, up to 2 s where one thread
+// runs both in turn), yet batch 40's failure is the one kept, and the first stage stops reading
+// once a failure is known.
+TEST(PipelineFailure, AnEarlierBatchFailingLaterIsStillTheOneKept) {
   PipelineFailure failure;
   std::uint64_t next = 0;
-  std::atomic<std::uint64_t> readAfterFailure{0};
+  std::atomic<bool> laterFailed{false};
   tbb::parallel_pipeline(
       4,
       tbb::make_filter<void, std::uint64_t>(tbb::filter_mode::serial_in_order,
@@ -41,14 +58,20 @@ TEST(PipelineFailure, StopsThePipelineAndKeepsTheEarliestBatch) {
                                               return next++;
                                             }) &
           tbb::make_filter<std::uint64_t, void>(tbb::filter_mode::parallel, [&](std::uint64_t b) {
-            if (failure.failed()) ++readAfterFailure;
-            if (b == 40 || b == 41)
+            if (b == 40) {
+              const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+              while (!laterFailed && std::chrono::steady_clock::now() < until)
+                std::this_thread::sleep_for(std::chrono::milliseconds(1));
+            }
+            if (failure.failedBefore(b)) return;
+            if (b == 40 || b == 41) {
               failure.fail(b, Error{ErrorKind::kIo, "batch " + std::to_string(b)});
+              if (b == 41) laterFailed = true;
+            }
           }));
   ASSERT_TRUE(failure.failed());
   EXPECT_EQ(failure.status().error().message, "batch 40");
-  EXPECT_LT(next, 1000u);                  // stopped early
-  EXPECT_LE(readAfterFailure.load(), 4u);  // at most the batches already in flight
+  EXPECT_LT(next, 1000u);  // the reading stopped
 }
 
 }  // namespace

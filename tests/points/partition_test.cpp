@@ -302,6 +302,30 @@ TEST(Partition, ExtraBytesFollowTheirPointsThroughEveryReorder) {
   EXPECT_FALSE(std::filesystem::exists(plain.workDirectory + "/b.extras"));
 }
 
+// The reading pass works on several batches at once: of two points in different batches that
+// cannot be placed, the first in the file is named, whichever failed first.
+TEST(Partition, AFailedPlacementNamesThePointFirstInTheFile) {
+  test::TempDir dir;
+  const std::vector<Vec3d> input = writeCloud(dir.file("cloud.xyz"), 3 * kInputBatchPoints, 8);
+  const Vec3d first = input[kInputBatchPoints + 100], second = input[2 * kInputBatchPoints + 7];
+  ASSERT_NE(first, second);
+  PartitionOptions options;
+  options.workDirectory = dir.file("work");
+  std::filesystem::create_directories(options.workDirectory);
+  options.transform = [&](Vec3d in, Vec3d& out) {
+    out = in;
+    return in != first && in != second;
+  };
+  Result<Partition> partition = partitionPoints(dir.file("cloud.xyz"), options);
+  ASSERT_FALSE(partition.ok());
+  EXPECT_EQ(partition.error().kind, ErrorKind::kBadInput);
+  // Its first occurrence (the cloud repeats some points).
+  const auto named = std::find(input.begin(), input.end(), first) - input.begin();
+  EXPECT_GE(named, static_cast<std::ptrdiff_t>(kInputBatchPoints));
+  EXPECT_NE(partition.error().message.find(fmt::format("point {} (", named)), std::string::npos)
+      << partition.error().message;
+}
+
 TEST(Partition, SplitsCoincidentPointsByCount) {
   // 5,000 copies of one point: no plane separates them, the median does.
   test::TempDir dir;

@@ -25,13 +25,16 @@ class PipelineFailure {
     if (control) control->stop();
   }
   bool failed() const { return failed_; }
+  // Whether a failure before `position` is kept: a stage skips work only then, so that a later
+  // batch failing first cannot hide an earlier batch's failure.
+  bool failedBefore(std::uint64_t position) const { return position_ < position; }
   // Read once the pipeline is over.
   const Status& status() const { return status_; }
 
  private:
   std::mutex mutex_;
   Status status_;
-  std::uint64_t position_ = std::numeric_limits<std::uint64_t>::max();
+  std::atomic<std::uint64_t> position_ = std::numeric_limits<std::uint64_t>::max();
   std::atomic<bool> failed_ = false;
 };
 

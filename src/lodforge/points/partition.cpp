@@ -201,9 +201,9 @@ struct ReadSlot {
 };
 
 // The reading pass' three stages over the input's batches: read (the reader is sequential),
-// then converted and encoded (two batches at once), then written and counted in file order.
-// Each stage was about a third of the pass; with the last two on one thread, the pass kept
-// 1.4–1.7 of this machine's 2 cores busy.
+// then converted and encoded (beside the reading and the writing), then written and counted in
+// file order; up to three batches in flight. Each stage is about a third of the pass: with the
+// last two on one thread, one thread waited on the other (docs/BENCHMARKS.md).
 Status readBatches(const std::string& input, const PartitionOptions& options, PointReader& reader,
                    const PointRecordLayout& layout, OutputFile& out, OutputFile* extrasOut,
                    [[maybe_unused]] std::size_t stride, Stats& stats, Progress& progress) {
@@ -222,14 +222,14 @@ Status readBatches(const std::string& input, const PartitionOptions& options, Po
     return &slot;
   };
   const auto encode = [&](ReadSlot* slot) {
-    if (failure.failed()) return slot;
+    if (failure.failedBefore(slot->batch.first)) return slot;
     const Status status =
         encodeBatch(input, options, layout, slot->batch, slot->records, slot->stats);
     if (!status.ok()) failure.fail(slot->batch.first, status);
     return slot;
   };
   const auto write = [&](ReadSlot* slot) {
-    if (failure.failed()) return;
+    if (failure.failedBefore(slot->batch.first + 1)) return;  // this batch's own failure too
     assert(!extrasOut || slot->batch.extras.size() == slot->batch.size() * stride);
     addBatch(stats, slot->stats);
     Status status = out.writeSpan(std::span<const std::byte>(slot->records));
@@ -663,6 +663,7 @@ Result<SliceRead> readInputSlice(const std::string& input, const PartitionOption
     if (!more) return more.status();
     if (!*more) break;
     const std::uint64_t at = batch.first;
+    assert(batch.extras.size() == batch.size() * stride);
     LODFORGE_TRY(encodeBatch(input, options, layout, batch, records, batchStats));
     addBatch(stats, batchStats);
     out.batchSums.push_back(batchStats.sum);

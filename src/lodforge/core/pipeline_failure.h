@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <cassert>
 #include <cstdint>
 #include <limits>
 #include <mutex>
@@ -19,12 +20,12 @@ class PipelineFailure {
  public:
   // `position`: where in the file (a record, a byte); `control`, from the first stage, stops it.
   void fail(std::uint64_t position, Status status, tbb::flow_control* control = nullptr) {
+    assert(position != std::numeric_limits<std::uint64_t>::max());  // max means none
     std::lock_guard lock(mutex_);
     if (status_.ok() || position < position_) status_ = std::move(status), position_ = position;
-    failed_ = true;
     if (control) control->stop();
   }
-  bool failed() const { return failed_; }
+  bool failed() const { return position_ != std::numeric_limits<std::uint64_t>::max(); }
   // Whether a failure before `position` is kept: a stage skips work only then, so that a later
   // batch failing first cannot hide an earlier batch's failure.
   bool failedBefore(std::uint64_t position) const { return position_ < position; }
@@ -35,7 +36,6 @@ class PipelineFailure {
   std::mutex mutex_;
   Status status_;
   std::atomic<std::uint64_t> position_ = std::numeric_limits<std::uint64_t>::max();
-  std::atomic<bool> failed_ = false;
 };
 
 }  // namespace lodforge

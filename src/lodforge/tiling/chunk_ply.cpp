@@ -214,7 +214,9 @@ std::shared_ptr<PlyBatch> PlyChunking::readVertexBatch(tbb::flow_control& contro
 }
 
 void PlyChunking::writeVertexBatch(const PlyBatch& batch, std::vector<std::byte>& buffer) {
-  if (failure_.failed()) return;
+  // Not on any failure: the reading stage, ahead, may fail on a later batch before this one's
+  // bad vertex is found, and the one nearest the start of the file is the one to report.
+  if (failure_.failedBefore(batch.first)) return;
   buffer.resize(batch.positions.size() * layout_.bytes());
   for (std::size_t i = 0; i < batch.positions.size(); ++i) {
     Vec3d p = batch.positions[i];
@@ -430,7 +432,7 @@ void PlyChunking::cutFaceBatch(FaceBatch& work) const {
 }
 
 void PlyChunking::addFaceBatch(const FaceBatch& work) {
-  if (failure_.failed()) return;
+  if (failure_.failedBefore(work.first)) return;  // as writeVertexBatch
   if (Status status = input_.chunks->addPieces(work.cells, work.pieces); !status.ok())
     return failure_.fail(work.first, std::move(status));
   input_.inputTriangles += work.triangles;

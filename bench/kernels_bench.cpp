@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 #include <meshoptimizer.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <numeric>
@@ -18,6 +19,7 @@
 #include "lodforge/io/mesh/ply_writer.h"
 #include "lodforge/io/mesh/vertex_codec.h"
 #include "lodforge/points/cluster.h"
+#include "lodforge/points/partition.h"
 
 namespace lodforge {
 namespace {
@@ -146,6 +148,29 @@ void BM_ClusterBlock(benchmark::State& state) {
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(block.size()));
 }
 BENCHMARK(BM_ClusterBlock)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// One in-memory split of a node's points at the centroid plane (random points: the side of each
+// is a coin toss): splitPoints (Arg 0) against std::partition, the plain Hoare scan that leaves
+// the same order (Arg 1).
+void BM_SplitPoints(benchmark::State& state) {
+  Random random(5);
+  std::vector<CloudPoint> node(4'000'000);
+  for (CloudPoint& p : node) p.position = {random.uniform(0, 1), random.uniform(0, 1), 0};
+  std::vector<CloudPoint> points(node.size());
+  for (auto _ : state) {
+    state.PauseTiming();
+    points = node;
+    state.ResumeTiming();
+    if (state.range(0) == 0) {
+      benchmark::DoNotOptimize(splitPoints(points, {0, 0.5}));
+    } else {
+      benchmark::DoNotOptimize(std::partition(
+          points.begin(), points.end(), [](const CloudPoint& p) { return p.position.x < 0.5; }));
+    }
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(node.size()));
+}
+BENCHMARK(BM_SplitPoints)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // EXT_meshopt_compression's attribute stream of the 1 M-triangle scan's welded vertices as a
 // quantised tile holds them (16-bit positions padded to 8 bytes): our encoder (Arg 0) and

@@ -383,6 +383,42 @@ TEST(Partition, SplitPointsSeparatesAtThePlane) {
   EXPECT_DOUBLE_EQ(centroidSplit(box, {0.2, 0.7, 0.1}).value, 0.7);
 }
 
+// The block scheme against std::partition: sizes around its blocks (64 a side), every share of
+// points below, and clustered sides; each point seen once, on the side where it ends.
+TEST(Partition, SplitRecordsLeavesStdPartitionsOrderAndSettlesEachPointOnce) {
+  Random random(21);
+  for (const std::size_t n : {0, 1, 2, 63, 64, 127, 128, 129, 130, 200, 257, 1'000, 20'000}) {
+    for (const double share : {0.0, 0.01, 0.3, 0.5, 0.97, 1.0}) {
+      std::vector<CloudPoint> points(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        // Half the sizes in runs: long stretches on one side, as a sorted file gives.
+        const double u = n % 2 == 0 ? random.uniform(0, 1) : double(i) / double(n);
+        points[i].position = {u, double(i), 0};
+      }
+      std::vector<CloudPoint> standard = points;
+      const auto below = [&](const CloudPoint& p) { return p.position.x < share; };
+      const auto end = std::partition(standard.begin(), standard.end(), below);
+      std::vector<std::uint32_t> ids(n);
+      std::iota(ids.begin(), ids.end(), 0u);
+      std::vector<int> seen(n, 0);
+      const std::vector<CloudPoint> original = points;
+      const std::size_t half = hoarePartition(
+          std::span(points), std::span(ids), [&](std::size_t i) { return below(points[i]); },
+          [&](const CloudPoint& p, int side) {
+            const auto i = static_cast<std::size_t>(p.position.y);
+            seen[i] += 1;
+            EXPECT_EQ(below(p), side == 0) << n << " " << share << " " << i;
+          });
+      ASSERT_EQ(half, static_cast<std::size_t>(end - standard.begin())) << n << " " << share;
+      for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(points[i].position, standard[i].position) << n << " " << share << " " << i;
+        ASSERT_EQ(points[i].position, original[ids[i]].position) << i;
+        ASSERT_EQ(seen[i], 1) << n << " " << share << " " << i;
+      }
+    }
+  }
+}
+
 TEST(Partition, RefusesAnEmptyInputAndBadPoints) {
   test::TempDir dir;
   test::writeFile(dir.file("empty.xyz"), "# nothing\n");

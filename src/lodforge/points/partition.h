@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cstdint>
 #include <functional>
@@ -91,27 +92,77 @@ void applyOrder(std::span<const std::uint32_t> order, std::span<T> values) {
   for (std::size_t k = 0; k < order.size(); ++k) values[k] = was[order[k]];
 }
 
-// The same for any record with a `position` (the clustering splits a compact copy). `flatStays`:
-// when every point has the axis' coordinate, any half will do and nothing moves (splitPoints
-// sets it when it has ids). Its swaps depend only on the positions, so the order it leaves is
-// the same for every record type.
-template <class Point>
-std::size_t splitRecords(std::span<Point> points, SplitPlane plane, std::span<std::uint32_t> ids,
-                         bool flatStays) {
-  assert(ids.empty() || ids.size() == points.size());
-  const auto below = [&](std::size_t i) { return points[i].position[plane.axis] < plane.value; };
+// Hoare's partition of `points` by `below(i)`, as std::partition leaves it, moving the ids too;
+// where the first point not below is. Its swaps, the k-th point not below from the left with
+// the k-th below from the right while they have not crossed, are made a block of each end at a
+// time with those points' offsets gathered first (BlockQuicksort's scheme, Edelkamp and Weiss
+// 2016): no branch on a point's side, which the scan mispredicted about every other point.
+template <class Point, class Below, class Settled>
+std::size_t hoarePartition(std::span<Point> points, std::span<std::uint32_t> ids, Below below,
+                           Settled&& settled) {
   const auto swap = [&](std::size_t i, std::size_t j) {
     std::swap(points[i], points[j]);
     if (!ids.empty()) std::swap(ids[i], ids[j]);
   };
-  // Hoare's partition, as std::partition does it (the same order), moving the ids too.
-  std::size_t i = 0, j = points.size();
-  while (true) {
-    while (i < j && below(i)) ++i;
-    while (i < j && !below(j - 1)) --j;
-    if (i >= j) break;
-    swap(i++, --j);
+  constexpr std::size_t kBlock = 64;
+  std::array<std::uint8_t, kBlock> aboveAt,
+      belowAt;  // from the left block's start, the right's end
+  std::size_t l = 0, r = points.size(), ahead = 0, behind = 0, nextAbove = 0, nextBelow = 0;
+  while (r - l > 2 * kBlock) {  // blocks [l, l + kBlock) and [r - kBlock, r) apart
+    if (ahead == 0) {
+      nextAbove = 0;
+      for (std::size_t k = 0; k < kBlock; ++k) {
+        aboveAt[ahead] = static_cast<std::uint8_t>(k);
+        ahead += static_cast<std::size_t>(!below(l + k));
+      }
+    }
+    if (behind == 0) {
+      nextBelow = 0;
+      for (std::size_t k = 0; k < kBlock; ++k) {
+        belowAt[behind] = static_cast<std::uint8_t>(k);
+        behind += static_cast<std::size_t>(below(r - 1 - k));
+      }
+    }
+    const std::size_t pairs = std::min(ahead, behind);
+    for (std::size_t k = 0; k < pairs; ++k)
+      swap(l + aboveAt[nextAbove + k], r - 1 - belowAt[nextBelow + k]);
+    ahead -= pairs, behind -= pairs, nextAbove += pairs, nextBelow += pairs;
+    if (ahead == 0) {
+      for (std::size_t k = 0; k < kBlock; ++k) settled(points[l + k], 0);
+      l += kBlock;
+    }
+    if (behind == 0) {
+      for (std::size_t k = 0; k < kBlock; ++k) settled(points[r - 1 - k], 1);
+      r -= kBlock;
+    }
   }
+  // Hoare's own loop from where its ends would be: each block's next point on the wrong side.
+  std::size_t i = ahead > 0 ? l + aboveAt[nextAbove] : l;
+  std::size_t j = behind > 0 ? r - belowAt[nextBelow] : r;
+  for (std::size_t k = l; k < i; ++k) settled(points[k], 0);
+  for (std::size_t k = j; k < r; ++k) settled(points[k], 1);
+  while (true) {
+    while (i < j && below(i)) settled(points[i++], 0);
+    while (i < j && !below(j - 1)) settled(points[--j], 1);
+    if (i >= j) return i;
+    swap(i, j - 1);
+    settled(points[i++], 0);
+    settled(points[--j], 1);
+  }
+}
+
+// The same for any record with a `position` (the clustering splits a compact copy). `flatStays`:
+// when every point has the axis' coordinate, any half will do and nothing moves (splitPoints
+// sets it when it has ids). Its swaps depend only on the positions, so the order it leaves is
+// the same for every record type. `settled(point, side)` sees each point once, where the
+// partition puts it (0 below, 1 above), unless every point is on one side (then it sees them
+// all on that side and the median split follows).
+template <class Point, class Settled = decltype([](const Point&, int) {})>
+std::size_t splitRecords(std::span<Point> points, SplitPlane plane, std::span<std::uint32_t> ids,
+                         bool flatStays, Settled settled = {}) {
+  assert(ids.empty() || ids.size() == points.size());
+  const auto below = [&](std::size_t i) { return points[i].position[plane.axis] < plane.value; };
+  const std::size_t i = hoarePartition(points, ids, below, settled);
   if ((i != 0 && i != points.size()) || points.size() < 2) return i;
   const std::size_t count = points.size() / 2;
   const auto half = static_cast<std::ptrdiff_t>(count);

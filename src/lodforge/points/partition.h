@@ -157,7 +157,11 @@ std::size_t hoarePartition(std::span<Point> points, std::span<std::uint32_t> ids
 // the same for every record type. `settled(point, side)` sees each point once, where the
 // partition puts it (0 below, 1 above), unless every point is on one side (then it sees them
 // all on that side and the median split follows).
-template <class Point, class Settled = decltype([](const Point&, int) {})>
+struct SettledNowhere {
+  template <class Point>
+  void operator()(const Point&, int) const {}
+};
+template <class Point, class Settled = SettledNowhere>
 std::size_t splitRecords(std::span<Point> points, SplitPlane plane, std::span<std::uint32_t> ids,
                          bool flatStays, Settled settled = {}) {
   assert(ids.empty() || ids.size() == points.size());

@@ -327,23 +327,31 @@ TEST(Partition, AFailedPlacementNamesThePointFirstInTheFile) {
 }
 
 TEST(Partition, SplitsCoincidentPointsByCount) {
-  // 5,000 copies of one point: no plane separates them, the median does.
+  // 5,000 copies of one point: no plane separates them, the median does. And a cloud where only
+  // a node further down is flat (3,000 copies beside 2,000 points along x). Every block's bounds
+  // and centroid are its points' (a median split sums its halves' stats afresh).
   test::TempDir dir;
+  std::map<std::string, Multiset> clouds;
   {
-    std::ofstream out(dir.file("same.xyz"));
-    for (int i = 0; i < 5'000; ++i) out << "1 2 3\n";
+    std::ofstream same(dir.file("same.xyz")), mixed(dir.file("mixed.xyz"));
+    for (int i = 0; i < 5'000; ++i) {
+      same << "1 2 3\n";
+      ++clouds["same"][{1, 2, 3}];
+      const double x = i < 3'000 ? 1 : 10 + i % 97;
+      mixed << x << " 2 3\n";
+      ++clouds["mixed"][{x, 2, 3}];
+    }
   }
-  PartitionOptions options;
-  options.blockSize = 600;
-  options.workDirectory = dir.path().string();
-  Result<Partition> partition = partitionPoints(dir.file("same.xyz"), options);
-  ASSERT_TRUE(partition.ok()) << partition.error().message;
-  std::uint64_t total = 0;
-  for (const PointBlock& b : partition->blocks) {
-    EXPECT_LE(b.count, 600u);
-    total += b.count;
+  for (const auto& [name, want] : clouds) {
+    const std::string work = dir.file(name + ".work");
+    std::filesystem::create_directories(work);
+    PartitionOptions options;
+    options.blockSize = 600;
+    options.workDirectory = work;
+    Result<Partition> partition = partitionPoints(dir.file(name + ".xyz"), options);
+    ASSERT_TRUE(partition.ok()) << partition.error().message;
+    EXPECT_EQ(blocksContent(*partition, 600), want) << name;
   }
-  EXPECT_EQ(total, 5'000u);
 }
 
 TEST(Partition, SplitPointsSeparatesAtThePlane) {
@@ -391,8 +399,8 @@ TEST(Partition, SplitRecordsLeavesStdPartitionsOrderAndSettlesEachPointOnce) {
     for (const double share : {0.0, 0.01, 0.3, 0.5, 0.97, 1.0}) {
       std::vector<CloudPoint> points(n);
       for (std::size_t i = 0; i < n; ++i) {
-        // Half the sizes in runs: long stretches on one side, as a sorted file gives.
-        const double u = n % 2 == 0 ? random.uniform(0, 1) : double(i) / double(n);
+        // Odd sizes in a descending run: every pair of ends swaps, block after block.
+        const double u = n % 2 == 0 ? random.uniform(0, 1) : 1 - double(i) / double(n);
         points[i].position = {u, double(i), 0};
       }
       std::vector<CloudPoint> standard = points;
@@ -417,6 +425,18 @@ TEST(Partition, SplitRecordsLeavesStdPartitionsOrderAndSettlesEachPointOnce) {
       }
     }
   }
+  // Every point on one side: the callback sees each there once (splitWithStats tells the median
+  // split by that), then the median splits by count.
+  std::vector<CloudPoint> line(300);
+  for (std::size_t i = 0; i < line.size(); ++i) line[i].position = {1 - double(i) / 300, 0, 0};
+  std::array<std::size_t, 2> sides{};
+  const std::size_t half = splitRecords(std::span(line), {0, 2.0}, {}, false,
+                                        [&](const CloudPoint&, int side) { ++sides[side]; });
+  EXPECT_EQ(half, 150u);
+  EXPECT_EQ(sides[0], 300u);
+  EXPECT_EQ(sides[1], 0u);
+  for (std::size_t i = 0; i < line.size(); ++i)
+    EXPECT_EQ(line[i].position.x < line[half].position.x, i < half) << i;
 }
 
 TEST(Partition, RefusesAnEmptyInputAndBadPoints) {

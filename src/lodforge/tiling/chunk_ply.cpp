@@ -128,6 +128,7 @@ Status PlyChunking::openVertices() {
   }
   if (!vertices) return vertices.status();
   vertices_ = std::move(*vertices);
+  read_ = read.vertexSlice.first;  // a slice's failures are placed in the whole file
   header_ = vertices_->header();
   if (header_.faceCount == 0) return badInput(path_, "no faces: a tileset needs a mesh");
   if (std::optional<std::string> unread = unreadPlyElements(header_, path_))
@@ -360,7 +361,7 @@ Status PlyChunking::cutFaces() {
   Result<PlyReader> faces = PlyReader::open(path_, faceReading());
   if (!faces) return faces.status();
   faces_ = std::move(*faces);
-  read_ = 0;
+  read_ = sliced_ ? rankSlice(header_.faceCount).first : 0;
   progress_.reset();
   // In slices, rank 0 shows the whole job's faces (JobProgress) instead of its own.
   if (!sliced_) progress_.emplace("tiles: chunks", header_.faceCount);

@@ -105,8 +105,9 @@ std::size_t hoarePartition(std::span<Point> points, std::span<std::uint32_t> ids
     if (!ids.empty()) std::swap(ids[i], ids[j]);
   };
   constexpr std::size_t kBlock = 64;
-  std::array<std::uint8_t, kBlock> aboveAt,
-      belowAt;  // from the left block's start, the right's end
+  // Offsets of the points to swap: from the left block's start, and from the right block's end.
+  std::array<std::uint8_t, kBlock> aboveAt;
+  std::array<std::uint8_t, kBlock> belowAt;
   std::size_t l = 0, r = points.size(), ahead = 0, behind = 0, nextAbove = 0, nextBelow = 0;
   while (r - l > 2 * kBlock) {  // blocks [l, l + kBlock) and [r - kBlock, r) apart
     if (ahead == 0) {

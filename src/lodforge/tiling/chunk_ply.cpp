@@ -361,7 +361,7 @@ Status PlyChunking::cutFaces() {
   Result<PlyReader> faces = PlyReader::open(path_, faceReading());
   if (!faces) return faces.status();
   faces_ = std::move(*faces);
-  read_ = sliced_ ? rankSlice(header_.faceCount).first : 0;
+  read_ = faceReading().faceSlice.first;  // a slice's failures are placed in the whole file
   progress_.reset();
   // In slices, rank 0 shows the whole job's faces (JobProgress) instead of its own.
   if (!sliced_) progress_.emplace("tiles: chunks", header_.faceCount);

@@ -10,6 +10,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "lodforge/core/distance.h"
 #include "lodforge/core/mesh.h"
 #include "lodforge/core/random.h"
 #include "lodforge/generate/scan.h"
@@ -20,6 +21,7 @@
 #include "lodforge/io/mesh/vertex_codec.h"
 #include "lodforge/points/cluster.h"
 #include "lodforge/points/partition.h"
+#include "lodforge/simplify/progressive.h"
 
 namespace lodforge {
 namespace {
@@ -198,6 +200,49 @@ void BM_EncodeVertexAttributes(benchmark::State& state) {
   state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(count * stride));
 }
 BENCHMARK(BM_EncodeVertexAttributes)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+// A parent tile's error as `tiles` measures it (simplify_node.cpp): a 200 K-triangle piece of a
+// scan simplified to a fifth, then the sampled Hausdorff distance between the two with 10,000
+// samples a side (Arg 0), or only the two grids built (Arg 1).
+struct NodePair {
+  std::vector<Vec3f> positions, keptPositions;
+  std::vector<std::uint32_t> indices, keptIndices;
+};
+
+const NodePair& nodePair() {
+  static const NodePair pair = [] {
+    const std::string path =
+        (std::filesystem::temp_directory_path() / "lodforge-bench-node.ply").string();
+    if (!generateScan({.triangles = 200'000}, path).ok()) std::abort();
+    Result<Model> model = readPly(path);
+    std::filesystem::remove(path);
+    NodePair p;
+    p.positions = model->positions;
+    p.indices = model->indices;
+    const SimplifiedMesh kept = simplifyMesh(
+        p.positions, p.indices,
+        {.minNormalCos = 0.866, .stopAtTriangles = std::uint32_t(p.indices.size() / 15)});
+    for (std::uint32_t v : kept.vertices) p.keptPositions.push_back(p.positions[v]);
+    p.keptIndices = kept.indices;
+    return p;
+  }();
+  return pair;
+}
+
+void BM_NodeError(benchmark::State& state) {
+  const NodePair& p = nodePair();
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      benchmark::DoNotOptimize(sampledHausdorff(p.keptPositions, p.keptIndices, p.positions,
+                                                p.indices, 10'000, 7, false));
+    } else {
+      const NearestTriangles all(p.positions, p.indices), kept(p.keptPositions, p.keptIndices);
+      benchmark::DoNotOptimize(&all);
+      benchmark::DoNotOptimize(&kept);
+    }
+  }
+}
+BENCHMARK(BM_NodeError)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace lodforge

@@ -78,7 +78,11 @@ namespace detail {
 // cells until no closer triangle can exist.
 class TriangleGrid {
  public:
-  TriangleGrid(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices)
+  // `queries`: about how many searches the grid will answer, when known. Beyond four cells per
+  // triangle it gets up to eight per query (a million at most): for a batch of a few thousand,
+  // building a million mostly empty cells cost more than the searches.
+  TriangleGrid(std::span<const Vec3f> positions, std::span<const std::uint32_t> indices,
+               std::size_t queries = std::numeric_limits<std::size_t>::max())
       : positions_(positions), indices_(indices) {
     Aabb box;
     for (std::uint32_t i : indices) box.add(positions[i]);
@@ -106,7 +110,8 @@ class TriangleGrid {
     }
     cell_ = std::max({cell_, box.longestSide() / 1024.0, 1e-9});
     // Keep the grid within a few cells per triangle (flat or sparse meshes would explode it).
-    const double maxCells = 4.0 * static_cast<double>(triangles) + 1e6;
+    const double maxCells =
+        4.0 * static_cast<double>(triangles) + std::min(1e6, 8.0 * static_cast<double>(queries));
     while (true) {
       for (int k = 0; k < 3; ++k)
         dims_[k] = std::max(1, std::min(1024, static_cast<int>(std::ceil(size[k] / cell_))));
@@ -116,6 +121,15 @@ class TriangleGrid {
     const std::size_t cells = static_cast<std::size_t>(dims_[0]) *
                               static_cast<std::size_t>(dims_[1]) *
                               static_cast<std::size_t>(dims_[2]);
+    // Each position's cell once (a vertex is on about six triangles): a triangle's cells are the
+    // box of its corners' cells, which is its bounding box's (clampCell never decreases).
+    vertexCells_.resize(positions.size());
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+      const Vec3f p = positions[v];
+      vertexCells_[v] = {static_cast<std::uint16_t>(clampCell(0, p.x)),
+                         static_cast<std::uint16_t>(clampCell(1, p.y)),
+                         static_cast<std::uint16_t>(clampCell(2, p.z))};
+    }
     // Counting sort of (cell, triangle) pairs. Most triangles lie in one cell: that cell is kept
     // from the counting pass, the few that span more are visited again.
     constexpr std::uint32_t kSpans = ~0u;
@@ -144,6 +158,7 @@ class TriangleGrid {
         forEachCell(cellRange(t), [&](std::size_t cell) { items_[--start_[cell]] = t; });
       }
     }
+    vertexCells_ = {};
   }
 
   // The squared distance from p to the nearest triangle, or any value not above `enough` as soon
@@ -232,10 +247,12 @@ class TriangleGrid {
   };
   // The cells triangle t's bounding box touches.
   CellRange cellRange(std::uint32_t t) const {
-    Aabb box;
-    for (int k = 0; k < 3; ++k) box.add(positions_[indices_[3 * t + static_cast<std::size_t>(k)]]);
-    return {clampCell(0, box.min.x), clampCell(0, box.max.x), clampCell(1, box.min.y),
-            clampCell(1, box.max.y), clampCell(2, box.min.z), clampCell(2, box.max.z)};
+    const std::array<std::uint16_t, 3>& a = vertexCells_[indices_[3 * std::size_t{t}]];
+    const std::array<std::uint16_t, 3>& b = vertexCells_[indices_[3 * std::size_t{t} + 1]];
+    const std::array<std::uint16_t, 3>& c = vertexCells_[indices_[3 * std::size_t{t} + 2]];
+    return {std::min({a[0], b[0], c[0]}), std::max({a[0], b[0], c[0]}),
+            std::min({a[1], b[1], c[1]}), std::max({a[1], b[1], c[1]}),
+            std::min({a[2], b[2], c[2]}), std::max({a[2], b[2], c[2]})};
   }
   template <class Fn>
   void forEachCell(const CellRange& r, Fn&& fn) const {
@@ -250,6 +267,7 @@ class TriangleGrid {
   double cell_ = 1;
   int dims_[3] = {1, 1, 1};
   std::vector<std::uint32_t> start_, items_;
+  std::vector<std::array<std::uint16_t, 3>> vertexCells_;  // while building: each position's cell
 };
 
 }  // namespace detail
@@ -391,10 +409,11 @@ double sampledHausdorff(std::span<const Vec3f> positionsA, std::span<const std::
                         std::span<const Vec3f> positionsB, std::span<const std::uint32_t> indicesB,
                         std::uint32_t samplesPerMesh, std::uint64_t seed, bool corners) {
   if (indicesA.empty() || indicesB.empty()) return std::numeric_limits<double>::infinity();
-  const double ab = farthest(samplePoints(positionsA, indicesA, samplesPerMesh, seed, corners),
-                             TriangleGrid(positionsB, indicesB));
-  const double ba = farthest(samplePoints(positionsB, indicesB, samplesPerMesh, seed + 1, corners),
-                             TriangleGrid(positionsA, indicesA));
+  const std::vector<Vec3d> onA = samplePoints(positionsA, indicesA, samplesPerMesh, seed, corners);
+  const double ab = farthest(onA, TriangleGrid(positionsB, indicesB, onA.size()));
+  const std::vector<Vec3d> onB =
+      samplePoints(positionsB, indicesB, samplesPerMesh, seed + 1, corners);
+  const double ba = farthest(onB, TriangleGrid(positionsA, indicesA, onB.size()));
   return std::max(ab, ba);
 }
 

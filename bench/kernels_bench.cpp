@@ -244,6 +244,31 @@ void BM_NodeError(benchmark::State& state) {
 }
 BENCHMARK(BM_NodeError)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
+// A parent tile's simplification, one thread: the 200 K-triangle piece of a scan to a fifth of
+// its triangles with the tiles' options (30 degrees, rims free to move) by our simplifier
+// (Arg 0), and by meshopt_simplify with its borders locked (Arg 1).
+void BM_NodeSimplify(benchmark::State& state) {
+  const NodePair& p = nodePair();
+  const auto target = static_cast<std::uint32_t>(p.indices.size() / 15);
+  std::vector<std::uint32_t> out(p.indices.size());
+  tbb::task_arena one(1);
+  for (auto _ : state) {
+    one.execute([&] {
+      if (state.range(0) == 0) {
+        benchmark::DoNotOptimize(simplifyMesh(
+            p.positions, p.indices,
+            {.minNormalCos = 0.866, .stopAtTriangles = target, .collapseBorders = true}));
+      } else {
+        benchmark::DoNotOptimize(meshopt_simplify(
+            out.data(), p.indices.data(), p.indices.size(), &p.positions[0].x, p.positions.size(),
+            sizeof(Vec3f), 3 * std::size_t{target}, 1e30f, meshopt_SimplifyLockBorder, nullptr));
+      }
+    });
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(p.indices.size() / 3));
+}
+BENCHMARK(BM_NodeSimplify)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace lodforge
 

@@ -133,6 +133,25 @@ TEST(FarthestDistance, EqualsTheBruteForceFarthestOfRandomPoints) {
   EXPECT_TRUE(std::isinf(farthestDistance(points, positions, {})));
 }
 
+TEST(NearestTriangles, VerticesNoTriangleUsesAndFarQueriesStayInTheGrid) {
+  // The grid places every position, used or not: an unused vertex at 1e30 or NaN, and queries
+  // 1e15 away from a triangle a millionth wide, are clamped to its edge cells (converted to an
+  // int first, they overflowed: UBSan in the sanitizer run), and the distances stay exact.
+  const std::vector<Vec3f> positions = {{0, 0, 0},
+                                        {1e-6f, 0, 0},
+                                        {0, 1e-6f, 0},
+                                        {1e30f, 0, 0},
+                                        {std::numeric_limits<float>::quiet_NaN(), 0, 0}};
+  const std::vector<std::uint32_t> indices = {0, 1, 2};
+  const NearestTriangles nearest(positions, indices);
+  std::uint32_t triangle = ~0u;
+  EXPECT_DOUBLE_EQ(nearest.nearestSquared({0, 0, 2}, triangle), 4.0);
+  EXPECT_EQ(triangle, 0u);
+  EXPECT_DOUBLE_EQ(nearest.nearestSquared({0, 0, -1e15}, triangle), 1e30);
+  const std::vector<Vec3f> far = {{-1e15f, 0, 0}, {0, 0, 3}};
+  EXPECT_DOUBLE_EQ(farthestDistance(far, positions, indices), -double(far[0].x));
+}
+
 TEST(NearestTriangles, FindsTheBruteForceNearestTriangleOfRandomPoints) {
   // A wavy surface and 500 random points in and far around it: the distance equals the
   // brute-force nearest over every triangle, and the triangle it names is at that distance.

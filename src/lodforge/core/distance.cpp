@@ -232,9 +232,12 @@ class TriangleGrid {
   Vec3d corner(std::uint32_t t, int k) const {
     return toDouble(positions_[indices_[3 * t + static_cast<std::size_t>(k)]]);
   }
+  // Clamped before the conversion: a point far outside the grid (a query, an unused vertex)
+  // or a NaN must not overflow an int.
   int clampCell(int axis, double v) const {
-    return std::clamp(static_cast<int>(std::floor((v - origin_[axis]) / cell_)), 0,
-                      dims_[axis] - 1);
+    const double cell = std::floor((v - origin_[axis]) / cell_);
+    if (!(cell > 0)) return 0;
+    return cell >= dims_[axis] - 1 ? dims_[axis] - 1 : static_cast<int>(cell);
   }
   std::size_t index(int x, int y, int z) const {
     return (static_cast<std::size_t>(z) * static_cast<std::size_t>(dims_[1]) +

@@ -928,7 +928,8 @@ void Simplifier::collapseAll() {
         if (to.vertex == kNone) continue;
         // The error `to` would carry, as collapse() sets it. Refused past the bound; ranked
         // again next pass (its neighbourhood may change).
-        const double step = stepDistance(from, to.vertex);
+        const double step =
+            options_.recordError || options_.maxError > 0 ? stepDistance(from, to.vertex) : 0.0;
         if (options_.maxError > 0 &&
             std::max(vertex_[to.vertex].error, vertex_[from].error + step) > options_.maxError)
           continue;

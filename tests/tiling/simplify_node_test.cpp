@@ -217,6 +217,32 @@ TEST(SimplifyNode, ItsErrorBoundsEveryChildVertexAndIsReproducible) {
   }
 }
 
+// An island that collapses away entirely (a lone small triangle floating 2 units above the
+// surface) leaves its vertices no fan to be measured against, and too little area for samples to
+// find: the error still covers how far they are from what remains.
+TEST(SimplifyNode, ItsErrorCoversAnIslandThatCollapsedAway) {
+  Node n = surfaceNode();
+  MeshPart island;
+  for (const Vec3d p : {Vec3d{4.3, 4.3, 2}, Vec3d{4.31, 4.3, 2}, Vec3d{4.3, 4.31, 2}}) {
+    island.positions.push_back(p);
+    island.colors.push_back(colorAt(p));
+    island.features.push_back(8);
+  }
+  island.indices = {0, 1, 2};
+  n.children.push_back(island);
+  n.node.bounds.add(boundsOf(island));
+  OctreeOptions options;
+  options.errorSamples = 4;
+  const SimplifiedNode out = simplifyNode(n.children, kGrid, n.node, options);
+  ASSERT_EQ(out.droppedSegments, 0u);
+  for (const Vec3d& p : out.mesh.positions) ASSERT_LT(p.z, 1) << "the island was kept";
+  double farthest = 0;
+  for (const Vec3d& p : island.positions)
+    farthest = std::max(farthest, distanceToMesh(p, out.mesh));
+  EXPECT_GT(farthest, 1.5);
+  EXPECT_LE(farthest, out.simplificationError * (1 + 1e-6));
+}
+
 // Small closed parts that cannot simplify and keep the parent over its target are left out,
 // smallest first, only as many as the target asks; the surface on the outer faces never; the
 // dropped error bounds how far every dropped point is from what remains.

@@ -88,7 +88,7 @@ class TriangleGrid {
     for (std::uint32_t i : indices) box.add(positions[i]);
     const std::size_t triangles = indices.size() / 3;
     origin_ = toDouble(box.min);
-    const Vec3d size = toDouble(box.size());
+    const Vec3d size = triangles > 0 ? toDouble(box.max) - toDouble(box.min) : Vec3d{};
     // Cells about twice the typical triangle's size: a few triangles per non-empty cell whether
     // the mesh fills a volume or lies on a surface (a volume-based size puts dozens of a flat
     // scan's triangles in every cell, or spreads a flat mesh's few big triangles over a million).
@@ -110,26 +110,19 @@ class TriangleGrid {
     }
     cell_ = std::max({cell_, box.longestSide() / 1024.0, 1e-9});
     // Keep the grid within a few cells per triangle (flat or sparse meshes would explode it).
-    const double maxCells =
-        4.0 * static_cast<double>(triangles) + std::min(1e6, 8.0 * static_cast<double>(queries));
+    const double maxCells = std::max(1.0, 4.0 * static_cast<double>(triangles) +
+                                              std::min(1e6, 8.0 * static_cast<double>(queries)));
     while (true) {
+      // Clamped before the conversion (a NaN clamps to 1024).
       for (int k = 0; k < 3; ++k)
-        dims_[k] = std::max(1, std::min(1024, static_cast<int>(std::ceil(size[k] / cell_))));
+        dims_[k] = std::max(1, static_cast<int>(std::min(1024.0, std::ceil(size[k] / cell_))));
       if (static_cast<double>(dims_[0]) * dims_[1] * dims_[2] <= maxCells) break;
       cell_ *= 1.26;
     }
     const std::size_t cells = static_cast<std::size_t>(dims_[0]) *
                               static_cast<std::size_t>(dims_[1]) *
                               static_cast<std::size_t>(dims_[2]);
-    // Each position's cell once (a vertex is on about six triangles): a triangle's cells are the
-    // box of its corners' cells, which is its bounding box's (clampCell never decreases).
-    vertexCells_.resize(positions.size());
-    for (std::size_t v = 0; v < positions.size(); ++v) {
-      const Vec3f p = positions[v];
-      vertexCells_[v] = {static_cast<std::uint16_t>(clampCell(0, p.x)),
-                         static_cast<std::uint16_t>(clampCell(1, p.y)),
-                         static_cast<std::uint16_t>(clampCell(2, p.z))};
-    }
+    placeVertices();
     // Counting sort of (cell, triangle) pairs. Most triangles lie in one cell: that cell is kept
     // from the counting pass, the few that span more are visited again.
     constexpr std::uint32_t kSpans = ~0u;
@@ -231,6 +224,17 @@ class TriangleGrid {
   }
   Vec3d corner(std::uint32_t t, int k) const {
     return toDouble(positions_[indices_[3 * t + static_cast<std::size_t>(k)]]);
+  }
+  // Each position's cell once (a vertex is on about six triangles): a triangle's cells are the
+  // box of its corners' cells, which is its bounding box's (clampCell never decreases).
+  void placeVertices() {
+    vertexCells_.resize(positions_.size());
+    for (std::size_t v = 0; v < positions_.size(); ++v) {
+      const Vec3f p = positions_[v];
+      vertexCells_[v] = {static_cast<std::uint16_t>(clampCell(0, p.x)),
+                         static_cast<std::uint16_t>(clampCell(1, p.y)),
+                         static_cast<std::uint16_t>(clampCell(2, p.z))};
+    }
   }
   // Clamped before the conversion: a point far outside the grid (a query, an unused vertex)
   // or a NaN must not overflow an int.

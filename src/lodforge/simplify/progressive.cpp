@@ -1142,6 +1142,7 @@ ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
                                  std::span<const Vec3f> normals, std::span<const Rgba8> colors,
                                  const ProgressiveOptions& options) {
   assert(indices.size() % 3 == 0);
+  assert(options.recordError);  // the error table is half of what a progressive mesh is for
   // Attributes are per vertex, or per wedge for a textured mesh.
   [[maybe_unused]] const std::size_t attributes =
       options.wedges.empty() ? positions.size() : options.wedgeUvs.size();

@@ -75,11 +75,13 @@ std::vector<std::uint8_t> onOuterFaces(const MeshPart& mesh, const ChunkGrid& gr
   return flags;
 }
 
-// A bound on how far any input vertex is from the simplified surface, without a search: each is
-// at most its distance to the triangles around the vertex it was collapsed into (a part of that
-// surface). Every vertex is covered, where area samples could miss a rim or a spike.
-double removedVertexBound(std::span<const Vec3f> input, std::span<const Vec3f> positions,
-                          std::span<const std::uint32_t> indices,
+// A bound on how far any input vertex is from the simplified surface, mostly without a search:
+// each is at most its distance to the triangles around the vertex it was collapsed into (a part
+// of that surface). A vertex whose whole piece collapsed away (an island's last triangle went)
+// has no such fan: its distance to the whole surface is searched. Every vertex of `inputIndices`
+// is covered, where area samples could miss a rim, a spike or a small island.
+double removedVertexBound(std::span<const Vec3f> input, std::span<const std::uint32_t> inputIndices,
+                          std::span<const Vec3f> positions, std::span<const std::uint32_t> indices,
                           const SimplifiedMesh& simplified) {
   // Triangles around each kept vertex (offsets into `fans`).
   std::vector<std::uint32_t> start(positions.size() + 1, 0), fans(indices.size());
@@ -88,10 +90,17 @@ double removedVertexBound(std::span<const Vec3f> input, std::span<const Vec3f> p
   std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
   for (std::size_t i = 0; i < indices.size(); ++i)
     fans[fill[indices[i]]++] = static_cast<std::uint32_t>(i / 3);
+  std::vector<std::uint8_t> used(input.size(), 0);
+  for (std::uint32_t v : inputIndices) used[v] = 1;
+  std::vector<Vec3f> vanished;
   double worst = 0;
   for (std::size_t v = 0; v < input.size(); ++v) {
     const std::uint32_t r = simplified.representative[v];
-    if (r == ~0u || simplified.vertices[r] == v) continue;  // unused, or kept
+    if (r == ~0u) {
+      if (used[v] != 0) vanished.push_back(input[v]);
+      continue;
+    }
+    if (simplified.vertices[r] == v) continue;  // kept
     double best = std::numeric_limits<double>::max();
     for (std::uint32_t i = start[r]; i < start[r + 1] && best > worst; ++i) {
       // (A vertex already within `worst` of the fan cannot raise it: its search ends there.)
@@ -103,7 +112,9 @@ double removedVertexBound(std::span<const Vec3f> input, std::span<const Vec3f> p
     }
     if (best < std::numeric_limits<double>::max()) worst = std::max(worst, best);
   }
-  return std::sqrt(worst);
+  const double bound = std::sqrt(worst);
+  if (vanished.empty()) return bound;
+  return std::max(bound, farthestDistance(vanished, positions, indices));
 }
 
 // Appends vertex `v` of `from` (every per-vertex array it has) to `to`.
@@ -249,8 +260,8 @@ Collapsed simplifyPlain(const MeshPart& merged, std::span<const Vec3f> positions
   out.mesh.indices = simplified.indices;
   out.source = simplified.vertices;
   out.border = std::move(simplified.border);
-  out.vertexError =
-      removedVertexBound(positions, relativeTo(out.mesh, center), out.mesh.indices, simplified);
+  out.vertexError = removedVertexBound(positions, merged.indices, relativeTo(out.mesh, center),
+                                       out.mesh.indices, simplified);
   return out;
 }
 
@@ -299,7 +310,8 @@ Collapsed simplifyTextured(const MeshPart& merged, std::span<const Vec3f> positi
   }
   std::vector<Vec3f> kept(simplified.vertices.size());
   for (std::size_t i = 0; i < kept.size(); ++i) kept[i] = surfacePositions[simplified.vertices[i]];
-  out.vertexError = removedVertexBound(surfacePositions, kept, simplified.indices, simplified);
+  out.vertexError =
+      removedVertexBound(surfacePositions, indices, kept, simplified.indices, simplified);
   return out;
 }
 
@@ -342,8 +354,9 @@ SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& gri
   // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
   // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
   // excursions, which area samples could miss, are bounded by each one's distance to the fan it
-  // went into (removedVertexBound; the simplifier's chain of steps, which it bounds too, summed
-  // each collapse's distance along a vertex's path and was never smaller). Measured before small
+  // went into, or to the whole surface for an island that collapsed away (removedVertexBound;
+  // the simplifier's own record, a sum of steps along a vertex's path against fans later
+  // collapses changed, is no such bound and is left off). Measured before small
   // segments are left out (whose cost is bounded apart: a sample near one would search far for
   // the nearest remaining surface).
   const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);

@@ -256,11 +256,9 @@ void BM_NodeSimplify(benchmark::State& state) {
   for (auto _ : state) {
     one.execute([&] {
       if (state.range(0) == 0) {
-        benchmark::DoNotOptimize(simplifyMesh(p.positions, p.indices,
-                                              {.minNormalCos = 0.866,
-                                               .stopAtTriangles = target,
-                                               .recordError = false,
-                                               .collapseBorders = true}));
+        benchmark::DoNotOptimize(simplifyMesh(
+            p.positions, p.indices,
+            {.minNormalCos = 0.866, .stopAtTriangles = target, .collapseBorders = true}));
       } else {
         benchmark::DoNotOptimize(meshopt_simplify(
             out.data(), p.indices.data(), p.indices.size(), &p.positions[0].x, p.positions.size(),

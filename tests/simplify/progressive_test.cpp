@@ -412,31 +412,6 @@ TEST(SimplifyMesh, MaxErrorHoldsTheVertexErrorWithinIt) {
   EXPECT_GT(previous, 100u);  // not to the minimum
 }
 
-// Tiles bound their error apart and leave the steps unmeasured: the same collapses (the step
-// decides none without maxError), an error of 0; with maxError the steps are measured anyway.
-TEST(SimplifyMesh, LeavingTheErrorUnrecordedCollapsesTheSame) {
-  Result<Model> model = readModel(test::dataPath("meshes/stanford-bunny.obj"));
-  ASSERT_TRUE(model.ok());
-  const PreparedObject bunny =
-      prepareObject(model->positions, {}, {}, model->indices, {.normals = false});
-  ProgressiveOptions options;
-  options.stopAtTriangles = static_cast<std::uint32_t>(bunny.indices.size() / 30);
-  options.collapseBorders = true;
-  const SimplifiedMesh recorded = simplifyMesh(bunny.positions, bunny.indices, options);
-  options.recordError = false;
-  const SimplifiedMesh unrecorded = simplifyMesh(bunny.positions, bunny.indices, options);
-  EXPECT_EQ(unrecorded.indices, recorded.indices);
-  EXPECT_EQ(unrecorded.vertices, recorded.vertices);
-  EXPECT_EQ(unrecorded.representative, recorded.representative);
-  EXPECT_EQ(unrecorded.border, recorded.border);
-  EXPECT_GT(recorded.error, 0.0f);
-  EXPECT_EQ(unrecorded.error, 0.0f);
-  options.maxError = 1e-3;
-  const SimplifiedMesh bounded = simplifyMesh(bunny.positions, bunny.indices, options);
-  EXPECT_GT(bounded.error, 0.0f);
-  EXPECT_LE(bounded.error, 1e-3 * (1 + 1e-6));
-}
-
 TEST(SimplifyMesh, StopsAtTheTargetKeepsLockedVerticesAndHonoursTheNormalLimit) {
   Result<Model> model = readModel(test::dataPath("meshes/stanford-bunny.obj"));
   ASSERT_TRUE(model.ok());

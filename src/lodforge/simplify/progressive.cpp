@@ -928,8 +928,7 @@ void Simplifier::collapseAll() {
         if (to.vertex == kNone) continue;
         // The error `to` would carry, as collapse() sets it. Refused past the bound; ranked
         // again next pass (its neighbourhood may change).
-        const double step =
-            options_.recordError || options_.maxError > 0 ? stepDistance(from, to.vertex) : 0.0;
+        const double step = stepDistance(from, to.vertex);
         if (options_.maxError > 0 &&
             std::max(vertex_[to.vertex].error, vertex_[from].error + step) > options_.maxError)
           continue;
@@ -1142,7 +1141,6 @@ ProgressiveMesh buildProgressive(std::span<const Vec3f> positions,
                                  std::span<const Vec3f> normals, std::span<const Rgba8> colors,
                                  const ProgressiveOptions& options) {
   assert(indices.size() % 3 == 0);
-  assert(options.recordError);  // the error table is half of what a progressive mesh is for
   // Attributes are per vertex, or per wedge for a textured mesh.
   [[maybe_unused]] const std::size_t attributes =
       options.wedges.empty() ? positions.size() : options.wedgeUvs.size();

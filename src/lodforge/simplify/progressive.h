@@ -39,12 +39,6 @@ struct ProgressiveOptions {
   // Refuse a collapse whose vertex error bound (ProgressiveMesh::error) would pass this (model
   // units; 0: no bound), so the result stays within it.
   double maxError = 0;
-  // Measure each collapse's step (how far the removed vertex lies from the fan replacing it) for
-  // the error table, SimplifiedMesh::error and `maxError`. Off, with no `maxError`, the error
-  // stays 0 and a collapse is a tenth cheaper: for simplifyMesh's callers that bound the distance
-  // their own way (a tile measures it against its children, every removed vertex included).
-  // buildProgressive needs it on.
-  bool recordError = true;
   // Let boundary vertices collapse along their boundary into a boundary neighbour (quadrics
   // then hold planes along boundary edges, so a rim keeps its shape). Off, as the CAD paper
   // has it: boundary vertices never move. Vertices where a boundary meets itself or a

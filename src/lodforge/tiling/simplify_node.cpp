@@ -244,12 +244,12 @@ Dropped dropSmallSegments(MeshPart& mesh, std::vector<std::uint8_t>& border,
 }
 
 // One level's mesh as the simplifier left it: each vertex's source in the merged mesh, whether
-// it sits on a boundary, and the removed vertices' bound.
+// it sits on a boundary, the recorded error and the removed vertices' bound.
 struct Collapsed {
   MeshPart mesh;
   std::vector<std::uint32_t> source;
   std::vector<std::uint8_t> border;
-  double vertexError = 0;
+  double recorded = 0, vertexError = 0;
 };
 
 Collapsed simplifyPlain(const MeshPart& merged, std::span<const Vec3f> positions,
@@ -260,6 +260,7 @@ Collapsed simplifyPlain(const MeshPart& merged, std::span<const Vec3f> positions
   out.mesh.indices = simplified.indices;
   out.source = simplified.vertices;
   out.border = std::move(simplified.border);
+  out.recorded = simplified.error;
   out.vertexError = removedVertexBound(positions, merged.indices, relativeTo(out.mesh, center),
                                        out.mesh.indices, simplified);
   return out;
@@ -308,6 +309,7 @@ Collapsed simplifyTextured(const MeshPart& merged, std::span<const Vec3f> positi
     }
     out.mesh.indices.push_back(remap[w]);
   }
+  out.recorded = simplified.error;
   std::vector<Vec3f> kept(simplified.vertices.size());
   for (std::size_t i = 0; i < kept.size(); ++i) kept[i] = surfacePositions[simplified.vertices[i]];
   out.vertexError =
@@ -339,8 +341,6 @@ SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& gri
   // input's own rims (and seams inside the node) may simplify, along themselves.
   const std::vector<std::uint8_t> outer = onOuterFaces(merged, grid, node);
   simplify.collapseBorders = true;
-  // The removed vertices' distance is bounded below, directly, not by the chain of steps.
-  simplify.recordError = false;
   const std::vector<std::uint32_t> samePosition = positionRepresentatives(merged);
   Collapsed collapsed;
   if (samePosition.empty()) {
@@ -353,10 +353,9 @@ SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& gri
   // Geometric error: measured against the children's geometry, plus what they already
   // deviate from the finest (the triangle inequality keeps it an upper bound, and makes it
   // non-increasing from parent to child). Sampled both ways by area; the removed vertices'
-  // excursions, which area samples could miss, are bounded by each one's distance to the fan it
-  // went into, or to the whole surface for an island that collapsed away (removedVertexBound;
-  // the simplifier's own record, a sum of steps along a vertex's path against fans later
-  // collapses changed, is no such bound and is left off). Measured before small
+  // excursions, which area samples could miss, are bounded by the simplifier's own record and
+  // by each one's distance to the fan it went into, or to the whole surface for an island that
+  // collapsed away (removedVertexBound). Measured before small
   // segments are left out (whose cost is bounded apart: a sample near one would search far for
   // the nearest remaining surface).
   const std::vector<Vec3f> simplifiedPositions = relativeTo(mesh, center);
@@ -372,7 +371,7 @@ SimplifiedNode simplifyNode(std::vector<MeshPart> children, const ChunkGrid& gri
   // The price of locking: border vertices the tile had to keep.
   out.lockedVertices =
       static_cast<std::uint64_t>(std::count(collapsed.border.begin(), collapsed.border.end(), 1));
-  out.simplificationError = std::max(sampled, collapsed.vertexError);
+  out.simplificationError = std::max({sampled, collapsed.recorded, collapsed.vertexError});
   out.droppedError = dropped.error;
   out.mesh = std::move(mesh);
   return out;

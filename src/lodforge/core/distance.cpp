@@ -122,14 +122,14 @@ class TriangleGrid {
     const std::size_t cells = static_cast<std::size_t>(dims_[0]) *
                               static_cast<std::size_t>(dims_[1]) *
                               static_cast<std::size_t>(dims_[2]);
-    placeVertices();
+    const std::vector<VertexCell> vertexCells = placeVertices();
     // Counting sort of (cell, triangle) pairs. Most triangles lie in one cell: that cell is kept
     // from the counting pass, the few that span more are visited again.
     constexpr std::uint32_t kSpans = ~0u;
     std::vector<std::uint32_t> single(triangles);
     start_.assign(cells + 1, 0);
     for (std::uint32_t t = 0; t < triangles; ++t) {
-      const CellRange r = cellRange(t);
+      const CellRange r = cellRange(vertexCells, t);
       if (r.x0 == r.x1 && r.y0 == r.y1 && r.z0 == r.z1) {
         const auto cell = static_cast<std::uint32_t>(index(r.x0, r.y0, r.z0));
         single[t] = cell;
@@ -148,10 +148,10 @@ class TriangleGrid {
       if (single[t] != kSpans) {
         items_[--start_[single[t]]] = t;
       } else {
-        forEachCell(cellRange(t), [&](std::size_t cell) { items_[--start_[cell]] = t; });
+        forEachCell(cellRange(vertexCells, t),
+                    [&](std::size_t cell) { items_[--start_[cell]] = t; });
       }
     }
-    vertexCells_ = {};
   }
 
   // The squared distance from p to the nearest triangle, or any value not above `enough` as soon
@@ -227,14 +227,16 @@ class TriangleGrid {
   }
   // Each position's cell once (a vertex is on about six triangles): a triangle's cells are the
   // box of its corners' cells, which is its bounding box's (clampCell never decreases).
-  void placeVertices() {
-    vertexCells_.resize(positions_.size());
+  using VertexCell = std::array<std::uint16_t, 3>;
+  std::vector<VertexCell> placeVertices() const {
+    std::vector<VertexCell> cells(positions_.size());
     for (std::size_t v = 0; v < positions_.size(); ++v) {
       const Vec3f p = positions_[v];
-      vertexCells_[v] = {static_cast<std::uint16_t>(clampCell(0, p.x)),
-                         static_cast<std::uint16_t>(clampCell(1, p.y)),
-                         static_cast<std::uint16_t>(clampCell(2, p.z))};
+      cells[v] = {static_cast<std::uint16_t>(clampCell(0, p.x)),
+                  static_cast<std::uint16_t>(clampCell(1, p.y)),
+                  static_cast<std::uint16_t>(clampCell(2, p.z))};
     }
+    return cells;
   }
   // Clamped before the conversion: a point far outside the grid (a query, an unused vertex)
   // or a NaN must not overflow an int.
@@ -253,10 +255,10 @@ class TriangleGrid {
     int x0, x1, y0, y1, z0, z1;
   };
   // The cells triangle t's bounding box touches.
-  CellRange cellRange(std::uint32_t t) const {
-    const std::array<std::uint16_t, 3>& a = vertexCells_[indices_[3 * std::size_t{t}]];
-    const std::array<std::uint16_t, 3>& b = vertexCells_[indices_[3 * std::size_t{t} + 1]];
-    const std::array<std::uint16_t, 3>& c = vertexCells_[indices_[3 * std::size_t{t} + 2]];
+  CellRange cellRange(std::span<const VertexCell> cells, std::uint32_t t) const {
+    const VertexCell& a = cells[indices_[3 * std::size_t{t}]];
+    const VertexCell& b = cells[indices_[3 * std::size_t{t} + 1]];
+    const VertexCell& c = cells[indices_[3 * std::size_t{t} + 2]];
     return {std::min({a[0], b[0], c[0]}), std::max({a[0], b[0], c[0]}),
             std::min({a[1], b[1], c[1]}), std::max({a[1], b[1], c[1]}),
             std::min({a[2], b[2], c[2]}), std::max({a[2], b[2], c[2]})};
@@ -274,7 +276,6 @@ class TriangleGrid {
   double cell_ = 1;
   int dims_[3] = {1, 1, 1};
   std::vector<std::uint32_t> start_, items_;
-  std::vector<std::array<std::uint16_t, 3>> vertexCells_;  // while building: each position's cell
 };
 
 }  // namespace detail
